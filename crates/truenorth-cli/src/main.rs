@@ -1,0 +1,54 @@
+//! `truenorth`: calibrate compasses, compute heading, and run the simulator demo from the
+//! command line. The CSV/JSON contract is in `ARCHITECTURE.md` and in each subcommand's
+//! `--help`. Errors exit non-zero with one line on stderr naming the file, the row and the
+//! problem.
+
+mod calibrate;
+mod demo;
+mod field;
+mod heading;
+mod io;
+
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+/// Calibrated heading, orientation and dead reckoning from low-cost navigation sensors.
+///
+/// Frames: body x forward, y right, z down; heading clockwise from north; a level compass
+/// reads mag_x = H cos(heading), mag_y = -H sin(heading).
+#[derive(Debug, Parser)]
+#[command(name = "truenorth", version, about, long_about = None)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// Run every method on a simulated drive and print a results table.
+    Demo(demo::Args),
+    /// Fit a compass calibration to a recording.
+    Calibrate(calibrate::Args),
+    /// Apply a compass calibration to a recording and output heading.
+    Heading(heading::Args),
+    /// The World Magnetic Model 2025 field at a place and date.
+    Field(field::Args),
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Demo(a) => demo::run(&a),
+        Command::Calibrate(a) => calibrate::run(&a),
+        Command::Heading(a) => heading::run(&a),
+        Command::Field(a) => field::run(&a),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("truenorth: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}

@@ -1,0 +1,62 @@
+//! # truenorth-core
+//!
+//! The vocabulary every other truenorth crate speaks: angles and units, the sample types
+//! that carry sensor readings, the traits that join sensor models, calibrators and
+//! estimators, input validation, and the one error type.
+//!
+//! Conventions (fixed across the workspace, see `ARCHITECTURE.md`): body axes x forward,
+//! y right, z down; heading clockwise from north; radians and SI units inside, degrees only
+//! at the edges through [`deg_to_rad`] / [`rad_to_deg`]; quaternions are Hamilton,
+//! scalar first, rotating body vectors into the NED reference frame.
+//!
+//! ```
+//! use truenorth_core::{wrap_pi, deg_to_rad, rad_to_deg, TimeStep};
+//!
+//! // 350° + 20° is 10°, not 370°.
+//! let h = wrap_pi(deg_to_rad(350.0) + deg_to_rad(20.0));
+//! assert!((rad_to_deg(h) - 10.0).abs() < 1e-9);
+//!
+//! // dt comes from timestamps; a timestamp that goes backwards is a typed error.
+//! let mut clock = TimeStep::new();
+//! assert_eq!(clock.dt_s(0.0).unwrap(), None);
+//! assert_eq!(clock.dt_s(0.01).unwrap(), Some(0.01));
+//! assert!(clock.dt_s(0.005).is_err());
+//! ```
+#![cfg_attr(not(feature = "std"), no_std)]
+
+mod angle;
+mod attitude;
+mod calibrator;
+mod error;
+mod estimator;
+mod heading;
+mod heading_source;
+mod noise;
+mod sample;
+mod sensor_model;
+mod units;
+mod validate;
+
+pub use angle::{Unwrapper, angle_diff, unwrap_near, wrap_pi, wrap_two_pi};
+pub use attitude::{EulerZyx, Tilt};
+pub use calibrator::{Calibration, Calibrator, Progress, Quality, Solution};
+pub use error::Error;
+pub use estimator::{HeadingEstimator, NavState, OrientationEstimator};
+pub use heading::{Declination, MagneticHeading, TrueHeading};
+pub use heading_source::{AbsoluteHeadingSource, RelativeHeadingSource};
+pub use noise::{NoiseSource, SplitMix64, ZeroNoise};
+pub use sample::{
+    AccelSample, GyroSample, ImuSample, Mag2Sample, Mag3Sample, VehicleSample, WheelSample,
+};
+pub use sensor_model::SensorModel;
+pub use units::{STANDARD_GRAVITY_MPS2, deg_to_rad, mph_to_mps, mps_to_mph, rad_to_deg};
+pub use validate::{TimeStep, check_dt, check_finite, check_finite2, check_finite3};
+
+/// Float methods (`sin`, `sqrt`, `atan2`, …) for `f64` that work with and without `std`.
+///
+/// With `std` the inherent `f64` methods are used; without it, `libm` through `num-traits`.
+/// Import it as `use truenorth_core::Float as _;` in modules that do float math.
+pub use num_traits::Float;
+
+/// Result type with the workspace error.
+pub type Result<T, E = Error> = core::result::Result<T, E>;

@@ -1,0 +1,27 @@
+//! The forward-model trait: truth → raw reading with the sensor's errors.
+
+use crate::NoiseSource;
+
+/// A forward model of a sensor: the reading it gives for a true physical state.
+///
+/// Used by the simulator to make realistic streams and by round-trip tests
+/// (truth → model → calibration with the model's true parameters → truth).
+pub trait SensorModel {
+    /// The true physical quantity (e.g. a field vector and attitude, an angular rate).
+    type Truth;
+    /// What the sensor reports.
+    type Reading;
+
+    /// The reading with only the deterministic errors (offset, scale, misalignment, …) and
+    /// no randomness or time-varying state. The inverse of the model's true calibration.
+    fn ideal(&self, truth: &Self::Truth) -> Self::Reading;
+
+    /// The reading with every error, drawing random terms from `noise` and advancing any
+    /// time-varying error state (random walks, drifts) by `dt_s` seconds.
+    fn sample(
+        &mut self,
+        truth: &Self::Truth,
+        dt_s: f64,
+        noise: &mut dyn NoiseSource,
+    ) -> Self::Reading;
+}
