@@ -1,0 +1,171 @@
+//! A route as a list of driving commands (duration, longitudinal acceleration, path
+//! curvature), built from distances, turn angles and speeds so scenarios read like directions.
+
+use serde::{Deserialize, Serialize};
+use truenorth_core::{Error, Result};
+
+/// One driving command, held for `duration_s`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Command {
+    /// How long the command lasts, seconds.
+    pub duration_s: f64,
+    /// Longitudinal acceleration, m/s².
+    pub accel_mps2: f64,
+    /// Path curvature of the rear-axle centre, 1/m, positive for a right turn.
+    pub curvature_per_m: f64,
+}
+
+/// A route: the commands and the speed it starts at.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Route {
+    /// Speed at the start, m/s.
+    pub start_speed_mps: f64,
+    /// The commands in order.
+    pub commands: Vec<Command>,
+}
+
+impl Route {
+    /// Total duration, seconds.
+    pub fn duration_s(&self) -> f64 {
+        self.commands.iter().map(|c| c.duration_s).sum()
+    }
+}
+
+/// Builds a [`Route`] from directions; tracks the current speed so each step's duration follows
+/// from its distance or angle.
+#[derive(Debug, Clone)]
+pub struct RouteBuilder {
+    speed_mps: f64,
+    route: Route,
+}
+
+impl Default for RouteBuilder {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl RouteBuilder {
+    /// Starts at rest.
+    pub fn new() -> Self {
+        Self {
+            speed_mps: 0.0,
+            route: Route {
+                start_speed_mps: 0.0,
+                commands: Vec::new(),
+            },
+        }
+    }
+
+    /// Starts already moving at `speed_mps` (no run-up).
+    pub fn at_speed(speed_mps: f64) -> Result<Self> {
+        positive("speed_mps", speed_mps)?;
+        Ok(Self {
+            speed_mps,
+            route: Route {
+                start_speed_mps: speed_mps,
+                commands: Vec::new(),
+            },
+        })
+    }
+
+    /// The speed at the end of the route so far, m/s.
+    pub fn speed_mps(&self) -> f64 {
+        self.speed_mps
+    }
+
+    fn moving(&self) -> Result<f64> {
+        if self.speed_mps > 0.0 {
+            Ok(self.speed_mps)
+        } else {
+            Err(Error::NotReady {
+                what: "a moving vehicle",
+                hint: "call change_speed before straight or turn",
+            })
+        }
+    }
+
+    /// Drives straight for `distance_m` at the current speed.
+    pub fn straight(mut self, distance_m: f64) -> Result<Self> {
+        positive("distance_m", distance_m)?;
+        let v = self.moving()?;
+        self.route.commands.push(Command {
+            duration_s: distance_m / v,
+            accel_mps2: 0.0,
+            curvature_per_m: 0.0,
+        });
+        Ok(self)
+    }
+
+    /// Turns through `angle_rad` (positive right) on a circle of `radius_m` at the current
+    /// speed.
+    pub fn turn(mut self, angle_rad: f64, radius_m: f64) -> Result<Self> {
+        positive("radius_m", radius_m)?;
+        positive("|angle_rad|", angle_rad.abs())?;
+        let v = self.moving()?;
+        self.route.commands.push(Command {
+            duration_s: angle_rad.abs() * radius_m / v,
+            accel_mps2: 0.0,
+            curvature_per_m: angle_rad.signum() / radius_m,
+        });
+        Ok(self)
+    }
+
+    /// Changes speed to `to_mps` at `|accel_mps2|`, driving straight meanwhile.
+    pub fn change_speed(mut self, to_mps: f64, accel_mps2: f64) -> Result<Self> {
+        if !(to_mps.is_finite() && to_mps >= 0.0) {
+            return Err(Error::OutOfRange {
+                what: "to_mps",
+                value: to_mps,
+                min: 0.0,
+                max: f64::INFINITY,
+            });
+        }
+        positive("accel_mps2", accel_mps2.abs())?;
+        let dv = to_mps - self.speed_mps;
+        if dv != 0.0 {
+            self.route.commands.push(Command {
+                duration_s: dv.abs() / accel_mps2.abs(),
+                accel_mps2: dv.signum() * accel_mps2.abs(),
+                curvature_per_m: 0.0,
+            });
+            self.speed_mps = to_mps;
+        }
+        Ok(self)
+    }
+
+    /// Stands still for `duration_s` (the vehicle must be at rest).
+    pub fn stop(mut self, duration_s: f64) -> Result<Self> {
+        positive("duration_s", duration_s)?;
+        if self.speed_mps != 0.0 {
+            return Err(Error::NotReady {
+                what: "a vehicle at rest",
+                hint: "call change_speed(0.0, ..) before stop",
+            });
+        }
+        self.route.commands.push(Command {
+            duration_s,
+            accel_mps2: 0.0,
+            curvature_per_m: 0.0,
+        });
+        Ok(self)
+    }
+
+    /// The route.
+    pub fn build(self) -> Route {
+        self.route
+    }
+}
+
+fn positive(what: &'static str, value: f64) -> Result<()> {
+    if value.is_finite() && value > 0.0 {
+        Ok(())
+    } else {
+        Err(Error::OutOfRange {
+            what,
+            value,
+            min: f64::MIN_POSITIVE,
+            max: f64::INFINITY,
+        })
+    }
+}

@@ -1,0 +1,134 @@
+//! Properties of the kinematic vehicle and the hand-held motion.
+
+use std::f64::consts::PI;
+
+use nalgebra::UnitQuaternion;
+use proptest::prelude::*;
+use truenorth_core::angle_diff;
+use truenorth_sim::{HandheldParams, RouteBuilder, handheld_motion, scenario, simulate};
+
+#[test]
+fn quarter_right_turn_ends_at_radius_radius() {
+    // Heading north, a right turn of radius R: the centre is R to the east, so after 90° the
+    // vehicle heads east at (north R, east R).
+    let r = 20.0;
+    let route = RouteBuilder::at_speed(4.0)
+        .unwrap()
+        .turn(PI / 2.0, r)
+        .unwrap()
+        .build();
+    let last = *simulate(&route, 0.0, 100.0).unwrap().last().unwrap();
+    assert!((last.north_m - r).abs() < 1e-9, "{last:?}");
+    assert!((last.east_m - r).abs() < 1e-9, "{last:?}");
+    assert!((last.heading_rad - PI / 2.0).abs() < 1e-12);
+    assert!(last.yaw_rate_rps >= 0.0);
+}
+
+#[test]
+fn scenarios_build_and_end_at_rest() {
+    for route in [
+        scenario::calibration_circle(10.0, 5.0, 1.25).unwrap(),
+        scenario::city_blocks(4, 100.0).unwrap(),
+        scenario::highway(2000.0).unwrap(),
+        scenario::parking().unwrap(),
+        scenario::demo_drive().unwrap(),
+    ] {
+        let truth = simulate(&route, 0.3, 50.0).unwrap();
+        let last = truth.last().unwrap();
+        assert!(last.speed_mps.abs() < 1e-9, "ends moving: {last:?}");
+        assert!(truth.iter().all(|s| s.speed_mps >= 0.0));
+    }
+}
+
+#[test]
+fn calibration_circle_turns_at_least_a_full_circle() {
+    let truth = simulate(
+        &scenario::calibration_circle(10.0, 5.0, 1.25).unwrap(),
+        0.0,
+        50.0,
+    )
+    .unwrap();
+    let turned = truth.last().unwrap().heading_unwrapped_rad;
+    assert!((turned.to_degrees() - 450.0).abs() < 1e-6);
+}
+
+#[test]
+fn bad_inputs_are_typed_errors() {
+    assert!(
+        RouteBuilder::new().straight(10.0).is_err(),
+        "straight at rest"
+    );
+    assert!(
+        RouteBuilder::at_speed(5.0).unwrap().stop(1.0).is_err(),
+        "stop while moving"
+    );
+    assert!(RouteBuilder::at_speed(f64::NAN).is_err());
+    assert!(RouteBuilder::at_speed(5.0).unwrap().turn(1.0, 0.0).is_err());
+    let route = RouteBuilder::at_speed(5.0)
+        .unwrap()
+        .straight(1.0)
+        .unwrap()
+        .build();
+    assert!(simulate(&route, 0.0, 0.0).is_err());
+    assert!(simulate(&route, 0.0, f64::NAN).is_err());
+    assert!(
+        handheld_motion(&HandheldParams {
+            rate_hz: -1.0,
+            ..Default::default()
+        })
+        .is_err()
+    );
+}
+
+proptest! {
+    #[test]
+    fn heading_change_is_curvature_times_distance(
+        legs in proptest::collection::vec((-3.0f64..3.0, 3.0f64..200.0, 1.0f64..30.0), 1..6),
+        rate in 5.0f64..200.0,
+    ) {
+        let mut b = RouteBuilder::at_speed(10.0).unwrap();
+        let mut expected = 0.0;
+        for (angle, radius, straight) in legs {
+            prop_assume!(angle.abs() > 1e-3);
+            b = b.turn(angle, radius).unwrap().straight(straight).unwrap();
+            expected += angle;
+        }
+        let truth = simulate(&b.build(), 0.0, rate).unwrap();
+        let last = truth.last().unwrap();
+        prop_assert!((last.heading_unwrapped_rad - expected).abs() < 1e-9);
+        prop_assert!(angle_diff(last.heading_rad, expected).abs() < 1e-9);
+        // Timestamps strictly increase.
+        prop_assert!(truth.windows(2).all(|w| w[1].t_s > w[0].t_s));
+    }
+
+    #[test]
+    fn full_circle_closes(radius in 2.0f64..500.0, speed in 0.5f64..40.0, rate in 10.0f64..200.0) {
+        let route = RouteBuilder::at_speed(speed).unwrap().turn(2.0 * PI, radius).unwrap().build();
+        let last = *simulate(&route, 1.0, rate).unwrap().last().unwrap();
+        prop_assert!(last.north_m.hypot(last.east_m) < 1e-9 * radius.max(1.0));
+        prop_assert!((last.distance_m - 2.0 * PI * radius).abs() < 1e-9 * radius);
+    }
+
+    #[test]
+    fn handheld_is_deterministic_by_seed(seed in any::<u64>()) {
+        let p = HandheldParams { duration_s: 2.0, seed, ..Default::default() };
+        let a = handheld_motion(&p).unwrap();
+        let b = handheld_motion(&p).unwrap();
+        prop_assert_eq!(&a, &b);
+        let c = handheld_motion(&HandheldParams { seed: seed.wrapping_add(1), ..p }).unwrap();
+        prop_assert!(a != c);
+    }
+
+    #[test]
+    fn handheld_gyro_matches_attitude(seed in any::<u64>()) {
+        // The attitude increment between samples is the body rate integrated over the step.
+        let p = HandheldParams { duration_s: 3.0, rate_hz: 200.0, seed, ..Default::default() };
+        let m = handheld_motion(&p).unwrap();
+        let dt = 1.0 / p.rate_hz;
+        for w in m.windows(2) {
+            let dq: UnitQuaternion<f64> = w[0].attitude.inverse() * w[1].attitude;
+            let mean_rate = 0.5 * (w[0].gyr_rps + w[1].gyr_rps);
+            prop_assert!((dq.scaled_axis() / dt - mean_rate).norm() < 1e-3);
+        }
+    }
+}
