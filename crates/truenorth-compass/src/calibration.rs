@@ -2,7 +2,9 @@
 
 use nalgebra::{Matrix2, Matrix3, Vector2, Vector3};
 use serde::{Deserialize, Serialize};
-use truenorth_core::{AbsoluteHeadingSource, Calibration, Mag2Sample, Result, check_finite2};
+use truenorth_core::{AbsoluteHeadingSource, Calibration, Mag2Sample, Result, Tilt, check_finite2};
+
+use crate::tilt_compensated_heading;
 
 #[allow(unused_imports)]
 use truenorth_core::Float as _;
@@ -103,6 +105,13 @@ impl CompassCalibration3d {
     #[inline]
     pub fn correct(&self, raw: &Vector3<f64>) -> Vector3<f64> {
         self.soft_iron * (raw - self.hard_iron)
+    }
+
+    /// Tilt-compensated heading of a raw reading on a body with the given pitch and roll,
+    /// radians clockwise from magnetic north, (-π, π]. See [`crate::level_field`].
+    #[inline]
+    pub fn heading_rad(&self, raw: &Vector3<f64>, tilt: &Tilt) -> f64 {
+        tilt_compensated_heading(&self.correct(raw), tilt)
     }
 }
 
