@@ -1,12 +1,225 @@
-//! `truenorth field` (not implemented yet).
+//! `truenorth field`: the World Magnetic Model 2025 field at a place and date, as one CSV
+//! row `x_nt,y_nt,z_nt,h_nt,f_nt,incl_deg,decl_deg` on stdout (ARCHITECTURE.md, CLI
+//! contract).
+//!
+//! Every argument is read as text and parsed here, so that any bad input — a missing flag
+//! included — ends with exactly one line on stderr and a non-zero exit.
+
+use std::time::{SystemTime, UNIX_EPOCH};
+
+use truenorth::core::Error;
+use truenorth::geomag::{
+    Extrapolation, MagneticField, WorldMagneticModel, decimal_year_from_date,
+    decimal_year_from_unix_seconds,
+};
 
 use crate::io::{CliError, CliResult};
 
-/// Arguments of `truenorth field`.
-#[derive(Debug, clap::Args)]
-pub struct Args {}
+/// The CSV header of the contract.
+pub const HEADER: &str = "x_nt,y_nt,z_nt,h_nt,f_nt,incl_deg,decl_deg";
 
-/// Runs the subcommand.
-pub fn run(_args: &Args) -> CliResult {
-    Err(CliError::msg("`field` is not implemented yet"))
+/// Arguments of `truenorth field`.
+#[derive(Debug, Clone, Default, clap::Args)]
+#[command(
+    override_usage = "truenorth field --lat DEG --lon DEG [--alt-km KM] [--date DECIMAL_YEAR] [--allow-extrapolation]",
+    long_about = "The geomagnetic field of the World Magnetic Model 2025 (valid 2025.0-2030.0) at a \
+place and date. Prints one CSV header `x_nt,y_nt,z_nt,h_nt,f_nt,incl_deg,decl_deg` and one row: \
+X north, Y east, Z down (nT, in the local WGS84 north-east-down frame), horizontal and total \
+intensity H and F (nT), inclination (dip, positive down) and declination (positive east: \
+true heading = magnetic heading + declination), in degrees.\n\n\
+Without --date the date is today's decimal year in UTC, from the system clock. A date outside \
+2025.0-2030.0 is refused unless --allow-extrapolation is given; then the row is printed and a \
+one-line warning goes to stderr."
+)]
+pub struct Args {
+    /// Required: geodetic latitude (WGS84), degrees north, -90 to 90.
+    #[arg(long, value_name = "DEG", allow_negative_numbers = true)]
+    pub lat: Option<String>,
+    /// Required: longitude, degrees east (west negative).
+    #[arg(long, value_name = "DEG", allow_negative_numbers = true)]
+    pub lon: Option<String>,
+    /// Height above the WGS84 ellipsoid, km [default: 0].
+    #[arg(long = "alt-km", value_name = "KM", allow_negative_numbers = true)]
+    pub alt_km: Option<String>,
+    /// Decimal year (e.g. 2026.5) or a calendar date YYYY-MM-DD (00:00 UTC)
+    /// [default: now, UTC, from the system clock].
+    #[arg(long, value_name = "DECIMAL_YEAR")]
+    pub date: Option<String>,
+    /// Evaluate dates outside 2025.0-2030.0 by extending the linear secular variation
+    /// (prints a warning on stderr).
+    #[arg(long)]
+    pub allow_extrapolation: bool,
+}
+
+/// Runs the subcommand: the CSV on stdout, an extrapolation warning (if any) on stderr.
+pub fn run(args: &Args) -> CliResult {
+    let year = match &args.date {
+        Some(text) => parse_date(text)?,
+        None => today_decimal_year()?,
+    };
+    let field = evaluate(args, year)?;
+    if let Some(w) = field.extrapolated {
+        eprintln!("truenorth: warning: {w}");
+    }
+    println!("{HEADER}");
+    println!("{}", csv_row(&field));
+    Ok(())
+}
+
+/// The field for the parsed arguments at decimal year `year`.
+fn evaluate(args: &Args, year: f64) -> CliResult<MagneticField> {
+    let lat = parse_number("--lat", required("--lat", &args.lat)?)?;
+    let lon = parse_number("--lon", required("--lon", &args.lon)?)?;
+    let alt_km = match &args.alt_km {
+        Some(text) => parse_number("--alt-km", text)?,
+        None => 0.0,
+    };
+    let policy = if args.allow_extrapolation {
+        Extrapolation::Allow
+    } else {
+        Extrapolation::Refuse
+    };
+    WorldMagneticModel::WMM2025
+        .with_extrapolation(policy)
+        .field_at_deg(lat, lon, alt_km, year)
+        .map_err(|e| match e {
+            Error::DateOutOfRange { .. } if !args.allow_extrapolation => {
+                CliError::msg(format!("field: {e} (with --allow-extrapolation)"))
+            }
+            e => CliError::msg(format!("field: {e}")),
+        })
+}
+
+/// One CSV row in the header's order; nT to 0.001, degrees to 0.00001.
+fn csv_row(f: &MagneticField) -> String {
+    format!(
+        "{:.3},{:.3},{:.3},{:.3},{:.3},{:.5},{:.5}",
+        f.x_nt,
+        f.y_nt,
+        f.z_nt,
+        f.h_nt,
+        f.f_nt,
+        f.inclination_deg(),
+        f.declination_deg()
+    )
+}
+
+fn required<'a>(flag: &str, value: &'a Option<String>) -> CliResult<&'a str> {
+    value
+        .as_deref()
+        .ok_or_else(|| CliError::msg(format!("field: {flag} is required")))
+}
+
+/// A number; NaN and infinities parse here and are refused by the model with a reason.
+fn parse_number(flag: &str, text: &str) -> CliResult<f64> {
+    text.trim()
+        .parse::<f64>()
+        .map_err(|_| CliError::msg(format!("field: {flag}: `{text}` is not a number")))
+}
+
+/// A decimal year (`2026.5`) or a calendar date (`2026-07-02`, 00:00 UTC).
+fn parse_date(text: &str) -> CliResult<f64> {
+    let t = text.trim();
+    if let Ok(year) = t.parse::<f64>() {
+        return Ok(year);
+    }
+    let bad = || {
+        CliError::msg(format!(
+            "field: --date: `{text}` is neither a decimal year (e.g. 2026.5) nor a date YYYY-MM-DD"
+        ))
+    };
+    let mut parts = t.splitn(3, '-');
+    let (Some(y), Some(m), Some(d)) = (parts.next(), parts.next(), parts.next()) else {
+        return Err(bad());
+    };
+    let (Ok(y), Ok(m), Ok(d)) = (y.parse::<i32>(), m.parse::<u32>(), d.parse::<u32>()) else {
+        return Err(bad());
+    };
+    decimal_year_from_date(y, m, d).map_err(|e| CliError::msg(format!("field: --date: {e}")))
+}
+
+/// Today's decimal year in UTC from the system clock.
+fn today_decimal_year() -> CliResult<f64> {
+    let unix_s = match SystemTime::now().duration_since(UNIX_EPOCH) {
+        Ok(d) => d.as_secs_f64(),
+        // A clock set before 1970: the error carries how far before.
+        Err(e) => -e.duration().as_secs_f64(),
+    };
+    decimal_year_from_unix_seconds(unix_s).map_err(|e| {
+        CliError::msg(format!(
+            "field: cannot read today's date from the system clock: {e}"
+        ))
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn args(lat: &str, lon: &str) -> Args {
+        Args {
+            lat: Some(lat.into()),
+            lon: Some(lon.into()),
+            ..Args::default()
+        }
+    }
+
+    /// A row of the official WMM2025 test values: 2025.0, 100 km, 80° S 240° E.
+    #[test]
+    fn reproduces_a_test_value_row() {
+        let a = Args {
+            alt_km: Some("100".into()),
+            ..args("-80", "240")
+        };
+        let f = evaluate(&a, 2025.0).unwrap();
+        let row: Vec<f64> = csv_row(&f).split(',').map(|v| v.parse().unwrap()).collect();
+        let want = [5907.6, 14780.3, -49540.7, 15917.1, 52035.0, -72.19, 68.21];
+        assert_eq!(row.len(), HEADER.split(',').count());
+        for (i, (got, want)) in row.iter().zip(want).enumerate() {
+            let tol = if i < 5 { 0.1 } else { 0.01 };
+            assert!((got - want).abs() <= tol, "column {i}: {got} vs {want}");
+        }
+    }
+
+    #[test]
+    fn bad_input_is_one_line_errors() {
+        let one_line = |e: CliError| {
+            let s = e.to_string();
+            assert!(!s.contains('\n'), "{s}");
+            s
+        };
+        assert!(
+            one_line(evaluate(&Args::default(), 2026.0).unwrap_err()).contains("--lat is required")
+        );
+        assert!(
+            one_line(evaluate(&args("abc", "0"), 2026.0).unwrap_err()).contains("not a number")
+        );
+        assert!(one_line(evaluate(&args("91", "0"), 2026.0).unwrap_err()).contains("latitude"));
+        assert!(one_line(evaluate(&args("nan", "0"), 2026.0).unwrap_err()).contains("not finite"));
+        let late = one_line(evaluate(&args("10", "0"), 2031.0).unwrap_err());
+        assert!(late.contains("--allow-extrapolation"), "{late}");
+        assert!(one_line(parse_date("20x6").unwrap_err()).contains("--date"));
+        assert!(one_line(parse_date("2026-02-30").unwrap_err()).contains("day of month"));
+    }
+
+    #[test]
+    fn extrapolation_is_an_explicit_opt_in() {
+        let a = Args {
+            allow_extrapolation: true,
+            ..args("10", "0")
+        };
+        let f = evaluate(&a, 2031.0).unwrap();
+        assert!(f.extrapolated.is_some());
+        assert!(evaluate(&a, 2026.0).unwrap().extrapolated.is_none());
+    }
+
+    #[test]
+    fn dates_parse_as_decimal_years_or_calendar_dates() {
+        assert_eq!(parse_date("2026.5").unwrap(), 2026.5);
+        assert_eq!(parse_date(" 2027 ").unwrap(), 2027.0);
+        assert_eq!(parse_date("2025-01-01").unwrap(), 2025.0);
+        assert!((parse_date("2027-07-02").unwrap() - (2027.0 + 182.0 / 365.0)).abs() < 1e-12);
+        let today = today_decimal_year().unwrap();
+        assert!(today > 2020.0 && today < 2100.0, "{today}");
+    }
 }
