@@ -94,3 +94,16 @@ pub fn field_at_deg(lat_deg: f64, lon_deg: f64, alt_km: f64, year: f64) -> Resul
 pub fn declination(lat_rad: f64, lon_rad: f64, height_m: f64, year: f64) -> Result<Declination> {
     WorldMagneticModel::WMM2025.declination(lat_rad, lon_rad, height_m, year)
 }
+
+/// WMM2025 expected total intensity F (nT) at a place (radians, metres) and decimal year:
+/// the field strength a calibrated magnetometer should report there (compare a fitted
+/// calibration radius with it, in the same unit, to spot a disturbed site or a unit error).
+pub fn total_intensity_nt(lat_rad: f64, lon_rad: f64, height_m: f64, year: f64) -> Result<f64> {
+    WorldMagneticModel::WMM2025.total_intensity_nt(lat_rad, lon_rad, height_m, year)
+}
+
+/// WMM2025 expected inclination (dip) at a place (radians, metres) and decimal year,
+/// radians, positive down: the angle a 3-D magnetometer should see below the horizontal.
+pub fn inclination_rad(lat_rad: f64, lon_rad: f64, height_m: f64, year: f64) -> Result<f64> {
+    WorldMagneticModel::WMM2025.inclination_rad(lat_rad, lon_rad, height_m, year)
+}

@@ -115,6 +115,33 @@ impl WorldMagneticModel {
             .declination())
     }
 
+    /// The expected total intensity F at a place (radians, metres) and date, nT: what a
+    /// calibrated magnetometer should measure there, for calibration quality reports and
+    /// disturbance detection.
+    pub fn total_intensity_nt(
+        &self,
+        lat_rad: f64,
+        lon_rad: f64,
+        height_m: f64,
+        year: f64,
+    ) -> Result<f64> {
+        Ok(self.field_at(lat_rad, lon_rad, height_m, year)?.f_nt)
+    }
+
+    /// The expected inclination (dip) I at a place (radians, metres) and date, radians,
+    /// positive down.
+    pub fn inclination_rad(
+        &self,
+        lat_rad: f64,
+        lon_rad: f64,
+        height_m: f64,
+        year: f64,
+    ) -> Result<f64> {
+        Ok(self
+            .field_at(lat_rad, lon_rad, height_m, year)?
+            .inclination_rad)
+    }
+
     fn evaluate(
         &self,
         at: &PreparedPoint,

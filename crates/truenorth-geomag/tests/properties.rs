@@ -8,7 +8,7 @@ use truenorth_core::{Error, MagneticHeading, angle_diff};
 use truenorth_geomag::{
     Extrapolation, GEOMAGNETIC_REFERENCE_RADIUS_M, Geodetic, MAX_DEGREE, MagneticField,
     PreparedPoint, SchmidtLegendre, WGS84_ECCENTRICITY_SQUARED, WGS84_SEMI_MAJOR_AXIS_M, WMM2025,
-    WorldMagneticModel, declination, field_at, field_at_deg,
+    WorldMagneticModel, declination, field_at, field_at_deg, inclination_rad, total_intensity_nt,
 };
 
 fn field(lat: f64, lon: f64, h: f64, year: f64) -> MagneticField {
@@ -342,6 +342,12 @@ fn declination_helper_and_true_heading() {
     assert_eq!(d, f.declination());
     // Test value: 0° N 120° E, 2025.0 → D = −0.16°.
     assert!((d.0.to_degrees() + 0.16).abs() < 0.01);
+    assert_eq!(total_intensity_nt(lat, lon, 0.0, 2025.0).unwrap(), f.f_nt);
+    assert_eq!(
+        inclination_rad(lat, lon, 0.0, 2025.0).unwrap(),
+        f.inclination_rad
+    );
+    assert!(total_intensity_nt(lat, lon, 0.0, 2035.0).is_err());
     let t = MagneticHeading::new(0.5).to_true(d);
     assert!(angle_diff(t.rad(), 0.5 + d.0).abs() < 1e-12);
 }
