@@ -10,7 +10,7 @@ use thiserror::Error;
 #[non_exhaustive]
 pub enum Error {
     /// A value that must be finite was NaN or infinite.
-    #[error("{what} is not finite ({value}); drop or repair that sample before passing it in")]
+    #[error("{what} is not finite ({value}); every input value must be a finite number")]
     NonFinite {
         /// Which quantity.
         what: &'static str,
