@@ -38,9 +38,10 @@
 //! | 0.28 | 3.7 m | 41.8° | −4.1e-2 | 3.8° |
 //! | 0.2841 (c_max) | 3.5 m | 43.4° | −8.9e-2 | 8.8° |
 //!
-//! The formula under-states the track (over-states the turn) by less than 0.1 % on curves
-//! wider than about 8 m, about 1 % at a typical full lock, and refuses beyond its c_max while
-//! the car itself could turn tighter (the exact ratio peaks at 0.2986 for this geometry).
+//! The formula under-states the track (over-states the turn) by less than 0.1 % on curves of
+//! radius above about 8 m, by 1.3-2 % at a typical full lock (inner wheel 36-39°), and
+//! refuses beyond its c_max while the car itself could turn tighter (the exact ratio peaks at
+//! 0.2986 for this geometry).
 //! Over B 2.2-3.3 m, T_F 1.3-1.8 m, p 0-0.12 m the error stays below 4.5e-4 for
 //! c ≤ c_max/2 and 1.4 % for c ≤ 0.9 c_max (tests in `tests/patent_vs_exact.rs`).
 //!
