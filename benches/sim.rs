@@ -3,7 +3,10 @@
 use std::hint::black_box;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use truenorth_sim::{HandheldParams, handheld_motion, scenario, simulate};
+use truenorth_sim::{
+    HandheldParams, ImuSensorParams, VehicleSensorParams, handheld_motion, imu_streams, scenario,
+    simulate, vehicle_streams,
+};
 
 fn bench(c: &mut Criterion) {
     let route = scenario::demo_drive().expect("the demo route is valid");
@@ -21,6 +24,18 @@ fn bench(c: &mut Criterion) {
     g.throughput(Throughput::Elements(6001));
     g.bench_function("handheld_truth_60s_100hz", |b| {
         b.iter(|| handheld_motion(black_box(&p)))
+    });
+    let truth = simulate(&route, 0.0, 100.0).expect("valid");
+    let vp = VehicleSensorParams::typical();
+    g.throughput(Throughput::Elements(n));
+    g.bench_function("vehicle_sensor_streams_demo_drive_100hz", |b| {
+        b.iter(|| vehicle_streams(black_box(&truth), &vp, 1))
+    });
+    let motion = handheld_motion(&p).expect("valid");
+    let ip = ImuSensorParams::typical();
+    g.throughput(Throughput::Elements(6001));
+    g.bench_function("imu_sensor_streams_60s_100hz", |b| {
+        b.iter(|| imu_streams(black_box(&motion), &ip, 1))
     });
     g.finish();
 }

@@ -4,7 +4,9 @@
 //! A route of driving commands is integrated by a rear-axle kinematic model
 //! ([`simulate`]); named [`scenario`]s cover a calibration circle, city blocks with stops,
 //! a highway stretch and a parking manoeuvre; [`handheld_motion`] gives smooth 3-D motion
-//! for orientation filters. Everything is deterministic for a given seed.
+//! for orientation filters. [`vehicle_streams`] and [`imu_streams`] run the truth through the
+//! sensor crates' forward models (gyro, odometer, compass, accelerometer) with errors from
+//! [`VehicleSensorParams`] / [`ImuSensorParams`]. Everything is deterministic for a given seed.
 //!
 //! ```
 //! use truenorth_sim::{RouteBuilder, simulate};
@@ -21,8 +23,12 @@
 mod handheld;
 mod route;
 pub mod scenario;
+mod streams;
 mod vehicle;
 
 pub use handheld::{HandheldParams, MotionTruth, handheld_motion};
 pub use route::{Command, Route, RouteBuilder};
+pub use streams::{
+    ImuSensorParams, VehicleSensorParams, imu_streams, rotated_soft_iron, vehicle_streams,
+};
 pub use vehicle::{VehicleTruth, simulate};

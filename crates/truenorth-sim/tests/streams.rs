@@ -1,0 +1,118 @@
+//! Properties of the simulated sensor streams.
+
+use nalgebra::{Matrix2, Matrix3, Vector2, Vector3};
+use proptest::prelude::*;
+use truenorth_accel::AccelParams;
+use truenorth_core::angle_diff;
+use truenorth_gyro::GyroAxisParams;
+use truenorth_odometer::{OdometerParams, OdometerWheels};
+use truenorth_sim::{
+    HandheldParams, ImuSensorParams, VehicleSensorParams, handheld_motion, imu_streams, scenario,
+    simulate, vehicle_streams,
+};
+
+fn perfect_vehicle() -> VehicleSensorParams {
+    VehicleSensorParams {
+        gyro: GyroAxisParams::PERFECT,
+        gyro_temp_c: 25.0,
+        odometer: OdometerParams::perfect(OdometerWheels::Rear { track_m: 1.5 }),
+        compass_hard_iron: Vector2::zeros(),
+        compass_soft_iron: Matrix2::identity(),
+        compass_noise: 0.0,
+        horizontal_field: 20.0,
+    }
+}
+
+#[test]
+fn perfect_vehicle_sensors_reproduce_the_truth() {
+    let truth = simulate(&scenario::city_blocks(3, 80.0).unwrap(), 0.7, 50.0).unwrap();
+    let s = vehicle_streams(&truth, &perfect_vehicle(), 3).unwrap();
+    assert_eq!(s.len(), truth.len());
+    for k in 1..truth.len() {
+        let (a, b) = (&truth[k - 1], &truth[k]);
+        let dpsi = angle_diff(b.heading_rad, a.heading_rad);
+        // Gyro: mean rate over the step.
+        let g = s[k].gyr_z_rps.unwrap();
+        assert!((g * (b.t_s - a.t_s) - dpsi).abs() < 1e-12);
+        // Odometer (rear wheels): (D_L − D_R)/T is the heading change; the mean is the distance.
+        let dl = s[k].dist_l_m - s[k - 1].dist_l_m;
+        let dr = s[k].dist_r_m - s[k - 1].dist_r_m;
+        assert!(((dl - dr) / 1.5 - dpsi).abs() < 1e-9);
+        assert!((0.5 * (dl + dr) - (b.distance_m - a.distance_m)).abs() < 1e-9);
+        // Compass: heading = atan2(−y, x).
+        let m = s[k].mag.unwrap();
+        assert!(angle_diff((-m.y).atan2(m.x), b.heading_rad).abs() < 1e-12);
+    }
+}
+
+#[test]
+fn perfect_imu_reproduces_the_truth() {
+    let truth = handheld_motion(&HandheldParams {
+        duration_s: 5.0,
+        ..Default::default()
+    })
+    .unwrap();
+    let p = ImuSensorParams {
+        gyro: GyroAxisParams::PERFECT,
+        accel: AccelParams::default(),
+        mag_hard_iron: Vector3::zeros(),
+        mag_soft_iron: Matrix3::identity(),
+        mag_noise: 0.0,
+        ..ImuSensorParams::typical()
+    };
+    let s = imu_streams(&truth, &p, 1).unwrap();
+    for (t, m) in truth.iter().zip(&s) {
+        assert!((m.gyr_rps - t.gyr_rps).norm() < 1e-12);
+        assert!((m.acc_mps2 - t.specific_force_mps2).norm() < 1e-9);
+        // The field, rotated back to NED, is the earth's field.
+        let ned = t.attitude * m.mag.unwrap();
+        let expect = Vector3::new(
+            50.0 * 60f64.to_radians().cos(),
+            0.0,
+            50.0 * 60f64.to_radians().sin(),
+        );
+        assert!((ned - expect).norm() < 1e-9, "{ned} vs {expect}");
+    }
+}
+
+#[test]
+fn typical_compass_is_undone_by_its_true_calibration() {
+    let truth = simulate(
+        &scenario::calibration_circle(10.0, 5.0, 1.0).unwrap(),
+        0.0,
+        20.0,
+    )
+    .unwrap();
+    let p = VehicleSensorParams {
+        compass_noise: 0.0,
+        ..VehicleSensorParams::typical()
+    };
+    let s = vehicle_streams(&truth, &p, 9).unwrap();
+    let cal = truenorth_compass::CompassCalibration2d {
+        hard_iron: p.compass_hard_iron,
+        soft_iron: p.compass_soft_iron.try_inverse().unwrap(),
+    };
+    for (t, m) in truth.iter().zip(&s) {
+        assert!(angle_diff(cal.heading_rad(&m.mag.unwrap()), t.heading_rad).abs() < 1e-9);
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(16))]
+
+    #[test]
+    fn streams_are_deterministic_by_seed(seed in any::<u64>()) {
+        let truth = simulate(&scenario::parking().unwrap(), 0.0, 20.0).unwrap();
+        let p = VehicleSensorParams::typical();
+        let a = vehicle_streams(&truth, &p, seed).unwrap();
+        let b = vehicle_streams(&truth, &p, seed).unwrap();
+        prop_assert_eq!(&a, &b);
+        let c = vehicle_streams(&truth, &p, seed ^ 1).unwrap();
+        prop_assert!(a != c);
+
+        let motion = handheld_motion(&HandheldParams { duration_s: 1.0, seed, ..Default::default() }).unwrap();
+        let i1 = imu_streams(&motion, &ImuSensorParams::typical(), seed).unwrap();
+        let i2 = imu_streams(&motion, &ImuSensorParams::typical(), seed).unwrap();
+        prop_assert_eq!(i1, i2);
+    }
+}
