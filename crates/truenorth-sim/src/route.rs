@@ -25,6 +25,19 @@ pub struct Route {
 }
 
 impl Route {
+    /// Total heading change, turning either way counted positive, radians: `Σ |κ| · distance`
+    /// over the commands (exact, unlike differences of sampled headings).
+    pub fn turned_rad(&self) -> f64 {
+        let mut v = self.start_speed_mps;
+        let mut turned = 0.0;
+        for c in &self.commands {
+            let d = v * c.duration_s + 0.5 * c.accel_mps2 * c.duration_s * c.duration_s;
+            turned += c.curvature_per_m.abs() * d;
+            v = (v + c.accel_mps2 * c.duration_s).max(0.0);
+        }
+        turned
+    }
+
     /// Total duration, seconds.
     pub fn duration_s(&self) -> f64 {
         self.commands.iter().map(|c| c.duration_s).sum()

@@ -56,6 +56,7 @@ pub fn simulate(route: &Route, heading0_rad: f64, rate_hz: f64) -> Result<Vec<Ve
         speed_mps: route.start_speed_mps,
         ..VehicleTruth::default()
     };
+    let mut planned_v = route.start_speed_mps;
     let mut cmd_idx = 0;
     let mut cmd_end = route.commands.first().map_or(0.0, |c| c.duration_s);
     set_command(&mut s, route, cmd_idx);
@@ -71,6 +72,12 @@ pub fn simulate(route: &Route, heading0_rad: f64, rate_hz: f64) -> Result<Vec<Ve
         let mut t = s.t_s;
         while t < t1 - 1e-12 {
             while cmd_idx < route.commands.len() && t >= cmd_end - 1e-12 {
+                // Snap to the planned speed at the boundary so rounding cannot leave a
+                // "stopped" vehicle creeping at 1e-16 m/s.
+                if let Some(c) = route.commands.get(cmd_idx) {
+                    planned_v = (planned_v + c.accel_mps2 * c.duration_s).max(0.0);
+                    s.speed_mps = planned_v;
+                }
                 cmd_idx += 1;
                 cmd_end += route.commands.get(cmd_idx).map_or(0.0, |c| c.duration_s);
                 set_command(&mut s, route, cmd_idx);

@@ -88,12 +88,16 @@ proptest! {
     ) {
         let mut b = RouteBuilder::at_speed(10.0).unwrap();
         let mut expected = 0.0;
+        let mut turned = 0.0;
         for (angle, radius, straight) in legs {
             prop_assume!(angle.abs() > 1e-3);
             b = b.turn(angle, radius).unwrap().straight(straight).unwrap();
             expected += angle;
+            turned += angle.abs();
         }
-        let truth = simulate(&b.build(), 0.0, rate).unwrap();
+        let route = b.build();
+        prop_assert!((route.turned_rad() - turned).abs() < 1e-9);
+        let truth = simulate(&route, 0.0, rate).unwrap();
         let last = truth.last().unwrap();
         prop_assert!((last.heading_unwrapped_rad - expected).abs() < 1e-9);
         prop_assert!(angle_diff(last.heading_rad, expected).abs() < 1e-9);
