@@ -2,8 +2,13 @@
 
 use std::path::PathBuf;
 
-use truenorth::core::angle_diff;
-use truenorth_sim::{Route, VehicleTruth, scenario, simulate};
+use truenorth::compass::CompassCalibration2d;
+use truenorth::core::{VehicleSample, WheelSample, angle_diff};
+use truenorth::gyro::{GyroCalibration, YawIntegrator};
+use truenorth::odometer::{DifferentialOdometer, FixedTrack, OdometerCalibration, OdometerWheels};
+use truenorth_sim::{
+    Route, VehicleSensorParams, VehicleTruth, scenario, simulate, vehicle_streams,
+};
 
 use crate::io::{CliError, CliResult};
 
@@ -27,6 +32,8 @@ pub fn run(args: &Args) -> CliResult {
         .map_err(|e| CliError::file(&args.out, format!("cannot create the output folder: {e}")))?;
     println!("truenorth demo (seed {})\n", args.seed);
     scenario_table()?;
+    let drive = DemoDrive::new(args.seed)?;
+    sensor_table(&drive);
     Ok(())
 }
 
@@ -108,4 +115,154 @@ fn scenario_table() -> CliResult {
     }
     println!();
     Ok(())
+}
+
+/// The demo drive with its sensor streams.
+struct DemoDrive {
+    params: VehicleSensorParams,
+    truth: Vec<VehicleTruth>,
+    samples: Vec<VehicleSample>,
+}
+
+impl DemoDrive {
+    fn new(seed: u64) -> CliResult<Self> {
+        let err = |e: truenorth::core::Error| CliError::msg(format!("demo drive: {e}"));
+        let route = scenario::demo_drive().map_err(err)?;
+        let truth = simulate(&route, 0.0, RATE_HZ).map_err(err)?;
+        let params = VehicleSensorParams::typical();
+        let samples = vehicle_streams(&truth, &params, seed).map_err(err)?;
+        Ok(Self {
+            params,
+            truth,
+            samples,
+        })
+    }
+}
+
+/// Heading error statistics of one estimate against the truth, degrees.
+struct HeadingError {
+    rms_deg: f64,
+    max_deg: f64,
+    final_deg: f64,
+}
+
+fn heading_error(truth: &[VehicleTruth], estimate: &[f64]) -> HeadingError {
+    let errs: Vec<f64> = truth
+        .iter()
+        .zip(estimate)
+        .map(|(t, e)| angle_diff(*e, t.heading_rad).to_degrees())
+        .collect();
+    let n = errs.len().max(1) as f64;
+    HeadingError {
+        rms_deg: (errs.iter().map(|e| e * e).sum::<f64>() / n).sqrt(),
+        max_deg: errs.iter().fold(0.0, |m, e| m.max(e.abs())),
+        final_deg: errs.last().copied().unwrap_or(0.0),
+    }
+}
+
+fn sensor_table(d: &DemoDrive) {
+    let p = &d.params;
+    println!("Sensor errors in the simulation (VehicleSensorParams::typical)");
+    println!(
+        "  yaw gyro   bias {:.2} deg/s, scale error +{:.1} % right / +{:.1} % left, noise {:.3} deg/s/rtHz, bias walk {:.4} deg/s/rts",
+        p.gyro.bias_rps.to_degrees(),
+        p.gyro.scale_error_pos * 100.0,
+        p.gyro.scale_error_neg * 100.0,
+        p.gyro.noise_density_rps_per_sqrt_hz.to_degrees(),
+        p.gyro.bias_walk_rps_per_sqrt_s.to_degrees()
+    );
+    let track_m = match p.odometer.wheels {
+        OdometerWheels::Rear { track_m } => track_m,
+        OdometerWheels::Front(a) => a.track_m,
+    };
+    println!(
+        "  odometer   rear track {:.2} m, wheel scale errors {:+.1} % left / {:+.1} % right, {} cm pulses",
+        track_m,
+        p.odometer.scale_error_l * 100.0,
+        p.odometer.scale_error_r * 100.0,
+        p.odometer.dist_per_pulse_m.map_or(0.0, |d| d * 100.0)
+    );
+    let hard = p.compass_hard_iron.norm() / p.horizontal_field;
+    let eig = p.compass_soft_iron.symmetric_eigen();
+    let (major, minor) = (eig.eigenvalues.max(), eig.eigenvalues.min());
+    println!(
+        "  compass    hard iron {:.2} x field, soft iron axis ratio {:.2}, noise {:.1} % of the {:.0} uT horizontal field",
+        hard,
+        major / minor,
+        p.compass_noise / p.horizontal_field * 100.0,
+        p.horizontal_field
+    );
+    println!();
+
+    // What each sensor gets wrong on its own, before any method calibrates it.
+    let h0 = d.truth.first().map_or(0.0, |t| t.heading_rad);
+    let mut rows: Vec<(&str, HeadingError)> = Vec::new();
+    for (name, cal) in [
+        ("gyro, raw", GyroCalibration::default()),
+        (
+            "gyro, true zero+scale",
+            GyroCalibration::asymmetric(
+                p.gyro.bias_rps,
+                1.0 + p.gyro.scale_error_pos,
+                1.0 + p.gyro.scale_error_neg,
+            )
+            .unwrap_or_default(),
+        ),
+    ] {
+        let mut g = YawIntegrator::new(cal);
+        let est: Vec<f64> = d
+            .samples
+            .iter()
+            .map(|s| {
+                g.push_yaw_rate(s.t_s, s.gyr_z_rps.unwrap_or(0.0))
+                    .map_or(f64::NAN, |_| g.heading_rad() + h0)
+            })
+            .collect();
+        rows.push((name, heading_error(&d.truth, &est)));
+    }
+    if let Ok(mut odo) = FixedTrack::new(track_m)
+        .and_then(|t| DifferentialOdometer::new(t, OdometerCalibration::default()))
+    {
+        let est: Vec<f64> = d
+            .samples
+            .iter()
+            .map(|s| {
+                let w = WheelSample {
+                    t_s: s.t_s,
+                    dist_l_m: s.dist_l_m,
+                    dist_r_m: s.dist_r_m,
+                };
+                odo.push(&w).map_or(f64::NAN, |_| odo.heading_rad() + h0)
+            })
+            .collect();
+        rows.push(("odometer, nominal", heading_error(&d.truth, &est)));
+    }
+    let raw_compass = CompassCalibration2d::identity();
+    let true_compass = CompassCalibration2d {
+        hard_iron: p.compass_hard_iron,
+        soft_iron: p.compass_soft_iron.try_inverse().unwrap_or_default(),
+    };
+    for (name, cal) in [
+        ("compass, raw", raw_compass),
+        ("compass, true calibration", true_compass),
+    ] {
+        let est: Vec<f64> = d
+            .samples
+            .iter()
+            .map(|s| s.mag.map_or(f64::NAN, |m| cal.heading_rad(&m)))
+            .collect();
+        rows.push((name, heading_error(&d.truth, &est)));
+    }
+    println!("Each sensor alone on the whole demo drive (heading error vs truth)");
+    println!(
+        "{:<28} {:>9} {:>9} {:>10}",
+        "source", "RMS deg", "max deg", "final deg"
+    );
+    for (name, e) in rows {
+        println!(
+            "{:<28} {:>9.2} {:>9.2} {:>10.2}",
+            name, e.rms_deg, e.max_deg, e.final_deg
+        );
+    }
+    println!();
 }
