@@ -5,11 +5,62 @@
 //! `progress`, `solve` for parameters plus a [`truenorth_core::Quality`] report, or get a
 //! typed refusal that says why the data cannot support a calibration.
 //!
+//! The least-squares calibrators fit everything they were given in one go:
+//! [`EllipseCalibrator`] (two-axis compass: hard iron and symmetric soft iron from a direct
+//! ellipse fit refined on the Sampson distance) and [`EllipsoidCalibrator`] (three-axis
+//! magnetometer: hard iron and full symmetric soft iron from a direct ellipsoid fit refined
+//! by Levenberg–Marquardt). The [`quality`] module holds the report every calibrator shares.
+//!
 //! ```
-//! assert_eq!(1 + 1, 2);
+//! use nalgebra::{Matrix2, Vector2};
+//! use truenorth_calib::EllipseCalibrator;
+//! use truenorth_core::{Calibrator, Error, Mag2Sample};
+//!
+//! // A level compass in a 20 µT horizontal field, turned once round. Its readings are
+//! // shifted by a (12, −7) µT hard iron and squashed 25 % along a diagonal (soft iron).
+//! let (s, c) = 45f64.to_radians().sin_cos();
+//! let axis = Matrix2::new(c, -s, s, c);
+//! let soft = axis * Matrix2::new(1.25, 0.0, 0.0, 1.0) * axis.transpose();
+//! let raw = |psi: f64| Vector2::new(12.0, -7.0) + soft * Vector2::new(20.0 * psi.cos(), -20.0 * psi.sin());
+//!
+//! let mut cal = EllipseCalibrator::new();
+//! for k in 0..90 {
+//!     let psi = (4.0 * k as f64).to_radians();
+//!     cal.push(&Mag2Sample { t_s: 0.1 * k as f64, mag: raw(psi) })?;
+//! }
+//! let solution = cal.solve()?;
+//! assert!((solution.params.hard_iron - Vector2::new(12.0, -7.0)).norm() < 1e-6);
+//! // Heading 120° (clockwise from magnetic north) comes out as 120°.
+//! let heading = solution.params.heading_rad(&raw(120f64.to_radians()));
+//! assert!((heading.to_degrees() - 120.0).abs() < 1e-6);
+//! // The report says how far to trust it.
+//! assert_eq!(solution.quality.coverage, 1.0);
+//! assert!(solution.quality.heading_error_bound_deg < 0.1);
+//!
+//! // Half a turn is not enough, and the refusal says so.
+//! let mut half = EllipseCalibrator::new();
+//! for k in 0..45 {
+//!     half.push(&Mag2Sample { t_s: k as f64, mag: raw((4.0 * k as f64).to_radians()) })?;
+//! }
+//! assert!(matches!(half.solve(), Err(Error::InsufficientCoverage { .. })));
+//! # Ok::<(), truenorth_core::Error>(())
 //! ```
 #![cfg_attr(not(feature = "std"), no_std)]
 
 extern crate alloc;
 
 pub mod quality;
+
+mod ellipse_fit;
+mod ellipsoid_fit;
+mod linalg;
+mod lm;
+mod normalise;
+
+pub use ellipse_fit::{
+    Ellipse, EllipseCalibrator, EllipseFitOptions, MIN_POINTS_2D, fit_ellipse, fit_ellipse_direct,
+};
+pub use ellipsoid_fit::{
+    Ellipsoid, EllipsoidCalibrator, EllipsoidFitOptions, MIN_POINTS_3D, fit_ellipsoid,
+    fit_ellipsoid_direct,
+};

@@ -1,10 +1,63 @@
-//! Quality measures shared by every compass calibrator: how much of the circle the data
-//! cover, and how large a heading error the residuals allow.
+//! Quality measures shared by every compass calibrator: how much of the circle (or sphere)
+//! the data cover, how far the calibrated readings stray from a circle (sphere), how well
+//! the geometry determines the calibration, and how large a heading error that allows.
+//!
+//! Every calibrator in this crate fills its [`Quality`] through [`assess_2d`] /
+//! [`quality_2d`] (or [`quality_3d`]), so the numbers mean the same thing whichever method
+//! produced them.
+//!
+//! # The heading-error bound (derivation)
+//!
+//! Write a calibrated reading as `h = F·u`, `u` a unit vector, `F` the field. Any 2-D
+//! calibration differs from the truth, to first order, by a small centre error `F·d` and a
+//! small symmetric matrix error `E` (the antisymmetric part of a soft-iron matrix is a pure
+//! rotation that no circle or ellipse fit can see; it is assumed zero, which is why the fits
+//! choose the symmetric square root). The estimate then maps a point on the true circle to
+//! `(I + E)(h − F·d)`, so
+//!
+//! * its radial residual, relative to `F`, is `uᵀE u − uᵀd` = `φ(u)ᵀ p` with
+//!   `p = (d_x, d_y, e₁₁, e₁₂, e₂₂)` and `φ(u) = (−u_x, −u_y, u_x², 2u_xu_y, u_y²)`;
+//! * its angle (heading) error is `u⊥ᵀ(E u − d)` = `g(u)ᵀ p`, `u⊥` the unit vector 90°
+//!   ahead of `u`.
+//!
+//! A least-squares calibration estimates `p` from the residuals of its `N` points; if those
+//! are independent with standard deviation `σ` (relative to `F`), the estimate's covariance
+//! is `σ²·A⁻¹` with the information matrix `A = Σᵢ φ(uᵢ)φ(uᵢ)ᵀ` (Gauss–Markov). The heading
+//! error at direction `u` then has variance `σ²·g(u)ᵀA⁻¹g(u)`, and the bound reported is
+//!
+//! `bound = 3 · σ · max_u √(g(u)ᵀ A⁻¹ g(u))`   (3 σ at the worst heading, in degrees),
+//!
+//! with `σ² = Σ rᵢ² / (N − 5)` from the calibrated residuals `rᵢ = |hᵢ|/F − 1`. So it grows
+//! with the residuals, shrinks as `1/√N` with the point count, and grows steeply as the
+//! coverage shrinks (the directions `uᵢ` fill `A`). For `N` points spread evenly round the
+//! circle `g(u)ᵀA⁻¹g(u) = 4/N` at every heading, so the bound is `3·2σ/√N` radians. It is the
+//! error the calibration adds to every later heading; each reading's own noise adds about
+//! `σ` radians (RMS) on top. It does not include model errors the residuals cannot reveal
+//! (a rotated soft iron, a tilted sensor, a field that changes during the turn).
+//!
+//! The `condition` reported is the condition number of `A` (largest over smallest
+//! eigenvalue): 2 for a full, evenly covered circle, growing without bound as the arc
+//! shortens. It is the condition of the linearised least-squares problem every 2-D
+//! calibration solves, in coordinates normalised by the field, so it does not depend on
+//! units or on where the hard iron is.
+//!
+//! The 3-D report is the same with `p = (d, e₁₁, e₁₂, e₁₃, e₂₂, e₂₃, e₃₃)` (9 parameters,
+//! condition 2.5 for an evenly covered sphere), the angle error being the component of
+//! `E u − d` perpendicular to `u` (the error of the field *direction*); the bound is the
+//! worst over the whole sphere of `3 σ √(trace of its covariance)`. The heading of a level
+//! compass errs by at most that divided by `cos(dip)`.
+
+// `!(x <= limit)` and `!(x > 0.0)` are deliberate: they are true for NaN, so a NaN fails
+// every check instead of slipping through one.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 use core::f64::consts::TAU;
 
-use nalgebra::Vector2;
-use truenorth_core::wrap_two_pi;
+use nalgebra::{SMatrix, SVector, Vector2, Vector3};
+use truenorth_compass::{CompassCalibration2d, CompassCalibration3d};
+use truenorth_core::{Error, Quality, Result, wrap_two_pi};
+
+use crate::linalg::{condition_from_eigenvalues, sym_eigen5, sym_eigen9};
 
 #[allow(unused_imports)]
 use truenorth_core::Float as _;
@@ -12,12 +65,45 @@ use truenorth_core::Float as _;
 /// Number of heading bins used for coverage (10° each).
 pub const COVERAGE_BINS: usize = 36;
 
+/// Number of fine bins (0.5° each) used to measure the largest empty arc.
+const GAP_BINS: usize = 720;
+
+/// Equal-area latitude bands of the direction cells on the sphere (uniform in `sin(lat)`,
+/// so every band has the same area).
+pub const SPHERE_BANDS: usize = 8;
+
+/// Longitude sectors per band of the direction cells on the sphere.
+pub const SPHERE_SECTORS: usize = 16;
+
+/// Number of equal-area direction cells on the sphere (`SPHERE_BANDS × SPHERE_SECTORS`,
+/// each about 320 square degrees, roughly 18° × 18° at the equator).
+pub const SPHERE_CELLS: usize = SPHERE_BANDS * SPHERE_SECTORS;
+
+/// The shortest arc of a turn, degrees, from which a 2-D calibration is accepted.
+///
+/// A half circle does not determine an ellipse (the missing half is extrapolated, and a
+/// small noise at its ends moves the centre a lot), so every 2-D calibrator refuses spans up
+/// to a little beyond 180°; the margin keeps a noisy half circle from slipping through.
+pub const MIN_ARC_DEG: f64 = 200.0;
+
+/// The smallest share of the direction cells on the sphere ([`SPHERE_CELLS`]) from which a
+/// 3-D calibration is accepted.
+///
+/// One turn about a single axis traces a great circle, which passes through about 20–25 %
+/// of the cells and does not determine an ellipsoid; turns about two or more axes reach
+/// well beyond this.
+pub const MIN_SPHERE_COVERAGE: f64 = 0.3;
+
+/// How many standard deviations the heading-error bound spans.
+pub const BOUND_SIGMAS: f64 = 3.0;
+
 /// How much of the circle a set of points covers, seen from a centre.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Coverage {
     /// Share of the [`COVERAGE_BINS`] direction bins that hold at least one point, in [0, 1].
     pub fraction: f64,
-    /// The largest empty arc between consecutive occupied directions, radians.
+    /// The largest empty arc between consecutive occupied directions, radians (measured in
+    /// bins of 0.5°).
     pub largest_gap_rad: f64,
 }
 
@@ -28,44 +114,447 @@ impl Coverage {
     }
 }
 
-/// Coverage of `points` seen from `centre`, in bins of 10°. Non-finite points are skipped.
-/// Allocates nothing.
+/// Occupancy of coarse (coverage) and fine (gap) direction bins.
+struct AngleBins {
+    coarse: [bool; COVERAGE_BINS],
+    fine: [bool; GAP_BINS],
+    any: bool,
+}
+
+impl AngleBins {
+    fn new() -> Self {
+        Self {
+            coarse: [false; COVERAGE_BINS],
+            fine: [false; GAP_BINS],
+            any: false,
+        }
+    }
+
+    /// Marks the direction of `d` (skipped if zero or not finite).
+    #[inline]
+    fn add(&mut self, d: &Vector2<f64>) {
+        if !(d.x.is_finite() && d.y.is_finite()) || (d.x == 0.0 && d.y == 0.0) {
+            return;
+        }
+        let turns = wrap_two_pi(d.y.atan2(d.x)) / TAU;
+        let c = (turns * COVERAGE_BINS as f64) as usize;
+        let f = (turns * GAP_BINS as f64) as usize;
+        self.coarse[c.min(COVERAGE_BINS - 1)] = true;
+        self.fine[f.min(GAP_BINS - 1)] = true;
+        self.any = true;
+    }
+
+    fn coverage(&self) -> Coverage {
+        if !self.any {
+            return Coverage {
+                fraction: 0.0,
+                largest_gap_rad: TAU,
+            };
+        }
+        let n = self.coarse.iter().filter(|&&f| f).count();
+        // Largest run of empty fine bins, going once round the circle from an occupied one.
+        let start = self.fine.iter().position(|&f| f).unwrap_or(0);
+        let (mut gap, mut run) = (0usize, 0usize);
+        for k in 1..=GAP_BINS {
+            if self.fine[(start + k) % GAP_BINS] {
+                run = 0;
+            } else {
+                run += 1;
+                gap = gap.max(run);
+            }
+        }
+        Coverage {
+            fraction: n as f64 / COVERAGE_BINS as f64,
+            largest_gap_rad: gap as f64 * TAU / GAP_BINS as f64,
+        }
+    }
+}
+
+/// Coverage of `points` seen from `centre`: share of 10° bins filled and the largest empty
+/// arc. Non-finite points are skipped. Allocates nothing.
 pub fn coverage<'a>(
     points: impl IntoIterator<Item = &'a Vector2<f64>>,
     centre: &Vector2<f64>,
 ) -> Coverage {
-    let mut filled = [false; COVERAGE_BINS];
-    let mut any = false;
+    let mut bins = AngleBins::new();
     for p in points {
-        let d = p - centre;
-        if !(d.x.is_finite() && d.y.is_finite()) || (d.x == 0.0 && d.y == 0.0) {
+        bins.add(&(p - centre));
+    }
+    bins.coverage()
+}
+
+/// The equal-area cell of a direction (any non-zero finite vector), in `0..SPHERE_CELLS`.
+#[inline]
+fn sphere_cell(d: &Vector3<f64>) -> Option<usize> {
+    let n = d.norm();
+    if !(n > 0.0 && n.is_finite()) {
+        return None;
+    }
+    // Archimedes: the area of a band of the unit sphere is 2π·Δz, so equal steps in z give
+    // equal-area bands.
+    let z = (d.z / n).clamp(-1.0, 1.0);
+    let band = (((z + 1.0) * 0.5 * SPHERE_BANDS as f64) as usize).min(SPHERE_BANDS - 1);
+    let turns = wrap_two_pi(d.y.atan2(d.x)) / TAU;
+    let sector = ((turns * SPHERE_SECTORS as f64) as usize).min(SPHERE_SECTORS - 1);
+    Some(band * SPHERE_SECTORS + sector)
+}
+
+/// Share of the [`SPHERE_CELLS`] equal-area direction cells that hold at least one point,
+/// seen from `centre`, in [0, 1]. Non-finite points are skipped. Allocates nothing.
+pub fn sphere_coverage<'a>(
+    points: impl IntoIterator<Item = &'a Vector3<f64>>,
+    centre: &Vector3<f64>,
+) -> f64 {
+    let mut filled = [false; SPHERE_CELLS];
+    for p in points {
+        if let Some(c) = sphere_cell(&(p - centre)) {
+            filled[c] = true;
+        }
+    }
+    filled.iter().filter(|&&f| f).count() as f64 / SPHERE_CELLS as f64
+}
+
+/// Refuses a 2-D calibration whose data span less than `need_deg` of heading (see
+/// [`MIN_ARC_DEG`]) with [`Error::InsufficientCoverage`].
+pub fn require_arc(coverage: &Coverage, need_deg: f64) -> Result<()> {
+    let covered_deg = coverage.span_rad().to_degrees();
+    if covered_deg < need_deg {
+        Err(Error::InsufficientCoverage {
+            // Rounded down, so a refusal never prints a span equal to the one it needs.
+            covered_deg: covered_deg.floor(),
+            need_deg,
+        })
+    } else {
+        Ok(())
+    }
+}
+
+/// Refuses a 3-D calibration whose data fill less than `need` of the direction cells (see
+/// [`MIN_SPHERE_COVERAGE`]) with [`Error::InsufficientCoverage`]; the degrees reported are
+/// the solid angle covered, as an equivalent share of 360°.
+pub fn require_sphere_coverage(fraction: f64, need: f64) -> Result<()> {
+    if fraction < need {
+        Err(Error::InsufficientCoverage {
+            covered_deg: fraction * 360.0,
+            need_deg: need * 360.0,
+        })
+    } else {
+        Ok(())
+    }
+}
+
+/// A 2-D quality report and the coverage behind it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Assessment2d {
+    /// The report to return with the solution.
+    pub quality: Quality,
+    /// Coverage of the calibrated headings (seen from the origin of the calibrated circle).
+    pub coverage: Coverage,
+}
+
+/// Everything the 2-D report needs, in one pass over the raw readings: the calibrated
+/// readings' residuals against `field`, their heading bins, and the information matrix
+/// of the module documentation. `field` is the radius of the calibrated circle (for a
+/// calibrator that does not define one, pass [`mean_corrected_norm_2d`]).
+///
+/// Non-finite readings are skipped. Allocates nothing.
+pub fn assess_2d(points: &[Vector2<f64>], cal: &CompassCalibration2d, field: f64) -> Assessment2d {
+    let mut bins = AngleBins::new();
+    let mut info = SMatrix::<f64, 5, 5>::zeros();
+    let (mut n, mut ss) = (0usize, 0.0);
+    let inv_f = 1.0 / field;
+    for p in points {
+        let h = cal.correct(p);
+        let rho = h.norm();
+        if !(rho > 0.0 && rho.is_finite()) {
             continue;
         }
-        let a = wrap_two_pi(d.y.atan2(d.x));
-        let bin = ((a / TAU) * COVERAGE_BINS as f64) as usize;
-        filled[bin.min(COVERAGE_BINS - 1)] = true;
-        any = true;
+        bins.add(&h);
+        let r = rho * inv_f - 1.0;
+        ss += r * r;
+        n += 1;
+        let u = h / rho;
+        let phi = SVector::<f64, 5>::new(-u.x, -u.y, u.x * u.x, 2.0 * u.x * u.y, u.y * u.y);
+        info += phi * phi.transpose();
     }
-    if !any {
-        return Coverage {
-            fraction: 0.0,
-            largest_gap_rad: TAU,
-        };
+    let coverage = bins.coverage();
+    let residual_rms_rel = if n > 0 { (ss / n as f64).sqrt() } else { 0.0 };
+    let condition = sym_eigen5(&info)
+        .map(|(l, _)| condition_from_eigenvalues(l.as_slice()))
+        .unwrap_or(f64::INFINITY);
+    let heading_error_bound_deg = bound_2d(&info, ss, n);
+    Assessment2d {
+        quality: Quality {
+            points: n,
+            coverage: coverage.fraction,
+            residual_rms_rel,
+            condition,
+            heading_error_bound_deg,
+            field_magnitude: field,
+            field_ratio_to_expected: None,
+        },
+        coverage,
     }
-    let n = filled.iter().filter(|&&f| f).count();
-    // Largest run of empty bins, going round the circle.
-    let mut gap = 0usize;
-    let mut run = 0usize;
-    for i in 0..2 * COVERAGE_BINS {
-        if filled[i % COVERAGE_BINS] {
-            run = 0;
-        } else {
-            run += 1;
-            gap = gap.max(run.min(COVERAGE_BINS));
+}
+
+/// The 2-D quality report of `cal` on `points` (see [`assess_2d`]).
+pub fn quality_2d(points: &[Vector2<f64>], cal: &CompassCalibration2d, field: f64) -> Quality {
+    assess_2d(points, cal, field).quality
+}
+
+/// `3 σ max_u √(gᵀA⁻¹g)` in degrees over 72 headings; infinite when `A` is singular or
+/// there are no more points than parameters.
+fn bound_2d(info: &SMatrix<f64, 5, 5>, sum_sq: f64, n: usize) -> f64 {
+    if n <= 5 {
+        return f64::INFINITY;
+    }
+    let Some(chol) = info.cholesky() else {
+        return f64::INFINITY;
+    };
+    let sigma = (sum_sq / (n - 5) as f64).sqrt();
+    let mut worst: f64 = 0.0;
+    for k in 0..72 {
+        let th = TAU * k as f64 / 72.0;
+        let (s, c) = th.sin_cos();
+        let (ux, uy, px, py) = (c, s, -s, c);
+        let g = SVector::<f64, 5>::new(-px, -py, px * ux, px * uy + py * ux, py * uy);
+        worst = worst.max(g.dot(&chol.solve(&g)));
+    }
+    let b = (BOUND_SIGMAS * sigma * worst.sqrt()).to_degrees();
+    if b.is_finite() { b } else { f64::INFINITY }
+}
+
+/// The 3-D quality report of `cal` on `points`: share of the sphere's direction cells
+/// filled, residual RMS relative to `field` (the radius of the calibrated sphere; see
+/// [`mean_corrected_norm_3d`] if the calibrator defines none), the condition number of the
+/// 9-parameter information matrix and the direction-error bound of the module
+/// documentation. Non-finite readings are skipped. Allocates nothing.
+pub fn quality_3d(points: &[Vector3<f64>], cal: &CompassCalibration3d, field: f64) -> Quality {
+    let mut filled = [false; SPHERE_CELLS];
+    let mut info = SMatrix::<f64, 9, 9>::zeros();
+    let (mut n, mut ss) = (0usize, 0.0);
+    let inv_f = 1.0 / field;
+    for p in points {
+        let h = cal.correct(p);
+        let rho = h.norm();
+        if !(rho > 0.0 && rho.is_finite()) {
+            continue;
+        }
+        if let Some(c) = sphere_cell(&h) {
+            filled[c] = true;
+        }
+        let r = rho * inv_f - 1.0;
+        ss += r * r;
+        n += 1;
+        let phi = phi3(&(h / rho));
+        info += phi * phi.transpose();
+    }
+    let coverage = filled.iter().filter(|&&f| f).count() as f64 / SPHERE_CELLS as f64;
+    let residual_rms_rel = if n > 0 { (ss / n as f64).sqrt() } else { 0.0 };
+    let condition = sym_eigen9(&info)
+        .map(|(l, _)| condition_from_eigenvalues(l.as_slice()))
+        .unwrap_or(f64::INFINITY);
+    Quality {
+        points: n,
+        coverage,
+        residual_rms_rel,
+        condition,
+        heading_error_bound_deg: bound_3d(&info, ss, n),
+        field_magnitude: field,
+        field_ratio_to_expected: None,
+    }
+}
+
+/// `φ(u)` of the 3-D model: radial residual = `φ(u)ᵀ (d, e₁₁, e₁₂, e₁₃, e₂₂, e₂₃, e₃₃)`.
+#[inline]
+fn phi3(u: &Vector3<f64>) -> SVector<f64, 9> {
+    SVector::<f64, 9>::from([
+        -u.x,
+        -u.y,
+        -u.z,
+        u.x * u.x,
+        2.0 * u.x * u.y,
+        2.0 * u.x * u.z,
+        u.y * u.y,
+        2.0 * u.y * u.z,
+        u.z * u.z,
+    ])
+}
+
+/// Number of test directions (a Fibonacci lattice) over which the 3-D bound takes its worst.
+const BOUND_DIRECTIONS_3D: usize = 256;
+
+/// `3 σ max_u √trace(G(u) A⁻¹ G(u)ᵀ)` in degrees, `G(u)` the 3×9 Jacobian of the direction
+/// error `(I − uuᵀ)(E u − d)`; infinite when `A` is singular or `N ≤ 9`.
+fn bound_3d(info: &SMatrix<f64, 9, 9>, sum_sq: f64, n: usize) -> f64 {
+    if n <= 9 {
+        return f64::INFINITY;
+    }
+    let Some(chol) = info.cholesky() else {
+        return f64::INFINITY;
+    };
+    let sigma = (sum_sq / (n - 9) as f64).sqrt();
+    let golden = core::f64::consts::PI * (3.0 - 5.0_f64.sqrt());
+    let mut worst: f64 = 0.0;
+    for k in 0..BOUND_DIRECTIONS_3D {
+        let z = 1.0 - (2.0 * k as f64 + 1.0) / BOUND_DIRECTIONS_3D as f64;
+        let r = (1.0 - z * z).max(0.0).sqrt();
+        let (s, c) = (golden * k as f64).sin_cos();
+        let u = Vector3::new(r * c, r * s, z);
+        let proj = nalgebra::Matrix3::identity() - u * u.transpose();
+        let mut g = SMatrix::<f64, 3, 9>::zeros();
+        for kk in 0..3 {
+            g.set_column(kk, &(-proj.column(kk)));
+        }
+        // E_kl u for (11, 12, 13, 22, 23, 33): the symmetric basis matrices applied to u.
+        let pairs = [(0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)];
+        for (j, &(a, b)) in pairs.iter().enumerate() {
+            let mut eu = Vector3::zeros();
+            eu[a] += u[b];
+            if a != b {
+                eu[b] += u[a];
+            }
+            g.set_column(3 + j, &(proj * eu));
+        }
+        let x = chol.solve(&g.transpose());
+        worst = worst.max((g * x).trace());
+    }
+    let b = (BOUND_SIGMAS * sigma * worst.sqrt()).to_degrees();
+    if b.is_finite() { b } else { f64::INFINITY }
+}
+
+/// Sets [`Quality::field_ratio_to_expected`]: the fitted field over `expected_field` (e.g.
+/// from the World Magnetic Model, in the input unit). Leaves it `None` when no positive
+/// finite expectation is given.
+pub fn with_expected_field(mut quality: Quality, expected_field: Option<f64>) -> Quality {
+    quality.field_ratio_to_expected = expected_field
+        .filter(|e| e.is_finite() && *e > 0.0)
+        .map(|e| quality.field_magnitude / e);
+    quality
+}
+
+/// Mean radius of the calibrated readings, for calibrators that do not fit a radius.
+/// Non-finite readings are skipped; 0 if none remain.
+pub fn mean_corrected_norm_2d(points: &[Vector2<f64>], cal: &CompassCalibration2d) -> f64 {
+    mean_norm(points.iter().map(|p| cal.correct(p).norm()))
+}
+
+/// Mean magnitude of the calibrated readings, for calibrators that do not fit a radius.
+/// Non-finite readings are skipped; 0 if none remain.
+pub fn mean_corrected_norm_3d(points: &[Vector3<f64>], cal: &CompassCalibration3d) -> f64 {
+    mean_norm(points.iter().map(|p| cal.correct(p).norm()))
+}
+
+fn mean_norm(norms: impl Iterator<Item = f64>) -> f64 {
+    let (mut s, mut n) = (0.0, 0usize);
+    for r in norms.filter(|r| r.is_finite()) {
+        s += r;
+        n += 1;
+    }
+    if n > 0 { s / n as f64 } else { 0.0 }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    extern crate alloc;
+    use alloc::vec::Vec;
+    use truenorth_core::{NoiseSource, SplitMix64};
+
+    fn circle(n: usize, from_deg: f64, to_deg: f64, radius: f64) -> Vec<Vector2<f64>> {
+        (0..n)
+            .map(|k| {
+                let a = (from_deg + (to_deg - from_deg) * k as f64 / (n - 1) as f64).to_radians();
+                Vector2::new(radius * a.cos(), radius * a.sin())
+            })
+            .collect()
+    }
+
+    #[test]
+    fn coverage_of_full_and_half_circle() {
+        let full = circle(360, 0.0, 359.0, 1.0);
+        let c = coverage(&full, &Vector2::zeros());
+        assert_eq!(c.fraction, 1.0);
+        assert!(c.span_rad().to_degrees() > 358.0);
+        let half = circle(181, 0.0, 180.0, 1.0);
+        let c = coverage(&half, &Vector2::zeros());
+        let span = c.span_rad().to_degrees();
+        assert!((179.0..=182.0).contains(&span), "{span}");
+        assert!(require_arc(&c, MIN_ARC_DEG).is_err());
+        assert_eq!(coverage(&[], &Vector2::zeros()).fraction, 0.0);
+    }
+
+    #[test]
+    fn perfect_circle_report() {
+        let pts = circle(3601, 0.0, 360.0, 2.0);
+        let q = quality_2d(&pts, &CompassCalibration2d::identity(), 2.0);
+        assert_eq!(q.coverage, 1.0);
+        assert!(q.residual_rms_rel < 1e-12);
+        assert!((q.condition - 2.0).abs() < 1e-2, "{}", q.condition);
+        assert!(q.heading_error_bound_deg < 1e-9);
+        assert!(with_expected_field(q, Some(4.0)).field_ratio_to_expected == Some(0.5));
+    }
+
+    #[test]
+    fn bound_matches_closed_form_for_even_coverage() {
+        // σ = 1 % radial noise, N evenly spread: bound = 3 · 2σ/√N rad.
+        let mut rng = SplitMix64::new(3);
+        let n = 2000;
+        let pts: Vec<_> = circle(n, 0.0, 360.0 * (n - 1) as f64 / n as f64, 1.0)
+            .into_iter()
+            .map(|p| p * (1.0 + rng.normal(0.01)))
+            .collect();
+        let q = quality_2d(&pts, &CompassCalibration2d::identity(), 1.0);
+        let expect = (3.0 * 2.0 * 0.01 / (n as f64).sqrt()).to_degrees();
+        assert!(
+            (q.heading_error_bound_deg / expect - 1.0).abs() < 0.1,
+            "{} vs {expect}",
+            q.heading_error_bound_deg
+        );
+    }
+
+    #[test]
+    fn shorter_arcs_have_worse_condition_and_bound() {
+        let mut rng = SplitMix64::new(5);
+        let mut last = (0.0, 0.0);
+        for span in [360.0, 270.0, 210.0] {
+            let pts: Vec<_> = circle(500, 0.0, span, 1.0)
+                .into_iter()
+                .map(|p| p * (1.0 + rng.normal(0.01)))
+                .collect();
+            let q = quality_2d(&pts, &CompassCalibration2d::identity(), 1.0);
+            assert!(q.condition > last.0 && q.heading_error_bound_deg > last.1);
+            last = (q.condition, q.heading_error_bound_deg);
         }
     }
-    Coverage {
-        fraction: n as f64 / COVERAGE_BINS as f64,
-        largest_gap_rad: gap as f64 * TAU / COVERAGE_BINS as f64,
+
+    #[test]
+    fn sphere_report() {
+        // Fibonacci sphere: even coverage, condition 2.5.
+        let n = 4000;
+        let golden = core::f64::consts::PI * (3.0 - 5.0_f64.sqrt());
+        let pts: Vec<_> = (0..n)
+            .map(|k| {
+                let z = 1.0 - (2.0 * k as f64 + 1.0) / n as f64;
+                let r = (1.0 - z * z).sqrt();
+                let (s, c) = (golden * k as f64).sin_cos();
+                Vector3::new(r * c, r * s, z) * 3.0
+            })
+            .collect();
+        let q = quality_3d(&pts, &CompassCalibration3d::identity(), 3.0);
+        assert_eq!(q.coverage, 1.0);
+        assert!((q.condition - 2.5).abs() < 0.01, "{}", q.condition);
+        assert!(q.residual_rms_rel < 1e-12);
+        assert_eq!(sphere_coverage(&pts, &Vector3::zeros()), 1.0);
+        // A great circle fills few cells.
+        let ring: Vec<_> = (0..360)
+            .map(|k| {
+                let a = (k as f64).to_radians();
+                Vector3::new(a.cos(), 0.0, a.sin())
+            })
+            .collect();
+        let f = sphere_coverage(&ring, &Vector3::zeros());
+        assert!(f < MIN_SPHERE_COVERAGE, "{f}");
+        assert!(require_sphere_coverage(f, MIN_SPHERE_COVERAGE).is_err());
     }
 }

@@ -1,0 +1,673 @@
+//! Least-squares ellipse calibration of a two-axis compass: a direct, ellipse-specific
+//! algebraic fit (Fitzgibbon, Pilu & Fisher 1999, in the numerically stable form of
+//! Halíř & Flusser 1998) refined by Levenberg–Marquardt on the Sampson distance, turned into
+//! a hard iron and a symmetric soft iron.
+//!
+//! Steps of [`fit_ellipse`]:
+//! 1. Refuse too few points and degenerate sets (all equal, collinear).
+//! 2. Normalise: centroid to the origin, RMS radius 1 (see the `normalise` module), so the
+//!    fit is equivariant under rotation, translation and scaling of the input.
+//! 3. Direct fit ([`fit_ellipse_direct`]): minimise the algebraic distance
+//!    `Σ (a x² + b xy + c y² + d x + e y + f)²` subject to `4ac − b² = 1`.
+//! 4. Refuse when the data are not an ellipse: the best conic without the ellipse
+//!    constraint is a hyperbola or parabola, or the ellipse is flatter than
+//!    [`EllipseFitOptions::max_axis_ratio`].
+//! 5. Geometric refinement: Levenberg–Marquardt on the Sampson distance
+//!    `g(m) / |∇g(m)|` with `g(m) = |B (m − c)|² − 1` (Sampson 1982; a first-order
+//!    approximation of the orthogonal distance, the maximum-likelihood residual for
+//!    isotropic sensor noise), over the centre `c` and the symmetric matrix `B`.
+//! 6. Calibration: `hard_iron = c`, `soft_iron = F·B` with `B` the symmetric positive
+//!    definite square root (no arbitrary rotation) and `F = √(a·b)`, the geometric mean of
+//!    the semi-axes, so that `det(soft_iron) = 1`: the soft iron preserves area and the
+//!    fitted field is the radius of the circle with the ellipse's area.
+//! 7. Quality report and refusals on coverage (arc shorter than
+//!    [`EllipseFitOptions::min_arc_deg`]) and conditioning (see [`crate::quality`]).
+//!
+//! An ellipse fit cannot see a rotation of the soft iron (any rotation of the corrected
+//! circle is another circle); choosing the symmetric root assumes the soft iron has none,
+//! which holds for induced magnetisation (its matrix is symmetric) and leaves any mounting
+//! rotation to be removed as a heading offset.
+
+// `!(x <= limit)` and `!(x > 0.0)` are deliberate: they are true for NaN, so a NaN fails
+// every check instead of slipping through one.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
+extern crate alloc;
+
+use alloc::vec::Vec;
+
+use nalgebra::{Matrix2, Matrix3, SMatrix, SVector, Vector2, Vector3};
+use truenorth_compass::CompassCalibration2d;
+use truenorth_core::{
+    Calibrator, Error, Mag2Sample, Progress, Result, Solution, check_finite, check_finite2,
+};
+
+use crate::linalg::{constrained_min3, sym_eigen2, sym_eigen3, sym_sqrt2};
+use crate::lm::{self, NormalEquations};
+use crate::normalise::Normaliser;
+use crate::quality::{self, MIN_ARC_DEG};
+
+#[allow(unused_imports)]
+use truenorth_core::Float as _;
+
+/// The fewest readings a 2-D least-squares fit accepts: five determine an ellipse, one
+/// more leaves a residual to judge it by.
+pub const MIN_POINTS_2D: usize = 6;
+
+/// Options of the least-squares ellipse fit.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EllipseFitOptions {
+    /// Refine the direct fit geometrically (Sampson distance). Default `true`; `false`
+    /// keeps the algebraic fit, which is faster and nearly as good at low noise.
+    pub refine: bool,
+    /// Most Levenberg–Marquardt steps before refusing with [`Error::NoConvergence`].
+    pub max_iterations: usize,
+    /// Shortest arc of heading accepted, degrees (default [`MIN_ARC_DEG`]).
+    pub min_arc_deg: f64,
+    /// Largest ratio of the semi-axes accepted (default 10): flatter ellipses are refused as
+    /// not an ellipse — no plausible soft iron squashes the field that much.
+    pub max_axis_ratio: f64,
+    /// Largest condition number of the information matrix accepted (default 1e4; a full
+    /// circle gives 2): above it the geometry does not determine the calibration.
+    pub max_condition: f64,
+    /// Largest residual RMS, relative to the fitted field, accepted (default 0.2): readings
+    /// that stray further from the best ellipse are not a rotation in a constant field
+    /// (a static sensor, a disturbed site, a badly tilting mount).
+    pub max_residual_rel: f64,
+    /// Largest predicted heading-error bound accepted, degrees (default 10; see
+    /// [`crate::quality`]): a calibration that uncertain is refused rather than returned.
+    pub max_heading_error_bound_deg: f64,
+}
+
+impl Default for EllipseFitOptions {
+    fn default() -> Self {
+        Self {
+            refine: true,
+            max_iterations: 100,
+            min_arc_deg: MIN_ARC_DEG,
+            max_axis_ratio: 10.0,
+            max_condition: 1e4,
+            max_residual_rel: 0.2,
+            max_heading_error_bound_deg: 10.0,
+        }
+    }
+}
+
+/// An ellipse `{ m : |B (m − c)| = 1 }`, `B` symmetric positive definite.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Ellipse {
+    /// Centre `c`.
+    pub centre: Vector2<f64>,
+    /// Symmetric positive-definite `B`: maps the ellipse about its centre onto the unit
+    /// circle. Its eigenvalues are the reciprocal semi-axes.
+    pub unit_map: Matrix2<f64>,
+}
+
+impl Ellipse {
+    /// Semi-axes, largest first (in the unit of the points). `None` if `unit_map` is not
+    /// positive definite.
+    pub fn semi_axes(&self) -> Option<(f64, f64)> {
+        let (l, _) = sym_eigen2(&self.unit_map)?;
+        if l[0] > 0.0 {
+            Some((1.0 / l[0], 1.0 / l[1]))
+        } else {
+            None
+        }
+    }
+
+    /// The compass calibration that maps this ellipse onto a circle, and that circle's
+    /// radius (the field): `hard_iron = c`, `soft_iron = F·B`, `F = 1/√det B`, so
+    /// `det(soft_iron) = 1`.
+    pub fn calibration(&self) -> (CompassCalibration2d, f64) {
+        let field = 1.0 / self.unit_map.determinant().sqrt();
+        (
+            CompassCalibration2d {
+                hard_iron: self.centre,
+                soft_iron: self.unit_map * field,
+            },
+            field,
+        )
+    }
+}
+
+/// The direct least-squares ellipse fit alone (steps 1–4 of the module documentation):
+/// Fitzgibbon, Pilu & Fisher (1999) in the form of Halíř & Flusser (1998), on normalised
+/// data. Fast (a single pass over the points plus 3×3 algebra) and always an ellipse.
+pub fn fit_ellipse_direct(points: &[Vector2<f64>]) -> Result<Ellipse> {
+    let (norm, e) = direct_normalised(points, f64::INFINITY)?;
+    Ok(denormalise(&norm, &e))
+}
+
+/// Refuses too few or non-finite points, normalises, checks for collinear data, fits.
+/// Returns the normaliser and the ellipse in normalised coordinates.
+fn direct_normalised(
+    points: &[Vector2<f64>],
+    max_axis_ratio: f64,
+) -> Result<(Normaliser<2>, Ellipse)> {
+    if points.len() < MIN_POINTS_2D {
+        return Err(Error::TooFewPoints {
+            got: points.len(),
+            need: MIN_POINTS_2D,
+        });
+    }
+    for p in points {
+        check_finite2("magnetometer reading", p)?;
+    }
+    let norm = Normaliser::of(points)?;
+    let (s, cov) = moments(points, &norm);
+    // Collinear: the spread across the best line is nil compared with the spread along it
+    // (the trace of `cov` is 1 after normalisation).
+    let (l, _) = sym_eigen2(&cov).ok_or(Error::Degenerate {
+        reason: "the readings could not be analysed",
+    })?;
+    if l[0] <= 1e-12 {
+        return Err(Error::Degenerate {
+            reason: "the readings lie on a straight line; the sensor must turn so the field traces a circle",
+        });
+    }
+    let e = conic_to_ellipse(&solve_direct(&s)?, max_axis_ratio)?;
+    Ok((norm, e))
+}
+
+/// The moments `Σ qqᵀ`-style sums the direct fit needs, in normalised coordinates: the
+/// 6×6 scatter matrix of `(x², xy, y², x, y, 1)` and the 2×2 covariance.
+fn moments(points: &[Vector2<f64>], norm: &Normaliser<2>) -> (SMatrix<f64, 6, 6>, Matrix2<f64>) {
+    // The 15 distinct monomials of degree ≤ 4, accumulated separately so the loop is plain
+    // arithmetic (the 10k-point benchmark lives here).
+    let (mut x4, mut x3y, mut x2y2, mut xy3, mut y4) = (0.0, 0.0, 0.0, 0.0, 0.0);
+    let (mut x3, mut x2y, mut xy2, mut y3) = (0.0, 0.0, 0.0, 0.0);
+    let (mut x2, mut xy, mut y2, mut sx, mut sy) = (0.0, 0.0, 0.0, 0.0, 0.0);
+    let inv = 1.0 / norm.scale;
+    for p in points {
+        let x = (p.x - norm.centre.x) * inv;
+        let y = (p.y - norm.centre.y) * inv;
+        let (xx, xyv, yy) = (x * x, x * y, y * y);
+        x4 += xx * xx;
+        x3y += xx * xyv;
+        x2y2 += xx * yy;
+        xy3 += xyv * yy;
+        y4 += yy * yy;
+        x3 += xx * x;
+        x2y += xx * y;
+        xy2 += x * yy;
+        y3 += yy * y;
+        x2 += xx;
+        xy += xyv;
+        y2 += yy;
+        sx += x;
+        sy += y;
+    }
+    let n = points.len() as f64;
+    #[rustfmt::skip]
+    let s = SMatrix::<f64, 6, 6>::from_row_slice(&[
+        x4,   x3y,  x2y2, x3,  x2y, x2,
+        x3y,  x2y2, xy3,  x2y, xy2, xy,
+        x2y2, xy3,  y4,   xy2, y3,  y2,
+        x3,   x2y,  xy2,  x2,  xy,  sx,
+        x2y,  xy2,  y3,   xy,  y2,  sy,
+        x2,   xy,   y2,   sx,  sy,  n,
+    ]);
+    (s, Matrix2::new(x2, xy, xy, y2) / n)
+}
+
+/// Halíř & Flusser (1998): split the scatter matrix into the quadratic (`S1`), mixed (`S2`)
+/// and linear (`S3`) blocks, eliminate the linear coefficients (`a₂ = T a₁`,
+/// `T = −S3⁻¹ S2ᵀ`, their eq. 14), and solve the reduced 3×3 constrained problem
+/// `min a₁ᵀ M a₁` s.t. `a₁ᵀ C₁ a₁ = 1`, `M = S1 + S2 T` (eq. 21), `C₁` the ellipse
+/// constraint `4ac − b²` (Fitzgibbon et al. eq. 5). Returns `(a, b, c, d, e, f)`.
+fn solve_direct(s: &SMatrix<f64, 6, 6>) -> Result<SVector<f64, 6>> {
+    let s1: Matrix3<f64> = s.fixed_view::<3, 3>(0, 0).into_owned();
+    let s2: Matrix3<f64> = s.fixed_view::<3, 3>(0, 3).into_owned();
+    let s3: Matrix3<f64> = s.fixed_view::<3, 3>(3, 3).into_owned();
+    let s3_inv = s3.try_inverse().ok_or(Error::Degenerate {
+        reason: "the readings lie on a straight line; the sensor must turn so the field traces a circle",
+    })?;
+    let t = -s3_inv * s2.transpose();
+    let m = s1 + s2 * t;
+    let m = (m + m.transpose()) * 0.5;
+    // Not an ellipse at all? The best conic without the ellipse constraint, normalised by
+    // the rotation-invariant a² + b²/2 + c² (so the test does not depend on orientation),
+    // is the smallest eigenvector of D⁻¹ M D⁻¹ with D = diag(1, 1/√2, 1).
+    let d_inv = Matrix3::from_diagonal(&Vector3::new(1.0, core::f64::consts::SQRT_2, 1.0));
+    if let Some((_, v)) = sym_eigen3(&(d_inv * m * d_inv)) {
+        let u = d_inv * v.column(0);
+        let disc = 4.0 * u[0] * u[2] - u[1] * u[1];
+        let size = u[0] * u[0] + 0.5 * u[1] * u[1] + u[2] * u[2];
+        if disc <= 1e-9 * size {
+            return Err(Error::NotAnEllipse {
+                detail: if disc < -1e-9 * size {
+                    " (it is a hyperbola)"
+                } else {
+                    " (it is a parabola)"
+                },
+            });
+        }
+    }
+    // 4ac − b² = a₁ᵀ C₁ a₁ for a₁ = (a, b, c).
+    let c1 = Matrix3::new(0.0, 0.0, 2.0, 0.0, -1.0, 0.0, 2.0, 0.0, 0.0);
+    let a1 = constrained_min3(&m, &c1).ok_or(Error::Degenerate {
+        reason: "fewer than five distinct readings off a line; record a turn with more varied headings",
+    })?;
+    let a2 = t * a1;
+    Ok(SVector::<f64, 6>::new(
+        a1[0], a1[1], a1[2], a2[0], a2[1], a2[2],
+    ))
+}
+
+/// Centre and unit map of the conic `a x² + b xy + c y² + d x + e y + f = 0`.
+fn conic_to_ellipse(k: &SVector<f64, 6>, max_axis_ratio: f64) -> Result<Ellipse> {
+    let q = Matrix2::new(k[0], 0.5 * k[1], 0.5 * k[1], k[2]);
+    let l = Vector2::new(k[3], k[4]);
+    let q_inv = q.try_inverse().ok_or(Error::NotAnEllipse {
+        detail: " (it is a parabola)",
+    })?;
+    let centre = -0.5 * q_inv * l;
+    let kappa = centre.dot(&(q * centre)) - k[5];
+    let a = q / kappa;
+    let unit_map = sym_sqrt2(&a).ok_or(Error::NotAnEllipse {
+        detail: " (it is an empty or point ellipse)",
+    })?;
+    let e = Ellipse { centre, unit_map };
+    check_axis_ratio(&e, max_axis_ratio)?;
+    Ok(e)
+}
+
+fn check_axis_ratio(e: &Ellipse, max_axis_ratio: f64) -> Result<()> {
+    match e.semi_axes() {
+        Some((a, b)) if a / b <= max_axis_ratio => Ok(()),
+        Some(_) => Err(Error::NotAnEllipse {
+            detail: " (it is flatter than any plausible soft iron; see max_axis_ratio)",
+        }),
+        None => Err(Error::NotAnEllipse {
+            detail: " (it is an empty or point ellipse)",
+        }),
+    }
+}
+
+/// Back from normalised coordinates: `q = (m − μ)/s` ⇒ centre `μ + s·c`, map `B/s`.
+fn denormalise(norm: &Normaliser<2>, e: &Ellipse) -> Ellipse {
+    Ellipse {
+        centre: norm.centre + e.centre * norm.scale,
+        unit_map: e.unit_map / norm.scale,
+    }
+}
+
+/// Parameter vector of the refinement: `(c_x, c_y, B₁₁, B₁₂, B₂₂)`.
+fn to_params(e: &Ellipse) -> SVector<f64, 5> {
+    SVector::<f64, 5>::new(
+        e.centre.x,
+        e.centre.y,
+        e.unit_map[(0, 0)],
+        e.unit_map[(0, 1)],
+        e.unit_map[(1, 1)],
+    )
+}
+
+fn from_params(p: &SVector<f64, 5>) -> Ellipse {
+    Ellipse {
+        centre: Vector2::new(p[0], p[1]),
+        unit_map: Matrix2::new(p[2], p[3], p[3], p[4]),
+    }
+}
+
+/// Sampson residuals and their analytic Jacobian, accumulated as normal equations.
+///
+/// With `v = q − c`, `w = B v`, `z = B w`, `y = B z`, `s = |z|`:
+/// `g = |w|² − 1`, `|∇g| = 2s`, residual `r = g / (2s)`,
+/// `∂r/∂c = (−z + (r/s)·B y) / s` (as `∂s/∂c = −B²z/s`),
+/// `∂r/∂θ = (wᵀE v − (r/s)(zᵀE w + yᵀE v)) / s` for each symmetric basis matrix `E` of `B`.
+fn sampson_normal_equations(
+    points: &[Vector2<f64>],
+    norm: &Normaliser<2>,
+    p: &SVector<f64, 5>,
+) -> Option<NormalEquations<5>> {
+    let c = Vector2::new(p[0], p[1]);
+    let b = Matrix2::new(p[2], p[3], p[3], p[4]);
+    let mut jtj = SMatrix::<f64, 5, 5>::zeros();
+    let mut jtr = SVector::<f64, 5>::zeros();
+    let mut cost = 0.0;
+    let inv = 1.0 / norm.scale;
+    for m in points {
+        let v = (m - norm.centre) * inv - c;
+        let w = b * v;
+        let z = b * w;
+        let s = z.norm();
+        if !(s > 1e-12) {
+            // A reading at the very centre has no defined distance; leave it out.
+            continue;
+        }
+        let y = b * z;
+        let inv_s = 1.0 / s;
+        let r = (w.norm_squared() - 1.0) * 0.5 * inv_s;
+        let k = r * inv_s;
+        let jc = (-z + (b * y) * k) * inv_s;
+        // Symmetric basis: E11 → a_x b_x; E12 → a_x b_y + a_y b_x; E22 → a_y b_y.
+        let e11 = w.x * v.x - k * (z.x * w.x + y.x * v.x);
+        let e12 = (w.x * v.y + w.y * v.x) - k * (z.x * w.y + z.y * w.x + y.x * v.y + y.y * v.x);
+        let e22 = w.y * v.y - k * (z.y * w.y + y.y * v.y);
+        let j = SVector::<f64, 5>::new(jc.x, jc.y, e11 * inv_s, e12 * inv_s, e22 * inv_s);
+        jtj += j * j.transpose();
+        jtr += j * r;
+        cost += r * r;
+    }
+    if cost.is_finite() {
+        Some(NormalEquations { cost, jtj, jtr })
+    } else {
+        None
+    }
+}
+
+/// The least-squares ellipse calibration of `points` (raw `(mag_x, mag_y)` readings of a
+/// level compass turning through at least [`EllipseFitOptions::min_arc_deg`]), with its
+/// quality report — or a typed refusal saying why the data cannot support one. See the
+/// module documentation for the steps.
+pub fn fit_ellipse(
+    points: &[Vector2<f64>],
+    options: &EllipseFitOptions,
+) -> Result<Solution<CompassCalibration2d>> {
+    fit_unchecked(points, options).map_err(|e| explain_short_arc(points, options, e))
+}
+
+/// A fit that failed on a short arc is better explained by the arc than by the symptom
+/// (a hyperbola, a refinement that wanders along a flat valley): if the readings span
+/// less than the minimum arc seen from their best-fitting circle, say so instead.
+fn explain_short_arc(points: &[Vector2<f64>], options: &EllipseFitOptions, e: Error) -> Error {
+    if !matches!(
+        e,
+        Error::NotAnEllipse { .. } | Error::NoConvergence { .. } | Error::Degenerate { .. }
+    ) {
+        return e;
+    }
+    match circle_centre(points) {
+        Some(c) => {
+            let cov = quality::coverage(points, &c);
+            quality::require_arc(&cov, options.min_arc_deg)
+                .err()
+                .unwrap_or(e)
+        }
+        None => e,
+    }
+}
+
+/// Centre of the algebraic best-fitting circle `x² + y² + D x + E y + F = 0` (Kåsa 1976),
+/// a linear least-squares problem that any three non-collinear points determine. Used only
+/// to measure the arc when the ellipse fit fails.
+fn circle_centre(points: &[Vector2<f64>]) -> Option<Vector2<f64>> {
+    let norm = Normaliser::of(points).ok()?;
+    let mut a = Matrix3::zeros();
+    let mut rhs = Vector3::zeros();
+    for p in points {
+        let q = norm.apply(p);
+        let row = Vector3::new(q.x, q.y, 1.0);
+        a += row * row.transpose();
+        rhs -= row * q.norm_squared();
+    }
+    let sol = a.cholesky()?.solve(&rhs);
+    let c = Vector2::new(-0.5 * sol[0], -0.5 * sol[1]);
+    let c = norm.centre + c * norm.scale;
+    c.iter().all(|x| x.is_finite()).then_some(c)
+}
+
+fn fit_unchecked(
+    points: &[Vector2<f64>],
+    options: &EllipseFitOptions,
+) -> Result<Solution<CompassCalibration2d>> {
+    let (norm, direct) = direct_normalised(points, options.max_axis_ratio)?;
+    let e = if options.refine {
+        let out = lm::minimise(
+            "ellipse geometric refinement",
+            to_params(&direct),
+            options.max_iterations,
+            |p| sampson_normal_equations(points, &norm, p),
+        )?;
+        let e = from_params(&out.params);
+        // |B v| depends on B only through B², so take the positive-definite root of B²
+        // (the refinement may have flipped the sign of B).
+        let unit_map = sym_sqrt2(&(e.unit_map * e.unit_map)).ok_or(Error::Degenerate {
+            reason: "the refined ellipse collapsed to a line; record a fuller turn",
+        })?;
+        let e = Ellipse {
+            centre: e.centre,
+            unit_map,
+        };
+        check_axis_ratio(&e, options.max_axis_ratio)?;
+        e
+    } else {
+        direct
+    };
+    let (cal, field) = denormalise(&norm, &e).calibration();
+    if !(field.is_finite() && field > 0.0 && cal.soft_iron.iter().all(|x| x.is_finite())) {
+        return Err(Error::Degenerate {
+            reason: "the fitted ellipse is not finite; check the input scale",
+        });
+    }
+    let a = quality::assess_2d(points, &cal, field);
+    quality::require_arc(&a.coverage, options.min_arc_deg)?;
+    if !(a.quality.condition <= options.max_condition) {
+        return Err(Error::Degenerate {
+            reason: "the headings seen do not determine the ellipse (information matrix ill-conditioned); turn through a fuller circle",
+        });
+    }
+    if !(a.quality.residual_rms_rel <= options.max_residual_rel) {
+        return Err(Error::NotAnEllipse {
+            detail: " (the readings stray from the best ellipse by more than max_residual_rel of the field)",
+        });
+    }
+    if !(a.quality.heading_error_bound_deg <= options.max_heading_error_bound_deg) {
+        return Err(Error::Degenerate {
+            reason: "the predicted heading error exceeds max_heading_error_bound_deg: too few readings or too much noise for the part of the circle covered; record a full turn away from magnetic disturbances",
+        });
+    }
+    Ok(Solution {
+        params: cal,
+        quality: a.quality,
+    })
+}
+
+/// Least-squares ellipse calibrator (batch): stores every reading pushed and fits them all
+/// with [`fit_ellipse`] on `solve`.
+///
+/// ```
+/// use truenorth_calib::EllipseCalibrator;
+/// use truenorth_core::{Calibrator, Mag2Sample};
+/// use nalgebra::Vector2;
+///
+/// let mut cal = EllipseCalibrator::new();
+/// for k in 0..72 {
+///     let psi = (k as f64 * 5.0).to_radians();
+///     // A level compass in a 30-unit field with a (10, −4) hard iron.
+///     let mag = Vector2::new(10.0 + 30.0 * psi.cos(), -4.0 - 30.0 * psi.sin());
+///     cal.push(&Mag2Sample { t_s: k as f64, mag }).unwrap();
+/// }
+/// let sol = cal.solve().unwrap();
+/// assert!((sol.params.hard_iron - Vector2::new(10.0, -4.0)).norm() < 1e-6);
+/// assert!((sol.quality.field_magnitude - 30.0).abs() < 1e-6);
+/// ```
+#[derive(Debug, Clone, Default)]
+pub struct EllipseCalibrator {
+    points: Vec<Vector2<f64>>,
+    options: EllipseFitOptions,
+    expected_field: Option<f64>,
+}
+
+impl EllipseCalibrator {
+    /// A calibrator with the default options.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// A calibrator with the given options.
+    pub fn with_options(options: EllipseFitOptions) -> Self {
+        Self {
+            options,
+            ..Self::default()
+        }
+    }
+
+    /// Sets the expected horizontal field (input unit, e.g. from the World Magnetic Model),
+    /// reported as [`truenorth_core::Quality::field_ratio_to_expected`].
+    pub fn with_expected_field(mut self, expected_field: f64) -> Self {
+        self.expected_field = Some(expected_field);
+        self
+    }
+
+    /// The readings stored so far.
+    pub fn points(&self) -> &[Vector2<f64>] {
+        &self.points
+    }
+
+    /// The options in use.
+    pub fn options(&self) -> &EllipseFitOptions {
+        &self.options
+    }
+}
+
+impl Calibrator for EllipseCalibrator {
+    type Sample = Mag2Sample;
+    type Params = CompassCalibration2d;
+
+    fn push(&mut self, sample: &Mag2Sample) -> Result<()> {
+        check_finite("timestamp t_s", sample.t_s)?;
+        check_finite2("magnetometer reading", &sample.mag)?;
+        self.points.push(sample.mag);
+        Ok(())
+    }
+
+    /// Coverage seen from the centre of the readings' bounding box (the centre of any full
+    /// ellipse; an estimate before the fit). O(n): call it now and then, not per sample.
+    fn progress(&self) -> Progress {
+        let c = bbox_centre(&self.points);
+        let cov = quality::coverage(&self.points, &c);
+        Progress {
+            samples: self.points.len(),
+            coverage: cov.fraction,
+            ready: self.points.len() >= MIN_POINTS_2D
+                && cov.span_rad().to_degrees() >= self.options.min_arc_deg,
+        }
+    }
+
+    fn solve(&mut self) -> Result<Solution<CompassCalibration2d>> {
+        let mut sol = fit_ellipse(&self.points, &self.options)?;
+        sol.quality = quality::with_expected_field(sol.quality, self.expected_field);
+        Ok(sol)
+    }
+
+    fn reset(&mut self) {
+        self.points.clear();
+    }
+}
+
+/// Centre of the axis-aligned bounding box (zero for no points).
+fn bbox_centre(points: &[Vector2<f64>]) -> Vector2<f64> {
+    let mut lo = Vector2::repeat(f64::INFINITY);
+    let mut hi = Vector2::repeat(f64::NEG_INFINITY);
+    for p in points {
+        lo = lo.inf(p);
+        hi = hi.sup(p);
+    }
+    if points.is_empty() {
+        Vector2::zeros()
+    } else {
+        (lo + hi) * 0.5
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn ellipse_points(n: usize, span_deg: f64) -> Vec<Vector2<f64>> {
+        let c = Vector2::new(3.0, -2.0);
+        let th = 0.5_f64;
+        let r = Matrix2::new(th.cos(), -th.sin(), th.sin(), th.cos());
+        (0..n)
+            .map(|k| {
+                let a = (span_deg * k as f64 / n as f64).to_radians();
+                c + r * Vector2::new(5.0 * a.cos(), 3.0 * a.sin())
+            })
+            .collect()
+    }
+
+    #[test]
+    fn sampson_jacobian_matches_finite_differences() {
+        let pts = ellipse_points(40, 360.0)
+            .into_iter()
+            .enumerate()
+            .map(|(k, p)| p * (1.0 + 0.05 * ((k * 7 % 11) as f64 / 11.0 - 0.5)))
+            .collect::<Vec<_>>();
+        let norm = Normaliser::of(&pts).unwrap();
+        let p0 = SVector::<f64, 5>::new(0.1, -0.05, 1.1, 0.2, 0.9);
+        // Check the gradient Jᵀr against the numerical derivative of cost/2.
+        let ne = sampson_normal_equations(&pts, &norm, &p0).unwrap();
+        for i in 0..5 {
+            let h = 1e-6;
+            let mut a = p0;
+            let mut b = p0;
+            a[i] += h;
+            b[i] -= h;
+            let ca = sampson_normal_equations(&pts, &norm, &a).unwrap().cost;
+            let cb = sampson_normal_equations(&pts, &norm, &b).unwrap().cost;
+            let num = (ca - cb) / (4.0 * h);
+            assert!(
+                (num - ne.jtr[i]).abs() < 1e-6 * (1.0 + num.abs()),
+                "{i}: {num} vs {}",
+                ne.jtr[i]
+            );
+        }
+    }
+
+    #[test]
+    fn exact_ellipse_is_recovered() {
+        let pts = ellipse_points(50, 360.0);
+        for refine in [false, true] {
+            let opts = EllipseFitOptions {
+                refine,
+                ..Default::default()
+            };
+            let sol = fit_ellipse(&pts, &opts).unwrap();
+            assert!((sol.params.hard_iron - Vector2::new(3.0, -2.0)).norm() < 1e-9);
+            assert!((sol.quality.field_magnitude - 15.0_f64.sqrt()).abs() < 1e-9);
+            assert!(sol.quality.residual_rms_rel < 1e-9);
+            assert!((sol.params.soft_iron.determinant() - 1.0).abs() < 1e-9);
+        }
+        let e = fit_ellipse_direct(&pts).unwrap();
+        let (a, b) = e.semi_axes().unwrap();
+        assert!((a - 5.0).abs() < 1e-9 && (b - 3.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn refusals() {
+        assert!(matches!(
+            fit_ellipse(&ellipse_points(5, 360.0), &Default::default()),
+            Err(Error::TooFewPoints { got: 5, need: 6 })
+        ));
+        let line: Vec<_> = (0..20)
+            .map(|k| Vector2::new(k as f64, 2.0 * k as f64))
+            .collect();
+        assert!(matches!(
+            fit_ellipse(&line, &Default::default()),
+            Err(Error::Degenerate { .. })
+        ));
+        let hyperbola: Vec<_> = (0..40)
+            .map(|k| {
+                let t = -1.5 + 3.0 * (k % 20) as f64 / 19.0;
+                let s = if k < 20 { 1.0 } else { -1.0 };
+                Vector2::new(s * t.cosh(), t.sinh())
+            })
+            .collect();
+        assert!(matches!(
+            fit_ellipse(&hyperbola, &Default::default()),
+            Err(Error::NotAnEllipse { .. })
+        ));
+        let mut nan = ellipse_points(20, 360.0);
+        nan[3].x = f64::NAN;
+        assert!(matches!(
+            fit_ellipse(&nan, &Default::default()),
+            Err(Error::NonFinite { .. })
+        ));
+        assert!(matches!(
+            fit_ellipse(&ellipse_points(100, 150.0), &Default::default()),
+            Err(Error::InsufficientCoverage { .. })
+        ));
+    }
+}

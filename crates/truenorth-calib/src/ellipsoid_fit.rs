@@ -1,0 +1,622 @@
+//! Least-squares ellipsoid calibration of a three-axis magnetometer (hard iron plus a full
+//! symmetric soft iron): a direct ellipsoid-specific algebraic fit (Li & Griffiths 2004)
+//! refined by Levenberg–Marquardt on the geometric residual `|S (m − b)| − F`.
+//!
+//! Steps of [`fit_ellipsoid`]:
+//! 1. Refuse too few points and degenerate sets (all equal, coplanar), and data that fill
+//!    too little of the sphere of directions (checked about the bounding-box centre — the
+//!    centre of any complete ellipsoid — before the fit, and about the fitted centre after).
+//! 2. Normalise (centroid, RMS radius; see the `normalise` module) for equivariance.
+//! 3. Direct fit ([`fit_ellipsoid_direct`]): minimise the algebraic distance of the quadric
+//!    `ax² + by² + cz² + 2fyz + 2gxz + 2hxy + 2px + 2qy + 2rz + d` subject to
+//!    `4J − I² = 1` (Li & Griffiths 2004, eq. 5, with their `k = 4`), where
+//!    `I = a + b + c` and `J = ab + bc + ca − f² − g² − h²`. The constraint makes the
+//!    answer an ellipsoid; it is exact for ellipsoids whose shortest axis is at least half
+//!    the longest (any plausible soft iron), and the refinement removes what bias remains.
+//!    The linear terms are eliminated as in Halíř & Flusser (1998) and the 6×6 problem is
+//!    solved as a symmetric eigenproblem (see the `linalg` module).
+//! 4. Refuse when the best quadric without the constraint is not an ellipsoid (hyperboloid)
+//!    or the ellipsoid is flatter than [`EllipsoidFitOptions::max_axis_ratio`].
+//! 5. Refinement: Levenberg–Marquardt over the centre `c` and a symmetric matrix `B` on
+//!    `rᵢ = |B (mᵢ − c)| − 1`. With `S = F·B` this is `(|S (mᵢ − c)| − F)/F`, the geometric
+//!    residual `|S(m − b)| − F` scaled by the constant `1/F`, so it has the same minimum.
+//! 6. Calibration: `hard_iron = c`, `soft_iron = F·B` (`B` the symmetric positive-definite
+//!    root, `F = (abc)^{1/3}` the geometric mean of the semi-axes, so `det(soft_iron) = 1`).
+//! 7. Quality report (see [`crate::quality`]) and refusals on coverage and conditioning.
+
+// `!(x <= limit)` and `!(x > 0.0)` are deliberate: they are true for NaN, so a NaN fails
+// every check instead of slipping through one.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
+extern crate alloc;
+
+use alloc::vec::Vec;
+
+use nalgebra::{Matrix3, Matrix4, SMatrix, SVector, Vector3, Vector6};
+use truenorth_compass::CompassCalibration3d;
+use truenorth_core::{
+    Calibrator, Error, Mag3Sample, Progress, Result, Solution, check_finite, check_finite3,
+};
+
+use crate::linalg::{constrained_min6, sym_eigen3, sym_eigen6, sym_sqrt3};
+use crate::lm::{self, NormalEquations};
+use crate::normalise::Normaliser;
+use crate::quality::{self, MIN_SPHERE_COVERAGE};
+
+#[allow(unused_imports)]
+use truenorth_core::Float as _;
+
+/// The fewest readings a 3-D least-squares fit accepts: nine determine an ellipsoid, one
+/// more leaves a residual to judge it by.
+pub const MIN_POINTS_3D: usize = 10;
+
+/// Options of the least-squares ellipsoid fit.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EllipsoidFitOptions {
+    /// Refine the direct fit geometrically (default `true`).
+    pub refine: bool,
+    /// Most Levenberg–Marquardt steps before refusing with [`Error::NoConvergence`].
+    pub max_iterations: usize,
+    /// Smallest share of the sphere's direction cells accepted (default
+    /// [`MIN_SPHERE_COVERAGE`]).
+    pub min_coverage: f64,
+    /// Largest ratio of longest to shortest semi-axis accepted (default 10).
+    pub max_axis_ratio: f64,
+    /// Largest condition number of the information matrix accepted (default 1e4; an
+    /// evenly covered sphere gives 2.5).
+    pub max_condition: f64,
+    /// Largest residual RMS, relative to the fitted field, accepted (default 0.2): readings
+    /// that stray further from the best ellipsoid are not a rotation in a constant field
+    /// (a static sensor, a disturbed site, a badly tilting mount).
+    pub max_residual_rel: f64,
+    /// Largest predicted heading-error bound accepted, degrees (default 10; see
+    /// [`crate::quality`]): a calibration that uncertain is refused rather than returned.
+    pub max_heading_error_bound_deg: f64,
+}
+
+impl Default for EllipsoidFitOptions {
+    fn default() -> Self {
+        Self {
+            refine: true,
+            max_iterations: 100,
+            min_coverage: MIN_SPHERE_COVERAGE,
+            max_axis_ratio: 10.0,
+            max_condition: 1e4,
+            max_residual_rel: 0.2,
+            max_heading_error_bound_deg: 10.0,
+        }
+    }
+}
+
+/// An ellipsoid `{ m : |B (m − c)| = 1 }`, `B` symmetric positive definite.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Ellipsoid {
+    /// Centre `c`.
+    pub centre: Vector3<f64>,
+    /// Symmetric positive-definite `B`: maps the ellipsoid about its centre onto the unit
+    /// sphere. Its eigenvalues are the reciprocal semi-axes.
+    pub unit_map: Matrix3<f64>,
+}
+
+impl Ellipsoid {
+    /// Semi-axes, largest first (in the unit of the points). `None` if `unit_map` is not
+    /// positive definite.
+    pub fn semi_axes(&self) -> Option<[f64; 3]> {
+        let (l, _) = sym_eigen3(&self.unit_map)?;
+        if l[0] > 0.0 {
+            Some([1.0 / l[0], 1.0 / l[1], 1.0 / l[2]])
+        } else {
+            None
+        }
+    }
+
+    /// The calibration that maps this ellipsoid onto a sphere, and that sphere's radius
+    /// (the total field): `hard_iron = c`, `soft_iron = F·B`, `F = (det B)^{−1/3}`, so
+    /// `det(soft_iron) = 1`.
+    pub fn calibration(&self) -> (CompassCalibration3d, f64) {
+        let field = self.unit_map.determinant().powf(-1.0 / 3.0);
+        (
+            CompassCalibration3d {
+                hard_iron: self.centre,
+                soft_iron: self.unit_map * field,
+            },
+            field,
+        )
+    }
+}
+
+/// The direct least-squares ellipsoid fit alone (steps 1–4 of the module documentation,
+/// without the coverage check): Li & Griffiths (2004) on normalised data.
+pub fn fit_ellipsoid_direct(points: &[Vector3<f64>]) -> Result<Ellipsoid> {
+    let (norm, e) = direct_normalised(points, f64::INFINITY)?;
+    Ok(denormalise(&norm, &e))
+}
+
+fn direct_normalised(
+    points: &[Vector3<f64>],
+    max_axis_ratio: f64,
+) -> Result<(Normaliser<3>, Ellipsoid)> {
+    if points.len() < MIN_POINTS_3D {
+        return Err(Error::TooFewPoints {
+            got: points.len(),
+            need: MIN_POINTS_3D,
+        });
+    }
+    for p in points {
+        check_finite3("magnetometer reading", p)?;
+    }
+    let norm = Normaliser::of(points)?;
+    let (s, cov) = moments(points, &norm);
+    let (l, _) = sym_eigen3(&cov).ok_or(Error::Degenerate {
+        reason: "the readings could not be analysed",
+    })?;
+    if l[0] <= 1e-12 {
+        return Err(Error::Degenerate {
+            reason: "the readings lie in a plane (or on a line); tumble the sensor about more than one axis",
+        });
+    }
+    let e = quadric_to_ellipsoid(&solve_direct(&s)?, max_axis_ratio)?;
+    Ok((norm, e))
+}
+
+/// The 10×10 scatter matrix of `(x², y², z², 2yz, 2xz, 2xy, 2x, 2y, 2z, 1)` and the 3×3
+/// covariance, in normalised coordinates.
+fn moments(points: &[Vector3<f64>], norm: &Normaliser<3>) -> (SMatrix<f64, 10, 10>, Matrix3<f64>) {
+    let mut s = SMatrix::<f64, 10, 10>::zeros();
+    for p in points {
+        let q = norm.apply(p);
+        let (x, y, z) = (q.x, q.y, q.z);
+        let d = SVector::<f64, 10>::from([
+            x * x,
+            y * y,
+            z * z,
+            2.0 * y * z,
+            2.0 * x * z,
+            2.0 * x * y,
+            2.0 * x,
+            2.0 * y,
+            2.0 * z,
+            1.0,
+        ]);
+        s += d * d.transpose();
+    }
+    let n = points.len() as f64;
+    // Σ qqᵀ from the quadratic moments: s[(0,9)] = Σx², s[(5,9)] = 2Σxy, ...
+    let cov = Matrix3::new(
+        s[(0, 9)],
+        0.5 * s[(5, 9)],
+        0.5 * s[(4, 9)],
+        0.5 * s[(5, 9)],
+        s[(1, 9)],
+        0.5 * s[(3, 9)],
+        0.5 * s[(4, 9)],
+        0.5 * s[(3, 9)],
+        s[(2, 9)],
+    ) / n;
+    (s, cov)
+}
+
+/// The constraint `4J − I² = a₁ᵀ C₁ a₁` on `a₁ = (a, b, c, f, g, h)` (Li & Griffiths 2004,
+/// eq. 7 with k = 4).
+fn li_griffiths_constraint() -> SMatrix<f64, 6, 6> {
+    let mut c = SMatrix::<f64, 6, 6>::zeros();
+    for i in 0..3 {
+        for j in 0..3 {
+            c[(i, j)] = if i == j { -1.0 } else { 1.0 };
+        }
+        c[(3 + i, 3 + i)] = -4.0;
+    }
+    c
+}
+
+/// Reduced direct fit (see the module documentation). Returns the ten quadric coefficients
+/// `(a, b, c, f, g, h, p, q, r, d)`.
+fn solve_direct(s: &SMatrix<f64, 10, 10>) -> Result<SVector<f64, 10>> {
+    let s1: SMatrix<f64, 6, 6> = s.fixed_view::<6, 6>(0, 0).into_owned();
+    let s2: SMatrix<f64, 6, 4> = s.fixed_view::<6, 4>(0, 6).into_owned();
+    let s3: Matrix4<f64> = s.fixed_view::<4, 4>(6, 6).into_owned();
+    let s3_inv = s3.try_inverse().ok_or(Error::Degenerate {
+        reason: "the readings lie in a plane (or on a line); tumble the sensor about more than one axis",
+    })?;
+    let t: SMatrix<f64, 4, 6> = -s3_inv * s2.transpose();
+    let m = s1 + s2 * t;
+    let m = (m + m.transpose()) * 0.5;
+    // The best quadric without the ellipsoid constraint, normalised by the Frobenius norm
+    // of its quadratic part (a rotation invariant): a hyperboloid means the data are not a
+    // rotation in a constant field.
+    let h = core::f64::consts::FRAC_1_SQRT_2;
+    let d_inv = SMatrix::<f64, 6, 6>::from_diagonal(&Vector6::new(1.0, 1.0, 1.0, h, h, h));
+    if let Some((_, v)) = sym_eigen6(&(d_inv * m * d_inv)) {
+        let u = d_inv * v.column(0);
+        if let Some((l, _)) = sym_eigen3(&quadratic_part(&u)) {
+            let tol = 1e-9 * l.amax();
+            if !(l[0] > tol || l[2] < -tol) {
+                return Err(Error::NotAnEllipse {
+                    detail: " (it is a hyperboloid or a cylinder)",
+                });
+            }
+        }
+    }
+    let a1 = constrained_min6(&m, &li_griffiths_constraint()).ok_or(Error::Degenerate {
+        reason: "too few distinct readings off a plane; tumble the sensor through more orientations",
+    })?;
+    let a2 = t * a1;
+    let mut k = SVector::<f64, 10>::zeros();
+    k.fixed_rows_mut::<6>(0).copy_from(&a1);
+    k.fixed_rows_mut::<4>(6).copy_from(&a2);
+    Ok(k)
+}
+
+/// The symmetric matrix `Q` of the quadratic part `xᵀQx` from `(a, b, c, f, g, h)`.
+fn quadratic_part<S: nalgebra::Storage<f64, nalgebra::U6>>(
+    a: &nalgebra::Vector<f64, nalgebra::U6, S>,
+) -> Matrix3<f64> {
+    Matrix3::new(a[0], a[5], a[4], a[5], a[1], a[3], a[4], a[3], a[2])
+}
+
+/// Centre and unit map of the quadric `xᵀQx + 2lᵀx + d = 0`: centre `−Q⁻¹l`,
+/// `B = (Q/κ)^{1/2}` with `κ = cᵀQc − d`.
+fn quadric_to_ellipsoid(k: &SVector<f64, 10>, max_axis_ratio: f64) -> Result<Ellipsoid> {
+    let q = quadratic_part(&k.fixed_rows::<6>(0));
+    let l = Vector3::new(k[6], k[7], k[8]);
+    let q_inv = q.try_inverse().ok_or(Error::NotAnEllipse {
+        detail: " (it is a cylinder or paraboloid)",
+    })?;
+    let centre = -(q_inv * l);
+    let kappa = centre.dot(&(q * centre)) - k[9];
+    let unit_map = sym_sqrt3(&(q / kappa)).ok_or(Error::NotAnEllipse {
+        detail: " (it is a hyperboloid, or an empty or point ellipsoid)",
+    })?;
+    let e = Ellipsoid { centre, unit_map };
+    check_axis_ratio(&e, max_axis_ratio)?;
+    Ok(e)
+}
+
+fn check_axis_ratio(e: &Ellipsoid, max_axis_ratio: f64) -> Result<()> {
+    match e.semi_axes() {
+        Some([a, _, c]) if a / c <= max_axis_ratio => Ok(()),
+        Some(_) => Err(Error::NotAnEllipse {
+            detail: " (it is flatter than any plausible soft iron; see max_axis_ratio)",
+        }),
+        None => Err(Error::NotAnEllipse {
+            detail: " (it is an empty or point ellipsoid)",
+        }),
+    }
+}
+
+fn denormalise(norm: &Normaliser<3>, e: &Ellipsoid) -> Ellipsoid {
+    Ellipsoid {
+        centre: norm.centre + e.centre * norm.scale,
+        unit_map: e.unit_map / norm.scale,
+    }
+}
+
+/// Index pairs of the six free entries of the symmetric `B`, in parameter order.
+const PAIRS: [(usize, usize); 6] = [(0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)];
+
+/// Parameter vector of the refinement: `(c, B₁₁, B₁₂, B₁₃, B₂₂, B₂₃, B₃₃)`.
+fn to_params(e: &Ellipsoid) -> SVector<f64, 9> {
+    let mut p = SVector::<f64, 9>::zeros();
+    p.fixed_rows_mut::<3>(0).copy_from(&e.centre);
+    for (j, &(a, b)) in PAIRS.iter().enumerate() {
+        p[3 + j] = e.unit_map[(a, b)];
+    }
+    p
+}
+
+fn from_params(p: &SVector<f64, 9>) -> Ellipsoid {
+    let mut b = Matrix3::zeros();
+    for (j, &(r, c)) in PAIRS.iter().enumerate() {
+        b[(r, c)] = p[3 + j];
+        b[(c, r)] = p[3 + j];
+    }
+    Ellipsoid {
+        centre: Vector3::new(p[0], p[1], p[2]),
+        unit_map: b,
+    }
+}
+
+/// Residuals `r = |B v| − 1` (`v = q − c`, `w = B v`, `ρ = |w|`) and their Jacobian:
+/// `∂r/∂c = −B w / ρ`, `∂r/∂B_kl = (w_k v_l + w_l v_k)/ρ` (`w_k v_k / ρ` on the diagonal).
+fn radial_normal_equations(
+    points: &[Vector3<f64>],
+    norm: &Normaliser<3>,
+    p: &SVector<f64, 9>,
+) -> Option<NormalEquations<9>> {
+    let e = from_params(p);
+    let (c, b) = (e.centre, e.unit_map);
+    let mut jtj = SMatrix::<f64, 9, 9>::zeros();
+    let mut jtr = SVector::<f64, 9>::zeros();
+    let mut cost = 0.0;
+    let inv = 1.0 / norm.scale;
+    for m in points {
+        let v = (m - norm.centre) * inv - c;
+        let w = b * v;
+        let rho = w.norm();
+        if !(rho > 1e-12) {
+            continue;
+        }
+        let inv_rho = 1.0 / rho;
+        let r = rho - 1.0;
+        let jc = -(b * w) * inv_rho;
+        let mut j = SVector::<f64, 9>::zeros();
+        j[0] = jc.x;
+        j[1] = jc.y;
+        j[2] = jc.z;
+        for (k, &(a, bb)) in PAIRS.iter().enumerate() {
+            j[3 + k] = if a == bb {
+                w[a] * v[a]
+            } else {
+                w[a] * v[bb] + w[bb] * v[a]
+            } * inv_rho;
+        }
+        jtj += j * j.transpose();
+        jtr += j * r;
+        cost += r * r;
+    }
+    if cost.is_finite() {
+        Some(NormalEquations { cost, jtj, jtr })
+    } else {
+        None
+    }
+}
+
+/// The least-squares ellipsoid calibration of `points` (raw 3-axis readings of a sensor
+/// tumbled through many orientations), with its quality report — or a typed refusal saying
+/// why the data cannot support one. See the module documentation for the steps.
+pub fn fit_ellipsoid(
+    points: &[Vector3<f64>],
+    options: &EllipsoidFitOptions,
+) -> Result<Solution<CompassCalibration3d>> {
+    if points.len() >= MIN_POINTS_3D && points.iter().all(|p| p.iter().all(|x| x.is_finite())) {
+        // Before fitting: seen from the bounding-box centre (the centre of any complete
+        // ellipsoid), a single-axis turn or a small patch of orientations fills few cells.
+        let pre = quality::sphere_coverage(points, &bbox_centre(points));
+        quality::require_sphere_coverage(pre, options.min_coverage)?;
+    }
+    let (norm, direct) = direct_normalised(points, options.max_axis_ratio)?;
+    let e = if options.refine {
+        let out = lm::minimise(
+            "ellipsoid geometric refinement",
+            to_params(&direct),
+            options.max_iterations,
+            |p| radial_normal_equations(points, &norm, p),
+        )?;
+        let e = from_params(&out.params);
+        let unit_map = sym_sqrt3(&(e.unit_map * e.unit_map)).ok_or(Error::Degenerate {
+            reason: "the refined ellipsoid collapsed to a plane; tumble the sensor through more orientations",
+        })?;
+        let e = Ellipsoid {
+            centre: e.centre,
+            unit_map,
+        };
+        check_axis_ratio(&e, options.max_axis_ratio)?;
+        e
+    } else {
+        direct
+    };
+    let (cal, field) = denormalise(&norm, &e).calibration();
+    if !(field.is_finite() && field > 0.0 && cal.soft_iron.iter().all(|x| x.is_finite())) {
+        return Err(Error::Degenerate {
+            reason: "the fitted ellipsoid is not finite; check the input scale",
+        });
+    }
+    let q = quality::quality_3d(points, &cal, field);
+    quality::require_sphere_coverage(q.coverage, options.min_coverage)?;
+    if !(q.condition <= options.max_condition) {
+        return Err(Error::Degenerate {
+            reason: "the orientations seen do not determine the ellipsoid (information matrix ill-conditioned); tumble the sensor about a third axis",
+        });
+    }
+    if !(q.residual_rms_rel <= options.max_residual_rel) {
+        return Err(Error::NotAnEllipse {
+            detail: " (the readings stray from the best ellipsoid by more than max_residual_rel of the field)",
+        });
+    }
+    if !(q.heading_error_bound_deg <= options.max_heading_error_bound_deg) {
+        return Err(Error::Degenerate {
+            reason: "the predicted heading error exceeds max_heading_error_bound_deg: too few readings or too much noise for the part of the sphere covered; record a full tumble away from magnetic disturbances",
+        });
+    }
+    Ok(Solution {
+        params: cal,
+        quality: q,
+    })
+}
+
+fn bbox_centre(points: &[Vector3<f64>]) -> Vector3<f64> {
+    let mut lo = Vector3::repeat(f64::INFINITY);
+    let mut hi = Vector3::repeat(f64::NEG_INFINITY);
+    for p in points {
+        lo = lo.inf(p);
+        hi = hi.sup(p);
+    }
+    if points.is_empty() {
+        Vector3::zeros()
+    } else {
+        (lo + hi) * 0.5
+    }
+}
+
+/// Least-squares ellipsoid calibrator (batch): stores every reading pushed and fits them
+/// all with [`fit_ellipsoid`] on `solve`.
+#[derive(Debug, Clone, Default)]
+pub struct EllipsoidCalibrator {
+    points: Vec<Vector3<f64>>,
+    options: EllipsoidFitOptions,
+    expected_field: Option<f64>,
+}
+
+impl EllipsoidCalibrator {
+    /// A calibrator with the default options.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// A calibrator with the given options.
+    pub fn with_options(options: EllipsoidFitOptions) -> Self {
+        Self {
+            options,
+            ..Self::default()
+        }
+    }
+
+    /// Sets the expected total field (input unit, e.g. from the World Magnetic Model),
+    /// reported as [`truenorth_core::Quality::field_ratio_to_expected`].
+    pub fn with_expected_field(mut self, expected_field: f64) -> Self {
+        self.expected_field = Some(expected_field);
+        self
+    }
+
+    /// The readings stored so far.
+    pub fn points(&self) -> &[Vector3<f64>] {
+        &self.points
+    }
+
+    /// The options in use.
+    pub fn options(&self) -> &EllipsoidFitOptions {
+        &self.options
+    }
+}
+
+impl Calibrator for EllipsoidCalibrator {
+    type Sample = Mag3Sample;
+    type Params = CompassCalibration3d;
+
+    fn push(&mut self, sample: &Mag3Sample) -> Result<()> {
+        check_finite("timestamp t_s", sample.t_s)?;
+        check_finite3("magnetometer reading", &sample.mag)?;
+        self.points.push(sample.mag);
+        Ok(())
+    }
+
+    /// Share of the sphere's direction cells filled, seen from the centre of the readings'
+    /// bounding box (an estimate before the fit). O(n): call it now and then.
+    fn progress(&self) -> Progress {
+        let coverage = quality::sphere_coverage(&self.points, &bbox_centre(&self.points));
+        Progress {
+            samples: self.points.len(),
+            coverage,
+            ready: self.points.len() >= MIN_POINTS_3D && coverage >= self.options.min_coverage,
+        }
+    }
+
+    fn solve(&mut self) -> Result<Solution<CompassCalibration3d>> {
+        let mut sol = fit_ellipsoid(&self.points, &self.options)?;
+        sol.quality = quality::with_expected_field(sol.quality, self.expected_field);
+        Ok(sol)
+    }
+
+    fn reset(&mut self) {
+        self.points.clear();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sphere_points(n: usize) -> Vec<Vector3<f64>> {
+        let golden = core::f64::consts::PI * (3.0 - 5.0_f64.sqrt());
+        (0..n)
+            .map(|k| {
+                let z = 1.0 - (2.0 * k as f64 + 1.0) / n as f64;
+                let r = (1.0 - z * z).sqrt();
+                let (s, c) = (golden * k as f64).sin_cos();
+                Vector3::new(r * c, r * s, z)
+            })
+            .collect()
+    }
+
+    fn distorted(n: usize) -> (Vec<Vector3<f64>>, Matrix3<f64>, Vector3<f64>) {
+        let w = Matrix3::new(1.2, 0.1, -0.05, 0.1, 0.9, 0.08, -0.05, 0.08, 1.05);
+        let b = Vector3::new(0.3, -0.7, 0.2);
+        let pts = sphere_points(n)
+            .into_iter()
+            .map(|u| b + w * u * 50.0)
+            .collect();
+        (pts, w, b)
+    }
+
+    #[test]
+    fn radial_jacobian_matches_finite_differences() {
+        let (pts, _, _) = distorted(60);
+        let pts: Vec<_> = pts
+            .iter()
+            .enumerate()
+            .map(|(k, p)| p * (1.0 + 0.03 * ((k * 5 % 13) as f64 / 13.0 - 0.5)))
+            .collect();
+        let norm = Normaliser::of(&pts).unwrap();
+        let p0 = SVector::<f64, 9>::from([0.05, -0.1, 0.02, 1.1, 0.1, -0.05, 0.9, 0.07, 1.0]);
+        let ne = radial_normal_equations(&pts, &norm, &p0).unwrap();
+        for i in 0..9 {
+            let h = 1e-6;
+            let (mut a, mut b) = (p0, p0);
+            a[i] += h;
+            b[i] -= h;
+            let ca = radial_normal_equations(&pts, &norm, &a).unwrap().cost;
+            let cb = radial_normal_equations(&pts, &norm, &b).unwrap().cost;
+            let num = (ca - cb) / (4.0 * h);
+            assert!(
+                (num - ne.jtr[i]).abs() < 1e-6 * (1.0 + num.abs()),
+                "{i}: {num} vs {}",
+                ne.jtr[i]
+            );
+        }
+    }
+
+    #[test]
+    fn exact_ellipsoid_is_recovered() {
+        let (pts, w, b) = distorted(300);
+        // The symmetric soft iron is w⁻¹ up to the scale fixed by det = 1.
+        let truth = w.try_inverse().unwrap();
+        let truth = truth / truth.determinant().cbrt();
+        for refine in [false, true] {
+            let opts = EllipsoidFitOptions {
+                refine,
+                ..Default::default()
+            };
+            let sol = fit_ellipsoid(&pts, &opts).unwrap();
+            assert!(
+                (sol.params.hard_iron - b).norm() < 1e-8,
+                "{}",
+                sol.params.hard_iron
+            );
+            assert!((sol.params.soft_iron - truth).norm() < 1e-9);
+            assert!(sol.quality.residual_rms_rel < 1e-10);
+            assert!((sol.quality.field_magnitude - 50.0 * w.determinant().cbrt()).abs() < 1e-8);
+        }
+    }
+
+    #[test]
+    fn refusals() {
+        let (pts, _, _) = distorted(300);
+        assert!(matches!(
+            fit_ellipsoid(&pts[..9], &Default::default()),
+            Err(Error::TooFewPoints { got: 9, need: 10 })
+        ));
+        let ring: Vec<_> = (0..100)
+            .map(|k| {
+                let a = k as f64 * 0.1;
+                Vector3::new(a.cos(), a.sin(), 0.3)
+            })
+            .collect();
+        assert!(fit_ellipsoid(&ring, &Default::default()).is_err());
+        let mut bad = pts.clone();
+        bad[7].z = f64::INFINITY;
+        assert!(matches!(
+            fit_ellipsoid(&bad, &Default::default()),
+            Err(Error::NonFinite { .. })
+        ));
+        // A hyperboloid of one sheet, x² + y² − z² = 1, sampled all round.
+        let hyp: Vec<_> = (0..400)
+            .map(|k| {
+                let t = -1.2 + 2.4 * (k % 20) as f64 / 19.0;
+                let a = (k / 20) as f64 * core::f64::consts::TAU / 20.0;
+                Vector3::new(t.cosh() * a.cos(), t.cosh() * a.sin(), t.sinh())
+            })
+            .collect();
+        let r = fit_ellipsoid(&hyp, &Default::default());
+        assert!(matches!(r, Err(Error::NotAnEllipse { .. })), "{r:?}");
+    }
+}

@@ -1,0 +1,129 @@
+//! Levenberg–Marquardt for small dense least-squares problems (Levenberg 1944; Marquardt
+//! 1963, with Marquardt's diagonal scaling `JᵀJ + λ·diag(JᵀJ)`), as used to refine the
+//! direct ellipse and ellipsoid fits on a geometric residual.
+//!
+//! The problem supplies one function that, for a parameter vector, returns the cost
+//! `Σ rᵢ²` together with the normal equations `JᵀJ` and `Jᵀr` — one pass over the data per
+//! trial point, so an accepted step needs no second pass.
+
+// `!(x <= limit)` and `!(x > 0.0)` are deliberate: they are true for NaN, so a NaN fails
+// every check instead of slipping through one.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
+use nalgebra::{SMatrix, SVector};
+use truenorth_core::{Error, Result};
+
+#[allow(unused_imports)]
+use truenorth_core::Float as _;
+
+/// Cost and normal equations at one parameter vector.
+pub(crate) struct NormalEquations<const P: usize> {
+    /// `Σ rᵢ²`.
+    pub cost: f64,
+    /// `JᵀJ`.
+    pub jtj: SMatrix<f64, P, P>,
+    /// `Jᵀr`.
+    pub jtr: SVector<f64, P>,
+}
+
+/// The result of a converged run.
+pub(crate) struct LmOutcome<const P: usize> {
+    /// The parameters at the minimum.
+    pub params: SVector<f64, P>,
+}
+
+/// Damping above which no step can reduce the cost any more: the current point is a
+/// minimum to rounding precision.
+const LAMBDA_MAX: f64 = 1e16;
+
+/// Minimises the cost from `start`. `eval` returns `None` where the model is undefined
+/// (e.g. a matrix became singular); such trial points are rejected like uphill ones.
+///
+/// Converges when an accepted step lowers the cost by less than `1e-12` of itself or moves
+/// the parameters by less than `1e-12` of their norm; refuses with
+/// [`Error::NoConvergence`] after `max_iterations` accepted steps without that.
+pub(crate) fn minimise<const P: usize>(
+    what: &'static str,
+    start: SVector<f64, P>,
+    max_iterations: usize,
+    mut eval: impl FnMut(&SVector<f64, P>) -> Option<NormalEquations<P>>,
+) -> Result<LmOutcome<P>> {
+    let mut p = start;
+    let Some(mut cur) = eval(&p) else {
+        return Err(Error::Degenerate {
+            reason: "the initial fit is not a valid starting point for the geometric refinement",
+        });
+    };
+    let mut lambda = 1e-4;
+    for _ in 0..max_iterations {
+        loop {
+            let mut h = cur.jtj;
+            let dmax = (0..P).map(|i| h[(i, i)]).fold(0.0_f64, f64::max);
+            for i in 0..P {
+                // Marquardt's scaling, with a floor so a parameter the data do not touch
+                // still gets a finite, damped step.
+                h[(i, i)] += lambda * h[(i, i)].max(1e-12 * dmax);
+            }
+            let step = h.cholesky().map(|c| -c.solve(&cur.jtr));
+            match step {
+                Some(delta) if delta.iter().all(|x| x.is_finite()) => {
+                    let trial = p + delta;
+                    match eval(&trial) {
+                        Some(next) if next.cost <= cur.cost => {
+                            let converged = cur.cost - next.cost <= 1e-12 * cur.cost
+                                || delta.norm() <= 1e-12 * p.norm().max(1e-300);
+                            p = trial;
+                            cur = next;
+                            lambda = (lambda * 0.1).max(1e-12);
+                            if converged {
+                                return Ok(LmOutcome { params: p });
+                            }
+                            break;
+                        }
+                        _ => {}
+                    }
+                }
+                _ => {}
+            }
+            lambda *= 10.0;
+            if lambda > LAMBDA_MAX {
+                // No direction lowers the cost: we are at a minimum to rounding precision.
+                return Ok(LmOutcome { params: p });
+            }
+        }
+    }
+    Err(Error::NoConvergence {
+        what,
+        iterations: max_iterations,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::{Matrix2, Vector2};
+
+    /// Rosenbrock as a least-squares problem: r = (10 (y − x²), 1 − x).
+    fn rosenbrock(p: &Vector2<f64>) -> Option<NormalEquations<2>> {
+        let (x, y) = (p[0], p[1]);
+        let r = Vector2::new(10.0 * (y - x * x), 1.0 - x);
+        let j = Matrix2::new(-20.0 * x, 10.0, -1.0, 0.0);
+        Some(NormalEquations {
+            cost: r.norm_squared(),
+            jtj: j.transpose() * j,
+            jtr: j.transpose() * r,
+        })
+    }
+
+    #[test]
+    fn finds_rosenbrock_minimum() {
+        let out = minimise("rosenbrock", Vector2::new(-1.2, 1.0), 200, rosenbrock).unwrap();
+        assert!((out.params - Vector2::new(1.0, 1.0)).norm() < 1e-6);
+    }
+
+    #[test]
+    fn reports_no_convergence() {
+        let e = minimise("rosenbrock", Vector2::new(-1.2, 1.0), 1, rosenbrock);
+        assert!(matches!(e, Err(Error::NoConvergence { .. })));
+    }
+}

@@ -1,0 +1,414 @@
+//! Property tests and measures of the least-squares ellipse and ellipsoid calibrations:
+//! equivariance, model → calibrator round trips, refusals, no panics, and the heading error
+//! against the noise floor.
+//!
+//! The forward model here is a deliberately tiny local one (raw = hard + W·h + noise, W
+//! symmetric), independent of the compass crate's model, so these tests check the fits
+//! against first principles.
+
+use std::f64::consts::{PI, TAU};
+
+use nalgebra::{Matrix2, Matrix3, Rotation3, Vector2, Vector3};
+use proptest::prelude::*;
+use truenorth_calib::{
+    EllipseCalibrator, EllipseFitOptions, EllipsoidCalibrator, EllipsoidFitOptions, fit_ellipse,
+    fit_ellipse_direct, fit_ellipsoid, quality,
+};
+use truenorth_compass::CompassCalibration2d;
+use truenorth_core::{
+    Calibrator, Error, Mag2Sample, Mag3Sample, NoiseSource, SplitMix64, angle_diff,
+};
+
+fn rot2(a: f64) -> Matrix2<f64> {
+    let (s, c) = a.sin_cos();
+    Matrix2::new(c, -s, s, c)
+}
+
+/// A level two-axis compass: `raw = hard + W·h(ψ) + noise`, `h = H (cos ψ, −sin ψ)`,
+/// W symmetric positive definite (induced soft iron).
+#[derive(Debug, Clone, Copy)]
+struct Model2 {
+    hard: Vector2<f64>,
+    w: Matrix2<f64>,
+    field: f64,
+}
+
+impl Model2 {
+    /// W with semi-axis ratio `ratio`, major axis at `angle` from x, unit determinant.
+    fn new(hard: Vector2<f64>, ratio: f64, angle: f64, field: f64) -> Self {
+        let d = Matrix2::new(ratio.sqrt(), 0.0, 0.0, 1.0 / ratio.sqrt());
+        Self {
+            hard,
+            w: rot2(angle) * d * rot2(angle).transpose(),
+            field,
+        }
+    }
+
+    fn raw(&self, psi: f64, noise: &mut impl NoiseSource, sigma: f64) -> Vector2<f64> {
+        let h = Vector2::new(self.field * psi.cos(), -self.field * psi.sin());
+        self.hard + self.w * h + Vector2::new(noise.normal(sigma), noise.normal(sigma))
+    }
+
+    /// The exact calibration, in the fits' convention (det soft iron = 1).
+    fn truth(&self) -> (CompassCalibration2d, f64) {
+        let s = self.w.try_inverse().unwrap();
+        let s = s / s.determinant().sqrt();
+        (
+            CompassCalibration2d {
+                hard_iron: self.hard,
+                soft_iron: s,
+            },
+            self.field * self.w.determinant().sqrt(),
+        )
+    }
+
+    /// `n` headings evenly over `span_deg` from `start_deg`, with noise.
+    fn turn(
+        &self,
+        n: usize,
+        start_deg: f64,
+        span_deg: f64,
+        sigma: f64,
+        seed: u64,
+    ) -> Vec<(f64, Vector2<f64>)> {
+        let mut rng = SplitMix64::new(seed);
+        (0..n)
+            .map(|k| {
+                let psi = (start_deg + span_deg * k as f64 / n as f64).to_radians();
+                (psi, self.raw(psi, &mut rng, sigma))
+            })
+            .collect()
+    }
+}
+
+fn points(turn: &[(f64, Vector2<f64>)]) -> Vec<Vector2<f64>> {
+    turn.iter().map(|t| t.1).collect()
+}
+
+fn heading_rms_deg(cal: &CompassCalibration2d, turn: &[(f64, Vector2<f64>)]) -> f64 {
+    let ss: f64 = turn
+        .iter()
+        .map(|(psi, raw)| angle_diff(cal.heading_rad(raw), *psi).powi(2))
+        .sum();
+    (ss / turn.len() as f64).sqrt().to_degrees()
+}
+
+/// The measure: full turn, hard iron 0.5 × field, soft-iron axis ratio 1.3 rotated
+/// 30°, noise 1 % of the field (per axis). Heading RMS of the least-squares fit against the
+/// noise floor (the true calibration applied to the same noisy samples).
+#[test]
+fn least_squares_heading_rms_is_within_ten_percent_of_the_noise_floor() {
+    let field = 1.0;
+    let hard = Vector2::new(
+        0.5 * field * 40f64.to_radians().cos(),
+        0.5 * field * 40f64.to_radians().sin(),
+    );
+    let m = Model2::new(hard, 1.3, 30f64.to_radians(), field);
+    let (truth, _) = m.truth();
+    let trials = 200;
+    let n = 360;
+    let (mut sum_fit, mut sum_floor, mut sum_direct, mut worst) = (0.0, 0.0, 0.0, 0.0_f64);
+    let mut bounds = 0.0;
+    for seed in 0..trials {
+        let turn = m.turn(n, 0.0, 360.0, 0.01 * field, seed);
+        let pts = points(&turn);
+        let sol = fit_ellipse(&pts, &EllipseFitOptions::default()).unwrap();
+        let direct = fit_ellipse_direct(&pts).unwrap().calibration().0;
+        let fit = heading_rms_deg(&sol.params, &turn);
+        let floor = heading_rms_deg(&truth, &turn);
+        sum_fit += fit;
+        sum_floor += floor;
+        sum_direct += heading_rms_deg(&direct, &turn);
+        worst = worst.max(fit / floor);
+        bounds += sol.quality.heading_error_bound_deg;
+    }
+    let ratio = sum_fit / sum_floor;
+    println!(
+        "LS ellipse, {trials} trials of {n} points: heading RMS {:.4}° (direct fit only {:.4}°), noise floor {:.4}°, ratio {:.4} (worst trial {:.4}); mean predicted bound {:.3}°",
+        sum_fit / trials as f64,
+        sum_direct / trials as f64,
+        sum_floor / trials as f64,
+        ratio,
+        worst,
+        bounds / trials as f64
+    );
+    assert!(ratio <= 1.10, "ratio {ratio}");
+    assert!(worst <= 1.10, "worst {worst}");
+}
+
+#[test]
+fn half_circle_and_shorter_arcs_are_refused_fuller_ones_accepted() {
+    let m = Model2::new(Vector2::new(0.5, 0.0), 1.3, 30f64.to_radians(), 1.0);
+    for span in [30.0, 90.0, 120.0, 150.0, 170.0, 180.0] {
+        for seed in 0..10 {
+            let turn = m.turn(200, seed as f64 * 36.0, span, 0.01, seed);
+            let r = fit_ellipse(&points(&turn), &EllipseFitOptions::default());
+            assert!(
+                matches!(r, Err(Error::InsufficientCoverage { .. })),
+                "span {span}, seed {seed}: {r:?}"
+            );
+        }
+    }
+    for span in [240.0, 300.0, 360.0] {
+        let turn = m.turn(200, 10.0, span, 0.01, 1);
+        assert!(fit_ellipse(&points(&turn), &EllipseFitOptions::default()).is_ok());
+    }
+}
+
+#[test]
+fn calibrator_lifecycle() {
+    let m = Model2::new(Vector2::new(3.0, -1.0), 1.2, 0.3, 20.0);
+    let mut cal = EllipseCalibrator::new().with_expected_field(25.0);
+    assert!(!cal.progress().ready);
+    assert!(matches!(cal.solve(), Err(Error::TooFewPoints { .. })));
+    let bad = Mag2Sample {
+        t_s: 0.0,
+        mag: Vector2::new(f64::NAN, 1.0),
+    };
+    assert!(matches!(cal.push(&bad), Err(Error::NonFinite { .. })));
+    for (k, (_, mag)) in m.turn(100, 0.0, 180.0, 0.01, 4).into_iter().enumerate() {
+        cal.push(&Mag2Sample { t_s: k as f64, mag }).unwrap();
+    }
+    assert_eq!(cal.progress().samples, 100);
+    assert!(matches!(
+        cal.solve(),
+        Err(Error::InsufficientCoverage { .. })
+    ));
+    for (k, (_, mag)) in m.turn(100, 180.0, 180.0, 0.01, 5).into_iter().enumerate() {
+        cal.push(&Mag2Sample {
+            t_s: 100.0 + k as f64,
+            mag,
+        })
+        .unwrap();
+    }
+    let p = cal.progress();
+    assert!(p.ready && p.coverage > 0.95, "{p:?}");
+    let sol = cal.solve().unwrap();
+    let ratio = sol.quality.field_ratio_to_expected.unwrap();
+    assert!((ratio - sol.quality.field_magnitude / 25.0).abs() < 1e-12);
+    assert!(sol.quality.coverage > 0.95 && sol.quality.heading_error_bound_deg < 1.0);
+    cal.reset();
+    assert_eq!(cal.progress().samples, 0);
+}
+
+/// `n` Fibonacci-sphere directions of a field `field` seen through `raw = hard + W·h`.
+fn sphere_turn(
+    hard: Vector3<f64>,
+    w: &Matrix3<f64>,
+    field: f64,
+    n: usize,
+    sigma: f64,
+    seed: u64,
+) -> Vec<Vector3<f64>> {
+    let mut rng = SplitMix64::new(seed);
+    let golden = PI * (3.0 - 5.0_f64.sqrt());
+    (0..n)
+        .map(|k| {
+            let z = 1.0 - (2.0 * k as f64 + 1.0) / n as f64;
+            let r = (1.0 - z * z).sqrt();
+            let (s, c) = (golden * k as f64).sin_cos();
+            let h = Vector3::new(r * c, r * s, z) * field;
+            hard + w * h + Vector3::new(rng.normal(sigma), rng.normal(sigma), rng.normal(sigma))
+        })
+        .collect()
+}
+
+/// A symmetric positive-definite soft iron with semi-axis ratios up to `1 + spread`,
+/// oriented by `rot`, unit determinant.
+fn soft3(rot: &Rotation3<f64>, a: f64, b: f64) -> Matrix3<f64> {
+    let d = Matrix3::from_diagonal(&Vector3::new(a, b, 1.0 / (a * b)));
+    rot.matrix() * d * rot.matrix().transpose()
+}
+
+#[test]
+fn ellipsoid_calibrator_lifecycle_and_single_axis_refusal() {
+    let rot = Rotation3::from_euler_angles(0.3, -0.2, 0.7);
+    let w = soft3(&rot, 1.15, 0.9);
+    let hard = Vector3::new(20.0, -35.0, 10.0);
+    let mut cal = EllipsoidCalibrator::new().with_expected_field(50.0);
+    for (k, mag) in sphere_turn(hard, &w, 48.0, 500, 0.5, 2)
+        .into_iter()
+        .enumerate()
+    {
+        cal.push(&Mag3Sample { t_s: k as f64, mag }).unwrap();
+    }
+    assert!(cal.progress().ready);
+    let sol = cal.solve().unwrap();
+    assert!((sol.params.hard_iron - hard).norm() < 0.5);
+    assert!((sol.quality.field_magnitude - 48.0).abs() < 0.5);
+    assert!(sol.quality.field_ratio_to_expected.is_some());
+    // One turn about a single axis: a great circle, refused.
+    let ring: Vec<_> = (0..360)
+        .map(|k| {
+            let a = (k as f64).to_radians();
+            hard + w * Vector3::new(48.0 * a.cos(), 48.0 * a.sin(), 20.0)
+        })
+        .collect();
+    let r = fit_ellipsoid(&ring, &EllipsoidFitOptions::default());
+    assert!(r.is_err(), "{r:?}");
+}
+
+fn any_rotation() -> impl Strategy<Value = Rotation3<f64>> {
+    (-PI..PI, -1.5f64..1.5, -PI..PI).prop_map(|(r, p, y)| Rotation3::from_euler_angles(r, p, y))
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 64, failure_persistence: None, ..ProptestConfig::default() })]
+
+    /// fit(k·R·p + t) = (k·R·b + t, R·S·Rᵀ, k·F) for rotation R, translation t, scale k.
+    #[test]
+    fn ellipse_fit_is_equivariant(
+        cx in -5.0f64..5.0, cy in -5.0f64..5.0, ratio in 1.0f64..1.8, angle in -PI..PI,
+        n in 30usize..300, seed in 0u64..1000,
+        phi in -PI..PI, tx in -100.0f64..100.0, ty in -100.0f64..100.0, log_k in -2.0f64..2.0,
+    ) {
+        let m = Model2::new(Vector2::new(cx, cy), ratio, angle, 2.0);
+        let p = points(&m.turn(n, 0.0, 360.0, 0.02, seed));
+        let (r, t, k) = (rot2(phi), Vector2::new(tx, ty), 10f64.powf(log_k));
+        let q: Vec<_> = p.iter().map(|v| r * v * k + t).collect();
+        let a = fit_ellipse(&p, &EllipseFitOptions::default()).unwrap();
+        let b = fit_ellipse(&q, &EllipseFitOptions::default()).unwrap();
+        let fa = a.quality.field_magnitude;
+        let expect_hard = r * a.params.hard_iron * k + t;
+        prop_assert!((b.params.hard_iron - expect_hard).norm() <= 1e-7 * (k * fa + t.norm()));
+        prop_assert!((b.params.soft_iron - r * a.params.soft_iron * r.transpose()).norm() <= 1e-7);
+        prop_assert!((b.quality.field_magnitude / (k * fa) - 1.0).abs() <= 1e-8);
+        prop_assert!((b.quality.residual_rms_rel - a.quality.residual_rms_rel).abs() <= 1e-8);
+    }
+
+    #[test]
+    fn ellipsoid_fit_is_equivariant(
+        hx in -1.0f64..1.0, hy in -1.0f64..1.0, hz in -1.0f64..1.0,
+        a1 in 0.85f64..1.2, a2 in 0.85f64..1.2, orient in any_rotation(),
+        n in 60usize..400, seed in 0u64..1000,
+        rot in any_rotation(), tx in -100.0f64..100.0, log_k in -2.0f64..2.0,
+    ) {
+        let w = soft3(&orient, a1, a2);
+        let p = sphere_turn(Vector3::new(hx, hy, hz), &w, 1.0, n, 0.01, seed);
+        let (r, t, k) = (rot.matrix(), Vector3::new(tx, -0.5 * tx, 0.3 * tx), 10f64.powf(log_k));
+        let q: Vec<_> = p.iter().map(|v| r * v * k + t).collect();
+        let a = fit_ellipsoid(&p, &EllipsoidFitOptions::default()).unwrap();
+        let b = fit_ellipsoid(&q, &EllipsoidFitOptions::default()).unwrap();
+        let fa = a.quality.field_magnitude;
+        let expect_hard = r * a.params.hard_iron * k + t;
+        prop_assert!((b.params.hard_iron - expect_hard).norm() <= 1e-7 * (k * fa + t.norm()));
+        prop_assert!((b.params.soft_iron - r * a.params.soft_iron * r.transpose()).norm() <= 1e-7);
+        prop_assert!((b.quality.field_magnitude / (k * fa) - 1.0).abs() <= 1e-8);
+    }
+
+    /// Model → calibrator round trip: the errors in hard iron (relative to the field), soft
+    /// iron and field shrink in proportion to the noise, down to rounding when it is zero.
+    #[test]
+    fn ellipse_round_trip_error_shrinks_with_noise(
+        hx in -2.0f64..2.0, hy in -2.0f64..2.0, ratio in 1.0f64..1.6, angle in -PI..PI,
+        field in 0.1f64..100.0, seed in 0u64..1000,
+    ) {
+        let m = Model2::new(Vector2::new(hx, hy) * field, ratio, angle, field);
+        let (truth, f_true) = m.truth();
+        for rel_sigma in [1e-2, 1e-3, 1e-4, 1e-6, 0.0] {
+            let turn = m.turn(180, 7.0, 360.0, rel_sigma * field, seed);
+            let sol = fit_ellipse(&points(&turn), &EllipseFitOptions::default()).unwrap();
+            let tol = rel_sigma + 1e-9;
+            prop_assert!((sol.params.hard_iron - truth.hard_iron).norm() / f_true <= 2.0 * tol,
+                "σ {rel_sigma}: hard {:?} vs {:?}", sol.params.hard_iron, truth.hard_iron);
+            prop_assert!((sol.params.soft_iron - truth.soft_iron).norm() <= 4.0 * tol,
+                "σ {rel_sigma}: soft {} vs {}", sol.params.soft_iron, truth.soft_iron);
+            prop_assert!((sol.quality.field_magnitude / f_true - 1.0).abs() <= 2.0 * tol);
+        }
+    }
+
+    #[test]
+    fn ellipsoid_round_trip_error_shrinks_with_noise(
+        hx in -2.0f64..2.0, hy in -2.0f64..2.0, hz in -2.0f64..2.0,
+        a1 in 0.8f64..1.25, a2 in 0.8f64..1.25, orient in any_rotation(),
+        field in 0.1f64..100.0, seed in 0u64..1000,
+    ) {
+        let w = soft3(&orient, a1, a2);
+        let hard = Vector3::new(hx, hy, hz) * field;
+        let s_true = w.try_inverse().unwrap();
+        let f_true = field * w.determinant().cbrt();
+        for rel_sigma in [1e-2, 1e-3, 1e-4, 1e-6, 0.0] {
+            let p = sphere_turn(hard, &w, field, 300, rel_sigma * field, seed);
+            let sol = fit_ellipsoid(&p, &EllipsoidFitOptions::default()).unwrap();
+            let tol = rel_sigma + 1e-9;
+            prop_assert!((sol.params.hard_iron - hard).norm() / f_true <= 2.0 * tol);
+            prop_assert!((sol.params.soft_iron - s_true / s_true.determinant().cbrt()).norm() <= 4.0 * tol);
+            prop_assert!((sol.quality.field_magnitude / f_true - 1.0).abs() <= 2.0 * tol);
+        }
+    }
+
+    /// Any arc of half a turn or less, any noise up to 3 %, any hard and soft iron: refused.
+    #[test]
+    fn short_arcs_are_always_refused(
+        span in 5.0f64..=180.0, start in 0.0f64..360.0, noise in 0.0f64..0.03,
+        hx in -1.0f64..1.0, ratio in 1.0f64..1.5, angle in -PI..PI, n in 6usize..400, seed in 0u64..1000,
+    ) {
+        let m = Model2::new(Vector2::new(hx, -hx), ratio, angle, 1.0);
+        let mut turn = m.turn(n, start, span, noise, seed);
+        // `turn` stops one step short of the span; include the end point.
+        let mut rng = SplitMix64::new(seed + 1);
+        let end = (start + span).to_radians();
+        turn.push((end, m.raw(end, &mut rng, noise)));
+        let r = fit_ellipse(&points(&turn), &EllipseFitOptions::default());
+        prop_assert!(r.is_err(), "span {span}: {r:?}");
+    }
+
+    /// No input makes the fits or calibrators panic: NaN, infinities, huge and tiny values,
+    /// duplicates, collinear and coplanar points, any count.
+    #[test]
+    fn no_input_panics(
+        raw in proptest::collection::vec(
+            prop_oneof![
+                4 => -1e3f64..1e3,
+                1 => proptest::num::f64::ANY,
+                1 => Just(f64::NAN),
+                1 => Just(0.0),
+                1 => Just(1e300),
+                1 => Just(1e-300),
+            ],
+            0..120,
+        ),
+        mode in 0usize..4,
+    ) {
+        let pts2: Vec<Vector2<f64>> = match mode {
+            // as drawn
+            0 => raw.chunks(2).filter(|c| c.len() == 2).map(|c| Vector2::new(c[0], c[1])).collect(),
+            // collinear
+            1 => raw.iter().map(|&x| Vector2::new(x, 2.0 * x + 1.0)).collect(),
+            // duplicates of a few points
+            2 => raw.iter().map(|&x| Vector2::new((x % 3.0).round(), 1.0)).collect(),
+            _ => raw.iter().map(|&x| Vector2::new(x.sin(), x.cos())).collect(),
+        };
+        let pts3: Vec<Vector3<f64>> = match mode {
+            0 => raw.chunks(3).filter(|c| c.len() == 3).map(|c| Vector3::new(c[0], c[1], c[2])).collect(),
+            1 => raw.iter().map(|&x| Vector3::new(x, x.sin(), 0.5)).collect(),
+            2 => raw.iter().map(|&x| Vector3::new((x % 3.0).round(), 1.0, 2.0)).collect(),
+            _ => raw.iter().map(|&x| Vector3::new(x.sin(), x.cos(), (2.0 * x).sin())).collect(),
+        };
+        for refine in [false, true] {
+            if let Ok(s) = fit_ellipse(&pts2, &EllipseFitOptions { refine, ..Default::default() }) {
+                prop_assert!(s.params.soft_iron.iter().all(|x| x.is_finite()));
+            }
+            if let Ok(s) = fit_ellipsoid(&pts3, &EllipsoidFitOptions { refine, ..Default::default() }) {
+                prop_assert!(s.params.soft_iron.iter().all(|x| x.is_finite()));
+            }
+        }
+        let _ = fit_ellipse_direct(&pts2);
+        let mut c2 = EllipseCalibrator::new();
+        for p in &pts2 {
+            let _ = c2.push(&Mag2Sample { t_s: 0.0, mag: *p });
+        }
+        let _ = c2.progress();
+        let _ = c2.solve();
+        let mut c3 = EllipsoidCalibrator::new();
+        for p in &pts3 {
+            let _ = c3.push(&Mag3Sample { t_s: 0.0, mag: *p });
+        }
+        let _ = c3.progress();
+        let _ = c3.solve();
+        let _ = quality::coverage(&pts2, &Vector2::zeros());
+        let _ = quality::sphere_coverage(&pts3, &Vector3::zeros());
+        let _ = quality::quality_2d(&pts2, &CompassCalibration2d::identity(), 1.0);
+        let _ = TAU;
+    }
+}

@@ -1,0 +1,248 @@
+//! Real recordings (../shared/data, see its README): the least-squares fits on raw
+//! magnetometer data. Each test prints what it measured and skips, with the reason, when
+//! the data are absent.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use nalgebra::{Matrix3, Vector2, Vector3};
+use truenorth_calib::{EllipseFitOptions, EllipsoidFitOptions, fit_ellipse, fit_ellipsoid};
+use truenorth_compass::CompassCalibration3d;
+use truenorth_core::angle_diff;
+
+fn data_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data")
+}
+
+/// Rows of a CSV file (optionally gzipped, read through the system's `gzip`), header
+/// skipped. `None` with a printed reason when it cannot be read.
+fn read_rows(path: &Path) -> Option<Vec<Vec<f64>>> {
+    let text = if path.extension().is_some_and(|e| e == "gz") {
+        match Command::new("gzip").arg("-dc").arg(path).output() {
+            Ok(o) if o.status.success() => String::from_utf8(o.stdout).ok()?,
+            Ok(_) | Err(_) => {
+                println!(
+                    "SKIP: cannot decompress {} (missing file or no `gzip`)",
+                    path.display()
+                );
+                return None;
+            }
+        }
+    } else {
+        match std::fs::read_to_string(path) {
+            Ok(t) => t,
+            Err(e) => {
+                println!("SKIP: cannot read {}: {e}", path.display());
+                return None;
+            }
+        }
+    };
+    let rows: Vec<Vec<f64>> = text
+        .lines()
+        .filter_map(|l| {
+            let cells: Option<Vec<f64>> = l
+                .split(|c: char| c == ',' || c.is_whitespace())
+                .filter(|c| !c.is_empty())
+                .map(|c| c.parse().ok())
+                .collect();
+            cells.filter(|c| !c.is_empty())
+        })
+        .collect();
+    Some(rows)
+}
+
+fn sunsided_mag(recording: &str) -> Option<Vec<Vector3<f64>>> {
+    let p = data_dir()
+        .join("magcal_sunsided_mpu6050_hmc5883l")
+        .join(recording)
+        .join("mag.csv.gz");
+    Some(
+        read_rows(&p)?
+            .iter()
+            .map(|r| Vector3::new(r[1], r[2], r[3]))
+            .collect(),
+    )
+}
+
+/// Standard deviation of the values divided by their mean.
+fn rel_std(v: impl Iterator<Item = f64> + Clone) -> f64 {
+    let n = v.clone().count() as f64;
+    let mean = v.clone().sum::<f64>() / n;
+    let var = v.map(|x| (x - mean).powi(2)).sum::<f64>() / n;
+    var.sqrt() / mean
+}
+
+fn full_sphere_calibration() -> Option<CompassCalibration3d> {
+    let pts = sunsided_mag("full-sphere")?;
+    Some(
+        fit_ellipsoid(&pts, &EllipsoidFitOptions::default())
+            .unwrap()
+            .params,
+    )
+}
+
+#[test]
+fn sunsided_full_sphere_field_constancy() {
+    let Some(pts) = sunsided_mag("full-sphere") else {
+        return;
+    };
+    let before = rel_std(pts.iter().map(|p| p.norm()));
+    let sol = fit_ellipsoid(&pts, &EllipsoidFitOptions::default()).unwrap();
+    let after = rel_std(pts.iter().map(|p| sol.params.correct(p).norm()));
+    println!(
+        "sunsided full-sphere: {} points, |B| relative std raw {:.2} % -> calibrated {:.3} %",
+        pts.len(),
+        100.0 * before,
+        100.0 * after
+    );
+    println!("  hard iron {:?}", sol.params.hard_iron.as_slice());
+    println!("  soft iron {:?}", sol.params.soft_iron);
+    println!("  quality {:?}", sol.quality);
+    assert!(after <= 0.01, "relative std {after}");
+    assert!(before > 0.1);
+}
+
+/// The four single-axis turns with the 2-D fit on the two axes perpendicular to the turn.
+///
+/// There is no heading reference, so each 2-D calibration is checked against the 3-D
+/// calibration of the `full-sphere` recording (same sensor, same session): both map the
+/// readings to angles in the plane of the turn (for the 3-D one, the plane perpendicular to
+/// the turn axis as the calibrated data show it, so the mount's mean tilt drops out), and
+/// the RMS of their difference (less its mean) is printed. A hand-held turn wobbles; the
+/// field here dips ≈ 65°, so for turns about the vertical the in-plane field is only
+/// ≈ 0.21 G against ≈ 0.48 G vertical, and a 1° wobble moves the in-plane reading by
+/// ≈ 2 % of it: those two recordings agree less well for reasons that are not the fit's.
+#[test]
+fn sunsided_single_axis_turns_2d() {
+    let Some(cal3) = full_sphere_calibration() else {
+        return;
+    };
+    // (recording, the two axes perpendicular to the rotation axis, turn axis horizontal?)
+    let cases = [
+        ("rotate-ccw-around-z-pointing-up", 0usize, 1usize, false),
+        ("rotate-ccw-around-x-pointing-up", 1, 2, false),
+        ("rotate-ccw-around-x-pointing-forward", 1, 2, true),
+        ("rotate-ccw-around-y-pointing-left", 0, 2, true),
+    ];
+    for (rec, i, j, horizontal_axis) in cases {
+        let Some(pts3) = sunsided_mag(rec) else {
+            return;
+        };
+        let pts: Vec<_> = pts3.iter().map(|p| Vector2::new(p[i], p[j])).collect();
+        let centroid = pts.iter().sum::<Vector2<f64>>() / pts.len() as f64;
+        let before = rel_std(pts.iter().map(|p| (p - centroid).norm()));
+        let sol = fit_ellipse(&pts, &EllipseFitOptions::default()).unwrap();
+        let after = rel_std(pts.iter().map(|p| sol.params.correct(p).norm()));
+
+        // The turn axis as the 3-D-calibrated data show it: the direction of least spread.
+        let c3: Vec<_> = pts3.iter().map(|p| cal3.correct(p)).collect();
+        let mean = c3.iter().sum::<Vector3<f64>>() / c3.len() as f64;
+        let mut cov = Matrix3::zeros();
+        for v in &c3 {
+            cov += (v - mean) * (v - mean).transpose();
+        }
+        let eig = cov.symmetric_eigen();
+        let mut axis: Vector3<f64> = eig.eigenvectors.column(eig.eigenvalues.imin()).into();
+        if axis[3 - i - j] < 0.0 {
+            axis = -axis;
+        }
+        let tilt_deg = axis[3 - i - j].acos().to_degrees();
+        let ui = (Vector3::ith(i, 1.0) - axis * axis[i]).normalize();
+        let uj = axis.cross(&ui);
+        let uj = if uj[j] < 0.0 { -uj } else { uj };
+        let d: Vec<f64> = c3
+            .iter()
+            .zip(&pts)
+            .map(|(v, p)| {
+                let a = sol.params.correct(p);
+                angle_diff(a.y.atan2(a.x), v.dot(&uj).atan2(v.dot(&ui)))
+            })
+            .collect();
+        let dm = d.iter().sum::<f64>() / d.len() as f64;
+        let rms = (d.iter().map(|x| (x - dm).powi(2)).sum::<f64>() / d.len() as f64).sqrt();
+        println!(
+            "{rec}, axes ({i},{j}): {} points; radius relative std {:.1} % raw (about the centroid) -> {:.2} % calibrated; coverage {:.2}, condition {:.1}, bound {:.2}°; turn axis {:.1}° off the sensor axis; in-plane angle vs the full-sphere 3-D fit: RMS {:.2}°",
+            pts.len(),
+            100.0 * before,
+            100.0 * after,
+            sol.quality.coverage,
+            sol.quality.condition,
+            sol.quality.heading_error_bound_deg,
+            tilt_deg,
+            rms.to_degrees()
+        );
+        assert_eq!(sol.quality.coverage, 1.0);
+        assert!(after < before);
+        if horizontal_axis {
+            assert!(rms.to_degrees() < 1.0, "{rec}: {}", rms.to_degrees());
+        }
+    }
+}
+
+/// The 347-point sample of ellipsoid_fit_python: a small fixture with strong hard iron.
+#[test]
+fn python_sample_fixture() {
+    let p = data_dir().join("magcal_ellipsoid_fit_python_sample/mag_out.txt");
+    let Some(rows) = read_rows(&p) else { return };
+    let pts: Vec<_> = rows
+        .iter()
+        .map(|r| Vector3::new(r[0], r[1], r[2]))
+        .collect();
+    assert_eq!(pts.len(), 347);
+    let sol = fit_ellipsoid(&pts, &EllipsoidFitOptions::default()).unwrap();
+    let before = rel_std(pts.iter().map(|p| p.norm()));
+    let after = rel_std(pts.iter().map(|p| sol.params.correct(p).norm()));
+    let axes = truenorth_calib::fit_ellipsoid_direct(&pts)
+        .unwrap()
+        .semi_axes()
+        .unwrap();
+    println!(
+        "ellipsoid_fit_python sample: |m| relative std {:.1} % -> {:.2} %; centre {:?}; field {:.1} counts; direct-fit semi-axes {:.0?}; {:?}",
+        100.0 * before,
+        100.0 * after,
+        sol.params.hard_iron.as_slice(),
+        sol.quality.field_magnitude,
+        axes,
+        sol.quality
+    );
+    assert!(before > 0.3 && after < 0.03);
+    // The README's general fit puts the centre near (−65, 80, −130) counts.
+    assert!((sol.params.hard_iron - Vector3::new(-64.8, 79.6, -130.1)).norm() < 10.0);
+}
+
+/// CK-Explorer's tumbling log (12,000 samples), an extra real check of the 3-D fit.
+#[test]
+fn ck_explorer_tumble() {
+    let p = data_dir().join("magcal_ck_explorer/acc_mag_log.csv");
+    let Some(rows) = read_rows(&p) else { return };
+    let pts: Vec<_> = rows
+        .iter()
+        .map(|r| Vector3::new(r[3], r[4], r[5]))
+        .collect();
+    let sol = fit_ellipsoid(&pts, &EllipsoidFitOptions::default()).unwrap();
+    let before = rel_std(pts.iter().map(|p| p.norm()));
+    let after = rel_std(pts.iter().map(|p| sol.params.correct(p).norm()));
+    println!(
+        "ck_explorer: {} points, |m| relative std {:.1} % -> {:.2} %; {:?}",
+        pts.len(),
+        100.0 * before,
+        100.0 * after,
+        sol.quality
+    );
+    assert!(after < before / 10.0);
+}
+
+/// Recordings that cannot support a 3-D calibration are refused with a reason.
+#[test]
+fn sunsided_3d_refusals() {
+    for rec in [
+        "rotate-ccw-around-z-pointing-up",
+        "pan-along-z-pointing-up",
+        "unmoved-with-x-pointing-forward",
+    ] {
+        let Some(pts) = sunsided_mag(rec) else { return };
+        let r = fit_ellipsoid(&pts, &EllipsoidFitOptions::default());
+        println!("3-D fit on {rec}: {:?}", r.as_ref().map(|s| s.quality));
+        assert!(r.is_err());
+    }
+}
