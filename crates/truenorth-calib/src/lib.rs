@@ -49,6 +49,7 @@
 
 extern crate alloc;
 
+pub mod extrema;
 pub mod quality;
 
 mod ellipse_fit;
@@ -57,10 +58,27 @@ mod linalg;
 mod lm;
 mod normalise;
 
+// Seed calibrators (turn, merit circle, binned ellipse) and their helpers.
+mod binned_ellipse;
+mod circumcentre;
+mod direction_slots;
+mod merit_circle;
+mod seed_quality;
+mod turn;
+
 pub use ellipse_fit::{
     Ellipse, EllipseCalibrator, EllipseFitOptions, MIN_POINTS_2D, fit_ellipse, fit_ellipse_direct,
 };
 pub use ellipsoid_fit::{
     Ellipsoid, EllipsoidCalibrator, EllipsoidFitOptions, MIN_POINTS_3D, fit_ellipsoid,
     fit_ellipsoid_direct,
+};
+pub use turn::{
+    MIN_TURN_SAMPLES, TurnCompassCalibrator, TurnConfig, TurnEllipse, TurnExtrema, TurnTag,
+};
+pub use circumcentre::{Circumcircle, circumcircle};
+pub use merit_circle::{MeritCircleCalibrator, MeritCircleConfig, MeritCircleState, RING};
+pub use binned_ellipse::{
+    BinState, BinnedEllipseCalibrator, BinnedEllipseConfig, MAX_BINS, MAX_INIT_SAMPLES,
+    ellipse_parameters,
 };

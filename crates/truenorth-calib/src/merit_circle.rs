@@ -1,0 +1,424 @@
+//! Auto-calibrating compass with a figure of merit (METHODS.md §C, seed US 5,297,063).
+//!
+//! The seed stores heading data points taken after the heading has changed (claim 1 step d),
+//! computes the centre of the circle through three of them (e), adds it to a running sum of
+//! centres and computes their mean-square error (f, g), computes a figure of merit for the new
+//! centre's accuracy (h), and moves the centre estimate towards the new centre by that figure
+//! of merit (i). Heading is the arctangent of the centred reading (j–l).
+//!
+//! ## What "the heading has changed" means here
+//! A reading becomes a *data point* when, compared with the previous data point, (1) it has
+//! moved by more than [`MeritCircleConfig::noise_multiple`] times the mean sample-to-sample
+//! step (so noise on a stationary compass never makes data points), and (2) once a centre
+//! estimate exists, its direction about that centre has turned by at least
+//! [`MeritCircleConfig::min_turn_rad`]; before then, it has moved by at least
+//! [`MeritCircleConfig::spread_fraction`] of the spread of the readings so far.
+//! The last [`RING`] data points are kept; each new one forms a triple with the two of them
+//! that give the best-conditioned centre.
+//!
+//! ## The figure of merit, exactly
+//! For the new circumcentre `c` (from the triple), with `ĉ` the current estimate:
+//!
+//! 1. **Geometry** — `γ`, the triple's noise amplification (see
+//!    [`circumcircle`](crate::circumcircle)): the centre's per-axis error per unit of point
+//!    noise. `w_geom = (2/3)/γ²`, which is 1 for the best possible triple (equilateral) and
+//!    falls to 0 as the points close up or line up. Triples with `γ >`
+//!    [`MeritCircleConfig::max_amplification`] are not used at all.
+//! 2. **MSE** — the running mean `c̄` and mean-square error `MSE = (1/n) Σ|cₖ − c̄|²` of all
+//!    `n` centres so far (Welford's update), the seed's steps (f)–(g). With `d = |c − ĉ|`,
+//!    `w_agree = MSE / (MSE + d²)`: a centre as far from the estimate as the centres
+//!    typically scatter gets ½, an outlier gets little. (`w_agree = 1` while `n < 3` or
+//!    `MSE = 0`.)
+//! 3. **Weight and merit** — `w = w_geom · w_agree`. With `W` the weight accumulated so far
+//!    (capped at [`MeritCircleConfig::weight_memory`] so the estimate keeps tracking slow
+//!    changes), the figure of merit is `m = w / (W + w)` ∈ [0, 1], and
+//!    `ĉ ← ĉ + m (c − ĉ)`, `W ← min(W + w, weight_memory)`. Until the cap is reached this is
+//!    exactly the weighted mean of all centres with weights `w`, i.e. an inverse-variance
+//!    weighting by geometry, de-weighted where the centre disagrees with the scatter seen so
+//!    far. The first centre has `m = 1`.
+//!
+//! The method fits a circle: it removes hard iron but not soft iron. The quality report's
+//! heading-error bound includes the two-cycle error that leaves.
+
+use core::f64::consts::PI;
+
+use nalgebra::Vector2;
+use serde::{Deserialize, Serialize};
+use truenorth_compass::CompassCalibration2d;
+use truenorth_core::{
+    Calibrator, Error, Mag2Sample, Progress, Result, Solution, angle_diff, check_finite2,
+};
+
+use crate::circumcentre::{BEST_AMPLIFICATION_SQ, Circumcircle, circumcircle};
+use crate::direction_slots::{DirectionSlots, SLOTS};
+use crate::quality::{MIN_ARC_DEG, coverage, mean_corrected_norm_2d, require_arc};
+use crate::seed_quality::seed_assessment;
+
+#[allow(unused_imports)]
+use truenorth_core::Float as _;
+
+/// Data points kept to form triples.
+pub const RING: usize = 8;
+
+/// Options of the [`MeritCircleCalibrator`] (defaults in brackets).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct MeritCircleConfig {
+    /// Turn about the current centre between data points, radians (30°).
+    pub min_turn_rad: f64,
+    /// A data point must be this many mean sample steps from the previous one (8).
+    pub noise_multiple: f64,
+    /// Before a centre exists, a data point must be this share of the spread of the readings
+    /// from the previous one (0.25).
+    pub spread_fraction: f64,
+    /// Samples seen before the first data point, to estimate the step size (8).
+    pub warmup_samples: usize,
+    /// Triples whose centre amplifies point noise by more than this are skipped (10).
+    pub max_amplification: f64,
+    /// Cap on the accumulated weight, in best-triple units (200).
+    pub weight_memory: f64,
+    /// Centres needed before solving (3).
+    pub min_centres: usize,
+    /// Shortest arc of headings accepted, degrees ([`MIN_ARC_DEG`]).
+    pub min_arc_deg: f64,
+}
+
+impl Default for MeritCircleConfig {
+    fn default() -> Self {
+        Self {
+            min_turn_rad: 30f64.to_radians(),
+            noise_multiple: 8.0,
+            spread_fraction: 0.25,
+            warmup_samples: 8,
+            max_amplification: 10.0,
+            weight_memory: 200.0,
+            min_centres: 3,
+            min_arc_deg: MIN_ARC_DEG,
+        }
+    }
+}
+
+impl MeritCircleConfig {
+    /// Checks every option's range.
+    pub fn validate(&self) -> Result<()> {
+        let check = |what, value: f64, min: f64, max: f64| {
+            if value.is_finite() && value >= min && value <= max {
+                Ok(())
+            } else {
+                Err(Error::OutOfRange {
+                    what,
+                    value,
+                    min,
+                    max,
+                })
+            }
+        };
+        check("merit circle min_turn_rad", self.min_turn_rad, 0.0, PI)?;
+        check("merit circle noise_multiple", self.noise_multiple, 0.0, 1e6)?;
+        check(
+            "merit circle spread_fraction",
+            self.spread_fraction,
+            0.0,
+            2.0,
+        )?;
+        check(
+            "merit circle max_amplification",
+            self.max_amplification,
+            0.82,
+            1e9,
+        )?;
+        check(
+            "merit circle weight_memory",
+            self.weight_memory,
+            1e-9,
+            f64::MAX,
+        )?;
+        check(
+            "merit circle min_centres",
+            self.min_centres as f64,
+            1.0,
+            1e9,
+        )?;
+        check("merit circle min_arc_deg", self.min_arc_deg, 0.0, 360.0)?;
+        Ok(())
+    }
+}
+
+/// Where the merit-circle estimate stands.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct MeritCircleState {
+    /// The current centre estimate ĉ, if any.
+    pub centre: Option<Vector2<f64>>,
+    /// Heading data points taken.
+    pub data_points: usize,
+    /// Circumcentres used.
+    pub centres: usize,
+    /// Triples skipped as degenerate (γ too large or collinear).
+    pub degenerate_triples: usize,
+    /// Mean of all circumcentres (the seed's running sum divided by the count).
+    pub centre_mean: Vector2<f64>,
+    /// Mean-square error of the circumcentres about their mean.
+    pub centre_mse: f64,
+    /// Figure of merit of the last centre.
+    pub last_merit: f64,
+    /// Accumulated weight W.
+    pub weight: f64,
+}
+
+/// The merit-circle calibrator (US 5,297,063). Push allocates nothing.
+///
+/// ```
+/// use nalgebra::{Matrix2, Vector2};
+/// use truenorth_calib::MeritCircleCalibrator;
+/// use truenorth_compass::{HeadingTruth, MagnetometerModel2d};
+/// use truenorth_core::{Calibrator, Mag2Sample, SensorModel};
+///
+/// let model = MagnetometerModel2d::new(Vector2::new(8.0, -3.0), Matrix2::identity(), 0.0)?;
+/// let mut cal = MeritCircleCalibrator::new();
+/// for i in 0..720 {
+///     let truth = HeadingTruth { heading_rad: (i as f64).to_radians(), horizontal_field: 20.0 };
+///     cal.push(&Mag2Sample { t_s: i as f64 * 0.1, mag: model.ideal(&truth) })?;
+/// }
+/// let sol = cal.solve()?;
+/// assert!((sol.params.hard_iron - Vector2::new(8.0, -3.0)).norm() < 1e-6);
+/// # Ok::<(), truenorth_core::Error>(())
+/// ```
+#[derive(Debug, Clone)]
+pub struct MeritCircleCalibrator {
+    config: MeritCircleConfig,
+    samples: usize,
+    prev: Option<Vector2<f64>>,
+    step_sum: f64,
+    lo: Vector2<f64>,
+    hi: Vector2<f64>,
+    ring: [Vector2<f64>; RING],
+    ring_len: usize,
+    ring_next: usize,
+    last_point: Option<Vector2<f64>>,
+    state: MeritCircleState,
+    centre_m2: f64,
+    slots: DirectionSlots,
+}
+
+impl Default for MeritCircleCalibrator {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl MeritCircleCalibrator {
+    /// A calibrator with the default options.
+    pub fn new() -> Self {
+        Self::build(MeritCircleConfig::default())
+    }
+
+    /// A calibrator with the given options (validated).
+    pub fn with_config(config: MeritCircleConfig) -> Result<Self> {
+        config.validate()?;
+        Ok(Self::build(config))
+    }
+
+    fn build(config: MeritCircleConfig) -> Self {
+        Self {
+            config,
+            samples: 0,
+            prev: None,
+            step_sum: 0.0,
+            lo: Vector2::repeat(f64::INFINITY),
+            hi: Vector2::repeat(f64::NEG_INFINITY),
+            ring: [Vector2::zeros(); RING],
+            ring_len: 0,
+            ring_next: 0,
+            last_point: None,
+            state: MeritCircleState {
+                centre: None,
+                data_points: 0,
+                centres: 0,
+                degenerate_triples: 0,
+                centre_mean: Vector2::zeros(),
+                centre_mse: 0.0,
+                last_merit: 0.0,
+                weight: 0.0,
+            },
+            centre_m2: 0.0,
+            slots: DirectionSlots::new(),
+        }
+    }
+
+    /// The options in force.
+    pub fn config(&self) -> &MeritCircleConfig {
+        &self.config
+    }
+
+    /// The estimate and its statistics.
+    pub fn state(&self) -> &MeritCircleState {
+        &self.state
+    }
+
+    /// Whether `p` counts as a new heading data point (see the module documentation).
+    fn heading_changed(&self, p: &Vector2<f64>) -> bool {
+        let Some(last) = self.last_point else {
+            return true;
+        };
+        let chord = (p - last).norm();
+        let mean_step = self.step_sum / (self.samples.max(2) - 1) as f64;
+        if chord <= self.config.noise_multiple * mean_step {
+            return false;
+        }
+        match self.state.centre {
+            Some(c) => {
+                let (a, b) = (p - c, last - c);
+                angle_diff(a.y.atan2(a.x), b.y.atan2(b.x)).abs() >= self.config.min_turn_rad
+            }
+            None => {
+                let spread = (self.hi - self.lo).max();
+                chord >= self.config.spread_fraction * spread
+            }
+        }
+    }
+
+    /// The best-conditioned triple of `p` with two kept data points.
+    fn best_triple(&self, p: &Vector2<f64>) -> Option<Circumcircle> {
+        let mut best: Option<Circumcircle> = None;
+        for i in 0..self.ring_len {
+            for j in i + 1..self.ring_len {
+                if let Some(c) = circumcircle(p, &self.ring[i], &self.ring[j])
+                    && best.is_none_or(|b| c.amplification < b.amplification)
+                {
+                    best = Some(c);
+                }
+            }
+        }
+        best
+    }
+
+    /// Steps (f)–(i) of the seed for a new circumcentre.
+    fn update(&mut self, cc: &Circumcircle) {
+        let s = &mut self.state;
+        let c = cc.centre;
+        s.centres += 1;
+        let n = s.centres as f64;
+        let delta = c - s.centre_mean;
+        s.centre_mean += delta / n;
+        self.centre_m2 += delta.dot(&(c - s.centre_mean));
+        s.centre_mse = self.centre_m2 / n;
+        let w_geom = BEST_AMPLIFICATION_SQ / (cc.amplification * cc.amplification);
+        let (w, estimate) = match s.centre {
+            None => (w_geom, c),
+            Some(e) => {
+                let d2 = (c - e).norm_squared();
+                let w_agree = if s.centres >= 3 && s.centre_mse > 0.0 {
+                    s.centre_mse / (s.centre_mse + d2)
+                } else {
+                    1.0
+                };
+                let w = w_geom * w_agree;
+                let merit = if s.weight + w > 0.0 {
+                    w / (s.weight + w)
+                } else {
+                    0.0
+                };
+                s.last_merit = merit;
+                (w, e + (c - e) * merit)
+            }
+        };
+        if s.centre.is_none() {
+            s.last_merit = 1.0;
+        }
+        s.centre = Some(estimate);
+        s.weight = (s.weight + w).min(self.config.weight_memory);
+    }
+}
+
+impl Calibrator for MeritCircleCalibrator {
+    type Sample = Mag2Sample;
+    type Params = CompassCalibration2d;
+
+    fn push(&mut self, sample: &Mag2Sample) -> Result<()> {
+        let p = sample.mag;
+        check_finite2("magnetometer reading", &p)?;
+        if let Some(prev) = self.prev {
+            self.step_sum += (p - prev).norm();
+        }
+        self.prev = Some(p);
+        self.samples += 1;
+        self.lo = self.lo.inf(&p);
+        self.hi = self.hi.sup(&p);
+        let slot_centre = self.state.centre.unwrap_or((self.lo + self.hi) * 0.5);
+        self.slots.push(&p, &slot_centre);
+        if self.samples <= self.config.warmup_samples || !self.heading_changed(&p) {
+            return Ok(());
+        }
+        // A new heading data point (step d).
+        self.state.data_points += 1;
+        self.last_point = Some(p);
+        if self.ring_len >= 2 {
+            match self.best_triple(&p) {
+                Some(cc) if cc.amplification <= self.config.max_amplification => self.update(&cc),
+                _ => self.state.degenerate_triples += 1,
+            }
+        }
+        self.ring[self.ring_next] = p;
+        self.ring_next = (self.ring_next + 1) % RING;
+        self.ring_len = (self.ring_len + 1).min(RING);
+        Ok(())
+    }
+
+    fn progress(&self) -> Progress {
+        let mut buf = [Vector2::zeros(); SLOTS];
+        let n = self.slots.collect(&mut buf);
+        let cov = self
+            .state
+            .centre
+            .map(|c| coverage(&buf[..n], &c))
+            .unwrap_or(crate::quality::Coverage {
+                fraction: 0.0,
+                largest_gap_rad: core::f64::consts::TAU,
+            });
+        Progress {
+            samples: self.samples,
+            coverage: cov.fraction,
+            ready: self.state.centres >= self.config.min_centres
+                && cov.span_rad().to_degrees() >= self.config.min_arc_deg,
+        }
+    }
+
+    fn solve(&mut self) -> Result<Solution<CompassCalibration2d>> {
+        let s = &self.state;
+        let centre = match s.centre {
+            Some(c) if s.centres >= self.config.min_centres => c,
+            _ if s.data_points >= 3 && s.degenerate_triples > 0 && s.centres == 0 => {
+                return Err(Error::Degenerate {
+                    reason: "every triple of heading data points was (nearly) collinear or bunched; turn the compass through a wider arc",
+                });
+            }
+            _ => {
+                return Err(Error::TooFewPoints {
+                    got: s.data_points,
+                    need: self.config.min_centres + 2,
+                });
+            }
+        };
+        let cal = CompassCalibration2d {
+            hard_iron: centre,
+            ..CompassCalibration2d::identity()
+        };
+        let mut buf = [Vector2::zeros(); SLOTS];
+        let n = self.slots.collect(&mut buf);
+        let field = mean_corrected_norm_2d(&buf[..n], &cal);
+        if !(field > 0.0 && field.is_finite()) {
+            return Err(Error::Degenerate {
+                reason: "the readings coincide with the fitted centre; the compass did not turn",
+            });
+        }
+        let a = seed_assessment(&buf[..n], &cal, field, self.samples);
+        require_arc(&a.coverage, self.config.min_arc_deg)?;
+        Ok(Solution {
+            params: cal,
+            quality: a.quality,
+        })
+    }
+
+    fn reset(&mut self) {
+        *self = Self::build(self.config);
+    }
+}

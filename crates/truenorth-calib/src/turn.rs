@@ -1,0 +1,430 @@
+//! The compass half of the one-turn calibration (METHODS.md §A.4–5, seed EP 0640207
+//! claims 4, 5 and 10).
+//!
+//! The vehicle turns through at least one full revolution. Each magnetometer axis passes a
+//! maximum and a minimum once per revolution; the centre of the locus is
+//! `X₀ = (X_max + X_min)/2`, `Y₀ = (Y_max + Y_min)/2` (claim 4), its radii
+//! `a = (X_max − X_min)/2`, `b = (Y_max − Y_min)/2` (claim 5), and the heading is the angle of
+//! the line from the centre to the reading with the axes scaled by `a` and `b` (claim 10).
+//!
+//! The extrema come from [`crate::extrema`], which the gyro half (conversion constant `k`
+//! from the relative heading at the extrema, §A.2–3) reuses: [`TurnExtrema`] is generic over
+//! the tag recorded with each extremum, and pairs each maximum with the minimum next to it in
+//! time — within one revolution, never across revolutions (§A.3) — averaging over all such
+//! pairs when the turn goes on for more than one revolution.
+//!
+//! Refusals: a turn of less than 360° ([`Error::IncompleteTurn`]); an axis whose maximum or
+//! minimum lies at the start or end of the record, where the true extremum may be outside it
+//! ([`Error::Degenerate`]); a turn that reverses direction.
+//!
+//! The method scales the two axes but cannot remove a *rotated* soft iron (an ellipse whose
+//! axes are not the sensor's): the quality report's heading-error bound includes what that
+//! leaves (the two-cycle part of the residual, added to the bound).
+
+use core::f64::consts::TAU;
+
+use nalgebra::{Matrix2, Vector2};
+use serde::{Deserialize, Serialize};
+use truenorth_compass::CompassCalibration2d;
+use truenorth_core::{
+    Calibrator, Error, Mag2Sample, Progress, Result, Solution, TimeStep, angle_diff, check_finite,
+    check_finite2,
+};
+
+use crate::direction_slots::{DirectionSlots, SLOTS};
+use crate::extrema::{ExtremaConfig, ExtremumKind, ExtremumTracker, HalfTurnPair, MAX_EXTREMA};
+use crate::quality::{MIN_ARC_DEG, require_arc};
+use crate::seed_quality::seed_assessment;
+
+#[allow(unused_imports)]
+use truenorth_core::Float as _;
+
+/// Fewest samples a turn calibration accepts.
+pub const MIN_TURN_SAMPLES: usize = 16;
+
+/// A step of the unwrapped turn that goes backwards by more than this (radians, 20°) means the
+/// turn reversed: the extrema would then not be half a revolution apart.
+const REVERSAL_RAD: f64 = 0.35;
+
+/// Centre, radii and the number of pairs behind them for X and Y.
+type PairAverages = (Vector2<f64>, Vector2<f64>, (usize, usize));
+
+/// A sample's raw reading and the caller's tag, recorded with each extremum.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct TurnTag<T> {
+    /// The raw (X, Y) reading at that sample.
+    pub point: Vector2<f64>,
+    /// The caller's tag (the compass half uses the timestamp; the gyro half the relative
+    /// heading G).
+    pub tag: T,
+}
+
+/// Centre, radii and turn angle found from the extrema of a turn.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct TurnEllipse {
+    /// `(X₀, Y₀)`, raw unit (claim 4).
+    pub centre: Vector2<f64>,
+    /// `(a, b)`, raw unit (claim 5).
+    pub radii: Vector2<f64>,
+    /// The angle turned over the record, radians, signed: positive for a right turn
+    /// (heading increasing).
+    pub turned_rad: f64,
+    /// Half-turn pairs averaged for X and for Y.
+    pub pairs: (usize, usize),
+}
+
+impl TurnEllipse {
+    /// The compass calibration of claim 10: `hard_iron = (X₀, Y₀)`,
+    /// `soft_iron = diag(R/a, R/b)` with `R = (a + b)/2`, so the corrected locus is a circle of
+    /// radius `R` (the field in the input unit) and its heading is
+    /// `atan2(−(Y − Y₀)/b, (X − X₀)/a)`.
+    pub fn calibration(&self) -> CompassCalibration2d {
+        let r = self.field();
+        CompassCalibration2d {
+            hard_iron: self.centre,
+            soft_iron: Matrix2::new(r / self.radii.x, 0.0, 0.0, r / self.radii.y),
+        }
+    }
+
+    /// `(a + b)/2`: the field in the input unit.
+    pub fn field(&self) -> f64 {
+        0.5 * (self.radii.x + self.radii.y)
+    }
+}
+
+/// The two axes' extremum trackers of one turn, plus the first and last reading: everything
+/// both halves of the turn calibration need, in constant memory.
+#[derive(Debug, Clone)]
+pub struct TurnExtrema<T: Copy> {
+    x: ExtremumTracker<TurnTag<T>>,
+    y: ExtremumTracker<TurnTag<T>>,
+    first: Option<Vector2<f64>>,
+    last: Option<Vector2<f64>>,
+    samples: usize,
+}
+
+impl<T: Copy> TurnExtrema<T> {
+    /// Empty trackers with the given detector thresholds.
+    pub fn new(config: ExtremaConfig) -> Result<Self> {
+        config.validate()?;
+        Ok(Self::with_valid_config(config))
+    }
+
+    fn with_valid_config(config: ExtremaConfig) -> Self {
+        Self {
+            x: ExtremumTracker::new(config),
+            y: ExtremumTracker::new(config),
+            first: None,
+            last: None,
+            samples: 0,
+        }
+    }
+
+    /// Forgets everything.
+    pub fn reset(&mut self) {
+        self.x.reset();
+        self.y.reset();
+        self.first = None;
+        self.last = None;
+        self.samples = 0;
+    }
+
+    /// Feeds one finite reading with its tag; returns its sample index.
+    /// Non-finite readings are refused with a typed error and not counted.
+    pub fn push(&mut self, point: &Vector2<f64>, tag: T) -> Result<usize> {
+        check_finite2("magnetometer reading", point)?;
+        let i = self.samples;
+        let t = TurnTag { point: *point, tag };
+        self.x.push(i, point.x, t);
+        self.y.push(i, point.y, t);
+        if self.first.is_none() {
+            self.first = Some(*point);
+        }
+        self.last = Some(*point);
+        self.samples += 1;
+        Ok(i)
+    }
+
+    /// Samples accepted.
+    pub fn samples(&self) -> usize {
+        self.samples
+    }
+
+    /// The X axis tracker (its extrema carry [`TurnTag`]s).
+    pub fn x(&self) -> &ExtremumTracker<TurnTag<T>> {
+        &self.x
+    }
+
+    /// The Y axis tracker.
+    pub fn y(&self) -> &ExtremumTracker<TurnTag<T>> {
+        &self.y
+    }
+
+    /// X maxima paired with the X minima next to them (same revolution).
+    pub fn x_pairs(&self) -> impl Iterator<Item = HalfTurnPair<TurnTag<T>>> + '_ {
+        self.x.half_turn_pairs()
+    }
+
+    /// Y maxima paired with the Y minima next to them (same revolution).
+    pub fn y_pairs(&self) -> impl Iterator<Item = HalfTurnPair<TurnTag<T>>> + '_ {
+        self.y.half_turn_pairs()
+    }
+
+    /// Midpoint of the running ranges: the centre estimate before the extrema are known.
+    pub fn provisional_centre(&self) -> Vector2<f64> {
+        let (x0, x1) = self.x.range();
+        let (y0, y1) = self.y.range();
+        if self.samples == 0 {
+            Vector2::zeros()
+        } else {
+            Vector2::new(0.5 * (x0 + x1), 0.5 * (y0 + y1))
+        }
+    }
+
+    /// Centre, radii and pair counts averaged over the half-turn pairs of each axis, if both
+    /// axes have one.
+    fn averaged_pairs(&self) -> Option<PairAverages> {
+        let avg = |it: &mut dyn Iterator<Item = HalfTurnPair<TurnTag<T>>>| {
+            let (mut c, mut r, mut n) = (0.0, 0.0, 0usize);
+            for p in it {
+                c += p.centre();
+                r += p.radius();
+                n += 1;
+            }
+            (n > 0).then(|| (c / n as f64, r / n as f64, n))
+        };
+        let (cx, rx, nx) = avg(&mut self.x.half_turn_pairs())?;
+        let (cy, ry, ny) = avg(&mut self.y.half_turn_pairs())?;
+        Some((Vector2::new(cx, cy), Vector2::new(rx, ry), (nx, ny)))
+    }
+
+    /// The signed angle turned (positive = right turn), measured about `centre` with the axes
+    /// scaled by `radii`, by unwrapping the sequence first reading → extrema of both axes in
+    /// time order → last reading (consecutive ones are about a quarter turn apart, so the
+    /// unwrapping is unambiguous). Constant memory.
+    fn turned_rad(&self, centre: &Vector2<f64>, radii: &Vector2<f64>) -> Result<f64> {
+        let (Some(first), Some(last)) = (self.first, self.last) else {
+            return Ok(0.0);
+        };
+        if self.x.confirmed_count() > MAX_EXTREMA || self.y.confirmed_count() > MAX_EXTREMA {
+            // Older extrema were dropped; at least this many half turns happened.
+            let half_turns = self.x.confirmed_count().min(self.y.confirmed_count());
+            return Ok(half_turns as f64 * core::f64::consts::PI);
+        }
+        // Phase in the raw plane (counter-clockwise); heading is its negative.
+        let phase =
+            |p: &Vector2<f64>| ((p.y - centre.y) / radii.y).atan2((p.x - centre.x) / radii.x);
+        let mut xs = self.x.extrema().peekable();
+        let mut ys = self.y.extrema().peekable();
+        let mut prev = phase(&first);
+        let (mut total, mut forward, mut backward) = (0.0f64, 0.0f64, 0.0f64);
+        let mut step_to = |p: &Vector2<f64>, total: &mut f64| {
+            let a = phase(p);
+            let s = angle_diff(a, prev);
+            prev = a;
+            *total += s;
+            forward = forward.max(s);
+            backward = backward.min(s);
+        };
+        loop {
+            let next = match (xs.peek(), ys.peek()) {
+                (Some(a), Some(b)) if a.index <= b.index => xs.next(),
+                (Some(_), Some(_)) => ys.next(),
+                (Some(_), None) => xs.next(),
+                (None, Some(_)) => ys.next(),
+                (None, None) => break,
+            };
+            if let Some(e) = next {
+                step_to(&e.tag.point, &mut total);
+            }
+        }
+        step_to(&last, &mut total);
+        if forward > REVERSAL_RAD && backward < -REVERSAL_RAD {
+            return Err(Error::Degenerate {
+                reason: "the turn changed direction; record one steady turn (at least 360° one way)",
+            });
+        }
+        Ok(-total)
+    }
+
+    /// Centre, radii and turn angle, or why the record does not support them: too few samples,
+    /// a turn under 360°, an extremum at the edge of the record, a reversed turn, or readings
+    /// that do not change.
+    pub fn solve(&self) -> Result<TurnEllipse> {
+        if self.samples < MIN_TURN_SAMPLES {
+            return Err(Error::TooFewPoints {
+                got: self.samples,
+                need: MIN_TURN_SAMPLES,
+            });
+        }
+        let paired = self.averaged_pairs();
+        let (centre, radii, pairs) = paired.unwrap_or_else(|| {
+            let (x0, x1) = self.x.range();
+            let (y0, y1) = self.y.range();
+            (
+                self.provisional_centre(),
+                Vector2::new(0.5 * (x1 - x0), 0.5 * (y1 - y0)),
+                (0, 0),
+            )
+        });
+        if !(radii.x > 0.0 && radii.y > 0.0 && radii.x.is_finite() && radii.y.is_finite()) {
+            return Err(Error::Degenerate {
+                reason: "the magnetometer readings do not change on one axis; the compass did not turn, or an axis is dead",
+            });
+        }
+        let turned_rad = self.turned_rad(&centre, &radii)?;
+        let need = TAU * (1.0 - 1e-9);
+        if turned_rad.abs() < need {
+            return Err(Error::IncompleteTurn {
+                turned_deg: turned_rad.abs().to_degrees(),
+                need_deg: 360.0,
+            });
+        }
+        let complete =
+            |t: &ExtremumTracker<TurnTag<T>>| t.has(ExtremumKind::Max) && t.has(ExtremumKind::Min);
+        if paired.is_none() || !complete(&self.x) || !complete(&self.y) {
+            return Err(Error::Degenerate {
+                reason: "a magnetometer maximum or minimum lies at the start or end of the record, where the true extremum may be outside it; turn on for another quarter turn",
+            });
+        }
+        Ok(TurnEllipse {
+            centre,
+            radii,
+            turned_rad,
+            pairs,
+        })
+    }
+}
+
+/// Options of the [`TurnCompassCalibrator`].
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct TurnConfig {
+    /// Extremum detector thresholds.
+    pub extrema: ExtremaConfig,
+    /// Shortest arc of calibrated headings accepted, degrees (a full turn always passes).
+    pub min_arc_deg: f64,
+}
+
+impl Default for TurnConfig {
+    fn default() -> Self {
+        Self {
+            extrema: ExtremaConfig::default(),
+            min_arc_deg: MIN_ARC_DEG,
+        }
+    }
+}
+
+/// The compass half of the turn calibrator: centre and radii from the extrema of one or more
+/// full turns (EP 0640207 claims 4, 5, 10). Push allocates nothing.
+///
+/// ```
+/// use nalgebra::{Matrix2, Vector2};
+/// use truenorth_calib::TurnCompassCalibrator;
+/// use truenorth_compass::{HeadingTruth, MagnetometerModel2d};
+/// use truenorth_core::{Calibrator, Mag2Sample, SensorModel};
+///
+/// let model = MagnetometerModel2d::new(Vector2::new(8.0, -3.0), Matrix2::new(1.2, 0.0, 0.0, 0.9), 0.0)?;
+/// let mut cal = TurnCompassCalibrator::new();
+/// for i in 0..450 { // 450° of turn, 1° per sample, starting at heading 10°
+///     let truth = HeadingTruth { heading_rad: (10.0 + i as f64).to_radians(), horizontal_field: 20.0 };
+///     cal.push(&Mag2Sample { t_s: i as f64 * 0.1, mag: model.ideal(&truth) })?;
+/// }
+/// let sol = cal.solve()?;
+/// assert!((sol.params.hard_iron - Vector2::new(8.0, -3.0)).norm() < 0.1);
+/// # Ok::<(), truenorth_core::Error>(())
+/// ```
+#[derive(Debug, Clone)]
+pub struct TurnCompassCalibrator {
+    config: TurnConfig,
+    extrema: TurnExtrema<f64>,
+    slots: DirectionSlots,
+    clock: TimeStep,
+}
+
+impl Default for TurnCompassCalibrator {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl TurnCompassCalibrator {
+    /// A calibrator with the default options.
+    pub fn new() -> Self {
+        Self {
+            config: TurnConfig::default(),
+            extrema: TurnExtrema::with_valid_config(ExtremaConfig::default()),
+            slots: DirectionSlots::new(),
+            clock: TimeStep::new(),
+        }
+    }
+
+    /// A calibrator with the given options (validated).
+    pub fn with_config(config: TurnConfig) -> Result<Self> {
+        check_finite("min_arc_deg", config.min_arc_deg)?;
+        Ok(Self {
+            config,
+            extrema: TurnExtrema::new(config.extrema)?,
+            slots: DirectionSlots::new(),
+            clock: TimeStep::new(),
+        })
+    }
+
+    /// The extrema found so far (tagged with timestamps).
+    pub fn extrema(&self) -> &TurnExtrema<f64> {
+        &self.extrema
+    }
+}
+
+impl Calibrator for TurnCompassCalibrator {
+    type Sample = Mag2Sample;
+    type Params = CompassCalibration2d;
+
+    /// Refuses non-finite readings and timestamps that do not increase (the extrema must be
+    /// found in time order).
+    fn push(&mut self, sample: &Mag2Sample) -> Result<()> {
+        check_finite2("magnetometer reading", &sample.mag)?;
+        self.clock.dt_s(sample.t_s)?;
+        self.extrema.push(&sample.mag, sample.t_s)?;
+        let c = self.extrema.provisional_centre();
+        self.slots.push(&sample.mag, &c);
+        Ok(())
+    }
+
+    fn progress(&self) -> Progress {
+        let samples = self.extrema.samples();
+        let (x0, x1) = self.extrema.x.range();
+        let (y0, y1) = self.extrema.y.range();
+        let radii = Vector2::new(0.5 * (x1 - x0), 0.5 * (y1 - y0));
+        let turned = if samples > 1 && radii.x > 0.0 && radii.y > 0.0 {
+            self.extrema
+                .turned_rad(&self.extrema.provisional_centre(), &radii)
+                .unwrap_or(0.0)
+        } else {
+            0.0
+        };
+        Progress {
+            samples,
+            coverage: (turned.abs() / TAU).min(1.0),
+            ready: self.extrema.solve().is_ok(),
+        }
+    }
+
+    fn solve(&mut self) -> Result<Solution<CompassCalibration2d>> {
+        let fit = self.extrema.solve()?;
+        let cal = fit.calibration();
+        let mut buf = [Vector2::zeros(); SLOTS];
+        let n = self.slots.collect(&mut buf);
+        let a = seed_assessment(&buf[..n], &cal, fit.field(), self.extrema.samples());
+        require_arc(&a.coverage, self.config.min_arc_deg)?;
+        Ok(Solution {
+            params: cal,
+            quality: a.quality,
+        })
+    }
+
+    fn reset(&mut self) {
+        self.extrema.reset();
+        self.slots.clear();
+        self.clock.reset();
+    }
+}
