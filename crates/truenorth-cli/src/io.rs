@@ -127,7 +127,9 @@ impl Table {
                         format!("column `{name}`: `{cell}` is not finite"),
                     ));
                 }
-                columns.get_mut(name).map(|c| c.push(v));
+                if let Some(c) = columns.get_mut(name) {
+                    c.push(v);
+                }
             }
             rows += 1;
         }
@@ -157,6 +159,19 @@ impl Table {
     pub fn req(&self, name: &str) -> CliResult<&[f64]> {
         self.col(name)
             .ok_or_else(|| CliError::file(&self.path, format!("missing column `{name}`")))
+    }
+
+    /// Refuses a table with a header but no data rows.
+    pub fn require_rows(&self) -> CliResult {
+        if self.is_empty() {
+            Err(CliError::row(
+                &self.path,
+                2,
+                "no data rows after the header",
+            ))
+        } else {
+            Ok(())
+        }
     }
 
     /// Checks that `t_s` increases strictly; names the first row where it does not.
@@ -195,4 +210,159 @@ pub fn write_csv(
     }
     w.flush()
         .map_err(|e| CliError::file(path, format!("cannot write: {e}")))
+}
+
+/// The `format` tag of a calibration file written by `truenorth calibrate`.
+pub const CALIBRATION_FORMAT: &str = "truenorth-compass-calibration";
+
+/// The version of the calibration file layout.
+pub const CALIBRATION_VERSION: u32 = 1;
+
+/// A compass calibration as stored on disk by `truenorth calibrate` and read by
+/// `truenorth heading` (see `truenorth calibrate --help` for the layout).
+///
+/// Matrices are written row by row (`soft_iron[i][j]` is row i, column j) so the file reads
+/// as printed maths; `corrected = soft_iron · (raw − hard_iron)`.
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
+pub struct CalibrationFile {
+    /// Always [`CALIBRATION_FORMAT`].
+    pub format: String,
+    /// Layout version, [`CALIBRATION_VERSION`].
+    pub version: u32,
+    /// The method that produced it (`ellipse`, `ellipsoid`, …).
+    pub method: String,
+    /// 2 (mag_x, mag_y) or 3 (mag_x, mag_y, mag_z).
+    pub dimensions: usize,
+    /// Offset subtracted from raw readings, input unit; `dimensions` values.
+    pub hard_iron: Vec<f64>,
+    /// Soft-iron matrix, `dimensions` rows of `dimensions` values.
+    pub soft_iron: Vec<Vec<f64>>,
+    /// Radius of the calibrated circle (2-D: horizontal field) or sphere (3-D: total
+    /// field), input unit.
+    pub field: f64,
+    /// How far the calibration can be trusted (written by `calibrate`; ignored by
+    /// `heading`, so a hand-written file may leave it out).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub quality: Option<QualityReport>,
+    /// The recording it was fitted to (informational).
+    #[serde(default)]
+    pub input: String,
+}
+
+/// The quality report as written to a calibration file: the library's
+/// [`truenorth::core::Quality`] with a number that is not finite (an unbounded condition
+/// or error bound) written as `null`, since JSON has no infinity.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct QualityReport {
+    /// Samples used in the solve.
+    pub points: usize,
+    /// Share of heading bins (3-D: direction cells) that hold data, in [0, 1].
+    pub coverage: f64,
+    /// RMS of |corrected| / field − 1.
+    pub residual_rms_rel: Option<f64>,
+    /// Condition number of the calibration's information matrix.
+    pub condition: Option<f64>,
+    /// 3-sigma bound on the heading (3-D: field direction) error the calibration adds, degrees.
+    pub heading_error_bound_deg: Option<f64>,
+    /// Fitted field, input unit.
+    pub field_magnitude: Option<f64>,
+    /// Fitted field over the expected one, if `--expected-field` was given.
+    pub field_ratio_to_expected: Option<f64>,
+}
+
+impl From<truenorth::core::Quality> for QualityReport {
+    fn from(q: truenorth::core::Quality) -> Self {
+        let finite = |v: f64| v.is_finite().then_some(v);
+        Self {
+            points: q.points,
+            coverage: q.coverage,
+            residual_rms_rel: finite(q.residual_rms_rel),
+            condition: finite(q.condition),
+            heading_error_bound_deg: finite(q.heading_error_bound_deg),
+            field_magnitude: finite(q.field_magnitude),
+            field_ratio_to_expected: q.field_ratio_to_expected.and_then(finite),
+        }
+    }
+}
+
+/// A calibration read from a [`CalibrationFile`], checked and typed.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum CompassCalibration {
+    /// Two-axis compass.
+    TwoD(truenorth::compass::CompassCalibration2d),
+    /// Three-axis magnetometer.
+    ThreeD(truenorth::compass::CompassCalibration3d),
+}
+
+impl CalibrationFile {
+    /// Writes the file as pretty-printed JSON.
+    pub fn write(&self, path: &Path) -> CliResult {
+        let text = serde_json::to_string_pretty(self)
+            .map_err(|e| CliError::file(path, format!("cannot encode the calibration: {e}")))?;
+        std::fs::write(path, text + "\n")
+            .map_err(|e| CliError::file(path, format!("cannot write: {e}")))
+    }
+
+    /// Reads and checks a calibration file.
+    pub fn read(path: &Path) -> CliResult<(Self, CompassCalibration)> {
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| CliError::file(path, format!("cannot read: {e}")))?;
+        let file: Self = serde_json::from_str(&text).map_err(|e| {
+            CliError::file(
+                path,
+                format!(
+                    "not a truenorth calibration file (write one with `truenorth calibrate`): {e}"
+                ),
+            )
+        })?;
+        let cal = file.check().map_err(|m| CliError::file(path, m))?;
+        Ok((file, cal))
+    }
+
+    /// The typed calibration, or what is wrong with the file.
+    fn check(&self) -> Result<CompassCalibration, String> {
+        use nalgebra::{Matrix2, Matrix3, Vector2, Vector3};
+        if self.format != CALIBRATION_FORMAT {
+            return Err(format!(
+                "`format` is `{}`, expected `{CALIBRATION_FORMAT}`",
+                self.format
+            ));
+        }
+        if self.version != CALIBRATION_VERSION {
+            return Err(format!(
+                "layout version {} is not supported (this build reads version {CALIBRATION_VERSION})",
+                self.version
+            ));
+        }
+        let n = self.dimensions;
+        if n != 2 && n != 3 {
+            return Err(format!("`dimensions` is {n}, must be 2 or 3"));
+        }
+        if self.hard_iron.len() != n
+            || self.soft_iron.len() != n
+            || self.soft_iron.iter().any(|r| r.len() != n)
+        {
+            return Err(format!(
+                "`hard_iron` must have {n} values and `soft_iron` {n} rows of {n} values"
+            ));
+        }
+        let all = self.hard_iron.iter().chain(self.soft_iron.iter().flatten());
+        if all.clone().any(|v| !v.is_finite()) {
+            return Err("`hard_iron` and `soft_iron` must be finite numbers".into());
+        }
+        let s = &self.soft_iron;
+        Ok(if n == 2 {
+            CompassCalibration::TwoD(truenorth::compass::CompassCalibration2d {
+                hard_iron: Vector2::new(self.hard_iron[0], self.hard_iron[1]),
+                soft_iron: Matrix2::new(s[0][0], s[0][1], s[1][0], s[1][1]),
+            })
+        } else {
+            CompassCalibration::ThreeD(truenorth::compass::CompassCalibration3d {
+                hard_iron: Vector3::new(self.hard_iron[0], self.hard_iron[1], self.hard_iron[2]),
+                soft_iron: Matrix3::new(
+                    s[0][0], s[0][1], s[0][2], s[1][0], s[1][1], s[1][2], s[2][0], s[2][1], s[2][2],
+                ),
+            })
+        })
+    }
 }
