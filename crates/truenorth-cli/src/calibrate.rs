@@ -8,7 +8,10 @@
 use std::path::{Path, PathBuf};
 
 use nalgebra::{Vector2, Vector3};
-use truenorth::calib::{EllipseCalibrator, EllipsoidCalibrator, quality};
+use truenorth::calib::{
+    BinnedEllipseCalibrator, EllipseCalibrator, EllipsoidCalibrator, MeritCircleCalibrator,
+    TurnCompassCalibrator, quality,
+};
 use truenorth::compass::{CompassCalibration2d, CompassCalibration3d};
 use truenorth::core::{Calibrator, Error, Mag2Sample, Mag3Sample, Quality, Solution};
 
@@ -47,8 +50,8 @@ impl Method {
 /// Arguments of `truenorth calibrate`.
 ///
 /// Input: CSV with a header row and columns `t_s,mag_x,mag_y` (plus `mag_z` for
-/// `ellipsoid`, `gyr_z` in rad/s for `turn`); other columns are ignored; magnetometer in any
-/// unit. Time must increase strictly. The readings should cover a full turn (2-D, level) or
+/// `ellipsoid`); other columns are ignored; magnetometer in any unit; `turn` also accepts `gyr_z` (rad/s), unused until the gyro half of the turn method
+/// lands. Time must increase strictly. The readings should cover a full turn (2-D, level) or
 /// many orientations (3-D).
 ///
 /// Output: JSON
@@ -95,21 +98,18 @@ pub fn run(args: &Args) -> CliResult {
     let file = match args.method {
         Method::Ellipse => calibrate_2d(args, EllipseCalibrator::new())?,
         Method::Ellipsoid => calibrate_3d(args, EllipsoidCalibrator::new())?,
-        Method::BinnedEllipse | Method::MeritCircle | Method::Turn => {
-            return Err(CliError::msg(format!(
-                "method `{}` is not available in this build yet; use `ellipse` (2-D) or `ellipsoid` (3-D)",
-                args.method.name()
-            )));
-        }
+        Method::BinnedEllipse => calibrate_2d(args, BinnedEllipseCalibrator::new())?,
+        Method::MeritCircle => calibrate_2d(args, MeritCircleCalibrator::new())?,
+        // The compass half of the turn method (A.4-5); `gyr_z` is accepted and will feed the
+        // gyro half (A.1-3) when it lands.
+        Method::Turn => calibrate_2d(args, TurnCompassCalibrator::new())?,
     };
     file.write(&args.output)
 }
 
-/// Reads the 2-D input (required columns plus `extra`), after checking time order.
-fn read_2d(path: &Path, extra: &[&str]) -> CliResult<(Table, Vec<Mag2Sample>)> {
-    let mut cols = vec!["t_s", "mag_x", "mag_y"];
-    cols.extend_from_slice(extra);
-    let table = Table::read(path, &cols, &[])?;
+/// Reads the 2-D input, after checking time order.
+fn read_2d(path: &Path) -> CliResult<Vec<Mag2Sample>> {
+    let table = Table::read(path, &["t_s", "mag_x", "mag_y"], &[])?;
     table.require_rows()?;
     table.check_increasing_time()?;
     let (t, x, y) = (table.req("t_s")?, table.req("mag_x")?, table.req("mag_y")?);
@@ -119,7 +119,7 @@ fn read_2d(path: &Path, extra: &[&str]) -> CliResult<(Table, Vec<Mag2Sample>)> {
             mag: Vector2::new(x[k], y[k]),
         })
         .collect();
-    Ok((table, samples))
+    Ok(samples)
 }
 
 /// Feeds every row to a 2-D calibrator, solves, and builds the output file.
@@ -127,7 +127,7 @@ fn calibrate_2d<C>(args: &Args, mut cal: C) -> CliResult<CalibrationFile>
 where
     C: Calibrator<Sample = Mag2Sample, Params = CompassCalibration2d>,
 {
-    let (_, samples) = read_2d(&args.input, &[])?;
+    let samples = read_2d(&args.input)?;
     let sol = feed_and_solve(args, &mut cal, &samples)?;
     let p = &sol.params;
     Ok(file_for(

@@ -377,3 +377,56 @@ fn unknown_method_is_a_usage_error() {
     ]);
     assert!(!out.status.success());
 }
+
+/// Every 2-D method is reachable from the command line and writes the same file layout;
+/// every one refuses half a turn.
+#[test]
+fn every_2d_method_calibrates_a_full_turn_and_refuses_a_half() {
+    let dir = scratch("all_methods");
+    // A little over one turn, so the turn method sees a complete revolution.
+    let (csv, _) = turn_csv(400);
+    let input = dir.join("turn.csv");
+    std::fs::write(&input, csv).unwrap();
+    for method in ["ellipse", "binned-ellipse", "merit-circle", "turn"] {
+        let cal = dir.join(format!("{method}.json"));
+        let out = truenorth(&[
+            "calibrate",
+            "--method",
+            method,
+            "--input",
+            p(&input),
+            "--output",
+            p(&cal),
+        ]);
+        assert!(
+            out.status.success(),
+            "{method}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let json: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&cal).unwrap()).unwrap();
+        assert_eq!(json["method"], method);
+        assert_eq!(json["dimensions"], 2);
+        let h = dir.join(format!("{method}.csv"));
+        let out = truenorth(&[
+            "heading",
+            "--calibration",
+            p(&cal),
+            "--input",
+            p(&input),
+            "--output",
+            p(&h),
+        ]);
+        assert!(
+            out.status.success(),
+            "{method}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        assert_eq!(read_headings(&h).len(), 400);
+
+        let (half, _) = turn_csv(181);
+        let (code, line, _) = refused(&format!("half_{method}"), method, &half);
+        assert_eq!(code, Some(1), "{method}");
+        assert!(line.contains(&format!("method `{method}`")), "{line}");
+    }
+}
