@@ -77,7 +77,9 @@ pub use turn::{
     MIN_TURN_SAMPLES, TurnCompassCalibrator, TurnConfig, TurnEllipse, TurnExtrema, TurnTag,
 };
 pub use circumcentre::{Circumcircle, circumcircle};
-pub use merit_circle::{MeritCircleCalibrator, MeritCircleConfig, MeritCircleState, RING};
+pub use merit_circle::{
+    MERIT_CIRCLE_MIN_ARC_DEG, MeritCircleCalibrator, MeritCircleConfig, MeritCircleState, RING,
+};
 pub use binned_ellipse::{
     BinState, BinnedEllipseCalibrator, BinnedEllipseConfig, MAX_BINS, MAX_INIT_SAMPLES,
     ellipse_parameters,

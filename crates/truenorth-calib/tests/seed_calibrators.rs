@@ -154,7 +154,7 @@ fn noise_level() -> impl Strategy<Value = f64> {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 48, ..ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig { cases: 96, ..ProptestConfig::default() })]
 
     /// Binned ellipse: model → calibrator recovers hard and soft iron, within tolerances that
     /// shrink with the noise (a floor for the binning itself plus a multiple of σ).
