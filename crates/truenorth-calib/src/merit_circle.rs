@@ -428,3 +428,97 @@ impl Calibrator for MeritCircleCalibrator {
         *self = Self::build(self.config);
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use truenorth_core::{NoiseSource, SplitMix64};
+
+    fn feed(c: &mut MeritCircleCalibrator, pts: impl Iterator<Item = Vector2<f64>>) {
+        for (i, p) in pts.enumerate() {
+            c.push(&Mag2Sample {
+                t_s: i as f64,
+                mag: p,
+            })
+            .unwrap();
+        }
+    }
+
+    fn circle(c: Vector2<f64>, r: f64, from: f64, deg: f64) -> impl Iterator<Item = Vector2<f64>> {
+        (0..(deg * 2.0) as usize).map(move |i| {
+            let a = (from + i as f64 * 0.5).to_radians();
+            c + Vector2::new(a.cos(), a.sin()) * r
+        })
+    }
+
+    #[test]
+    fn on_a_circle_every_centre_is_exact_and_the_merit_falls_as_weight_builds() {
+        let ctr = Vector2::new(7.0, -3.0);
+        let mut c = MeritCircleCalibrator::new();
+        feed(&mut c, circle(ctr, 20.0, 0.0, 120.0));
+        let first = *c.state();
+        assert!(first.centres >= 1);
+        assert!((first.centre.unwrap() - ctr).norm() < 1e-9);
+        feed(&mut c, circle(ctr, 20.0, 120.0, 600.0));
+        let s = c.state();
+        assert!(s.centres > first.centres);
+        assert!(s.last_merit < 0.3, "{}", s.last_merit);
+        assert!(s.centre_mse < 1e-18);
+        assert!((c.solve().unwrap().params.hard_iron - ctr).norm() < 1e-9);
+    }
+
+    #[test]
+    fn noise_on_a_stationary_compass_makes_no_data_points() {
+        let mut rng = SplitMix64::new(4);
+        let mut c = MeritCircleCalibrator::new();
+        feed(
+            &mut c,
+            (0..2000).map(|_| Vector2::new(20.0 + rng.normal(0.2), rng.normal(0.2))),
+        );
+        assert!(c.state().data_points <= 1, "{:?}", c.state());
+        assert!(matches!(c.solve(), Err(Error::TooFewPoints { .. })));
+    }
+
+    #[test]
+    fn an_outlying_centre_gets_a_small_merit() {
+        let ctr = Vector2::new(0.0, 0.0);
+        let mut c = MeritCircleCalibrator::new();
+        feed(&mut c, circle(ctr, 20.0, 0.0, 720.0));
+        let mut rng = SplitMix64::new(8);
+        // Add scatter so the MSE is not zero, then one reading far off the circle.
+        feed(
+            &mut c,
+            circle(ctr, 20.0, 0.0, 360.0)
+                .map(|p| p + Vector2::new(rng.normal(0.2), rng.normal(0.2))),
+        );
+        let before = c.state().centre.unwrap();
+        let mut out = c.clone();
+        feed(&mut out, core::iter::once(Vector2::new(60.0, 60.0)));
+        let after = out.state().centre.unwrap();
+        assert!(
+            (after - before).norm() < 0.5,
+            "moved {}",
+            (after - before).norm()
+        );
+    }
+
+    #[test]
+    fn config_is_validated() {
+        for cfg in [
+            MeritCircleConfig {
+                min_turn_rad: -1.0,
+                ..Default::default()
+            },
+            MeritCircleConfig {
+                weight_memory: 0.0,
+                ..Default::default()
+            },
+            MeritCircleConfig {
+                max_amplification: 0.5,
+                ..Default::default()
+            },
+        ] {
+            assert!(MeritCircleCalibrator::with_config(cfg).is_err());
+        }
+    }
+}
