@@ -11,6 +11,13 @@
 //! magnetometer: hard iron and full symmetric soft iron from a direct ellipsoid fit refined
 //! by Levenberg–Marquardt). The [`quality`] module holds the report every calibrator shares.
 //!
+//! The seed calibrators learn online, sample by sample, without allocating:
+//! [`MeritCircleCalibrator`] (US 5,297,063: circumcentres of reading triples, merged by a
+//! figure of merit; hard iron only), [`BinnedEllipseCalibrator`] (EP 0634001: heading bins,
+//! origin iteration and the counter-rotating phasor ellipse; hard and soft iron, with
+//! persistence and restart) and [`TurnCompassCalibrator`] (EP 0640207: centre and radii from
+//! the extrema of a full turn, found by the [`extrema`] tracker that the gyro half reuses).
+//!
 //! ```
 //! use nalgebra::{Matrix2, Vector2};
 //! use truenorth_calib::EllipseCalibrator;
