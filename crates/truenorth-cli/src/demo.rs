@@ -2,8 +2,11 @@
 
 use std::path::PathBuf;
 
+use truenorth::calib::{
+    BinnedEllipseCalibrator, EllipseCalibrator, MeritCircleCalibrator, TurnCompassCalibrator,
+};
 use truenorth::compass::CompassCalibration2d;
-use truenorth::core::{VehicleSample, WheelSample, angle_diff};
+use truenorth::core::{Calibrator, Mag2Sample, VehicleSample, WheelSample, angle_diff};
 use truenorth::gyro::{GyroCalibration, YawIntegrator};
 use truenorth::odometer::{DifferentialOdometer, FixedTrack, OdometerCalibration, OdometerWheels};
 use truenorth_sim::{
@@ -11,6 +14,7 @@ use truenorth_sim::{
 };
 
 use crate::io::{CliError, CliResult};
+use crate::svg::{Series, write_plot};
 
 /// Arguments of `truenorth demo`.
 #[derive(Debug, clap::Args)]
@@ -21,6 +25,11 @@ pub struct Args {
     /// Random seed of the simulation.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
+}
+
+/// The calibration circle that opens the demo drive.
+fn opening_circle() -> truenorth::core::Result<Route> {
+    scenario::calibration_circle(12.0, 5.0, 1.25)
 }
 
 /// Truth sample rate of the demo, Hz.
@@ -34,6 +43,7 @@ pub fn run(args: &Args) -> CliResult {
     scenario_table()?;
     let drive = DemoDrive::new(args.seed)?;
     sensor_table(&drive);
+    compass_section(&drive, &args.out)?;
     Ok(())
 }
 
@@ -83,10 +93,7 @@ fn summarise(route: &Route, truth: &[VehicleTruth]) -> Summary {
 
 fn scenario_table() -> CliResult {
     let scenarios: [(&str, truenorth::core::Result<Route>); 5] = [
-        (
-            "calibration circle",
-            scenario::calibration_circle(12.0, 5.0, 1.25),
-        ),
+        ("calibration circle", opening_circle()),
         ("city blocks", scenario::city_blocks(8, 150.0)),
         ("highway", scenario::highway(3000.0)),
         ("parking", scenario::parking()),
@@ -119,6 +126,8 @@ fn scenario_table() -> CliResult {
 
 /// The demo drive with its sensor streams.
 struct DemoDrive {
+    /// End of the opening calibration circle, seconds.
+    circle_end_s: f64,
     params: VehicleSensorParams,
     truth: Vec<VehicleTruth>,
     samples: Vec<VehicleSample>,
@@ -131,7 +140,9 @@ impl DemoDrive {
         let truth = simulate(&route, 0.0, RATE_HZ).map_err(err)?;
         let params = VehicleSensorParams::typical();
         let samples = vehicle_streams(&truth, &params, seed).map_err(err)?;
+        let circle_end_s = opening_circle().map_err(err)?.duration_s();
         Ok(Self {
+            circle_end_s,
             params,
             truth,
             samples,
@@ -265,4 +276,157 @@ fn sensor_table(d: &DemoDrive) {
         );
     }
     println!();
+}
+
+type Compass2dCalibrator = dyn Calibrator<Sample = Mag2Sample, Params = CompassCalibration2d>;
+
+fn compass_section(d: &DemoDrive, out: &std::path::Path) -> CliResult {
+    let cal_samples: Vec<Mag2Sample> = d
+        .samples
+        .iter()
+        .filter(|s| s.t_s <= d.circle_end_s)
+        .filter_map(|s| s.mag.map(|mag| Mag2Sample { t_s: s.t_s, mag }))
+        .collect();
+    let p = &d.params;
+    println!(
+        "Compass calibration: each method fitted on the opening circle ({} samples, hard iron {:.2} x field, soft iron 1.3 rotated 30 deg, noise {:.0} % of field), then applied to the whole drive",
+        cal_samples.len(),
+        p.compass_hard_iron.norm() / p.horizontal_field,
+        p.compass_noise / p.horizontal_field * 100.0
+    );
+    println!(
+        "{:<26} {:>9} {:>9} {:>11} {:>9} {:>11}",
+        "method", "RMS deg", "max deg", "cal 3sd deg", "coverage", "residual %"
+    );
+    let heading_rms = |cal: &CompassCalibration2d| {
+        let est: Vec<f64> = d
+            .samples
+            .iter()
+            .map(|s| s.mag.map_or(f64::NAN, |m| cal.heading_rad(&m)))
+            .collect();
+        heading_error(&d.truth, &est)
+    };
+    let truth_cal = CompassCalibration2d {
+        hard_iron: p.compass_hard_iron,
+        soft_iron: p.compass_soft_iron.try_inverse().unwrap_or_default(),
+    };
+    let floor = heading_rms(&truth_cal);
+    println!(
+        "{:<26} {:>9.2} {:>9.2} {:>11} {:>9} {:>11}",
+        "(noise floor: true cal.)", floor.rms_deg, floor.max_deg, "-", "-", "-"
+    );
+    let mut methods: Vec<(&str, Box<Compass2dCalibrator>)> = vec![
+        ("least-squares ellipse", Box::new(EllipseCalibrator::new())),
+        (
+            "binned ellipse (EP0634001)",
+            Box::new(BinnedEllipseCalibrator::new()),
+        ),
+        (
+            "merit circle (US5297063)",
+            Box::new(MeritCircleCalibrator::new()),
+        ),
+        (
+            "turn extrema (EP0640207)",
+            Box::new(TurnCompassCalibrator::new()),
+        ),
+    ];
+    let mut ls_fit: Option<(CompassCalibration2d, f64)> = None;
+    for (name, cal) in methods.iter_mut() {
+        for s in &cal_samples {
+            // A rejected sample is skipped; the solve reports what the rest supports.
+            let _ = cal.push(s);
+        }
+        match cal.solve() {
+            Ok(sol) => {
+                let e = heading_rms(&sol.params);
+                println!(
+                    "{:<26} {:>9.2} {:>9.2} {:>11.2} {:>8.0}% {:>11.2}",
+                    name,
+                    e.rms_deg,
+                    e.max_deg,
+                    sol.quality.heading_error_bound_deg,
+                    sol.quality.coverage * 100.0,
+                    sol.quality.residual_rms_rel * 100.0
+                );
+                if ls_fit.is_none() {
+                    ls_fit = Some((sol.params, sol.quality.field_magnitude));
+                }
+            }
+            Err(e) => println!("{name:<26} refused: {e}"),
+        }
+    }
+    // A half circle is not enough for any method: each must refuse, not guess.
+    let half: Vec<&Mag2Sample> = cal_samples
+        .iter()
+        .zip(&d.truth)
+        .filter(|(_, t)| t.heading_unwrapped_rad < std::f64::consts::PI)
+        .map(|(s, _)| s)
+        .collect();
+    let mut refused = 0;
+    for (_, cal) in methods.iter_mut() {
+        cal.reset();
+        for s in &half {
+            let _ = cal.push(s);
+        }
+        refused += usize::from(cal.solve().is_err());
+    }
+    println!(
+        "RMS/max: heading error on the whole drive, noise included. cal 3sd: the solve's own predicted bound on\n\
+         the calibration's heading error (per-sample noise excluded). residual: RMS distance from the fitted\n\
+         circle divided by the field."
+    );
+    println!(
+        "half circle (< 180 deg of turn): {refused} of {} methods refuse, as they must",
+        methods.len()
+    );
+
+    if let Some((cal, field)) = ls_fit {
+        let raw: Vec<(f64, f64)> = cal_samples.iter().map(|s| (s.mag.x, s.mag.y)).collect();
+        let inverse = cal.soft_iron.try_inverse().unwrap_or_default();
+        let ellipse: Vec<(f64, f64)> = (0..360)
+            .map(|k| {
+                let a = (k as f64).to_radians();
+                let r = inverse * nalgebra::Vector2::new(field * a.cos(), field * a.sin())
+                    + cal.hard_iron;
+                (r.x, r.y)
+            })
+            .collect();
+        let corrected: Vec<(f64, f64)> = cal_samples
+            .iter()
+            .map(|s| {
+                let c = cal.correct(&s.mag);
+                (c.x, c.y)
+            })
+            .collect();
+        let path = out.join("compass_calibration.svg");
+        write_plot(
+            &path,
+            "Compass: raw locus, least-squares ellipse, corrected circle",
+            "mag_x (uT)",
+            "mag_y (uT)",
+            &[
+                Series {
+                    label: "raw readings",
+                    colour: "#d62728",
+                    points: raw,
+                    line: false,
+                },
+                Series {
+                    label: "fitted ellipse",
+                    colour: "#1f77b4",
+                    points: ellipse,
+                    line: true,
+                },
+                Series {
+                    label: "corrected",
+                    colour: "#2ca02c",
+                    points: corrected,
+                    line: false,
+                },
+            ],
+        )?;
+        println!("plot: {}", path.display());
+    }
+    println!();
+    Ok(())
 }

@@ -8,6 +8,7 @@ mod demo;
 mod field;
 mod heading;
 mod io;
+mod svg;
 
 use std::process::ExitCode;
 

@@ -66,7 +66,7 @@ impl VehicleSensorParams {
                 speed_coeff_s2_per_m2: 0.0,
                 dist_per_pulse_m: Some(0.02),
             },
-            compass_hard_iron: Vector2::new(8.0, -5.0),
+            compass_hard_iron: Vector2::new(8.0, -6.0),
             compass_soft_iron: rotated_soft_iron(1.3, 1.0, 30f64.to_radians()),
             compass_noise: 0.2,
             horizontal_field: 20.0,

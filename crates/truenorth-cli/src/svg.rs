@@ -1,0 +1,136 @@
+//! A minimal SVG scatter/line plot writer for the demo's figures (no plotting dependency:
+//! the figures are a handful of point sets on equal axes).
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use crate::io::{CliError, CliResult};
+
+/// One data series: points drawn as dots or joined as a line.
+pub struct Series<'a> {
+    /// Legend label.
+    pub label: &'a str,
+    /// CSS colour.
+    pub colour: &'a str,
+    /// (x, y) points.
+    pub points: Vec<(f64, f64)>,
+    /// Joined as a closed line instead of dots.
+    pub line: bool,
+}
+
+/// Writes an equal-axes plot of `series` to `path`.
+pub fn write_plot(
+    path: &Path,
+    title: &str,
+    x_label: &str,
+    y_label: &str,
+    series: &[Series],
+) -> CliResult {
+    const SIZE: f64 = 560.0;
+    const MARGIN: f64 = 60.0;
+    let all = series
+        .iter()
+        .flat_map(|s| s.points.iter())
+        .filter(|p| p.0.is_finite() && p.1.is_finite());
+    let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
+    for &(x, y) in all {
+        x0 = x0.min(x);
+        x1 = x1.max(x);
+        y0 = y0.min(y);
+        y1 = y1.max(y);
+    }
+    if x0 > x1 {
+        return Err(CliError::file(path, "nothing to plot"));
+    }
+    // Equal scales on both axes so that a circle looks like a circle.
+    let span = (x1 - x0).max(y1 - y0).max(1e-12) * 1.1;
+    let (cx, cy) = (0.5 * (x0 + x1), 0.5 * (y0 + y1));
+    let sx = |x: f64| MARGIN + (x - cx + span / 2.0) / span * SIZE;
+    let sy = |y: f64| MARGIN + (cy + span / 2.0 - y) / span * SIZE;
+    let w = SIZE + 2.0 * MARGIN;
+    let mut svg = String::new();
+    let _ = writeln!(
+        svg,
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{w}" viewBox="0 0 {w} {w}" font-family="sans-serif" font-size="13">"#
+    );
+    let _ = writeln!(svg, r#"<rect width="100%" height="100%" fill="white"/>"#);
+    let _ = writeln!(
+        svg,
+        r#"<text x="{}" y="24" text-anchor="middle" font-size="16">{title}</text>"#,
+        w / 2.0
+    );
+    let _ = writeln!(
+        svg,
+        r#"<text x="{}" y="{}" text-anchor="middle">{x_label}</text>"#,
+        w / 2.0,
+        w - 15.0
+    );
+    let _ = writeln!(
+        svg,
+        r#"<text x="18" y="{}" text-anchor="middle" transform="rotate(-90 18 {})">{y_label}</text>"#,
+        w / 2.0,
+        w / 2.0
+    );
+    let _ = writeln!(
+        svg,
+        r##"<rect x="{MARGIN}" y="{MARGIN}" width="{SIZE}" height="{SIZE}" fill="none" stroke="#888"/>"##
+    );
+    // Axes through zero when zero is in view.
+    if (cx - span / 2.0..cx + span / 2.0).contains(&0.0) {
+        let _ = writeln!(
+            svg,
+            r##"<line x1="{0}" y1="{MARGIN}" x2="{0}" y2="{1}" stroke="#ccc"/>"##,
+            sx(0.0),
+            MARGIN + SIZE
+        );
+    }
+    if (cy - span / 2.0..cy + span / 2.0).contains(&0.0) {
+        let _ = writeln!(
+            svg,
+            r##"<line x1="{MARGIN}" y1="{0}" x2="{1}" y2="{0}" stroke="#ccc"/>"##,
+            sy(0.0),
+            MARGIN + SIZE
+        );
+    }
+    for (k, s) in series.iter().enumerate() {
+        if s.line {
+            let pts: Vec<String> = s
+                .points
+                .iter()
+                .map(|&(x, y)| format!("{:.1},{:.1}", sx(x), sy(y)))
+                .collect();
+            let _ = writeln!(
+                svg,
+                r#"<polygon points="{}" fill="none" stroke="{}" stroke-width="2"/>"#,
+                pts.join(" "),
+                s.colour
+            );
+        } else {
+            for &(x, y) in &s.points {
+                let _ = writeln!(
+                    svg,
+                    r#"<circle cx="{:.1}" cy="{:.1}" r="1.6" fill="{}"/>"#,
+                    sx(x),
+                    sy(y),
+                    s.colour
+                );
+            }
+        }
+        let ly = MARGIN + 18.0 + 18.0 * k as f64;
+        let _ = writeln!(
+            svg,
+            r#"<rect x="{}" y="{}" width="12" height="12" fill="{}"/>"#,
+            MARGIN + 10.0,
+            ly - 10.0,
+            s.colour
+        );
+        let _ = writeln!(
+            svg,
+            r#"<text x="{}" y="{ly}">{}</text>"#,
+            MARGIN + 28.0,
+            s.label
+        );
+    }
+    svg.push_str("</svg>\n");
+    std::fs::write(path, svg).map_err(|e| CliError::file(path, format!("cannot write: {e}")))
+}
