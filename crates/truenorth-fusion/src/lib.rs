@@ -1,8 +1,29 @@
 //! # truenorth-fusion
 //!
-//! Estimators: Euler orientation detector, quaternion filter, vehicle heading and dead reckoning.
+//! Estimators that fuse the calibrated sensors: the Euler orientation detector of
+//! WO 00/36376, a quaternion orientation filter, and vehicle heading and dead reckoning.
+//!
+//! **Status:** no estimator is implemented yet. They will implement the traits defined in
+//! `truenorth-core`, [`truenorth_core::OrientationEstimator`] (IMU samples → attitude) and
+//! [`truenorth_core::HeadingEstimator`] (vehicle samples → heading and position), so that
+//! tests, benches and the CLI take any of them:
 //!
 //! ```
-//! assert_eq!(1 + 1, 2);
+//! use truenorth_core::{HeadingEstimator, NavState};
+//!
+//! fn final_position(est: &impl HeadingEstimator) -> (f64, f64) {
+//!     let NavState { north_m, east_m, .. } = est.state();
+//!     (north_m, east_m)
+//! }
+//! # let _ = final_position::<truenorth_core_dummy::Dummy>;
+//! # mod truenorth_core_dummy {
+//! #     use truenorth_core::*;
+//! #     pub struct Dummy;
+//! #     impl HeadingEstimator for Dummy {
+//! #         fn update(&mut self, _: &VehicleSample) -> Result<NavState> { Ok(NavState::default()) }
+//! #         fn state(&self) -> NavState { NavState::default() }
+//! #         fn reset(&mut self) {}
+//! #     }
+//! # }
 //! ```
 #![cfg_attr(not(feature = "std"), no_std)]
