@@ -11,19 +11,10 @@
 //! ```
 //! use truenorth_core::{HeadingEstimator, NavState};
 //!
-//! fn final_position(est: &impl HeadingEstimator) -> (f64, f64) {
+//! /// Works with whichever vehicle estimator the caller picks.
+//! fn final_position<E: HeadingEstimator>(est: &E) -> (f64, f64) {
 //!     let NavState { north_m, east_m, .. } = est.state();
 //!     (north_m, east_m)
 //! }
-//! # let _ = final_position::<truenorth_core_dummy::Dummy>;
-//! # mod truenorth_core_dummy {
-//! #     use truenorth_core::*;
-//! #     pub struct Dummy;
-//! #     impl HeadingEstimator for Dummy {
-//! #         fn update(&mut self, _: &VehicleSample) -> Result<NavState> { Ok(NavState::default()) }
-//! #         fn state(&self) -> NavState { NavState::default() }
-//! #         fn reset(&mut self) {}
-//! #     }
-//! # }
 //! ```
 #![cfg_attr(not(feature = "std"), no_std)]
