@@ -1,0 +1,134 @@
+//! Cross-crate: the simulator's drive → every 2-D compass calibrator → heading on the whole
+//! drive, against the ground truth. The figures the demo prints are held to here.
+
+use truenorth::calib::{
+    BinnedEllipseCalibrator, EllipseCalibrator, MeritCircleCalibrator, TurnCompassCalibrator,
+};
+use truenorth::compass::CompassCalibration2d;
+use truenorth::prelude::*;
+use truenorth_sim::{VehicleSensorParams, VehicleTruth, scenario, simulate, vehicle_streams};
+
+type Boxed = Box<dyn Calibrator<Sample = Mag2Sample, Params = CompassCalibration2d>>;
+
+struct Drive {
+    truth: Vec<VehicleTruth>,
+    mags: Vec<Mag2Sample>,
+    circle_end_s: f64,
+    params: VehicleSensorParams,
+}
+
+fn drive(seed: u64) -> Drive {
+    let circle = scenario::calibration_circle(12.0, 5.0, 1.25).unwrap();
+    let mut route = circle.clone();
+    route
+        .commands
+        .extend(scenario::city_blocks(4, 120.0).unwrap().commands);
+    let truth = simulate(&route, 0.4, 50.0).unwrap();
+    let params = VehicleSensorParams::typical();
+    let mags = vehicle_streams(&truth, &params, seed)
+        .unwrap()
+        .into_iter()
+        .map(|s| Mag2Sample {
+            t_s: s.t_s,
+            mag: s.mag.unwrap(),
+        })
+        .collect();
+    Drive {
+        truth,
+        mags,
+        circle_end_s: circle.duration_s(),
+        params,
+    }
+}
+
+fn heading_rms_deg(d: &Drive, cal: &CompassCalibration2d) -> f64 {
+    let sum: f64 = d
+        .truth
+        .iter()
+        .zip(&d.mags)
+        .map(|(t, m)| angle_diff(cal.heading_rad(&m.mag), t.heading_rad).powi(2))
+        .sum();
+    (sum / d.truth.len() as f64).sqrt().to_degrees()
+}
+
+fn fit(cal: &mut Boxed, samples: &[Mag2Sample]) -> Result<Solution<CompassCalibration2d>, Error> {
+    cal.reset();
+    for s in samples {
+        cal.push(s)?;
+    }
+    cal.solve()
+}
+
+#[test]
+fn every_calibrator_on_a_simulated_drive() {
+    for seed in [1, 2, 3] {
+        let d = drive(seed);
+        let true_cal = CompassCalibration2d {
+            hard_iron: d.params.compass_hard_iron,
+            soft_iron: d.params.compass_soft_iron.try_inverse().unwrap(),
+        };
+        let floor = heading_rms_deg(&d, &true_cal);
+        let circle: Vec<Mag2Sample> = d
+            .mags
+            .iter()
+            .copied()
+            .filter(|m| m.t_s <= d.circle_end_s)
+            .collect();
+
+        let mut ls: Boxed = Box::new(EllipseCalibrator::new());
+        let ls_rms = heading_rms_deg(&d, &fit(&mut ls, &circle).unwrap().params);
+        // Issue goal: least squares within 10 % of the noise floor.
+        assert!(
+            ls_rms <= 1.1 * floor,
+            "seed {seed}: LS {ls_rms:.3} vs floor {floor:.3}"
+        );
+
+        let mut binned: Boxed = Box::new(BinnedEllipseCalibrator::new());
+        let b_rms = heading_rms_deg(&d, &fit(&mut binned, &circle).unwrap().params);
+        assert!(b_rms <= 1.0, "seed {seed}: binned ellipse {b_rms:.3} deg");
+
+        // Circle-only methods cannot remove a rotated soft iron: worse than the ellipse
+        // methods, but their own quality report must own up to it.
+        for mut cal in [
+            Box::new(MeritCircleCalibrator::new()) as Boxed,
+            Box::new(TurnCompassCalibrator::new()),
+        ] {
+            let sol = fit(&mut cal, &circle).unwrap();
+            let rms = heading_rms_deg(&d, &sol.params);
+            assert!(
+                rms > 2.0 * ls_rms,
+                "seed {seed}: circle method {rms:.2} unexpectedly good"
+            );
+            assert!(
+                sol.quality.heading_error_bound_deg >= rms,
+                "seed {seed}: bound {:.2} hides an error of {rms:.2}",
+                sol.quality.heading_error_bound_deg
+            );
+        }
+    }
+}
+
+#[test]
+fn half_a_turn_is_refused_by_every_calibrator() {
+    let d = drive(7);
+    // The circle starts after a 5 s standstill; keep the run-up plus < 180° of turn.
+    let half: Vec<Mag2Sample> = d
+        .mags
+        .iter()
+        .zip(&d.truth)
+        .filter(|(_, t)| {
+            t.t_s <= d.circle_end_s && t.heading_unwrapped_rad - 0.4 < 170f64.to_radians()
+        })
+        .map(|(m, _)| *m)
+        .collect();
+    let all: [Boxed; 4] = [
+        Box::new(EllipseCalibrator::new()),
+        Box::new(BinnedEllipseCalibrator::new()),
+        Box::new(MeritCircleCalibrator::new()),
+        Box::new(TurnCompassCalibrator::new()),
+    ];
+    for mut cal in all {
+        let r = fit(&mut cal, &half);
+        assert!(r.is_err(), "a half turn was accepted: {r:?}");
+    }
+}
