@@ -2,7 +2,9 @@
 
 use nalgebra::{Matrix2, Matrix3, Vector2, Vector3};
 use serde::{Deserialize, Serialize};
-use truenorth_core::{AbsoluteHeadingSource, Calibration, Mag2Sample, Result, Tilt, check_finite2};
+use truenorth_core::{
+    AbsoluteHeadingSource, Calibration, Mag2Sample, MagneticHeading, Result, Tilt, check_finite2,
+};
 
 use crate::tilt_compensated_heading;
 
@@ -54,6 +56,13 @@ impl CompassCalibration2d {
     #[inline]
     pub fn heading_rad(&self, raw: &Vector2<f64>) -> f64 {
         heading_from_horizontal(&self.correct(raw))
+    }
+
+    /// Heading of a raw reading as a [`MagneticHeading`]: the typed form that turns into a
+    /// true heading only through [`MagneticHeading::to_true`], so declination is added once.
+    #[inline]
+    pub fn magnetic_heading(&self, raw: &Vector2<f64>) -> MagneticHeading {
+        MagneticHeading::new(self.heading_rad(raw))
     }
 }
 
@@ -113,6 +122,13 @@ impl CompassCalibration3d {
     pub fn heading_rad(&self, raw: &Vector3<f64>, tilt: &Tilt) -> f64 {
         tilt_compensated_heading(&self.correct(raw), tilt)
     }
+
+    /// Tilt-compensated heading as a [`MagneticHeading`] (see
+    /// [`CompassCalibration2d::magnetic_heading`]).
+    #[inline]
+    pub fn magnetic_heading(&self, raw: &Vector3<f64>, tilt: &Tilt) -> MagneticHeading {
+        MagneticHeading::new(self.heading_rad(raw, tilt))
+    }
 }
 
 impl Calibration for CompassCalibration3d {
@@ -121,5 +137,31 @@ impl Calibration for CompassCalibration3d {
 
     fn apply(&self, raw: &Vector3<f64>) -> Vector3<f64> {
         self.correct(raw)
+    }
+}
+
+#[cfg(test)]
+mod typed_heading_tests {
+    use super::*;
+    use proptest::prelude::*;
+    use truenorth_core::{Declination, angle_diff};
+
+    proptest! {
+        #[test]
+        fn true_heading_is_magnetic_plus_declination_once(
+            heading in -3.14f64..3.14,
+            decl in -0.5f64..0.5,
+            hx in -50.0f64..50.0,
+            hy in -50.0f64..50.0,
+            field in 1.0f64..60.0,
+        ) {
+            let cal = CompassCalibration2d { hard_iron: Vector2::new(hx, hy), soft_iron: Matrix2::identity() };
+            // A level compass at magnetic heading ψ reads (H cos ψ, −H sin ψ) + hard iron.
+            let raw = Vector2::new(field * heading.cos() + hx, -field * heading.sin() + hy);
+            let mag = cal.magnetic_heading(&raw);
+            prop_assert!(angle_diff(mag.rad(), heading).abs() < 1e-9);
+            let truth = mag.to_true(Declination(decl));
+            prop_assert!(angle_diff(truth.rad(), heading + decl).abs() < 1e-9);
+        }
     }
 }
