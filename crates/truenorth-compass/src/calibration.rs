@@ -149,7 +149,7 @@ mod typed_heading_tests {
     proptest! {
         #[test]
         fn true_heading_is_magnetic_plus_declination_once(
-            heading in -3.14f64..3.14,
+            heading in -3.0f64..3.0,
             decl in -0.5f64..0.5,
             hx in -50.0f64..50.0,
             hy in -50.0f64..50.0,
