@@ -43,7 +43,7 @@ use truenorth_core::{
 };
 
 use crate::linalg::{constrained_min3, sym_eigen2, sym_eigen3, sym_sqrt2};
-use crate::lm::{self, NormalEquations};
+use crate::lm::{self, NormalAccumulator, NormalEquations};
 use crate::normalise::Normaliser;
 use crate::quality::{self, MIN_ARC_DEG};
 
@@ -323,9 +323,7 @@ fn sampson_normal_equations(
 ) -> Option<NormalEquations<5>> {
     let c = Vector2::new(p[0], p[1]);
     let b = Matrix2::new(p[2], p[3], p[3], p[4]);
-    let mut jtj = SMatrix::<f64, 5, 5>::zeros();
-    let mut jtr = SVector::<f64, 5>::zeros();
-    let mut cost = 0.0;
+    let mut acc = NormalAccumulator::<5>::new();
     let inv = 1.0 / norm.scale;
     for m in points {
         let v = (m - norm.centre) * inv - c;
@@ -345,16 +343,9 @@ fn sampson_normal_equations(
         let e11 = w.x * v.x - k * (z.x * w.x + y.x * v.x);
         let e12 = (w.x * v.y + w.y * v.x) - k * (z.x * w.y + z.y * w.x + y.x * v.y + y.y * v.x);
         let e22 = w.y * v.y - k * (z.y * w.y + y.y * v.y);
-        let j = SVector::<f64, 5>::new(jc.x, jc.y, e11 * inv_s, e12 * inv_s, e22 * inv_s);
-        jtj += j * j.transpose();
-        jtr += j * r;
-        cost += r * r;
+        acc.add(&[jc.x, jc.y, e11 * inv_s, e12 * inv_s, e22 * inv_s], r);
     }
-    if cost.is_finite() {
-        Some(NormalEquations { cost, jtj, jtr })
-    } else {
-        None
-    }
+    acc.finish()
 }
 
 /// The least-squares ellipse calibration of `points` (raw `(mag_x, mag_y)` readings of a

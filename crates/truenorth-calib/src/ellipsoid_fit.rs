@@ -39,7 +39,7 @@ use truenorth_core::{
 };
 
 use crate::linalg::{constrained_min6, sym_eigen3, sym_eigen6, sym_sqrt3};
-use crate::lm::{self, NormalEquations};
+use crate::lm::{self, NormalAccumulator, NormalEquations};
 use crate::normalise::Normaliser;
 use crate::quality::{self, MIN_SPHERE_COVERAGE};
 
@@ -325,9 +325,7 @@ fn radial_normal_equations(
 ) -> Option<NormalEquations<9>> {
     let e = from_params(p);
     let (c, b) = (e.centre, e.unit_map);
-    let mut jtj = SMatrix::<f64, 9, 9>::zeros();
-    let mut jtr = SVector::<f64, 9>::zeros();
-    let mut cost = 0.0;
+    let mut acc = NormalAccumulator::<9>::new();
     let inv = 1.0 / norm.scale;
     for m in points {
         let v = (m - norm.centre) * inv - c;
@@ -339,7 +337,7 @@ fn radial_normal_equations(
         let inv_rho = 1.0 / rho;
         let r = rho - 1.0;
         let jc = -(b * w) * inv_rho;
-        let mut j = SVector::<f64, 9>::zeros();
+        let mut j = [0.0; 9];
         j[0] = jc.x;
         j[1] = jc.y;
         j[2] = jc.z;
@@ -350,15 +348,9 @@ fn radial_normal_equations(
                 w[a] * v[bb] + w[bb] * v[a]
             } * inv_rho;
         }
-        jtj += j * j.transpose();
-        jtr += j * r;
-        cost += r * r;
+        acc.add(&j, r);
     }
-    if cost.is_finite() {
-        Some(NormalEquations { cost, jtj, jtr })
-    } else {
-        None
-    }
+    acc.finish()
 }
 
 /// The least-squares ellipsoid calibration of `points` (raw 3-axis readings of a sensor

@@ -26,6 +26,55 @@ pub(crate) struct NormalEquations<const P: usize> {
     pub jtr: SVector<f64, P>,
 }
 
+/// Accumulates `JᵀJ` (upper triangle only, mirrored at the end) and `Jᵀr` one residual at
+/// a time. Plain arrays rather than `j * jᵀ` on matrices: this is the inner loop of every
+/// refinement pass, and half the products are redundant.
+pub(crate) struct NormalAccumulator<const P: usize> {
+    jtj: [[f64; P]; P],
+    jtr: [f64; P],
+    cost: f64,
+}
+
+impl<const P: usize> NormalAccumulator<P> {
+    /// Nothing accumulated.
+    pub fn new() -> Self {
+        Self {
+            jtj: [[0.0; P]; P],
+            jtr: [0.0; P],
+            cost: 0.0,
+        }
+    }
+
+    /// Adds one residual `r` with gradient row `j`.
+    #[inline]
+    pub fn add(&mut self, j: &[f64; P], r: f64) {
+        for (a, &ja) in j.iter().enumerate() {
+            for (m, &jb) in self.jtj[a][a..].iter_mut().zip(&j[a..]) {
+                *m += ja * jb;
+            }
+            self.jtr[a] += ja * r;
+        }
+        self.cost += r * r;
+    }
+
+    /// The normal equations, or `None` if anything overflowed.
+    pub fn finish(&self) -> Option<NormalEquations<P>> {
+        let mut jtj = SMatrix::<f64, P, P>::zeros();
+        for a in 0..P {
+            for b in a..P {
+                jtj[(a, b)] = self.jtj[a][b];
+                jtj[(b, a)] = self.jtj[a][b];
+            }
+        }
+        let ne = NormalEquations {
+            cost: self.cost,
+            jtj,
+            jtr: SVector::<f64, P>::from(self.jtr),
+        };
+        (ne.cost.is_finite() && ne.jtj.iter().all(|x| x.is_finite())).then_some(ne)
+    }
+}
+
 /// The result of a converged run.
 pub(crate) struct LmOutcome<const P: usize> {
     /// The parameters at the minimum.
