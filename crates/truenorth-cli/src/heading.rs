@@ -3,8 +3,7 @@
 use std::path::PathBuf;
 
 use nalgebra::{Vector2, Vector3};
-use truenorth::compass::heading_from_horizontal;
-use truenorth::core::{rad_to_deg, wrap_two_pi};
+use truenorth::core::{Tilt, rad_to_deg, wrap_two_pi};
 
 use crate::io::{CalibrationFile, CliResult, CompassCalibration, Table, write_csv};
 
@@ -61,9 +60,9 @@ pub fn run(args: &Args) -> CliResult {
     let rows = (0..table.len()).map(|k| {
         let magnetic = match (&cal, z) {
             (CompassCalibration::TwoD(c), _) => c.heading_rad(&Vector2::new(x[k], y[k])),
+            // Level: zero pitch and roll, i.e. the corrected x and y.
             (CompassCalibration::ThreeD(c), Some(z)) => {
-                let h = c.correct(&Vector3::new(x[k], y[k], z[k]));
-                heading_from_horizontal(&Vector2::new(h.x, h.y))
+                c.heading_rad(&Vector3::new(x[k], y[k], z[k]), &Tilt::default())
             }
             (CompassCalibration::ThreeD(_), None) => f64::NAN,
         };
