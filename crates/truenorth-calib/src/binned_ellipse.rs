@@ -58,7 +58,7 @@ use truenorth_core::{
     wrap_two_pi,
 };
 
-use crate::quality::{MIN_ARC_DEG, require_arc};
+use crate::quality::{MIN_ARC_DEG, locus_turning_rad, require_arc};
 use crate::seed_quality::seed_assessment;
 
 #[allow(unused_imports)]
@@ -269,6 +269,37 @@ impl Default for BinnedEllipseCalibrator {
 }
 
 impl BinnedEllipseCalibrator {
+    /// How far the tangent of the locus turns along the bins holding readings (measured or
+    /// regenerated from a verified calibration), walked in bin order from just after the
+    /// longest run of empty bins so that no chord cuts across the locus.
+    fn measured_turning_rad(&self) -> f64 {
+        let n = self.config.bins;
+        let has_reading = |i: usize| self.bins[i % n].state != BinState::Empty;
+        let (mut run, mut longest, mut longest_end) = (0usize, 0usize, 0usize);
+        for i in 0..2 * n {
+            if has_reading(i) {
+                run = 0;
+            } else {
+                run += 1;
+                if run > longest {
+                    longest = run;
+                    longest_end = i;
+                }
+            }
+        }
+        let start = if longest == 0 {
+            0
+        } else {
+            (longest_end + 1) % n
+        };
+        locus_turning_rad(
+            (0..n)
+                .map(|k| (start + k) % n)
+                .filter(|&i| has_reading(i))
+                .map(|i| &self.bins[i].value),
+        )
+    }
+
     /// A calibrator with the default options.
     pub fn new() -> Self {
         Self::build(BinnedEllipseConfig::default())
@@ -712,6 +743,16 @@ impl Calibrator for BinnedEllipseCalibrator {
         }
         let a = seed_assessment(&pts[..k], &cal, params.earth_magnitude, self.samples);
         require_arc(&a.coverage, self.config.min_arc_deg)?;
+        // The arc above is seen from the method's own origin, which a short arc pulls towards
+        // itself (so the arc looks longer than it is); the locus's own turning cannot be
+        // fooled that way.
+        let turned_deg = self.measured_turning_rad().to_degrees();
+        if turned_deg < self.config.min_arc_deg {
+            return Err(Error::InsufficientCoverage {
+                covered_deg: turned_deg.floor(),
+                need_deg: self.config.min_arc_deg,
+            });
+        }
         // NaN residuals are refused too.
         if a.quality.residual_rms_rel.is_nan()
             || a.quality.residual_rms_rel > self.config.max_residual_rel

@@ -73,6 +73,11 @@ mod merit_circle;
 mod seed_quality;
 mod turn;
 
+pub use binned_ellipse::{
+    BinState, BinnedEllipseCalibrator, BinnedEllipseConfig, MAX_BINS, MAX_INIT_SAMPLES,
+    ellipse_parameters,
+};
+pub use circumcentre::{Circumcircle, circumcircle};
 pub use ellipse_fit::{
     Ellipse, EllipseCalibrator, EllipseFitOptions, MIN_POINTS_2D, fit_ellipse, fit_ellipse_direct,
 };
@@ -80,14 +85,9 @@ pub use ellipsoid_fit::{
     Ellipsoid, EllipsoidCalibrator, EllipsoidFitOptions, MIN_POINTS_3D, fit_ellipsoid,
     fit_ellipsoid_direct,
 };
-pub use turn::{
-    MIN_TURN_SAMPLES, TurnCompassCalibrator, TurnConfig, TurnEllipse, TurnExtrema, TurnTag,
-};
-pub use circumcentre::{Circumcircle, circumcircle};
 pub use merit_circle::{
     MERIT_CIRCLE_MIN_ARC_DEG, MeritCircleCalibrator, MeritCircleConfig, MeritCircleState, RING,
 };
-pub use binned_ellipse::{
-    BinState, BinnedEllipseCalibrator, BinnedEllipseConfig, MAX_BINS, MAX_INIT_SAMPLES,
-    ellipse_parameters,
+pub use turn::{
+    MIN_TURN_SAMPLES, TurnCompassCalibrator, TurnConfig, TurnEllipse, TurnExtrema, TurnTag,
 };

@@ -55,7 +55,7 @@ use core::f64::consts::TAU;
 
 use nalgebra::{SMatrix, SVector, Vector2, Vector3};
 use truenorth_compass::{CompassCalibration2d, CompassCalibration3d};
-use truenorth_core::{Error, Quality, Result};
+use truenorth_core::{Error, Quality, Result, angle_diff};
 
 use crate::linalg::{condition_from_eigenvalues, sym_eigen5, sym_eigen9};
 use crate::lm::NormalAccumulator;
@@ -256,6 +256,53 @@ pub fn sphere_coverage<'a>(
         }
     }
     filled.iter().filter(|&&f| f).count() as f64 / SPHERE_CELLS as f64
+}
+
+/// How far the tangent of the locus turns along `points` taken in order, radians (≥ 0).
+///
+/// A centre-free measure of the arc that a set of readings covers. Tangents at opposite ends
+/// of a diameter of any ellipse are parallel, so over half a turn the tangent of the raw
+/// locus turns by exactly π whatever the hard and soft iron; over a shorter arc it turns by
+/// less. A calibrator whose own centre is wrong sees its readings spread over more of the
+/// circle than they are; this measure cannot be fooled that way.
+///
+/// The directions of successive chords stand in for the tangent at chord midpoints; their
+/// wrapped differences telescope, so noise enters only at the two ends, and half a chord's
+/// turning is added at each end to reach the first and last points. Chords shorter than
+/// 10⁻¹² of the locus size are skipped. Fewer than three usable points give 0.
+pub fn locus_turning_rad<'a>(points: impl IntoIterator<Item = &'a Vector2<f64>>) -> f64 {
+    let mut prev_point: Option<Vector2<f64>> = None;
+    let mut first_dir: Option<f64> = None;
+    let mut dir = 0.0;
+    let mut chords = 0usize;
+    let mut turned = 0.0;
+    for p in points {
+        if !(p.x.is_finite() && p.y.is_finite()) {
+            continue;
+        }
+        let Some(q) = prev_point else {
+            prev_point = Some(*p);
+            continue;
+        };
+        let d = p - q;
+        if d.norm() <= 1e-12 * p.norm().max(q.norm()).max(f64::MIN_POSITIVE) {
+            continue;
+        }
+        let a = d.y.atan2(d.x);
+        match first_dir {
+            None => first_dir = Some(a),
+            Some(_) => turned += angle_diff(a, dir),
+        }
+        dir = a;
+        chords += 1;
+        prev_point = Some(*p);
+    }
+    if chords < 2 {
+        return 0.0;
+    }
+    let turned = turned.abs();
+    // End correction: half a mean chord step at each end.
+    turned + turned / (chords - 1) as f64
 }
 
 /// Refuses a 2-D calibration whose data span less than `need_deg` of heading (see
@@ -630,5 +677,66 @@ mod tests {
         let f = sphere_coverage(&ring, &Vector3::zeros());
         assert!(f < MIN_SPHERE_COVERAGE, "{f}");
         assert!(require_sphere_coverage(f, MIN_SPHERE_COVERAGE).is_err());
+    }
+}
+
+#[cfg(test)]
+mod turning_tests {
+    use super::*;
+    use nalgebra::Matrix2;
+    use proptest::prelude::*;
+
+    fn ellipse_arc(span_deg: f64, start_deg: f64, m: &Matrix2<f64>, n: usize) -> Vec<Vector2<f64>> {
+        (0..n)
+            .map(|k| {
+                let t = (start_deg + span_deg * k as f64 / (n - 1) as f64).to_radians();
+                m * Vector2::new(t.cos(), t.sin()) + Vector2::new(3.0, -2.0)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn full_and_half_circles() {
+        let m = Matrix2::identity();
+        let full = locus_turning_rad(&ellipse_arc(360.0, 0.0, &m, 361)).to_degrees();
+        assert!((full - 360.0).abs() < 1.5, "{full}");
+        let half = locus_turning_rad(&ellipse_arc(180.0, 10.0, &m, 181)).to_degrees();
+        assert!((half - 180.0).abs() < 0.5, "{half}");
+        assert_eq!(locus_turning_rad(&[Vector2::new(1.0, 1.0); 5]), 0.0);
+    }
+
+    proptest! {
+        /// Over at most half an ellipse the tangent turns by at most π, whatever the affine
+        /// distortion; over more than half it turns by more.
+        #[test]
+        fn half_an_ellipse_or_less_never_reads_as_more(
+            span in 20.0f64..180.0,
+            start in 0.0f64..360.0,
+            a in 0.5f64..2.0, b in 0.5f64..2.0, c in -0.5f64..0.5,
+        ) {
+            let m = Matrix2::new(a, c, c, b);
+            prop_assume!(m.determinant() > 0.1);
+            let t = locus_turning_rad(&ellipse_arc(span, start, &m, 200)).to_degrees();
+            prop_assert!(t <= 180.0 + 0.5, "span {span} turned {t}");
+        }
+
+        #[test]
+        fn more_than_half_an_ellipse_reads_as_more_than_half(
+            span in 181.0f64..359.0,
+            start in 0.0f64..360.0,
+            a in 0.5f64..2.0, b in 0.5f64..2.0, c in -0.5f64..0.5,
+        ) {
+            let m = Matrix2::new(a, c, c, b);
+            prop_assume!(m.determinant() > 0.1);
+            let t = locus_turning_rad(&ellipse_arc(span, start, &m, 400)).to_degrees();
+            prop_assert!(t >= 180.0 - 0.5, "span {span} turned {t}");
+        }
+
+        #[test]
+        fn any_input_is_finite(pts in proptest::collection::vec((proptest::num::f64::ANY, proptest::num::f64::ANY), 0..20)) {
+            let v: Vec<Vector2<f64>> = pts.into_iter().map(|(x, y)| Vector2::new(x, y)).collect();
+            let t = locus_turning_rad(&v);
+            prop_assert!(t.is_finite() && t >= 0.0);
+        }
     }
 }
