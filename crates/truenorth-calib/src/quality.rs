@@ -532,6 +532,58 @@ pub fn with_expected_field(mut quality: Quality, expected_field: Option<f64>) ->
     quality
 }
 
+/// How far the fitted field may stray from the expected one before [`field_mismatch`] warns:
+/// ±15 %. The WMM's own uncertainty is about 1 %, so beyond this the site is disturbed, the
+/// unit is wrong, or a 2-axis sensor is tilted (it then sees part of the vertical field).
+pub const FIELD_RATIO_TOLERANCE: f64 = 0.15;
+
+/// A fitted field that disagrees with the expected one (e.g. the World Magnetic Model's
+/// field at the place and date, converted to the input unit).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FieldMismatch {
+    /// The fitted field, input unit.
+    pub fitted: f64,
+    /// The expected field, input unit.
+    pub expected: f64,
+}
+
+impl FieldMismatch {
+    /// fitted / expected.
+    pub fn ratio(&self) -> f64 {
+        self.fitted / self.expected
+    }
+}
+
+impl core::fmt::Display for FieldMismatch {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        write!(
+            f,
+            "the fitted field {:.4} is {:.2} x the expected {:.4}: a magnetically disturbed site, a wrong unit, or a tilted 2-axis sensor",
+            self.fitted,
+            self.ratio(),
+            self.expected
+        )
+    }
+}
+
+/// A warning when the report's fitted field differs from `expected_field` by more than
+/// [`FIELD_RATIO_TOLERANCE`]; `None` when it agrees or no positive finite expectation is given.
+pub fn field_mismatch(quality: &Quality, expected_field: f64) -> Option<FieldMismatch> {
+    if !(expected_field.is_finite() && expected_field > 0.0) {
+        return None;
+    }
+    let m = FieldMismatch {
+        fitted: quality.field_magnitude,
+        expected: expected_field,
+    };
+    // Written so that a NaN ratio (no fitted field) is a mismatch too.
+    if (m.ratio() - 1.0).abs() <= FIELD_RATIO_TOLERANCE {
+        None
+    } else {
+        Some(m)
+    }
+}
+
 /// Mean radius of the calibrated readings, for calibrators that do not fit a radius.
 /// Non-finite readings are skipped; 0 if none remain.
 pub fn mean_corrected_norm_2d(points: &[Vector2<f64>], cal: &CompassCalibration2d) -> f64 {
@@ -737,6 +789,32 @@ mod turning_tests {
             let v: Vec<Vector2<f64>> = pts.into_iter().map(|(x, y)| Vector2::new(x, y)).collect();
             let t = locus_turning_rad(&v);
             prop_assert!(t.is_finite() && t >= 0.0);
+        }
+    }
+}
+
+#[cfg(test)]
+mod field_mismatch_tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    proptest! {
+        #[test]
+        fn warns_exactly_outside_the_tolerance(fitted in 0.0f64..100.0, expected in 1e-3f64..100.0) {
+            let q = Quality { field_magnitude: fitted, ..Quality::default() };
+            let ratio = fitted / expected;
+            let warned = field_mismatch(&q, expected);
+            prop_assert_eq!(warned.is_some(), (ratio - 1.0).abs() > FIELD_RATIO_TOLERANCE);
+            if let Some(w) = warned {
+                prop_assert!((w.ratio() - ratio).abs() < 1e-12);
+            }
+        }
+
+        #[test]
+        fn no_expectation_no_warning(fitted in proptest::num::f64::ANY, expected in proptest::num::f64::ANY) {
+            prop_assume!(!(expected.is_finite() && expected > 0.0));
+            let q = Quality { field_magnitude: fitted, ..Quality::default() };
+            prop_assert!(field_mismatch(&q, expected).is_none());
         }
     }
 }

@@ -15,6 +15,7 @@ use truenorth::calib::{
 use truenorth::compass::{CompassCalibration2d, CompassCalibration3d};
 use truenorth::core::{Calibrator, Error, Mag2Sample, Mag3Sample, Quality, Solution};
 
+use crate::field::Place;
 use crate::io::{
     CALIBRATION_FORMAT, CALIBRATION_VERSION, CalibrationFile, CliError, CliResult, Table,
 };
@@ -84,6 +85,63 @@ pub struct Args {
     /// `field_ratio_to_expected`.
     #[arg(long, value_name = "FIELD")]
     pub expected_field: Option<f64>,
+    /// Unit of the readings; with --lat/--lon the World Magnetic Model field there (horizontal
+    /// for 2-D methods, total for `ellipsoid`) becomes the expected field. A fit more than
+    /// 15 % away from it prints a warning on stderr.
+    #[arg(long, value_enum, value_name = "UNIT")]
+    pub mag_unit: Option<MagUnit>,
+    /// Where and when the recording was made (for the expected field).
+    #[command(flatten)]
+    pub place: Place,
+}
+
+/// Units a magnetometer may report in.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum MagUnit {
+    /// Nanotesla.
+    #[value(name = "nT")]
+    NanoTesla,
+    /// Microtesla.
+    #[value(name = "uT")]
+    MicroTesla,
+    /// Milligauss (= 100 nT).
+    #[value(name = "mG")]
+    MilliGauss,
+    /// Gauss (= 100 000 nT).
+    #[value(name = "G")]
+    Gauss,
+}
+
+impl MagUnit {
+    fn nanotesla(self) -> f64 {
+        match self {
+            Self::NanoTesla => 1.0,
+            Self::MicroTesla => 1e3,
+            Self::MilliGauss => 1e2,
+            Self::Gauss => 1e5,
+        }
+    }
+}
+
+/// The field the fit should find, in the input unit: given directly, or from the World
+/// Magnetic Model at `--lat/--lon/--date` (horizontal for `dimensions` = 2, total for 3).
+fn expected_field(args: &Args, dimensions: usize) -> CliResult<Option<f64>> {
+    if !args.place.is_given() {
+        return Ok(args.expected_field);
+    }
+    if args.expected_field.is_some() {
+        return Err(CliError::msg(
+            "give either --expected-field or --lat/--lon, not both",
+        ));
+    }
+    let unit = args.mag_unit.ok_or_else(|| {
+        CliError::msg(
+            "--lat/--lon need --mag-unit (nT, uT, mG or G) to compare the fit with the WMM field",
+        )
+    })?;
+    let f = args.place.field()?;
+    let nt = if dimensions == 3 { f.f_nt } else { f.h_nt };
+    Ok(Some(nt / unit.nanotesla()))
 }
 
 /// Runs the subcommand.
@@ -128,7 +186,7 @@ where
     C: Calibrator<Sample = Mag2Sample, Params = CompassCalibration2d>,
 {
     let samples = read_2d(&args.input)?;
-    let sol = feed_and_solve(args, &mut cal, &samples)?;
+    let sol = feed_and_solve(args, &mut cal, &samples, expected_field(args, 2)?)?;
     let p = &sol.params;
     Ok(file_for(
         args,
@@ -158,7 +216,7 @@ where
             mag: Vector3::new(x[k], y[k], z[k]),
         })
         .collect();
-    let sol = feed_and_solve(args, &mut cal, &samples)?;
+    let sol = feed_and_solve(args, &mut cal, &samples, expected_field(args, 3)?)?;
     let p = &sol.params;
     Ok(file_for(
         args,
@@ -178,6 +236,7 @@ fn feed_and_solve<C: Calibrator>(
     args: &Args,
     cal: &mut C,
     samples: &[C::Sample],
+    expected: Option<f64>,
 ) -> CliResult<Solution<C::Params>> {
     for (k, s) in samples.iter().enumerate() {
         cal.push(s)
@@ -193,7 +252,10 @@ fn feed_and_solve<C: Calibrator>(
             ),
         )
     })?;
-    sol.quality = quality::with_expected_field(sol.quality, args.expected_field);
+    sol.quality = quality::with_expected_field(sol.quality, expected);
+    if let Some(w) = expected.and_then(|e| quality::field_mismatch(&sol.quality, e)) {
+        eprintln!("truenorth: warning: {}: {w}", args.input.display());
+    }
     Ok(sol)
 }
 

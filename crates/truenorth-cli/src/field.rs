@@ -32,10 +32,19 @@ Without --date the date is today's decimal year in UTC, from the system clock. A
 one-line warning goes to stderr."
 )]
 pub struct Args {
-    /// Required: geodetic latitude (WGS84), degrees north, -90 to 90.
+    /// The place and date.
+    #[command(flatten)]
+    pub place: Place,
+}
+
+/// Where and when to evaluate the World Magnetic Model; shared by every command that can
+/// turn magnetic into true heading.
+#[derive(Debug, Clone, Default, clap::Args)]
+pub struct Place {
+    /// Geodetic latitude (WGS84), degrees north, -90 to 90.
     #[arg(long, value_name = "DEG", allow_negative_numbers = true)]
     pub lat: Option<String>,
-    /// Required: longitude, degrees east (west negative).
+    /// Longitude, degrees east (west negative).
     #[arg(long, value_name = "DEG", allow_negative_numbers = true)]
     pub lon: Option<String>,
     /// Height above the WGS84 ellipsoid, km [default: 0].
@@ -53,21 +62,35 @@ pub struct Args {
 
 /// Runs the subcommand: the CSV on stdout, an extrapolation warning (if any) on stderr.
 pub fn run(args: &Args) -> CliResult {
-    let year = match &args.date {
-        Some(text) => parse_date(text)?,
-        None => today_decimal_year()?,
-    };
-    let field = evaluate(args, year)?;
-    if let Some(w) = field.extrapolated {
-        eprintln!("truenorth: warning: {w}");
-    }
+    let field = args.place.field()?;
     println!("{HEADER}");
     println!("{}", csv_row(&field));
     Ok(())
 }
 
+impl Place {
+    /// Whether a place was given at all (`--lat` or `--lon`).
+    pub fn is_given(&self) -> bool {
+        self.lat.is_some() || self.lon.is_some()
+    }
+
+    /// The field at this place and date (today if no date was given); an extrapolation
+    /// warning goes to stderr.
+    pub fn field(&self) -> CliResult<MagneticField> {
+        let year = match &self.date {
+            Some(text) => parse_date(text)?,
+            None => today_decimal_year()?,
+        };
+        let field = evaluate(self, year)?;
+        if let Some(w) = field.extrapolated {
+            eprintln!("truenorth: warning: {w}");
+        }
+        Ok(field)
+    }
+}
+
 /// The field for the parsed arguments at decimal year `year`.
-fn evaluate(args: &Args, year: f64) -> CliResult<MagneticField> {
+fn evaluate(args: &Place, year: f64) -> CliResult<MagneticField> {
     let lat = parse_number("--lat", required("--lat", &args.lat)?)?;
     let lon = parse_number("--lon", required("--lon", &args.lon)?)?;
     let alt_km = match &args.alt_km {
@@ -84,9 +107,9 @@ fn evaluate(args: &Args, year: f64) -> CliResult<MagneticField> {
         .field_at_deg(lat, lon, alt_km, year)
         .map_err(|e| match e {
             Error::DateOutOfRange { .. } if !args.allow_extrapolation => {
-                CliError::msg(format!("field: {e} (with --allow-extrapolation)"))
+                CliError::msg(format!("{e} (with --allow-extrapolation)"))
             }
-            e => CliError::msg(format!("field: {e}")),
+            e => CliError::msg(e.to_string()),
         })
 }
 
@@ -107,14 +130,14 @@ fn csv_row(f: &MagneticField) -> String {
 fn required<'a>(flag: &str, value: &'a Option<String>) -> CliResult<&'a str> {
     value
         .as_deref()
-        .ok_or_else(|| CliError::msg(format!("field: {flag} is required")))
+        .ok_or_else(|| CliError::msg(format!("{flag} is required")))
 }
 
 /// A number; NaN and infinities parse here and are refused by the model with a reason.
 fn parse_number(flag: &str, text: &str) -> CliResult<f64> {
     text.trim()
         .parse::<f64>()
-        .map_err(|_| CliError::msg(format!("field: {flag}: `{text}` is not a number")))
+        .map_err(|_| CliError::msg(format!("{flag}: `{text}` is not a number")))
 }
 
 /// A decimal year (`2026.5`) or a calendar date (`2026-07-02`, 00:00 UTC).
@@ -125,7 +148,7 @@ fn parse_date(text: &str) -> CliResult<f64> {
     }
     let bad = || {
         CliError::msg(format!(
-            "field: --date: `{text}` is neither a decimal year (e.g. 2026.5) nor a date YYYY-MM-DD"
+            "--date: `{text}` is neither a decimal year (e.g. 2026.5) nor a date YYYY-MM-DD"
         ))
     };
     let mut parts = t.splitn(3, '-');
@@ -135,7 +158,7 @@ fn parse_date(text: &str) -> CliResult<f64> {
     let (Ok(y), Ok(m), Ok(d)) = (y.parse::<i32>(), m.parse::<u32>(), d.parse::<u32>()) else {
         return Err(bad());
     };
-    decimal_year_from_date(y, m, d).map_err(|e| CliError::msg(format!("field: --date: {e}")))
+    decimal_year_from_date(y, m, d).map_err(|e| CliError::msg(format!("--date: {e}")))
 }
 
 /// Today's decimal year in UTC from the system clock.
@@ -147,7 +170,7 @@ fn today_decimal_year() -> CliResult<f64> {
     };
     decimal_year_from_unix_seconds(unix_s).map_err(|e| {
         CliError::msg(format!(
-            "field: cannot read today's date from the system clock: {e}"
+            "cannot read today's date from the system clock: {e}"
         ))
     })
 }
@@ -156,18 +179,18 @@ fn today_decimal_year() -> CliResult<f64> {
 mod tests {
     use super::*;
 
-    fn args(lat: &str, lon: &str) -> Args {
-        Args {
+    fn args(lat: &str, lon: &str) -> Place {
+        Place {
             lat: Some(lat.into()),
             lon: Some(lon.into()),
-            ..Args::default()
+            ..Place::default()
         }
     }
 
     /// A row of the official WMM2025 test values: 2025.0, 100 km, 80° S 240° E.
     #[test]
     fn reproduces_a_test_value_row() {
-        let a = Args {
+        let a = Place {
             alt_km: Some("100".into()),
             ..args("-80", "240")
         };
@@ -189,7 +212,8 @@ mod tests {
             s
         };
         assert!(
-            one_line(evaluate(&Args::default(), 2026.0).unwrap_err()).contains("--lat is required")
+            one_line(evaluate(&Place::default(), 2026.0).unwrap_err())
+                .contains("--lat is required")
         );
         assert!(
             one_line(evaluate(&args("abc", "0"), 2026.0).unwrap_err()).contains("not a number")
@@ -204,7 +228,7 @@ mod tests {
 
     #[test]
     fn extrapolation_is_an_explicit_opt_in() {
-        let a = Args {
+        let a = Place {
             allow_extrapolation: true,
             ..args("10", "0")
         };

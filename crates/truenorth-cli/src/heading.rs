@@ -3,15 +3,18 @@
 use std::path::PathBuf;
 
 use nalgebra::{Vector2, Vector3};
-use truenorth::core::{Tilt, rad_to_deg, wrap_two_pi};
+use truenorth::core::{Declination, MagneticHeading, Tilt, rad_to_deg};
 
-use crate::io::{CalibrationFile, CliResult, CompassCalibration, Table, write_csv};
+use crate::field::Place;
+use crate::io::{CalibrationFile, CliError, CliResult, CompassCalibration, Table, write_csv};
 
 /// Arguments of `truenorth heading`.
 ///
 /// Input: CSV with `t_s,mag_x,mag_y` (plus `mag_z` for a 3-D calibration), strictly
-/// increasing time, other columns ignored. Output: CSV `t_s,heading_deg`, the magnetic
-/// heading in degrees clockwise from magnetic north, in [0, 360).
+/// increasing time, other columns ignored. Output: CSV `t_s,heading_deg`, in degrees
+/// clockwise in [0, 360): from magnetic north, or, with `--lat` and `--lon` (and optionally
+/// `--date`, default today), from true north — magnetic heading plus the World Magnetic
+/// Model 2025 declination at that place and date.
 ///
 /// A 2-D calibration gives `heading = atan2(−y, x)` of the corrected (x, y). A 3-D
 /// calibration corrects all three axes and takes the heading from the corrected x and y,
@@ -28,23 +31,28 @@ pub struct Args {
     /// Output CSV.
     #[arg(long)]
     pub output: PathBuf,
-    // Integrator: `--lat/--lon/--date` go here; see `reference_offset_rad`.
+    /// Where and when the recording was made, for true heading.
+    #[command(flatten)]
+    pub place: Place,
 }
 
-/// What to add to the magnetic heading to get the heading that is written: 0 (magnetic
-/// north) for now.
-///
-/// Integrator: with `--lat/--lon/--date` this returns the World Magnetic Model declination
-/// at that place and date (east positive), turning the output into true heading; the
-/// header of the output stays `heading_deg` and `--help` must say which north it is.
-fn reference_offset_rad(_args: &Args) -> CliResult<f64> {
-    Ok(0.0)
+/// The declination that turns magnetic into true heading, if a place was given.
+fn declination(args: &Args) -> CliResult<Option<Declination>> {
+    if args.place.is_given() {
+        Ok(Some(args.place.field()?.declination()))
+    } else if args.place.date.is_some() || args.place.alt_km.is_some() {
+        Err(CliError::msg(
+            "heading: --date and --alt-km need --lat and --lon (the declination depends on the place)",
+        ))
+    } else {
+        Ok(None)
+    }
 }
 
 /// Runs the subcommand.
 pub fn run(args: &Args) -> CliResult {
     let (_, cal) = CalibrationFile::read(&args.calibration)?;
-    let offset = reference_offset_rad(args)?;
+    let declination = declination(args)?;
     let needed: &[&str] = match cal {
         CompassCalibration::TwoD(_) => &["t_s", "mag_x", "mag_y"],
         CompassCalibration::ThreeD(_) => &["t_s", "mag_x", "mag_y", "mag_z"],
@@ -59,14 +67,18 @@ pub fn run(args: &Args) -> CliResult {
     };
     let rows = (0..table.len()).map(|k| {
         let magnetic = match (&cal, z) {
-            (CompassCalibration::TwoD(c), _) => c.heading_rad(&Vector2::new(x[k], y[k])),
+            (CompassCalibration::TwoD(c), _) => c.magnetic_heading(&Vector2::new(x[k], y[k])),
             // Level: zero pitch and roll, i.e. the corrected x and y.
             (CompassCalibration::ThreeD(c), Some(z)) => {
-                c.heading_rad(&Vector3::new(x[k], y[k], z[k]), &Tilt::default())
+                c.magnetic_heading(&Vector3::new(x[k], y[k], z[k]), &Tilt::default())
             }
-            (CompassCalibration::ThreeD(_), None) => f64::NAN,
+            (CompassCalibration::ThreeD(_), None) => MagneticHeading::new(f64::NAN),
         };
-        vec![t[k], rad_to_deg(wrap_two_pi(magnetic + offset))]
+        let rad = match declination {
+            Some(d) => magnetic.to_true(d).rad(),
+            None => magnetic.rad(),
+        };
+        vec![t[k], rad_to_deg(rad)]
     });
     write_csv(&args.output, &["t_s", "heading_deg"], rows)
 }

@@ -31,7 +31,8 @@ enum Command {
     Demo(demo::Args),
     /// Fit a compass calibration to a recording.
     Calibrate(calibrate::Args),
-    /// Apply a compass calibration to a recording and output heading.
+    /// Apply a compass calibration to a recording and output heading (from magnetic north;
+    /// from true north with --lat/--lon).
     Heading(heading::Args),
     /// The World Magnetic Model 2025 field at a place and date.
     Field(field::Args),

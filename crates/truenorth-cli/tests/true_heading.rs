@@ -1,0 +1,180 @@
+//! `heading --lat/--lon/--date`: true heading is magnetic heading plus the declination that
+//! `truenorth field` reports for the same place and date, added exactly once.
+
+use std::path::Path;
+use std::process::Command;
+
+fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_truenorth"))
+}
+
+fn run_ok(cmd: &mut Command) -> String {
+    let out = cmd.output().expect("the binary runs");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8_lossy(&out.stdout).into_owned()
+}
+
+fn headings(path: &Path) -> Vec<f64> {
+    std::fs::read_to_string(path)
+        .expect("output written")
+        .lines()
+        .skip(1)
+        .map(|l| {
+            l.split(',')
+                .nth(1)
+                .and_then(|h| h.parse().ok())
+                .expect("a number")
+        })
+        .collect()
+}
+
+#[test]
+fn true_heading_adds_the_wmm_declination_once() {
+    let dir = std::env::temp_dir().join(format!("truenorth-true-heading-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let input = dir.join("turn.csv");
+    // A level compass turning through a full circle with hard iron (3, -2) on a 20 µT field.
+    let mut csv = String::from("t_s,mag_x,mag_y\n");
+    for k in 0..360 {
+        let h = f64::from(k).to_radians();
+        csv += &format!(
+            "{},{},{}\n",
+            f64::from(k) * 0.1,
+            20.0 * h.cos() + 3.0,
+            -20.0 * h.sin() - 2.0
+        );
+    }
+    std::fs::write(&input, csv).unwrap();
+    let cal = dir.join("cal.json");
+    run_ok(
+        bin()
+            .args(["calibrate", "--method", "ellipse", "--input"])
+            .arg(&input)
+            .arg("--output")
+            .arg(&cal),
+    );
+
+    let magnetic = dir.join("magnetic.csv");
+    run_ok(
+        bin()
+            .arg("heading")
+            .arg("--calibration")
+            .arg(&cal)
+            .arg("--input")
+            .arg(&input)
+            .arg("--output")
+            .arg(&magnetic),
+    );
+    let truth = dir.join("true.csv");
+    let place = ["--lat", "51.5", "--lon", "-0.13", "--date", "2026.5"];
+    run_ok(
+        bin()
+            .arg("heading")
+            .arg("--calibration")
+            .arg(&cal)
+            .arg("--input")
+            .arg(&input)
+            .arg("--output")
+            .arg(&truth)
+            .args(place),
+    );
+
+    let field = run_ok(bin().arg("field").args(place));
+    let decl: f64 = field
+        .lines()
+        .nth(1)
+        .and_then(|r| r.split(',').nth(6))
+        .and_then(|d| d.parse().ok())
+        .unwrap();
+    assert!(decl.abs() > 0.1, "London's declination is not ~0: {decl}");
+    let (m, t) = (headings(&magnetic), headings(&truth));
+    assert_eq!(m.len(), 360);
+    for (k, (m, t)) in m.iter().zip(&t).enumerate() {
+        assert!((0.0..360.0).contains(t));
+        let d = (t - m - decl + 540.0).rem_euclid(360.0) - 180.0;
+        assert!(
+            d.abs() < 1e-4,
+            "row {k}: true {t} magnetic {m} declination {decl}"
+        );
+        // And the magnetic heading is the simulated one.
+        let e = (m - k as f64 + 540.0).rem_euclid(360.0) - 180.0;
+        assert!(e.abs() < 1e-6, "row {k}: magnetic {m}");
+    }
+
+    // A date without a place is refused with one line.
+    let out = bin()
+        .arg("heading")
+        .arg("--calibration")
+        .arg(&cal)
+        .arg("--input")
+        .arg(&input)
+        .arg("--output")
+        .arg(dir.join("x.csv"))
+        .args(["--date", "2026.5"])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(err.contains("--lat"), "{err}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn calibrate_compares_the_fit_with_the_wmm_field() {
+    let dir = std::env::temp_dir().join(format!("truenorth-expected-field-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let input = dir.join("turn.csv");
+    // 19.6 µT: London's horizontal field in 2026 (WMM2025 gives 19.56 µT).
+    let mut csv = String::from("t_s,mag_x,mag_y\n");
+    for k in 0..360 {
+        let h = f64::from(k).to_radians();
+        csv += &format!(
+            "{},{},{}\n",
+            f64::from(k) * 0.1,
+            19.6 * h.cos(),
+            -19.6 * h.sin()
+        );
+    }
+    std::fs::write(&input, csv).unwrap();
+    let cal = dir.join("cal.json");
+    let place = ["--lat", "51.5", "--lon", "-0.13", "--date", "2026.5"];
+    let calibrate = |unit: &str| {
+        bin()
+            .args(["calibrate", "--method", "ellipse", "--input"])
+            .arg(&input)
+            .arg("--output")
+            .arg(&cal)
+            .args(place)
+            .args(["--mag-unit", unit])
+            .output()
+            .unwrap()
+    };
+    let ok = calibrate("uT");
+    assert!(ok.status.success());
+    assert!(
+        ok.stderr.is_empty(),
+        "{}",
+        String::from_utf8_lossy(&ok.stderr)
+    );
+    let json = std::fs::read_to_string(&cal).unwrap();
+    let ratio: f64 = json
+        .split("\"field_ratio_to_expected\":")
+        .nth(1)
+        .and_then(|r| r.split([',', '}']).next())
+        .and_then(|r| r.trim().parse().ok())
+        .unwrap();
+    assert!((ratio - 1.0).abs() < 0.01, "{ratio}");
+
+    // Readings in µT declared as mG: ten times too small a field — a warning with the numbers.
+    let wrong = calibrate("mG");
+    assert!(wrong.status.success());
+    let err = String::from_utf8_lossy(&wrong.stderr);
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(err.contains("warning") && err.contains("0.10 x"), "{err}");
+    std::fs::remove_dir_all(&dir).ok();
+}
