@@ -325,9 +325,9 @@ pub fn require_arc(coverage: &Coverage, need_deg: f64) -> Result<()> {
 /// the solid angle covered, as an equivalent share of 360°.
 pub fn require_sphere_coverage(fraction: f64, need: f64) -> Result<()> {
     if fraction < need {
-        Err(Error::InsufficientCoverage {
-            covered_deg: fraction * 360.0,
-            need_deg: need * 360.0,
+        Err(Error::InsufficientSphereCoverage {
+            covered_fraction: fraction,
+            need_fraction: need,
         })
     } else {
         Ok(())

@@ -13,7 +13,7 @@ use truenorth::calib::{
     TurnCompassCalibrator, quality,
 };
 use truenorth::compass::{CompassCalibration2d, CompassCalibration3d};
-use truenorth::core::{Calibrator, Error, Mag2Sample, Mag3Sample, Quality, Solution};
+use truenorth::core::{Calibrator, Mag2Sample, Mag3Sample, Quality, Solution};
 
 use crate::field::Place;
 use crate::io::{
@@ -248,7 +248,7 @@ fn feed_and_solve<C: Calibrator>(
             format!(
                 "cannot calibrate with method `{}`: {}",
                 args.method.name(),
-                explain(args.method, &e)
+                e
             ),
         )
     })?;
@@ -257,24 +257,6 @@ fn feed_and_solve<C: Calibrator>(
         eprintln!("truenorth: warning: {}: {w}", args.input.display());
     }
     Ok(sol)
-}
-
-/// The library's reason, reworded where the 3-D case needs other words.
-fn explain(method: Method, e: &Error) -> String {
-    match (method, e) {
-        (
-            Method::Ellipsoid,
-            Error::InsufficientCoverage {
-                covered_deg,
-                need_deg,
-            },
-        ) => format!(
-            "the orientations fill only {:.0} % of the sphere's direction cells, need at least {:.0} %; tumble the sensor through more orientations (turns about three axes)",
-            100.0 * covered_deg / 360.0,
-            100.0 * need_deg / 360.0
-        ),
-        _ => e.to_string(),
-    }
 }
 
 fn file_for(

@@ -63,6 +63,18 @@ pub enum Error {
         /// Heading span required, degrees.
         need_deg: f64,
     },
+    /// The orientations seen cover too little of the sphere to determine a 3-D calibration.
+    #[error(
+        "the orientations fill only {:.0} % of the sphere's direction cells, need at least {:.0} %; tumble the sensor through more orientations (turns about three axes)",
+        100.0 * covered_fraction,
+        100.0 * need_fraction
+    )]
+    InsufficientSphereCoverage {
+        /// Share of direction cells with data, in [0, 1].
+        covered_fraction: f64,
+        /// Share required, in [0, 1].
+        need_fraction: f64,
+    },
     /// A turn-based method saw less than one full revolution.
     #[error(
         "the turn covered only {turned_deg:.0}°, need at least {need_deg:.0}°; drive a complete circle"
