@@ -3,6 +3,7 @@
 
 use nalgebra::{Matrix2, Vector2};
 use serde::{Deserialize, Serialize};
+use truenorth_core::check_range;
 use truenorth_core::{Error, NoiseSource, Result, SensorModel, check_finite, check_finite2};
 
 use crate::{CompassCalibration2d, Disturbance, Disturbances};
@@ -134,16 +135,7 @@ pub(crate) fn ned_to_level_body(n: f64, e: f64, heading_rad: f64) -> Vector2<f64
 }
 
 pub(crate) fn check_noise(noise_sigma: f64) -> Result<()> {
-    if noise_sigma.is_finite() && noise_sigma >= 0.0 {
-        Ok(())
-    } else {
-        Err(Error::OutOfRange {
-            what: "noise standard deviation",
-            value: noise_sigma,
-            min: 0.0,
-            max: f64::INFINITY,
-        })
-    }
+    check_range("noise standard deviation", noise_sigma, 0.0, f64::INFINITY).map(drop)
 }
 
 impl SensorModel for MagnetometerModel2d {

@@ -50,7 +50,9 @@ pub use sample::{
 };
 pub use sensor_model::SensorModel;
 pub use units::{STANDARD_GRAVITY_MPS2, deg_to_rad, mph_to_mps, mps_to_mph, rad_to_deg};
-pub use validate::{TimeStep, check_dt, check_finite, check_finite2, check_finite3};
+pub use validate::{
+    TimeStep, check_dt, check_finite, check_finite2, check_finite3, check_positive, check_range,
+};
 
 /// Float methods (`sin`, `sqrt`, `atan2`, …) for `f64` that work with and without `std`.
 ///

@@ -13,6 +13,40 @@ pub fn check_finite(what: &'static str, value: f64) -> Result<f64> {
     }
 }
 
+/// Returns `value` if it is finite and within `[min, max]`: otherwise
+/// [`Error::NonFinite`] or [`Error::OutOfRange`] naming `what` and the valid range.
+#[inline]
+pub fn check_range(what: &'static str, value: f64, min: f64, max: f64) -> Result<f64> {
+    check_finite(what, value)?;
+    if (min..=max).contains(&value) {
+        Ok(value)
+    } else {
+        Err(Error::OutOfRange {
+            what,
+            value,
+            min,
+            max,
+        })
+    }
+}
+
+/// Returns `value` if it is finite and strictly positive (a length, a gain, a rate).
+#[inline]
+pub fn check_positive(what: &'static str, value: f64) -> Result<f64> {
+    check_finite(what, value)?;
+    if value > 0.0 {
+        Ok(value)
+    } else {
+        Err(Error::OutOfRange {
+            what,
+            value,
+            // The smallest normal positive number stands for "just above zero".
+            min: f64::MIN_POSITIVE,
+            max: f64::MAX,
+        })
+    }
+}
+
 /// Checks both components of a 2-vector.
 #[inline]
 pub fn check_finite2(what: &'static str, v: &Vector2<f64>) -> Result<()> {
@@ -115,6 +149,18 @@ mod tests {
             );
             prop_assert!(is_nonincreasing_error);
             prop_assert_eq!(c.last_s(), Some(t));
+        }
+
+        #[test]
+        fn range_checks_accept_exactly_the_range(v in proptest::num::f64::ANY, a in -1e3f64..1e3, w in 0.0f64..1e3) {
+            let b = a + w;
+            let ok = v.is_finite() && v >= a && v <= b;
+            prop_assert_eq!(check_range("v", v, a, b).is_ok(), ok);
+            prop_assert_eq!(check_positive("v", v).is_ok(), v.is_finite() && v > 0.0);
+            if !v.is_finite() {
+                let non_finite = matches!(check_range("v", v, a, b), Err(Error::NonFinite { .. }));
+                prop_assert!(non_finite);
+            }
         }
 
         #[test]

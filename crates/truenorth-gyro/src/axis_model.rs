@@ -8,7 +8,8 @@
 use serde::{Deserialize, Serialize};
 #[allow(unused_imports)]
 use truenorth_core::Float as _;
-use truenorth_core::{Error, NoiseSource, Result, SensorModel, check_dt, check_finite};
+use truenorth_core::check_range;
+use truenorth_core::{NoiseSource, Result, SensorModel, check_dt, check_finite};
 
 use crate::GyroCalibration;
 
@@ -63,44 +64,32 @@ impl GyroAxisParams {
         check_finite("gyro bias_rps", self.bias_rps)?;
         check_finite("gyro temp_coeff_rps_per_k", self.temp_coeff_rps_per_k)?;
         check_finite("gyro ref_temp_c", self.ref_temp_c)?;
-        non_negative(
+        check_range(
             "gyro bias_walk_rps_per_sqrt_s",
             self.bias_walk_rps_per_sqrt_s,
+            0.0,
+            f64::MAX,
         )?;
-        non_negative(
+        check_range(
             "gyro noise_density_rps_per_sqrt_hz",
             self.noise_density_rps_per_sqrt_hz,
+            0.0,
+            f64::MAX,
         )?;
-        scale_error("gyro scale_error_pos", self.scale_error_pos)?;
-        scale_error("gyro scale_error_neg", self.scale_error_neg)?;
+        check_range(
+            "gyro scale_error_pos",
+            self.scale_error_pos,
+            MIN_SCALE_ERROR,
+            f64::MAX,
+        )?;
+        check_range(
+            "gyro scale_error_neg",
+            self.scale_error_neg,
+            MIN_SCALE_ERROR,
+            f64::MAX,
+        )?;
         Ok(())
     }
-}
-
-fn non_negative(what: &'static str, value: f64) -> Result<()> {
-    check_finite(what, value)?;
-    if value < 0.0 {
-        return Err(Error::OutOfRange {
-            what,
-            value,
-            min: 0.0,
-            max: f64::MAX,
-        });
-    }
-    Ok(())
-}
-
-fn scale_error(what: &'static str, value: f64) -> Result<()> {
-    check_finite(what, value)?;
-    if value < MIN_SCALE_ERROR {
-        return Err(Error::OutOfRange {
-            what,
-            value,
-            min: MIN_SCALE_ERROR,
-            max: f64::MAX,
-        });
-    }
-    Ok(())
 }
 
 /// Coefficients derived from [`GyroAxisParams`] once, at construction.
@@ -255,7 +244,7 @@ impl SensorModel for GyroAxisModel {
 mod tests {
     use super::*;
     use proptest::prelude::*;
-    use truenorth_core::{Calibration, SplitMix64, ZeroNoise};
+    use truenorth_core::{Calibration, Error, SplitMix64, ZeroNoise};
 
     fn params() -> impl Strategy<Value = GyroAxisParams> {
         (

@@ -7,7 +7,8 @@
 
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
-use truenorth_core::{Calibration, Error, Result, check_finite};
+use truenorth_core::check_positive;
+use truenorth_core::{Calibration, Result, check_finite};
 
 /// Zero and gain of one gyro axis: `rate = (raw − zero) / gain`, with `gain_pos` used when
 /// `raw − zero ≥ 0` and `gain_neg` otherwise. Gains are dimensionless (raw rad/s per true
@@ -26,19 +27,6 @@ impl Default for GyroCalibration {
     fn default() -> Self {
         Self::IDENTITY
     }
-}
-
-fn gain(what: &'static str, value: f64) -> Result<f64> {
-    check_finite(what, value)?;
-    if value <= 0.0 {
-        return Err(Error::OutOfRange {
-            what,
-            value,
-            min: f64::MIN_POSITIVE,
-            max: f64::MAX,
-        });
-    }
-    Ok(value)
 }
 
 impl GyroCalibration {
@@ -69,8 +57,8 @@ impl GyroCalibration {
     /// loading parameters from disk).
     pub fn validate(&self) -> Result<()> {
         check_finite("gyro calibration zero_rps", self.zero_rps)?;
-        gain("gyro calibration gain_pos", self.gain_pos)?;
-        gain("gyro calibration gain_neg", self.gain_neg)?;
+        check_positive("gyro calibration gain_pos", self.gain_pos)?;
+        check_positive("gyro calibration gain_neg", self.gain_neg)?;
         Ok(())
     }
 

@@ -42,6 +42,7 @@
 use serde::{Deserialize, Serialize};
 #[allow(unused_imports)]
 use truenorth_core::Float as _;
+use truenorth_core::check_positive;
 use truenorth_core::{Error, Result, check_finite};
 
 use crate::{EffectiveTrack, WheelDistances};
@@ -76,8 +77,8 @@ impl AckermannParams {
 
     /// Checks the dimensions: B > 0, T_F > 0, 0 ≤ p < min(T_F/2, B), all finite.
     pub fn validate(&self) -> Result<()> {
-        positive("wheelbase_m", self.wheelbase_m)?;
-        positive("front track_m", self.track_m)?;
+        check_positive("wheelbase_m", self.wheelbase_m)?;
+        check_positive("front track_m", self.track_m)?;
         let p = check_finite("kingpin_offset_m", self.kingpin_offset_m)?;
         // p = T_F/2 would put both kingpins on the centre line; p ≥ B would let the inner
         // wheel's contact point reach the turn centre.
@@ -92,19 +93,6 @@ impl AckermannParams {
         }
         Ok(())
     }
-}
-
-pub(crate) fn positive(what: &'static str, value: f64) -> Result<f64> {
-    check_finite(what, value)?;
-    if value <= 0.0 {
-        return Err(Error::OutOfRange {
-            what,
-            value,
-            min: f64::MIN_POSITIVE,
-            max: f64::MAX,
-        });
-    }
-    Ok(value)
 }
 
 /// Quantities derived from [`AckermannParams`] once.

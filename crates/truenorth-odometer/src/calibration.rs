@@ -8,8 +8,8 @@ use serde::{Deserialize, Serialize};
 use truenorth_core::{Calibration, Result, check_finite};
 
 use crate::WheelDistances;
-use crate::ackermann::positive;
 use crate::differential::speed_factor;
+use truenorth_core::check_positive;
 
 /// What the calibration needs: one step's raw wheel distances and the mean speed of the two
 /// odometer wheels over the step (`|AD| / dt`, as the odometer itself can measure it).
@@ -64,8 +64,8 @@ impl OdometerCalibration {
 
     /// Checks the gains and `a` (useful after loading from disk).
     pub fn validate(&self) -> Result<()> {
-        positive("odometer gain_l", self.gain_l)?;
-        positive("odometer gain_r", self.gain_r)?;
+        check_positive("odometer gain_l", self.gain_l)?;
+        check_positive("odometer gain_r", self.gain_r)?;
         check_finite("speed coefficient a (s²/m²)", self.speed_coeff_s2_per_m2)?;
         Ok(())
     }

@@ -5,13 +5,13 @@
 
 use truenorth_core::{Error, Result, check_finite};
 
-use crate::ackermann::positive;
+use truenorth_core::check_positive;
 
 /// Plain differential heading change `Δθ = (D_L − D_R) / T` (eq. 1/7), radians.
 pub fn heading_change_plain_rad(dist_l_m: f64, dist_r_m: f64, track_m: f64) -> Result<f64> {
     let l = check_finite("left wheel distance", dist_l_m)?;
     let r = check_finite("right wheel distance", dist_r_m)?;
-    let t = positive("track_m", track_m)?;
+    let t = check_positive("track_m", track_m)?;
     // Huge finite inputs can overflow; say so instead of returning inf.
     check_finite("heading change (wheel distances too large)", (l - r) / t)
 }

@@ -8,7 +8,7 @@
 use serde::{Deserialize, Serialize};
 use truenorth_core::{Result, check_finite};
 
-use crate::ackermann::positive;
+use truenorth_core::check_positive;
 
 /// A source of effective track as a function of the measured curvature ratio.
 pub trait EffectiveTrack {
@@ -31,7 +31,7 @@ impl FixedTrack {
     /// A fixed track of `track_m` metres (positive, finite).
     pub fn new(track_m: f64) -> Result<Self> {
         Ok(Self {
-            track_m: positive("track_m", track_m)?,
+            track_m: check_positive("track_m", track_m)?,
         })
     }
 

@@ -14,13 +14,12 @@
 use serde::{Deserialize, Serialize};
 #[allow(unused_imports)]
 use truenorth_core::Float as _;
-use truenorth_core::{
-    Error, NoiseSource, Result, SensorModel, WheelSample, check_dt, check_finite,
-};
+use truenorth_core::check_range;
+use truenorth_core::{NoiseSource, Result, SensorModel, WheelSample, check_dt, check_finite};
 
-use crate::ackermann::positive;
 use crate::differential::speed_factor;
 use crate::{OdometerCalibration, OdometerWheels, WheelDistances, WheelGeometry, WheelMotion};
+use truenorth_core::check_positive;
 
 /// Smallest accepted scale error (a gain of 0.001; ≤ 0 could not be inverted).
 pub const MIN_SCALE_ERROR: f64 = -0.999;
@@ -51,19 +50,6 @@ impl OdometerParams {
             dist_per_pulse_m: None,
         }
     }
-}
-
-fn scale_error(what: &'static str, value: f64) -> Result<f64> {
-    check_finite(what, value)?;
-    if value < MIN_SCALE_ERROR {
-        return Err(Error::OutOfRange {
-            what,
-            value,
-            min: MIN_SCALE_ERROR,
-            max: f64::MAX,
-        });
-    }
-    Ok(value)
 }
 
 /// Quantities derived from [`OdometerParams`] once.
@@ -102,11 +88,23 @@ impl OdometerModel {
     /// Validates the parameters and builds the model (all accumulators at zero).
     pub fn new(params: OdometerParams) -> Result<Self> {
         let geometry = WheelGeometry::new(params.wheels)?;
-        let gain_l = 1.0 + scale_error("odometer scale_error_l", params.scale_error_l)?;
-        let gain_r = 1.0 + scale_error("odometer scale_error_r", params.scale_error_r)?;
+        let gain_l = 1.0
+            + check_range(
+                "odometer scale_error_l",
+                params.scale_error_l,
+                MIN_SCALE_ERROR,
+                f64::MAX,
+            )?;
+        let gain_r = 1.0
+            + check_range(
+                "odometer scale_error_r",
+                params.scale_error_r,
+                MIN_SCALE_ERROR,
+                f64::MAX,
+            )?;
         check_finite("speed coefficient a (s²/m²)", params.speed_coeff_s2_per_m2)?;
         if let Some(d) = params.dist_per_pulse_m {
-            positive("dist_per_pulse_m", d)?;
+            check_positive("dist_per_pulse_m", d)?;
         }
         Ok(Self {
             params,
@@ -290,7 +288,7 @@ mod tests {
     use super::*;
     use crate::AckermannParams;
     use proptest::prelude::*;
-    use truenorth_core::{Calibration, ZeroNoise};
+    use truenorth_core::{Calibration, Error, ZeroNoise};
 
     use crate::OdometerRaw;
 

@@ -24,8 +24,8 @@
 use truenorth_core::Float as _;
 use truenorth_core::{Error, Result, check_finite};
 
-use crate::ackermann::positive;
 use crate::{AckermannParams, EffectiveTrack};
+use truenorth_core::check_positive;
 
 /// US 4,788,645 eq. 14 for one vehicle, with its derived coefficients.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -44,8 +44,8 @@ impl PatentAckermannTrack {
     /// The patent gives P as "approx. 1/8" in one place and "approximately 1/3" in another,
     /// so it is a parameter.
     pub fn new(wheelbase_m: f64, track_m: f64, pitman_ratio: f64) -> Result<Self> {
-        positive("wheelbase_m", wheelbase_m)?;
-        positive("front track_m", track_m)?;
+        check_positive("wheelbase_m", wheelbase_m)?;
+        check_positive("front track_m", track_m)?;
         let p = check_finite("pitman_ratio", pitman_ratio)?;
         if !(0.0..1.0).contains(&p) {
             return Err(Error::OutOfRange {

@@ -4,8 +4,8 @@
 use serde::{Deserialize, Serialize};
 use truenorth_core::{Result, check_finite};
 
-use crate::ackermann::positive;
 use crate::{AckermannGeometry, AckermannParams, RigidMotion};
+use truenorth_core::check_positive;
 
 /// Which pair of wheels the odometer senses (the parameters; see [`WheelGeometry`]).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -38,7 +38,7 @@ impl WheelGeometry {
     pub fn new(wheels: OdometerWheels) -> Result<Self> {
         Ok(match wheels {
             OdometerWheels::Rear { track_m } => Self::Rear {
-                track_m: positive("rear track_m", track_m)?,
+                track_m: check_positive("rear track_m", track_m)?,
             },
             OdometerWheels::Front(p) => Self::Front(AckermannGeometry::new(p)?),
         })

@@ -2,6 +2,7 @@
 //! curvature), built from distances, turn angles and speeds so scenarios read like directions.
 
 use serde::{Deserialize, Serialize};
+use truenorth_core::check_positive;
 use truenorth_core::{Error, Result};
 
 /// One driving command, held for `duration_s`.
@@ -72,7 +73,7 @@ impl RouteBuilder {
 
     /// Starts already moving at `speed_mps` (no run-up).
     pub fn at_speed(speed_mps: f64) -> Result<Self> {
-        positive("speed_mps", speed_mps)?;
+        check_positive("speed_mps", speed_mps)?;
         Ok(Self {
             speed_mps,
             route: Route {
@@ -100,7 +101,7 @@ impl RouteBuilder {
 
     /// Drives straight for `distance_m` at the current speed.
     pub fn straight(mut self, distance_m: f64) -> Result<Self> {
-        positive("distance_m", distance_m)?;
+        check_positive("distance_m", distance_m)?;
         let v = self.moving()?;
         self.route.commands.push(Command {
             duration_s: distance_m / v,
@@ -113,8 +114,8 @@ impl RouteBuilder {
     /// Turns through `angle_rad` (positive right) on a circle of `radius_m` at the current
     /// speed.
     pub fn turn(mut self, angle_rad: f64, radius_m: f64) -> Result<Self> {
-        positive("radius_m", radius_m)?;
-        positive("|angle_rad|", angle_rad.abs())?;
+        check_positive("radius_m", radius_m)?;
+        check_positive("|angle_rad|", angle_rad.abs())?;
         let v = self.moving()?;
         self.route.commands.push(Command {
             duration_s: angle_rad.abs() * radius_m / v,
@@ -134,7 +135,7 @@ impl RouteBuilder {
                 max: f64::INFINITY,
             });
         }
-        positive("accel_mps2", accel_mps2.abs())?;
+        check_positive("accel_mps2", accel_mps2.abs())?;
         let dv = to_mps - self.speed_mps;
         if dv != 0.0 {
             self.route.commands.push(Command {
@@ -149,7 +150,7 @@ impl RouteBuilder {
 
     /// Stands still for `duration_s` (the vehicle must be at rest).
     pub fn stop(mut self, duration_s: f64) -> Result<Self> {
-        positive("duration_s", duration_s)?;
+        check_positive("duration_s", duration_s)?;
         if self.speed_mps != 0.0 {
             return Err(Error::NotReady {
                 what: "a vehicle at rest",
@@ -167,18 +168,5 @@ impl RouteBuilder {
     /// The route.
     pub fn build(self) -> Route {
         self.route
-    }
-}
-
-fn positive(what: &'static str, value: f64) -> Result<()> {
-    if value.is_finite() && value > 0.0 {
-        Ok(())
-    } else {
-        Err(Error::OutOfRange {
-            what,
-            value,
-            min: f64::MIN_POSITIVE,
-            max: f64::INFINITY,
-        })
     }
 }
