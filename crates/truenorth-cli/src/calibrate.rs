@@ -7,7 +7,7 @@
 
 use std::path::{Path, PathBuf};
 
-use nalgebra::{Vector2, Vector3};
+use nalgebra::{SMatrix, SVector, Vector2, Vector3};
 use truenorth::calib::{
     BinnedEllipseCalibrator, EllipseCalibrator, EllipsoidCalibrator, MeritCircleCalibrator,
     TurnCompassCalibrator, quality,
@@ -187,15 +187,10 @@ where
 {
     let samples = read_2d(&args.input)?;
     let sol = feed_and_solve(args, &mut cal, &samples, expected_field(args, 2)?)?;
-    let p = &sol.params;
     Ok(file_for(
         args,
-        2,
-        p.hard_iron.iter().copied().collect(),
-        p.soft_iron
-            .row_iter()
-            .map(|r| r.iter().copied().collect())
-            .collect(),
+        &sol.params.hard_iron,
+        &sol.params.soft_iron,
         sol.quality,
     ))
 }
@@ -217,15 +212,10 @@ where
         })
         .collect();
     let sol = feed_and_solve(args, &mut cal, &samples, expected_field(args, 3)?)?;
-    let p = &sol.params;
     Ok(file_for(
         args,
-        3,
-        p.hard_iron.iter().copied().collect(),
-        p.soft_iron
-            .row_iter()
-            .map(|r| r.iter().copied().collect())
-            .collect(),
+        &sol.params.hard_iron,
+        &sol.params.soft_iron,
         sol.quality,
     ))
 }
@@ -259,20 +249,23 @@ fn feed_and_solve<C: Calibrator>(
     Ok(sol)
 }
 
-fn file_for(
+fn file_for<const D: usize>(
     args: &Args,
-    dimensions: usize,
-    hard_iron: Vec<f64>,
-    soft_iron: Vec<Vec<f64>>,
+    hard_iron: &SVector<f64, D>,
+    soft_iron: &SMatrix<f64, D, D>,
     q: Quality,
 ) -> CalibrationFile {
     CalibrationFile {
         format: CALIBRATION_FORMAT.into(),
         version: CALIBRATION_VERSION,
         method: args.method.name().into(),
-        dimensions,
-        hard_iron,
-        soft_iron,
+        dimensions: D,
+        hard_iron: hard_iron.iter().copied().collect(),
+        // Row by row, as the file format says.
+        soft_iron: soft_iron
+            .row_iter()
+            .map(|r| r.iter().copied().collect())
+            .collect(),
         field: q.field_magnitude,
         quality: Some(q.into()),
         input: args.input.display().to_string(),
