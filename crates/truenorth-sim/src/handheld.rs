@@ -5,7 +5,7 @@ use core::f64::consts::TAU;
 
 use nalgebra::{UnitQuaternion, Vector3};
 use serde::{Deserialize, Serialize};
-use truenorth_core::{Error, NoiseSource, Result, STANDARD_GRAVITY_MPS2, SplitMix64};
+use truenorth_core::{Error, NoiseSource, Result, STANDARD_GRAVITY_MPS2, SplitMix64, check_range};
 
 /// Ground truth of a hand-held motion at one instant.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -97,7 +97,12 @@ pub fn handheld_motion(p: &HandheldParams) -> Result<Vec<MotionTruth>> {
         ) * p.accel_amplitude_mps2
     };
     let dt = 1.0 / p.rate_hz;
-    let n = (p.duration_s * p.rate_hz).round() as usize;
+    let n = check_range(
+        "hand-held samples (duration × rate)",
+        (p.duration_s * p.rate_hz).round(),
+        0.0,
+        crate::vehicle::MAX_SAMPLES,
+    )? as usize;
     let g = Vector3::new(0.0, 0.0, STANDARD_GRAVITY_MPS2);
     let mut q = UnitQuaternion::identity();
     let mut out = Vec::with_capacity(n + 1);

@@ -31,4 +31,4 @@ pub use route::{Command, Route, RouteBuilder};
 pub use streams::{
     ImuSensorParams, VehicleSensorParams, imu_streams, rotated_soft_iron, vehicle_streams,
 };
-pub use vehicle::{VehicleTruth, simulate};
+pub use vehicle::{MAX_SAMPLES, VehicleTruth, simulate};

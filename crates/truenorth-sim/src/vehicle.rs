@@ -1,9 +1,13 @@
 //! Rear-axle kinematic vehicle: integrates a [`Route`] into ground truth at a fixed rate.
 
 use serde::{Deserialize, Serialize};
-use truenorth_core::{Error, Result, wrap_pi};
+use truenorth_core::{Error, Result, check_range, wrap_pi};
 
 use crate::route::Route;
+
+/// Most samples one simulation may produce (10⁸: about 8 GB of truth); more is refused
+/// rather than attempted.
+pub const MAX_SAMPLES: f64 = 1e8;
 
 /// The state of the vehicle (rear-axle centre) at one instant: the ground truth.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
@@ -47,8 +51,14 @@ pub fn simulate(route: &Route, heading0_rad: f64, rate_hz: f64) -> Result<Vec<Ve
     }
     let dt = 1.0 / rate_hz;
     let total = route.duration_s();
+    let steps = check_range(
+        "route samples (duration × rate)",
+        total * rate_hz,
+        0.0,
+        MAX_SAMPLES,
+    )?;
     // Whole steps strictly before the end, then the end itself.
-    let whole = ((total * rate_hz) * (1.0 - 1e-12)).floor() as usize;
+    let whole = (steps * (1.0 - 1e-12)).floor() as usize;
     let mut out = Vec::with_capacity(whole + 2);
     let mut s = VehicleTruth {
         heading_rad: wrap_pi(heading0_rad),
