@@ -78,6 +78,13 @@ fn bad_inputs_are_typed_errors() {
         })
         .is_err()
     );
+    // Absurd sizes are refused, not attempted.
+    assert!(simulate(&route, 0.0, 1e300).is_err());
+    let huge = HandheldParams {
+        rate_hz: 1e300,
+        ..Default::default()
+    };
+    assert!(handheld_motion(&huge).is_err());
 }
 
 proptest! {
