@@ -267,15 +267,13 @@ pub fn sphere_coverage<'a>(
 /// circle than they are; this measure cannot be fooled that way.
 ///
 /// The directions of successive chords stand in for the tangent at chord midpoints; their
-/// wrapped differences telescope, so noise enters only at the two ends, and half a chord's
-/// turning is added at each end to reach the first and last points. Chords shorter than
+/// wrapped differences telescope, so noise enters only at the two ends, and half the end
+/// chords' turn is added at each end to reach the first and last points. Chords shorter than
 /// 10⁻¹² of the locus size are skipped. Fewer than three usable points give 0.
 pub fn locus_turning_rad<'a>(points: impl IntoIterator<Item = &'a Vector2<f64>>) -> f64 {
     let mut prev_point: Option<Vector2<f64>> = None;
-    let mut first_dir: Option<f64> = None;
-    let mut dir = 0.0;
-    let mut chords = 0usize;
-    let mut turned = 0.0;
+    let mut dir: Option<f64> = None;
+    let (mut turned, mut first_turn, mut last_turn) = (0.0, None, 0.0);
     for p in points {
         if !(p.x.is_finite() && p.y.is_finite()) {
             continue;
@@ -289,20 +287,22 @@ pub fn locus_turning_rad<'a>(points: impl IntoIterator<Item = &'a Vector2<f64>>)
             continue;
         }
         let a = d.y.atan2(d.x);
-        match first_dir {
-            None => first_dir = Some(a),
-            Some(_) => turned += angle_diff(a, dir),
+        if let Some(prev) = dir {
+            let turn = angle_diff(a, prev);
+            turned += turn;
+            first_turn.get_or_insert(turn);
+            last_turn = turn;
         }
-        dir = a;
-        chords += 1;
+        dir = Some(a);
         prev_point = Some(*p);
     }
-    if chords < 2 {
-        return 0.0;
+    // End correction: the chords' directions are the tangent half a chord in from each end;
+    // the turning there is about half the turn between the two end chords. Local, so it
+    // holds where the turning bunches up (the ends of a long axis).
+    match first_turn {
+        Some(first) => (turned + 0.5 * (first + last_turn)).abs(),
+        None => 0.0,
     }
-    let turned = turned.abs();
-    // End correction: half a mean chord step at each end.
-    turned + turned / (chords - 1) as f64
 }
 
 /// Refuses a 2-D calibration whose data span less than `need_deg` of heading (see

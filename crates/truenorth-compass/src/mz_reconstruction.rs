@@ -216,8 +216,11 @@ mod tests {
             let mag = rec.magnitude(&m.xy()).unwrap();
             prop_assert!((mag - m.z.abs()).abs() < 1e-6 * total);
             // The sign (and so the heading) is right wherever M_z is not too close to zero for
-            // a previous-azimuth error to flip it.
-            prop_assume!(m.z.abs() > 0.3 * total);
+            // a previous-azimuth error to flip it (elsewhere the magnitude check above is all
+            // there is to test, so the case passes rather than counting as a reject).
+            if m.z.abs() <= 0.3 * total {
+                return Ok(());
+            }
             let got = rec.reconstruct(&m.xy(), &att.tilt(), yaw + prev_err).unwrap();
             prop_assert!((got - m).norm() < 1e-6 * total, "got {:?} want {:?}", got, m);
             let h = rec.heading_rad(&m.xy(), &att.tilt(), yaw + prev_err).unwrap();
