@@ -29,6 +29,7 @@ mod vehicle;
 pub use handheld::{HandheldParams, MotionTruth, handheld_motion};
 pub use route::{Command, Route, RouteBuilder};
 pub use streams::{
-    ImuSensorParams, VehicleSensorParams, imu_streams, rotated_soft_iron, vehicle_streams,
+    ImuSensorParams, VehicleSensorParams, imu_streams, rotated_soft_iron, vehicle_accel_stream,
+    vehicle_streams,
 };
 pub use vehicle::{MAX_SAMPLES, VehicleTruth, simulate};

@@ -7,7 +7,7 @@ use truenorth_compass::{
     AttitudeTruth, HeadingTruth, MagnetometerModel2d, MagnetometerModel3d, earth_field_ned,
 };
 use truenorth_core::{
-    EulerZyx, ImuSample, Result, SensorModel, SplitMix64, VehicleSample, angle_diff,
+    AccelSample, EulerZyx, ImuSample, Result, SensorModel, SplitMix64, VehicleSample, angle_diff,
 };
 use truenorth_gyro::{Gyro3Model, GyroAxisModel, GyroAxisParams, Rate3Truth, RateTruth};
 use truenorth_odometer::{OdometerModel, OdometerParams, OdometerWheels, WheelMotion};
@@ -138,6 +138,48 @@ pub fn vehicle_streams(
             mag: Some(mag),
         });
         prev = Some(s);
+    }
+    Ok(out)
+}
+
+/// Runs `truth` through an accelerometer fixed level in the vehicle (x forward, y right,
+/// z down). The vehicle's own acceleration is the rear-axle point's: `dv/dt` forward and
+/// `v²κ` to the right (centripetal, towards the centre of a right turn), so a level sensor
+/// reads `(dv/dt, v²κ, −g)` plus its errors. Random errors drawn from `seed`.
+pub fn vehicle_accel_stream(
+    truth: &[VehicleTruth],
+    params: &AccelParams,
+    seed: u64,
+) -> Result<Vec<AccelSample>> {
+    let mut rng = SplitMix64::new(seed);
+    let accel = AccelModel::new(*params)?;
+    let mut out = Vec::with_capacity(truth.len());
+    let mut prev_t: Option<f64> = None;
+    for s in truth {
+        let forward = s.accel_mps2;
+        let right = s.speed_mps * s.speed_mps * s.curvature_per_m;
+        let (sin, cos) = s.heading_rad.sin_cos();
+        let a = AccelTruth {
+            attitude: EulerZyx {
+                yaw_rad: s.heading_rad,
+                ..EulerZyx::default()
+            }
+            .to_quaternion(),
+            accel_ned_mps2: Vector3::new(
+                forward * cos - right * sin,
+                forward * sin + right * cos,
+                0.0,
+            ),
+        };
+        let reading = match prev_t {
+            None => accel.ideal(&a),
+            Some(p) => accel.try_sample(&a, s.t_s - p, &mut rng)?,
+        };
+        out.push(AccelSample {
+            t_s: s.t_s,
+            acc_mps2: reading,
+        });
+        prev_t = Some(s.t_s);
     }
     Ok(out)
 }

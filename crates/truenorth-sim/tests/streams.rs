@@ -7,8 +7,8 @@ use truenorth_core::angle_diff;
 use truenorth_gyro::GyroAxisParams;
 use truenorth_odometer::{OdometerParams, OdometerWheels};
 use truenorth_sim::{
-    HandheldParams, ImuSensorParams, VehicleSensorParams, handheld_motion, imu_streams, scenario,
-    simulate, vehicle_streams,
+    HandheldParams, ImuSensorParams, RouteBuilder, VehicleSensorParams, handheld_motion,
+    imu_streams, scenario, simulate, vehicle_accel_stream, vehicle_streams,
 };
 
 fn perfect_vehicle() -> VehicleSensorParams {
@@ -97,8 +97,43 @@ fn typical_compass_is_undone_by_its_true_calibration() {
     }
 }
 
+#[test]
+fn perfect_vehicle_accelerometer_reads_forward_and_centripetal_acceleration() {
+    let truth = simulate(&scenario::city_blocks(3, 80.0).unwrap(), 1.1, 50.0).unwrap();
+    let acc = vehicle_accel_stream(&truth, &AccelParams::default(), 5).unwrap();
+    assert_eq!(acc.len(), truth.len());
+    let g = truenorth_core::STANDARD_GRAVITY_MPS2;
+    for (t, a) in truth.iter().zip(&acc) {
+        let want = Vector3::new(
+            t.accel_mps2,
+            t.speed_mps * t.speed_mps * t.curvature_per_m,
+            -g,
+        );
+        assert!(
+            (a.acc_mps2 - want).norm() < 1e-9,
+            "{} vs {want}",
+            a.acc_mps2
+        );
+    }
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(16))]
+
+    #[test]
+    fn circle_at_steady_speed_reads_v_squared_over_r(
+        speed in 1.0f64..30.0, radius in 5.0f64..200.0, left in any::<bool>(),
+    ) {
+        let angle = if left { -3.0 } else { 3.0 };
+        let route = RouteBuilder::at_speed(speed).unwrap().turn(angle, radius).unwrap().build();
+        let truth = simulate(&route, 0.0, 20.0).unwrap();
+        let acc = vehicle_accel_stream(&truth, &AccelParams::default(), 1).unwrap();
+        let lateral = angle.signum() * speed * speed / radius;
+        for a in &acc {
+            prop_assert!((a.acc_mps2.y - lateral).abs() < 1e-9 * lateral.abs().max(1.0));
+            prop_assert!(a.acc_mps2.x.abs() < 1e-12);
+        }
+    }
 
     #[test]
     fn streams_are_deterministic_by_seed(seed in any::<u64>()) {
