@@ -75,6 +75,44 @@ pub fn write_plot(
         svg,
         r##"<rect x="{MARGIN}" y="{MARGIN}" width="{SIZE}" height="{SIZE}" fill="none" stroke="#888"/>"##
     );
+    // Tick labels at round values (1, 2 or 5 times a power of ten), about six per axis.
+    let step = nice_step(span / 6.0);
+    for (lo, to_px, vertical) in [
+        (cx - span / 2.0, &sx as &dyn Fn(f64) -> f64, true),
+        (cy - span / 2.0, &sy, false),
+    ] {
+        let mut v = (lo / step).ceil() * step;
+        while v <= lo + span {
+            let px = to_px(v);
+            let label = format!("{}", (v / step).round() * step);
+            if vertical {
+                let _ = writeln!(
+                    svg,
+                    r##"<line x1="{px:.1}" y1="{0}" x2="{px:.1}" y2="{1}" stroke="#888"/>"##,
+                    MARGIN + SIZE,
+                    MARGIN + SIZE + 5.0
+                );
+                let _ = writeln!(
+                    svg,
+                    r#"<text x="{px:.1}" y="{}" text-anchor="middle" font-size="11">{label}</text>"#,
+                    MARGIN + SIZE + 18.0
+                );
+            } else {
+                let _ = writeln!(
+                    svg,
+                    r##"<line x1="{0}" y1="{px:.1}" x2="{MARGIN}" y2="{px:.1}" stroke="#888"/>"##,
+                    MARGIN - 5.0
+                );
+                let _ = writeln!(
+                    svg,
+                    r#"<text x="{}" y="{:.1}" text-anchor="end" font-size="11">{label}</text>"#,
+                    MARGIN - 8.0,
+                    px + 4.0
+                );
+            }
+            v += step;
+        }
+    }
     // Axes through zero when zero is in view.
     if (cx - span / 2.0..cx + span / 2.0).contains(&0.0) {
         let _ = writeln!(
@@ -133,4 +171,14 @@ pub fn write_plot(
     }
     svg.push_str("</svg>\n");
     std::fs::write(path, svg).map_err(|e| CliError::file(path, format!("cannot write: {e}")))
+}
+
+/// The round step (1, 2 or 5 × 10ⁿ) nearest above `raw`.
+fn nice_step(raw: f64) -> f64 {
+    let p = 10f64.powf(raw.max(1e-300).log10().floor());
+    [1.0, 2.0, 5.0, 10.0]
+        .iter()
+        .map(|m| m * p)
+        .find(|&s| s >= raw)
+        .unwrap_or(10.0 * p)
 }
