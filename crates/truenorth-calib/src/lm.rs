@@ -85,11 +85,23 @@ pub(crate) struct LmOutcome<const P: usize> {
 /// minimum to rounding precision.
 const LAMBDA_MAX: f64 = 1e16;
 
+/// The largest decrease of the cost that any step can bring according to the Gauss–Newton
+/// model `Σ (rᵢ + Jᵢδ)²`: `gᵀ(JᵀJ)⁻¹g` with `g = Jᵀr` (the squared Newton decrement of
+/// Boyd & Vandenberghe 2004, *Convex Optimization*, §9.5.1, for this model). `None` when
+/// `JᵀJ` is not positive definite.
+fn gauss_newton_decrement<const P: usize>(ne: &NormalEquations<P>) -> Option<f64> {
+    let g = &ne.jtr;
+    let d = g.dot(&ne.jtj.cholesky()?.solve(g));
+    d.is_finite().then_some(d)
+}
+
 /// Minimises the cost from `start`. `eval` returns `None` where the model is undefined
 /// (e.g. a matrix became singular); such trial points are rejected like uphill ones.
 ///
 /// Converges when an accepted step lowers the cost by less than `1e-12` of itself or moves
-/// the parameters by less than `1e-12` of their norm; refuses with
+/// the parameters by less than `1e-12` of their norm, or — checked before each step, so
+/// the last, negligible step needs no pass over the data — when the Gauss–Newton model
+/// says no step can lower the cost by more than `1e-12` of itself; refuses with
 /// [`Error::NoConvergence`] after `max_iterations` accepted steps without that.
 pub(crate) fn minimise<const P: usize>(
     what: &'static str,
@@ -105,6 +117,12 @@ pub(crate) fn minimise<const P: usize>(
     };
     let mut lambda = 1e-4;
     for _ in 0..max_iterations {
+        if gauss_newton_decrement(&cur).is_some_and(|d| d <= 1e-12 * cur.cost) {
+            // No step can lower the cost by more than 1e-12 of itself (the accepted-step
+            // test below): we are at the minimum, and evaluating that last step would
+            // cost a pass over the data to move the parameters by a negligible amount.
+            return Ok(LmOutcome { params: p });
+        }
         loop {
             let mut h = cur.jtj;
             let dmax = (0..P).map(|i| h[(i, i)]).fold(0.0_f64, f64::max);
