@@ -150,10 +150,7 @@ fn direct_normalised(
             need: MIN_POINTS_2D,
         });
     }
-    for p in points {
-        check_finite2("magnetometer reading", p)?;
-    }
-    let norm = Normaliser::of(points)?;
+    let norm = Normaliser::of_finite(points, "magnetometer reading")?;
     let (s, cov) = moments(points, &norm);
     // Collinear: the spread across the best line is nil compared with the spread along it
     // (the trace of `cov` is 1 after normalisation).

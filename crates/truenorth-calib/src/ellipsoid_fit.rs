@@ -142,10 +142,7 @@ fn direct_normalised(
             need: MIN_POINTS_3D,
         });
     }
-    for p in points {
-        check_finite3("magnetometer reading", p)?;
-    }
-    let norm = Normaliser::of(points)?;
+    let norm = Normaliser::of_finite(points, "magnetometer reading")?;
     let (s, cov) = moments(points, &norm);
     let (l, _) = sym_eigen3(&cov).ok_or(Error::Degenerate {
         reason: "the readings could not be analysed",
