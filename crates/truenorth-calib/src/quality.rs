@@ -58,7 +58,7 @@ use truenorth_compass::{CompassCalibration2d, CompassCalibration3d};
 use truenorth_core::{Error, Quality, Result, angle_diff};
 
 use crate::linalg::{condition_from_eigenvalues, sym_eigen5, sym_eigen9};
-use crate::lm::NormalAccumulator;
+use crate::lm::{BLOCK, blocks, dot_block, sum_block};
 
 #[allow(unused_imports)]
 use truenorth_core::Float as _;
@@ -136,7 +136,10 @@ fn turns(y: f64, x: f64) -> f64 {
     ];
     let (ax, ay) = (x.abs(), y.abs());
     let swap = ay > ax;
-    let z = if swap { ax / ay } else { ay / ax };
+    // Written as one division of selected operands so that it compiles without branches
+    // (and vectorises in the quality pass); the value is the same.
+    let (num, den) = if swap { (ax, ay) } else { (ay, ax) };
+    let z = num / den;
     let z2 = z * z;
     let mut poly = A[7];
     for &a in A[..7].iter().rev() {
@@ -176,7 +179,12 @@ impl AngleBins {
         if !(d.x.is_finite() && d.y.is_finite()) || (d.x == 0.0 && d.y == 0.0) {
             return;
         }
-        let t = turns(d.y, d.x);
+        self.mark(turns(d.y, d.x));
+    }
+
+    /// Marks the direction `t` (a share of a full turn in [0, 1), from [`turns`]).
+    #[inline]
+    fn mark(&mut self, t: f64) {
         let c = (t * COVERAGE_BINS as f64) as usize;
         let f = (t * GAP_BINS as f64) as usize;
         self.coarse[c.min(COVERAGE_BINS - 1)] = true;
@@ -223,24 +231,45 @@ pub fn coverage<'a>(
     bins.coverage()
 }
 
-/// The equal-area cell of a direction (any non-zero finite vector), in `0..SPHERE_CELLS`.
-#[inline]
-fn sphere_cell(d: &Vector3<f64>) -> Option<usize> {
-    let n = d.norm();
-    if !(n > 0.0 && n.is_finite()) {
-        return None;
+/// Marks the equal-area cells of the directions `d` (a block of vectors, one array per
+/// coordinate, with their norms `n`) in `filled`, for the first `len` rows whose norm is
+/// positive and finite.
+///
+/// The cell: Archimedes — the area of a band of the unit sphere is 2π·Δz, so equal steps in
+/// `z = d_z/|d|` give equal-area bands — and equal sectors of longitude in each band. The
+/// arithmetic goes over the whole block first, in a loop the compiler vectorises; only the
+/// marking is done point by point.
+#[inline(always)]
+fn mark_sphere_cells(
+    d: &[[f64; BLOCK]; 3],
+    n: &[f64; BLOCK],
+    len: usize,
+    filled: &mut [bool; SPHERE_CELLS],
+) -> usize {
+    let mut cell = [0u32; BLOCK];
+    for i in 0..BLOCK {
+        let band = ((d[2][i] / n[i]).clamp(-1.0, 1.0) + 1.0) * 0.5 * SPHERE_BANDS as f64;
+        // Computed either way and then chosen, so that the loop has no branch.
+        let ti = turns(d[1][i], d[0][i]);
+        let t = if d[0][i] == 0.0 && d[1][i] == 0.0 {
+            0.0
+        } else {
+            ti
+        };
+        // Both in [0, 8] and [0, 16] (or NaN, for a row that is skipped), where `as u32`
+        // truncates like `as usize`; u32 keeps the conversion in SIMD registers.
+        let b = (band as u32).min(SPHERE_BANDS as u32 - 1);
+        let sector = ((t * SPHERE_SECTORS as f64) as u32).min(SPHERE_SECTORS as u32 - 1);
+        cell[i] = b * SPHERE_SECTORS as u32 + sector;
     }
-    // Archimedes: the area of a band of the unit sphere is 2π·Δz, so equal steps in z give
-    // equal-area bands.
-    let z = (d.z / n).clamp(-1.0, 1.0);
-    let band = (((z + 1.0) * 0.5 * SPHERE_BANDS as f64) as usize).min(SPHERE_BANDS - 1);
-    let t = if d.x == 0.0 && d.y == 0.0 {
-        0.0
-    } else {
-        turns(d.y, d.x)
-    };
-    let sector = ((t * SPHERE_SECTORS as f64) as usize).min(SPHERE_SECTORS - 1);
-    Some(band * SPHERE_SECTORS + sector)
+    let mut marked = 0;
+    for i in 0..len {
+        if n[i] > 0.0 && n[i].is_finite() {
+            filled[cell[i] as usize] = true;
+            marked += 1;
+        }
+    }
+    marked
 }
 
 /// Share of the [`SPHERE_CELLS`] equal-area direction cells that hold at least one point,
@@ -250,10 +279,24 @@ pub fn sphere_coverage<'a>(
     centre: &Vector3<f64>,
 ) -> f64 {
     let mut filled = [false; SPHERE_CELLS];
-    for p in points {
-        if let Some(c) = sphere_cell(&(p - centre)) {
-            filled[c] = true;
+    let mut points = points.into_iter();
+    // A block of points at a time (see `crate::lm::BLOCK`).
+    loop {
+        let mut d = [[0.0; BLOCK]; 3];
+        let mut len = 0;
+        for p in points.by_ref().take(BLOCK) {
+            for (k, dk) in d.iter_mut().enumerate() {
+                dk[len] = p[k] - centre[k];
+            }
+            len += 1;
         }
+        if len == 0 {
+            break;
+        }
+        let n: [f64; BLOCK] = core::array::from_fn(|i| {
+            (d[0][i] * d[0][i] + d[1][i] * d[1][i] + d[2][i] * d[2][i]).sqrt()
+        });
+        mark_sphere_cells(&d, &n, len, &mut filled);
     }
     filled.iter().filter(|&&f| f).count() as f64 / SPHERE_CELLS as f64
 }
@@ -351,23 +394,78 @@ pub struct Assessment2d {
 /// Non-finite readings are skipped. Allocates nothing.
 pub fn assess_2d(points: &[Vector2<f64>], cal: &CompassCalibration2d, field: f64) -> Assessment2d {
     let mut bins = AngleBins::new();
-    let mut acc = NormalAccumulator::<5>::new();
-    let (mut n, mut ss) = (0usize, 0.0);
+    // Sums of the squared residuals and of the monomials of `u` that make up the
+    // information matrix (see `information_2d`).
+    let mut sums = [0.0; MONOMIALS_2D];
+    let mut ss = 0.0;
+    let mut n = 0usize;
     let inv_f = 1.0 / field;
-    for p in points {
-        let h = cal.correct(p);
-        let rho = h.norm();
-        if !(rho > 0.0 && rho.is_finite()) {
-            continue;
+    let (s, c) = (&cal.soft_iron, &cal.hard_iron);
+    // A block of points at a time (see `crate::lm::BLOCK`): first every point's direction,
+    // its products, its residual and its heading, then the sums and the bins.
+    let mut ux = [0.0; BLOCK];
+    let mut uy = [0.0; BLOCK];
+    let mut xx = [0.0; BLOCK];
+    let mut xy = [0.0; BLOCK];
+    let mut yy = [0.0; BLOCK];
+    let mut r2 = [0.0; BLOCK];
+    let mut t = [0.0; BLOCK];
+    for ([px, py], len) in blocks(points) {
+        for i in 0..BLOCK {
+            // h = soft_iron · (p − hard_iron), as `CompassCalibration2d::correct`.
+            let (dx, dy) = (px[i] - c.x, py[i] - c.y);
+            let (hx, hy) = (
+                s[(0, 0)] * dx + s[(0, 1)] * dy,
+                s[(1, 0)] * dx + s[(1, 1)] * dy,
+            );
+            let rho = (hx * hx + hy * hy).sqrt();
+            // Non-finite readings are skipped, and the rows past the end of the data: their
+            // direction is set to zero, which adds nothing to the sums and marks the row
+            // as skipped for the bins (a kept row's direction is a unit vector).
+            let keep = rho > 0.0 && rho.is_finite() && i < len;
+            let inv_rho = 1.0 / rho;
+            let (x, y) = if keep {
+                (hx * inv_rho, hy * inv_rho)
+            } else {
+                (0.0, 0.0)
+            };
+            let r = rho * inv_f - 1.0;
+            ux[i] = x;
+            uy[i] = y;
+            xx[i] = x * x;
+            xy[i] = x * y;
+            yy[i] = y * y;
+            r2[i] = if keep { r * r } else { 0.0 };
+            t[i] = turns(hy, hx);
         }
-        bins.add(&h);
-        let r = rho * inv_f - 1.0;
-        ss += r * r;
-        n += 1;
-        let u = h / rho;
-        acc.add(&[-u.x, -u.y, u.x * u.x, 2.0 * u.x * u.y, u.y * u.y], 0.0);
+        // In the order of `information_2d`: x², xy, y², x³, x²y, xy², y³, x⁴, x³y, x²y²,
+        // xy³, y⁴.
+        let products = [
+            (&ux, &ux),
+            (&ux, &uy),
+            (&uy, &uy),
+            (&xx, &ux),
+            (&xx, &uy),
+            (&yy, &ux),
+            (&yy, &uy),
+            (&xx, &xx),
+            (&xx, &xy),
+            (&xx, &yy),
+            (&xy, &yy),
+            (&yy, &yy),
+        ];
+        for (sk, (a, b)) in sums.iter_mut().zip(products) {
+            *sk += dot_block(a, b);
+        }
+        ss += sum_block(&r2);
+        for i in 0..len {
+            if ux[i] != 0.0 || uy[i] != 0.0 {
+                bins.mark(t[i]);
+                n += 1;
+            }
+        }
     }
-    let info = information(&acc);
+    let info = information_2d(&sums);
     let coverage = bins.coverage();
     let residual_rms_rel = if n > 0 { (ss / n as f64).sqrt() } else { 0.0 };
     let condition = sym_eigen5(&info)
@@ -422,24 +520,51 @@ fn bound_2d(info: &SMatrix<f64, 5, 5>, sum_sq: f64, n: usize) -> f64 {
 /// documentation. Non-finite readings are skipped. Allocates nothing.
 pub fn quality_3d(points: &[Vector3<f64>], cal: &CompassCalibration3d, field: f64) -> Quality {
     let mut filled = [false; SPHERE_CELLS];
-    let mut acc = NormalAccumulator::<9>::new();
-    let (mut n, mut ss) = (0usize, 0.0);
+    // Sums of the squared residuals and of the monomials of `u` that make up the
+    // information matrix (see `information_3d`).
+    let mut sums = [0.0; MONOMIALS_3D];
+    let mut ss = 0.0;
+    let mut n = 0usize;
     let inv_f = 1.0 / field;
-    for p in points {
-        let h = cal.correct(p);
-        let rho = h.norm();
-        if !(rho > 0.0 && rho.is_finite()) {
-            continue;
+    let (s, c) = (&cal.soft_iron, &cal.hard_iron);
+    let plan = monomial_plan_3d();
+    // A block of points at a time (see `crate::lm::BLOCK`): first every point's direction,
+    // its products and its residual, then the sums and the cells. `cols` holds `u_a` in
+    // columns 0–2 and the products `u_a u_b` of `QUAD_3D` in columns 3–8.
+    let mut cols = [[0.0; BLOCK]; 9];
+    let mut h = [[0.0; BLOCK]; 3];
+    let mut rho = [0.0; BLOCK];
+    let mut r2 = [0.0; BLOCK];
+    for (p, len) in blocks(points) {
+        for i in 0..BLOCK {
+            // h = soft_iron · (p − hard_iron), as `CompassCalibration3d::correct`.
+            let d = [p[0][i] - c.x, p[1][i] - c.y, p[2][i] - c.z];
+            let hi: [f64; 3] =
+                core::array::from_fn(|a| s[(a, 0)] * d[0] + s[(a, 1)] * d[1] + s[(a, 2)] * d[2]);
+            let rh = (hi[0] * hi[0] + hi[1] * hi[1] + hi[2] * hi[2]).sqrt();
+            // Non-finite readings are skipped, and the rows past the end of the data: a row
+            // of zeros adds nothing.
+            let k = rh > 0.0 && rh.is_finite() && i < len;
+            let inv_rho = 1.0 / rh;
+            let ui = hi.map(|x| if k { x * inv_rho } else { 0.0 });
+            for a in 0..3 {
+                cols[a][i] = ui[a];
+                h[a][i] = hi[a];
+            }
+            for (j, &(a, b)) in QUAD_3D.iter().enumerate() {
+                cols[3 + j][i] = ui[a] * ui[b];
+            }
+            let r = rh * inv_f - 1.0;
+            r2[i] = if k { r * r } else { 0.0 };
+            rho[i] = rh;
         }
-        if let Some(c) = sphere_cell(&h) {
-            filled[c] = true;
+        for (sk, &(a, b)) in sums.iter_mut().zip(&plan) {
+            *sk += dot_block(&cols[a], &cols[b]);
         }
-        let r = rho * inv_f - 1.0;
-        ss += r * r;
-        n += 1;
-        acc.add(&phi3(&(h / rho)), 0.0);
+        ss += sum_block(&r2);
+        n += mark_sphere_cells(&h, &rho, len, &mut filled);
     }
-    let info = information(&acc);
+    let info = information_3d(&sums);
     let coverage = filled.iter().filter(|&&f| f).count() as f64 / SPHERE_CELLS as f64;
     let residual_rms_rel = if n > 0 { (ss / n as f64).sqrt() } else { 0.0 };
     let condition = sym_eigen9(&info)
@@ -456,28 +581,127 @@ pub fn quality_3d(points: &[Vector3<f64>], cal: &CompassCalibration3d, field: f6
     }
 }
 
-/// The information matrix `Σ φφᵀ` (NaN if it overflowed, which makes the condition and
-/// the bound infinite).
-fn information<const P: usize>(acc: &NormalAccumulator<P>) -> SMatrix<f64, P, P> {
-    acc.finish()
-        .map(|ne| ne.jtj)
-        .unwrap_or_else(|| SMatrix::from_element(f64::NAN))
+/// Number of distinct monomials of degree 2 to 4 in `(u_x, u_y)`.
+const MONOMIALS_2D: usize = 12;
+
+/// The 2-D information matrix `A = Σ φ(u)φ(u)ᵀ`, `φ = (−u_x, −u_y, u_x², 2u_xu_y, u_y²)`,
+/// from the sums over the points of the monomials it is made of, in the order
+/// `(x², xy, y², x³, x²y, xy², y³, x⁴, x³y, x²y², xy³, y⁴)` of `u = (x, y)`.
+///
+/// Every entry of `φφᵀ` is a monomial of degree 2, 3 or 4 in `u` times a constant, and 12
+/// distinct monomials fill its 15 distinct entries: summing those is the same matrix with
+/// fewer products per point. NaN if a sum overflowed, which makes the condition and the
+/// bound infinite.
+fn information_2d(m: &[f64; MONOMIALS_2D]) -> SMatrix<f64, 5, 5> {
+    let [x2, xy, y2, x3, x2y, xy2, y3, x4, x3y, x2y2, xy3, y4] = *m;
+    #[rustfmt::skip]
+    let a = SMatrix::<f64, 5, 5>::from_row_slice(&[
+        x2,         xy,         -x3,        -2.0 * x2y, -xy2,
+        xy,         y2,         -x2y,       -2.0 * xy2, -y3,
+        -x3,        -x2y,       x4,         2.0 * x3y,  x2y2,
+        -2.0 * x2y, -2.0 * xy2, 2.0 * x3y,  4.0 * x2y2, 2.0 * xy3,
+        -xy2,       -y3,        x2y2,       2.0 * xy3,  y4,
+    ]);
+    finite_or_nan(a)
 }
 
-/// `φ(u)` of the 3-D model: radial residual = `φ(u)ᵀ (d, e₁₁, e₁₂, e₁₃, e₂₂, e₂₃, e₃₃)`.
-#[inline]
-fn phi3(u: &Vector3<f64>) -> [f64; 9] {
-    [
-        -u.x,
-        -u.y,
-        -u.z,
-        u.x * u.x,
-        2.0 * u.x * u.y,
-        2.0 * u.x * u.z,
-        u.y * u.y,
-        2.0 * u.y * u.z,
-        u.z * u.z,
-    ]
+/// Number of distinct monomials of degree 2 to 4 in `(u_x, u_y, u_z)`: 6 + 10 + 15.
+const MONOMIALS_3D: usize = 31;
+
+/// The index pairs `(a, b)` of the quadratic terms `u_a u_b` of `φ` in the 3-D model, in
+/// the parameter order `(e₁₁, e₁₂, e₁₃, e₂₂, e₂₃, e₃₃)` of the module documentation.
+const QUAD_3D: [(usize, usize); 6] = [(0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)];
+
+/// The monomials of degree 2, 3 and 4 in `u = (u₀, u₁, u₂)`, each once, as sorted index
+/// tuples `(a, b)`, `(a, b, c)`, `(a, b, c, d)` (unused places zero) with their degree, in
+/// lexicographic order within each degree: the order of the sums behind
+/// [`information_3d`].
+fn monomial_tuples_3d() -> [([usize; 4], usize); MONOMIALS_3D] {
+    let mut out = [([0; 4], 0); MONOMIALS_3D];
+    let mut k = 0;
+    for a in 0..3 {
+        for b in a..3 {
+            out[k] = ([a, b, 0, 0], 2);
+            k += 1;
+        }
+    }
+    for a in 0..3 {
+        for b in a..3 {
+            for c in b..3 {
+                out[k] = ([a, b, c, 0], 3);
+                k += 1;
+            }
+        }
+    }
+    for a in 0..3 {
+        for b in a..3 {
+            for c in b..3 {
+                for d in c..3 {
+                    out[k] = ([a, b, c, d], 4);
+                    k += 1;
+                }
+            }
+        }
+    }
+    out
+}
+
+/// For each monomial of [`monomial_tuples_3d`], two columns of the quality pass whose
+/// product it is (columns 0–2: `u_a`; 3–8: `u_a u_b` in the order of [`QUAD_3D`]): degree 2
+/// is `u_a · u_b`, degree 3 `(u_a u_b) · u_c`, degree 4 `(u_a u_b) · (u_c u_d)`.
+fn monomial_plan_3d() -> [(usize, usize); MONOMIALS_3D] {
+    let quad = |a: usize, b: usize| 3 + QUAD_3D.iter().position(|&p| p == (a, b)).unwrap_or(0);
+    monomial_tuples_3d().map(|(t, deg)| match deg {
+        2 => (t[0], t[1]),
+        3 => (quad(t[0], t[1]), t[2]),
+        _ => (quad(t[0], t[1]), quad(t[2], t[3])),
+    })
+}
+
+/// The 3-D information matrix `A = Σ φ(u)φ(u)ᵀ`,
+/// `φ = (−u_x, −u_y, −u_z, u_x², 2u_xu_y, 2u_xu_z, u_y², 2u_yu_z, u_z²)`, from the sums of
+/// the monomials of [`monomial_tuples_3d`]: 31 distinct monomials fill its 45 distinct
+/// entries (see [`information_2d`]). NaN if a sum overflowed.
+fn information_3d(m: &[f64; MONOMIALS_3D]) -> SMatrix<f64, 9, 9> {
+    // φ_i = factor_i · (the monomial with indices idx_i): −u_a for i < 3, then the
+    // quadratic terms, with factor 1 on the diagonal pairs and 2 off it.
+    let term = |i: usize| -> (f64, [usize; 2], usize) {
+        if i < 3 {
+            (-1.0, [i, 0], 1)
+        } else {
+            let (a, b) = QUAD_3D[i - 3];
+            (if a == b { 1.0 } else { 2.0 }, [a, b], 2)
+        }
+    };
+    let tuples = monomial_tuples_3d();
+    let mut a = SMatrix::<f64, 9, 9>::zeros();
+    for i in 0..9 {
+        for j in i..9 {
+            let (si, ii, ni) = term(i);
+            let (sj, ij, nj) = term(j);
+            let mut idx = [0usize; 4];
+            idx[..ni].copy_from_slice(&ii[..ni]);
+            idx[ni..ni + nj].copy_from_slice(&ij[..nj]);
+            idx[..ni + nj].sort_unstable();
+            let k = tuples
+                .iter()
+                .position(|&(t, deg)| deg == ni + nj && t[..deg] == idx[..deg])
+                .unwrap_or(0);
+            let v = si * sj * m[k];
+            a[(i, j)] = v;
+            a[(j, i)] = v;
+        }
+    }
+    finite_or_nan(a)
+}
+
+/// `a`, or all NaN if any entry is not finite.
+fn finite_or_nan<const P: usize>(a: SMatrix<f64, P, P>) -> SMatrix<f64, P, P> {
+    if a.iter().all(|x| x.is_finite()) {
+        a
+    } else {
+        SMatrix::from_element(f64::NAN)
+    }
 }
 
 /// Number of test directions (a Fibonacci lattice) over which the 3-D bound takes its worst.
@@ -699,6 +923,66 @@ mod tests {
             assert!(q.condition > last.0 && q.heading_error_bound_deg > last.1);
             last = (q.condition, q.heading_error_bound_deg);
         }
+    }
+
+    /// The information matrices built from monomial sums equal `Σ φφᵀ` summed directly.
+    #[test]
+    fn information_from_monomials_matches_outer_products() {
+        let mut rng = SplitMix64::new(11);
+        let dirs3: Vec<Vector3<f64>> = (0..37)
+            .map(|_| {
+                let v = Vector3::new(rng.normal(1.0), rng.normal(1.0), rng.normal(1.0));
+                v / v.norm()
+            })
+            .collect();
+
+        let mut direct2 = SMatrix::<f64, 5, 5>::zeros();
+        let mut sums2 = [0.0; MONOMIALS_2D];
+        for d in &dirs3 {
+            let u = d.xy() / d.xy().norm();
+            let phi = SVector::<f64, 5>::new(-u.x, -u.y, u.x * u.x, 2.0 * u.x * u.y, u.y * u.y);
+            direct2 += phi * phi.transpose();
+            let (x, y) = (u.x, u.y);
+            let m = [
+                x * x,
+                x * y,
+                y * y,
+                x * x * x,
+                x * x * y,
+                x * y * y,
+                y * y * y,
+                x.powi(4),
+                x.powi(3) * y,
+                x * x * y * y,
+                x * y.powi(3),
+                y.powi(4),
+            ];
+            for (s, v) in sums2.iter_mut().zip(m) {
+                *s += v;
+            }
+        }
+        assert!((information_2d(&sums2) - direct2).amax() < 1e-12);
+
+        let mut direct3 = SMatrix::<f64, 9, 9>::zeros();
+        let mut sums3 = [0.0; MONOMIALS_3D];
+        for u in &dirs3 {
+            let phi = SVector::<f64, 9>::from([
+                -u.x,
+                -u.y,
+                -u.z,
+                u.x * u.x,
+                2.0 * u.x * u.y,
+                2.0 * u.x * u.z,
+                u.y * u.y,
+                2.0 * u.y * u.z,
+                u.z * u.z,
+            ]);
+            direct3 += phi * phi.transpose();
+            for (s, (idx, deg)) in sums3.iter_mut().zip(monomial_tuples_3d()) {
+                *s += idx[..deg].iter().map(|&a| u[a]).product::<f64>();
+            }
+        }
+        assert!((information_3d(&sums3) - direct3).amax() < 1e-12);
     }
 
     #[test]
