@@ -39,7 +39,7 @@ use truenorth_core::{
 };
 
 use crate::linalg::{constrained_min6, sym_eigen3, sym_eigen6, sym_sqrt3};
-use crate::lm::{self, NormalAccumulator, NormalEquations};
+use crate::lm::{self, BLOCK, NormalAccumulator, NormalEquations, blocks};
 use crate::normalise::Normaliser;
 use crate::quality::{self, MIN_SPHERE_COVERAGE};
 
@@ -313,8 +313,15 @@ fn from_params(p: &SVector<f64, 9>) -> Ellipsoid {
     }
 }
 
-/// Residuals `r = |B v| − 1` (`v = q − c`, `w = B v`, `ρ = |w|`) and their Jacobian:
-/// `∂r/∂c = −B w / ρ`, `∂r/∂B_kl = (w_k v_l + w_l v_k)/ρ` (`w_k v_k / ρ` on the diagonal).
+/// Residuals `r = |B v| − 1` (`v = q − c`) and their Jacobian, accumulated as normal
+/// equations.
+///
+/// `r` depends on `B` only through `A = B²` (`|B v| = √(vᵀA v)`), so the pass over the
+/// points differentiates with respect to `(c, A)`, which takes fewer products per point than
+/// going through `B`: with `z = A v`, `ρ = √(vᵀz)`, `∂r/∂c = −z/ρ` and
+/// `∂r/∂A_kl = v_k v_l/ρ` (`v_k²/(2ρ)` on the diagonal). The chain rule through `A = B²`, a
+/// linear map of the parameter changes that is the same for every point, then gives the
+/// normal equations in the refinement's parameters `(c, B)` (see [`square_jacobian`]).
 fn radial_normal_equations(
     points: &[Vector3<f64>],
     norm: &Normaliser<3>,
@@ -322,32 +329,60 @@ fn radial_normal_equations(
 ) -> Option<NormalEquations<9>> {
     let e = from_params(p);
     let (c, b) = (e.centre, e.unit_map);
-    let mut acc = NormalAccumulator::<9>::new();
+    let a = b * b;
+    let a = (a + a.transpose()) * 0.5;
+    let mu = norm.centre;
     let inv = 1.0 / norm.scale;
-    for m in points {
-        let v = (m - norm.centre) * inv - c;
-        let w = b * v;
-        let rho = w.norm();
-        if !(rho > 1e-12) {
-            continue;
+    let mut acc = NormalAccumulator::<9, 10>::new();
+    // A block of points at a time (see `BLOCK`): first every point's gradient row and
+    // residual, then the sums.
+    for ([qx, qy, qz], len) in blocks(points) {
+        let cols = &mut acc.cols;
+        for i in 0..BLOCK {
+            let v = [
+                (qx[i] - mu.x) * inv - c.x,
+                (qy[i] - mu.y) * inv - c.y,
+                (qz[i] - mu.z) * inv - c.z,
+            ];
+            let z: [f64; 3] =
+                core::array::from_fn(|k| a[(k, 0)] * v[0] + a[(k, 1)] * v[1] + a[(k, 2)] * v[2]);
+            let rho = (v[0] * z[0] + v[1] * z[1] + v[2] * z[2]).sqrt();
+            let inv_rho = 1.0 / rho;
+            // A reading at the very centre has no defined direction; leave it out, and the
+            // rows past the end of the data: a row of zeros adds nothing.
+            let keep = rho > 1e-12 && i < len;
+            for k in 0..3 {
+                cols[k][i] = if keep { -z[k] * inv_rho } else { 0.0 };
+            }
+            for (k, &(r, s)) in PAIRS.iter().enumerate() {
+                let d = if r == s {
+                    0.5 * v[r] * v[r]
+                } else {
+                    v[r] * v[s]
+                };
+                cols[3 + k][i] = if keep { d * inv_rho } else { 0.0 };
+            }
+            cols[9][i] = if keep { rho - 1.0 } else { 0.0 };
         }
-        let inv_rho = 1.0 / rho;
-        let r = rho - 1.0;
-        let jc = -(b * w) * inv_rho;
-        let mut j = [0.0; 9];
-        j[0] = jc.x;
-        j[1] = jc.y;
-        j[2] = jc.z;
-        for (k, &(a, bb)) in PAIRS.iter().enumerate() {
-            j[3 + k] = if a == bb {
-                w[a] * v[a]
-            } else {
-                w[a] * v[bb] + w[bb] * v[a]
-            } * inv_rho;
-        }
-        acc.add(&j, r);
+        acc.add_block();
     }
-    acc.finish()
+    acc.finish()?.reparametrised(&square_jacobian(&b))
+}
+
+/// `∂(c, A)/∂(c, B)` for `A = B²`, `B` symmetric, in the parameter order of [`to_params`]:
+/// `dA = B dB + dB B`.
+fn square_jacobian(b: &Matrix3<f64>) -> SMatrix<f64, 9, 9> {
+    let mut m = SMatrix::<f64, 9, 9>::identity();
+    for (j, &(r, s)) in PAIRS.iter().enumerate() {
+        let mut e = Matrix3::zeros();
+        e[(r, s)] = 1.0;
+        e[(s, r)] = 1.0;
+        let da = b * e + e * b;
+        for (i, &(k, l)) in PAIRS.iter().enumerate() {
+            m[(3 + i, 3 + j)] = da[(k, l)];
+        }
+    }
+    m
 }
 
 /// The least-squares ellipsoid calibration of `points` (raw 3-axis readings of a sensor
@@ -552,6 +587,40 @@ mod tests {
                 ne.jtr[i]
             );
         }
+    }
+
+    /// The normal equations in `(c, B)` obtained through `A = B²` equal those summed from
+    /// the Jacobian rows taken directly with respect to `B`.
+    #[test]
+    fn normal_equations_through_b_squared_match_direct_rows() {
+        let (pts, _, _) = distorted(61);
+        let norm = Normaliser::of(&pts).unwrap();
+        let p = SVector::<f64, 9>::from([0.05, -0.1, 0.02, 1.1, 0.1, -0.05, 0.9, 0.07, 1.0]);
+        let e = from_params(&p);
+        let (mut jtj, mut jtr, mut cost) = (SMatrix::<f64, 9, 9>::zeros(), SVector::zeros(), 0.0);
+        for m in &pts {
+            let v = norm.apply(m) - e.centre;
+            let w = e.unit_map * v;
+            let rho = w.norm();
+            let jc = -(e.unit_map * w) / rho;
+            let mut j = SVector::<f64, 9>::zeros();
+            j.fixed_rows_mut::<3>(0).copy_from(&jc);
+            for (k, &(a, b)) in PAIRS.iter().enumerate() {
+                j[3 + k] = if a == b {
+                    w[a] * v[a]
+                } else {
+                    w[a] * v[b] + w[b] * v[a]
+                } / rho;
+            }
+            let r = rho - 1.0;
+            jtj += j * j.transpose();
+            jtr += j * r;
+            cost += r * r;
+        }
+        let ne = radial_normal_equations(&pts, &norm, &p).unwrap();
+        assert!((ne.cost - cost).abs() < 1e-12 * cost);
+        assert!((ne.jtj - jtj).amax() < 1e-12 * jtj.amax());
+        assert!((ne.jtr - jtr).amax() < 1e-12 * jtj.amax());
     }
 
     #[test]

@@ -26,6 +26,31 @@ pub(crate) struct NormalEquations<const P: usize> {
     pub jtr: SVector<f64, P>,
 }
 
+impl<const P: usize> NormalEquations<P> {
+    /// The normal equations in other parameters `θ`, given `m = ∂φ/∂θ` for the parameters
+    /// `φ` these were accumulated in: by the chain rule `J_θ = J_φ m`, so `J_θᵀJ_θ =
+    /// mᵀ(J_φᵀJ_φ)m` and `J_θᵀr = mᵀ(J_φᵀr)`; the cost is the same. `None` if anything
+    /// overflowed.
+    pub fn reparametrised(&self, m: &SMatrix<f64, P, P>) -> Option<Self> {
+        let jtj = m.transpose() * self.jtj * m;
+        // Mirror the upper triangle: JᵀJ is symmetric, the rounding of the products not
+        // quite, and the Cholesky factorisation reads one triangle only.
+        let jtj = SMatrix::<f64, P, P>::from_fn(|i, j| jtj[(i.min(j), i.max(j))]);
+        let ne = Self {
+            cost: self.cost,
+            jtj,
+            jtr: m.transpose() * self.jtr,
+        };
+        ne.is_finite().then_some(ne)
+    }
+
+    /// Whether the cost and `JᵀJ` are finite (a non-finite `Jᵀr` gives a non-finite step,
+    /// which [`minimise`] rejects).
+    fn is_finite(&self) -> bool {
+        self.cost.is_finite() && self.jtj.iter().all(|x| x.is_finite())
+    }
+}
+
 /// How many points the hot loops over the data (the refinement passes, the moments of the
 /// 3-D direct fit, the quality reports) process at a time.
 ///
@@ -85,52 +110,55 @@ pub(crate) fn blocks<const D: usize>(
     })
 }
 
-/// Accumulates `JᵀJ` (upper triangle only, mirrored at the end) and `Jᵀr` one residual at
-/// a time. Plain arrays rather than `j * jᵀ` on matrices: this is the inner loop of every
-/// refinement pass, and half the products are redundant.
-pub(crate) struct NormalAccumulator<const P: usize> {
-    jtj: [[f64; P]; P],
-    jtr: [f64; P],
-    cost: f64,
+/// Accumulates `JᵀJ` (upper triangle only, mirrored at the end), `Jᵀr` and `Σ r²` a block
+/// of residuals at a time: the caller fills [`Self::cols`] — column `k < P` with the `k`-th
+/// gradient component of each residual of the block, column `P` with the residuals — and
+/// calls [`Self::add_block`]. Rows past the end of the data must be zeros, which add
+/// nothing.
+pub(crate) struct NormalAccumulator<const P: usize, const K: usize> {
+    /// The block being filled: `K = P + 1` columns of [`BLOCK`] rows.
+    pub cols: [[f64; BLOCK]; K],
+    sums: [[f64; K]; K],
 }
 
-impl<const P: usize> NormalAccumulator<P> {
+impl<const P: usize, const K: usize> NormalAccumulator<P, K> {
     /// Nothing accumulated.
+    #[inline(always)]
     pub fn new() -> Self {
+        const { assert!(K == P + 1) };
         Self {
-            jtj: [[0.0; P]; P],
-            jtr: [0.0; P],
-            cost: 0.0,
+            cols: [[0.0; BLOCK]; K],
+            sums: [[0.0; K]; K],
         }
     }
 
-    /// Adds one residual `r` with gradient row `j`.
-    #[inline]
-    pub fn add(&mut self, j: &[f64; P], r: f64) {
-        for (a, &ja) in j.iter().enumerate() {
-            for (m, &jb) in self.jtj[a][a..].iter_mut().zip(&j[a..]) {
-                *m += ja * jb;
+    /// Adds the block in [`Self::cols`]: every product of two columns, summed over the rows.
+    #[inline(always)]
+    pub fn add_block(&mut self) {
+        for a in 0..K {
+            for b in a..K {
+                self.sums[a][b] += dot_block(&self.cols[a], &self.cols[b]);
             }
-            self.jtr[a] += ja * r;
         }
-        self.cost += r * r;
     }
 
     /// The normal equations, or `None` if anything overflowed.
     pub fn finish(&self) -> Option<NormalEquations<P>> {
         let mut jtj = SMatrix::<f64, P, P>::zeros();
+        let mut jtr = SVector::<f64, P>::zeros();
         for a in 0..P {
             for b in a..P {
-                jtj[(a, b)] = self.jtj[a][b];
-                jtj[(b, a)] = self.jtj[a][b];
+                jtj[(a, b)] = self.sums[a][b];
+                jtj[(b, a)] = self.sums[a][b];
             }
+            jtr[a] = self.sums[a][P];
         }
         let ne = NormalEquations {
-            cost: self.cost,
+            cost: self.sums[P][P],
             jtj,
-            jtr: SVector::<f64, P>::from(self.jtr),
+            jtr,
         };
-        (ne.cost.is_finite() && ne.jtj.iter().all(|x| x.is_finite())).then_some(ne)
+        ne.is_finite().then_some(ne)
     }
 }
 
