@@ -39,7 +39,7 @@ use truenorth_core::{
 };
 
 use crate::linalg::{constrained_min6, sym_eigen3, sym_eigen6, sym_sqrt3};
-use crate::lm::{self, BLOCK, NormalAccumulator, NormalEquations, blocks};
+use crate::lm::{self, BLOCK, NormalAccumulator, NormalEquations, blocks, dot_block};
 use crate::normalise::Normaliser;
 use crate::quality::{self, MIN_SPHERE_COVERAGE};
 
@@ -156,26 +156,95 @@ fn direct_normalised(
     Ok((norm, e))
 }
 
+/// The terms of the quadric `(x², y², z², 2yz, 2xz, 2xy, 2x, 2y, 2z, 1)`: each is a constant
+/// factor times a monomial of degree ≤ 2, given by its exponents of `(x, y, z)`.
+const TERMS: [(f64, [u8; 3]); 10] = [
+    (1.0, [2, 0, 0]),
+    (1.0, [0, 2, 0]),
+    (1.0, [0, 0, 2]),
+    (2.0, [0, 1, 1]),
+    (2.0, [1, 0, 1]),
+    (2.0, [1, 1, 0]),
+    (2.0, [1, 0, 0]),
+    (2.0, [0, 1, 0]),
+    (2.0, [0, 0, 1]),
+    (1.0, [0, 0, 0]),
+];
+
+/// The exponents of `(x, y, z)` in the product of the monomials of terms `a` and `b`.
+fn product_exponents(a: usize, b: usize) -> [u8; 3] {
+    core::array::from_fn(|i| TERMS[a].1[i] + TERMS[b].1[i])
+}
+
+/// The distinct monomials of degree ≤ 4 in `(x, y, z)` (35 of them), each with a pair of
+/// [`TERMS`] whose monomials multiply to it; in the order the pairs are first met going
+/// through the upper triangle of the scatter matrix.
+fn moment_pairs() -> ([[u8; 3]; 35], [(usize, usize); 35]) {
+    let mut exps = [[0u8; 3]; 35];
+    let mut pairs = [(0, 0); 35];
+    let mut k = 0;
+    for a in 0..TERMS.len() {
+        for b in a..TERMS.len() {
+            let e = product_exponents(a, b);
+            if !exps[..k].contains(&e) {
+                exps[k] = e;
+                pairs[k] = (a, b);
+                k += 1;
+            }
+        }
+    }
+    debug_assert_eq!(k, 35);
+    (exps, pairs)
+}
+
 /// The 10×10 scatter matrix of `(x², y², z², 2yz, 2xz, 2xy, 2x, 2y, 2z, 1)` and the 3×3
 /// covariance, in normalised coordinates.
 fn moments(points: &[Vector3<f64>], norm: &Normaliser<3>) -> (SMatrix<f64, 10, 10>, Matrix3<f64>) {
+    // The scatter matrix has 55 distinct entries but only 35 distinct values up to the
+    // factors of 2 (the sums of the monomials of degree ≤ 4): sum those, a block of points
+    // at a time (see `BLOCK`), and multiply the factors in afterwards (exactly: they are
+    // powers of 2).
+    let (exps, pairs) = moment_pairs();
+    let mut sums = [0.0; 35];
+    let inv = 1.0 / norm.scale;
+    let c = norm.centre;
+    let mut t = [[0.0; BLOCK]; 10];
+    for ([x, y, z], len) in blocks(points) {
+        for i in 0..BLOCK {
+            // Rows past the end of the data are zeros, which add nothing.
+            let live = i < len;
+            let q = [(x[i] - c.x) * inv, (y[i] - c.y) * inv, (z[i] - c.z) * inv]
+                .map(|v| if live { v } else { 0.0 });
+            let [qx, qy, qz] = q;
+            let m = [
+                qx * qx,
+                qy * qy,
+                qz * qz,
+                qy * qz,
+                qx * qz,
+                qx * qy,
+                qx,
+                qy,
+                qz,
+                if live { 1.0 } else { 0.0 },
+            ];
+            for (tk, mk) in t.iter_mut().zip(m) {
+                tk[i] = mk;
+            }
+        }
+        for (sk, &(a, b)) in sums.iter_mut().zip(&pairs) {
+            *sk += dot_block(&t[a], &t[b]);
+        }
+    }
     let mut s = SMatrix::<f64, 10, 10>::zeros();
-    for p in points {
-        let q = norm.apply(p);
-        let (x, y, z) = (q.x, q.y, q.z);
-        let d = SVector::<f64, 10>::from([
-            x * x,
-            y * y,
-            z * z,
-            2.0 * y * z,
-            2.0 * x * z,
-            2.0 * x * y,
-            2.0 * x,
-            2.0 * y,
-            2.0 * z,
-            1.0,
-        ]);
-        s += d * d.transpose();
+    for a in 0..TERMS.len() {
+        for b in a..TERMS.len() {
+            let e = product_exponents(a, b);
+            let k = exps.iter().position(|&x| x == e).unwrap_or(0);
+            let v = TERMS[a].0 * TERMS[b].0 * sums[k];
+            s[(a, b)] = v;
+            s[(b, a)] = v;
+        }
     }
     let n = points.len() as f64;
     // Σ qqᵀ from the quadratic moments: s[(0,9)] = Σx², s[(5,9)] = 2Σxy, ...
@@ -621,6 +690,35 @@ mod tests {
         assert!((ne.cost - cost).abs() < 1e-12 * cost);
         assert!((ne.jtj - jtj).amax() < 1e-12 * jtj.amax());
         assert!((ne.jtr - jtr).amax() < 1e-12 * jtj.amax());
+    }
+
+    /// The scatter matrix from the 35 monomial sums equals `Σ d dᵀ` summed directly.
+    #[test]
+    fn moments_match_outer_products() {
+        let (pts, _, _) = distorted(75);
+        let norm = Normaliser::of(&pts).unwrap();
+        let (s, cov) = moments(&pts, &norm);
+        let mut reference = SMatrix::<f64, 10, 10>::zeros();
+        for p in &pts {
+            let q = norm.apply(p);
+            let (x, y, z) = (q.x, q.y, q.z);
+            let d = SVector::<f64, 10>::from([
+                x * x,
+                y * y,
+                z * z,
+                2.0 * y * z,
+                2.0 * x * z,
+                2.0 * x * y,
+                2.0 * x,
+                2.0 * y,
+                2.0 * z,
+                1.0,
+            ]);
+            reference += d * d.transpose();
+        }
+        assert!((s - reference).amax() < 1e-12 * reference.amax());
+        assert_eq!(s[(9, 9)], pts.len() as f64);
+        assert!((cov.trace() - 1.0).abs() < 1e-12);
     }
 
     #[test]
