@@ -500,6 +500,14 @@ fn bound_2d(info: &SMatrix<f64, 5, 5>, sum_sq: f64, n: usize) -> f64 {
     let Some(chol) = info.cholesky() else {
         return f64::INFINITY;
     };
+    // gᵀA⁻¹g = ‖L⁻¹g‖² for A = L Lᵀ: with L⁻¹ formed once, each heading costs one small
+    // matrix-vector product instead of two triangular solves.
+    let Some(l_inv) = chol
+        .l()
+        .solve_lower_triangular(&SMatrix::<f64, 5, 5>::identity())
+    else {
+        return f64::INFINITY;
+    };
     let sigma = (sum_sq / (n - 5) as f64).sqrt();
     let mut worst: f64 = 0.0;
     for k in 0..72 {
@@ -507,7 +515,7 @@ fn bound_2d(info: &SMatrix<f64, 5, 5>, sum_sq: f64, n: usize) -> f64 {
         let (s, c) = th.sin_cos();
         let (ux, uy, px, py) = (c, s, -s, c);
         let g = SVector::<f64, 5>::new(-px, -py, px * ux, px * uy + py * ux, py * uy);
-        worst = worst.max(g.dot(&chol.solve(&g)));
+        worst = worst.max((l_inv * g).norm_squared());
     }
     let b = (BOUND_SIGMAS * sigma * worst.sqrt()).to_degrees();
     if b.is_finite() { b } else { f64::INFINITY }
@@ -716,6 +724,15 @@ fn bound_3d(info: &SMatrix<f64, 9, 9>, sum_sq: f64, n: usize) -> f64 {
     let Some(chol) = info.cholesky() else {
         return f64::INFINITY;
     };
+    // trace(G A⁻¹ Gᵀ) = ‖L⁻¹ Gᵀ‖²_F for A = L Lᵀ: with L⁻¹ formed once, each direction
+    // costs one small matrix product instead of two triangular solves with three
+    // right-hand sides.
+    let Some(l_inv) = chol
+        .l()
+        .solve_lower_triangular(&SMatrix::<f64, 9, 9>::identity())
+    else {
+        return f64::INFINITY;
+    };
     let sigma = (sum_sq / (n - 9) as f64).sqrt();
     let golden = core::f64::consts::PI * (3.0 - 5.0_f64.sqrt());
     let mut worst: f64 = 0.0;
@@ -739,8 +756,7 @@ fn bound_3d(info: &SMatrix<f64, 9, 9>, sum_sq: f64, n: usize) -> f64 {
             }
             g.set_column(3 + j, &(proj * eu));
         }
-        let x = chol.solve(&g.transpose());
-        worst = worst.max((g * x).trace());
+        worst = worst.max((l_inv * g.transpose()).norm_squared());
     }
     let b = (BOUND_SIGMAS * sigma * worst.sqrt()).to_degrees();
     if b.is_finite() { b } else { f64::INFINITY }
@@ -923,6 +939,41 @@ mod tests {
             assert!(q.condition > last.0 && q.heading_error_bound_deg > last.1);
             last = (q.condition, q.heading_error_bound_deg);
         }
+    }
+
+    /// The 3-D bound through `L⁻¹` equals the one from solving with `A` for each direction.
+    #[test]
+    fn bound_3d_matches_solving_with_the_information_matrix() {
+        let mut rng = SplitMix64::new(13);
+        let m = SMatrix::<f64, 9, 9>::from_fn(|_, _| rng.normal(1.0));
+        let info = m * m.transpose() + SMatrix::<f64, 9, 9>::identity();
+        let chol = info.cholesky().unwrap();
+        let golden = core::f64::consts::PI * (3.0 - 5.0_f64.sqrt());
+        let mut worst: f64 = 0.0;
+        for k in 0..BOUND_DIRECTIONS_3D {
+            let z = 1.0 - (2.0 * k as f64 + 1.0) / BOUND_DIRECTIONS_3D as f64;
+            let r = (1.0 - z * z).max(0.0).sqrt();
+            let (s, c) = (golden * k as f64).sin_cos();
+            let u = Vector3::new(r * c, r * s, z);
+            let proj = nalgebra::Matrix3::identity() - u * u.transpose();
+            let mut g = SMatrix::<f64, 3, 9>::zeros();
+            for kk in 0..3 {
+                g.set_column(kk, &(-proj.column(kk)));
+            }
+            for (j, &(a, b)) in QUAD_3D.iter().enumerate() {
+                let mut eu = Vector3::zeros();
+                eu[a] += u[b];
+                if a != b {
+                    eu[b] += u[a];
+                }
+                g.set_column(3 + j, &(proj * eu));
+            }
+            worst = worst.max((g * chol.solve(&g.transpose())).trace());
+        }
+        let (sum_sq, n) = (0.5, 100);
+        let expect = (BOUND_SIGMAS * (sum_sq / (n - 9) as f64).sqrt() * worst.sqrt()).to_degrees();
+        let got = bound_3d(&info, sum_sq, n);
+        assert!((got / expect - 1.0).abs() < 1e-12, "{got} vs {expect}");
     }
 
     /// The information matrices built from monomial sums equal `Σ φφᵀ` summed directly.
