@@ -182,13 +182,30 @@ fn gauss_newton_decrement<const P: usize>(ne: &NormalEquations<P>) -> Option<f64
     d.is_finite().then_some(d)
 }
 
+/// The Levenberg–Marquardt step `−(JᵀJ + λ·D)⁻¹Jᵀr`, `D` the diagonal of `JᵀJ` with a floor
+/// (Marquardt's scaling), or `None` if it is not finite.
+fn damped_step<const P: usize>(ne: &NormalEquations<P>, lambda: f64) -> Option<SVector<f64, P>> {
+    let mut h = ne.jtj;
+    let dmax = (0..P).map(|i| h[(i, i)]).fold(0.0_f64, f64::max);
+    for i in 0..P {
+        // Marquardt's scaling, with a floor so a parameter the data do not touch still gets
+        // a finite, damped step.
+        h[(i, i)] += lambda * h[(i, i)].max(1e-12 * dmax);
+    }
+    let step = -h.cholesky()?.solve(&ne.jtr);
+    step.iter().all(|x| x.is_finite()).then_some(step)
+}
+
 /// Minimises the cost from `start`. `eval` returns `None` where the model is undefined
 /// (e.g. a matrix became singular); such trial points are rejected like uphill ones.
 ///
 /// Converges when an accepted step lowers the cost by less than `1e-12` of itself or moves
-/// the parameters by less than `1e-12` of their norm, or — checked before each step, so
-/// the last, negligible step needs no pass over the data — when the Gauss–Newton model
-/// says no step can lower the cost by more than `1e-12` of itself; refuses with
+/// the parameters by less than `1e-12` of their norm. Before each step the Gauss–Newton
+/// model is asked how much any step could lower the cost: when that is at most `1e-12` of
+/// it, the step about to be tried would be the last, and it is taken without evaluating
+/// it, as evaluating it could only confirm a change the test does not resolve (often below
+/// the rounding of the cost, where the test would reject it by chance and retry with ever
+/// more damping). Refuses with
 /// [`Error::NoConvergence`] after `max_iterations` accepted steps without that.
 pub(crate) fn minimise<const P: usize>(
     what: &'static str,
@@ -205,39 +222,28 @@ pub(crate) fn minimise<const P: usize>(
     let mut lambda = 1e-4;
     for _ in 0..max_iterations {
         if gauss_newton_decrement(&cur).is_some_and(|d| d <= 1e-12 * cur.cost) {
-            // No step can lower the cost by more than 1e-12 of itself (the accepted-step
-            // test below): we are at the minimum, and evaluating that last step would
-            // cost a pass over the data to move the parameters by a negligible amount.
-            return Ok(LmOutcome { params: p });
+            // No step can lower the cost by more than 1e-12 of itself, so the next accepted
+            // step meets the test below and is the last. Take it without the pass over the
+            // data, which would only confirm a change of the cost below what that test
+            // resolves (and at this size often only rounding noise).
+            return Ok(LmOutcome {
+                params: damped_step(&cur, lambda).map_or(p, |delta| p + delta),
+            });
         }
         loop {
-            let mut h = cur.jtj;
-            let dmax = (0..P).map(|i| h[(i, i)]).fold(0.0_f64, f64::max);
-            for i in 0..P {
-                // Marquardt's scaling, with a floor so a parameter the data do not touch
-                // still gets a finite, damped step.
-                h[(i, i)] += lambda * h[(i, i)].max(1e-12 * dmax);
-            }
-            let step = h.cholesky().map(|c| -c.solve(&cur.jtr));
-            match step {
-                Some(delta) if delta.iter().all(|x| x.is_finite()) => {
-                    let trial = p + delta;
-                    match eval(&trial) {
-                        Some(next) if next.cost <= cur.cost => {
-                            let converged = cur.cost - next.cost <= 1e-12 * cur.cost
-                                || delta.norm() <= 1e-12 * p.norm().max(1e-300);
-                            p = trial;
-                            cur = next;
-                            lambda = (lambda * 0.1).max(1e-12);
-                            if converged {
-                                return Ok(LmOutcome { params: p });
-                            }
-                            break;
-                        }
-                        _ => {}
+            if let Some(delta) = damped_step(&cur, lambda) {
+                let trial = p + delta;
+                if let Some(next) = eval(&trial).filter(|next| next.cost <= cur.cost) {
+                    let converged = cur.cost - next.cost <= 1e-12 * cur.cost
+                        || delta.norm() <= 1e-12 * p.norm().max(1e-300);
+                    p = trial;
+                    cur = next;
+                    lambda = (lambda * 0.1).max(1e-12);
+                    if converged {
+                        return Ok(LmOutcome { params: p });
                     }
+                    break;
                 }
-                _ => {}
             }
             lambda *= 10.0;
             if lambda > LAMBDA_MAX {
