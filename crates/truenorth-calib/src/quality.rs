@@ -301,7 +301,8 @@ pub fn sphere_coverage<'a>(
     filled.iter().filter(|&&f| f).count() as f64 / SPHERE_CELLS as f64
 }
 
-/// How far the tangent of the locus turns along `points` taken in order, radians (≥ 0).
+/// How far the tangent of the locus turns along `points` taken in order, radians (≥ 0): a
+/// lower bound that errs short.
 ///
 /// A centre-free measure of the arc that a set of readings covers. Tangents at opposite ends
 /// of a diameter of any ellipse are parallel, so over half a turn the tangent of the raw
@@ -309,14 +310,21 @@ pub fn sphere_coverage<'a>(
 /// less. A calibrator whose own centre is wrong sees its readings spread over more of the
 /// circle than they are; this measure cannot be fooled that way.
 ///
-/// The directions of successive chords stand in for the tangent at chord midpoints; their
-/// wrapped differences telescope, so noise enters only at the two ends, and half the end
-/// chords' turn is added at each end to reach the first and last points. Chords shorter than
-/// 10⁻¹² of the locus size are skipped. Fewer than three usable points give 0.
-pub fn locus_turning_rad<'a>(points: impl IntoIterator<Item = &'a Vector2<f64>>) -> f64 {
+/// The turning is taken between successive chords. On a convex curve each chord's direction
+/// lies between the tangents at its two ends (mean value theorem), so the result never exceeds
+/// the tangent's turning from the first point to the last: half an ellipse never reads as
+/// more than π. It falls short by up to one chord's turning at each end. The wrapped
+/// differences telescope, so noise enters only through the two end chords; chords shorter
+/// than `min_chord` (and than 10⁻¹² of the locus size) are skipped, the next point being
+/// taken from the last one kept, so that noisy points a short way apart cannot turn the
+/// chords at random. Fewer than three usable points give 0.
+pub fn locus_turning_rad<'a>(
+    points: impl IntoIterator<Item = &'a Vector2<f64>>,
+    min_chord: f64,
+) -> f64 {
     let mut prev_point: Option<Vector2<f64>> = None;
     let mut dir: Option<f64> = None;
-    let (mut turned, mut first_turn, mut last_turn) = (0.0, None, 0.0);
+    let mut turned = 0.0;
     for p in points {
         if !(p.x.is_finite() && p.y.is_finite()) {
             continue;
@@ -326,26 +334,17 @@ pub fn locus_turning_rad<'a>(points: impl IntoIterator<Item = &'a Vector2<f64>>)
             continue;
         };
         let d = p - q;
-        if d.norm() <= 1e-12 * p.norm().max(q.norm()).max(f64::MIN_POSITIVE) {
+        if d.norm() <= min_chord.max(1e-12 * p.norm().max(q.norm()).max(f64::MIN_POSITIVE)) {
             continue;
         }
         let a = d.y.atan2(d.x);
         if let Some(prev) = dir {
-            let turn = angle_diff(a, prev);
-            turned += turn;
-            first_turn.get_or_insert(turn);
-            last_turn = turn;
+            turned += angle_diff(a, prev);
         }
         dir = Some(a);
         prev_point = Some(*p);
     }
-    // End correction: the chords' directions are the tangent half a chord in from each end;
-    // the turning there is about half the turn between the two end chords. Local, so it
-    // holds where the turning bunches up (the ends of a long axis).
-    match first_turn {
-        Some(first) => (turned + 0.5 * (first + last_turn)).abs(),
-        None => 0.0,
-    }
+    turned.abs()
 }
 
 /// Refuses a 2-D calibration whose data span less than `need_deg` of heading (see
@@ -1085,16 +1084,17 @@ mod turning_tests {
     #[test]
     fn full_and_half_circles() {
         let m = Matrix2::identity();
-        let full = locus_turning_rad(&ellipse_arc(360.0, 0.0, &m, 361)).to_degrees();
-        assert!((full - 360.0).abs() < 1.5, "{full}");
-        let half = locus_turning_rad(&ellipse_arc(180.0, 10.0, &m, 181)).to_degrees();
-        assert!((half - 180.0).abs() < 0.5, "{half}");
-        assert_eq!(locus_turning_rad(&[Vector2::new(1.0, 1.0); 5]), 0.0);
+        // One-degree chords: short by about a degree, never long.
+        let full = locus_turning_rad(&ellipse_arc(360.0, 0.0, &m, 361), 0.0).to_degrees();
+        assert!((358.5..=360.0).contains(&full), "{full}");
+        let half = locus_turning_rad(&ellipse_arc(180.0, 10.0, &m, 181), 0.0).to_degrees();
+        assert!((178.5..=180.0 + 1e-9).contains(&half), "{half}");
+        assert_eq!(locus_turning_rad(&[Vector2::new(1.0, 1.0); 5], 0.0), 0.0);
     }
 
     proptest! {
-        /// Over at most half an ellipse the tangent turns by at most π, whatever the affine
-        /// distortion; over more than half it turns by more.
+        /// Over at most half an ellipse the chords turn by at most π, whatever the affine
+        /// distortion.
         #[test]
         fn half_an_ellipse_or_less_never_reads_as_more(
             span in 20.0f64..180.0,
@@ -1103,26 +1103,48 @@ mod turning_tests {
         ) {
             let m = Matrix2::new(a, c, c, b);
             prop_assume!(m.determinant() > 0.1);
-            let t = locus_turning_rad(&ellipse_arc(span, start, &m, 200)).to_degrees();
-            prop_assert!(t <= 180.0 + 0.5, "span {span} turned {t}");
+            let t = locus_turning_rad(&ellipse_arc(span, start, &m, 200), 0.0).to_degrees();
+            prop_assert!(t <= 180.0 + 1e-9, "span {span} turned {t}");
+        }
+
+        /// Skipping short chords keeps half an ellipse at most half, and loses at most two
+        /// chords' turning on a full one.
+        #[test]
+        fn a_minimum_chord_keeps_the_laws(
+            span in 20.0f64..180.0,
+            start in 0.0f64..360.0,
+            a in 0.7f64..1.5, b in 0.7f64..1.5, c in -0.3f64..0.3,
+            min_chord in 0.0f64..0.3,
+        ) {
+            let m = Matrix2::new(a, c, c, b);
+            prop_assume!(m.determinant() > 0.3);
+            let t = locus_turning_rad(&ellipse_arc(span, start, &m, 300), min_chord).to_degrees();
+            prop_assert!(t <= 180.0 + 1e-9, "span {span} turned {t}");
+            // Skipping errs short, by at most the last chord's turning at each end: two chord
+            // angles at the smallest radius of curvature, b²/a at the ends of the major axis.
+            let e = m.symmetric_eigenvalues();
+            let rho_min = e.min().powi(2) / e.max();
+            let chord_deg = 2.0 * (min_chord / (2.0 * rho_min)).min(1.0).asin().to_degrees();
+            let full = locus_turning_rad(&ellipse_arc(360.0, start, &m, 721), min_chord).to_degrees();
+            prop_assert!(full >= 360.0 - 2.0 * chord_deg - 1.0, "a full turn read as {full} (chord {chord_deg}°)");
         }
 
         #[test]
         fn more_than_half_an_ellipse_reads_as_more_than_half(
-            span in 181.0f64..359.0,
+            span in 190.0f64..359.0,
             start in 0.0f64..360.0,
             a in 0.5f64..2.0, b in 0.5f64..2.0, c in -0.5f64..0.5,
         ) {
             let m = Matrix2::new(a, c, c, b);
             prop_assume!(m.determinant() > 0.1);
-            let t = locus_turning_rad(&ellipse_arc(span, start, &m, 400)).to_degrees();
-            prop_assert!(t >= 180.0 - 0.5, "span {span} turned {t}");
+            let t = locus_turning_rad(&ellipse_arc(span, start, &m, 400), 0.0).to_degrees();
+            prop_assert!(t >= 180.0, "span {span} turned {t}");
         }
 
         #[test]
         fn any_input_is_finite(pts in proptest::collection::vec((proptest::num::f64::ANY, proptest::num::f64::ANY), 0..20)) {
             let v: Vec<Vector2<f64>> = pts.into_iter().map(|(x, y)| Vector2::new(x, y)).collect();
-            let t = locus_turning_rad(&v);
+            let t = locus_turning_rad(&v, 0.0);
             prop_assert!(t.is_finite() && t >= 0.0);
         }
     }
