@@ -490,24 +490,32 @@ pub fn quality_2d(points: &[Vector2<f64>], cal: &CompassCalibration2d, field: f6
     assess_2d(points, cal, field).quality
 }
 
+/// For an information matrix `A = L Lᵀ` of `P` parameters fitted to `n` points with residual
+/// sum of squares `sum_sq`: `L⁻¹`, formed once so that every test direction costs one small
+/// product instead of two triangular solves, and the residual standard deviation
+/// `σ = √(sum_sq / (n − P))`. `None` when `n ≤ P` or `A` is not positive definite.
+fn whitened<const P: usize>(
+    info: &SMatrix<f64, P, P>,
+    sum_sq: f64,
+    n: usize,
+) -> Option<(SMatrix<f64, P, P>, f64)> {
+    if n <= P {
+        return None;
+    }
+    let l_inv = info
+        .cholesky()?
+        .l()
+        .solve_lower_triangular(&SMatrix::<f64, P, P>::identity())?;
+    Some((l_inv, (sum_sq / (n - P) as f64).sqrt()))
+}
+
 /// `3 σ max_u √(gᵀA⁻¹g)` in degrees over 72 headings; infinite when `A` is singular or
 /// there are no more points than parameters.
 fn bound_2d(info: &SMatrix<f64, 5, 5>, sum_sq: f64, n: usize) -> f64 {
-    if n <= 5 {
-        return f64::INFINITY;
-    }
-    let Some(chol) = info.cholesky() else {
+    // gᵀA⁻¹g = ‖L⁻¹g‖²: each heading costs one small matrix-vector product.
+    let Some((l_inv, sigma)) = whitened(info, sum_sq, n) else {
         return f64::INFINITY;
     };
-    // gᵀA⁻¹g = ‖L⁻¹g‖² for A = L Lᵀ: with L⁻¹ formed once, each heading costs one small
-    // matrix-vector product instead of two triangular solves.
-    let Some(l_inv) = chol
-        .l()
-        .solve_lower_triangular(&SMatrix::<f64, 5, 5>::identity())
-    else {
-        return f64::INFINITY;
-    };
-    let sigma = (sum_sq / (n - 5) as f64).sqrt();
     let mut worst: f64 = 0.0;
     for k in 0..72 {
         let th = TAU * k as f64 / 72.0;
@@ -717,22 +725,10 @@ const BOUND_DIRECTIONS_3D: usize = 256;
 /// `3 σ max_u √trace(G(u) A⁻¹ G(u)ᵀ)` in degrees, `G(u)` the 3×9 Jacobian of the direction
 /// error `(I − uuᵀ)(E u − d)`; infinite when `A` is singular or `N ≤ 9`.
 fn bound_3d(info: &SMatrix<f64, 9, 9>, sum_sq: f64, n: usize) -> f64 {
-    if n <= 9 {
-        return f64::INFINITY;
-    }
-    let Some(chol) = info.cholesky() else {
+    // trace(G A⁻¹ Gᵀ) = ‖L⁻¹ Gᵀ‖²_F: each direction costs one small matrix product.
+    let Some((l_inv, sigma)) = whitened(info, sum_sq, n) else {
         return f64::INFINITY;
     };
-    // trace(G A⁻¹ Gᵀ) = ‖L⁻¹ Gᵀ‖²_F for A = L Lᵀ: with L⁻¹ formed once, each direction
-    // costs one small matrix product instead of two triangular solves with three
-    // right-hand sides.
-    let Some(l_inv) = chol
-        .l()
-        .solve_lower_triangular(&SMatrix::<f64, 9, 9>::identity())
-    else {
-        return f64::INFINITY;
-    };
-    let sigma = (sum_sq / (n - 9) as f64).sqrt();
     let golden = core::f64::consts::PI * (3.0 - 5.0_f64.sqrt());
     let mut worst: f64 = 0.0;
     for k in 0..BOUND_DIRECTIONS_3D {
