@@ -1,7 +1,7 @@
 //! `heading --lat/--lon/--date`: true heading is magnetic heading plus the declination that
 //! `truenorth field` reports for the same place and date, added exactly once.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::Command;
 
 fn bin() -> Command {
@@ -32,23 +32,30 @@ fn headings(path: &Path) -> Vec<f64> {
         .collect()
 }
 
-#[test]
-fn true_heading_adds_the_wmm_declination_once() {
-    let dir = std::env::temp_dir().join(format!("truenorth-true-heading-{}", std::process::id()));
+/// A fresh folder holding `turn.csv`: a level compass turning through 360° one degree per
+/// row, reading `field·(cos h, −sin h) + hard_iron`. Returns (folder, csv path).
+fn level_turn(tag: &str, field: f64, hard_iron: (f64, f64)) -> (PathBuf, PathBuf) {
+    let dir = std::env::temp_dir().join(format!("truenorth-{tag}-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let input = dir.join("turn.csv");
-    // A level compass turning through a full circle with hard iron (3, -2) on a 20 µT field.
     let mut csv = String::from("t_s,mag_x,mag_y\n");
     for k in 0..360 {
         let h = f64::from(k).to_radians();
         csv += &format!(
             "{},{},{}\n",
             f64::from(k) * 0.1,
-            20.0 * h.cos() + 3.0,
-            -20.0 * h.sin() - 2.0
+            field * h.cos() + hard_iron.0,
+            -field * h.sin() + hard_iron.1
         );
     }
     std::fs::write(&input, csv).unwrap();
+    (dir, input)
+}
+
+#[test]
+fn true_heading_adds_the_wmm_declination_once() {
+    // A level compass turning through a full circle with hard iron (3, -2) on a 20 µT field.
+    let (dir, input) = level_turn("true-heading", 20.0, (3.0, -2.0));
     let cal = dir.join("cal.json");
     run_ok(
         bin()
@@ -126,21 +133,8 @@ fn true_heading_adds_the_wmm_declination_once() {
 
 #[test]
 fn calibrate_compares_the_fit_with_the_wmm_field() {
-    let dir = std::env::temp_dir().join(format!("truenorth-expected-field-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let input = dir.join("turn.csv");
     // 19.6 µT: London's horizontal field in 2026 (WMM2025 gives 19.56 µT).
-    let mut csv = String::from("t_s,mag_x,mag_y\n");
-    for k in 0..360 {
-        let h = f64::from(k).to_radians();
-        csv += &format!(
-            "{},{},{}\n",
-            f64::from(k) * 0.1,
-            19.6 * h.cos(),
-            -19.6 * h.sin()
-        );
-    }
-    std::fs::write(&input, csv).unwrap();
+    let (dir, input) = level_turn("expected-field", 19.6, (0.0, 0.0));
     let cal = dir.join("cal.json");
     let place = ["--lat", "51.5", "--lon", "-0.13", "--date", "2026.5"];
     let calibrate = |unit: &str| {
