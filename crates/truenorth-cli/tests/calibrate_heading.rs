@@ -24,6 +24,17 @@ fn truenorth(args: &[&str]) -> Output {
         .expect("the truenorth binary runs")
 }
 
+/// Runs the binary and asserts that it succeeded, showing the arguments and stderr if not.
+fn ok(args: &[&str]) -> Output {
+    let out = truenorth(args);
+    assert!(
+        out.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
 fn p(path: &Path) -> &str {
     path.to_str().unwrap()
 }
@@ -87,7 +98,7 @@ fn ellipse_calibration_then_heading() {
     let input = dir.join("turn.csv");
     std::fs::write(&input, csv).unwrap();
     let cal = dir.join("cal.json");
-    let out = truenorth(&[
+    ok(&[
         "calibrate",
         "--method",
         "ellipse",
@@ -98,11 +109,6 @@ fn ellipse_calibration_then_heading() {
         "--expected-field",
         "20",
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&cal).unwrap()).unwrap();
     assert_eq!(json["format"], "truenorth-compass-calibration");
@@ -135,7 +141,7 @@ fn ellipse_calibration_then_heading() {
     assert!((ratio - 1.3f64.sqrt()).abs() < 0.01, "{ratio}");
 
     let headings = dir.join("heading.csv");
-    let out = truenorth(&[
+    ok(&[
         "heading",
         "--calibration",
         p(&cal),
@@ -144,11 +150,6 @@ fn ellipse_calibration_then_heading() {
         "--output",
         p(&headings),
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
     let got = read_headings(&headings);
     assert_eq!(got.len(), 360);
     assert!(got.iter().all(|(_, h)| (0.0..360.0).contains(h)));
@@ -186,7 +187,7 @@ fn ellipsoid_calibration_then_level_heading() {
     let input = dir.join("tumble.csv");
     std::fs::write(&input, csv).unwrap();
     let cal = dir.join("cal3.json");
-    let out = truenorth(&[
+    ok(&[
         "calibrate",
         "--method",
         "ellipsoid",
@@ -195,11 +196,6 @@ fn ellipsoid_calibration_then_level_heading() {
         "--output",
         p(&cal),
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&cal).unwrap()).unwrap();
     assert_eq!(json["dimensions"], 3);
@@ -224,7 +220,7 @@ fn ellipsoid_calibration_then_level_heading() {
     let level_in = dir.join("level.csv");
     std::fs::write(&level_in, level).unwrap();
     let headings = dir.join("heading3.csv");
-    let out = truenorth(&[
+    ok(&[
         "heading",
         "--calibration",
         p(&cal),
@@ -233,11 +229,6 @@ fn ellipsoid_calibration_then_level_heading() {
         "--output",
         p(&headings),
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
     let rms = rms_deg(&read_headings(&headings), &truth);
     assert!(rms < 0.01, "heading RMS {rms}°");
 }
@@ -389,7 +380,7 @@ fn every_2d_method_calibrates_a_full_turn_and_refuses_a_half() {
     std::fs::write(&input, csv).unwrap();
     for method in ["ellipse", "binned-ellipse", "merit-circle", "turn"] {
         let cal = dir.join(format!("{method}.json"));
-        let out = truenorth(&[
+        ok(&[
             "calibrate",
             "--method",
             method,
@@ -398,17 +389,12 @@ fn every_2d_method_calibrates_a_full_turn_and_refuses_a_half() {
             "--output",
             p(&cal),
         ]);
-        assert!(
-            out.status.success(),
-            "{method}: {}",
-            String::from_utf8_lossy(&out.stderr)
-        );
         let json: serde_json::Value =
             serde_json::from_str(&std::fs::read_to_string(&cal).unwrap()).unwrap();
         assert_eq!(json["method"], method);
         assert_eq!(json["dimensions"], 2);
         let h = dir.join(format!("{method}.csv"));
-        let out = truenorth(&[
+        ok(&[
             "heading",
             "--calibration",
             p(&cal),
@@ -417,11 +403,6 @@ fn every_2d_method_calibrates_a_full_turn_and_refuses_a_half() {
             "--output",
             p(&h),
         ]);
-        assert!(
-            out.status.success(),
-            "{method}: {}",
-            String::from_utf8_lossy(&out.stderr)
-        );
         assert_eq!(read_headings(&h).len(), 400);
 
         let (half, _) = turn_csv(181);
