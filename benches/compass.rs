@@ -5,6 +5,8 @@
 //!   refinement, quality report and refusal checks).
 //! * Per-sample heading, `CompassCalibration2d::heading_rad` (goal ≤ 20 ns).
 //! * 3-D least-squares fit of 10,000 readings, direct and refined.
+//! * Per-push cost of the binned-ellipse calibrator (criterion's mean over pushes, and the
+//!   median and worst single push of a long turn, printed).
 //!
 //! Run: `cargo bench --bench compass -- --warm-up-time 1 --measurement-time 3`.
 
@@ -13,11 +15,11 @@ use std::hint::black_box;
 use criterion::{Criterion, criterion_group, criterion_main};
 use nalgebra::{Matrix2, Matrix3, Vector2, Vector3};
 use truenorth::calib::{
-    EllipseFitOptions, EllipsoidFitOptions, fit_ellipse, fit_ellipse_direct, fit_ellipsoid,
-    fit_ellipsoid_direct,
+    BinnedEllipseCalibrator, EllipseConfig, EllipsoidConfig, fit_ellipse, fit_ellipse_direct,
+    fit_ellipsoid, fit_ellipsoid_direct,
 };
 use truenorth::compass::CompassCalibration2d;
-use truenorth::core::{NoiseSource, SplitMix64};
+use truenorth::core::{Calibrator, Mag2Sample, NoiseSource, SplitMix64};
 
 const N: usize = 10_000;
 
@@ -61,14 +63,14 @@ fn bench(c: &mut Criterion) {
     c.bench_function("ellipse/direct_fit_10k", |b| {
         b.iter(|| fit_ellipse_direct(black_box(&pts)).unwrap())
     });
-    let no_refine = EllipseFitOptions {
+    let no_refine = EllipseConfig {
         refine: false,
         ..Default::default()
     };
     c.bench_function("ellipse/direct_fit_with_quality_10k", |b| {
         b.iter(|| fit_ellipse(black_box(&pts), &no_refine).unwrap())
     });
-    let full = EllipseFitOptions::default();
+    let full = EllipseConfig::default();
     c.bench_function("ellipse/refined_fit_with_quality_10k", |b| {
         b.iter(|| fit_ellipse(black_box(&pts), &full).unwrap())
     });
@@ -86,10 +88,45 @@ fn bench(c: &mut Criterion) {
     c.bench_function("ellipsoid/direct_fit_10k", |b| {
         b.iter(|| fit_ellipsoid_direct(black_box(&pts3)).unwrap())
     });
-    let full3 = EllipsoidFitOptions::default();
+    let full3 = EllipsoidConfig::default();
     c.bench_function("ellipsoid/refined_fit_with_quality_10k", |b| {
         b.iter(|| fit_ellipsoid(black_box(&pts3), &full3).unwrap())
     });
+
+    // Binned ellipse: a slow turn (0.5° per reading), pushed again and again.
+    let stream: Vec<Mag2Sample> = (0..20_000)
+        .map(|i| Mag2Sample {
+            t_s: 0.05 * i as f64,
+            mag: pts[(i * 7) % N],
+        })
+        .collect();
+    let mut cal = BinnedEllipseCalibrator::default();
+    let mut i = 0usize;
+    c.bench_function("binned_ellipse/push", |b| {
+        b.iter(|| {
+            i = (i + 1) % stream.len();
+            cal.push(black_box(&stream[i])).unwrap()
+        })
+    });
+    // Median and worst single push (criterion reports means over batches, which hide the
+    // worst push).
+    let mut cal = BinnedEllipseCalibrator::default();
+    let mut ns: Vec<u128> = stream
+        .iter()
+        .map(|s| {
+            let t0 = std::time::Instant::now();
+            black_box(cal.push(black_box(s)).unwrap());
+            t0.elapsed().as_nanos()
+        })
+        .collect();
+    ns.sort_unstable();
+    println!(
+        "binned_ellipse/push single pushes: median {} ns, 99th percentile {} ns, 99.9th {} ns, worst {} ns",
+        ns[ns.len() / 2],
+        ns[ns.len() * 99 / 100],
+        ns[ns.len() * 999 / 1000],
+        ns[ns.len() - 1]
+    );
 }
 
 criterion_group!(benches, bench);

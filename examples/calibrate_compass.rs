@@ -17,7 +17,7 @@ fn main() -> Result<(), Error> {
     let samples = vehicle_streams(&truth, &VehicleSensorParams::typical(), 7)?;
 
     // Calibrate: push the compass readings, then solve (or be told why not).
-    let mut calibrator = EllipseCalibrator::new();
+    let mut calibrator = EllipseCalibrator::default();
     for s in &samples {
         if let Some(mag) = s.mag {
             calibrator.push(&Mag2Sample { t_s: s.t_s, mag })?;
@@ -34,9 +34,9 @@ fn main() -> Result<(), Error> {
     );
     println!(
         "coverage {:.0} %, residual {:.2} % of the field, predicted heading-error bound {:.2} deg",
-        quality.coverage * 100.0,
-        quality.residual_rms_rel * 100.0,
-        quality.heading_error_bound_deg
+        quality.fit.coverage * 100.0,
+        quality.fit.residual_rms_rel * 100.0,
+        quality.heading_error_bound_deg()
     );
 
     // Heading error against the truth, before and after.

@@ -17,6 +17,9 @@
 //! | [`calib`] | `truenorth-calib` | calibrators with quality reports |
 //! | [`fusion`] | `truenorth-fusion` | orientation and vehicle heading estimators |
 //!
+//! The [`pipeline`] module wires them: a self-calibrating compass, or any vehicle or
+//! orientation estimator, with true north from the World Magnetic Model, in a few lines.
+//!
 //! ```
 //! use truenorth::prelude::*;
 //!
@@ -24,6 +27,8 @@
 //! assert!((rad_to_deg(h) - 10.0).abs() < 1e-9);
 //! ```
 #![cfg_attr(not(feature = "std"), no_std)]
+
+pub mod pipeline;
 
 pub use truenorth_accel as accel;
 pub use truenorth_calib as calib;
@@ -36,11 +41,13 @@ pub use truenorth_odometer as odometer;
 
 /// The types and functions most programs need, in one import.
 pub mod prelude {
+    pub use crate::pipeline::{CompassPipeline, NavPipeline, OrientationPipeline, Place};
     pub use truenorth_compass::{CompassCalibration2d, CompassCalibration3d};
     pub use truenorth_core::{
-        AbsoluteHeadingSource, Calibration, Calibrator, Declination, Error, HeadingEstimator,
-        ImuSample, Mag2Sample, Mag3Sample, MagneticHeading, NavState, OrientationEstimator,
-        Quality, RelativeHeadingSource, Solution, TrueHeading, VehicleSample, WheelSample,
-        angle_diff, deg_to_rad, rad_to_deg, wrap_pi, wrap_two_pi,
+        AbsoluteHeadingSource, AttitudeEstimate, Axes, Calibration, Calibrator, CompassQuality,
+        Declination, Error, HeadingEstimator, ImuSample, Mag2Sample, Mag3Sample, MagneticHeading,
+        NavEstimate, OnlineCalibrator, OrientationEstimator, Persistent, Pushed,
+        RelativeHeadingSource, Solution, TrueHeading, VehicleSample, WheelSample, angle_diff,
+        deg_to_rad, rad_to_deg, wrap_pi, wrap_two_pi,
     };
 }

@@ -8,7 +8,9 @@ use truenorth::compass::CompassCalibration2d;
 use truenorth::prelude::*;
 use truenorth_sim::{VehicleSensorParams, VehicleTruth, scenario, simulate, vehicle_streams};
 
-type Boxed = Box<dyn Calibrator<Sample = Mag2Sample, Params = CompassCalibration2d>>;
+type Boxed = Box<
+    dyn Calibrator<Sample = Mag2Sample, Params = CompassCalibration2d, Quality = CompassQuality>,
+>;
 
 struct Drive {
     truth: Vec<VehicleTruth>,
@@ -75,23 +77,24 @@ fn every_calibrator_on_a_simulated_drive() {
             .filter(|m| m.t_s <= d.circle_end_s)
             .collect();
 
-        let mut ls: Boxed = Box::new(EllipseCalibrator::new());
+        let mut ls: Boxed = Box::<EllipseCalibrator>::default();
         let ls_rms = heading_rms_deg(&d, &fit(&mut ls, &circle).unwrap().params);
-        // Issue goal: least squares within 10 % of the noise floor.
+        // Least squares within 10 % of the noise floor: its estimate is efficient, so its
+        // excess over the floor shrinks as 1/N (0.5 % on this circle, lsq_fits.rs).
         assert!(
             ls_rms <= 1.1 * floor,
             "seed {seed}: LS {ls_rms:.3} vs floor {floor:.3}"
         );
 
-        let mut binned: Boxed = Box::new(BinnedEllipseCalibrator::new());
+        let mut binned: Boxed = Box::<BinnedEllipseCalibrator>::default();
         let b_rms = heading_rms_deg(&d, &fit(&mut binned, &circle).unwrap().params);
         assert!(b_rms <= 1.0, "seed {seed}: binned ellipse {b_rms:.3} deg");
 
         // Circle-only methods cannot remove a rotated soft iron: worse than the ellipse
         // methods, but their own quality report must own up to it.
         for mut cal in [
-            Box::new(MeritCircleCalibrator::new()) as Boxed,
-            Box::new(TurnCompassCalibrator::new()),
+            Box::new(MeritCircleCalibrator::default()) as Boxed,
+            Box::new(TurnCompassCalibrator::default()),
         ] {
             let sol = fit(&mut cal, &circle).unwrap();
             let rms = heading_rms_deg(&d, &sol.params);
@@ -100,9 +103,9 @@ fn every_calibrator_on_a_simulated_drive() {
                 "seed {seed}: circle method {rms:.2} unexpectedly good"
             );
             assert!(
-                sol.quality.heading_error_bound_deg >= rms,
+                sol.quality.heading_error_bound_deg() >= rms,
                 "seed {seed}: bound {:.2} hides an error of {rms:.2}",
-                sol.quality.heading_error_bound_deg
+                sol.quality.heading_error_bound_deg()
             );
         }
     }
@@ -122,10 +125,10 @@ fn half_a_turn_is_refused_by_every_calibrator() {
         .map(|(m, _)| *m)
         .collect();
     let all: [Boxed; 4] = [
-        Box::new(EllipseCalibrator::new()),
-        Box::new(BinnedEllipseCalibrator::new()),
-        Box::new(MeritCircleCalibrator::new()),
-        Box::new(TurnCompassCalibrator::new()),
+        Box::new(EllipseCalibrator::default()),
+        Box::new(BinnedEllipseCalibrator::default()),
+        Box::new(MeritCircleCalibrator::default()),
+        Box::new(TurnCompassCalibrator::default()),
     ];
     for mut cal in all {
         let r = fit(&mut cal, &half);
@@ -165,12 +168,12 @@ mod round_trip {
                 .into_iter()
                 .map(|s| Mag2Sample { t_s: s.t_s, mag: s.mag.unwrap() })
                 .collect();
-            let mut cal: Boxed = Box::new(EllipseCalibrator::new());
+            let mut cal: Boxed = Box::<EllipseCalibrator>::default();
             let sol = fit(&mut cal, &mags).unwrap();
             let d = Drive { truth, mags, circle_end_s: route.duration_s(), params };
             let rms = heading_rms_deg(&d, &sol.params);
             prop_assert!(rms < 0.25, "heading RMS {rms:.3} deg");
-            prop_assert!(sol.quality.coverage > 0.95);
+            prop_assert!(sol.quality.fit.coverage > 0.95);
         }
     }
 }

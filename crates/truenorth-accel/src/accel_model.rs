@@ -11,16 +11,22 @@ use serde::{Deserialize, Serialize};
 #[allow(unused_imports)]
 use truenorth_core::Float as _;
 use truenorth_core::{
-    Error, NoiseSource, Result, STANDARD_GRAVITY_MPS2, SensorModel, check_dt, check_finite,
-    check_finite3,
+    NoiseSource, Result, STANDARD_GRAVITY_MPS2, SensorModel, Validate, check_dt, check_finite3,
+    check_positive, check_range,
 };
 
-use crate::{AccelCalibration, AccelTruth, specific_force_body_mps2};
+use crate::specific_force::specific_force_unchecked;
+use crate::{AccelCalibration, AccelTruth};
 
 /// Smallest accepted scale error per axis (a gain of 0.001; ≤ 0 could not be inverted).
 pub const MIN_SCALE_ERROR: f64 = -0.999;
 
-/// The accelerometer's error parameters.
+/// The accelerometer's true error parameters.
+///
+/// A forward model's parameters are called `*Params` (not `*Config`): they describe the
+/// sensor's actual errors, which a calibration estimates, rather than options a user picks.
+/// They are validated like every config ([`Validate`]) and [`AccelModel::new`] refuses
+/// invalid ones. `Default` is a perfect sensor under standard gravity.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct AccelParams {
     /// Bias per axis (x, y, z), m/s².
@@ -44,39 +50,20 @@ impl Default for AccelParams {
     }
 }
 
-impl AccelParams {
-    /// Checks every parameter: finite, noise ≥ 0, gravity > 0, scale errors ≥
-    /// [`MIN_SCALE_ERROR`].
-    pub fn validate(&self) -> Result<()> {
+impl Validate for AccelParams {
+    /// Every parameter finite, scale errors ≥ [`MIN_SCALE_ERROR`], noise ≥ 0, gravity > 0.
+    fn validate(&self) -> Result<()> {
         check_finite3("accel bias_mps2", &self.bias_mps2)?;
-        check_finite3("accel scale_error", &self.scale_error)?;
         for &s in self.scale_error.iter() {
-            if s < MIN_SCALE_ERROR {
-                return Err(Error::OutOfRange {
-                    what: "accel scale_error",
-                    value: s,
-                    min: MIN_SCALE_ERROR,
-                    max: f64::MAX,
-                });
-            }
+            check_range("accel scale_error", s, MIN_SCALE_ERROR, f64::MAX)?;
         }
-        let n = check_finite(
+        check_range(
             "accel noise_density_mps2_per_sqrt_hz",
             self.noise_density_mps2_per_sqrt_hz,
+            0.0,
+            f64::MAX,
         )?;
-        let g = check_finite("gravity_mps2", self.gravity_mps2)?;
-        if n < 0.0 || g <= 0.0 {
-            return Err(Error::OutOfRange {
-                what: if n < 0.0 {
-                    "accel noise_density_mps2_per_sqrt_hz"
-                } else {
-                    "gravity_mps2"
-                },
-                value: if n < 0.0 { n } else { g },
-                min: 0.0,
-                max: f64::MAX,
-            });
-        }
+        check_positive("gravity_mps2", self.gravity_mps2)?;
         Ok(())
     }
 }
@@ -96,7 +83,7 @@ pub struct AccelModel {
 }
 
 impl AccelModel {
-    /// A model with these parameters.
+    /// A model with these parameters (validated first).
     pub fn new(params: AccelParams) -> Result<Self> {
         params.validate()?;
         Ok(Self {
@@ -127,14 +114,29 @@ impl AccelModel {
     }
 
     fn deterministic(&self, truth: &AccelTruth) -> Vector3<f64> {
-        specific_force_body_mps2(truth, self.params.gravity_mps2).component_mul(&self.coeffs.gain)
+        specific_force_unchecked(truth, self.params.gravity_mps2).component_mul(&self.coeffs.gain)
             + self.params.bias_mps2
     }
+}
 
-    /// [`SensorModel::sample`] with validation: a typed error for non-finite truth or a
-    /// `dt_s` that is not positive and finite.
-    pub fn try_sample(
-        &self,
+impl SensorModel for AccelModel {
+    type Truth = AccelTruth;
+    type Reading = Vector3<f64>;
+
+    /// Gravity plus acceleration, with bias and scale; no noise. A typed error for a
+    /// non-finite truth or a reading too large to represent.
+    fn ideal(&self, truth: &AccelTruth) -> Result<Vector3<f64>> {
+        truth.validate()?;
+        let reading = self.deterministic(truth);
+        check_finite3("accelerometer reading (inputs too large)", &reading)?;
+        Ok(reading)
+    }
+
+    /// Every error: [`SensorModel::ideal`] plus white noise of `N/√dt` per axis. A typed
+    /// error for a non-finite truth, a `dt_s` that is not positive and finite, or a reading
+    /// too large to represent. The model has no time-varying state.
+    fn sample(
+        &mut self,
         truth: &AccelTruth,
         dt_s: f64,
         noise: &mut dyn NoiseSource,
@@ -153,34 +155,14 @@ impl AccelModel {
     }
 }
 
-impl SensorModel for AccelModel {
-    type Truth = AccelTruth;
-    type Reading = Vector3<f64>;
-
-    /// Gravity plus acceleration, with bias and scale; no noise.
-    fn ideal(&self, truth: &AccelTruth) -> Vector3<f64> {
-        self.deterministic(truth)
-    }
-
-    /// Every error; NaN components for invalid input (see [`AccelModel::try_sample`]).
-    fn sample(
-        &mut self,
-        truth: &AccelTruth,
-        dt_s: f64,
-        noise: &mut dyn NoiseSource,
-    ) -> Vector3<f64> {
-        self.try_sample(truth, dt_s, noise)
-            .unwrap_or_else(|_| Vector3::repeat(f64::NAN))
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::specific_force_body_mps2;
     use crate::static_tilt;
     use core::f64::consts::PI;
     use proptest::prelude::*;
-    use truenorth_core::{Calibration, EulerZyx, SplitMix64, ZeroNoise, angle_diff};
+    use truenorth_core::{Calibration, Error, EulerZyx, SplitMix64, ZeroNoise, angle_diff};
 
     fn params() -> impl Strategy<Value = AccelParams> {
         (
@@ -212,8 +194,8 @@ mod tests {
         ) {
             let m = AccelModel::new(p).unwrap();
             let truth = AccelTruth { attitude: e.to_quaternion(), accel_ned_mps2: Vector3::from(a) };
-            let back = m.true_calibration().apply(&m.ideal(&truth));
-            let want = specific_force_body_mps2(&truth, p.gravity_mps2);
+            let back = m.true_calibration().apply(&m.ideal(&truth).unwrap()).unwrap();
+            let want = specific_force_body_mps2(&truth, p.gravity_mps2).unwrap();
             prop_assert!((back - want).amax() < 1e-12 * (1.0 + want.amax()));
             // And the specific force maps back to the NED acceleration.
             let a_back = truth.attitude.transform_vector(&back) + crate::gravity_ned_mps2(p.gravity_mps2);
@@ -225,7 +207,7 @@ mod tests {
         #[test]
         fn at_rest_round_trip_gives_the_tilt(p in params(), e in euler()) {
             let m = AccelModel::new(p).unwrap();
-            let f = m.true_calibration().apply(&m.ideal(&AccelTruth::at_rest(e.to_quaternion())));
+            let f = m.true_calibration().apply(&m.ideal(&AccelTruth::at_rest(e.to_quaternion())).unwrap()).unwrap();
             let t = static_tilt(&f).unwrap();
             prop_assert!((t.pitch_rad - e.pitch_rad).abs() < 1e-9);
             prop_assert!(angle_diff(t.roll_rad, e.roll_rad).abs() < 1e-9);
@@ -235,7 +217,7 @@ mod tests {
         #[test]
         fn uncalibrated_bias_tilts_the_answer(b in 0.2f64..1.0, e in euler()) {
             let m = AccelModel::new(AccelParams { bias_mps2: Vector3::new(b, 0.0, 0.0), ..AccelParams::default() }).unwrap();
-            let raw = m.ideal(&AccelTruth::at_rest(e.to_quaternion()));
+            let raw = m.ideal(&AccelTruth::at_rest(e.to_quaternion())).unwrap();
             let t = static_tilt(&raw).unwrap();
             prop_assert!((t.pitch_rad - e.pitch_rad).abs() > 1e-4);
         }
@@ -248,12 +230,19 @@ mod tests {
             let q = nalgebra::UnitQuaternion::new_unchecked(nalgebra::Quaternion::new(w, 0.0, 0.0, 0.0));
             let truth = AccelTruth { attitude: q, accel_ned_mps2: Vector3::new(x, 0.0, 0.0) };
             let ok = x.is_finite() && w.is_finite() && dt.is_finite() && dt > 0.0;
-            let r = m.try_sample(&truth, dt, &mut SplitMix64::new(2));
+            let r = m.sample(&truth, dt, &mut SplitMix64::new(2));
             if !ok {
-                prop_assert!(r.is_err());
-                prop_assert!(m.sample(&truth, dt, &mut SplitMix64::new(2)).x.is_nan());
+                let typed = matches!(r, Err(Error::NonFinite { .. } | Error::InvalidDt { .. }));
+                prop_assert!(typed, "{r:?}");
             }
             if let Ok(v) = r { prop_assert!(v.iter().all(|c| c.is_finite())); }
+            match m.ideal(&truth) {
+                Ok(v) => prop_assert!(v.iter().all(|c| c.is_finite())),
+                Err(e) => prop_assert!(matches!(e, Error::NonFinite { .. }), "{e:?}"),
+            }
+            if !(x.is_finite() && w.is_finite()) {
+                prop_assert!(m.ideal(&truth).is_err());
+            }
         }
     }
 
@@ -261,21 +250,21 @@ mod tests {
     fn zero_noise_sample_is_ideal_and_noise_has_the_stated_size() {
         let dt = 0.01;
         let density = 0.002;
-        let m = AccelModel::new(AccelParams {
+        let mut m = AccelModel::new(AccelParams {
             noise_density_mps2_per_sqrt_hz: density,
             ..AccelParams::default()
         })
         .unwrap();
         let truth = AccelTruth::at_rest(nalgebra::UnitQuaternion::identity());
         assert_eq!(
-            m.try_sample(&truth, dt, &mut ZeroNoise).unwrap(),
-            m.ideal(&truth)
+            m.sample(&truth, dt, &mut ZeroNoise).unwrap(),
+            m.ideal(&truth).unwrap()
         );
         let mut rng = SplitMix64::new(11);
         let n = 20_000;
         let mut s2 = 0.0;
         for _ in 0..n {
-            let e = m.try_sample(&truth, dt, &mut rng).unwrap() - m.ideal(&truth);
+            let e = m.sample(&truth, dt, &mut rng).unwrap() - m.ideal(&truth).unwrap();
             s2 += e.norm_squared();
         }
         let sigma = (s2 / (3 * n) as f64).sqrt();

@@ -10,20 +10,21 @@ use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 #[allow(unused_imports)]
 use truenorth_core::Float as _;
-use truenorth_core::{Error, Result, STANDARD_GRAVITY_MPS2, check_finite, check_finite3};
+use truenorth_core::{Result, STANDARD_GRAVITY_MPS2, Validate, check_finite3, check_positive};
 
-/// Decides whether a specific-force reading is (close to) gravity alone.
+/// Settings of a [`QuasiStaticDetector`].
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct QuasiStaticDetector {
-    /// Local gravity, m/s².
+#[serde(default)]
+pub struct QuasiStaticConfig {
+    /// Local gravity, m/s² (> 0). Default: standard gravity.
     pub gravity_mps2: f64,
-    /// Largest accepted `| |f| − g |`, m/s².
+    /// Largest accepted `| |f| − g |`, m/s² (> 0). Default 0.2 m/s² (≈ 0.02 g): a few times
+    /// a consumer MEMS accelerometer's noise per sample plus its residual scale error near
+    /// 1 g.
     pub threshold_mps2: f64,
 }
 
-impl Default for QuasiStaticDetector {
-    /// Standard gravity and a 0.2 m/s² (≈ 0.02 g) threshold: a few times a consumer MEMS
-    /// accelerometer's noise per sample plus its residual scale error near 1 g.
+impl Default for QuasiStaticConfig {
     fn default() -> Self {
         Self {
             gravity_mps2: STANDARD_GRAVITY_MPS2,
@@ -32,40 +33,46 @@ impl Default for QuasiStaticDetector {
     }
 }
 
-impl QuasiStaticDetector {
-    /// A detector with positive finite gravity and threshold.
-    pub fn new(gravity_mps2: f64, threshold_mps2: f64) -> Result<Self> {
-        let d = Self {
-            gravity_mps2,
-            threshold_mps2,
-        };
-        d.validate()?;
-        Ok(d)
-    }
-
-    /// Checks gravity and threshold (useful after loading from disk).
-    pub fn validate(&self) -> Result<()> {
-        for (what, v) in [
-            ("gravity_mps2", self.gravity_mps2),
-            ("quasi-static threshold_mps2", self.threshold_mps2),
-        ] {
-            check_finite(what, v)?;
-            if v <= 0.0 {
-                return Err(Error::OutOfRange {
-                    what,
-                    value: v,
-                    min: f64::MIN_POSITIVE,
-                    max: f64::MAX,
-                });
-            }
-        }
+impl Validate for QuasiStaticConfig {
+    /// Gravity and threshold positive and finite.
+    fn validate(&self) -> Result<()> {
+        check_positive("gravity_mps2", self.gravity_mps2)?;
+        check_positive("quasi-static threshold_mps2", self.threshold_mps2)?;
         Ok(())
     }
+}
 
-    /// `| |f| − g |`, m/s², for a calibrated specific-force reading.
+/// Decides whether a specific-force reading is (close to) gravity alone.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct QuasiStaticDetector {
+    config: QuasiStaticConfig,
+}
+
+impl Default for QuasiStaticDetector {
+    /// The detector of [`QuasiStaticConfig::default`].
+    fn default() -> Self {
+        Self {
+            config: QuasiStaticConfig::default(),
+        }
+    }
+}
+
+impl QuasiStaticDetector {
+    /// A detector with a validated `config`.
+    pub fn new(config: QuasiStaticConfig) -> Result<Self> {
+        config.validate()?;
+        Ok(Self { config })
+    }
+
+    /// The settings in use.
+    pub fn config(&self) -> &QuasiStaticConfig {
+        &self.config
+    }
+
+    /// `| |f| − g |`, m/s², for a calibrated specific-force reading; a typed error if a
+    /// component is not finite.
     pub fn deviation_mps2(&self, f_b_mps2: &Vector3<f64>) -> Result<f64> {
         check_finite3("specific force", f_b_mps2)?;
-        self.validate()?;
         // Scaled norm: huge finite readings must not overflow to inf.
         let scale = f_b_mps2.amax();
         let norm = if scale > 0.0 {
@@ -73,12 +80,12 @@ impl QuasiStaticDetector {
         } else {
             0.0
         };
-        Ok((norm - self.gravity_mps2).abs())
+        Ok((norm - self.config.gravity_mps2).abs())
     }
 
     /// Whether the reading is within the threshold of gravity.
     pub fn is_quasi_static(&self, f_b_mps2: &Vector3<f64>) -> Result<bool> {
-        Ok(self.deviation_mps2(f_b_mps2)? <= self.threshold_mps2)
+        Ok(self.deviation_mps2(f_b_mps2)? <= self.config.threshold_mps2)
     }
 }
 
@@ -103,7 +110,7 @@ mod tests {
         #[test]
         fn at_rest_is_quasi_static_in_any_attitude(y in -PI..PI, p in -1.57f64..1.57, r in -PI..PI) {
             let d = QuasiStaticDetector::default();
-            let f = specific_force_body_mps2(&AccelTruth::at_rest(attitude(y, p, r)), d.gravity_mps2);
+            let f = specific_force_body_mps2(&AccelTruth::at_rest(attitude(y, p, r)), d.config().gravity_mps2).unwrap();
             prop_assert!(d.deviation_mps2(&f).unwrap() < 1e-12);
             prop_assert!(d.is_quasi_static(&f).unwrap());
         }
@@ -119,10 +126,11 @@ mod tests {
                 attitude: attitude(y, p, r),
                 accel_ned_mps2: Vector3::new(m * dir.cos(), m * dir.sin(), 0.0),
             };
-            let f = specific_force_body_mps2(&truth, d.gravity_mps2);
-            let dev = (m * m + d.gravity_mps2 * d.gravity_mps2).sqrt() - d.gravity_mps2;
-            prop_assume!((dev - d.threshold_mps2).abs() > 1e-9);
-            prop_assert_eq!(d.is_quasi_static(&f).unwrap(), dev <= d.threshold_mps2);
+            let c = *d.config();
+            let f = specific_force_body_mps2(&truth, c.gravity_mps2).unwrap();
+            let dev = (m * m + c.gravity_mps2 * c.gravity_mps2).sqrt() - c.gravity_mps2;
+            prop_assume!((dev - c.threshold_mps2).abs() > 1e-9);
+            prop_assert_eq!(d.is_quasi_static(&f).unwrap(), dev <= c.threshold_mps2);
         }
 
         #[test]
@@ -130,11 +138,15 @@ mod tests {
             x in proptest::num::f64::ANY, g in proptest::num::f64::ANY, t in proptest::num::f64::ANY,
         ) {
             let f = Vector3::new(x, 1.0, -9.8);
-            prop_assert_eq!(QuasiStaticDetector::default().is_quasi_static(&f).is_ok(), x.is_finite());
-            let d = QuasiStaticDetector { gravity_mps2: g, threshold_mps2: t };
+            let r = QuasiStaticDetector::default().is_quasi_static(&f);
+            prop_assert_eq!(r.is_ok(), x.is_finite());
+            if r.is_err() {
+                let non_finite = matches!(r, Err(truenorth_core::Error::NonFinite { .. }));
+                prop_assert!(non_finite);
+            }
+            let config = QuasiStaticConfig { gravity_mps2: g, threshold_mps2: t };
             let valid = g.is_finite() && g > 0.0 && t.is_finite() && t > 0.0;
-            prop_assert_eq!(d.deviation_mps2(&Vector3::new(0.0, 0.0, -9.8)).is_ok(), valid);
-            prop_assert_eq!(QuasiStaticDetector::new(g, t).is_ok(), valid);
+            prop_assert_eq!(QuasiStaticDetector::new(config).is_ok(), valid);
         }
     }
 }

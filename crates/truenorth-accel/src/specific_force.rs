@@ -42,17 +42,19 @@ pub fn gravity_ned_mps2(gravity_mps2: f64) -> Vector3<f64> {
     Vector3::new(0.0, 0.0, gravity_mps2)
 }
 
-/// The specific force in body axes, `Rᵀ (a_ned − g_ned)`, m/s². No validation (NaN in, NaN
-/// out); see [`try_specific_force_body_mps2`].
-pub fn specific_force_body_mps2(truth: &AccelTruth, gravity_mps2: f64) -> Vector3<f64> {
+/// The specific force in body axes, `Rᵀ (a_ned − g_ned)`, m/s²: what an ideal
+/// accelerometer reads. A typed error for a non-finite truth or gravity.
+pub fn specific_force_body_mps2(truth: &AccelTruth, gravity_mps2: f64) -> Result<Vector3<f64>> {
+    truth.validate()?;
+    check_finite("gravity_mps2", gravity_mps2)?;
+    let f = specific_force_unchecked(truth, gravity_mps2);
+    check_finite3("specific force (inputs too large)", &f)?;
+    Ok(f)
+}
+
+/// [`specific_force_body_mps2`] for inputs already checked.
+pub(crate) fn specific_force_unchecked(truth: &AccelTruth, gravity_mps2: f64) -> Vector3<f64> {
     truth
         .attitude
         .inverse_transform_vector(&(truth.accel_ned_mps2 - gravity_ned_mps2(gravity_mps2)))
-}
-
-/// [`specific_force_body_mps2`] with a typed error for non-finite truth or gravity.
-pub fn try_specific_force_body_mps2(truth: &AccelTruth, gravity_mps2: f64) -> Result<Vector3<f64>> {
-    truth.validate()?;
-    check_finite("gravity_mps2", gravity_mps2)?;
-    Ok(specific_force_body_mps2(truth, gravity_mps2))
 }

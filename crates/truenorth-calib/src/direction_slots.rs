@@ -1,6 +1,8 @@
 //! A fixed-size sample of raw readings spread by direction, kept by the online calibrators so
 //! that their quality report can be computed on real readings without storing every sample.
 
+extern crate alloc;
+
 use core::f64::consts::TAU;
 
 use nalgebra::Vector2;
@@ -18,7 +20,7 @@ pub(crate) const SLOTS: usize = 72;
 /// kept are real ones whatever the slot, so a report computed on them about the final centre is
 /// honest — at worst it undercounts coverage (two readings landed in one slot), never
 /// overcounts it.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, PartialEq)]
 pub(crate) struct DirectionSlots {
     points: [Vector2<f64>; SLOTS],
     filled: [bool; SLOTS],
@@ -46,6 +48,34 @@ impl DirectionSlots {
         let i = ((wrap_two_pi(d.y.atan2(d.x)) / TAU * SLOTS as f64) as usize).min(SLOTS - 1);
         self.points[i] = *p;
         self.filled[i] = true;
+    }
+
+    /// The slots in order, `None` where empty (for saving).
+    pub(crate) fn to_vec(&self) -> alloc::vec::Vec<Option<Vector2<f64>>> {
+        self.points
+            .iter()
+            .zip(self.filled.iter())
+            .map(|(p, &f)| f.then_some(*p))
+            .collect()
+    }
+
+    /// Slots from [`Self::to_vec`]'s output; `None` unless there are exactly [`SLOTS`]
+    /// entries, all finite.
+    pub(crate) fn from_slice(saved: &[Option<Vector2<f64>>]) -> Option<Self> {
+        if saved.len() != SLOTS {
+            return None;
+        }
+        let mut s = Self::new();
+        for (i, p) in saved.iter().enumerate() {
+            if let Some(p) = p {
+                if !(p.x.is_finite() && p.y.is_finite()) {
+                    return None;
+                }
+                s.points[i] = *p;
+                s.filled[i] = true;
+            }
+        }
+        Some(s)
     }
 
     /// Copies the kept readings to the front of `buf`; returns how many.

@@ -11,7 +11,7 @@
 //!    `Σ (a x² + b xy + c y² + d x + e y + f)²` subject to `4ac − b² = 1`.
 //! 4. Refuse when the data are not an ellipse: the best conic without the ellipse
 //!    constraint is a hyperbola or parabola, or the ellipse is flatter than
-//!    [`EllipseFitOptions::max_axis_ratio`].
+//!    [`EllipseConfig::max_axis_ratio`].
 //! 5. Geometric refinement: Levenberg–Marquardt on the Sampson distance
 //!    `g(m) / |∇g(m)|` with `g(m) = |B (m − c)|² − 1` (Sampson 1982; a first-order
 //!    approximation of the orthogonal distance, the maximum-likelihood residual for
@@ -21,7 +21,7 @@
 //!    the semi-axes, so that `det(soft_iron) = 1`: the soft iron preserves area and the
 //!    fitted field is the radius of the circle with the ellipse's area.
 //! 7. Quality report and refusals on coverage (arc shorter than
-//!    [`EllipseFitOptions::min_arc_deg`]) and conditioning (see [`crate::quality`]).
+//!    [`EllipseConfig::min_arc_deg`]) and conditioning (see [`crate::quality`]).
 //!
 //! An ellipse fit cannot see a rotation of the soft iron (any rotation of the corrected
 //! circle is another circle); choosing the symmetric root assumes the soft iron has none,
@@ -37,11 +37,14 @@ extern crate alloc;
 use alloc::vec::Vec;
 
 use nalgebra::{Matrix2, Matrix3, SMatrix, SVector, Vector2, Vector3};
+use serde::{Deserialize, Serialize};
 use truenorth_compass::CompassCalibration2d;
 use truenorth_core::{
-    Calibrator, Error, Mag2Sample, Progress, Result, Solution, check_finite, check_finite2,
+    Calibrator, CompassQuality, Error, Mag2Sample, Progress, Pushed, Result, Solution, Validate,
+    check_finite, check_finite2, check_positive, check_range,
 };
 
+use crate::conic_sums::t_factor;
 use crate::linalg::{constrained_min3, sym_eigen2, sym_eigen3, sym_sqrt2};
 use crate::lm::{self, BLOCK, NormalAccumulator, NormalEquations, blocks};
 use crate::normalise::Normaliser;
@@ -54,32 +57,38 @@ use truenorth_core::Float as _;
 /// more leaves a residual to judge it by.
 pub const MIN_POINTS_2D: usize = 6;
 
-/// Options of the least-squares ellipse fit.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct EllipseFitOptions {
-    /// Refine the direct fit geometrically (Sampson distance). Default `true`; `false`
-    /// keeps the algebraic fit, which is faster and nearly as good at low noise.
+/// Configuration of the least-squares ellipse fit (defaults in brackets).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct EllipseConfig {
+    /// Refine the direct fit geometrically (Sampson distance) (`true`); `false` keeps the
+    /// algebraic fit, which is faster and nearly as good at low noise.
     pub refine: bool,
-    /// Most Levenberg–Marquardt steps before refusing with [`Error::NoConvergence`].
+    /// Most Levenberg–Marquardt steps before refusing with [`Error::NoConvergence`], 1..=10⁶
+    /// (100).
     pub max_iterations: usize,
-    /// Shortest arc of heading accepted, degrees (default [`MIN_ARC_DEG`]).
+    /// Shortest arc of heading accepted, degrees, 0..=360 ([`MIN_ARC_DEG`]).
     pub min_arc_deg: f64,
-    /// Largest ratio of the semi-axes accepted (default 10): flatter ellipses are refused as
+    /// Largest ratio of the semi-axes accepted, ≥ 1 (10): flatter ellipses are refused as
     /// not an ellipse — no plausible soft iron squashes the field that much.
     pub max_axis_ratio: f64,
-    /// Largest condition number of the information matrix accepted (default 1e4; a full
+    /// Largest condition number of the information matrix accepted, ≥ 1 (1e4; a full
     /// circle gives 2): above it the geometry does not determine the calibration.
     pub max_condition: f64,
-    /// Largest residual RMS, relative to the fitted field, accepted (default 0.2): readings
+    /// Largest residual RMS, relative to the fitted field, accepted, > 0 (0.2): readings
     /// that stray further from the best ellipse are not a rotation in a constant field
     /// (a static sensor, a disturbed site, a badly tilting mount).
     pub max_residual_rel: f64,
-    /// Largest predicted heading-error bound accepted, degrees (default 10; see
+    /// Largest heading-error bound of the calibration accepted
+    /// ([`CompassQuality::heading_error_bound_deg`]), degrees, > 0 (10; see
     /// [`crate::quality`]): a calibration that uncertain is refused rather than returned.
     pub max_heading_error_bound_deg: f64,
+    /// The expected horizontal field, input unit (e.g. from the World Magnetic Model), > 0,
+    /// reported as [`CompassQuality::field_ratio_to_expected`] (`None`).
+    pub expected_field: Option<f64>,
 }
 
-impl Default for EllipseFitOptions {
+impl Default for EllipseConfig {
     fn default() -> Self {
         Self {
             refine: true,
@@ -89,7 +98,31 @@ impl Default for EllipseFitOptions {
             max_condition: 1e4,
             max_residual_rel: 0.2,
             max_heading_error_bound_deg: 10.0,
+            expected_field: None,
         }
+    }
+}
+
+impl Validate for EllipseConfig {
+    fn validate(&self) -> Result<()> {
+        check_range(
+            "ellipse max_iterations",
+            self.max_iterations as f64,
+            1.0,
+            1e6,
+        )?;
+        check_range("ellipse min_arc_deg", self.min_arc_deg, 0.0, 360.0)?;
+        check_range("ellipse max_axis_ratio", self.max_axis_ratio, 1.0, f64::MAX)?;
+        check_range("ellipse max_condition", self.max_condition, 1.0, f64::MAX)?;
+        check_positive("ellipse max_residual_rel", self.max_residual_rel)?;
+        check_positive(
+            "ellipse max_heading_error_bound_deg",
+            self.max_heading_error_bound_deg,
+        )?;
+        if let Some(f) = self.expected_field {
+            check_positive("ellipse expected_field", f)?;
+        }
+        Ok(())
     }
 }
 
@@ -212,7 +245,7 @@ fn moments(points: &[Vector2<f64>], norm: &Normaliser<2>) -> (SMatrix<f64, 6, 6>
 /// `T = −S3⁻¹ S2ᵀ`, their eq. 14), and solve the reduced 3×3 constrained problem
 /// `min a₁ᵀ M a₁` s.t. `a₁ᵀ C₁ a₁ = 1`, `M = S1 + S2 T` (eq. 21), `C₁` the ellipse
 /// constraint `4ac − b²` (Fitzgibbon et al. eq. 5). Returns `(a, b, c, d, e, f)`.
-fn solve_direct(s: &SMatrix<f64, 6, 6>) -> Result<SVector<f64, 6>> {
+pub(crate) fn solve_direct(s: &SMatrix<f64, 6, 6>) -> Result<SVector<f64, 6>> {
     let s1: Matrix3<f64> = s.fixed_view::<3, 3>(0, 0).into_owned();
     let s2: Matrix3<f64> = s.fixed_view::<3, 3>(0, 3).into_owned();
     let s3: Matrix3<f64> = s.fixed_view::<3, 3>(3, 3).into_owned();
@@ -252,7 +285,7 @@ fn solve_direct(s: &SMatrix<f64, 6, 6>) -> Result<SVector<f64, 6>> {
 }
 
 /// Centre and unit map of the conic `a x² + b xy + c y² + d x + e y + f = 0`.
-fn conic_to_ellipse(k: &SVector<f64, 6>, max_axis_ratio: f64) -> Result<Ellipse> {
+pub(crate) fn conic_to_ellipse(k: &SVector<f64, 6>, max_axis_ratio: f64) -> Result<Ellipse> {
     let q = Matrix2::new(k[0], 0.5 * k[1], 0.5 * k[1], k[2]);
     let l = Vector2::new(k[3], k[4]);
     let q_inv = q.try_inverse().ok_or(Error::NotAnEllipse {
@@ -382,20 +415,24 @@ fn square_jacobian(b: &Matrix2<f64>) -> SMatrix<f64, 5, 5> {
 }
 
 /// The least-squares ellipse calibration of `points` (raw `(mag_x, mag_y)` readings of a
-/// level compass turning through at least [`EllipseFitOptions::min_arc_deg`]), with its
-/// quality report — or a typed refusal saying why the data cannot support one. See the
-/// module documentation for the steps.
+/// level compass turning through at least [`EllipseConfig::min_arc_deg`]), with its
+/// quality report — or a typed refusal saying why the data cannot support one (an invalid
+/// `config` is refused first). See the module documentation for the steps.
 pub fn fit_ellipse(
     points: &[Vector2<f64>],
-    options: &EllipseFitOptions,
+    config: &EllipseConfig,
 ) -> Result<Solution<CompassCalibration2d>> {
-    fit_unchecked(points, options).map_err(|e| explain_short_arc(points, options, e))
+    config.validate()?;
+    let mut sol =
+        fit_unchecked(points, config).map_err(|e| explain_short_arc(points, config, e))?;
+    sol.quality = quality::with_expected_field(sol.quality, config.expected_field);
+    Ok(sol)
 }
 
 /// A fit that failed on a short arc is better explained by the arc than by the symptom
 /// (a hyperbola, a refinement that wanders along a flat valley): if the readings span
 /// less than the minimum arc seen from their best-fitting circle, say so instead.
-fn explain_short_arc(points: &[Vector2<f64>], options: &EllipseFitOptions, e: Error) -> Error {
+fn explain_short_arc(points: &[Vector2<f64>], config: &EllipseConfig, e: Error) -> Error {
     if !matches!(
         e,
         Error::NotAnEllipse { .. } | Error::NoConvergence { .. } | Error::Degenerate { .. }
@@ -405,11 +442,34 @@ fn explain_short_arc(points: &[Vector2<f64>], options: &EllipseFitOptions, e: Er
     match circle_centre(points) {
         Some(c) => {
             let cov = quality::coverage(points, &c);
-            quality::require_arc(&cov, options.min_arc_deg)
+            quality::require_arc(&cov, config.min_arc_deg)
                 .err()
                 .unwrap_or(e)
         }
         None => e,
+    }
+}
+
+/// Refuses readings whose raw locus, taken in the order given, turns through less than
+/// `need_deg` ([`quality::locus_turning_rad`], chords of at least a quarter of the fitted
+/// `field`), with [`Error::InsufficientCoverage`].
+///
+/// The coverage about the fitted centre cannot catch a short noisy arc on its own: a few
+/// readings a degree or two apart fit a small ellipse around themselves, and seen from its
+/// centre they cover the whole circle. The locus's own turning does not depend on any
+/// centre. Chords of a quarter of the field (about 14° of the fitted circle) are long
+/// compared with the noise of any reading the residual test accepts, so their directions
+/// follow the locus rather than the noise; the measure then errs short by up to one chord at
+/// each end (see [`quality::locus_turning_rad`]).
+fn require_locus_turning(points: &[Vector2<f64>], field: f64, need_deg: f64) -> Result<()> {
+    let turned_deg = quality::locus_turning_rad(points, 0.25 * field).to_degrees();
+    if turned_deg < need_deg {
+        Err(Error::InsufficientCoverage {
+            covered_deg: turned_deg.floor(),
+            need_deg,
+        })
+    } else {
+        Ok(())
     }
 }
 
@@ -434,14 +494,14 @@ fn circle_centre(points: &[Vector2<f64>]) -> Option<Vector2<f64>> {
 
 fn fit_unchecked(
     points: &[Vector2<f64>],
-    options: &EllipseFitOptions,
+    config: &EllipseConfig,
 ) -> Result<Solution<CompassCalibration2d>> {
-    let (norm, direct) = direct_normalised(points, options.max_axis_ratio)?;
-    let e = if options.refine {
+    let (norm, direct) = direct_normalised(points, config.max_axis_ratio)?;
+    let e = if config.refine {
         let out = lm::minimise(
             "ellipse geometric refinement",
             to_params(&direct),
-            options.max_iterations,
+            config.max_iterations,
             |p| sampson_normal_equations(points, &norm, p),
         )?;
         let e = from_params(&out.params);
@@ -454,7 +514,7 @@ fn fit_unchecked(
             centre: e.centre,
             unit_map,
         };
-        check_axis_ratio(&e, options.max_axis_ratio)?;
+        check_axis_ratio(&e, config.max_axis_ratio)?;
         e
     } else {
         direct
@@ -466,18 +526,24 @@ fn fit_unchecked(
         });
     }
     let a = quality::assess_2d(points, &cal, field);
-    quality::require_arc(&a.coverage, options.min_arc_deg)?;
-    if !(a.quality.condition <= options.max_condition) {
+    quality::require_arc(&a.coverage, config.min_arc_deg)?;
+    require_locus_turning(points, field, config.min_arc_deg)?;
+    if !(a.quality.fit.condition <= config.max_condition) {
         return Err(Error::Degenerate {
             reason: "the headings seen do not determine the ellipse (information matrix ill-conditioned); turn through a fuller circle",
         });
     }
-    if !(a.quality.residual_rms_rel <= options.max_residual_rel) {
+    if !(a.quality.fit.residual_rms_rel <= config.max_residual_rel) {
         return Err(Error::NotAnEllipse {
             detail: " (the readings stray from the best ellipse by more than max_residual_rel of the field)",
         });
     }
-    if !(a.quality.heading_error_bound_deg <= options.max_heading_error_bound_deg) {
+    // The refusal widens the bound to the Student-t quantile of its σ's degrees of freedom
+    // (the report keeps the plain 3σ): a fit of a few readings estimates σ from one or two
+    // residuals and can look certain by chance.
+    let dof = a.quality.fit.points as f64 - 5.0;
+    if !(a.quality.heading_error_bound_deg() * t_factor(dof) <= config.max_heading_error_bound_deg)
+    {
         return Err(Error::Degenerate {
             reason: "the predicted heading error exceeds max_heading_error_bound_deg: too few readings or too much noise for the part of the circle covered; record a full turn away from magnetic disturbances",
         });
@@ -491,48 +557,44 @@ fn fit_unchecked(
 /// Least-squares ellipse calibrator (batch): stores every reading pushed and fits them all
 /// with [`fit_ellipse`] on `solve`.
 ///
+/// Its memory grows with every push; for calibrating while driving use the online
+/// least-squares calibrator, which keeps only the fit's sums.
+///
+/// [`Calibrator::progress`] runs the whole fit to decide `ready` (so that it agrees with
+/// `solve` exactly): it costs as much as `solve`, O(n). Call it now and then, not per sample.
+///
 /// ```
-/// use truenorth_calib::EllipseCalibrator;
+/// use truenorth_calib::{EllipseCalibrator, EllipseConfig};
 /// use truenorth_core::{Calibrator, Mag2Sample};
 /// use nalgebra::Vector2;
 ///
-/// let mut cal = EllipseCalibrator::new();
+/// let mut cal = EllipseCalibrator::new(EllipseConfig::default())?;
 /// for k in 0..72 {
 ///     let psi = (k as f64 * 5.0).to_radians();
 ///     // A level compass in a 30-unit field with a (10, −4) hard iron.
 ///     let mag = Vector2::new(10.0 + 30.0 * psi.cos(), -4.0 - 30.0 * psi.sin());
-///     cal.push(&Mag2Sample { t_s: k as f64, mag }).unwrap();
+///     cal.push(&Mag2Sample { t_s: k as f64, mag })?;
 /// }
-/// let sol = cal.solve().unwrap();
+/// assert!(cal.progress().ready);
+/// let sol = cal.solve()?;
 /// assert!((sol.params.hard_iron - Vector2::new(10.0, -4.0)).norm() < 1e-6);
 /// assert!((sol.quality.field_magnitude - 30.0).abs() < 1e-6);
+/// # Ok::<(), truenorth_core::Error>(())
 /// ```
 #[derive(Debug, Clone, Default)]
 pub struct EllipseCalibrator {
     points: Vec<Vector2<f64>>,
-    options: EllipseFitOptions,
-    expected_field: Option<f64>,
+    config: EllipseConfig,
 }
 
 impl EllipseCalibrator {
-    /// A calibrator with the default options.
-    pub fn new() -> Self {
-        Self::default()
-    }
-
-    /// A calibrator with the given options.
-    pub fn with_options(options: EllipseFitOptions) -> Self {
-        Self {
-            options,
-            ..Self::default()
-        }
-    }
-
-    /// Sets the expected horizontal field (input unit, e.g. from the World Magnetic Model),
-    /// reported as [`truenorth_core::Quality::field_ratio_to_expected`].
-    pub fn with_expected_field(mut self, expected_field: f64) -> Self {
-        self.expected_field = Some(expected_field);
-        self
+    /// A calibrator with the given configuration (validated).
+    pub fn new(config: EllipseConfig) -> Result<Self> {
+        config.validate()?;
+        Ok(Self {
+            points: Vec::new(),
+            config,
+        })
     }
 
     /// The readings stored so far.
@@ -540,40 +602,39 @@ impl EllipseCalibrator {
         &self.points
     }
 
-    /// The options in use.
-    pub fn options(&self) -> &EllipseFitOptions {
-        &self.options
+    /// The configuration in use.
+    pub fn config(&self) -> &EllipseConfig {
+        &self.config
     }
 }
 
 impl Calibrator for EllipseCalibrator {
     type Sample = Mag2Sample;
     type Params = CompassCalibration2d;
+    type Quality = CompassQuality;
 
-    fn push(&mut self, sample: &Mag2Sample) -> Result<()> {
+    fn push(&mut self, sample: &Mag2Sample) -> Result<Pushed> {
         check_finite("timestamp t_s", sample.t_s)?;
         check_finite2("magnetometer reading", &sample.mag)?;
         self.points.push(sample.mag);
-        Ok(())
+        Ok(Pushed::Accepted)
     }
 
-    /// Coverage seen from the centre of the readings' bounding box (the centre of any full
-    /// ellipse; an estimate before the fit). O(n): call it now and then, not per sample.
+    /// `ready` runs the fit (see the type's documentation); `coverage` is seen from the
+    /// centre of the readings' bounding box (the centre of any full ellipse; an estimate
+    /// before the fit).
     fn progress(&self) -> Progress {
         let c = bbox_centre(&self.points);
         let cov = quality::coverage(&self.points, &c);
         Progress {
             samples: self.points.len(),
             coverage: cov.fraction,
-            ready: self.points.len() >= MIN_POINTS_2D
-                && cov.span_rad().to_degrees() >= self.options.min_arc_deg,
+            ready: self.solve().is_ok(),
         }
     }
 
-    fn solve(&mut self) -> Result<Solution<CompassCalibration2d>> {
-        let mut sol = fit_ellipse(&self.points, &self.options)?;
-        sol.quality = quality::with_expected_field(sol.quality, self.expected_field);
-        Ok(sol)
+    fn solve(&self) -> Result<Solution<CompassCalibration2d>> {
+        fit_ellipse(&self.points, &self.config)
     }
 
     fn reset(&mut self) {
@@ -681,14 +742,14 @@ mod tests {
     fn exact_ellipse_is_recovered() {
         let pts = ellipse_points(50, 360.0);
         for refine in [false, true] {
-            let opts = EllipseFitOptions {
+            let opts = EllipseConfig {
                 refine,
                 ..Default::default()
             };
             let sol = fit_ellipse(&pts, &opts).unwrap();
             assert!((sol.params.hard_iron - Vector2::new(3.0, -2.0)).norm() < 1e-9);
             assert!((sol.quality.field_magnitude - 15.0_f64.sqrt()).abs() < 1e-9);
-            assert!(sol.quality.residual_rms_rel < 1e-9);
+            assert!(sol.quality.fit.residual_rms_rel < 1e-9);
             assert!((sol.params.soft_iron.determinant() - 1.0).abs() < 1e-9);
         }
         let e = fit_ellipse_direct(&pts).unwrap();

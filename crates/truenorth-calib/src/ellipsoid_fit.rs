@@ -16,7 +16,7 @@
 //!    The linear terms are eliminated as in Halíř & Flusser (1998) and the 6×6 problem is
 //!    solved as a symmetric eigenproblem (see the `linalg` module).
 //! 4. Refuse when the best quadric without the constraint is not an ellipsoid (hyperboloid)
-//!    or the ellipsoid is flatter than [`EllipsoidFitOptions::max_axis_ratio`].
+//!    or the ellipsoid is flatter than [`EllipsoidConfig::max_axis_ratio`].
 //! 5. Refinement: Levenberg–Marquardt over the centre `c` and a symmetric matrix `B` on
 //!    `rᵢ = |B (mᵢ − c)| − 1`. With `S = F·B` this is `(|S (mᵢ − c)| − F)/F`, the geometric
 //!    residual `|S(m − b)| − F` scaled by the constant `1/F`, so it has the same minimum.
@@ -33,11 +33,14 @@ extern crate alloc;
 use alloc::vec::Vec;
 
 use nalgebra::{Matrix3, Matrix4, SMatrix, SVector, Vector3, Vector6};
+use serde::{Deserialize, Serialize};
 use truenorth_compass::CompassCalibration3d;
 use truenorth_core::{
-    Calibrator, Error, Mag3Sample, Progress, Result, Solution, check_finite, check_finite3,
+    Calibrator, CompassQuality, Error, Mag3Sample, Progress, Pushed, Result, Solution, Validate,
+    check_finite, check_finite3, check_positive, check_range,
 };
 
+use crate::conic_sums::t_factor;
 use crate::linalg::{constrained_min6, sym_eigen3, sym_eigen6, sym_sqrt3};
 use crate::lm::{self, BLOCK, NormalAccumulator, NormalEquations, blocks, dot_block};
 use crate::normalise::Normaliser;
@@ -50,31 +53,37 @@ use truenorth_core::Float as _;
 /// more leaves a residual to judge it by.
 pub const MIN_POINTS_3D: usize = 10;
 
-/// Options of the least-squares ellipsoid fit.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct EllipsoidFitOptions {
-    /// Refine the direct fit geometrically (default `true`).
+/// Configuration of the least-squares ellipsoid fit (defaults in brackets).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct EllipsoidConfig {
+    /// Refine the direct fit geometrically (`true`).
     pub refine: bool,
-    /// Most Levenberg–Marquardt steps before refusing with [`Error::NoConvergence`].
+    /// Most Levenberg–Marquardt steps before refusing with [`Error::NoConvergence`], 1..=10⁶
+    /// (100).
     pub max_iterations: usize,
-    /// Smallest share of the sphere's direction cells accepted (default
-    /// [`MIN_SPHERE_COVERAGE`]).
+    /// Smallest share of the sphere's direction cells accepted, in [0, 1]
+    /// ([`MIN_SPHERE_COVERAGE`]).
     pub min_coverage: f64,
-    /// Largest ratio of longest to shortest semi-axis accepted (default 10).
+    /// Largest ratio of longest to shortest semi-axis accepted, ≥ 1 (10).
     pub max_axis_ratio: f64,
-    /// Largest condition number of the information matrix accepted (default 1e4; an
-    /// evenly covered sphere gives 2.5).
+    /// Largest condition number of the information matrix accepted, ≥ 1 (1e4; an evenly
+    /// covered sphere gives 2.5).
     pub max_condition: f64,
-    /// Largest residual RMS, relative to the fitted field, accepted (default 0.2): readings
+    /// Largest residual RMS, relative to the fitted field, accepted, > 0 (0.2): readings
     /// that stray further from the best ellipsoid are not a rotation in a constant field
     /// (a static sensor, a disturbed site, a badly tilting mount).
     pub max_residual_rel: f64,
-    /// Largest predicted heading-error bound accepted, degrees (default 10; see
+    /// Largest direction-error bound of the calibration accepted
+    /// ([`CompassQuality::heading_error_bound_deg`]), degrees, > 0 (10; see
     /// [`crate::quality`]): a calibration that uncertain is refused rather than returned.
     pub max_heading_error_bound_deg: f64,
+    /// The expected total field, input unit (e.g. from the World Magnetic Model), > 0,
+    /// reported as [`CompassQuality::field_ratio_to_expected`] (`None`).
+    pub expected_field: Option<f64>,
 }
 
-impl Default for EllipsoidFitOptions {
+impl Default for EllipsoidConfig {
     fn default() -> Self {
         Self {
             refine: true,
@@ -84,7 +93,36 @@ impl Default for EllipsoidFitOptions {
             max_condition: 1e4,
             max_residual_rel: 0.2,
             max_heading_error_bound_deg: 10.0,
+            expected_field: None,
         }
+    }
+}
+
+impl Validate for EllipsoidConfig {
+    fn validate(&self) -> Result<()> {
+        check_range(
+            "ellipsoid max_iterations",
+            self.max_iterations as f64,
+            1.0,
+            1e6,
+        )?;
+        check_range("ellipsoid min_coverage", self.min_coverage, 0.0, 1.0)?;
+        check_range(
+            "ellipsoid max_axis_ratio",
+            self.max_axis_ratio,
+            1.0,
+            f64::MAX,
+        )?;
+        check_range("ellipsoid max_condition", self.max_condition, 1.0, f64::MAX)?;
+        check_positive("ellipsoid max_residual_rel", self.max_residual_rel)?;
+        check_positive(
+            "ellipsoid max_heading_error_bound_deg",
+            self.max_heading_error_bound_deg,
+        )?;
+        if let Some(f) = self.expected_field {
+            check_positive("ellipsoid expected_field", f)?;
+        }
+        Ok(())
     }
 }
 
@@ -277,7 +315,7 @@ fn li_griffiths_constraint() -> SMatrix<f64, 6, 6> {
 
 /// Reduced direct fit (see the module documentation). Returns the ten quadric coefficients
 /// `(a, b, c, f, g, h, p, q, r, d)`.
-fn solve_direct(s: &SMatrix<f64, 10, 10>) -> Result<SVector<f64, 10>> {
+pub(crate) fn solve_direct(s: &SMatrix<f64, 10, 10>) -> Result<SVector<f64, 10>> {
     let s1: SMatrix<f64, 6, 6> = s.fixed_view::<6, 6>(0, 0).into_owned();
     let s2: SMatrix<f64, 6, 4> = s.fixed_view::<6, 4>(0, 6).into_owned();
     let s3: Matrix4<f64> = s.fixed_view::<4, 4>(6, 6).into_owned();
@@ -322,7 +360,7 @@ fn quadratic_part<S: nalgebra::Storage<f64, nalgebra::U6>>(
 
 /// Centre and unit map of the quadric `xᵀQx + 2lᵀx + d = 0`: centre `−Q⁻¹l`,
 /// `B = (Q/κ)^{1/2}` with `κ = cᵀQc − d`.
-fn quadric_to_ellipsoid(k: &SVector<f64, 10>, max_axis_ratio: f64) -> Result<Ellipsoid> {
+pub(crate) fn quadric_to_ellipsoid(k: &SVector<f64, 10>, max_axis_ratio: f64) -> Result<Ellipsoid> {
     let q = quadratic_part(&k.fixed_rows::<6>(0));
     let l = Vector3::new(k[6], k[7], k[8]);
     let q_inv = q.try_inverse().ok_or(Error::NotAnEllipse {
@@ -456,23 +494,34 @@ fn square_jacobian(b: &Matrix3<f64>) -> SMatrix<f64, 9, 9> {
 
 /// The least-squares ellipsoid calibration of `points` (raw 3-axis readings of a sensor
 /// tumbled through many orientations), with its quality report — or a typed refusal saying
-/// why the data cannot support one. See the module documentation for the steps.
+/// why the data cannot support one (an invalid `config` is refused first). See the module
+/// documentation for the steps.
 pub fn fit_ellipsoid(
     points: &[Vector3<f64>],
-    options: &EllipsoidFitOptions,
+    config: &EllipsoidConfig,
+) -> Result<Solution<CompassCalibration3d>> {
+    config.validate()?;
+    let mut sol = fit_unchecked(points, config)?;
+    sol.quality = quality::with_expected_field(sol.quality, config.expected_field);
+    Ok(sol)
+}
+
+fn fit_unchecked(
+    points: &[Vector3<f64>],
+    config: &EllipsoidConfig,
 ) -> Result<Solution<CompassCalibration3d>> {
     if points.len() >= MIN_POINTS_3D && points.iter().all(|p| p.iter().all(|x| x.is_finite())) {
         // Before fitting: seen from the bounding-box centre (the centre of any complete
         // ellipsoid), a single-axis turn or a small patch of orientations fills few cells.
         let pre = quality::sphere_coverage(points, &bbox_centre(points));
-        quality::require_sphere_coverage(pre, options.min_coverage)?;
+        quality::require_sphere_coverage(pre, config.min_coverage)?;
     }
-    let (norm, direct) = direct_normalised(points, options.max_axis_ratio)?;
-    let e = if options.refine {
+    let (norm, direct) = direct_normalised(points, config.max_axis_ratio)?;
+    let e = if config.refine {
         let out = lm::minimise(
             "ellipsoid geometric refinement",
             to_params(&direct),
-            options.max_iterations,
+            config.max_iterations,
             |p| radial_normal_equations(points, &norm, p),
         )?;
         let e = from_params(&out.params);
@@ -483,7 +532,7 @@ pub fn fit_ellipsoid(
             centre: e.centre,
             unit_map,
         };
-        check_axis_ratio(&e, options.max_axis_ratio)?;
+        check_axis_ratio(&e, config.max_axis_ratio)?;
         e
     } else {
         direct
@@ -495,18 +544,20 @@ pub fn fit_ellipsoid(
         });
     }
     let q = quality::quality_3d(points, &cal, field);
-    quality::require_sphere_coverage(q.coverage, options.min_coverage)?;
-    if !(q.condition <= options.max_condition) {
+    quality::require_sphere_coverage(q.fit.coverage, config.min_coverage)?;
+    if !(q.fit.condition <= config.max_condition) {
         return Err(Error::Degenerate {
             reason: "the orientations seen do not determine the ellipsoid (information matrix ill-conditioned); tumble the sensor about a third axis",
         });
     }
-    if !(q.residual_rms_rel <= options.max_residual_rel) {
+    if !(q.fit.residual_rms_rel <= config.max_residual_rel) {
         return Err(Error::NotAnEllipse {
             detail: " (the readings stray from the best ellipsoid by more than max_residual_rel of the field)",
         });
     }
-    if !(q.heading_error_bound_deg <= options.max_heading_error_bound_deg) {
+    // Widened to the Student-t quantile of σ's degrees of freedom, as the 2-D fit's.
+    let dof = q.fit.points as f64 - 9.0;
+    if !(q.heading_error_bound_deg() * t_factor(dof) <= config.max_heading_error_bound_deg) {
         return Err(Error::Degenerate {
             reason: "the predicted heading error exceeds max_heading_error_bound_deg: too few readings or too much noise for the part of the sphere covered; record a full tumble away from magnetic disturbances",
         });
@@ -533,32 +584,23 @@ fn bbox_centre(points: &[Vector3<f64>]) -> Vector3<f64> {
 
 /// Least-squares ellipsoid calibrator (batch): stores every reading pushed and fits them
 /// all with [`fit_ellipsoid`] on `solve`.
+///
+/// [`Calibrator::progress`] runs the whole fit to decide `ready` (so that it agrees with
+/// `solve` exactly): it costs as much as `solve`, O(n). Call it now and then, not per sample.
 #[derive(Debug, Clone, Default)]
 pub struct EllipsoidCalibrator {
     points: Vec<Vector3<f64>>,
-    options: EllipsoidFitOptions,
-    expected_field: Option<f64>,
+    config: EllipsoidConfig,
 }
 
 impl EllipsoidCalibrator {
-    /// A calibrator with the default options.
-    pub fn new() -> Self {
-        Self::default()
-    }
-
-    /// A calibrator with the given options.
-    pub fn with_options(options: EllipsoidFitOptions) -> Self {
-        Self {
-            options,
-            ..Self::default()
-        }
-    }
-
-    /// Sets the expected total field (input unit, e.g. from the World Magnetic Model),
-    /// reported as [`truenorth_core::Quality::field_ratio_to_expected`].
-    pub fn with_expected_field(mut self, expected_field: f64) -> Self {
-        self.expected_field = Some(expected_field);
-        self
+    /// A calibrator with the given configuration (validated).
+    pub fn new(config: EllipsoidConfig) -> Result<Self> {
+        config.validate()?;
+        Ok(Self {
+            points: Vec::new(),
+            config,
+        })
     }
 
     /// The readings stored so far.
@@ -566,38 +608,38 @@ impl EllipsoidCalibrator {
         &self.points
     }
 
-    /// The options in use.
-    pub fn options(&self) -> &EllipsoidFitOptions {
-        &self.options
+    /// The configuration in use.
+    pub fn config(&self) -> &EllipsoidConfig {
+        &self.config
     }
 }
 
 impl Calibrator for EllipsoidCalibrator {
     type Sample = Mag3Sample;
     type Params = CompassCalibration3d;
+    type Quality = CompassQuality;
 
-    fn push(&mut self, sample: &Mag3Sample) -> Result<()> {
+    fn push(&mut self, sample: &Mag3Sample) -> Result<Pushed> {
         check_finite("timestamp t_s", sample.t_s)?;
         check_finite3("magnetometer reading", &sample.mag)?;
         self.points.push(sample.mag);
-        Ok(())
+        Ok(Pushed::Accepted)
     }
 
-    /// Share of the sphere's direction cells filled, seen from the centre of the readings'
-    /// bounding box (an estimate before the fit). O(n): call it now and then.
+    /// `ready` runs the fit (see the type's documentation); `coverage` is the share of the
+    /// sphere's direction cells filled, seen from the centre of the readings' bounding box
+    /// (an estimate before the fit).
     fn progress(&self) -> Progress {
         let coverage = quality::sphere_coverage(&self.points, &bbox_centre(&self.points));
         Progress {
             samples: self.points.len(),
             coverage,
-            ready: self.points.len() >= MIN_POINTS_3D && coverage >= self.options.min_coverage,
+            ready: self.solve().is_ok(),
         }
     }
 
-    fn solve(&mut self) -> Result<Solution<CompassCalibration3d>> {
-        let mut sol = fit_ellipsoid(&self.points, &self.options)?;
-        sol.quality = quality::with_expected_field(sol.quality, self.expected_field);
-        Ok(sol)
+    fn solve(&self) -> Result<Solution<CompassCalibration3d>> {
+        fit_ellipsoid(&self.points, &self.config)
     }
 
     fn reset(&mut self) {
@@ -728,7 +770,7 @@ mod tests {
         let truth = w.try_inverse().unwrap();
         let truth = truth / truth.determinant().cbrt();
         for refine in [false, true] {
-            let opts = EllipsoidFitOptions {
+            let opts = EllipsoidConfig {
                 refine,
                 ..Default::default()
             };
@@ -739,7 +781,7 @@ mod tests {
                 sol.params.hard_iron
             );
             assert!((sol.params.soft_iron - truth).norm() < 1e-9);
-            assert!(sol.quality.residual_rms_rel < 1e-10);
+            assert!(sol.quality.fit.residual_rms_rel < 1e-10);
             assert!((sol.quality.field_magnitude - 50.0 * w.determinant().cbrt()).abs() < 1e-8);
         }
     }

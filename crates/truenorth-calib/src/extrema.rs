@@ -20,8 +20,12 @@
 //! record" is refused, not guessed). Allocation-free: the most recent [`MAX_EXTREMA`]
 //! extrema are kept.
 
+extern crate alloc;
+
+use alloc::vec::Vec;
+
 use serde::{Deserialize, Serialize};
-use truenorth_core::{Error, Result};
+use truenorth_core::{Error, Result, Validate, check_range};
 
 #[allow(unused_imports)]
 use truenorth_core::Float as _;
@@ -97,30 +101,23 @@ impl Default for ExtremaConfig {
     }
 }
 
-impl ExtremaConfig {
-    /// Checks the ranges documented on the fields.
-    pub fn validate(&self) -> Result<()> {
-        if !(self.swing_fraction > 0.0 && self.swing_fraction < 1.0) {
-            return Err(Error::OutOfRange {
-                what: "extrema swing_fraction",
-                value: self.swing_fraction,
-                min: 0.0,
-                max: 1.0,
-            });
-        }
-        if !(self.noise_multiple >= 0.0 && self.noise_multiple.is_finite()) {
-            return Err(Error::OutOfRange {
-                what: "extrema noise_multiple",
-                value: self.noise_multiple,
-                min: 0.0,
-                max: f64::INFINITY,
-            });
-        }
+impl Validate for ExtremaConfig {
+    /// Checks the ranges documented on the fields: `swing_fraction` strictly between 0 and 1,
+    /// `noise_multiple` finite and ≥ 0.
+    fn validate(&self) -> Result<()> {
+        // The open interval (0, 1) as the closed one between its first and last f64.
+        check_range(
+            "extrema swing_fraction",
+            self.swing_fraction,
+            f64::MIN_POSITIVE,
+            1.0 - f64::EPSILON / 2.0,
+        )?;
+        check_range("extrema noise_multiple", self.noise_multiple, 0.0, f64::MAX)?;
         Ok(())
     }
 }
 
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 enum Phase<T> {
     /// No direction known yet: track the running max and min, and the opposite extreme seen
     /// before each, to tell an interior extremum from one at the start of the record.
@@ -139,7 +136,7 @@ enum Phase<T> {
 }
 
 /// Streaming extremum detector for one axis. See the module documentation.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct ExtremumTracker<T: Copy> {
     config: ExtremaConfig,
     phase: Option<Phase<T>>,
@@ -154,7 +151,7 @@ pub struct ExtremumTracker<T: Copy> {
 }
 
 impl<T: Copy> ExtremumTracker<T> {
-    /// An empty tracker. Validate `config` first ([`ExtremaConfig::validate`]).
+    /// An empty tracker. Validate `config` first ([`Validate::validate`]).
     pub fn new(config: ExtremaConfig) -> Self {
         Self {
             config,
@@ -178,6 +175,11 @@ impl<T: Copy> ExtremumTracker<T> {
     /// Samples seen.
     pub fn samples(&self) -> usize {
         self.samples
+    }
+
+    /// The detector thresholds in force.
+    pub fn config(&self) -> &ExtremaConfig {
+        &self.config
     }
 
     /// Smallest and largest value seen (`(inf, -inf)` before any sample).
@@ -341,6 +343,93 @@ impl<T: Copy> ExtremumTracker<T> {
                 _ => None,
             }
         })
+    }
+}
+
+/// The saved state of an [`ExtremumTracker`]: everything it has learned, with its
+/// configuration. Opaque; restore it with [`ExtremumTracker::from_saved`].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ExtremumTrackerSaved<T> {
+    config: ExtremaConfig,
+    phase: Option<Phase<T>>,
+    ring: Vec<Option<Extremum<T>>>,
+    confirmed: usize,
+    leading_edge: Option<Extremum<T>>,
+    samples: usize,
+    last: f64,
+    abs_step_sum: f64,
+    /// Smallest and largest value (`None` before any sample: never an infinity).
+    range: Option<(f64, f64)>,
+}
+
+impl<T: Copy> ExtremumTracker<T> {
+    /// The saved state.
+    pub fn saved(&self) -> ExtremumTrackerSaved<T> {
+        ExtremumTrackerSaved {
+            config: self.config,
+            phase: self.phase,
+            ring: self.ring.to_vec(),
+            confirmed: self.confirmed,
+            leading_edge: self.leading_edge,
+            samples: self.samples,
+            last: self.last,
+            abs_step_sum: self.abs_step_sum,
+            range: (self.samples > 0).then_some((self.min, self.max)),
+        }
+    }
+
+    /// Rebuilds a tracker from [`Self::saved`], refusing an invalid configuration or
+    /// values that are not finite or do not fit together.
+    pub fn from_saved(s: ExtremumTrackerSaved<T>) -> Result<Self> {
+        s.config.validate()?;
+        let invalid = |reason| Err(Error::InvalidSnapshot { reason });
+        if s.ring.len() != MAX_EXTREMA {
+            return invalid("an extremum tracker must keep exactly 64 extremum slots");
+        }
+        let extremum_ok = |e: &Extremum<T>| e.value.is_finite();
+        let phase_ok = match &s.phase {
+            None => s.samples == 0,
+            Some(Phase::Start {
+                hi,
+                lo,
+                lo_before_hi,
+                hi_before_lo,
+            }) => {
+                extremum_ok(hi)
+                    && extremum_ok(lo)
+                    && lo_before_hi.is_finite()
+                    && hi_before_lo.is_finite()
+            }
+            Some(Phase::Rising(c)) | Some(Phase::Falling(c)) => extremum_ok(c),
+        };
+        let range_ok = match s.range {
+            None => s.samples == 0,
+            Some((lo, hi)) => lo.is_finite() && hi.is_finite() && lo <= hi,
+        };
+        if !(phase_ok
+            && range_ok
+            && s.ring.iter().flatten().all(extremum_ok)
+            && s.leading_edge.iter().all(extremum_ok)
+            && s.last.is_finite()
+            && s.abs_step_sum.is_finite()
+            && s.abs_step_sum >= 0.0
+            && s.ring.iter().filter(|e| e.is_some()).count() == s.confirmed.min(MAX_EXTREMA))
+        {
+            return invalid("an extremum tracker's values are not finite or do not fit together");
+        }
+        let mut t = Self::new(s.config);
+        t.phase = s.phase;
+        t.ring.copy_from_slice(&s.ring);
+        t.confirmed = s.confirmed;
+        t.leading_edge = s.leading_edge;
+        t.samples = s.samples;
+        t.last = s.last;
+        t.abs_step_sum = s.abs_step_sum;
+        if let Some((lo, hi)) = s.range {
+            t.min = lo;
+            t.max = hi;
+        }
+        Ok(t)
     }
 }
 

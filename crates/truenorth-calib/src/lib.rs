@@ -2,8 +2,11 @@
 //!
 //! Calibrators: they learn sensor parameters from data and say how far to trust them.
 //! Every calibrator implements [`truenorth_core::Calibrator`]: `push` samples, watch
-//! `progress`, `solve` for parameters plus a [`truenorth_core::Quality`] report, or get a
-//! typed refusal that says why the data cannot support a calibration.
+//! `progress` (whose `ready` says exactly whether `solve` would succeed), `solve` for
+//! parameters plus a [`truenorth_core::CompassQuality`] report, or get a typed refusal that
+//! says why the data cannot support a calibration. `solve` never changes what a calibrator
+//! has learned. Every calibrator is built from a validated, serde `*Config` with
+//! `new(config)`.
 //!
 //! The least-squares calibrators fit everything they were given in one go:
 //! [`EllipseCalibrator`] (two-axis compass: hard iron and symmetric soft iron from a direct
@@ -15,12 +18,15 @@
 //! [`MeritCircleCalibrator`] (US 5,297,063: circumcentres of reading triples, merged by a
 //! figure of merit; hard iron only), [`BinnedEllipseCalibrator`] (EP 0634001: heading bins,
 //! origin iteration and the counter-rotating phasor ellipse; hard and soft iron, with
-//! persistence and restart) and [`TurnCompassCalibrator`] (EP 0640207: centre and radii from
-//! the extrema of a full turn, found by the [`extrema`] tracker that the gyro half reuses).
+//! restart) and [`TurnCompassCalibrator`] (EP 0640207: centre and radii from the extrema of a
+//! full turn, found by the [`extrema`] tracker that the gyro half reuses). The merit circle
+//! and the binned ellipse keep a running estimate
+//! ([`truenorth_core::OnlineCalibrator::estimate`]); all three save and restore their state
+//! ([`truenorth_core::Persistent`]).
 //!
 //! ```
 //! use nalgebra::{Matrix2, Vector2};
-//! use truenorth_calib::EllipseCalibrator;
+//! use truenorth_calib::{EllipseCalibrator, EllipseConfig};
 //! use truenorth_core::{Calibrator, Error, Mag2Sample};
 //!
 //! // A level compass in a 20 µT horizontal field, turned once round. Its readings are
@@ -30,7 +36,7 @@
 //! let soft = axis * Matrix2::new(1.25, 0.0, 0.0, 1.0) * axis.transpose();
 //! let raw = |psi: f64| Vector2::new(12.0, -7.0) + soft * Vector2::new(20.0 * psi.cos(), -20.0 * psi.sin());
 //!
-//! let mut cal = EllipseCalibrator::new();
+//! let mut cal = EllipseCalibrator::new(EllipseConfig::default())?;
 //! for k in 0..90 {
 //!     let psi = (4.0 * k as f64).to_radians();
 //!     cal.push(&Mag2Sample { t_s: 0.1 * k as f64, mag: raw(psi) })?;
@@ -41,15 +47,16 @@
 //! let heading = solution.params.heading_rad(&raw(120f64.to_radians()));
 //! assert!((heading.to_degrees() - 120.0).abs() < 1e-6);
 //! // The report says how far to trust it.
-//! assert_eq!(solution.quality.coverage, 1.0);
-//! assert!(solution.quality.heading_error_bound_deg < 0.1);
+//! assert_eq!(solution.quality.fit.coverage, 1.0);
+//! assert!(solution.quality.heading_error_bound_deg() < 0.1);
 //!
-//! // Half a turn is not enough, and the refusal says so.
-//! let mut half = EllipseCalibrator::new();
+//! // Half a turn is not enough, and the refusal says so; `progress` agrees.
+//! let mut half = EllipseCalibrator::new(EllipseConfig::default())?;
 //! for k in 0..45 {
 //!     half.push(&Mag2Sample { t_s: k as f64, mag: raw((4.0 * k as f64).to_radians()) })?;
 //! }
 //! assert!(matches!(half.solve(), Err(Error::InsufficientCoverage { .. })));
+//! assert!(!half.progress().ready);
 //! # Ok::<(), truenorth_core::Error>(())
 //! ```
 #![cfg_attr(not(feature = "std"), no_std)]
@@ -65,8 +72,17 @@ mod linalg;
 mod lm;
 mod normalise;
 
+// Online least-squares calibrators from running monomial sums.
+mod conic_sums;
+mod online_ellipse;
+mod online_ellipsoid;
+
 // Seed calibrators (turn, merit circle, binned ellipse) and their helpers.
+mod binned_assess;
+mod binned_config;
 mod binned_ellipse;
+mod binned_persist;
+mod binned_refresh;
 mod circumcentre;
 mod direction_slots;
 mod merit_circle;
@@ -74,20 +90,31 @@ mod seed_quality;
 mod turn;
 
 pub use binned_ellipse::{
-    BinState, BinnedEllipseCalibrator, BinnedEllipseConfig, MAX_BINS, MAX_INIT_SAMPLES,
-    ellipse_parameters,
+    BinnedEllipseCalibrator, BinnedEllipseConfig, MAX_INIT_SAMPLES, MAX_UPDATE_PUSHES, UpdatePhase,
 };
+pub use binned_persist::{BinnedEllipseSaved, BinnedUpdateSaved};
+pub use binned_refresh::{BinState, MAX_BINS, ellipse_parameters};
 pub use circumcentre::{Circumcircle, circumcircle};
+pub use conic_sums::{RetainedSnapshot, SumsSnapshot};
 pub use ellipse_fit::{
-    Ellipse, EllipseCalibrator, EllipseFitOptions, MIN_POINTS_2D, fit_ellipse, fit_ellipse_direct,
+    Ellipse, EllipseCalibrator, EllipseConfig, MIN_POINTS_2D, fit_ellipse, fit_ellipse_direct,
 };
 pub use ellipsoid_fit::{
-    Ellipsoid, EllipsoidCalibrator, EllipsoidFitOptions, MIN_POINTS_3D, fit_ellipsoid,
+    Ellipsoid, EllipsoidCalibrator, EllipsoidConfig, MIN_POINTS_3D, fit_ellipsoid,
     fit_ellipsoid_direct,
 };
 pub use merit_circle::{
-    MERIT_CIRCLE_MIN_ARC_DEG, MeritCircleCalibrator, MeritCircleConfig, MeritCircleState, RING,
+    MERIT_CIRCLE_MIN_ARC_DEG, MeritCircleCalibrator, MeritCircleConfig, MeritCircleSaved,
+    MeritCircleState, RING,
+};
+pub use online_ellipse::{
+    ONLINE_SLOTS_2D, OnlineEllipseCalibrator, OnlineEllipseConfig, OnlineEllipseState,
+    PendingRefresh,
+};
+pub use online_ellipsoid::{
+    OnlineEllipsoidCalibrator, OnlineEllipsoidConfig, OnlineEllipsoidState,
 };
 pub use turn::{
-    MIN_TURN_SAMPLES, TurnCompassCalibrator, TurnConfig, TurnEllipse, TurnExtrema, TurnTag,
+    MIN_TURN_SAMPLES, TurnCompassCalibrator, TurnConfig, TurnEllipse, TurnExtrema,
+    TurnExtremaSaved, TurnSaved, TurnTag,
 };

@@ -37,21 +37,33 @@
 //!    weighting by geometry, de-weighted where the centre disagrees with the scatter seen so
 //!    far. The first centre has `m = 1`.
 //!
-//! The method fits a circle: it removes hard iron but not soft iron. The quality report's
-//! heading-error bound includes the two-cycle error that leaves.
+//! The method fits a circle: it removes hard iron but not soft iron. The quality report
+//! gives the two-cycle heading error that leaves as `heading_error_systematic_deg`.
+//!
+//! ## Online estimate, readiness and persistence
+//! At every new heading data point the calibrator runs its own `solve` and keeps the result
+//! as the current estimate ([`OnlineCalibrator::estimate`], O(1)); the push that changed it
+//! returns [`Pushed::NewEstimate`]. `progress().ready` runs the acceptance tests of `solve`
+//! (centres, field, arc) on the same data, so the two always agree. The whole learned state,
+//! configuration included, is saved and restored through [`Persistent`].
 
+extern crate alloc;
+
+use alloc::vec::Vec;
 use core::f64::consts::PI;
 
 use nalgebra::Vector2;
 use serde::{Deserialize, Serialize};
 use truenorth_compass::CompassCalibration2d;
 use truenorth_core::{
-    Calibrator, Error, Mag2Sample, Progress, Result, Solution, angle_diff, check_finite2,
+    Calibrator, CompassQuality, Error, Mag2Sample, OnlineCalibrator, Persistent, Progress, Pushed,
+    Result, Snapshot, Solution, Validate, angle_diff, check_finite, check_finite2, check_range,
+    check_snapshot_version,
 };
 
 use crate::circumcentre::{BEST_AMPLIFICATION_SQ, Circumcircle, circumcircle};
 use crate::direction_slots::{DirectionSlots, SLOTS};
-use crate::quality::{MIN_ARC_DEG, coverage, mean_corrected_norm_2d, require_arc};
+use crate::quality::{Coverage, MIN_ARC_DEG, coverage, mean_corrected_norm_2d, require_arc};
 use crate::seed_quality::seed_assessment;
 
 #[allow(unused_imports)]
@@ -60,8 +72,9 @@ use truenorth_core::Float as _;
 /// Data points kept to form triples.
 pub const RING: usize = 8;
 
-/// Options of the [`MeritCircleCalibrator`] (defaults in brackets).
+/// Configuration of the [`MeritCircleCalibrator`] (defaults in brackets).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
 pub struct MeritCircleConfig {
     /// Turn about the current centre between data points, radians (30°).
     pub min_turn_rad: f64,
@@ -103,48 +116,35 @@ impl Default for MeritCircleConfig {
     }
 }
 
-impl MeritCircleConfig {
-    /// Checks every option's range.
-    pub fn validate(&self) -> Result<()> {
-        let check = |what, value: f64, min: f64, max: f64| {
-            if value.is_finite() && value >= min && value <= max {
-                Ok(())
-            } else {
-                Err(Error::OutOfRange {
-                    what,
-                    value,
-                    min,
-                    max,
-                })
-            }
-        };
-        check("merit circle min_turn_rad", self.min_turn_rad, 0.0, PI)?;
-        check("merit circle noise_multiple", self.noise_multiple, 0.0, 1e6)?;
-        check(
+impl Validate for MeritCircleConfig {
+    fn validate(&self) -> Result<()> {
+        check_range("merit circle min_turn_rad", self.min_turn_rad, 0.0, PI)?;
+        check_range("merit circle noise_multiple", self.noise_multiple, 0.0, 1e6)?;
+        check_range(
             "merit circle spread_fraction",
             self.spread_fraction,
             0.0,
             2.0,
         )?;
-        check(
+        check_range(
             "merit circle max_amplification",
             self.max_amplification,
             0.82,
             1e9,
         )?;
-        check(
+        check_range(
             "merit circle weight_memory",
             self.weight_memory,
             1e-9,
             f64::MAX,
         )?;
-        check(
+        check_range(
             "merit circle min_centres",
             self.min_centres as f64,
             1.0,
             1e9,
         )?;
-        check("merit circle min_arc_deg", self.min_arc_deg, 0.0, 360.0)?;
+        check_range("merit circle min_arc_deg", self.min_arc_deg, 0.0, 360.0)?;
         Ok(())
     }
 }
@@ -174,18 +174,21 @@ pub struct MeritCircleState {
 ///
 /// ```
 /// use nalgebra::{Matrix2, Vector2};
-/// use truenorth_calib::MeritCircleCalibrator;
+/// use truenorth_calib::{MeritCircleCalibrator, MeritCircleConfig};
 /// use truenorth_compass::{HeadingTruth, MagnetometerModel2d};
-/// use truenorth_core::{Calibrator, Mag2Sample, SensorModel};
+/// use truenorth_core::{Calibrator, Mag2Sample, OnlineCalibrator, SensorModel};
 ///
 /// let model = MagnetometerModel2d::new(Vector2::new(8.0, -3.0), Matrix2::identity(), 0.0)?;
-/// let mut cal = MeritCircleCalibrator::new();
+/// let mut cal = MeritCircleCalibrator::new(MeritCircleConfig::default())?;
 /// for i in 0..720 {
 ///     let truth = HeadingTruth { heading_rad: (i as f64).to_radians(), horizontal_field: 20.0 };
-///     cal.push(&Mag2Sample { t_s: i as f64 * 0.1, mag: model.ideal(&truth) })?;
+///     cal.push(&Mag2Sample { t_s: i as f64 * 0.1, mag: model.ideal(&truth)? })?;
 /// }
+/// assert!(cal.progress().ready);
 /// let sol = cal.solve()?;
 /// assert!((sol.params.hard_iron - Vector2::new(8.0, -3.0)).norm() < 1e-6);
+/// // The running estimate, O(1), is the solve of the last heading data point.
+/// assert!(cal.estimate().is_some());
 /// # Ok::<(), truenorth_core::Error>(())
 /// ```
 #[derive(Debug, Clone)]
@@ -203,22 +206,18 @@ pub struct MeritCircleCalibrator {
     state: MeritCircleState,
     centre_m2: f64,
     slots: DirectionSlots,
+    estimate: Option<Solution<CompassCalibration2d>>,
 }
 
 impl Default for MeritCircleCalibrator {
     fn default() -> Self {
-        Self::new()
+        Self::build(MeritCircleConfig::default())
     }
 }
 
 impl MeritCircleCalibrator {
-    /// A calibrator with the default options.
-    pub fn new() -> Self {
-        Self::build(MeritCircleConfig::default())
-    }
-
-    /// A calibrator with the given options (validated).
-    pub fn with_config(config: MeritCircleConfig) -> Result<Self> {
+    /// A calibrator with the given configuration (validated).
+    pub fn new(config: MeritCircleConfig) -> Result<Self> {
         config.validate()?;
         Ok(Self::build(config))
     }
@@ -247,6 +246,7 @@ impl MeritCircleCalibrator {
             },
             centre_m2: 0.0,
             slots: DirectionSlots::new(),
+            estimate: None,
         }
     }
 
@@ -335,60 +335,21 @@ impl MeritCircleCalibrator {
     }
 }
 
-impl Calibrator for MeritCircleCalibrator {
-    type Sample = Mag2Sample;
-    type Params = CompassCalibration2d;
+/// What the acceptance tests of the merit circle pass on: the calibration, the field, the
+/// kept readings (the front `n` of the buffer) and their coverage.
+type Accepted = (
+    CompassCalibration2d,
+    f64,
+    [Vector2<f64>; SLOTS],
+    usize,
+    Coverage,
+);
 
-    fn push(&mut self, sample: &Mag2Sample) -> Result<()> {
-        let p = sample.mag;
-        check_finite2("magnetometer reading", &p)?;
-        if let Some(prev) = self.prev {
-            self.step_sum += (p - prev).norm();
-        }
-        self.prev = Some(p);
-        self.samples += 1;
-        self.lo = self.lo.inf(&p);
-        self.hi = self.hi.sup(&p);
-        let slot_centre = self.state.centre.unwrap_or((self.lo + self.hi) * 0.5);
-        self.slots.push(&p, &slot_centre);
-        if self.samples <= self.config.warmup_samples || !self.heading_changed(&p) {
-            return Ok(());
-        }
-        // A new heading data point (step d).
-        self.state.data_points += 1;
-        self.last_point = Some(p);
-        if self.ring_len >= 2 {
-            match self.best_triple(&p) {
-                Some(cc) if cc.amplification <= self.config.max_amplification => self.update(&cc),
-                _ => self.state.degenerate_triples += 1,
-            }
-        }
-        self.ring[self.ring_next] = p;
-        self.ring_next = (self.ring_next + 1) % RING;
-        self.ring_len = (self.ring_len + 1).min(RING);
-        Ok(())
-    }
-
-    fn progress(&self) -> Progress {
-        let mut buf = [Vector2::zeros(); SLOTS];
-        let n = self.slots.collect(&mut buf);
-        let cov = self
-            .state
-            .centre
-            .map(|c| coverage(&buf[..n], &c))
-            .unwrap_or(crate::quality::Coverage {
-                fraction: 0.0,
-                largest_gap_rad: core::f64::consts::TAU,
-            });
-        Progress {
-            samples: self.samples,
-            coverage: cov.fraction,
-            ready: self.state.centres >= self.config.min_centres
-                && cov.span_rad().to_degrees() >= self.config.min_arc_deg,
-        }
-    }
-
-    fn solve(&mut self) -> Result<Solution<CompassCalibration2d>> {
+impl MeritCircleCalibrator {
+    /// The acceptance tests of `solve`, shared with `progress` so the two always agree:
+    /// enough centres, a field, and the arc about the centre. Returns the calibration, the
+    /// field, the kept readings (front `n` of the buffer) and their coverage.
+    fn accepted(&self) -> Result<Accepted> {
         let s = &self.state;
         let centre = match s.centre {
             Some(c) if s.centres >= self.config.min_centres => c,
@@ -416,8 +377,83 @@ impl Calibrator for MeritCircleCalibrator {
                 reason: "the readings coincide with the fitted centre; the compass did not turn",
             });
         }
+        let cov = coverage(&buf[..n], &centre);
+        require_arc(&cov, self.config.min_arc_deg)?;
+        Ok((cal, field, buf, n, cov))
+    }
+}
+
+impl Calibrator for MeritCircleCalibrator {
+    type Sample = Mag2Sample;
+    type Params = CompassCalibration2d;
+    type Quality = CompassQuality;
+
+    /// Refuses a non-finite reading or timestamp (and changes nothing). Returns
+    /// [`Pushed::NewEstimate`] when the reading was a heading data point that changed the
+    /// estimate.
+    fn push(&mut self, sample: &Mag2Sample) -> Result<Pushed> {
+        let p = sample.mag;
+        check_finite("timestamp t_s", sample.t_s)?;
+        check_finite2("magnetometer reading", &p)?;
+        if let Some(prev) = self.prev {
+            self.step_sum += (p - prev).norm();
+        }
+        self.prev = Some(p);
+        self.samples += 1;
+        self.lo = self.lo.inf(&p);
+        self.hi = self.hi.sup(&p);
+        let slot_centre = self.state.centre.unwrap_or((self.lo + self.hi) * 0.5);
+        self.slots.push(&p, &slot_centre);
+        if self.samples <= self.config.warmup_samples || !self.heading_changed(&p) {
+            return Ok(Pushed::Accepted);
+        }
+        // A new heading data point (step d).
+        self.state.data_points += 1;
+        self.last_point = Some(p);
+        if self.ring_len >= 2 {
+            match self.best_triple(&p) {
+                Some(cc) if cc.amplification <= self.config.max_amplification => self.update(&cc),
+                _ => self.state.degenerate_triples += 1,
+            }
+        }
+        self.ring[self.ring_next] = p;
+        self.ring_next = (self.ring_next + 1) % RING;
+        self.ring_len = (self.ring_len + 1).min(RING);
+        // The estimate is refreshed once per data point (every `min_turn_rad` of turn): a
+        // bounded pass over the kept readings, never per sample.
+        let estimate = self.solve().ok();
+        if estimate == self.estimate {
+            Ok(Pushed::Accepted)
+        } else {
+            self.estimate = estimate;
+            Ok(Pushed::NewEstimate)
+        }
+    }
+
+    /// Runs the acceptance tests of [`Calibrator::solve`] (bounded: at most 72 kept
+    /// readings), so `ready` is exactly whether `solve` succeeds.
+    fn progress(&self) -> Progress {
+        let (coverage, ready) = match self.accepted() {
+            Ok((_, _, _, _, cov)) => (cov.fraction, true),
+            Err(_) => {
+                let cov = self.state.centre.map(|c| {
+                    let mut buf = [Vector2::zeros(); SLOTS];
+                    let n = self.slots.collect(&mut buf);
+                    coverage(&buf[..n], &c).fraction
+                });
+                (cov.unwrap_or(0.0), false)
+            }
+        };
+        Progress {
+            samples: self.samples,
+            coverage,
+            ready,
+        }
+    }
+
+    fn solve(&self) -> Result<Solution<CompassCalibration2d>> {
+        let (cal, field, buf, n, _) = self.accepted()?;
         let a = seed_assessment(&buf[..n], &cal, field, self.samples);
-        require_arc(&a.coverage, self.config.min_arc_deg)?;
         Ok(Solution {
             params: cal,
             quality: a.quality,
@@ -426,6 +462,141 @@ impl Calibrator for MeritCircleCalibrator {
 
     fn reset(&mut self) {
         *self = Self::build(self.config);
+    }
+}
+
+impl OnlineCalibrator for MeritCircleCalibrator {
+    /// The solve of the latest heading data point (`None` before one succeeded).
+    fn estimate(&self) -> Option<Solution<CompassCalibration2d>> {
+        self.estimate
+    }
+}
+
+/// The saved state of a [`MeritCircleCalibrator`] ([`Persistent::State`]): its
+/// configuration and everything it has learned. Unset values are `None` (never an infinity),
+/// so the state is plain JSON-friendly data.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MeritCircleSaved {
+    /// The configuration.
+    pub config: MeritCircleConfig,
+    /// Samples pushed.
+    pub samples: usize,
+    /// The previous reading.
+    pub prev: Option<Vector2<f64>>,
+    /// Sum of the sample-to-sample steps.
+    pub step_sum: f64,
+    /// Smallest and largest coordinates seen (`None` before any sample).
+    pub range: Option<(Vector2<f64>, Vector2<f64>)>,
+    /// The kept data points in ring order (at most [`RING`]).
+    pub ring: Vec<Vector2<f64>>,
+    /// Ring slot the next data point goes to.
+    pub ring_next: usize,
+    /// The last data point.
+    pub last_point: Option<Vector2<f64>>,
+    /// The estimate and its statistics.
+    pub stats: MeritCircleState,
+    /// Sum of squared deviations of the circumcentres from their mean (Welford).
+    pub centre_m2: f64,
+    /// The kept readings by direction slot (72 entries, `None` where empty).
+    pub slots: Vec<Option<Vector2<f64>>>,
+    /// The current estimate.
+    pub estimate: Option<Solution<CompassCalibration2d>>,
+}
+
+fn finite2(v: &Vector2<f64>) -> bool {
+    v.x.is_finite() && v.y.is_finite()
+}
+
+impl Persistent for MeritCircleCalibrator {
+    type State = MeritCircleSaved;
+    const SNAPSHOT_VERSION: u32 = 1;
+
+    fn snapshot(&self) -> Snapshot<MeritCircleSaved> {
+        Snapshot {
+            version: Self::SNAPSHOT_VERSION,
+            state: MeritCircleSaved {
+                config: self.config,
+                samples: self.samples,
+                prev: self.prev,
+                step_sum: self.step_sum,
+                range: (self.samples > 0).then_some((self.lo, self.hi)),
+                ring: self.ring[..self.ring_len].to_vec(),
+                ring_next: self.ring_next,
+                last_point: self.last_point,
+                stats: self.state,
+                centre_m2: self.centre_m2,
+                slots: self.slots.to_vec(),
+                estimate: self.estimate,
+            },
+        }
+    }
+
+    fn restore(snapshot: Snapshot<MeritCircleSaved>) -> Result<Self> {
+        check_snapshot_version(snapshot.version, Self::SNAPSHOT_VERSION)?;
+        let s = snapshot.state;
+        s.config.validate()?;
+        let invalid = |reason| Err(Error::InvalidSnapshot { reason });
+        let st = &s.stats;
+        let vectors_finite = s
+            .prev
+            .iter()
+            .chain(&s.last_point)
+            .chain(&s.ring)
+            .all(finite2)
+            && s.range.iter().all(|(a, b)| finite2(a) && finite2(b))
+            && st.centre.iter().all(finite2)
+            && finite2(&st.centre_mean);
+        let scalars_ok = [
+            s.step_sum,
+            s.centre_m2,
+            st.centre_mse,
+            st.weight,
+            st.last_merit,
+        ]
+        .iter()
+        .all(|x| x.is_finite() && *x >= 0.0);
+        if !(vectors_finite && scalars_ok) {
+            return invalid("a merit-circle value is negative or not finite");
+        }
+        if s.ring.len() > RING
+            || s.ring_next >= RING
+            || (s.ring.len() < RING && s.ring_next != s.ring.len())
+        {
+            return invalid("the merit-circle ring of data points is inconsistent");
+        }
+        if st.centres + st.degenerate_triples > st.data_points
+            || st.data_points > s.samples
+            || (st.centres > 0) != st.centre.is_some()
+            || (s.samples > 0) != s.range.is_some()
+            || (s.samples > 0) != s.prev.is_some()
+        {
+            return invalid("the merit-circle counts do not fit together");
+        }
+        if let Some(e) = &s.estimate
+            && !(e.params.hard_iron.iter().chain(e.params.soft_iron.iter())).all(|x| x.is_finite())
+        {
+            return invalid("the merit-circle estimate is not finite");
+        }
+        let slots = DirectionSlots::from_slice(&s.slots).ok_or(Error::InvalidSnapshot {
+            reason: "the merit-circle direction slots must be 72 finite readings or empty",
+        })?;
+        let mut c = Self::build(s.config);
+        c.samples = s.samples;
+        c.prev = s.prev;
+        c.step_sum = s.step_sum;
+        if let Some((lo, hi)) = s.range {
+            c.lo = lo;
+            c.hi = hi;
+        }
+        c.ring[..s.ring.len()].copy_from_slice(&s.ring);
+        c.ring_len = s.ring.len();
+        c.ring_next = s.ring_next;
+        c.last_point = s.last_point;
+        c.state = s.stats;
+        c.centre_m2 = s.centre_m2;
+        c.slots = slots;
+        c.estimate = s.estimate;
+        Ok(c)
     }
 }
 
@@ -454,7 +625,7 @@ mod tests {
     #[test]
     fn on_a_circle_every_centre_is_exact_and_the_merit_falls_as_weight_builds() {
         let ctr = Vector2::new(7.0, -3.0);
-        let mut c = MeritCircleCalibrator::new();
+        let mut c = MeritCircleCalibrator::default();
         feed(&mut c, circle(ctr, 20.0, 0.0, 120.0));
         let first = *c.state();
         assert!(first.centres >= 1);
@@ -470,7 +641,7 @@ mod tests {
     #[test]
     fn noise_on_a_stationary_compass_makes_no_data_points() {
         let mut rng = SplitMix64::new(4);
-        let mut c = MeritCircleCalibrator::new();
+        let mut c = MeritCircleCalibrator::default();
         feed(
             &mut c,
             (0..2000).map(|_| Vector2::new(20.0 + rng.normal(0.2), rng.normal(0.2))),
@@ -482,7 +653,7 @@ mod tests {
     #[test]
     fn an_outlying_centre_gets_a_small_merit() {
         let ctr = Vector2::new(0.0, 0.0);
-        let mut c = MeritCircleCalibrator::new();
+        let mut c = MeritCircleCalibrator::default();
         feed(&mut c, circle(ctr, 20.0, 0.0, 720.0));
         let mut rng = SplitMix64::new(8);
         // Add scatter so the MSE is not zero, then one reading far off the circle.
@@ -518,7 +689,7 @@ mod tests {
                 ..Default::default()
             },
         ] {
-            assert!(MeritCircleCalibrator::with_config(cfg).is_err());
+            assert!(MeritCircleCalibrator::new(cfg).is_err());
         }
     }
 }

@@ -2,9 +2,30 @@
 //! the data cover, how far the calibrated readings stray from a circle (sphere), how well
 //! the geometry determines the calibration, and how large a heading error that allows.
 //!
-//! Every calibrator in this crate fills its [`Quality`] through [`assess_2d`] /
+//! Every calibrator in this crate fills its [`CompassQuality`] through [`assess_2d`] /
 //! [`quality_2d`] (or [`quality_3d`]), so the numbers mean the same thing whichever method
 //! produced them.
+//!
+//! # The three parts of the heading error
+//!
+//! * `heading_error_3sigma_deg` — three standard deviations of the heading error caused by
+//!   the uncertainty of the fitted parameters, at the worst heading (derived below). It is
+//!   the error the calibration adds to every later heading; it shrinks as `1/√N` with more
+//!   readings. Per-reading noise is **not** in it.
+//! * `heading_error_systematic_deg` — the deterministic heading error the method's model
+//!   leaves even with perfect data: 0 for the least-squares ellipse and ellipsoid (their
+//!   model represents any symmetric soft iron); for the seed methods that fit a circle or an
+//!   axis-aligned ellipse, the peak of the two-cycle error of an unremoved rotated soft iron
+//!   (see the `seed_quality` module).
+//! * `heading_noise_rms_deg` — the RMS heading noise of one calibrated reading, estimated
+//!   from the residuals that remain once the model (and, for the seed methods, the
+//!   systematic two-cycle part) is taken out: for isotropic sensor noise of standard
+//!   deviation `σ·F` per axis the radial residual and the heading error of one reading both
+//!   have standard deviation `σ` (radians). Averaging readings reduces it; recalibrating
+//!   does not.
+//!
+//! [`CompassQuality::heading_error_bound_deg`] is the first two added: a bound on the error
+//! of the calibration itself. A single reading's heading errs by that plus its own noise.
 //!
 //! # The heading-error bound (derivation)
 //!
@@ -23,7 +44,8 @@
 //! A least-squares calibration estimates `p` from the residuals of its `N` points; if those
 //! are independent with standard deviation `σ` (relative to `F`), the estimate's covariance
 //! is `σ²·A⁻¹` with the information matrix `A = Σᵢ φ(uᵢ)φ(uᵢ)ᵀ` (Gauss–Markov). The heading
-//! error at direction `u` then has variance `σ²·g(u)ᵀA⁻¹g(u)`, and the bound reported is
+//! error at direction `u` then has variance `σ²·g(u)ᵀA⁻¹g(u)`, and the bound reported as
+//! `heading_error_3sigma_deg` is
 //!
 //! `bound = 3 · σ · max_u √(g(u)ᵀ A⁻¹ g(u))`   (3 σ at the worst heading, in degrees),
 //!
@@ -32,8 +54,10 @@
 //! coverage shrinks (the directions `uᵢ` fill `A`). For `N` points spread evenly round the
 //! circle `g(u)ᵀA⁻¹g(u) = 4/N` at every heading, so the bound is `3·2σ/√N` radians. It is the
 //! error the calibration adds to every later heading; each reading's own noise adds about
-//! `σ` radians (RMS) on top. It does not include model errors the residuals cannot reveal
-//! (a rotated soft iron, a tilted sensor, a field that changes during the turn).
+//! `σ` radians (RMS) on top, reported apart as `heading_noise_rms_deg`. It does not include
+//! model errors the residuals cannot reveal (a rotated soft iron, a tilted sensor, a field
+//! that changes during the turn); the seed methods report the part of those their model is
+//! known to leave as `heading_error_systematic_deg`.
 //!
 //! The `condition` reported is the condition number of `A` (largest over smallest
 //! eigenvalue): 2 for a full, evenly covered circle, growing without bound as the arc
@@ -55,7 +79,7 @@ use core::f64::consts::TAU;
 
 use nalgebra::{SMatrix, SVector, Vector2, Vector3};
 use truenorth_compass::{CompassCalibration2d, CompassCalibration3d};
-use truenorth_core::{Error, Quality, Result, angle_diff};
+use truenorth_core::{CompassQuality, Error, FitQuality, Result, angle_diff};
 
 use crate::linalg::{condition_from_eigenvalues, sym_eigen5, sym_eigen9};
 use crate::lm::{BLOCK, blocks, dot_block, sum_block};
@@ -67,7 +91,7 @@ use truenorth_core::Float as _;
 pub const COVERAGE_BINS: usize = 36;
 
 /// Number of fine bins (0.5° each) used to measure the largest empty arc.
-const GAP_BINS: usize = 720;
+pub(crate) const GAP_BINS: usize = 720;
 
 /// Equal-area latitude bands of the direction cells on the sphere (uniform in `sin(lat)`,
 /// so every band has the same area).
@@ -122,7 +146,7 @@ impl Coverage {
 /// of the whole quality pass, so this uses the minimax polynomial of Abramowitz & Stegun
 /// (1964) 4.4.49 for `atan z` on [0, 1] (|error| ≤ 2·10⁻⁸ rad) with an octant reduction.
 #[inline]
-fn turns(y: f64, x: f64) -> f64 {
+pub(crate) fn turns(y: f64, x: f64) -> f64 {
     use core::f64::consts::{FRAC_PI_2, PI};
     const A: [f64; 8] = [
         -0.333_331_452_8,
@@ -380,7 +404,7 @@ pub fn require_sphere_coverage(fraction: f64, need: f64) -> Result<()> {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Assessment2d {
     /// The report to return with the solution.
-    pub quality: Quality,
+    pub quality: CompassQuality,
     /// Coverage of the calibrated headings (seen from the origin of the calibrated circle).
     pub coverage: Coverage,
 }
@@ -470,14 +494,17 @@ pub fn assess_2d(points: &[Vector2<f64>], cal: &CompassCalibration2d, field: f64
     let condition = sym_eigen5(&info)
         .map(|(l, _)| condition_from_eigenvalues(l.as_slice()))
         .unwrap_or(f64::INFINITY);
-    let heading_error_bound_deg = bound_2d(&info, ss, n);
     Assessment2d {
-        quality: Quality {
-            points: n,
-            coverage: coverage.fraction,
-            residual_rms_rel,
-            condition,
-            heading_error_bound_deg,
+        quality: CompassQuality {
+            fit: FitQuality {
+                points: n,
+                coverage: coverage.fraction,
+                residual_rms_rel,
+                condition,
+            },
+            heading_error_3sigma_deg: bound_2d(&info, ss, n),
+            heading_error_systematic_deg: 0.0,
+            heading_noise_rms_deg: noise_rms_deg(ss, n, 5),
             field_magnitude: field,
             field_ratio_to_expected: None,
         },
@@ -485,8 +512,33 @@ pub fn assess_2d(points: &[Vector2<f64>], cal: &CompassCalibration2d, field: f64
     }
 }
 
+/// Coverage of the calibrated readings `cal(p)` of `points` about the origin, with the same
+/// arithmetic as [`assess_2d`] (so a calibrator that refuses on it and reports
+/// [`assess_2d`]'s coverage sees the same bins). Non-finite readings are skipped. Allocates
+/// nothing.
+pub fn calibrated_coverage_2d(points: &[Vector2<f64>], cal: &CompassCalibration2d) -> Coverage {
+    let mut bins = AngleBins::new();
+    let (s, c) = (&cal.soft_iron, &cal.hard_iron);
+    for p in points {
+        let (dx, dy) = (p.x - c.x, p.y - c.y);
+        let (hx, hy) = (
+            s[(0, 0)] * dx + s[(0, 1)] * dy,
+            s[(1, 0)] * dx + s[(1, 1)] * dy,
+        );
+        let rho = (hx * hx + hy * hy).sqrt();
+        if rho > 0.0 && rho.is_finite() {
+            bins.mark(turns(hy, hx));
+        }
+    }
+    bins.coverage()
+}
+
 /// The 2-D quality report of `cal` on `points` (see [`assess_2d`]).
-pub fn quality_2d(points: &[Vector2<f64>], cal: &CompassCalibration2d, field: f64) -> Quality {
+pub fn quality_2d(
+    points: &[Vector2<f64>],
+    cal: &CompassCalibration2d,
+    field: f64,
+) -> CompassQuality {
     assess_2d(points, cal, field).quality
 }
 
@@ -533,7 +585,11 @@ fn bound_2d(info: &SMatrix<f64, 5, 5>, sum_sq: f64, n: usize) -> f64 {
 /// [`mean_corrected_norm_3d`] if the calibrator defines none), the condition number of the
 /// 9-parameter information matrix and the direction-error bound of the module
 /// documentation. Non-finite readings are skipped. Allocates nothing.
-pub fn quality_3d(points: &[Vector3<f64>], cal: &CompassCalibration3d, field: f64) -> Quality {
+pub fn quality_3d(
+    points: &[Vector3<f64>],
+    cal: &CompassCalibration3d,
+    field: f64,
+) -> CompassQuality {
     let mut filled = [false; SPHERE_CELLS];
     // Sums of the squared residuals and of the monomials of `u` that make up the
     // information matrix (see `information_3d`).
@@ -585,15 +641,27 @@ pub fn quality_3d(points: &[Vector3<f64>], cal: &CompassCalibration3d, field: f6
     let condition = sym_eigen9(&info)
         .map(|(l, _)| condition_from_eigenvalues(l.as_slice()))
         .unwrap_or(f64::INFINITY);
-    Quality {
-        points: n,
-        coverage,
-        residual_rms_rel,
-        condition,
-        heading_error_bound_deg: bound_3d(&info, ss, n),
+    CompassQuality {
+        fit: FitQuality {
+            points: n,
+            coverage,
+            residual_rms_rel,
+            condition,
+        },
+        heading_error_3sigma_deg: bound_3d(&info, ss, n),
+        heading_error_systematic_deg: 0.0,
+        heading_noise_rms_deg: noise_rms_deg(ss, n, 9),
         field_magnitude: field,
         field_ratio_to_expected: None,
     }
+}
+
+/// Per-reading noise, degrees: the residual standard deviation `√(sum_sq / (n − p))` of a
+/// fit of `p` parameters (relative to the field, so radians of heading; see the module
+/// documentation), or the plain RMS when there are no more points than parameters.
+fn noise_rms_deg(sum_sq: f64, n: usize, p: usize) -> f64 {
+    let dof = if n > p { n - p } else { n.max(1) };
+    (sum_sq / dof as f64).sqrt().to_degrees()
 }
 
 /// Number of distinct monomials of degree 2 to 4 in `(u_x, u_y)`.
@@ -757,10 +825,13 @@ fn bound_3d(info: &SMatrix<f64, 9, 9>, sum_sq: f64, n: usize) -> f64 {
     if b.is_finite() { b } else { f64::INFINITY }
 }
 
-/// Sets [`Quality::field_ratio_to_expected`]: the fitted field over `expected_field` (e.g.
+/// Sets [`CompassQuality::field_ratio_to_expected`]: the fitted field over `expected_field` (e.g.
 /// from the World Magnetic Model, in the input unit). Leaves it `None` when no positive
 /// finite expectation is given.
-pub fn with_expected_field(mut quality: Quality, expected_field: Option<f64>) -> Quality {
+pub fn with_expected_field(
+    mut quality: CompassQuality,
+    expected_field: Option<f64>,
+) -> CompassQuality {
     quality.field_ratio_to_expected = expected_field
         .filter(|e| e.is_finite() && *e > 0.0)
         .map(|e| quality.field_magnitude / e);
@@ -803,7 +874,7 @@ impl core::fmt::Display for FieldMismatch {
 
 /// A warning when the report's fitted field differs from `expected_field` by more than
 /// [`FIELD_RATIO_TOLERANCE`]; `None` when it agrees or no positive finite expectation is given.
-pub fn field_mismatch(quality: &Quality, expected_field: f64) -> Option<FieldMismatch> {
+pub fn field_mismatch(quality: &CompassQuality, expected_field: f64) -> Option<FieldMismatch> {
     if !(expected_field.is_finite() && expected_field > 0.0) {
         return None;
     }
@@ -896,10 +967,10 @@ mod tests {
     fn perfect_circle_report() {
         let pts = circle(3601, 0.0, 360.0, 2.0);
         let q = quality_2d(&pts, &CompassCalibration2d::identity(), 2.0);
-        assert_eq!(q.coverage, 1.0);
-        assert!(q.residual_rms_rel < 1e-12);
-        assert!((q.condition - 2.0).abs() < 1e-2, "{}", q.condition);
-        assert!(q.heading_error_bound_deg < 1e-9);
+        assert_eq!(q.fit.coverage, 1.0);
+        assert!(q.fit.residual_rms_rel < 1e-12);
+        assert!((q.fit.condition - 2.0).abs() < 1e-2, "{}", q.fit.condition);
+        assert!(q.heading_error_3sigma_deg < 1e-9);
         assert!(with_expected_field(q, Some(4.0)).field_ratio_to_expected == Some(0.5));
     }
 
@@ -915,9 +986,9 @@ mod tests {
         let q = quality_2d(&pts, &CompassCalibration2d::identity(), 1.0);
         let expect = (3.0 * 2.0 * 0.01 / (n as f64).sqrt()).to_degrees();
         assert!(
-            (q.heading_error_bound_deg / expect - 1.0).abs() < 0.1,
+            (q.heading_error_3sigma_deg / expect - 1.0).abs() < 0.1,
             "{} vs {expect}",
-            q.heading_error_bound_deg
+            q.heading_error_3sigma_deg
         );
     }
 
@@ -931,8 +1002,8 @@ mod tests {
                 .map(|p| p * (1.0 + rng.normal(0.01)))
                 .collect();
             let q = quality_2d(&pts, &CompassCalibration2d::identity(), 1.0);
-            assert!(q.condition > last.0 && q.heading_error_bound_deg > last.1);
-            last = (q.condition, q.heading_error_bound_deg);
+            assert!(q.fit.condition > last.0 && q.heading_error_3sigma_deg > last.1);
+            last = (q.fit.condition, q.heading_error_3sigma_deg);
         }
     }
 
@@ -1045,9 +1116,9 @@ mod tests {
             })
             .collect();
         let q = quality_3d(&pts, &CompassCalibration3d::identity(), 3.0);
-        assert_eq!(q.coverage, 1.0);
-        assert!((q.condition - 2.5).abs() < 0.01, "{}", q.condition);
-        assert!(q.residual_rms_rel < 1e-12);
+        assert_eq!(q.fit.coverage, 1.0);
+        assert!((q.fit.condition - 2.5).abs() < 0.01, "{}", q.fit.condition);
+        assert!(q.fit.residual_rms_rel < 1e-12);
         assert_eq!(sphere_coverage(&pts, &Vector3::zeros()), 1.0);
         // A great circle fills few cells.
         let ring: Vec<_> = (0..360)
@@ -1154,7 +1225,7 @@ mod field_mismatch_tests {
     proptest! {
         #[test]
         fn warns_exactly_outside_the_tolerance(fitted in 0.0f64..100.0, expected in 1e-3f64..100.0) {
-            let q = Quality { field_magnitude: fitted, ..Quality::default() };
+            let q = CompassQuality { field_magnitude: fitted, ..CompassQuality::default() };
             let ratio = fitted / expected;
             let warned = field_mismatch(&q, expected);
             prop_assert_eq!(warned.is_some(), (ratio - 1.0).abs() > FIELD_RATIO_TOLERANCE);
@@ -1174,7 +1245,7 @@ mod field_mismatch_tests {
                 -1e9f64..0.0,
             ],
         ) {
-            let q = Quality { field_magnitude: fitted, ..Quality::default() };
+            let q = CompassQuality { field_magnitude: fitted, ..CompassQuality::default() };
             prop_assert!(field_mismatch(&q, expected).is_none());
         }
     }

@@ -18,22 +18,32 @@
 //! ([`Error::Degenerate`]); a turn that reverses direction.
 //!
 //! The method scales the two axes but cannot remove a *rotated* soft iron (an ellipse whose
-//! axes are not the sensor's): the quality report's heading-error bound includes what that
-//! leaves (the two-cycle part of the residual, added to the bound).
+//! axes are not the sensor's): the quality report gives what that leaves (the two-cycle part
+//! of the residual) as `heading_error_systematic_deg`.
+//!
+//! `progress().ready` runs the acceptance tests of `solve` (the extrema, then the arc of the
+//! calibrated readings), so the two always agree; the calibrator saves and restores its whole
+//! state through [`Persistent`].
 
+extern crate alloc;
+
+use alloc::vec::Vec;
 use core::f64::consts::TAU;
 
 use nalgebra::{Matrix2, Vector2};
 use serde::{Deserialize, Serialize};
 use truenorth_compass::CompassCalibration2d;
 use truenorth_core::{
-    Calibrator, Error, Mag2Sample, Progress, Result, Solution, TimeStep, angle_diff, check_finite,
-    check_finite2,
+    Calibrator, CompassQuality, Error, Mag2Sample, Persistent, Progress, Pushed, Result, Snapshot,
+    Solution, TimeStep, Validate, angle_diff, check_finite, check_finite2, check_range,
+    check_snapshot_version,
 };
 
 use crate::direction_slots::{DirectionSlots, SLOTS};
-use crate::extrema::{ExtremaConfig, ExtremumKind, ExtremumTracker, HalfTurnPair, MAX_EXTREMA};
-use crate::quality::{MIN_ARC_DEG, require_arc};
+use crate::extrema::{
+    ExtremaConfig, ExtremumKind, ExtremumTracker, ExtremumTrackerSaved, HalfTurnPair, MAX_EXTREMA,
+};
+use crate::quality::{MIN_ARC_DEG, calibrated_coverage_2d, require_arc};
 use crate::seed_quality::seed_assessment;
 
 #[allow(unused_imports)]
@@ -94,7 +104,7 @@ impl TurnEllipse {
 
 /// The two axes' extremum trackers of one turn, plus the first and last reading: everything
 /// both halves of the turn calibration need, in constant memory.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct TurnExtrema<T: Copy> {
     x: ExtremumTracker<TurnTag<T>>,
     y: ExtremumTracker<TurnTag<T>>,
@@ -127,6 +137,40 @@ impl<T: Copy> TurnExtrema<T> {
         self.first = None;
         self.last = None;
         self.samples = 0;
+    }
+
+    /// The saved state.
+    pub fn saved(&self) -> TurnExtremaSaved<T> {
+        TurnExtremaSaved {
+            x: self.x.saved(),
+            y: self.y.saved(),
+            first: self.first,
+            last: self.last,
+            samples: self.samples,
+        }
+    }
+
+    /// Rebuilds the trackers from [`Self::saved`], refusing invalid or inconsistent values.
+    pub fn from_saved(s: TurnExtremaSaved<T>) -> Result<Self> {
+        let finite = |v: &Vector2<f64>| v.x.is_finite() && v.y.is_finite();
+        let t = Self {
+            x: ExtremumTracker::from_saved(s.x)?,
+            y: ExtremumTracker::from_saved(s.y)?,
+            first: s.first,
+            last: s.last,
+            samples: s.samples,
+        };
+        if !(t.first.iter().chain(&t.last).all(finite)
+            && t.x.samples() == t.samples
+            && t.y.samples() == t.samples
+            && (t.samples > 0) == t.first.is_some()
+            && (t.samples > 0) == t.last.is_some())
+        {
+            return Err(Error::InvalidSnapshot {
+                reason: "the turn's extremum trackers do not fit together",
+            });
+        }
+        Ok(t)
     }
 
     /// Feeds one finite reading with its tag; returns its sample index.
@@ -296,13 +340,33 @@ impl<T: Copy> TurnExtrema<T> {
     }
 }
 
-/// Options of the [`TurnCompassCalibrator`].
+/// The saved state of a [`TurnExtrema`] (opaque; see [`TurnExtrema::from_saved`]).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct TurnExtremaSaved<T> {
+    x: ExtremumTrackerSaved<TurnTag<T>>,
+    y: ExtremumTrackerSaved<TurnTag<T>>,
+    first: Option<Vector2<f64>>,
+    last: Option<Vector2<f64>>,
+    samples: usize,
+}
+
+/// Configuration of the [`TurnCompassCalibrator`] (defaults in brackets).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
 pub struct TurnConfig {
-    /// Extremum detector thresholds.
+    /// Extremum detector thresholds ([`ExtremaConfig::default`]).
     pub extrema: ExtremaConfig,
-    /// Shortest arc of calibrated headings accepted, degrees (a full turn always passes).
+    /// Shortest arc of calibrated headings accepted, degrees, 0..=360 ([`MIN_ARC_DEG`]; a
+    /// full turn always passes).
     pub min_arc_deg: f64,
+}
+
+impl Validate for TurnConfig {
+    fn validate(&self) -> Result<()> {
+        self.extrema.validate()?;
+        check_range("turn min_arc_deg", self.min_arc_deg, 0.0, 360.0)?;
+        Ok(())
+    }
 }
 
 impl Default for TurnConfig {
@@ -319,16 +383,17 @@ impl Default for TurnConfig {
 ///
 /// ```
 /// use nalgebra::{Matrix2, Vector2};
-/// use truenorth_calib::TurnCompassCalibrator;
+/// use truenorth_calib::{TurnCompassCalibrator, TurnConfig};
 /// use truenorth_compass::{HeadingTruth, MagnetometerModel2d};
 /// use truenorth_core::{Calibrator, Mag2Sample, SensorModel};
 ///
 /// let model = MagnetometerModel2d::new(Vector2::new(8.0, -3.0), Matrix2::new(1.2, 0.0, 0.0, 0.9), 0.0)?;
-/// let mut cal = TurnCompassCalibrator::new();
+/// let mut cal = TurnCompassCalibrator::new(TurnConfig::default())?;
 /// for i in 0..450 { // 450° of turn, 1° per sample, starting at heading 10°
 ///     let truth = HeadingTruth { heading_rad: (10.0 + i as f64).to_radians(), horizontal_field: 20.0 };
-///     cal.push(&Mag2Sample { t_s: i as f64 * 0.1, mag: model.ideal(&truth) })?;
+///     cal.push(&Mag2Sample { t_s: i as f64 * 0.1, mag: model.ideal(&truth)? })?;
 /// }
+/// assert!(cal.progress().ready);
 /// let sol = cal.solve()?;
 /// assert!((sol.params.hard_iron - Vector2::new(8.0, -3.0)).norm() < 0.1);
 /// # Ok::<(), truenorth_core::Error>(())
@@ -343,53 +408,68 @@ pub struct TurnCompassCalibrator {
 
 impl Default for TurnCompassCalibrator {
     fn default() -> Self {
-        Self::new()
+        Self::build(TurnConfig::default())
     }
 }
 
 impl TurnCompassCalibrator {
-    /// A calibrator with the default options.
-    pub fn new() -> Self {
+    /// A calibrator with the given configuration (validated).
+    pub fn new(config: TurnConfig) -> Result<Self> {
+        config.validate()?;
+        Ok(Self::build(config))
+    }
+
+    fn build(config: TurnConfig) -> Self {
         Self {
-            config: TurnConfig::default(),
-            extrema: TurnExtrema::with_valid_config(ExtremaConfig::default()),
+            config,
+            extrema: TurnExtrema::with_valid_config(config.extrema),
             slots: DirectionSlots::new(),
             clock: TimeStep::new(),
         }
     }
 
-    /// A calibrator with the given options (validated).
-    pub fn with_config(config: TurnConfig) -> Result<Self> {
-        check_finite("min_arc_deg", config.min_arc_deg)?;
-        Ok(Self {
-            config,
-            extrema: TurnExtrema::new(config.extrema)?,
-            slots: DirectionSlots::new(),
-            clock: TimeStep::new(),
-        })
+    /// The configuration in use.
+    pub fn config(&self) -> &TurnConfig {
+        &self.config
     }
 
     /// The extrema found so far (tagged with timestamps).
     pub fn extrema(&self) -> &TurnExtrema<f64> {
         &self.extrema
     }
+
+    /// The acceptance tests of `solve`, shared with `progress`: the extrema of a full turn,
+    /// then the arc of the calibrated readings.
+    fn accepted(&self) -> Result<(TurnEllipse, [Vector2<f64>; SLOTS], usize)> {
+        let fit = self.extrema.solve()?;
+        let mut buf = [Vector2::zeros(); SLOTS];
+        let n = self.slots.collect(&mut buf);
+        require_arc(
+            &calibrated_coverage_2d(&buf[..n], &fit.calibration()),
+            self.config.min_arc_deg,
+        )?;
+        Ok((fit, buf, n))
+    }
 }
 
 impl Calibrator for TurnCompassCalibrator {
     type Sample = Mag2Sample;
     type Params = CompassCalibration2d;
+    type Quality = CompassQuality;
 
-    /// Refuses non-finite readings and timestamps that do not increase (the extrema must be
-    /// found in time order).
-    fn push(&mut self, sample: &Mag2Sample) -> Result<()> {
+    /// Refuses non-finite readings and timestamps that are not finite or do not increase
+    /// (the extrema must be found in time order); a refused sample changes nothing.
+    fn push(&mut self, sample: &Mag2Sample) -> Result<Pushed> {
         check_finite2("magnetometer reading", &sample.mag)?;
         self.clock.dt_s(sample.t_s)?;
         self.extrema.push(&sample.mag, sample.t_s)?;
         let c = self.extrema.provisional_centre();
         self.slots.push(&sample.mag, &c);
-        Ok(())
+        Ok(Pushed::Accepted)
     }
 
+    /// `ready` runs the acceptance tests of [`Calibrator::solve`] (bounded: the kept
+    /// extrema and at most 72 readings).
     fn progress(&self) -> Progress {
         let samples = self.extrema.samples();
         let (x0, x1) = self.extrema.x.range();
@@ -405,19 +485,20 @@ impl Calibrator for TurnCompassCalibrator {
         Progress {
             samples,
             coverage: (turned.abs() / TAU).min(1.0),
-            ready: self.extrema.solve().is_ok(),
+            ready: self.accepted().is_ok(),
         }
     }
 
-    fn solve(&mut self) -> Result<Solution<CompassCalibration2d>> {
-        let fit = self.extrema.solve()?;
-        let cal = fit.calibration();
-        let mut buf = [Vector2::zeros(); SLOTS];
-        let n = self.slots.collect(&mut buf);
-        let a = seed_assessment(&buf[..n], &cal, fit.field(), self.extrema.samples());
-        require_arc(&a.coverage, self.config.min_arc_deg)?;
+    fn solve(&self) -> Result<Solution<CompassCalibration2d>> {
+        let (fit, buf, n) = self.accepted()?;
+        let a = seed_assessment(
+            &buf[..n],
+            &fit.calibration(),
+            fit.field(),
+            self.extrema.samples(),
+        );
         Ok(Solution {
-            params: cal,
+            params: fit.calibration(),
             quality: a.quality,
         })
     }
@@ -426,6 +507,68 @@ impl Calibrator for TurnCompassCalibrator {
         self.extrema.reset();
         self.slots.clear();
         self.clock.reset();
+    }
+}
+
+/// The saved state of a [`TurnCompassCalibrator`] ([`Persistent::State`]): configuration,
+/// extremum trackers, the kept readings and the last timestamp.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct TurnSaved {
+    /// The configuration.
+    pub config: TurnConfig,
+    /// The extremum trackers (opaque).
+    pub extrema: TurnExtremaSaved<f64>,
+    /// The kept readings by direction slot (72 entries, `None` where empty).
+    pub slots: Vec<Option<Vector2<f64>>>,
+    /// The last accepted timestamp, seconds.
+    pub last_t_s: Option<f64>,
+}
+
+impl Persistent for TurnCompassCalibrator {
+    type State = TurnSaved;
+    const SNAPSHOT_VERSION: u32 = 1;
+
+    fn snapshot(&self) -> Snapshot<TurnSaved> {
+        Snapshot {
+            version: Self::SNAPSHOT_VERSION,
+            state: TurnSaved {
+                config: self.config,
+                extrema: self.extrema.saved(),
+                slots: self.slots.to_vec(),
+                last_t_s: self.clock.last_s(),
+            },
+        }
+    }
+
+    fn restore(snapshot: Snapshot<TurnSaved>) -> Result<Self> {
+        check_snapshot_version(snapshot.version, Self::SNAPSHOT_VERSION)?;
+        let s = snapshot.state;
+        s.config.validate()?;
+        let extrema = TurnExtrema::from_saved(s.extrema)?;
+        if extrema.x.config() != &s.config.extrema || extrema.y.config() != &s.config.extrema {
+            return Err(Error::InvalidSnapshot {
+                reason: "the turn's extremum trackers were saved with another configuration",
+            });
+        }
+        let slots = DirectionSlots::from_slice(&s.slots).ok_or(Error::InvalidSnapshot {
+            reason: "the turn's direction slots must be 72 finite readings or empty",
+        })?;
+        let mut clock = TimeStep::new();
+        if let Some(t) = s.last_t_s {
+            check_finite("saved timestamp", t)?;
+            clock.dt_s(t)?;
+        }
+        if (extrema.samples() > 0) != s.last_t_s.is_some() {
+            return Err(Error::InvalidSnapshot {
+                reason: "the turn's timestamp does not fit its sample count",
+            });
+        }
+        Ok(Self {
+            config: s.config,
+            extrema,
+            slots,
+            clock,
+        })
     }
 }
 
@@ -443,7 +586,7 @@ mod tests {
             0.0,
         )
         .unwrap();
-        let mut c = TurnCompassCalibrator::new();
+        let mut c = TurnCompassCalibrator::default();
         for (i, h) in headings.enumerate() {
             let truth = HeadingTruth {
                 heading_rad: h.to_radians(),
@@ -451,7 +594,7 @@ mod tests {
             };
             c.push(&Mag2Sample {
                 t_s: i as f64,
-                mag: m.ideal(&truth),
+                mag: m.ideal(&truth).unwrap(),
             })
             .unwrap();
         }
@@ -465,7 +608,7 @@ mod tests {
 
     #[test]
     fn a_turn_and_a_half_gives_centre_radii_and_the_signed_angle() {
-        let mut c = run(sweep(20.0, 540.0));
+        let c = run(sweep(20.0, 540.0));
         let fit = c.extrema().solve().unwrap();
         assert!(
             (fit.turned_rad.to_degrees() - 540.0).abs() < 1.0,
@@ -487,20 +630,20 @@ mod tests {
 
     #[test]
     fn less_than_a_full_turn_is_refused() {
-        let mut c = run(sweep(40.0, 300.0));
+        let c = run(sweep(40.0, 300.0));
         assert!(
             matches!(c.solve(), Err(Error::IncompleteTurn { .. })),
             "{:?}",
             c.solve()
         );
-        let mut c = run(sweep(40.0, 120.0));
+        let c = run(sweep(40.0, 120.0));
         assert!(matches!(c.solve(), Err(Error::IncompleteTurn { .. })));
     }
 
     #[test]
     fn an_extremum_at_the_edge_is_refused() {
         // Exactly one turn from north: the X maximum is at both ends of the record.
-        let mut c = run(sweep(0.0, 360.0));
+        let c = run(sweep(0.0, 360.0));
         assert!(
             matches!(c.solve(), Err(Error::Degenerate { .. })),
             "{:?}",
@@ -514,7 +657,7 @@ mod tests {
     fn a_reversed_turn_is_refused() {
         let there = sweep(30.0, 300.0);
         let back = sweep(330.0, -300.0);
-        let mut c = run(there.chain(back).chain(sweep(30.0, 300.0)));
+        let c = run(there.chain(back).chain(sweep(30.0, 300.0)));
         assert!(c.solve().is_err());
     }
 
@@ -530,7 +673,7 @@ mod tests {
             .is_err()
         );
         assert!(
-            TurnCompassCalibrator::with_config(TurnConfig {
+            TurnCompassCalibrator::new(TurnConfig {
                 extrema: ExtremaConfig {
                     swing_fraction: 1.5,
                     noise_multiple: 8.0

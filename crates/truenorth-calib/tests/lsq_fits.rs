@@ -11,7 +11,7 @@ use std::f64::consts::{PI, TAU};
 use nalgebra::{Matrix2, Matrix3, Rotation3, Vector2, Vector3};
 use proptest::prelude::*;
 use truenorth_calib::{
-    EllipseCalibrator, EllipseFitOptions, EllipsoidCalibrator, EllipsoidFitOptions, fit_ellipse,
+    EllipseCalibrator, EllipseConfig, EllipsoidCalibrator, EllipsoidConfig, fit_ellipse,
     fit_ellipse_direct, fit_ellipsoid, quality,
 };
 use truenorth_compass::CompassCalibration2d;
@@ -112,7 +112,7 @@ fn least_squares_heading_rms_is_within_ten_percent_of_the_noise_floor() {
     for seed in 0..trials {
         let turn = m.turn(n, 0.0, 360.0, 0.01 * field, seed);
         let pts = points(&turn);
-        let sol = fit_ellipse(&pts, &EllipseFitOptions::default()).unwrap();
+        let sol = fit_ellipse(&pts, &EllipseConfig::default()).unwrap();
         let direct = fit_ellipse_direct(&pts).unwrap().calibration().0;
         let fit = heading_rms_deg(&sol.params, &turn);
         let floor = heading_rms_deg(&truth, &turn);
@@ -120,7 +120,7 @@ fn least_squares_heading_rms_is_within_ten_percent_of_the_noise_floor() {
         sum_floor += floor;
         sum_direct += heading_rms_deg(&direct, &turn);
         worst = worst.max(fit / floor);
-        bounds += sol.quality.heading_error_bound_deg;
+        bounds += sol.quality.heading_error_bound_deg();
     }
     let ratio = sum_fit / sum_floor;
     println!(
@@ -142,7 +142,7 @@ fn half_circle_and_shorter_arcs_are_refused_fuller_ones_accepted() {
     for span in [30.0, 90.0, 120.0, 150.0, 170.0, 180.0] {
         for seed in 0..10 {
             let turn = m.turn(200, seed as f64 * 36.0, span, 0.01, seed);
-            let r = fit_ellipse(&points(&turn), &EllipseFitOptions::default());
+            let r = fit_ellipse(&points(&turn), &EllipseConfig::default());
             assert!(
                 matches!(r, Err(Error::InsufficientCoverage { .. })),
                 "span {span}, seed {seed}: {r:?}"
@@ -151,14 +151,18 @@ fn half_circle_and_shorter_arcs_are_refused_fuller_ones_accepted() {
     }
     for span in [240.0, 300.0, 360.0] {
         let turn = m.turn(200, 10.0, span, 0.01, 1);
-        assert!(fit_ellipse(&points(&turn), &EllipseFitOptions::default()).is_ok());
+        assert!(fit_ellipse(&points(&turn), &EllipseConfig::default()).is_ok());
     }
 }
 
 #[test]
 fn calibrator_lifecycle() {
     let m = Model2::new(Vector2::new(3.0, -1.0), 1.2, 0.3, 20.0);
-    let mut cal = EllipseCalibrator::new().with_expected_field(25.0);
+    let mut cal = EllipseCalibrator::new(EllipseConfig {
+        expected_field: Some(25.0),
+        ..EllipseConfig::default()
+    })
+    .unwrap();
     assert!(!cal.progress().ready);
     assert!(matches!(cal.solve(), Err(Error::TooFewPoints { .. })));
     let bad = Mag2Sample {
@@ -186,7 +190,7 @@ fn calibrator_lifecycle() {
     let sol = cal.solve().unwrap();
     let ratio = sol.quality.field_ratio_to_expected.unwrap();
     assert!((ratio - sol.quality.field_magnitude / 25.0).abs() < 1e-12);
-    assert!(sol.quality.coverage > 0.95 && sol.quality.heading_error_bound_deg < 1.0);
+    assert!(sol.quality.fit.coverage > 0.95 && sol.quality.heading_error_bound_deg() < 1.0);
     cal.reset();
     assert_eq!(cal.progress().samples, 0);
 }
@@ -225,7 +229,11 @@ fn ellipsoid_calibrator_lifecycle_and_single_axis_refusal() {
     let rot = Rotation3::from_euler_angles(0.3, -0.2, 0.7);
     let w = soft3(&rot, 1.15, 0.9);
     let hard = Vector3::new(20.0, -35.0, 10.0);
-    let mut cal = EllipsoidCalibrator::new().with_expected_field(50.0);
+    let mut cal = EllipsoidCalibrator::new(EllipsoidConfig {
+        expected_field: Some(50.0),
+        ..EllipsoidConfig::default()
+    })
+    .unwrap();
     for (k, mag) in sphere_turn(hard, &w, 48.0, 500, 0.5, 2)
         .into_iter()
         .enumerate()
@@ -244,7 +252,7 @@ fn ellipsoid_calibrator_lifecycle_and_single_axis_refusal() {
             hard + w * Vector3::new(48.0 * a.cos(), 48.0 * a.sin(), 20.0)
         })
         .collect();
-    let r = fit_ellipsoid(&ring, &EllipsoidFitOptions::default());
+    let r = fit_ellipsoid(&ring, &EllipsoidConfig::default());
     assert!(r.is_err(), "{r:?}");
 }
 
@@ -266,14 +274,14 @@ proptest! {
         let p = points(&m.turn(n, 0.0, 360.0, 0.02, seed));
         let (r, t, k) = (rot2(phi), Vector2::new(tx, ty), 10f64.powf(log_k));
         let q: Vec<_> = p.iter().map(|v| r * v * k + t).collect();
-        let a = fit_ellipse(&p, &EllipseFitOptions::default()).unwrap();
-        let b = fit_ellipse(&q, &EllipseFitOptions::default()).unwrap();
+        let a = fit_ellipse(&p, &EllipseConfig::default()).unwrap();
+        let b = fit_ellipse(&q, &EllipseConfig::default()).unwrap();
         let fa = a.quality.field_magnitude;
         let expect_hard = r * a.params.hard_iron * k + t;
         prop_assert!((b.params.hard_iron - expect_hard).norm() <= 1e-7 * (k * fa + t.norm()));
         prop_assert!((b.params.soft_iron - r * a.params.soft_iron * r.transpose()).norm() <= 1e-7);
         prop_assert!((b.quality.field_magnitude / (k * fa) - 1.0).abs() <= 1e-8);
-        prop_assert!((b.quality.residual_rms_rel - a.quality.residual_rms_rel).abs() <= 1e-8);
+        prop_assert!((b.quality.fit.residual_rms_rel - a.quality.fit.residual_rms_rel).abs() <= 1e-8);
     }
 
     #[test]
@@ -287,8 +295,8 @@ proptest! {
         let p = sphere_turn(Vector3::new(hx, hy, hz), &w, 1.0, n, 0.01, seed);
         let (r, t, k) = (rot.matrix(), Vector3::new(tx, -0.5 * tx, 0.3 * tx), 10f64.powf(log_k));
         let q: Vec<_> = p.iter().map(|v| r * v * k + t).collect();
-        let a = fit_ellipsoid(&p, &EllipsoidFitOptions::default()).unwrap();
-        let b = fit_ellipsoid(&q, &EllipsoidFitOptions::default()).unwrap();
+        let a = fit_ellipsoid(&p, &EllipsoidConfig::default()).unwrap();
+        let b = fit_ellipsoid(&q, &EllipsoidConfig::default()).unwrap();
         let fa = a.quality.field_magnitude;
         let expect_hard = r * a.params.hard_iron * k + t;
         prop_assert!((b.params.hard_iron - expect_hard).norm() <= 1e-7 * (k * fa + t.norm()));
@@ -307,7 +315,7 @@ proptest! {
         let (truth, f_true) = m.truth();
         for rel_sigma in [1e-2, 1e-3, 1e-4, 1e-6, 0.0] {
             let turn = m.turn(180, 7.0, 360.0, rel_sigma * field, seed);
-            let sol = fit_ellipse(&points(&turn), &EllipseFitOptions::default()).unwrap();
+            let sol = fit_ellipse(&points(&turn), &EllipseConfig::default()).unwrap();
             let tol = rel_sigma + 1e-9;
             prop_assert!((sol.params.hard_iron - truth.hard_iron).norm() / f_true <= 2.0 * tol,
                 "σ {rel_sigma}: hard {:?} vs {:?}", sol.params.hard_iron, truth.hard_iron);
@@ -329,28 +337,12 @@ proptest! {
         let f_true = field * w.determinant().cbrt();
         for rel_sigma in [1e-2, 1e-3, 1e-4, 1e-6, 0.0] {
             let p = sphere_turn(hard, &w, field, 300, rel_sigma * field, seed);
-            let sol = fit_ellipsoid(&p, &EllipsoidFitOptions::default()).unwrap();
+            let sol = fit_ellipsoid(&p, &EllipsoidConfig::default()).unwrap();
             let tol = rel_sigma + 1e-9;
             prop_assert!((sol.params.hard_iron - hard).norm() / f_true <= 2.0 * tol);
             prop_assert!((sol.params.soft_iron - s_true / s_true.determinant().cbrt()).norm() <= 4.0 * tol);
             prop_assert!((sol.quality.field_magnitude / f_true - 1.0).abs() <= 2.0 * tol);
         }
-    }
-
-    /// Any arc of half a turn or less, any noise up to 3 %, any hard and soft iron: refused.
-    #[test]
-    fn short_arcs_are_always_refused(
-        span in 5.0f64..=180.0, start in 0.0f64..360.0, noise in 0.0f64..0.03,
-        hx in -1.0f64..1.0, ratio in 1.0f64..1.5, angle in -PI..PI, n in 6usize..400, seed in 0u64..1000,
-    ) {
-        let m = Model2::new(Vector2::new(hx, -hx), ratio, angle, 1.0);
-        let mut turn = m.turn(n, start, span, noise, seed);
-        // `turn` stops one step short of the span; include the end point.
-        let mut rng = SplitMix64::new(seed + 1);
-        let end = (start + span).to_radians();
-        turn.push((end, m.raw(end, &mut rng, noise)));
-        let r = fit_ellipse(&points(&turn), &EllipseFitOptions::default());
-        prop_assert!(r.is_err(), "span {span}: {r:?}");
     }
 
     /// No input makes the fits or calibrators panic: NaN, infinities, huge and tiny values,
@@ -386,29 +378,58 @@ proptest! {
             _ => raw.iter().map(|&x| Vector3::new(x.sin(), x.cos(), (2.0 * x).sin())).collect(),
         };
         for refine in [false, true] {
-            if let Ok(s) = fit_ellipse(&pts2, &EllipseFitOptions { refine, ..Default::default() }) {
+            if let Ok(s) = fit_ellipse(&pts2, &EllipseConfig { refine, ..Default::default() }) {
                 prop_assert!(s.params.soft_iron.iter().all(|x| x.is_finite()));
             }
-            if let Ok(s) = fit_ellipsoid(&pts3, &EllipsoidFitOptions { refine, ..Default::default() }) {
+            if let Ok(s) = fit_ellipsoid(&pts3, &EllipsoidConfig { refine, ..Default::default() }) {
                 prop_assert!(s.params.soft_iron.iter().all(|x| x.is_finite()));
             }
         }
         let _ = fit_ellipse_direct(&pts2);
-        let mut c2 = EllipseCalibrator::new();
+        let mut c2 = EllipseCalibrator::default();
         for p in &pts2 {
             let _ = c2.push(&Mag2Sample { t_s: 0.0, mag: *p });
         }
-        let _ = c2.progress();
-        let _ = c2.solve();
-        let mut c3 = EllipsoidCalibrator::new();
+        prop_assert_eq!(c2.progress().ready, c2.solve().is_ok());
+        let mut c3 = EllipsoidCalibrator::default();
         for p in &pts3 {
             let _ = c3.push(&Mag3Sample { t_s: 0.0, mag: *p });
         }
-        let _ = c3.progress();
-        let _ = c3.solve();
+        prop_assert_eq!(c3.progress().ready, c3.solve().is_ok());
         let _ = quality::coverage(&pts2, &Vector2::zeros());
         let _ = quality::sphere_coverage(&pts3, &Vector3::zeros());
         let _ = quality::quality_2d(&pts2, &CompassCalibration2d::identity(), 1.0);
         let _ = TAU;
+    }
+}
+
+proptest! {
+    // More cases than the other properties: the refusals it checks fail on rare draws.
+    #![proptest_config(ProptestConfig { cases: 512, failure_persistence: None, ..ProptestConfig::default() })]
+
+    /// Any arc of half a turn or less (down to 1°, where a handful of noisy readings fit a
+    /// small ellipse around themselves that they seem to cover completely), any noise up to
+    /// 3 %, 6 to 400 readings, any hard and soft iron: refused, and the calibrator's `ready`
+    /// says so too.
+    #[test]
+    fn short_arcs_are_always_refused(
+        span in 1.0f64..=180.0, start in 0.0f64..360.0, noise in 0.0f64..0.03,
+        hx in -1.0f64..1.0, ratio in 1.0f64..1.5, angle in -PI..PI, n in 6usize..400, seed in 0u64..1000,
+    ) {
+        let m = Model2::new(Vector2::new(hx, -hx), ratio, angle, 1.0);
+        let mut turn = m.turn(n, start, span, noise, seed);
+        // `turn` stops one step short of the span; include the end point.
+        let mut rng = SplitMix64::new(seed + 1);
+        let end = (start + span).to_radians();
+        turn.push((end, m.raw(end, &mut rng, noise)));
+        let r = fit_ellipse(&points(&turn), &EllipseConfig::default());
+        prop_assert!(r.is_err(), "span {span}, noise {noise}, {} points: {r:?}", turn.len());
+        let mut cal = EllipseCalibrator::default();
+        for (k, (_, mag)) in turn.iter().enumerate() {
+            cal.push(&Mag2Sample { t_s: k as f64, mag: *mag }).unwrap();
+            if k + 1 >= 6 && (k + 1) % 7 == 6 {
+                prop_assert!(!cal.progress().ready, "span {span}, noise {noise}: ready after {} readings", k + 1);
+            }
+        }
     }
 }

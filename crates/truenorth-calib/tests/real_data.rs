@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use nalgebra::{Matrix3, Vector2, Vector3};
-use truenorth_calib::{EllipseFitOptions, EllipsoidFitOptions, fit_ellipse, fit_ellipsoid};
+use truenorth_calib::{EllipseConfig, EllipsoidConfig, fit_ellipse, fit_ellipsoid};
 use truenorth_compass::CompassCalibration3d;
 use truenorth_core::angle_diff;
 
@@ -75,7 +75,7 @@ fn rel_std(v: impl Iterator<Item = f64> + Clone) -> f64 {
 fn full_sphere_calibration() -> Option<CompassCalibration3d> {
     let pts = sunsided_mag("full-sphere")?;
     Some(
-        fit_ellipsoid(&pts, &EllipsoidFitOptions::default())
+        fit_ellipsoid(&pts, &EllipsoidConfig::default())
             .unwrap()
             .params,
     )
@@ -87,7 +87,7 @@ fn sunsided_full_sphere_field_constancy() {
         return;
     };
     let before = rel_std(pts.iter().map(|p| p.norm()));
-    let sol = fit_ellipsoid(&pts, &EllipsoidFitOptions::default()).unwrap();
+    let sol = fit_ellipsoid(&pts, &EllipsoidConfig::default()).unwrap();
     let after = rel_std(pts.iter().map(|p| sol.params.correct(p).norm()));
     println!(
         "sunsided full-sphere: {} points, |B| relative std raw {:.2} % -> calibrated {:.3} %",
@@ -131,7 +131,7 @@ fn sunsided_single_axis_turns_2d() {
         let pts: Vec<_> = pts3.iter().map(|p| Vector2::new(p[i], p[j])).collect();
         let centroid = pts.iter().sum::<Vector2<f64>>() / pts.len() as f64;
         let before = rel_std(pts.iter().map(|p| (p - centroid).norm()));
-        let sol = fit_ellipse(&pts, &EllipseFitOptions::default()).unwrap();
+        let sol = fit_ellipse(&pts, &EllipseConfig::default()).unwrap();
         let after = rel_std(pts.iter().map(|p| sol.params.correct(p).norm()));
 
         // The turn axis as the 3-D-calibrated data show it: the direction of least spread.
@@ -165,13 +165,13 @@ fn sunsided_single_axis_turns_2d() {
             pts.len(),
             100.0 * before,
             100.0 * after,
-            sol.quality.coverage,
-            sol.quality.condition,
-            sol.quality.heading_error_bound_deg,
+            sol.quality.fit.coverage,
+            sol.quality.fit.condition,
+            sol.quality.heading_error_bound_deg(),
             tilt_deg,
             rms.to_degrees()
         );
-        assert_eq!(sol.quality.coverage, 1.0);
+        assert_eq!(sol.quality.fit.coverage, 1.0);
         assert!(after < before);
         if horizontal_axis {
             assert!(rms.to_degrees() < 1.0, "{rec}: {}", rms.to_degrees());
@@ -189,7 +189,7 @@ fn python_sample_fixture() {
         .map(|r| Vector3::new(r[0], r[1], r[2]))
         .collect();
     assert_eq!(pts.len(), 347);
-    let sol = fit_ellipsoid(&pts, &EllipsoidFitOptions::default()).unwrap();
+    let sol = fit_ellipsoid(&pts, &EllipsoidConfig::default()).unwrap();
     let before = rel_std(pts.iter().map(|p| p.norm()));
     let after = rel_std(pts.iter().map(|p| sol.params.correct(p).norm()));
     let axes = truenorth_calib::fit_ellipsoid_direct(&pts)
@@ -219,7 +219,7 @@ fn ck_explorer_tumble() {
         .iter()
         .map(|r| Vector3::new(r[3], r[4], r[5]))
         .collect();
-    let sol = fit_ellipsoid(&pts, &EllipsoidFitOptions::default()).unwrap();
+    let sol = fit_ellipsoid(&pts, &EllipsoidConfig::default()).unwrap();
     let before = rel_std(pts.iter().map(|p| p.norm()));
     let after = rel_std(pts.iter().map(|p| sol.params.correct(p).norm()));
     println!(
@@ -241,7 +241,7 @@ fn sunsided_3d_refusals() {
         "unmoved-with-x-pointing-forward",
     ] {
         let Some(pts) = sunsided_mag(rec) else { return };
-        let r = fit_ellipsoid(&pts, &EllipsoidFitOptions::default());
+        let r = fit_ellipsoid(&pts, &EllipsoidConfig::default());
         println!("3-D fit on {rec}: {:?}", r.as_ref().map(|s| s.quality));
         assert!(r.is_err());
     }

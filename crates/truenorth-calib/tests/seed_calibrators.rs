@@ -10,7 +10,7 @@ use truenorth_compass::{
     CompassCalibration2d, HeadingTruth, MagnetometerModel2d, soft_iron_from_axes,
 };
 use truenorth_core::{
-    Calibrator, Error, Mag2Sample, NoiseSource, SensorModel, SplitMix64, angle_diff,
+    Calibrator, CompassQuality, Error, Mag2Sample, NoiseSource, SensorModel, SplitMix64, angle_diff,
 };
 
 const H: f64 = 20.0;
@@ -34,20 +34,30 @@ fn turn(
             };
             Mag2Sample {
                 t_s: i as f64 * 0.05,
-                mag: model.sample(&truth, 0.05, rng),
+                mag: model.sample(&truth, 0.05, rng).unwrap(),
             }
         })
         .collect()
 }
 
-fn solve<C: Calibrator<Sample = Mag2Sample, Params = CompassCalibration2d>>(
+fn solve<
+    C: Calibrator<Sample = Mag2Sample, Params = CompassCalibration2d, Quality = CompassQuality>,
+>(
     mut c: C,
     samples: &[Mag2Sample],
 ) -> truenorth_core::Result<truenorth_core::Solution<CompassCalibration2d>> {
     for s in samples {
         let _ = c.push(s);
     }
-    c.solve()
+    // Asking for progress must agree with solving.
+    let ready = c.progress().ready;
+    let sol = c.solve();
+    assert_eq!(
+        ready,
+        sol.is_ok(),
+        "progress().ready disagrees with solve(): {sol:?}"
+    );
+    sol
 }
 
 /// Heading RMS (degrees) of `cal` against truth over 360 headings, on readings with the
@@ -65,9 +75,9 @@ fn heading_rms_deg(
             horizontal_field: H,
         };
         let raw = if noisy {
-            model.sample(&truth, 0.05, rng)
+            model.sample(&truth, 0.05, rng).unwrap()
         } else {
-            model.ideal(&truth)
+            model.ideal(&truth).unwrap()
         };
         ss += angle_diff(cal.heading_rad(&raw), truth.heading_rad).powi(2);
     }
@@ -102,9 +112,9 @@ fn measure_heading_rms_on_the_reference_turn() {
         // 1.25 turns at 2 samples per degree, starting 10° past north.
         let data = turn(&mut model, 10.0, 450.0, 2.0, &mut rng);
         let sols = [
-            solve(BinnedEllipseCalibrator::new(), &data),
-            solve(MeritCircleCalibrator::new(), &data),
-            solve(TurnCompassCalibrator::new(), &data),
+            solve(BinnedEllipseCalibrator::default(), &data),
+            solve(MeritCircleCalibrator::default(), &data),
+            solve(TurnCompassCalibrator::default(), &data),
         ];
         for (row, sol) in rows.iter_mut().zip(sols) {
             let sol = sol.unwrap_or_else(|e| panic!("{} failed on seed {seed}: {e}", row.0));
@@ -170,7 +180,7 @@ fn binned_ellipse_refuses_a_178_degree_arc() {
         4.0,
         &mut rng,
     );
-    let r = solve(BinnedEllipseCalibrator::new(), &data);
+    let r = solve(BinnedEllipseCalibrator::default(), &data);
     assert!(
         matches!(r, Err(Error::InsufficientCoverage { .. })),
         "{r:?}"
@@ -193,7 +203,7 @@ proptest! {
         let mut m = model(hard, soft, sigma);
         let mut rng = SplitMix64::new(seed);
         let data = turn(&mut m, start, 450.0, 2.0, &mut rng);
-        let sol = solve(BinnedEllipseCalibrator::new(), &data).unwrap();
+        let sol = solve(BinnedEllipseCalibrator::default(), &data).unwrap();
         let dh = (sol.params.hard_iron - hard).norm() / H;
         // The origin is the mean of N = 64 single noisy readings (σ/8 per axis) plus what the
         // interpolation adds: tails reach ≈ σ.
@@ -214,7 +224,7 @@ proptest! {
         let mut m = model(hard, Matrix2::identity() * gain, sigma);
         let mut rng = SplitMix64::new(seed);
         let data = turn(&mut m, start, 450.0, 2.0, &mut rng);
-        let sol = solve(MeritCircleCalibrator::new(), &data).unwrap();
+        let sol = solve(MeritCircleCalibrator::default(), &data).unwrap();
         // Noise relative to the circle's radius.
         let sigma = sigma / gain;
         // ~15 data points (one per 30° of turn) make ~14 triples, each centre off by about
@@ -238,7 +248,7 @@ proptest! {
         let mut m = model(hard, soft, sigma);
         let mut rng = SplitMix64::new(seed);
         let data = turn(&mut m, start, 450.0, 2.0, &mut rng);
-        let sol = solve(TurnCompassCalibrator::new(), &data).unwrap();
+        let sol = solve(TurnCompassCalibrator::default(), &data).unwrap();
         // Extremum values are single noisy samples picked as the largest: a bias of order σ.
         let dh = (sol.params.hard_iron - hard).norm() / H;
         prop_assert!(dh <= 1e-4 + 2.0 * sigma, "hard-iron error {} at σ {}", dh, sigma);
@@ -263,13 +273,13 @@ proptest! {
             let mut rng = SplitMix64::new(1);
             let data = turn(&mut m, start, 450.0, 2.0, &mut rng);
             let sol = match which {
-                0 => solve(BinnedEllipseCalibrator::new(), &data),
-                1 => solve(MeritCircleCalibrator::new(), &data),
-                _ => solve(TurnCompassCalibrator::new(), &data),
+                0 => solve(BinnedEllipseCalibrator::default(), &data),
+                1 => solve(MeritCircleCalibrator::default(), &data),
+                _ => solve(TurnCompassCalibrator::default(), &data),
             }.unwrap();
             for d in 0..360 {
                 let truth = HeadingTruth { heading_rad: f64::from(d).to_radians(), horizontal_field: H };
-                let err = angle_diff(sol.params.heading_rad(&m.ideal(&truth)), truth.heading_rad).abs().to_degrees();
+                let err = angle_diff(sol.params.heading_rad(&m.ideal(&truth).unwrap()), truth.heading_rad).abs().to_degrees();
                 prop_assert!(err <= tol_deg, "method {} heading {}°: error {}°", which, d, err);
             }
         }
@@ -285,9 +295,9 @@ proptest! {
         let mut rng = SplitMix64::new(seed);
         let data = turn(&mut m, start, span, 4.0, &mut rng);
         let results = [
-            solve(BinnedEllipseCalibrator::new(), &data),
-            solve(MeritCircleCalibrator::new(), &data),
-            solve(TurnCompassCalibrator::new(), &data),
+            solve(BinnedEllipseCalibrator::default(), &data),
+            solve(MeritCircleCalibrator::default(), &data),
+            solve(TurnCompassCalibrator::default(), &data),
         ];
         for (i, r) in results.into_iter().enumerate() {
             let refused = matches!(
@@ -309,14 +319,14 @@ proptest! {
             .collect();
         for (i, s) in data.iter().enumerate() {
             if !(s.mag.x.is_finite() && s.mag.y.is_finite()) {
-                let mut c = MeritCircleCalibrator::new();
+                let mut c = MeritCircleCalibrator::default();
                 prop_assert!(c.push(s).is_err(), "sample {} accepted", i);
             }
         }
         let solved = [
-            solve(BinnedEllipseCalibrator::new(), &data),
-            solve(MeritCircleCalibrator::new(), &data),
-            solve(TurnCompassCalibrator::new(), &data),
+            solve(BinnedEllipseCalibrator::default(), &data),
+            solve(MeritCircleCalibrator::default(), &data),
+            solve(TurnCompassCalibrator::default(), &data),
         ];
         for sol in solved.iter().flatten() {
             prop_assert!(sol.params.hard_iron.iter().chain(sol.params.soft_iron.iter()).all(|v| v.is_finite()));
@@ -342,12 +352,12 @@ fn duplicates_and_collinear_points_are_refused_not_panicked() {
         })
         .collect();
     for data in [&same, &line] {
-        assert!(solve(BinnedEllipseCalibrator::new(), data).is_err());
-        assert!(solve(MeritCircleCalibrator::new(), data).is_err());
-        assert!(solve(TurnCompassCalibrator::new(), data).is_err());
+        assert!(solve(BinnedEllipseCalibrator::default(), data).is_err());
+        assert!(solve(MeritCircleCalibrator::default(), data).is_err());
+        assert!(solve(TurnCompassCalibrator::default(), data).is_err());
     }
     // Repeated timestamps: the turn method needs time order and says so.
-    let mut turn_cal = TurnCompassCalibrator::new();
+    let mut turn_cal = TurnCompassCalibrator::default();
     turn_cal.push(&same[0]).unwrap();
     assert!(matches!(
         turn_cal.push(&same[0]),

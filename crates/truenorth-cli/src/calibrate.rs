@@ -13,7 +13,7 @@ use truenorth::calib::{
     TurnCompassCalibrator, quality,
 };
 use truenorth::compass::{CompassCalibration2d, CompassCalibration3d};
-use truenorth::core::{Calibrator, Mag2Sample, Mag3Sample, Quality, Solution};
+use truenorth::core::{Calibrator, CompassQuality, Mag2Sample, Mag3Sample, Solution};
 
 use crate::field::Place;
 use crate::io::{
@@ -51,21 +51,25 @@ impl Method {
 /// Arguments of `truenorth calibrate`.
 ///
 /// Input: CSV with a header row and columns `t_s,mag_x,mag_y` (plus `mag_z` for
-/// `ellipsoid`); other columns are ignored; magnetometer in any unit; `turn` also accepts `gyr_z` (rad/s), unused until the gyro half of the turn method
-/// lands. Time must increase strictly. The readings should cover a full turn (2-D, level) or
+/// `ellipsoid`); other columns are ignored; magnetometer in any unit; `turn` also accepts
+/// `gyr_z` (rad/s) and ignores it (the method calibrates the compass). Time must increase strictly. The readings should cover a full turn (2-D, level) or
 /// many orientations (3-D).
 ///
 /// Output: JSON
 /// `{"format": "truenorth-compass-calibration", "version": 1, "method": M,
 ///   "dimensions": 2|3, "hard_iron": [..], "soft_iron": [[..], ..] (row by row),
 ///   "field": F, "quality": {"points", "coverage", "residual_rms_rel", "condition",
-///   "heading_error_bound_deg", "field_magnitude", "field_ratio_to_expected"}, "input": FILE}`
+///   "heading_error_bound_deg", "heading_error_3sigma_deg", "heading_error_systematic_deg",
+///   "heading_noise_rms_deg", "field_magnitude", "field_ratio_to_expected"}, "input": FILE}`
 /// with `corrected = soft_iron · (raw − hard_iron)`, a circle (sphere) of radius `field` in
 /// the input unit. `coverage`: share of 10° heading bins (3-D: of 128 equal-area direction
 /// cells) filled; `residual_rms_rel`: RMS of |corrected|/field − 1; `condition`: condition
 /// number of the calibration's information matrix (2 = a full, even circle);
-/// `heading_error_bound_deg`: 3-sigma bound on the heading error the calibration adds (3-D:
-/// on the field direction error).
+/// `heading_error_bound_deg`: bound on the heading error the calibration adds (3-D: on the
+/// field direction error), the sum of `heading_error_3sigma_deg` (3-sigma, from the
+/// uncertainty of the fitted parameters) and `heading_error_systematic_deg` (what the
+/// method's model cannot remove, e.g. a rotated soft iron under `merit-circle` or `turn`);
+/// `heading_noise_rms_deg`: the noise of each calibrated reading, which comes on top.
 ///
 /// Exit status 1 with one line on stderr when the file is bad or the data cannot support a
 /// calibration (too few points, too little of the circle, degenerate, not an ellipse).
@@ -154,13 +158,13 @@ pub fn run(args: &Args) -> CliResult {
         )));
     }
     let file = match args.method {
-        Method::Ellipse => calibrate_2d(args, EllipseCalibrator::new())?,
-        Method::Ellipsoid => calibrate_3d(args, EllipsoidCalibrator::new())?,
-        Method::BinnedEllipse => calibrate_2d(args, BinnedEllipseCalibrator::new())?,
-        Method::MeritCircle => calibrate_2d(args, MeritCircleCalibrator::new())?,
-        // The compass half of the turn method (A.4-5); `gyr_z` is accepted and will feed the
-        // gyro half (A.1-3) when it lands.
-        Method::Turn => calibrate_2d(args, TurnCompassCalibrator::new())?,
+        Method::Ellipse => calibrate_2d(args, EllipseCalibrator::default())?,
+        Method::Ellipsoid => calibrate_3d(args, EllipsoidCalibrator::default())?,
+        Method::BinnedEllipse => calibrate_2d(args, BinnedEllipseCalibrator::default())?,
+        Method::MeritCircle => calibrate_2d(args, MeritCircleCalibrator::default())?,
+        // The compass half of the turn method (METHODS.md §A.4-5); `gyr_z` is accepted so
+        // that one recording serves both halves, and ignored here.
+        Method::Turn => calibrate_2d(args, TurnCompassCalibrator::default())?,
     };
     file.write(&args.output)
 }
@@ -183,7 +187,7 @@ fn read_2d(path: &Path) -> CliResult<Vec<Mag2Sample>> {
 /// Feeds every row to a 2-D calibrator, solves, and builds the output file.
 fn calibrate_2d<C>(args: &Args, mut cal: C) -> CliResult<CalibrationFile>
 where
-    C: Calibrator<Sample = Mag2Sample, Params = CompassCalibration2d>,
+    C: Calibrator<Sample = Mag2Sample, Params = CompassCalibration2d, Quality = CompassQuality>,
 {
     let samples = read_2d(&args.input)?;
     let sol = feed_and_solve(args, &mut cal, &samples, expected_field(args, 2)?)?;
@@ -198,7 +202,7 @@ where
 /// Feeds every row to a 3-D calibrator, solves, and builds the output file.
 fn calibrate_3d<C>(args: &Args, mut cal: C) -> CliResult<CalibrationFile>
 where
-    C: Calibrator<Sample = Mag3Sample, Params = CompassCalibration3d>,
+    C: Calibrator<Sample = Mag3Sample, Params = CompassCalibration3d, Quality = CompassQuality>,
 {
     let table = Table::read(&args.input, &["t_s", "mag_x", "mag_y", "mag_z"], &[])?;
     table.require_rows()?;
@@ -222,7 +226,7 @@ where
 
 /// Pushes the samples (a rejected one names its row) and solves; a refusal names the file
 /// and the reason.
-fn feed_and_solve<C: Calibrator>(
+fn feed_and_solve<C: Calibrator<Quality = CompassQuality>>(
     args: &Args,
     cal: &mut C,
     samples: &[C::Sample],
@@ -253,7 +257,7 @@ fn file_for<const D: usize>(
     args: &Args,
     hard_iron: &SVector<f64, D>,
     soft_iron: &SMatrix<f64, D, D>,
-    q: Quality,
+    q: CompassQuality,
 ) -> CalibrationFile {
     CalibrationFile {
         format: CALIBRATION_FORMAT.into(),

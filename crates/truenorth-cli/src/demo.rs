@@ -6,9 +6,13 @@ use truenorth::calib::{
     BinnedEllipseCalibrator, EllipseCalibrator, MeritCircleCalibrator, TurnCompassCalibrator,
 };
 use truenorth::compass::CompassCalibration2d;
-use truenorth::core::{Calibrator, Mag2Sample, VehicleSample, WheelSample, angle_diff};
-use truenorth::gyro::{GyroCalibration, YawIntegrator};
-use truenorth::odometer::{DifferentialOdometer, FixedTrack, OdometerCalibration, OdometerWheels};
+use truenorth::core::{
+    Calibrator, CompassQuality, Mag2Sample, VehicleSample, WheelSample, angle_diff,
+};
+use truenorth::gyro::{GyroCalibration, YawIntegrator, YawIntegratorConfig};
+use truenorth::odometer::{
+    DifferentialOdometer, DifferentialOdometerConfig, FixedTrack, OdometerWheels,
+};
 use truenorth_sim::{
     Route, VehicleSensorParams, VehicleTruth, scenario, simulate, vehicle_streams,
 };
@@ -220,7 +224,9 @@ fn sensor_table(d: &DemoDrive) {
             .unwrap_or_default(),
         ),
     ] {
-        let mut g = YawIntegrator::new(cal);
+        let Ok(mut g) = YawIntegrator::new(YawIntegratorConfig { calibration: cal }) else {
+            continue;
+        };
         let est: Vec<f64> = d
             .samples
             .iter()
@@ -232,7 +238,7 @@ fn sensor_table(d: &DemoDrive) {
         rows.push((name, heading_error(&d.truth, &est)));
     }
     if let Ok(mut odo) = FixedTrack::new(track_m)
-        .and_then(|t| DifferentialOdometer::new(t, OdometerCalibration::default()))
+        .and_then(|t| DifferentialOdometer::new(t, DifferentialOdometerConfig::default()))
     {
         let est: Vec<f64> = d
             .samples
@@ -278,7 +284,8 @@ fn sensor_table(d: &DemoDrive) {
     println!();
 }
 
-type Compass2dCalibrator = dyn Calibrator<Sample = Mag2Sample, Params = CompassCalibration2d>;
+type Compass2dCalibrator =
+    dyn Calibrator<Sample = Mag2Sample, Params = CompassCalibration2d, Quality = CompassQuality>;
 
 fn compass_section(d: &DemoDrive, out: &std::path::Path) -> CliResult {
     let cal_samples: Vec<Mag2Sample> = d
@@ -316,18 +323,21 @@ fn compass_section(d: &DemoDrive, out: &std::path::Path) -> CliResult {
         "(noise floor: true cal.)", floor.rms_deg, floor.max_deg, "-", "-", "-"
     );
     let mut methods: Vec<(&str, Box<Compass2dCalibrator>)> = vec![
-        ("least-squares ellipse", Box::new(EllipseCalibrator::new())),
+        (
+            "least-squares ellipse",
+            Box::new(EllipseCalibrator::default()),
+        ),
         (
             "binned ellipse (EP0634001)",
-            Box::new(BinnedEllipseCalibrator::new()),
+            Box::new(BinnedEllipseCalibrator::default()),
         ),
         (
             "merit circle (US5297063)",
-            Box::new(MeritCircleCalibrator::new()),
+            Box::new(MeritCircleCalibrator::default()),
         ),
         (
             "turn extrema (EP0640207)",
-            Box::new(TurnCompassCalibrator::new()),
+            Box::new(TurnCompassCalibrator::default()),
         ),
     ];
     let mut ls_fit: Option<(CompassCalibration2d, f64)> = None;
@@ -344,9 +354,9 @@ fn compass_section(d: &DemoDrive, out: &std::path::Path) -> CliResult {
                     name,
                     e.rms_deg,
                     e.max_deg,
-                    sol.quality.heading_error_bound_deg,
-                    sol.quality.coverage * 100.0,
-                    sol.quality.residual_rms_rel * 100.0
+                    sol.quality.heading_error_bound_deg(),
+                    sol.quality.fit.coverage * 100.0,
+                    sol.quality.fit.residual_rms_rel * 100.0
                 );
                 if ls_fit.is_none() {
                     ls_fit = Some((sol.params, sol.quality.field_magnitude));

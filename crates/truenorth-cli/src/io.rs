@@ -250,8 +250,8 @@ pub struct CalibrationFile {
 }
 
 /// The quality report as written to a calibration file: the library's
-/// [`truenorth::core::Quality`] with a number that is not finite (an unbounded condition
-/// or error bound) written as `null`, since JSON has no infinity.
+/// [`truenorth::core::CompassQuality`], flattened, with a number that is not finite (an
+/// unbounded condition or error bound) written as `null`, since JSON has no infinity.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct QualityReport {
     /// Samples used in the solve.
@@ -262,23 +262,39 @@ pub struct QualityReport {
     pub residual_rms_rel: Option<f64>,
     /// Condition number of the calibration's information matrix.
     pub condition: Option<f64>,
-    /// 3-sigma bound on the heading (3-D: field direction) error the calibration adds, degrees.
+    /// Bound on the heading (3-D: field direction) error the calibration itself adds,
+    /// degrees: `heading_error_3sigma_deg + heading_error_systematic_deg`. Per-reading
+    /// noise (`heading_noise_rms_deg`) comes on top.
     pub heading_error_bound_deg: Option<f64>,
+    /// Three standard deviations of the heading error from the uncertainty of the fitted
+    /// parameters, degrees.
+    #[serde(default)]
+    pub heading_error_3sigma_deg: Option<f64>,
+    /// Heading error the method's model leaves whatever the data (e.g. a rotated soft iron
+    /// under a circle-only method), degrees.
+    #[serde(default)]
+    pub heading_error_systematic_deg: Option<f64>,
+    /// RMS heading noise of one calibrated reading, from the residuals, degrees.
+    #[serde(default)]
+    pub heading_noise_rms_deg: Option<f64>,
     /// Fitted field, input unit.
     pub field_magnitude: Option<f64>,
     /// Fitted field over the expected one, if `--expected-field` was given.
     pub field_ratio_to_expected: Option<f64>,
 }
 
-impl From<truenorth::core::Quality> for QualityReport {
-    fn from(q: truenorth::core::Quality) -> Self {
+impl From<truenorth::core::CompassQuality> for QualityReport {
+    fn from(q: truenorth::core::CompassQuality) -> Self {
         let finite = |v: f64| v.is_finite().then_some(v);
         Self {
-            points: q.points,
-            coverage: q.coverage,
-            residual_rms_rel: finite(q.residual_rms_rel),
-            condition: finite(q.condition),
-            heading_error_bound_deg: finite(q.heading_error_bound_deg),
+            points: q.fit.points,
+            coverage: q.fit.coverage,
+            residual_rms_rel: finite(q.fit.residual_rms_rel),
+            condition: finite(q.fit.condition),
+            heading_error_bound_deg: finite(q.heading_error_bound_deg()),
+            heading_error_3sigma_deg: finite(q.heading_error_3sigma_deg),
+            heading_error_systematic_deg: finite(q.heading_error_systematic_deg),
+            heading_noise_rms_deg: finite(q.heading_noise_rms_deg),
             field_magnitude: finite(q.field_magnitude),
             field_ratio_to_expected: q.field_ratio_to_expected.and_then(finite),
         }

@@ -3,10 +3,11 @@
 use nalgebra::{Matrix2, Matrix3, Vector2, Vector3};
 use serde::{Deserialize, Serialize};
 use truenorth_core::{
-    AbsoluteHeadingSource, Calibration, Mag2Sample, MagneticHeading, Result, Tilt, check_finite2,
+    AbsoluteHeading, AbsoluteHeadingSource, Calibration, Error, Mag2Sample, Mag3Sample,
+    MagneticHeading, Result, Tilt, check_finite, check_finite2, check_finite3,
 };
 
-use crate::tilt_compensated_heading;
+use crate::{level_field, tilt_compensated_heading};
 
 #[allow(unused_imports)]
 use truenorth_core::Float as _;
@@ -70,17 +71,56 @@ impl Calibration for CompassCalibration2d {
     type Raw = Vector2<f64>;
     type Physical = Vector2<f64>;
 
-    fn apply(&self, raw: &Vector2<f64>) -> Vector2<f64> {
-        self.correct(raw)
+    /// Refuses a non-finite reading, and parameters that are not finite or whose soft iron
+    /// is singular or reflecting (it would give constant or mirrored headings).
+    fn apply(&self, raw: &Vector2<f64>) -> Result<Vector2<f64>> {
+        check_finite2("magnetometer reading", raw)?;
+        check_finite2("hard iron", &self.hard_iron)?;
+        check_soft_iron_det(self.soft_iron.iter(), self.soft_iron.determinant())?;
+        Ok(self.correct(raw))
     }
 }
+
+/// Tilts below this (radians) count as level for a two-axis compass: 0.01° keeps the
+/// heading error of ignoring them under 2·10⁻⁴ rad even at a 70° dip.
+const LEVEL_TILT_RAD: f64 = 1.745e-4;
 
 impl AbsoluteHeadingSource for CompassCalibration2d {
     type Sample = Mag2Sample;
 
-    fn heading_rad(&self, sample: &Mag2Sample) -> Result<f64> {
-        check_finite2("magnetometer reading", &sample.mag)?;
-        Ok(CompassCalibration2d::heading_rad(self, &sample.mag))
+    /// A two-axis compass cannot compensate tilt: a tilt beyond 0.01° is refused with
+    /// [`Error::Unsupported`] rather than silently ignored.
+    fn heading(&self, sample: &Mag2Sample, tilt: Option<&Tilt>) -> Result<AbsoluteHeading> {
+        if let Some(t) = tilt {
+            check_finite("pitch", t.pitch_rad)?;
+            check_finite("roll", t.roll_rad)?;
+            if t.pitch_rad.abs() > LEVEL_TILT_RAD || t.roll_rad.abs() > LEVEL_TILT_RAD {
+                return Err(Error::Unsupported {
+                    reason: "a two-axis compass cannot compensate tilt; use a three-axis magnetometer (CompassCalibration3d) or pass no tilt to assume level",
+                });
+            }
+        }
+        let h = self.apply(&sample.mag)?;
+        Ok(AbsoluteHeading {
+            heading: MagneticHeading::new(heading_from_horizontal(&h)),
+            field_norm: h.norm(),
+            dip_rad: None,
+        })
+    }
+}
+
+/// Refuses soft-iron entries that are not finite and a determinant that is not positive: a
+/// singular matrix collapses every reading onto a line, a negative one mirrors the heading.
+fn check_soft_iron_det<'a>(entries: impl Iterator<Item = &'a f64>, det: f64) -> Result<()> {
+    for v in entries {
+        check_finite("soft iron entry", *v)?;
+    }
+    if det > 0.0 {
+        Ok(())
+    } else {
+        Err(Error::Degenerate {
+            reason: "the soft-iron matrix is singular or reflecting (determinant not positive); recalibrate",
+        })
     }
 }
 
@@ -135,8 +175,32 @@ impl Calibration for CompassCalibration3d {
     type Raw = Vector3<f64>;
     type Physical = Vector3<f64>;
 
-    fn apply(&self, raw: &Vector3<f64>) -> Vector3<f64> {
-        self.correct(raw)
+    /// Refuses a non-finite reading, and parameters that are not finite or whose soft iron
+    /// is singular or reflecting.
+    fn apply(&self, raw: &Vector3<f64>) -> Result<Vector3<f64>> {
+        check_finite3("magnetometer reading", raw)?;
+        check_finite3("hard iron", &self.hard_iron)?;
+        check_soft_iron_det(self.soft_iron.iter(), self.soft_iron.determinant())?;
+        Ok(self.correct(raw))
+    }
+}
+
+impl AbsoluteHeadingSource for CompassCalibration3d {
+    type Sample = Mag3Sample;
+
+    /// Tilt-compensated heading; `None` assumes a level body. The dip is measured in the
+    /// levelled frame, positive with the field pointing below the horizontal.
+    fn heading(&self, sample: &Mag3Sample, tilt: Option<&Tilt>) -> Result<AbsoluteHeading> {
+        let level = Tilt::default();
+        let tilt = tilt.unwrap_or(&level);
+        check_finite("pitch", tilt.pitch_rad)?;
+        check_finite("roll", tilt.roll_rad)?;
+        let m = level_field(&self.apply(&sample.mag)?, tilt);
+        Ok(AbsoluteHeading {
+            heading: MagneticHeading::new(heading_from_horizontal(&m.xy())),
+            field_norm: m.norm(),
+            dip_rad: Some(m.z.atan2(m.xy().norm())),
+        })
     }
 }
 

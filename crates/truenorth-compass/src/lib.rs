@@ -45,7 +45,7 @@
 //!     0.0,                                                // no noise
 //! )?;
 //! let truth = HeadingTruth { heading_rad: 1.0, horizontal_field: 20.0 };
-//! let raw = model.ideal(&truth);
+//! let raw = model.ideal(&truth)?;
 //! let heading = model.true_calibration().heading_rad(&raw);
 //! assert!((heading - 1.0).abs() < 1e-9);
 //! # Ok::<(), truenorth_core::Error>(())

@@ -27,6 +27,11 @@ impl HeadingTruth {
         let (s, c) = self.heading_rad.sin_cos();
         Vector2::new(self.horizontal_field * c, -self.horizontal_field * s)
     }
+
+    fn check(&self) -> Result<()> {
+        check_finite("true heading", self.heading_rad)?;
+        check_finite("true horizontal field", self.horizontal_field).map(drop)
+    }
 }
 
 /// A level two-axis magnetometer: `raw = soft_iron · (b + d(t)) + hard_iron + n`, with `b` the
@@ -142,28 +147,31 @@ impl SensorModel for MagnetometerModel2d {
     type Truth = HeadingTruth;
     type Reading = Vector2<f64>;
 
-    fn ideal(&self, truth: &HeadingTruth) -> Vector2<f64> {
-        self.distort(&truth.body_field())
+    fn ideal(&self, truth: &HeadingTruth) -> Result<Vector2<f64>> {
+        truth.check()?;
+        Ok(self.distort(&truth.body_field()))
     }
 
-    /// Advances model time by `dt_s` (a non-finite or negative step counts as 0), then reads
-    /// the earth field plus any disturbance active at the new time, plus noise.
+    /// Advances model time by `dt_s` (zero is allowed: a second reading at the same
+    /// instant), then reads the earth field plus any disturbance active at the new time,
+    /// plus noise. A non-finite truth or a negative or non-finite `dt_s` is an error and
+    /// leaves the model time unchanged.
     fn sample(
         &mut self,
         truth: &HeadingTruth,
         dt_s: f64,
         noise: &mut dyn NoiseSource,
-    ) -> Vector2<f64> {
-        if dt_s.is_finite() && dt_s > 0.0 {
-            self.t_s += dt_s;
-        }
+    ) -> Result<Vector2<f64>> {
+        truth.check()?;
+        check_range("time step dt_s", dt_s, 0.0, f64::MAX)?;
+        self.t_s += dt_s;
         let d = self.disturbances.field_at(self.t_s);
         let body = truth.body_field() + ned_to_level_body(d.x, d.y, truth.heading_rad);
         let n = Vector2::new(
             noise.normal(self.noise_sigma),
             noise.normal(self.noise_sigma),
         );
-        self.distort(&body) + n
+        Ok(self.distort(&body) + n)
     }
 }
 
@@ -193,9 +201,9 @@ mod tests {
             let m = MagnetometerModel2d::new(Vector2::new(hx, hy), s, 0.0).unwrap();
             let truth = HeadingTruth { heading_rad: heading, horizontal_field: h };
             let cal = m.true_calibration();
-            let back = cal.correct(&m.ideal(&truth));
+            let back = cal.correct(&m.ideal(&truth).unwrap());
             prop_assert!((back - truth.body_field()).norm() < 1e-9 * h.max(1.0));
-            prop_assert!(angle_diff(cal.heading_rad(&m.ideal(&truth)), heading).abs() < 1e-9);
+            prop_assert!(angle_diff(cal.heading_rad(&m.ideal(&truth).unwrap()), heading).abs() < 1e-9);
         }
 
         #[test]
@@ -203,7 +211,7 @@ mod tests {
             let mut m = MagnetometerModel2d::new(
                 Vector2::new(3.0, -2.0), soft_iron_from_axes(1.3, 1.0, 0.5), 0.5).unwrap();
             let truth = HeadingTruth { heading_rad: heading, horizontal_field: 20.0 };
-            prop_assert_eq!(m.sample(&truth, dt, &mut ZeroNoise), m.ideal(&truth));
+            prop_assert_eq!(m.sample(&truth, dt, &mut ZeroNoise).unwrap(), m.ideal(&truth).unwrap());
         }
     }
 
@@ -214,11 +222,11 @@ mod tests {
             heading_rad: 0.4,
             horizontal_field: 10.0,
         };
-        let ideal = m.ideal(&truth);
+        let ideal = m.ideal(&truth).unwrap();
         let mut rng = SplitMix64::new(3);
         let n = 20_000;
         let ss: f64 = (0..n)
-            .map(|_| (m.sample(&truth, 0.01, &mut rng) - ideal).norm_squared())
+            .map(|_| (m.sample(&truth, 0.01, &mut rng).unwrap() - ideal).norm_squared())
             .sum();
         let sigma = (ss / (2.0 * n as f64)).sqrt();
         assert!((sigma - 0.3).abs() < 0.01, "{sigma}");
@@ -241,9 +249,9 @@ mod tests {
             heading_rad: core::f64::consts::FRAC_PI_2,
             horizontal_field: 10.0,
         };
-        let before = m.sample(&truth, 0.5, &mut ZeroNoise);
-        let during = m.sample(&truth, 1.0, &mut ZeroNoise);
-        let after = m.sample(&truth, 1.0, &mut ZeroNoise);
+        let before = m.sample(&truth, 0.5, &mut ZeroNoise).unwrap();
+        let during = m.sample(&truth, 1.0, &mut ZeroNoise).unwrap();
+        let after = m.sample(&truth, 1.0, &mut ZeroNoise).unwrap();
         assert!((during - before - Vector2::new(5.0, 0.0)).norm() < 1e-9);
         assert!((after - before).norm() < 1e-12);
         assert_eq!(m.time_s(), 2.5);

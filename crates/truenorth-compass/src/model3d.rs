@@ -10,6 +10,7 @@ use truenorth_core::{
 
 use crate::model2d::check_noise;
 use crate::{CompassCalibration3d, Disturbance, Disturbances};
+use truenorth_core::check_range;
 
 #[allow(unused_imports)]
 use truenorth_core::Float as _;
@@ -36,6 +37,13 @@ impl AttitudeTruth {
     /// The undistorted field in body axes, `Rᵀ · field_ned`.
     pub fn body_field(&self) -> Vector3<f64> {
         ned_to_body(&self.attitude, &self.field_ned)
+    }
+
+    fn check(&self) -> Result<()> {
+        check_finite("true yaw", self.attitude.yaw_rad)?;
+        check_finite("true pitch", self.attitude.pitch_rad)?;
+        check_finite("true roll", self.attitude.roll_rad)?;
+        check_finite3("true field", &self.field_ned)
     }
 }
 
@@ -140,26 +148,29 @@ impl SensorModel for MagnetometerModel3d {
     type Truth = AttitudeTruth;
     type Reading = Vector3<f64>;
 
-    fn ideal(&self, truth: &AttitudeTruth) -> Vector3<f64> {
-        self.soft_iron * truth.body_field() + self.hard_iron
+    fn ideal(&self, truth: &AttitudeTruth) -> Result<Vector3<f64>> {
+        truth.check()?;
+        Ok(self.soft_iron * truth.body_field() + self.hard_iron)
     }
 
-    /// Advances model time by `dt_s` (a non-finite or negative step counts as 0), then reads
-    /// the earth field plus any disturbance active at the new time, plus noise.
+    /// Advances model time by `dt_s` (zero is allowed: a second reading at the same
+    /// instant), then reads the earth field plus any disturbance active at the new time,
+    /// plus noise. A non-finite truth or a negative or non-finite `dt_s` is an error and
+    /// leaves the model time unchanged.
     fn sample(
         &mut self,
         truth: &AttitudeTruth,
         dt_s: f64,
         noise: &mut dyn NoiseSource,
-    ) -> Vector3<f64> {
-        if dt_s.is_finite() && dt_s > 0.0 {
-            self.t_s += dt_s;
-        }
+    ) -> Result<Vector3<f64>> {
+        truth.check()?;
+        check_range("time step dt_s", dt_s, 0.0, f64::MAX)?;
+        self.t_s += dt_s;
         let total = truth.field_ned + self.disturbances.field_at(self.t_s);
         let body = ned_to_body(&truth.attitude, &total);
         let s = self.noise_sigma;
         let n = Vector3::new(noise.normal(s), noise.normal(s), noise.normal(s));
-        self.soft_iron * body + self.hard_iron + n
+        Ok(self.soft_iron * body + self.hard_iron + n)
     }
 }
 
@@ -189,7 +200,7 @@ mod tests {
                 attitude: EulerZyx { yaw_rad: yaw, pitch_rad: pitch, roll_rad: roll },
                 field_ned: earth_field_ned(total, incl),
             };
-            let back = m.true_calibration().correct(&m.ideal(&truth));
+            let back = m.true_calibration().correct(&m.ideal(&truth).unwrap());
             prop_assert!((back - truth.body_field()).norm() < 1e-9 * total);
             prop_assert!((back.norm() - total).abs() < 1e-9 * total);
         }
@@ -237,10 +248,10 @@ mod tests {
             attitude: EulerZyx::default(),
             field_ned: earth_field_ned(30.0, 1.0),
         };
-        let peak = m.sample(&truth, 1.0, &mut ZeroNoise);
-        assert!((peak - m.ideal(&truth) - Vector3::new(0.0, 0.0, 7.0)).norm() < 1e-9);
-        let after = m.sample(&truth, 1.5, &mut ZeroNoise);
-        assert!((after - m.ideal(&truth)).norm() < 1e-12);
+        let peak = m.sample(&truth, 1.0, &mut ZeroNoise).unwrap();
+        assert!((peak - m.ideal(&truth).unwrap() - Vector3::new(0.0, 0.0, 7.0)).norm() < 1e-9);
+        let after = m.sample(&truth, 1.5, &mut ZeroNoise).unwrap();
+        assert!((after - m.ideal(&truth).unwrap()).norm() < 1e-12);
     }
 
     #[test]

@@ -316,7 +316,7 @@ mod tests {
             let h = 20.0;
             let m = MagnetometerModel2d::new(Vector2::new(hx, hy), soft_iron_from_axes(g1, g2, alpha), 0.0).unwrap();
             let p = EllipsePhasors::new(Vector2::new(hx, hy), alpha, (g1 - g2) / (g1 + g2), h * (g1 + g2) / 2.0).unwrap();
-            let raw = m.ideal(&HeadingTruth { heading_rad: heading, horizontal_field: h });
+            let raw = m.ideal(&HeadingTruth { heading_rad: heading, horizontal_field: h }).unwrap();
             prop_assert!((p.sensed_at_heading(heading) - raw).norm() < 1e-9 * h);
         }
     }

@@ -1,19 +1,43 @@
 //! Calibration (raw → physical, given parameters) and calibrators (samples → parameters plus
 //! a report on how far those parameters can be trusted).
+//!
+//! A [`Calibrator`] learns from samples pushed one at a time and is asked for a solution with
+//! [`Calibrator::solve`], which takes `&self`: asking never changes what the calibrator has
+//! learned, so an estimator can poll it while it keeps learning. Calibrators that keep a
+//! current estimate as they go also implement [`OnlineCalibrator`], whose
+//! [`OnlineCalibrator::estimate`] costs O(1); [`Calibrator::push`] says with
+//! [`Pushed::NewEstimate`] when that estimate changed.
 
 use serde::{Deserialize, Serialize};
 
 use crate::Result;
 
 /// A calibration: turns a raw reading into a physical quantity using stored parameters.
+///
+/// Fallible because parameters are plain data a user may have loaded from disk (a zero
+/// scale, a singular soft iron) and readings may be non-finite: both are typed errors, never
+/// NaN outputs.
 pub trait Calibration {
     /// The raw reading.
     type Raw;
     /// The calibrated quantity.
     type Physical;
 
-    /// Applies the calibration.
-    fn apply(&self, raw: &Self::Raw) -> Self::Physical;
+    /// Applies the calibration, or says why the reading or the parameters cannot be used.
+    fn apply(&self, raw: &Self::Raw) -> Result<Self::Physical>;
+}
+
+/// What a [`Calibrator::push`] did with a sample.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Pushed {
+    /// The sample was valid but not used (e.g. too close to the previous one, or outside the
+    /// conditions the method learns in).
+    Ignored,
+    /// The sample was used; the current estimate, if any, is unchanged.
+    Accepted,
+    /// The sample was used and the current estimate changed (see
+    /// [`OnlineCalibrator::estimate`]).
+    NewEstimate,
 }
 
 /// How far a calibrator has got.
@@ -23,37 +47,79 @@ pub struct Progress {
     pub samples: usize,
     /// Share of the needed excitation seen so far, in [0, 1] (e.g. heading bins filled).
     pub coverage: f64,
-    /// Whether `solve` would be expected to succeed now.
+    /// `true` exactly when [`Calibrator::solve`] would succeed now: every calibrator
+    /// computes it from the same tests `solve` applies, so the two never disagree.
     pub ready: bool,
 }
 
-/// How good a calibration is. Every solve returns one, so a poor calibration is visible.
+/// How well a fit is determined, for every calibrator family.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
-pub struct Quality {
+pub struct FitQuality {
     /// Samples used in the solve.
     pub points: usize,
-    /// Share of heading (or direction) bins that hold data, in [0, 1].
+    /// Share of the needed excitation the samples cover, in [0, 1] (e.g. of the heading
+    /// circle, of the sphere's directions, of the speed range).
     pub coverage: f64,
-    /// RMS of the residuals divided by the fitted field magnitude (dimensionless).
+    /// RMS of the residuals divided by the size of the fitted quantity (dimensionless;
+    /// for a compass, relative to the fitted field).
     pub residual_rms_rel: f64,
-    /// Condition number of the solve (large = poorly determined).
+    /// Condition number of the solve's information matrix (1 is ideal; large means some
+    /// combination of parameters is poorly determined).
     pub condition: f64,
-    /// Predicted bound on the heading error from the residuals and coverage, degrees.
-    pub heading_error_bound_deg: f64,
-    /// Fitted field magnitude, in the input unit.
+}
+
+/// How good a compass calibration is.
+///
+/// Heading error has three parts, reported apart so none is mistaken for another:
+/// the uncertainty of the fitted parameters (`heading_error_3sigma_deg`), the error the
+/// method's model cannot remove whatever the data (`heading_error_systematic_deg`, e.g. a
+/// rotated soft iron under a circle-only method), and the noise of each reading, which no
+/// calibration removes (`heading_noise_rms_deg`).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct CompassQuality {
+    /// What every calibrator reports.
+    pub fit: FitQuality,
+    /// Three standard deviations of the heading error caused by the uncertainty of the
+    /// fitted parameters, worst over heading, degrees. Excludes per-reading noise.
+    pub heading_error_3sigma_deg: f64,
+    /// Largest heading error the method's model leaves in place even with perfect data,
+    /// degrees (0 when the model can represent the distortion it was given).
+    pub heading_error_systematic_deg: f64,
+    /// RMS heading noise of a single calibrated reading, estimated from the residuals,
+    /// degrees. Averaging readings reduces it; recalibrating does not.
+    pub heading_noise_rms_deg: f64,
+    /// Fitted field magnitude (horizontal for 2-D, total for 3-D), in the input unit.
     pub field_magnitude: f64,
     /// Fitted field magnitude divided by the expected one (from a geomagnetic model), if
     /// one was supplied. Far from 1 means a disturbed site or wrong units.
     pub field_ratio_to_expected: Option<f64>,
 }
 
+impl CompassQuality {
+    /// Bound on the heading error of the calibration itself, degrees: the 3σ parameter
+    /// uncertainty plus the systematic part. Per-reading noise comes on top.
+    pub fn heading_error_bound_deg(&self) -> f64 {
+        self.heading_error_3sigma_deg + self.heading_error_systematic_deg
+    }
+}
+
+/// How good the calibration of one scalar coefficient is (a gyro bias or scale, an odometer
+/// wheel scale, the speed coefficient `a`).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct ScalarQuality {
+    /// What every calibrator reports.
+    pub fit: FitQuality,
+    /// One standard deviation of the estimate, in the coefficient's own unit.
+    pub sigma: f64,
+}
+
 /// The result of a successful solve.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct Solution<P> {
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Solution<P, Q = CompassQuality> {
     /// The calibration parameters.
     pub params: P,
     /// How far they can be trusted.
-    pub quality: Quality,
+    pub quality: Q,
 }
 
 /// A calibrator: fed samples one at a time, solved for parameters when enough were seen.
@@ -65,16 +131,49 @@ pub trait Calibrator {
     type Sample;
     /// The parameters it produces.
     type Params;
+    /// The quality report of its family ([`CompassQuality`], [`ScalarQuality`], …).
+    type Quality;
 
-    /// Feeds one sample. Non-finite samples are rejected with a typed error and ignored.
-    fn push(&mut self, sample: &Self::Sample) -> Result<()>;
+    /// Feeds one sample. Non-finite samples are rejected with a typed error and change
+    /// nothing.
+    fn push(&mut self, sample: &Self::Sample) -> Result<Pushed>;
 
-    /// How far the calibrator has got.
+    /// How far the calibrator has got. `progress().ready` is `true` exactly when
+    /// [`Calibrator::solve`] would succeed.
     fn progress(&self) -> Progress;
 
-    /// Solves for the parameters, or says why the data cannot support a calibration.
-    fn solve(&mut self) -> Result<Solution<Self::Params>>;
+    /// Solves for the parameters from everything learned so far, or says why the data
+    /// cannot support a calibration. Does not change the calibrator.
+    fn solve(&self) -> Result<Solution<Self::Params, Self::Quality>>;
 
-    /// Forgets all samples.
+    /// Forgets all samples (the configuration stays).
     fn reset(&mut self);
+}
+
+/// A calibrator that keeps a current estimate as samples arrive.
+pub trait OnlineCalibrator: Calibrator {
+    /// The current estimate, if the calibrator has one: O(1), no allocation. It is the
+    /// result of the latest refresh, which [`Calibrator::push`] announces with
+    /// [`Pushed::NewEstimate`].
+    fn estimate(&self) -> Option<Solution<Self::Params, Self::Quality>>;
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    proptest! {
+        #[test]
+        fn heading_bound_is_uncertainty_plus_systematic(a in 0.0f64..90.0, b in 0.0f64..90.0, n in 0.0f64..10.0) {
+            let q = CompassQuality {
+                heading_error_3sigma_deg: a,
+                heading_error_systematic_deg: b,
+                heading_noise_rms_deg: n,
+                ..Default::default()
+            };
+            // Per-reading noise is reported apart and never enters the calibration's bound.
+            prop_assert_eq!(q.heading_error_bound_deg(), a + b);
+        }
+    }
 }

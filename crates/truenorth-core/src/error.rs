@@ -128,4 +128,27 @@ pub enum Error {
         /// What to do.
         hint: &'static str,
     },
+    /// A saved state was written by another layout version.
+    #[error(
+        "the snapshot has layout version {found}, this build reads version {expected}; recalibrate or restore with the version that wrote it"
+    )]
+    SnapshotVersion {
+        /// Version found in the snapshot.
+        found: u32,
+        /// Version this build reads.
+        expected: u32,
+    },
+    /// A saved state or stored parameter set is internally inconsistent.
+    #[error("invalid saved state: {reason}")]
+    InvalidSnapshot {
+        /// What was wrong.
+        reason: &'static str,
+    },
+    /// The operation needs something this sensor or method does not have (e.g. tilt
+    /// compensation with a two-axis compass).
+    #[error("not supported: {reason}")]
+    Unsupported {
+        /// What is missing and what to use instead.
+        reason: &'static str,
+    },
 }

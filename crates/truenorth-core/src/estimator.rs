@@ -1,43 +1,125 @@
 //! Estimators: IMU samples → attitude, and vehicle streams → heading and position.
+//!
+//! Both kinds return a full estimate from every `update` — the state, its uncertainty and
+//! what the estimator currently believes about its sensors (biases, rest, disturbances) —
+//! so that a caller can log, gate or fuse it without reaching into the estimator.
 
-use nalgebra::UnitQuaternion;
+use nalgebra::{Matrix2, UnitQuaternion, Vector3};
 use serde::{Deserialize, Serialize};
 
-use crate::{ImuSample, Result, VehicleSample};
+use crate::{ImuSample, MagneticHeading, Result, VehicleSample};
+
+/// What an orientation estimator currently believes about its inputs.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct AttitudeStatus {
+    /// The sensor is judged to be at rest (gyro bias is being learned from it).
+    pub at_rest: bool,
+    /// The accelerometer was used to correct inclination at this sample (not rejected as
+    /// disturbed by acceleration).
+    pub accel_used: bool,
+    /// The magnetometer was used to correct heading at this sample.
+    pub mag_used: bool,
+    /// The magnetic field is judged disturbed (norm or dip off the learned values); heading
+    /// runs on the gyro alone meanwhile.
+    pub mag_disturbed: bool,
+    /// The estimator is re-estimating the magnetometer's hard iron.
+    pub mag_calibrating: bool,
+}
+
+/// An orientation estimate.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct AttitudeEstimate {
+    /// Timestamp of the last sample, seconds.
+    pub t_s: f64,
+    /// Best attitude, body → reference (NED), using the magnetometer when one is present
+    /// and trusted (9-D).
+    pub attitude: UnitQuaternion<f64>,
+    /// Attitude from gyro and accelerometer only (6-D): inclination as good as `attitude`,
+    /// heading relative to the start and drifting with the uncorrected gyro bias.
+    pub attitude_6d: UnitQuaternion<f64>,
+    /// Estimated gyro bias, rad/s, body axes (subtracted from the raw rates).
+    pub gyro_bias_rps: Vector3<f64>,
+    /// One standard deviation of the attitude error about the reference x, y, z axes
+    /// (roll, pitch, heading), radians; `None` when the estimator does not model it.
+    pub sigma_rad: Option<Vector3<f64>>,
+    /// Rest and disturbance flags.
+    pub status: AttitudeStatus,
+}
+
+impl AttitudeEstimate {
+    /// The estimate before any sample: level, heading north, no bias.
+    pub fn initial(attitude: UnitQuaternion<f64>) -> Self {
+        Self {
+            t_s: f64::NAN,
+            attitude,
+            attitude_6d: attitude,
+            gyro_bias_rps: Vector3::zeros(),
+            sigma_rad: None,
+            status: AttitudeStatus::default(),
+        }
+    }
+}
 
 /// An orientation estimator. Every seed method and modern filter implements it, so tests,
 /// benches, the CLI and the evaluation harness take any of them.
 pub trait OrientationEstimator {
-    /// Takes one sample (dt from its timestamp) and returns the new body → NED attitude.
-    fn update(&mut self, sample: &ImuSample) -> Result<UnitQuaternion<f64>>;
+    /// Takes one sample (dt from its timestamp; a non-increasing timestamp is an error and
+    /// changes nothing) and returns the new estimate.
+    fn update(&mut self, sample: &ImuSample) -> Result<AttitudeEstimate>;
 
-    /// The current attitude estimate, body → NED.
-    fn orientation(&self) -> UnitQuaternion<f64>;
+    /// The current estimate, without changing anything.
+    fn estimate(&self) -> AttitudeEstimate;
 
     /// Returns to the initial state.
     fn reset(&mut self);
 }
 
-/// Position and heading of a land vehicle relative to its start point.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
-pub struct NavState {
+/// Position, heading and speed of a land vehicle relative to its start point, with their
+/// uncertainty.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct NavEstimate {
     /// Timestamp, seconds.
     pub t_s: f64,
     /// Northward displacement from the start, metres.
     pub north_m: f64,
     /// Eastward displacement from the start, metres.
     pub east_m: f64,
-    /// Heading, radians clockwise from north, (-π, π].
-    pub heading_rad: f64,
+    /// Heading from magnetic north (add the declination for true north).
+    pub heading: MagneticHeading,
+    /// One standard deviation of the heading, radians.
+    pub heading_sigma_rad: f64,
+    /// Covariance of (north, east), m².
+    pub position_cov_m2: Matrix2<f64>,
+    /// Speed along the track, m/s.
+    pub speed_mps: f64,
+    /// Distance travelled since the start, metres.
+    pub distance_m: f64,
+}
+
+impl NavEstimate {
+    /// At the start point with the given heading and its uncertainty, at rest.
+    pub fn at_start(t_s: f64, heading: MagneticHeading, heading_sigma_rad: f64) -> Self {
+        Self {
+            t_s,
+            north_m: 0.0,
+            east_m: 0.0,
+            heading,
+            heading_sigma_rad,
+            position_cov_m2: Matrix2::zeros(),
+            speed_mps: 0.0,
+            distance_m: 0.0,
+        }
+    }
 }
 
 /// A vehicle heading / dead-reckoning estimator.
 pub trait HeadingEstimator {
-    /// Takes one sample and returns the new state.
-    fn update(&mut self, sample: &VehicleSample) -> Result<NavState>;
+    /// Takes one sample (a non-increasing timestamp is an error and changes nothing) and
+    /// returns the new estimate.
+    fn update(&mut self, sample: &VehicleSample) -> Result<NavEstimate>;
 
-    /// The current state.
-    fn state(&self) -> NavState;
+    /// The current estimate, without changing anything.
+    fn estimate(&self) -> NavEstimate;
 
     /// Returns to the initial state.
     fn reset(&mut self);

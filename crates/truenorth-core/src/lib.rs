@@ -32,6 +32,7 @@ mod estimator;
 mod heading;
 mod heading_source;
 mod noise;
+mod persist;
 mod sample;
 mod sensor_model;
 mod units;
@@ -39,19 +40,28 @@ mod validate;
 
 pub use angle::{Unwrapper, angle_diff, unwrap_near, wrap_pi, wrap_two_pi};
 pub use attitude::{EulerZyx, Tilt};
-pub use calibrator::{Calibration, Calibrator, Progress, Quality, Solution};
+pub use calibrator::{
+    Calibration, Calibrator, CompassQuality, FitQuality, OnlineCalibrator, Progress, Pushed,
+    ScalarQuality, Solution,
+};
 pub use error::Error;
-pub use estimator::{HeadingEstimator, NavState, OrientationEstimator};
+pub use estimator::{
+    AttitudeEstimate, AttitudeStatus, HeadingEstimator, NavEstimate, OrientationEstimator,
+};
 pub use heading::{Declination, MagneticHeading, TrueHeading};
-pub use heading_source::{AbsoluteHeadingSource, RelativeHeadingSource};
+pub use heading_source::{
+    AbsoluteHeading, AbsoluteHeadingSource, RelativeHeadingSource, RelativeStep,
+};
 pub use noise::{NoiseSource, SplitMix64, ZeroNoise};
+pub use persist::{Persistent, Snapshot, check_snapshot_version};
 pub use sample::{
-    AccelSample, GyroSample, ImuSample, Mag2Sample, Mag3Sample, VehicleSample, WheelSample,
+    AccelSample, Axes, GyroSample, ImuSample, Mag2Sample, Mag3Sample, VehicleSample, WheelSample,
 };
 pub use sensor_model::SensorModel;
 pub use units::{STANDARD_GRAVITY_MPS2, deg_to_rad, mph_to_mps, mps_to_mph, rad_to_deg};
 pub use validate::{
-    TimeStep, check_dt, check_finite, check_finite2, check_finite3, check_positive, check_range,
+    TimeStep, Validate, check_dt, check_finite, check_finite2, check_finite3, check_positive,
+    check_range,
 };
 
 /// Float methods (`sin`, `sqrt`, `atan2`, …) for `f64` that work with and without `std`.

@@ -4,6 +4,8 @@
 use nalgebra::{Vector2, Vector3};
 use serde::{Deserialize, Serialize};
 
+use crate::{Result, check_finite};
+
 /// A two-axis magnetometer reading (any unit; calibration removes it).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Mag2Sample {
@@ -23,6 +25,12 @@ pub struct Mag3Sample {
 }
 
 /// A three-axis rate-gyro reading.
+///
+/// **Sample convention** (shared by the simulator and every integrator in truenorth): the
+/// rate is the instantaneous angular rate at `t_s`, as a MEMS gyro's filtered output
+/// approximates it, not the mean over the preceding interval. Integrators therefore use the
+/// trapezoid rule between consecutive samples, which is exact for a rate that changes
+/// linearly between them.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct GyroSample {
     /// Timestamp, seconds.
@@ -40,17 +48,130 @@ pub struct AccelSample {
     pub acc_mps2: Vector3<f64>,
 }
 
-/// One IMU sample: gyro and accelerometer, optionally a magnetometer.
+/// The readings of up to three sensors on the body axes x, y, z, any of which may be absent:
+/// a two-axis magnetometer (x, y), the two accelerometers and two gyros of a reduced
+/// orientation detector (WO 00/36376 §E.10), or a full triad.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct Axes {
+    /// Reading on the body x axis, if that sensor is fitted.
+    pub x: Option<f64>,
+    /// Reading on the body y axis, if that sensor is fitted.
+    pub y: Option<f64>,
+    /// Reading on the body z axis, if that sensor is fitted.
+    pub z: Option<f64>,
+}
+
+impl Axes {
+    /// No sensor on any axis.
+    pub const NONE: Self = Self {
+        x: None,
+        y: None,
+        z: None,
+    };
+
+    /// All three axes.
+    pub fn xyz(v: Vector3<f64>) -> Self {
+        Self {
+            x: Some(v.x),
+            y: Some(v.y),
+            z: Some(v.z),
+        }
+    }
+
+    /// The x and y axes only (a two-axis magnetometer or accelerometer).
+    pub fn xy(v: Vector2<f64>) -> Self {
+        Self {
+            x: Some(v.x),
+            y: Some(v.y),
+            z: None,
+        }
+    }
+
+    /// The three readings, if all three axes are present.
+    pub fn as_xyz(&self) -> Option<Vector3<f64>> {
+        Some(Vector3::new(self.x?, self.y?, self.z?))
+    }
+
+    /// The x and y readings, if both are present.
+    pub fn as_xy(&self) -> Option<Vector2<f64>> {
+        Some(Vector2::new(self.x?, self.y?))
+    }
+
+    /// How many axes are present.
+    pub fn count(&self) -> usize {
+        usize::from(self.x.is_some())
+            + usize::from(self.y.is_some())
+            + usize::from(self.z.is_some())
+    }
+
+    /// Whether no axis is present.
+    pub fn is_empty(&self) -> bool {
+        self.count() == 0
+    }
+
+    /// Checks that every present reading is finite.
+    pub fn check_finite(&self, what: &'static str) -> Result<()> {
+        for v in [self.x, self.y, self.z].into_iter().flatten() {
+            check_finite(what, v)?;
+        }
+        Ok(())
+    }
+}
+
+impl From<Vector3<f64>> for Axes {
+    fn from(v: Vector3<f64>) -> Self {
+        Self::xyz(v)
+    }
+}
+
+/// One IMU sample: gyros, accelerometers and magnetometers, each on whichever body axes the
+/// device has. A 6-D IMU has no magnetometer ([`Axes::NONE`]); a magnetometer slower than
+/// the gyro is absent on the samples between its readings.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct ImuSample {
     /// Timestamp, seconds.
     pub t_s: f64,
     /// Angular rate, rad/s.
-    pub gyr_rps: Vector3<f64>,
-    /// Specific force, m/s².
-    pub acc_mps2: Vector3<f64>,
-    /// Magnetic field (any unit), if a magnetometer is present.
-    pub mag: Option<Vector3<f64>>,
+    pub gyr_rps: Axes,
+    /// Specific force, m/s². At rest and level, z reads −g (z down).
+    pub acc_mps2: Axes,
+    /// Magnetic field (any unit).
+    pub mag: Axes,
+}
+
+impl ImuSample {
+    /// A 9-axis sample (gyro, accelerometer and magnetometer triads).
+    pub fn new_9d(
+        t_s: f64,
+        gyr_rps: Vector3<f64>,
+        acc_mps2: Vector3<f64>,
+        mag: Vector3<f64>,
+    ) -> Self {
+        Self {
+            t_s,
+            gyr_rps: Axes::xyz(gyr_rps),
+            acc_mps2: Axes::xyz(acc_mps2),
+            mag: Axes::xyz(mag),
+        }
+    }
+
+    /// A 6-axis sample (gyro and accelerometer triads, no magnetometer).
+    pub fn new_6d(t_s: f64, gyr_rps: Vector3<f64>, acc_mps2: Vector3<f64>) -> Self {
+        Self {
+            t_s,
+            gyr_rps: Axes::xyz(gyr_rps),
+            acc_mps2: Axes::xyz(acc_mps2),
+            mag: Axes::NONE,
+        }
+    }
+
+    /// Checks that the timestamp and every present reading are finite.
+    pub fn check_finite(&self) -> Result<()> {
+        check_finite("timestamp t_s", self.t_s)?;
+        self.gyr_rps.check_finite("gyro reading")?;
+        self.acc_mps2.check_finite("accelerometer reading")?;
+        self.mag.check_finite("magnetometer reading")
+    }
 }
 
 /// Cumulative distances of the left and right odometer wheels, as the odometer reports them.
@@ -77,4 +198,49 @@ pub struct VehicleSample {
     pub gyr_z_rps: Option<f64>,
     /// Raw, uncalibrated horizontal magnetometer reading, if a compass is fitted.
     pub mag: Option<Vector2<f64>>,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    fn any_axis() -> impl Strategy<Value = Option<f64>> {
+        prop_oneof![
+            Just(None),
+            any::<f64>().prop_map(Some),
+            (-1e3f64..1e3).prop_map(Some),
+        ]
+    }
+
+    proptest! {
+        #[test]
+        fn axes_report_exactly_what_is_present(x in any_axis(), y in any_axis(), z in any_axis()) {
+            let a = Axes { x, y, z };
+            prop_assert_eq!(a.as_xyz().is_some(), x.is_some() && y.is_some() && z.is_some());
+            prop_assert_eq!(a.as_xy().is_some(), x.is_some() && y.is_some());
+            prop_assert_eq!(a.count(), [x, y, z].iter().filter(|v| v.is_some()).count());
+            prop_assert_eq!(a.is_empty(), a.count() == 0);
+            let all_finite = [x, y, z].iter().flatten().all(|v| v.is_finite());
+            prop_assert_eq!(a.check_finite("test").is_ok(), all_finite);
+        }
+
+        #[test]
+        fn imu_sample_rejects_any_non_finite_value(
+            t in any::<f64>(),
+            g in proptest::array::uniform3(any::<f64>()),
+            a in proptest::array::uniform3(-20.0f64..20.0),
+            m in proptest::array::uniform3(any::<f64>()),
+        ) {
+            let s = ImuSample::new_9d(t, Vector3::from(g), Vector3::from(a), Vector3::from(m));
+            let finite = t.is_finite() && g.iter().chain(&m).all(|v| v.is_finite());
+            prop_assert_eq!(s.check_finite().is_ok(), finite);
+            let six = ImuSample::new_6d(t, Vector3::from(g), Vector3::from(a));
+            prop_assert!(six.mag.is_empty());
+            prop_assert_eq!(
+                six.check_finite().is_ok(),
+                t.is_finite() && g.iter().all(|v| v.is_finite())
+            );
+        }
+    }
 }

@@ -1,11 +1,13 @@
 //! The forward-model trait: truth → raw reading with the sensor's errors.
 
-use crate::NoiseSource;
+use crate::{NoiseSource, Result};
 
 /// A forward model of a sensor: the reading it gives for a true physical state.
 ///
 /// Used by the simulator to make realistic streams and by round-trip tests
-/// (truth → model → calibration with the model's true parameters → truth).
+/// (truth → model → calibration with the model's true parameters → truth). Both methods are
+/// fallible: a non-finite truth or a non-positive `dt_s` is a typed error, and the model's
+/// time-varying state is left unchanged by a failed call.
 pub trait SensorModel {
     /// The true physical quantity (e.g. a field vector and attitude, an angular rate).
     type Truth;
@@ -14,7 +16,7 @@ pub trait SensorModel {
 
     /// The reading with only the deterministic errors (offset, scale, misalignment, …) and
     /// no randomness or time-varying state. The inverse of the model's true calibration.
-    fn ideal(&self, truth: &Self::Truth) -> Self::Reading;
+    fn ideal(&self, truth: &Self::Truth) -> Result<Self::Reading>;
 
     /// The reading with every error, drawing random terms from `noise` and advancing any
     /// time-varying error state (random walks, drifts) by `dt_s` seconds.
@@ -23,5 +25,5 @@ pub trait SensorModel {
         truth: &Self::Truth,
         dt_s: f64,
         noise: &mut dyn NoiseSource,
-    ) -> Self::Reading;
+    ) -> Result<Self::Reading>;
 }

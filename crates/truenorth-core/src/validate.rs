@@ -3,6 +3,15 @@
 use crate::{Error, Result};
 use nalgebra::{Vector2, Vector3};
 
+/// A configuration that can check itself: every `Config` in truenorth implements it, and
+/// every `new(config)` calls it first, so an invalid parameter is a typed error at
+/// construction, never a NaN later.
+pub trait Validate {
+    /// `Ok` when every parameter is finite and in its documented range; otherwise the first
+    /// offending parameter, named.
+    fn validate(&self) -> Result<()>;
+}
+
 /// Returns `value` if it is finite, otherwise [`Error::NonFinite`] naming `what`.
 #[inline]
 pub fn check_finite(what: &'static str, value: f64) -> Result<f64> {

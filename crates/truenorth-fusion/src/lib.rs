@@ -3,18 +3,36 @@
 //! Estimators that fuse the calibrated sensors: the Euler orientation detector of
 //! WO 00/36376, a quaternion orientation filter, and vehicle heading and dead reckoning.
 //!
-//! **Status:** no estimator is implemented yet. They will implement the traits defined in
-//! `truenorth-core`, [`truenorth_core::OrientationEstimator`] (IMU samples → attitude) and
-//! [`truenorth_core::HeadingEstimator`] (vehicle samples → heading and position), so that
-//! tests, benches and the CLI take any of them:
+//! Every estimator here implements one of the two traits of `truenorth-core`, so tests,
+//! benches, the CLI and the facade's pipelines take any of them:
+//! [`truenorth_core::OrientationEstimator`] (IMU samples → [`AttitudeEstimate`]: 9-D and 6-D
+//! attitude, gyro bias, rest and disturbance flags, σ) and
+//! [`truenorth_core::HeadingEstimator`] (vehicle samples → [`NavEstimate`]: position,
+//! heading, speed and their uncertainty).
+//!
+//! - [`QuaternionFilter`]: 6-D / 9-D quaternion filter with gyro-bias estimation at rest
+//!   ([`RestDetector`]) and in motion, and magnetic-disturbance rejection ([`MagReference`]).
+//!
+//! Code written against the traits works with whichever estimator is picked:
 //!
 //! ```
-//! use truenorth_core::{HeadingEstimator, NavState};
+//! use truenorth_core::{HeadingEstimator, NavEstimate};
 //!
-//! /// Works with whichever vehicle estimator the caller picks.
-//! fn final_position<E: HeadingEstimator>(est: &E) -> (f64, f64) {
-//!     let NavState { north_m, east_m, .. } = est.state();
-//!     (north_m, east_m)
+//! /// Final position and its 1σ radius, for whichever vehicle estimator the caller picks.
+//! fn final_position<E: HeadingEstimator>(est: &E) -> (f64, f64, f64) {
+//!     let NavEstimate { north_m, east_m, position_cov_m2, .. } = est.estimate();
+//!     (north_m, east_m, position_cov_m2.trace().sqrt())
 //! }
 //! ```
+//!
+//! [`AttitudeEstimate`]: truenorth_core::AttitudeEstimate
+//! [`NavEstimate`]: truenorth_core::NavEstimate
 #![cfg_attr(not(feature = "std"), no_std)]
+
+mod mag_reference;
+mod quaternion_filter;
+mod rest_detector;
+
+pub use mag_reference::{MagReference, MagReferenceConfig};
+pub use quaternion_filter::{QuaternionFilter, QuaternionFilterConfig};
+pub use rest_detector::{RestConfig, RestDetector};

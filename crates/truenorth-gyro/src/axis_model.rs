@@ -8,8 +8,9 @@
 use serde::{Deserialize, Serialize};
 #[allow(unused_imports)]
 use truenorth_core::Float as _;
-use truenorth_core::check_range;
-use truenorth_core::{NoiseSource, Result, SensorModel, check_dt, check_finite};
+use truenorth_core::{
+    NoiseSource, Result, SensorModel, Validate, check_dt, check_finite, check_range,
+};
 
 use crate::GyroCalibration;
 
@@ -17,7 +18,12 @@ use crate::GyroCalibration;
 /// gain ≤ 0 would make the model impossible to invert.
 pub const MIN_SCALE_ERROR: f64 = -0.999;
 
-/// The error parameters of one gyro axis. All rates in rad/s.
+/// The true error parameters of one gyro axis. All rates in rad/s.
+///
+/// A forward model's parameters are called `*Params` (not `*Config`): they describe the
+/// sensor's actual errors, which a calibration estimates, rather than options a user picks.
+/// They are validated like every config ([`Validate`]) and [`GyroAxisModel::new`] refuses
+/// invalid ones.
 ///
 /// For a yaw gyro, "positive" rotation is a right turn and "negative" a left turn (body z
 /// down, heading clockwise). `Default` is a perfect gyro at a 25 °C reference.
@@ -57,10 +63,11 @@ impl GyroAxisParams {
         temp_coeff_rps_per_k: 0.0,
         ref_temp_c: 25.0,
     };
+}
 
-    /// Checks every parameter: finite, noise terms non-negative, scale errors ≥
-    /// [`MIN_SCALE_ERROR`].
-    pub fn validate(&self) -> Result<()> {
+impl Validate for GyroAxisParams {
+    /// Every parameter finite, noise terms non-negative, scale errors ≥ [`MIN_SCALE_ERROR`].
+    fn validate(&self) -> Result<()> {
         check_finite("gyro bias_rps", self.bias_rps)?;
         check_finite("gyro temp_coeff_rps_per_k", self.temp_coeff_rps_per_k)?;
         check_finite("gyro ref_temp_c", self.ref_temp_c)?;
@@ -118,6 +125,12 @@ pub struct RateTruth {
 }
 
 impl RateTruth {
+    /// Checks that the rate and the temperature are finite.
+    pub fn check_finite(&self) -> Result<()> {
+        check_finite("true rate rate_rps", self.rate_rps)?;
+        check_finite("gyro temperature temp_c", self.temp_c).map(drop)
+    }
+
     /// A rate at the model's reference temperature (so the temperature term is zero).
     pub fn at_reference(rate_rps: f64, params: &GyroAxisParams) -> Self {
         Self {
@@ -136,7 +149,7 @@ pub struct GyroAxisModel {
 }
 
 impl GyroAxisModel {
-    /// A model with these parameters and the random walk at zero.
+    /// A model with these parameters (validated first) and the random walk at zero.
     pub fn new(params: GyroAxisParams) -> Result<Self> {
         params.validate()?;
         Ok(Self {
@@ -202,41 +215,36 @@ impl GyroAxisModel {
         };
         gain * truth.rate_rps + self.bias_rps(truth.temp_c)
     }
-
-    /// [`SensorModel::sample`] with validation: advances the random walk by `dt_s` and adds
-    /// white noise. Returns a typed error (and leaves the state unchanged) if the truth is not
-    /// finite or `dt_s` is not a positive finite number.
-    pub fn try_sample(
-        &mut self,
-        truth: &RateTruth,
-        dt_s: f64,
-        noise: &mut dyn NoiseSource,
-    ) -> Result<f64> {
-        check_finite("true rate rate_rps", truth.rate_rps)?;
-        check_finite("gyro temperature temp_c", truth.temp_c)?;
-        let dt_s = check_dt(dt_s)?;
-        // Random walk: the bias increment over dt has variance σ_b²·dt.
-        self.state.bias_walk_rps +=
-            noise.normal(self.params.bias_walk_rps_per_sqrt_s * dt_s.sqrt());
-        // White rate noise sampled at 1/dt: σ = N/√dt (density times √bandwidth).
-        let white = noise.normal(self.params.noise_density_rps_per_sqrt_hz / dt_s.sqrt());
-        Ok(self.deterministic(truth) + self.state.bias_walk_rps + white)
-    }
 }
 
 impl SensorModel for GyroAxisModel {
     type Truth = RateTruth;
     type Reading = f64;
 
-    /// Bias (with its temperature term) and scale error; no random walk, no noise.
-    fn ideal(&self, truth: &RateTruth) -> f64 {
-        self.deterministic(truth)
+    /// Bias (with its temperature term) and scale error; no random walk, no noise. A typed
+    /// error for a non-finite truth or a reading too large to represent.
+    fn ideal(&self, truth: &RateTruth) -> Result<f64> {
+        truth.check_finite()?;
+        check_finite("gyro reading (inputs too large)", self.deterministic(truth))
     }
 
-    /// Every error. Invalid input (non-finite truth, `dt_s` ≤ 0) gives NaN and leaves the
-    /// state unchanged; use [`GyroAxisModel::try_sample`] to get the reason.
-    fn sample(&mut self, truth: &RateTruth, dt_s: f64, noise: &mut dyn NoiseSource) -> f64 {
-        self.try_sample(truth, dt_s, noise).unwrap_or(f64::NAN)
+    /// Every error: advances the random walk by `dt_s` and adds white noise. A typed error
+    /// (and the state unchanged) if the truth is not finite, `dt_s` is not a positive finite
+    /// number or the reading would overflow.
+    fn sample(&mut self, truth: &RateTruth, dt_s: f64, noise: &mut dyn NoiseSource) -> Result<f64> {
+        truth.check_finite()?;
+        let dt_s = check_dt(dt_s)?;
+        // Random walk: the bias increment over dt has variance σ_b²·dt.
+        let walk = self.state.bias_walk_rps
+            + noise.normal(self.params.bias_walk_rps_per_sqrt_s * dt_s.sqrt());
+        // White rate noise sampled at 1/dt: σ = N/√dt (density times √bandwidth).
+        let white = noise.normal(self.params.noise_density_rps_per_sqrt_hz / dt_s.sqrt());
+        let reading = check_finite(
+            "gyro reading (inputs too large)",
+            self.deterministic(truth) + walk + white,
+        )?;
+        self.state.bias_walk_rps = walk;
+        Ok(reading)
     }
 }
 
@@ -271,7 +279,7 @@ mod tests {
         ) {
             let m = GyroAxisModel::new(p).unwrap();
             let truth = RateTruth { rate_rps: rate, temp_c: temp };
-            let back = m.true_calibration(temp).unwrap().apply(&m.ideal(&truth));
+            let back = m.true_calibration(temp).unwrap().apply(&m.ideal(&truth).unwrap()).unwrap();
             prop_assert!((back - rate).abs() <= 1e-12 * (1.0 + rate.abs()), "{back} vs {rate}");
         }
 
@@ -281,8 +289,8 @@ mod tests {
         ) {
             let m = GyroAxisModel::new(p).unwrap();
             let b = m.bias_rps(p.ref_temp_c);
-            let right = m.ideal(&RateTruth::at_reference(rate, &p)) - b;
-            let left = m.ideal(&RateTruth::at_reference(-rate, &p)) - b;
+            let right = m.ideal(&RateTruth::at_reference(rate, &p)).unwrap() - b;
+            let left = m.ideal(&RateTruth::at_reference(-rate, &p)).unwrap() - b;
             prop_assert!((right - (1.0 + p.scale_error_pos) * rate).abs() < 1e-12 * (1.0 + rate));
             prop_assert!((left + (1.0 + p.scale_error_neg) * rate).abs() < 1e-12 * (1.0 + rate));
         }
@@ -290,8 +298,8 @@ mod tests {
         #[test]
         fn temperature_shifts_the_bias_linearly(p in params(), dt_c in -60.0f64..60.0) {
             let m = GyroAxisModel::new(p).unwrap();
-            let r0 = m.ideal(&RateTruth { rate_rps: 0.0, temp_c: p.ref_temp_c });
-            let r1 = m.ideal(&RateTruth { rate_rps: 0.0, temp_c: p.ref_temp_c + dt_c });
+            let r0 = m.ideal(&RateTruth { rate_rps: 0.0, temp_c: p.ref_temp_c }).unwrap();
+            let r1 = m.ideal(&RateTruth { rate_rps: 0.0, temp_c: p.ref_temp_c + dt_c }).unwrap();
             prop_assert!((r1 - r0 - p.temp_coeff_rps_per_k * dt_c).abs() < 1e-12);
         }
 
@@ -310,12 +318,16 @@ mod tests {
             let truth = RateTruth { rate_rps: rate, temp_c: temp };
             let ok = rate.is_finite() && temp.is_finite() && dt.is_finite() && dt > 0.0;
             let before = *m.state();
-            let r = m.try_sample(&truth, dt, &mut n);
+            let r = m.sample(&truth, dt, &mut n);
             prop_assert_eq!(r.is_ok(), ok);
             if !ok {
                 prop_assert_eq!(*m.state(), before);
-                prop_assert!(m.sample(&truth, dt, &mut n).is_nan());
+                let non_finite = matches!(r, Err(Error::NonFinite { .. }));
+                let bad_dt = matches!(r, Err(Error::InvalidDt { .. }));
+                prop_assert!(non_finite || bad_dt, "{r:?}");
             }
+            let ideal_ok = rate.is_finite() && temp.is_finite();
+            prop_assert_eq!(m.ideal(&truth).is_ok(), ideal_ok);
         }
 
         #[test]
@@ -347,7 +359,10 @@ mod tests {
         let mut m = GyroAxisModel::new(p).unwrap();
         for &w in &[-1.0, 0.0, 0.3] {
             let t = RateTruth::at_reference(w, &p);
-            assert_eq!(m.try_sample(&t, 0.01, &mut ZeroNoise).unwrap(), m.ideal(&t));
+            assert_eq!(
+                m.sample(&t, 0.01, &mut ZeroNoise).unwrap(),
+                m.ideal(&t).unwrap()
+            );
         }
     }
 
@@ -366,7 +381,7 @@ mod tests {
         let n = 40_000;
         let truth = RateTruth::at_reference(0.0, &p);
         let var: f64 = (0..n)
-            .map(|_| m.try_sample(&truth, dt, &mut rng).unwrap().powi(2))
+            .map(|_| m.sample(&truth, dt, &mut rng).unwrap().powi(2))
             .sum::<f64>()
             / n as f64;
         let want = density / dt.sqrt();
@@ -388,7 +403,7 @@ mod tests {
         for _ in 0..walks {
             let mut mw = GyroAxisModel::new(pw).unwrap();
             for _ in 0..steps {
-                mw.try_sample(&truth, dt, &mut rng).unwrap();
+                mw.sample(&truth, dt, &mut rng).unwrap();
             }
             s2 += mw.state().bias_walk_rps.powi(2);
         }

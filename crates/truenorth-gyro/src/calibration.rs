@@ -7,8 +7,7 @@
 
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
-use truenorth_core::check_positive;
-use truenorth_core::{Calibration, Result, check_finite};
+use truenorth_core::{Calibration, Result, Validate, check_finite, check_positive};
 
 /// Zero and gain of one gyro axis: `rate = (raw − zero) / gain`, with `gain_pos` used when
 /// `raw − zero ≥ 0` and `gain_neg` otherwise. Gains are dimensionless (raw rad/s per true
@@ -53,23 +52,7 @@ impl GyroCalibration {
         Ok(cal)
     }
 
-    /// Checks that the zero is finite and both gains are positive and finite (useful after
-    /// loading parameters from disk).
-    pub fn validate(&self) -> Result<()> {
-        check_finite("gyro calibration zero_rps", self.zero_rps)?;
-        check_positive("gyro calibration gain_pos", self.gain_pos)?;
-        check_positive("gyro calibration gain_neg", self.gain_neg)?;
-        Ok(())
-    }
-
-    /// The calibrated rate, or a typed error if `raw_rps` is not finite or the calibration is
-    /// invalid.
-    pub fn try_apply(&self, raw_rps: f64) -> Result<f64> {
-        check_finite("raw gyro rate", raw_rps)?;
-        self.validate()?;
-        Ok(self.apply_unchecked(raw_rps))
-    }
-
+    /// `(raw − zero) / gain` for a valid calibration and a finite `raw_rps`.
     #[inline]
     fn apply_unchecked(&self, raw_rps: f64) -> f64 {
         let centred = raw_rps - self.zero_rps;
@@ -82,14 +65,30 @@ impl GyroCalibration {
     }
 }
 
+impl Validate for GyroCalibration {
+    /// The zero finite and both gains positive and finite. The fields are public (a
+    /// calibration is loaded from disk), so [`Calibration::apply`] checks again.
+    fn validate(&self) -> Result<()> {
+        check_finite("gyro calibration zero_rps", self.zero_rps)?;
+        check_positive("gyro calibration gain_pos", self.gain_pos)?;
+        check_positive("gyro calibration gain_neg", self.gain_neg)?;
+        Ok(())
+    }
+}
+
 impl Calibration for GyroCalibration {
     type Raw = f64;
     type Physical = f64;
 
-    /// `(raw − zero) / gain`. Never panics: a NaN input gives NaN; use
-    /// [`GyroCalibration::try_apply`] for a typed error instead.
-    fn apply(&self, raw: &f64) -> f64 {
-        self.apply_unchecked(*raw)
+    /// `(raw − zero) / gain`, or a typed error if `raw` is not finite, the calibration is
+    /// invalid, or the result overflows.
+    fn apply(&self, raw: &f64) -> Result<f64> {
+        check_finite("raw gyro rate", *raw)?;
+        self.validate()?;
+        check_finite(
+            "calibrated gyro rate (reading too large)",
+            self.apply_unchecked(*raw),
+        )
     }
 }
 
@@ -100,15 +99,10 @@ pub struct Gyro3Calibration {
     pub axes: [GyroCalibration; 3],
 }
 
-impl Gyro3Calibration {
-    /// The calibrated rate vector, or a typed error naming the first bad component.
-    pub fn try_apply(&self, raw_rps: &Vector3<f64>) -> Result<Vector3<f64>> {
-        let [x, y, z] = &self.axes;
-        Ok(Vector3::new(
-            x.try_apply(raw_rps.x)?,
-            y.try_apply(raw_rps.y)?,
-            z.try_apply(raw_rps.z)?,
-        ))
+impl Validate for Gyro3Calibration {
+    /// Every axis valid (see [`GyroCalibration`]).
+    fn validate(&self) -> Result<()> {
+        self.axes.iter().try_for_each(Validate::validate)
     }
 }
 
@@ -116,9 +110,15 @@ impl Calibration for Gyro3Calibration {
     type Raw = Vector3<f64>;
     type Physical = Vector3<f64>;
 
-    fn apply(&self, raw: &Vector3<f64>) -> Vector3<f64> {
+    /// Each axis through its own [`GyroCalibration`]; a typed error naming the first bad
+    /// component.
+    fn apply(&self, raw: &Vector3<f64>) -> Result<Vector3<f64>> {
         let [x, y, z] = &self.axes;
-        Vector3::new(x.apply(&raw.x), y.apply(&raw.y), z.apply(&raw.z))
+        Ok(Vector3::new(
+            x.apply(&raw.x)?,
+            y.apply(&raw.y)?,
+            z.apply(&raw.z)?,
+        ))
     }
 }
 
@@ -126,6 +126,7 @@ impl Calibration for Gyro3Calibration {
 mod tests {
     use super::*;
     use proptest::prelude::*;
+    use truenorth_core::Error;
 
     proptest! {
         #[test]
@@ -134,19 +135,26 @@ mod tests {
         ) {
             let cal = GyroCalibration::asymmetric(zero, gp, gn).unwrap();
             let raw = if rate >= 0.0 { gp * rate } else { gn * rate } + zero;
-            prop_assert!((cal.try_apply(raw).unwrap() - rate).abs() < 1e-12 * (1.0 + rate.abs()));
+            prop_assert!((cal.apply(&raw).unwrap() - rate).abs() < 1e-12 * (1.0 + rate.abs()));
         }
 
         #[test]
         fn never_panics(raw in proptest::num::f64::ANY, g in proptest::num::f64::ANY) {
-            let _ = GyroCalibration::IDENTITY.apply(&raw);
-            prop_assert_eq!(GyroCalibration::IDENTITY.try_apply(raw).is_ok(), raw.is_finite());
+            prop_assert_eq!(GyroCalibration::IDENTITY.apply(&raw).is_ok(), raw.is_finite());
             let ok = g.is_finite() && g > 0.0;
             prop_assert_eq!(GyroCalibration::new(0.0, g).is_ok(), ok);
-            // A deserialised calibration with a bad gain is refused by try_apply, not divided by.
+            // A deserialised calibration with a bad gain is refused by apply, not divided by.
             let loaded = GyroCalibration { zero_rps: 0.0, gain_pos: g, gain_neg: g };
-            let _ = loaded.apply(&raw);
-            prop_assert_eq!(loaded.try_apply(1.0).is_ok(), ok);
+            let r = loaded.apply(&raw);
+            // Refused exactly when something is invalid or the quotient overflows.
+            let fits = (raw / g).is_finite();
+            prop_assert_eq!(r.is_ok(), ok && raw.is_finite() && fits);
+            if let Err(e) = r {
+                let typed = matches!(e, Error::NonFinite { .. } | Error::OutOfRange { .. });
+                prop_assert!(typed, "{e:?}");
+            }
+            let three = Gyro3Calibration { axes: [GyroCalibration::IDENTITY, loaded, GyroCalibration::IDENTITY] };
+            prop_assert_eq!(three.apply(&Vector3::new(0.0, raw, 0.0)).is_ok(), ok && raw.is_finite() && fits);
         }
     }
 }

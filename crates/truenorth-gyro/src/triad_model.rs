@@ -3,7 +3,9 @@
 
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
-use truenorth_core::{NoiseSource, Result, SensorModel, check_dt, check_finite, check_finite3};
+use truenorth_core::{
+    NoiseSource, Result, SensorModel, Validate, check_dt, check_finite, check_finite3,
+};
 
 use crate::{Gyro3Calibration, GyroAxisModel, GyroAxisParams, RateTruth};
 
@@ -16,6 +18,42 @@ pub struct Rate3Truth {
     pub temp_c: f64,
 }
 
+impl Rate3Truth {
+    /// Checks that every rate component and the temperature are finite.
+    pub fn check_finite(&self) -> Result<()> {
+        check_finite3("true rate rate_rps", &self.rate_rps)?;
+        check_finite("gyro temperature temp_c", self.temp_c).map(drop)
+    }
+
+    fn axis(&self, i: usize) -> RateTruth {
+        RateTruth {
+            rate_rps: self.rate_rps[i],
+            temp_c: self.temp_c,
+        }
+    }
+}
+
+/// The true error parameters of a three-axis gyro: one [`GyroAxisParams`] per body axis.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct Gyro3Params {
+    /// Parameters of the x, y and z axes.
+    pub axes: [GyroAxisParams; 3],
+}
+
+impl Gyro3Params {
+    /// The same parameters on all three axes.
+    pub const fn uniform(params: GyroAxisParams) -> Self {
+        Self { axes: [params; 3] }
+    }
+}
+
+impl Validate for Gyro3Params {
+    /// Every axis valid (see [`GyroAxisParams`]).
+    fn validate(&self) -> Result<()> {
+        self.axes.iter().try_for_each(Validate::validate)
+    }
+}
+
 /// Forward model of a three-axis gyro.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Gyro3Model {
@@ -23,9 +61,10 @@ pub struct Gyro3Model {
 }
 
 impl Gyro3Model {
-    /// A model with the given parameters for the x, y and z axes.
-    pub fn new(params: [GyroAxisParams; 3]) -> Result<Self> {
-        let [x, y, z] = params;
+    /// A model with the given parameters for the x, y and z axes (validated first).
+    pub fn new(params: Gyro3Params) -> Result<Self> {
+        params.validate()?;
+        let [x, y, z] = params.axes;
         Ok(Self {
             axes: [
                 GyroAxisModel::new(x)?,
@@ -33,11 +72,6 @@ impl Gyro3Model {
                 GyroAxisModel::new(z)?,
             ],
         })
-    }
-
-    /// The same parameters on all three axes.
-    pub fn uniform(params: GyroAxisParams) -> Result<Self> {
-        Self::new([params; 3])
     }
 
     /// The per-axis models, x, y, z.
@@ -64,56 +98,40 @@ impl Gyro3Model {
             ],
         })
     }
-
-    /// [`SensorModel::sample`] with validation; on error no axis state changes.
-    pub fn try_sample(
-        &mut self,
-        truth: &Rate3Truth,
-        dt_s: f64,
-        noise: &mut dyn NoiseSource,
-    ) -> Result<Vector3<f64>> {
-        // Validate everything first so that a bad z does not leave x and y advanced.
-        check_finite3("true rate rate_rps", &truth.rate_rps)?;
-        check_finite("gyro temperature temp_c", truth.temp_c)?;
-        check_dt(dt_s)?;
-        let mut out = Vector3::zeros();
-        for (i, axis) in self.axes.iter_mut().enumerate() {
-            let t = RateTruth {
-                rate_rps: truth.rate_rps[i],
-                temp_c: truth.temp_c,
-            };
-            out[i] = axis.try_sample(&t, dt_s, noise)?;
-        }
-        Ok(out)
-    }
 }
 
 impl SensorModel for Gyro3Model {
     type Truth = Rate3Truth;
     type Reading = Vector3<f64>;
 
-    fn ideal(&self, truth: &Rate3Truth) -> Vector3<f64> {
+    /// Each axis's [`SensorModel::ideal`]; a typed error naming the first bad component.
+    fn ideal(&self, truth: &Rate3Truth) -> Result<Vector3<f64>> {
+        truth.check_finite()?;
         let [x, y, z] = &self.axes;
-        let at = |rate_rps| RateTruth {
-            rate_rps,
-            temp_c: truth.temp_c,
-        };
-        Vector3::new(
-            x.ideal(&at(truth.rate_rps.x)),
-            y.ideal(&at(truth.rate_rps.y)),
-            z.ideal(&at(truth.rate_rps.z)),
-        )
+        Ok(Vector3::new(
+            x.ideal(&truth.axis(0))?,
+            y.ideal(&truth.axis(1))?,
+            z.ideal(&truth.axis(2))?,
+        ))
     }
 
-    /// Every error; NaN components for invalid input (see [`Gyro3Model::try_sample`]).
+    /// Every error on every axis. On error no axis state changes: the axes are advanced on a
+    /// copy that replaces the model only when all three succeeded.
     fn sample(
         &mut self,
         truth: &Rate3Truth,
         dt_s: f64,
         noise: &mut dyn NoiseSource,
-    ) -> Vector3<f64> {
-        self.try_sample(truth, dt_s, noise)
-            .unwrap_or_else(|_| Vector3::repeat(f64::NAN))
+    ) -> Result<Vector3<f64>> {
+        truth.check_finite()?;
+        check_dt(dt_s)?;
+        let mut axes = self.axes;
+        let mut out = Vector3::zeros();
+        for (i, axis) in axes.iter_mut().enumerate() {
+            out[i] = axis.sample(&truth.axis(i), dt_s, noise)?;
+        }
+        self.axes = axes;
+        Ok(out)
     }
 }
 
@@ -121,7 +139,7 @@ impl SensorModel for Gyro3Model {
 mod tests {
     use super::*;
     use proptest::prelude::*;
-    use truenorth_core::{Calibration, SplitMix64};
+    use truenorth_core::{Calibration, Error, SplitMix64};
 
     fn axis() -> impl Strategy<Value = GyroAxisParams> {
         (-0.5f64..0.5, -0.3f64..0.3, -0.3f64..0.3, -1e-3f64..1e-3).prop_map(|(b, sp, sn, kt)| {
@@ -141,9 +159,9 @@ mod tests {
             px in axis(), py in axis(), pz in axis(),
             w in proptest::array::uniform3(-20.0f64..20.0), temp in -40.0f64..85.0,
         ) {
-            let m = Gyro3Model::new([px, py, pz]).unwrap();
+            let m = Gyro3Model::new(Gyro3Params { axes: [px, py, pz] }).unwrap();
             let truth = Rate3Truth { rate_rps: Vector3::from(w), temp_c: temp };
-            let back = m.true_calibration(temp).unwrap().apply(&m.ideal(&truth));
+            let back = m.true_calibration(temp).unwrap().apply(&m.ideal(&truth).unwrap()).unwrap();
             prop_assert!((back - truth.rate_rps).amax() < 1e-12 * (1.0 + truth.rate_rps.amax()));
         }
 
@@ -152,16 +170,19 @@ mod tests {
             bad in prop_oneof![Just(f64::NAN), Just(f64::INFINITY), Just(f64::NEG_INFINITY)],
             axis in 0usize..3,
         ) {
-            let mut m = Gyro3Model::uniform(GyroAxisParams {
+            let mut m = Gyro3Model::new(Gyro3Params::uniform(GyroAxisParams {
                 bias_walk_rps_per_sqrt_s: 0.1, ..GyroAxisParams::PERFECT
-            }).unwrap();
+            })).unwrap();
             let before = m;
             let mut rate = Vector3::new(0.1, 0.2, 0.3);
             rate[axis] = bad;
             let truth = Rate3Truth { rate_rps: rate, temp_c: 25.0 };
-            prop_assert!(m.try_sample(&truth, 0.01, &mut SplitMix64::new(5)).is_err());
+            let r = m.sample(&truth, 0.01, &mut SplitMix64::new(5));
+            let non_finite = matches!(r, Err(Error::NonFinite { .. }));
+            prop_assert!(non_finite, "{r:?}");
             prop_assert_eq!(m, before);
-            prop_assert!(m.sample(&truth, 0.01, &mut SplitMix64::new(5)).x.is_nan());
+            let non_finite = matches!(m.ideal(&truth), Err(Error::NonFinite { .. }));
+            prop_assert!(non_finite);
         }
     }
 }

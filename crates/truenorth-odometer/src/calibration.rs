@@ -5,11 +5,10 @@
 //! `(1 + aV²)` (US 4,788,645 eq. 2/8), which leaves the mean of the two wheels unchanged.
 
 use serde::{Deserialize, Serialize};
-use truenorth_core::{Calibration, Result, check_finite};
+use truenorth_core::{Calibration, Result, Validate, check_finite, check_positive};
 
 use crate::WheelDistances;
 use crate::differential::speed_factor;
-use truenorth_core::check_positive;
 
 /// What the calibration needs: one step's raw wheel distances and the mean speed of the two
 /// odometer wheels over the step (`|AD| / dt`, as the odometer itself can measure it).
@@ -62,35 +61,27 @@ impl OdometerCalibration {
         Ok(cal)
     }
 
-    /// Checks the gains and `a` (useful after loading from disk).
-    pub fn validate(&self) -> Result<()> {
-        check_positive("odometer gain_l", self.gain_l)?;
-        check_positive("odometer gain_r", self.gain_r)?;
-        check_finite("speed coefficient a (s²/m²)", self.speed_coeff_s2_per_m2)?;
-        Ok(())
-    }
-
     /// Removes the scale errors only: the two wheels' distances in true metres, but with the
     /// speed-dependent difference still in (needed to estimate the speed itself).
     pub fn unscale(&self, dist_l_m: f64, dist_r_m: f64) -> Result<WheelDistances> {
         self.validate()?;
+        let l = check_finite("left wheel distance", dist_l_m)?;
+        let r = check_finite("right wheel distance", dist_r_m)?;
         Ok(WheelDistances {
-            left_m: check_finite("left wheel distance", dist_l_m)? / self.gain_l,
-            right_m: check_finite("right wheel distance", dist_r_m)? / self.gain_r,
+            left_m: check_finite("unscaled left distance (too large)", l / self.gain_l)?,
+            right_m: check_finite("unscaled right distance (too large)", r / self.gain_r)?,
         })
     }
+}
 
-    /// The true wheel path lengths, or a typed error (non-finite input, invalid calibration,
-    /// `1 + aV² ≤ 0`).
-    pub fn try_apply(&self, raw: &OdometerRaw) -> Result<WheelDistances> {
-        let u = self.unscale(raw.dist_l_m, raw.dist_r_m)?;
-        let factor = speed_factor(self.speed_coeff_s2_per_m2, raw.wheel_speed_mps)?;
-        let mean = 0.5 * (u.left_m + u.right_m);
-        let half_diff = 0.5 * (u.left_m - u.right_m) / factor;
-        Ok(WheelDistances {
-            left_m: mean + half_diff,
-            right_m: mean - half_diff,
-        })
+impl Validate for OdometerCalibration {
+    /// Both gains positive and finite, `a` finite. The fields are public (a calibration is
+    /// loaded from disk), so [`Calibration::apply`] checks again.
+    fn validate(&self) -> Result<()> {
+        check_positive("odometer gain_l", self.gain_l)?;
+        check_positive("odometer gain_r", self.gain_r)?;
+        check_finite("speed coefficient a (s²/m²)", self.speed_coeff_s2_per_m2)?;
+        Ok(())
     }
 }
 
@@ -98,11 +89,22 @@ impl Calibration for OdometerCalibration {
     type Raw = OdometerRaw;
     type Physical = WheelDistances;
 
-    /// See [`OdometerCalibration::try_apply`]; invalid input gives NaN distances.
-    fn apply(&self, raw: &OdometerRaw) -> WheelDistances {
-        self.try_apply(raw).unwrap_or(WheelDistances {
-            left_m: f64::NAN,
-            right_m: f64::NAN,
+    /// The true wheel path lengths, or a typed error (non-finite input, invalid calibration,
+    /// `1 + aV² ≤ 0`).
+    fn apply(&self, raw: &OdometerRaw) -> Result<WheelDistances> {
+        let u = self.unscale(raw.dist_l_m, raw.dist_r_m)?;
+        let factor = speed_factor(self.speed_coeff_s2_per_m2, raw.wheel_speed_mps)?;
+        let mean = 0.5 * (u.left_m + u.right_m);
+        let half_diff = 0.5 * (u.left_m - u.right_m) / factor;
+        Ok(WheelDistances {
+            left_m: check_finite(
+                "calibrated left distance (inputs too large)",
+                mean + half_diff,
+            )?,
+            right_m: check_finite(
+                "calibrated right distance (inputs too large)",
+                mean - half_diff,
+            )?,
         })
     }
 }

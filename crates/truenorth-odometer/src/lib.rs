@@ -9,14 +9,15 @@
 //!   speed) → raw wheel distances with per-wheel scale error, the speed-dependent
 //!   differential error `(1 + aV²)` and pulse quantisation, over either rear wheels or
 //!   Ackermann-steered front wheels with **exact** rigid-body geometry ([`AckermannGeometry`]).
-//! * [`OdometerCalibration`]: the inverse of the scale and speed errors.
+//! * [`OdometerCalibration`]: the inverse of the scale and speed errors
+//!   ([`truenorth_core::Calibration::apply`], fallible like every entry point here).
 //! * [`heading_change_plain_rad`] (eq. 1/7) and [`heading_change_speed_corrected_rad`]
 //!   (eq. 2/8).
 //! * The effective front track ([`EffectiveTrack`]): exact ([`AckermannGeometry`]), the
 //!   patent's eq. 3/14 ([`PatentAckermannTrack`]) and its look-up table
 //!   ([`EffectiveTrackTable`], claims 15-16).
-//! * [`DifferentialOdometer`]: cumulative [`truenorth_core::WheelSample`]s → heading change,
-//!   a [`truenorth_core::RelativeHeadingSource`].
+//! * [`DifferentialOdometer`]: cumulative [`truenorth_core::WheelSample`]s → heading change
+//!   and distance per step, a [`truenorth_core::RelativeHeadingSource`].
 //!
 //! Sign: the left wheel rolling further is a right turn (positive heading change).
 //!
@@ -46,25 +47,32 @@
 //! c ≤ c_max/2 and 1.4 % for c ≤ 0.9 c_max (tests in `tests/patent_vs_exact.rs`).
 //!
 //! ```
-//! use truenorth_core::RelativeHeadingSource;
+//! use truenorth_core::{RelativeHeadingSource, SensorModel, ZeroNoise};
 //! use truenorth_odometer::{
-//!     AckermannGeometry, AckermannParams, DifferentialOdometer, OdometerCalibration,
+//!     AckermannGeometry, AckermannParams, DifferentialOdometer, DifferentialOdometerConfig,
 //!     OdometerModel, OdometerParams, OdometerWheels, WheelMotion,
 //! };
 //!
 //! let car = AckermannParams { wheelbase_m: 2.7, track_m: 1.55, kingpin_offset_m: 0.1 };
-//! let mut odometer = OdometerModel::new(OdometerParams::perfect(OdometerWheels::Front(car))).unwrap();
-//! let mut heading = DifferentialOdometer::new(
-//!     AckermannGeometry::new(car).unwrap(), OdometerCalibration::IDENTITY).unwrap();
+//! let mut odometer = OdometerModel::new(OdometerParams::perfect(OdometerWheels::Front(car)))?;
+//! let mut heading =
+//!     DifferentialOdometer::new(AckermannGeometry::new(car)?, DifferentialOdometerConfig::default())?;
 //!
 //! // 10 m on a right-hand curve of radius 8 m, in one step of 1 s.
-//! let start = odometer.sample_cumulative(0.0, &WheelMotion::default(), 1.0).unwrap();
-//! heading.heading_change_rad(&start).unwrap();
+//! let start = odometer.sample_cumulative(0.0, &WheelMotion::default(), 1.0)?;
+//! assert_eq!(heading.step(&start)?, None); // the first sample only starts the clock
 //! let arc = WheelMotion { ds_m: 10.0, curvature_per_m: 1.0 / 8.0, speed_mps: 10.0 };
-//! let end = odometer.sample_cumulative(1.0, &arc, 1.0).unwrap();
+//! let end = odometer.sample_cumulative(1.0, &arc, 1.0)?;
 //! assert!(end.dist_l_m > end.dist_r_m); // left longer: right turn
-//! let turned = heading.heading_change_rad(&end).unwrap();
-//! assert!((turned - 10.0 / 8.0).abs() < 1e-9);
+//! let step = heading.step(&end)?.unwrap();
+//! assert!((step.heading_change_rad - 10.0 / 8.0).abs() < 1e-9);
+//! // The distance is the front wheels' mean path, longer than the rear axle's 10 m.
+//! assert!(step.distance_m.unwrap() > 10.0);
+//!
+//! // Every fallible entry point returns a typed error, never NaN.
+//! assert!(odometer.sample(&WheelMotion { ds_m: f64::NAN, ..arc }, 1.0, &mut ZeroNoise).is_err());
+//! assert!(heading.step(&end).is_err()); // the same timestamp again
+//! # Ok::<(), truenorth_core::Error>(())
 //! ```
 #![cfg_attr(not(feature = "std"), no_std)]
 
@@ -83,7 +91,7 @@ pub use calibration::{OdometerCalibration, OdometerRaw};
 pub use differential::{
     curvature_ratio, heading_change_plain_rad, heading_change_speed_corrected_rad, speed_factor,
 };
-pub use differential_odometer::{DifferentialOdometer, OdometerStep};
+pub use differential_odometer::{DifferentialOdometer, DifferentialOdometerConfig, OdometerStep};
 pub use effective_track::{EffectiveTrack, FixedTrack};
 pub use odometer_model::{
     MIN_SCALE_ERROR, OdometerCoefficients, OdometerModel, OdometerParams, OdometerState,

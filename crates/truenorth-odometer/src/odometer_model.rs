@@ -14,17 +14,23 @@
 use serde::{Deserialize, Serialize};
 #[allow(unused_imports)]
 use truenorth_core::Float as _;
-use truenorth_core::check_range;
-use truenorth_core::{NoiseSource, Result, SensorModel, WheelSample, check_dt, check_finite};
+use truenorth_core::{
+    NoiseSource, Result, SensorModel, Validate, WheelSample, check_dt, check_finite,
+    check_positive, check_range,
+};
 
 use crate::differential::speed_factor;
 use crate::{OdometerCalibration, OdometerWheels, WheelDistances, WheelGeometry, WheelMotion};
-use truenorth_core::check_positive;
 
 /// Smallest accepted scale error (a gain of 0.001; ≤ 0 could not be inverted).
 pub const MIN_SCALE_ERROR: f64 = -0.999;
 
-/// The odometer's parameters.
+/// The odometer's true error parameters (and its wheel geometry).
+///
+/// A forward model's parameters are called `*Params` (not `*Config`): they describe the
+/// sensor's actual errors, which a calibration estimates, rather than options a user picks.
+/// They are validated like every config ([`Validate`]) and [`OdometerModel::new`] refuses
+/// invalid ones.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct OdometerParams {
     /// Which wheels, and their geometry.
@@ -49,6 +55,31 @@ impl OdometerParams {
             speed_coeff_s2_per_m2: 0.0,
             dist_per_pulse_m: None,
         }
+    }
+}
+
+impl Validate for OdometerParams {
+    /// The geometry valid (see [`OdometerWheels`]), scale errors ≥ [`MIN_SCALE_ERROR`], `a`
+    /// finite, and the pulse length, if any, positive.
+    fn validate(&self) -> Result<()> {
+        self.wheels.validate()?;
+        check_range(
+            "odometer scale_error_l",
+            self.scale_error_l,
+            MIN_SCALE_ERROR,
+            f64::MAX,
+        )?;
+        check_range(
+            "odometer scale_error_r",
+            self.scale_error_r,
+            MIN_SCALE_ERROR,
+            f64::MAX,
+        )?;
+        check_finite("speed coefficient a (s²/m²)", self.speed_coeff_s2_per_m2)?;
+        if let Some(d) = self.dist_per_pulse_m {
+            check_positive("dist_per_pulse_m", d)?;
+        }
+        Ok(())
     }
 }
 
@@ -87,31 +118,13 @@ pub struct OdometerModel {
 impl OdometerModel {
     /// Validates the parameters and builds the model (all accumulators at zero).
     pub fn new(params: OdometerParams) -> Result<Self> {
-        let geometry = WheelGeometry::new(params.wheels)?;
-        let gain_l = 1.0
-            + check_range(
-                "odometer scale_error_l",
-                params.scale_error_l,
-                MIN_SCALE_ERROR,
-                f64::MAX,
-            )?;
-        let gain_r = 1.0
-            + check_range(
-                "odometer scale_error_r",
-                params.scale_error_r,
-                MIN_SCALE_ERROR,
-                f64::MAX,
-            )?;
-        check_finite("speed coefficient a (s²/m²)", params.speed_coeff_s2_per_m2)?;
-        if let Some(d) = params.dist_per_pulse_m {
-            check_positive("dist_per_pulse_m", d)?;
-        }
+        params.validate()?;
         Ok(Self {
             params,
             coeffs: OdometerCoefficients {
-                geometry,
-                gain_l,
-                gain_r,
+                geometry: WheelGeometry::new(params.wheels)?,
+                gain_l: 1.0 + params.scale_error_l,
+                gain_r: 1.0 + params.scale_error_r,
             },
             state: OdometerState::default(),
         })
@@ -163,10 +176,9 @@ impl OdometerModel {
         Ok(v.abs() * 0.5 * (f.left_m + f.right_m))
     }
 
-    /// [`SensorModel::ideal`] with validation: geometry, speed term and scale, no
-    /// quantisation. A typed error for non-finite truth, a curvature the geometry cannot
-    /// make, or `1 + aV² ≤ 0`.
-    pub fn try_ideal(&self, truth: &WheelMotion) -> Result<WheelDistances> {
+    /// Geometry, speed term and scale, no quantisation (see [`SensorModel::ideal`]).
+    fn deterministic(&self, truth: &WheelMotion) -> Result<WheelDistances> {
+        truth.check_finite()?;
         let paths = self
             .coeffs
             .geometry
@@ -190,12 +202,10 @@ impl OdometerModel {
         })
     }
 
-    /// [`SensorModel::sample`] with validation: the step's raw distances after pulse
-    /// quantisation (each a whole number of pulses; the remainder carries over to the next
-    /// step). On error the state is unchanged.
-    pub fn try_sample(&mut self, truth: &WheelMotion, dt_s: f64) -> Result<WheelDistances> {
+    /// One quantised step (see [`SensorModel::sample`]); on error the state is unchanged.
+    fn advance(&mut self, truth: &WheelMotion, dt_s: f64) -> Result<WheelDistances> {
+        let d = self.deterministic(truth)?;
         check_dt(dt_s)?;
-        let d = self.try_ideal(truth)?;
         let raw_l = check_finite("accumulated left distance", self.state.raw_l_m + d.left_m)?;
         let raw_r = check_finite("accumulated right distance", self.state.raw_r_m + d.right_m)?;
         let Some(dpp) = self.params.dist_per_pulse_m else {
@@ -244,7 +254,7 @@ impl OdometerModel {
         dt_s: f64,
     ) -> Result<WheelSample> {
         check_finite("timestamp t_s", t_s)?;
-        self.try_sample(truth, dt_s)?;
+        self.advance(truth, dt_s)?;
         let c = self.cumulative_m();
         Ok(WheelSample {
             t_s,
@@ -258,28 +268,25 @@ impl SensorModel for OdometerModel {
     type Truth = WheelMotion;
     type Reading = WheelDistances;
 
-    /// Raw distances of one step without quantisation; NaN for invalid input (see
-    /// [`OdometerModel::try_ideal`]).
-    fn ideal(&self, truth: &WheelMotion) -> WheelDistances {
-        self.try_ideal(truth).unwrap_or(WheelDistances {
-            left_m: f64::NAN,
-            right_m: f64::NAN,
-        })
+    /// Raw distances of one step: geometry, speed term and scale, no quantisation. A typed
+    /// error for a non-finite truth, a curvature the geometry cannot make, `1 + aV² ≤ 0`, or
+    /// a reading too large to represent.
+    fn ideal(&self, truth: &WheelMotion) -> Result<WheelDistances> {
+        self.deterministic(truth)
     }
 
-    /// One quantised step. The odometer has no random error of its own here (random slip
-    /// belongs to the vehicle simulation), so `noise` is not drawn from. NaN for invalid
-    /// input; see [`OdometerModel::try_sample`].
+    /// One step's raw distances after pulse quantisation (each a whole number of pulses; the
+    /// remainder carries over to the next step). The odometer has no random error of its own
+    /// here (random slip belongs to the vehicle simulation), so `noise` is not drawn from.
+    /// On error (as for [`SensorModel::ideal`], or `dt_s` not positive and finite) the state
+    /// is unchanged.
     fn sample(
         &mut self,
         truth: &WheelMotion,
         dt_s: f64,
         _noise: &mut dyn NoiseSource,
-    ) -> WheelDistances {
-        self.try_sample(truth, dt_s).unwrap_or(WheelDistances {
-            left_m: f64::NAN,
-            right_m: f64::NAN,
-        })
+    ) -> Result<WheelDistances> {
+        self.advance(truth, dt_s)
     }
 }
 
@@ -333,13 +340,13 @@ mod tests {
         ) {
             let m = OdometerModel::new(p).unwrap();
             let truth = WheelMotion { ds_m: ds, curvature_per_m: u * k_max(&m), speed_mps: v };
-            let raw = m.ideal(&truth);
+            let raw = m.ideal(&truth).unwrap();
             let raw = OdometerRaw {
                 dist_l_m: raw.left_m,
                 dist_r_m: raw.right_m,
                 wheel_speed_mps: m.wheel_speed_mps(&truth).unwrap(),
             };
-            let paths = m.true_calibration().apply(&raw);
+            let paths = m.true_calibration().apply(&raw).unwrap();
             let want = m.geometry().wheel_paths_m(ds, truth.curvature_per_m).unwrap();
             prop_assert!((paths.left_m - want.left_m).abs() < 1e-12 * (1.0 + ds.abs()));
             prop_assert!((paths.right_m - want.right_m).abs() < 1e-12 * (1.0 + ds.abs()));
@@ -357,7 +364,7 @@ mod tests {
             let with = OdometerModel::new(OdometerParams { speed_coeff_s2_per_m2: a, ..OdometerParams::perfect(w) }).unwrap();
             let without = OdometerModel::new(OdometerParams::perfect(w)).unwrap();
             let truth = WheelMotion { ds_m: 1.0, curvature_per_m: u * k_max(&with), speed_mps: v };
-            let (d1, d0) = (with.ideal(&truth), without.ideal(&truth));
+            let (d1, d0) = (with.ideal(&truth).unwrap(), without.ideal(&truth).unwrap());
             let vw = with.wheel_speed_mps(&truth).unwrap();
             let ratio = (d1.left_m - d1.right_m) / (d0.left_m - d0.right_m);
             prop_assert!((ratio - (1.0 + a * vw * vw)).abs() < 1e-9);
@@ -378,7 +385,7 @@ mod tests {
             }).unwrap();
             let (mut sum_l, mut sum_r) = (0.0, 0.0);
             for (ds, k) in steps {
-                let d = m.try_sample(&WheelMotion { ds_m: ds, curvature_per_m: k, speed_mps: 10.0 }, 0.1).unwrap();
+                let d = m.sample(&WheelMotion { ds_m: ds, curvature_per_m: k, speed_mps: 10.0 }, 0.1, &mut ZeroNoise).unwrap();
                 for x in [d.left_m, d.right_m] {
                     let n = x / dpp;
                     prop_assert!((n - n.round()).abs() < 1e-6, "{x} is not whole pulses of {dpp}");
@@ -410,16 +417,28 @@ mod tests {
             let before = m;
             let truth = WheelMotion { ds_m: ds, curvature_per_m: k, speed_mps: v };
             let finite = ds.is_finite() && k.is_finite() && v.is_finite();
-            let r = m.try_sample(&truth, dt);
+            let r = m.sample(&truth, dt, &mut ZeroNoise);
             if !(finite && dt.is_finite() && dt > 0.0) {
                 prop_assert!(r.is_err());
+            }
+            if !finite {
+                let non_finite = matches!(r, Err(Error::NonFinite { .. }));
+                prop_assert!(non_finite, "{r:?}");
+                let non_finite = matches!(m.ideal(&truth), Err(Error::NonFinite { .. }));
+                prop_assert!(non_finite);
             }
             match r {
                 Ok(d) => prop_assert!(d.left_m.is_finite() && d.right_m.is_finite()),
                 Err(_) => prop_assert_eq!(m, before),
             }
-            let _ = m.sample(&truth, dt, &mut ZeroNoise);
-            let _ = m.sample_cumulative(dt, &truth, 0.1);
+            if let Ok(d) = m.ideal(&truth) {
+                prop_assert!(d.left_m.is_finite() && d.right_m.is_finite());
+            }
+            let before = m;
+            match m.sample_cumulative(dt, &truth, 0.1) {
+                Ok(s) => prop_assert!(s.dist_l_m.is_finite() && s.dist_r_m.is_finite()),
+                Err(_) => prop_assert_eq!(m, before),
+            }
             let _ = OdometerModel::new(OdometerParams { dist_per_pulse_m: Some(ds), ..OdometerParams::perfect(w) });
         }
     }
@@ -455,6 +474,6 @@ mod tests {
             curvature_per_m: 0.1,
             speed_mps: 20.0,
         };
-        assert!(matches!(m.try_ideal(&fast), Err(Error::OutOfRange { .. })));
+        assert!(matches!(m.ideal(&fast), Err(Error::OutOfRange { .. })));
     }
 }

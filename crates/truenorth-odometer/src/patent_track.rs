@@ -22,10 +22,9 @@
 
 #[allow(unused_imports)]
 use truenorth_core::Float as _;
-use truenorth_core::{Error, Result, check_finite};
+use truenorth_core::{Error, Result, Validate, check_finite, check_positive, check_range};
 
 use crate::{AckermannParams, EffectiveTrack};
-use truenorth_core::check_positive;
 
 /// US 4,788,645 eq. 14 for one vehicle, with its derived coefficients.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -46,10 +45,11 @@ impl PatentAckermannTrack {
     pub fn new(wheelbase_m: f64, track_m: f64, pitman_ratio: f64) -> Result<Self> {
         check_positive("wheelbase_m", wheelbase_m)?;
         check_positive("front track_m", track_m)?;
-        let p = check_finite("pitman_ratio", pitman_ratio)?;
-        if !(0.0..1.0).contains(&p) {
+        // P = 1 would leave no kingpin track at all; check_range includes its upper end.
+        let p = check_range("pitman_ratio", pitman_ratio, 0.0, 1.0)?;
+        if p == 1.0 {
             return Err(Error::OutOfRange {
-                what: "pitman_ratio",
+                what: "pitman_ratio (must be below 1)",
                 value: p,
                 min: 0.0,
                 max: 1.0,

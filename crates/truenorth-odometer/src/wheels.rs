@@ -2,10 +2,9 @@
 //! vehicle, the odometer model and the heading computation.
 
 use serde::{Deserialize, Serialize};
-use truenorth_core::{Result, check_finite};
+use truenorth_core::{Result, Validate, check_finite, check_positive};
 
 use crate::{AckermannGeometry, AckermannParams, RigidMotion};
-use truenorth_core::check_positive;
 
 /// Which pair of wheels the odometer senses (the parameters; see [`WheelGeometry`]).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -18,6 +17,17 @@ pub enum OdometerWheels {
     },
     /// Ackermann-steered front wheels.
     Front(AckermannParams),
+}
+
+impl Validate for OdometerWheels {
+    /// A rear track positive and finite, or valid front-axle dimensions
+    /// ([`AckermannParams`]).
+    fn validate(&self) -> Result<()> {
+        match self {
+            Self::Rear { track_m } => check_positive("rear track_m", *track_m).map(drop),
+            Self::Front(p) => p.validate(),
+        }
+    }
 }
 
 /// The built geometry of [`OdometerWheels`]: how far each wheel rolls for a given motion of
@@ -109,6 +119,15 @@ pub struct WheelMotion {
     pub curvature_per_m: f64,
     /// Speed of the rear-axle centre, m/s (its magnitude sets the `(1 + aV²)` error).
     pub speed_mps: f64,
+}
+
+impl WheelMotion {
+    /// Checks that the distance, curvature and speed are finite.
+    pub fn check_finite(&self) -> Result<()> {
+        check_finite("ds_m", self.ds_m)?;
+        check_finite("curvature_per_m", self.curvature_per_m)?;
+        check_finite("speed_mps", self.speed_mps).map(drop)
+    }
 }
 
 #[cfg(test)]

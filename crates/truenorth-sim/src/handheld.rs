@@ -5,7 +5,9 @@ use core::f64::consts::TAU;
 
 use nalgebra::{UnitQuaternion, Vector3};
 use serde::{Deserialize, Serialize};
-use truenorth_core::{Error, NoiseSource, Result, STANDARD_GRAVITY_MPS2, SplitMix64, check_range};
+use truenorth_core::{
+    NoiseSource, Result, STANDARD_GRAVITY_MPS2, SplitMix64, Validate, check_positive, check_range,
+};
 
 /// Ground truth of a hand-held motion at one instant.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -14,7 +16,7 @@ pub struct MotionTruth {
     pub t_s: f64,
     /// Attitude, body → NED.
     pub attitude: UnitQuaternion<f64>,
-    /// Angular rate in body axes, rad/s.
+    /// Angular rate in body axes at `t_s` (instantaneous, not a mean over a step), rad/s.
     pub gyr_rps: Vector3<f64>,
     /// Linear acceleration in NED, m/s².
     pub accel_ned_mps2: Vector3<f64>,
@@ -22,7 +24,7 @@ pub struct MotionTruth {
     pub specific_force_mps2: Vector3<f64>,
 }
 
-/// Parameters of the motion.
+/// Parameters of the motion (`Default`: one minute at 100 Hz, 1 rad/s and 0.5 m/s² peaks).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct HandheldParams {
     /// Length, seconds.
@@ -49,6 +51,22 @@ impl Default for HandheldParams {
     }
 }
 
+impl Validate for HandheldParams {
+    /// Duration and rate positive and finite, amplitudes finite and ≥ 0.
+    fn validate(&self) -> Result<()> {
+        check_positive("duration_s", self.duration_s)?;
+        check_positive("rate_hz", self.rate_hz)?;
+        check_range("rate_amplitude_rps", self.rate_amplitude_rps, 0.0, f64::MAX)?;
+        check_range(
+            "accel_amplitude_mps2",
+            self.accel_amplitude_mps2,
+            0.0,
+            f64::MAX,
+        )?;
+        Ok(())
+    }
+}
+
 /// One sinusoid per axis and term: frequency (Hz), phase (rad).
 #[derive(Clone, Copy)]
 struct Tone {
@@ -61,17 +79,10 @@ const TONES: usize = 3;
 /// Generates the motion. Angular rate is a sum of three sinusoids per axis between 0.05 and
 /// 1 Hz (head and hand motion is mostly below 1 Hz), integrated exactly per step as a
 /// rotation vector at the mid-step rate; the translation is a zero-mean oscillation.
+/// [`MotionTruth::gyr_rps`] is the analytic body rate at the sample time (what a gyro
+/// following the instantaneous-rate convention reads).
 pub fn handheld_motion(p: &HandheldParams) -> Result<Vec<MotionTruth>> {
-    for (what, v) in [("duration_s", p.duration_s), ("rate_hz", p.rate_hz)] {
-        if !(v.is_finite() && v > 0.0) {
-            return Err(Error::OutOfRange {
-                what,
-                value: v,
-                min: f64::MIN_POSITIVE,
-                max: f64::INFINITY,
-            });
-        }
-    }
+    p.validate()?;
     let mut rng = SplitMix64::new(p.seed);
     let mut tone = || Tone {
         freq_hz: 0.05 + 0.95 * rng.uniform(),

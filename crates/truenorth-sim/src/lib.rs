@@ -7,22 +7,31 @@
 //! for orientation filters. [`vehicle_streams`] and [`imu_streams`] run the truth through the
 //! sensor crates' forward models (gyro, odometer, compass, accelerometer) with errors from
 //! [`VehicleSensorParams`] / [`ImuSensorParams`]. Everything is deterministic for a given seed.
+//! Gyro samples are the instantaneous rate at their timestamp (the convention of
+//! [`truenorth_core::GyroSample`]), so a trapezoid integrator tracks the heading to second
+//! order in the sample interval.
 //!
 //! ```
-//! use truenorth_sim::{RouteBuilder, simulate};
+//! use truenorth_sim::{RouteBuilder, VehicleSensorParams, simulate, vehicle_streams};
 //!
 //! let route = RouteBuilder::at_speed(5.0)?.turn(2.0 * std::f64::consts::PI, 10.0)?.build();
-//! let truth = simulate(&route, 0.0, 50.0).unwrap();
+//! let truth = simulate(&route, 0.0, 50.0)?;
 //! let last = truth.last().unwrap();
 //! // One full circle: back where it started, having turned 360°.
 //! assert!(last.north_m.hypot(last.east_m) < 1e-6);
 //! assert!((last.heading_unwrapped_rad.to_degrees() - 360.0).abs() < 1e-6);
+//!
+//! // The sensors of a typical installation, one sample per truth sample.
+//! let samples = vehicle_streams(&truth, &VehicleSensorParams::typical(), 7)?;
+//! assert_eq!(samples.len(), truth.len());
+//! assert!(samples.iter().all(|s| s.gyr_z_rps.is_some() && s.mag.is_some()));
 //! # Ok::<(), truenorth_core::Error>(())
 //! ```
 
 mod handheld;
 mod route;
 pub mod scenario;
+pub mod shared_data;
 mod streams;
 mod vehicle;
 

@@ -1,4 +1,9 @@
 //! Sensor streams: ground truth run through the sensor crates' forward models.
+//!
+//! Gyro convention (the one [`truenorth_core::GyroSample`] documents and every integrator
+//! assumes): each gyro sample is the instantaneous true rate at its timestamp, plus the
+//! sensor's errors. A sample holding the mean rate over the preceding step would, when
+//! integrated by the trapezoid rule, lag the truth by half a sample.
 
 use nalgebra::{Matrix2, Matrix3, Rotation2, Vector2, Vector3};
 use serde::{Deserialize, Serialize};
@@ -7,14 +12,18 @@ use truenorth_compass::{
     AttitudeTruth, HeadingTruth, MagnetometerModel2d, MagnetometerModel3d, earth_field_ned,
 };
 use truenorth_core::{
-    AccelSample, EulerZyx, ImuSample, Result, SensorModel, SplitMix64, VehicleSample, angle_diff,
+    AccelSample, EulerZyx, ImuSample, Result, SensorModel, SplitMix64, Validate, VehicleSample,
+    angle_diff, check_finite, check_finite2, check_finite3, check_positive, check_range,
 };
-use truenorth_gyro::{Gyro3Model, GyroAxisModel, GyroAxisParams, Rate3Truth, RateTruth};
+use truenorth_gyro::{
+    Gyro3Model, Gyro3Params, GyroAxisModel, GyroAxisParams, Rate3Truth, RateTruth,
+};
 use truenorth_odometer::{OdometerModel, OdometerParams, OdometerWheels, WheelMotion};
 
 use crate::{MotionTruth, VehicleTruth};
 
-/// The errors of a land vehicle's navigation sensors.
+/// The true errors of a land vehicle's navigation sensors (`*Params`, like every forward
+/// model's: what the sensors actually do, which the calibrators must find).
 ///
 /// The simulated heading is the magnetic heading (declination zero): add a declination at the
 /// edge if a scenario needs true north.
@@ -34,6 +43,23 @@ pub struct VehicleSensorParams {
     pub compass_noise: f64,
     /// Earth's horizontal field, µT.
     pub horizontal_field: f64,
+}
+
+impl Validate for VehicleSensorParams {
+    /// Each sensor's parameters valid; temperature and compass terms finite, noise ≥ 0 and
+    /// the field positive. (A singular soft iron is refused when the streams are made.)
+    fn validate(&self) -> Result<()> {
+        self.gyro.validate()?;
+        check_finite("gyro_temp_c", self.gyro_temp_c)?;
+        self.odometer.validate()?;
+        check_finite2("compass_hard_iron", &self.compass_hard_iron)?;
+        for &x in self.compass_soft_iron.iter() {
+            check_finite("compass_soft_iron entry", x)?;
+        }
+        check_range("compass_noise", self.compass_noise, 0.0, f64::MAX)?;
+        check_positive("horizontal_field", self.horizontal_field)?;
+        Ok(())
+    }
 }
 
 /// A soft-iron distortion with principal gains `major` and `minor` whose major axis is rotated
@@ -76,11 +102,16 @@ impl VehicleSensorParams {
 
 /// Runs `truth` through the vehicle's sensor models. One sample per truth sample; random
 /// errors drawn from `seed`, so the same inputs always give the same stream.
+///
+/// The gyro reads the instantaneous yaw rate at each sample time (speed × curvature there),
+/// the odometer the wheels' travel over each step, and the compass the field at each sample
+/// time.
 pub fn vehicle_streams(
     truth: &[VehicleTruth],
     params: &VehicleSensorParams,
     seed: u64,
 ) -> Result<Vec<VehicleSample>> {
+    params.validate()?;
     let mut rng = SplitMix64::new(seed);
     let mut gyro = GyroAxisModel::new(params.gyro)?;
     let mut odo = OdometerModel::new(params.odometer)?;
@@ -96,16 +127,16 @@ pub fn vehicle_streams(
             heading_rad: s.heading_rad,
             horizontal_field: params.horizontal_field,
         };
+        let rate = RateTruth {
+            rate_rps: s.yaw_rate_rps,
+            temp_c: params.gyro_temp_c,
+        };
         let (gyr, mag, dist) = match prev {
             None => {
                 compass.set_time_s(s.t_s);
-                let rate = RateTruth {
-                    rate_rps: s.yaw_rate_rps,
-                    temp_c: params.gyro_temp_c,
-                };
                 (
-                    gyro.ideal(&rate),
-                    compass.ideal(&heading),
+                    gyro.ideal(&rate)?,
+                    compass.ideal(&heading)?,
                     odo.cumulative_m(),
                 )
             }
@@ -113,20 +144,17 @@ pub fn vehicle_streams(
                 let dt = s.t_s - p.t_s;
                 let ds = s.distance_m - p.distance_m;
                 let dpsi = angle_diff(s.heading_rad, p.heading_rad);
-                // The step's mean curvature and rate make the wheels and gyro agree with the
-                // truth's heading change exactly, whatever happened inside the step.
+                // The wheels measure distance travelled, an integral over the step: the
+                // step's mean curvature makes them agree with the truth's heading change
+                // exactly, whatever happened inside the step.
                 let motion = WheelMotion {
                     ds_m: ds,
                     curvature_per_m: if ds > 0.0 { dpsi / ds } else { 0.0 },
                     speed_mps: ds / dt,
                 };
-                odo.try_sample(&motion, dt)?;
-                let rate = RateTruth {
-                    rate_rps: dpsi / dt,
-                    temp_c: params.gyro_temp_c,
-                };
-                let g = gyro.try_sample(&rate, dt, &mut rng)?;
-                let m = compass.sample(&heading, dt, &mut rng);
+                odo.sample(&motion, dt, &mut rng)?;
+                let g = gyro.sample(&rate, dt, &mut rng)?;
+                let m = compass.sample(&heading, dt, &mut rng)?;
                 (g, m, odo.cumulative_m())
             }
         };
@@ -152,7 +180,7 @@ pub fn vehicle_accel_stream(
     seed: u64,
 ) -> Result<Vec<AccelSample>> {
     let mut rng = SplitMix64::new(seed);
-    let accel = AccelModel::new(*params)?;
+    let mut accel = AccelModel::new(*params)?;
     let mut out = Vec::with_capacity(truth.len());
     let mut prev_t: Option<f64> = None;
     for s in truth {
@@ -172,8 +200,8 @@ pub fn vehicle_accel_stream(
             ),
         };
         let reading = match prev_t {
-            None => accel.ideal(&a),
-            Some(p) => accel.try_sample(&a, s.t_s - p, &mut rng)?,
+            None => accel.ideal(&a)?,
+            Some(p) => accel.sample(&a, s.t_s - p, &mut rng)?,
         };
         out.push(AccelSample {
             t_s: s.t_s,
@@ -184,7 +212,7 @@ pub fn vehicle_accel_stream(
     Ok(out)
 }
 
-/// The errors of a 9-axis IMU.
+/// The true errors of a 9-axis IMU (`*Params`, like every forward model's).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct ImuSensorParams {
     /// Each gyro axis.
@@ -230,15 +258,39 @@ impl ImuSensorParams {
     }
 }
 
+impl Validate for ImuSensorParams {
+    /// Each sensor's parameters valid; temperature, magnetometer terms and inclination
+    /// finite, noise ≥ 0 and the field positive. (A singular soft iron is refused when the
+    /// streams are made.)
+    fn validate(&self) -> Result<()> {
+        self.gyro.validate()?;
+        check_finite("gyro_temp_c", self.gyro_temp_c)?;
+        self.accel.validate()?;
+        check_finite3("mag_hard_iron", &self.mag_hard_iron)?;
+        for &x in self.mag_soft_iron.iter() {
+            check_finite("mag_soft_iron entry", x)?;
+        }
+        check_range("mag_noise", self.mag_noise, 0.0, f64::MAX)?;
+        check_positive("field_total", self.field_total)?;
+        check_finite("inclination_rad", self.inclination_rad)?;
+        Ok(())
+    }
+}
+
 /// Runs hand-held motion truth through a 9-axis IMU model. Random errors drawn from `seed`.
+///
+/// The gyros read the instantaneous body rate at each sample time
+/// ([`MotionTruth::gyr_rps`]), the accelerometers and magnetometers the specific force and
+/// field there.
 pub fn imu_streams(
     truth: &[MotionTruth],
     params: &ImuSensorParams,
     seed: u64,
 ) -> Result<Vec<ImuSample>> {
+    params.validate()?;
     let mut rng = SplitMix64::new(seed);
-    let mut gyro = Gyro3Model::uniform(params.gyro)?;
-    let accel = AccelModel::new(params.accel)?;
+    let mut gyro = Gyro3Model::new(Gyro3Params::uniform(params.gyro))?;
+    let mut accel = AccelModel::new(params.accel)?;
     let mut mag =
         MagnetometerModel3d::new(params.mag_hard_iron, params.mag_soft_iron, params.mag_noise)?;
     let field_ned = earth_field_ned(params.field_total, params.inclination_rad);
@@ -260,23 +312,22 @@ pub fn imu_streams(
         let (g, a, m) = match prev_t {
             None => {
                 mag.set_time_s(s.t_s);
-                (gyro.ideal(&rate), accel.ideal(&acc_truth), mag.ideal(&att))
+                (
+                    gyro.ideal(&rate)?,
+                    accel.ideal(&acc_truth)?,
+                    mag.ideal(&att)?,
+                )
             }
             Some(p) => {
                 let dt = s.t_s - p;
                 (
-                    gyro.try_sample(&rate, dt, &mut rng)?,
-                    accel.try_sample(&acc_truth, dt, &mut rng)?,
-                    mag.sample(&att, dt, &mut rng),
+                    gyro.sample(&rate, dt, &mut rng)?,
+                    accel.sample(&acc_truth, dt, &mut rng)?,
+                    mag.sample(&att, dt, &mut rng)?,
                 )
             }
         };
-        out.push(ImuSample {
-            t_s: s.t_s,
-            gyr_rps: g,
-            acc_mps2: a,
-            mag: Some(m),
-        });
+        out.push(ImuSample::new_9d(s.t_s, g, a, m));
         prev_t = Some(s.t_s);
     }
     Ok(out)

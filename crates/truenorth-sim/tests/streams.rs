@@ -3,7 +3,7 @@
 use nalgebra::{Matrix2, Matrix3, Vector2, Vector3};
 use proptest::prelude::*;
 use truenorth_accel::AccelParams;
-use truenorth_core::angle_diff;
+use truenorth_core::{Validate, angle_diff};
 use truenorth_gyro::GyroAxisParams;
 use truenorth_odometer::{OdometerParams, OdometerWheels};
 use truenorth_sim::{
@@ -31,9 +31,9 @@ fn perfect_vehicle_sensors_reproduce_the_truth() {
     for k in 1..truth.len() {
         let (a, b) = (&truth[k - 1], &truth[k]);
         let dpsi = angle_diff(b.heading_rad, a.heading_rad);
-        // Gyro: mean rate over the step.
+        // Gyro: the instantaneous rate at the sample time.
         let g = s[k].gyr_z_rps.unwrap();
-        assert!((g * (b.t_s - a.t_s) - dpsi).abs() < 1e-12);
+        assert_eq!(g, b.speed_mps * b.curvature_per_m);
         // Odometer (rear wheels): (D_L − D_R)/T is the heading change; the mean is the distance.
         let dl = s[k].dist_l_m - s[k - 1].dist_l_m;
         let dr = s[k].dist_r_m - s[k - 1].dist_r_m;
@@ -62,10 +62,10 @@ fn perfect_imu_reproduces_the_truth() {
     };
     let s = imu_streams(&truth, &p, 1).unwrap();
     for (t, m) in truth.iter().zip(&s) {
-        assert!((m.gyr_rps - t.gyr_rps).norm() < 1e-12);
-        assert!((m.acc_mps2 - t.specific_force_mps2).norm() < 1e-9);
+        assert!((m.gyr_rps.as_xyz().unwrap() - t.gyr_rps).norm() < 1e-12);
+        assert!((m.acc_mps2.as_xyz().unwrap() - t.specific_force_mps2).norm() < 1e-9);
         // The field, rotated back to NED, is the earth's field.
-        let ned = t.attitude * m.mag.unwrap();
+        let ned = t.attitude * m.mag.as_xyz().unwrap();
         let expect = Vector3::new(
             50.0 * 60f64.to_radians().cos(),
             0.0,
@@ -95,6 +95,48 @@ fn typical_compass_is_undone_by_its_true_calibration() {
     for (t, m) in truth.iter().zip(&s) {
         assert!(angle_diff(cal.heading_rad(&m.mag.unwrap()), t.heading_rad).abs() < 1e-9);
     }
+}
+
+/// Invalid sensor parameters are refused before any stream is made.
+#[test]
+fn invalid_sensor_params_are_typed_errors() {
+    let truth = simulate(&scenario::parking().unwrap(), 0.0, 20.0).unwrap();
+    let bad = [
+        VehicleSensorParams {
+            gyro_temp_c: f64::NAN,
+            ..VehicleSensorParams::typical()
+        },
+        VehicleSensorParams {
+            compass_noise: -1.0,
+            ..VehicleSensorParams::typical()
+        },
+        VehicleSensorParams {
+            horizontal_field: f64::INFINITY,
+            ..VehicleSensorParams::typical()
+        },
+    ];
+    for p in bad {
+        assert!(p.validate().is_err(), "{p:?}");
+        assert!(vehicle_streams(&truth, &p, 1).is_err(), "{p:?}");
+    }
+    let motion = handheld_motion(&HandheldParams {
+        duration_s: 1.0,
+        ..Default::default()
+    })
+    .unwrap();
+    let p = ImuSensorParams {
+        inclination_rad: f64::NAN,
+        ..ImuSensorParams::typical()
+    };
+    assert!(matches!(
+        imu_streams(&motion, &p, 1),
+        Err(truenorth_core::Error::NonFinite { .. })
+    ));
+    let nan_amplitude = HandheldParams {
+        rate_amplitude_rps: f64::NAN,
+        ..Default::default()
+    };
+    assert!(handheld_motion(&nan_amplitude).is_err());
 }
 
 #[test]

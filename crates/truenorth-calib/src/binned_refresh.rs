@@ -1,0 +1,807 @@
+//! The full-set update of the binned ellipse (EP 0634001 claims 1–2, 5, 7–9, 12), written so
+//! that it can run in bounded slices: interpolation of the full set, origin iteration with
+//! re-binning, and the search for the ellipse parameters.
+//!
+//! [`RefreshJob`] does exactly the arithmetic of a refresh run in one go, in the same order,
+//! but stops after a given amount of work and resumes on the next call. A calibrator starts a
+//! job on a copy of its bins and lets each push advance it by one slice, so no push pays for
+//! the whole update; the copy keeps the estimate in use consistent until the job completes
+//! (double buffering). The work is counted in *bin operations* (one bin's share of one pass:
+//! one interpolation partner tested, one bin re-binned, one bin's term of `S(θ)`), which
+//! makes the slicing deterministic: the same pushes give the same slices on every machine.
+
+// `!(x <= limit)` and `!(x > 0.0)` are deliberate: they are true for NaN, so a NaN fails
+// every check instead of slipping through one.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
+use core::f64::consts::{PI, TAU};
+
+use nalgebra::Vector2;
+use serde::{Deserialize, Serialize};
+use truenorth_compass::EllipsePhasors;
+use truenorth_core::{Error, Result, angle_diff, check_finite2, wrap_two_pi};
+
+#[allow(unused_imports)]
+use truenorth_core::Float as _;
+
+/// Most bins a calibrator can have (fixed arrays keep it allocation-free).
+pub const MAX_BINS: usize = 128;
+
+/// What a bin holds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum BinState {
+    /// Nothing yet: the full set interpolates it.
+    Empty,
+    /// Real readings.
+    Measured,
+    /// Regenerated from stored parameters (claim 13); the next reading replaces it.
+    Regenerated,
+}
+
+/// One direction bin: its reading (or running mean of readings), how many readings it
+/// holds, and where they came from.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub(crate) struct Bin {
+    pub value: Vector2<f64>,
+    pub count: u32,
+    pub state: BinState,
+}
+
+pub(crate) const EMPTY: Bin = Bin {
+    value: Vector2::new(0.0, 0.0),
+    count: 0,
+    state: BinState::Empty,
+};
+
+/// The bins of a calibrator (the first `n` are in use).
+pub(crate) type Bins = [Bin; MAX_BINS];
+
+/// Number of `S(θ)` evaluations of the parameter search: a 1° scan of [0, π), the two
+/// starting points and 60 steps of the golden section, and the two weighted sums.
+const EVALUATIONS: usize = 180 + 2 + 60 + 2;
+
+/// Cost, in bin operations, of one bin's share of a pass that needs a trigonometric
+/// function per bin (polar form, re-binning, placing a full-set value): about eight times
+/// one bin's term of `S(θ)`.
+const TRIG_COST: usize = 8;
+
+/// `RefreshJob::slot` of a bin that holds no reading off the origin.
+const NO_READING: u8 = u8::MAX;
+
+/// Steps of the golden-section search.
+const GOLDEN_STEPS: usize = 60;
+
+/// The bin of direction `d` among `n`, or `None` for a zero or non-finite `d`.
+pub(crate) fn bin_index(d: &Vector2<f64>, n: usize) -> Option<usize> {
+    if !(d.x.is_finite() && d.y.is_finite()) || (d.x == 0.0 && d.y == 0.0) {
+        return None;
+    }
+    Some(((wrap_two_pi(d.y.atan2(d.x)) / TAU * n as f64) as usize).min(n - 1))
+}
+
+/// Puts reading `p` in its bin about `origin` (claims 1, 3, 4): it replaces what a bin
+/// that holds no measurement has; otherwise it enters the running mean of the last
+/// `memory` readings.
+pub(crate) fn bin_reading(
+    bins: &mut Bins,
+    n: usize,
+    origin: &Vector2<f64>,
+    p: &Vector2<f64>,
+    memory: u32,
+) {
+    let Some(i) = bin_index(&(p - origin), n) else {
+        return;
+    };
+    let b = &mut bins[i];
+    if b.state != BinState::Measured {
+        *b = Bin {
+            value: *p,
+            count: 1,
+            state: BinState::Measured,
+        };
+    } else {
+        b.count = b.count.saturating_add(1);
+        let w = 1.0 / f64::from(b.count.min(memory));
+        b.value += (p - b.value) * w;
+    }
+}
+
+/// Moves every stored reading to its bin about `new_origin`, merging readings that land in
+/// one bin (weighted by their counts) — the "adjusting" of claim 1.
+pub(crate) fn rebin(bins: &mut Bins, n: usize, new_origin: &Vector2<f64>) {
+    let old = *bins;
+    *bins = [EMPTY; MAX_BINS];
+    for b in old[..n].iter().filter(|b| b.state != BinState::Empty) {
+        let Some(i) = bin_index(&(b.value - new_origin), n) else {
+            continue;
+        };
+        let t = &mut bins[i];
+        if t.state == BinState::Empty {
+            *t = *b;
+        } else {
+            let (wa, wb) = (f64::from(t.count.max(1)), f64::from(b.count.max(1)));
+            t.value = (t.value * wa + b.value * wb) / (wa + wb);
+            t.count = t.count.saturating_add(b.count);
+            if b.state == BinState::Measured {
+                t.state = BinState::Measured;
+            }
+        }
+    }
+}
+
+/// Bins holding real or regenerated readings.
+pub(crate) fn filled(bins: &Bins, n: usize) -> usize {
+    bins[..n]
+        .iter()
+        .filter(|b| b.state != BinState::Empty)
+        .count()
+}
+
+/// `∫₀ˣ |cos t| dt = 2k + (−1)ᵏ sin x` with `k = round(x/π)`: continuous and exact. The
+/// caller gives `sin x` (computed by the angle-difference formula from values it keeps).
+#[inline]
+fn int_abs_cos(x: f64, sin_x: f64) -> f64 {
+    let k = (x / PI).round();
+    let sign = if (k as i64) % 2 == 0 { 1.0 } else { -1.0 };
+    2.0 * k + sign * sin_x
+}
+
+/// Where the search for the ellipse parameters stands.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Search {
+    /// The 1° scan of [0, π): next step and the best so far.
+    Scan { k: usize, best: f64, best_s: f64 },
+    /// The golden section on the bracket around the best scan point (before its two
+    /// starting evaluations when `sc`/`sd` are `None`).
+    Golden {
+        step: usize,
+        a: f64,
+        b: f64,
+        c: f64,
+        d: f64,
+        sc: Option<f64>,
+        sd: Option<f64>,
+    },
+    /// The two weighted sums about Ω.
+    Sums { omega: f64, sx: Option<f64> },
+}
+
+/// The seed's ellipse parameters of a full set (claims 7–9), one `S(θ)` evaluation at a time
+/// (see [`ellipse_parameters`] for the method).
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct ParamSearch {
+    origin: Vector2<f64>,
+    n: usize,
+    /// `R_i²` and `R_i³` of the full set about the origin.
+    r2: [f64; MAX_BINS],
+    r3: [f64; MAX_BINS],
+    /// The bin boundaries `β_j = j·Δ` (`Δ = 2π/N`, `j = 0..=N`) with their sines and
+    /// cosines, so that each evaluation of `S(θ)` needs one `sin_cos` instead of two sines
+    /// per bin.
+    edge: [f64; MAX_BINS + 1],
+    edge_sin: [f64; MAX_BINS + 1],
+    edge_cos: [f64; MAX_BINS + 1],
+    sum_w: f64,
+    search: Search,
+}
+
+impl ParamSearch {
+    /// Checks the full set and prepares the search.
+    fn new(full: &[Vector2<f64>], origin: &Vector2<f64>) -> Result<Self> {
+        let n = full.len();
+        let mut sum_w = 0.0;
+        let (mut r2, mut r3) = ([0.0; MAX_BINS], [0.0; MAX_BINS]);
+        for (i, p) in full.iter().enumerate() {
+            check_finite2("binned-ellipse full set", p)?;
+            sum_w += (p - origin).norm_squared();
+            let r = (p - origin).norm();
+            r2[i] = r.powi(2);
+            r3[i] = r.powi(3);
+        }
+        if !(sum_w > 0.0 && sum_w.is_finite()) || n < 4 {
+            return Err(Error::Degenerate {
+                reason: "all binned readings coincide with the origin; the compass did not turn",
+            });
+        }
+        let half = PI / n as f64;
+        let mut edge = [0.0; MAX_BINS + 1];
+        let (mut edge_sin, mut edge_cos) = ([0.0; MAX_BINS + 1], [0.0; MAX_BINS + 1]);
+        for j in 0..=n {
+            edge[j] = j as f64 * 2.0 * half;
+            (edge_sin[j], edge_cos[j]) = edge[j].sin_cos();
+        }
+        Ok(Self {
+            origin: *origin,
+            n,
+            r2,
+            r3,
+            edge,
+            edge_sin,
+            edge_cos,
+            sum_w,
+            search: Search::Scan {
+                k: 0,
+                best: 0.0,
+                best_s: f64::INFINITY,
+            },
+        })
+    }
+
+    /// `Σ R_i^power · mean_bin |cos(φ − θ)|` (`power` 2 or 3), the mean over bin `i`
+    /// being `(G(β_{i+1} − θ) − G(β_i − θ))/Δ` with `G(x) = ∫₀ˣ |cos t| dt`; neighbouring
+    /// bins share a boundary, so `G` is evaluated once per boundary, and
+    /// `sin(β − θ) = sin β cos θ − cos β sin θ`.
+    fn weighted(&self, theta: f64, cubed: bool) -> f64 {
+        let width = TAU / self.n as f64;
+        let r = if cubed { &self.r3 } else { &self.r2 };
+        let (st, ct) = theta.sin_cos();
+        let g = |j: usize| {
+            int_abs_cos(
+                self.edge[j] - theta,
+                self.edge_sin[j] * ct - self.edge_cos[j] * st,
+            )
+        };
+        let mut sum = 0.0;
+        let mut lower = g(0);
+        for (i, ri) in r[..self.n].iter().enumerate() {
+            let upper = g(i + 1);
+            sum += ri * (upper - lower);
+            lower = upper;
+        }
+        sum / width
+    }
+
+    /// One evaluation's worth of the search; `Some` with the parameters (or the refusal)
+    /// when it is over.
+    fn step(&mut self) -> Option<Result<EllipsePhasors>> {
+        let step = PI / 180.0;
+        let g = 0.5 * (5f64.sqrt() - 1.0);
+        let s = |me: &Self, t: f64| me.weighted(t, false);
+        self.search = match self.search {
+            Search::Scan { k, best, best_s } => {
+                let t = k as f64 * step;
+                let v = s(self, t);
+                let (best, best_s) = if v < best_s { (t, v) } else { (best, best_s) };
+                if k + 1 < 180 {
+                    Search::Scan {
+                        k: k + 1,
+                        best,
+                        best_s,
+                    }
+                } else {
+                    let (a, b) = (best - step, best + step);
+                    Search::Golden {
+                        step: 0,
+                        a,
+                        b,
+                        c: b - g * (b - a),
+                        d: a + g * (b - a),
+                        sc: None,
+                        sd: None,
+                    }
+                }
+            }
+            Search::Golden {
+                step: k,
+                a,
+                b,
+                c,
+                d,
+                sc,
+                sd,
+            } => match (sc, sd) {
+                (None, _) => Search::Golden {
+                    step: k,
+                    a,
+                    b,
+                    c,
+                    d,
+                    sc: Some(s(self, c)),
+                    sd,
+                },
+                (Some(sc), None) => Search::Golden {
+                    step: k,
+                    a,
+                    b,
+                    c,
+                    d,
+                    sc: Some(sc),
+                    sd: Some(s(self, d)),
+                },
+                (Some(sc), Some(sd)) if k < GOLDEN_STEPS => {
+                    let (a, b, c, d, sc, sd) = if sc < sd {
+                        let (b, d, sd) = (d, c, sc);
+                        let c = b - g * (b - a);
+                        (a, b, c, d, s(self, c), sd)
+                    } else {
+                        let (a, c, sc) = (c, d, sd);
+                        let d = a + g * (b - a);
+                        (a, b, c, d, sc, s(self, d))
+                    };
+                    Search::Golden {
+                        step: k + 1,
+                        a,
+                        b,
+                        c,
+                        d,
+                        sc: Some(sc),
+                        sd: Some(sd),
+                    }
+                }
+                (Some(_), Some(_)) => {
+                    // Σ R²|X'| = Σ R³|cos(φ − Ω)|.
+                    let omega = 0.5 * (a + b);
+                    Search::Sums {
+                        omega,
+                        sx: Some(self.weighted(omega, true)),
+                    }
+                }
+            },
+            Search::Sums { omega, sx } => {
+                let sx = sx.unwrap_or_else(|| self.weighted(omega, true));
+                // Σ R²|Y'| = Σ R³|sin(φ − Ω)| = Σ R³|cos(φ − Ω − π/2)|.
+                let sy = self.weighted(omega + 0.5 * PI, true);
+                return Some(self.finish(omega, sx, sy));
+            }
+        };
+        None
+    }
+
+    fn finish(&self, omega: f64, sx: f64, sy: f64) -> Result<EllipsePhasors> {
+        if !(sy > 0.0 && sx > 0.0) {
+            return Err(Error::NotAnEllipse {
+                detail: " (the binned readings lie on a line through the origin)",
+            });
+        }
+        let k = sx / sy;
+        let ratio = (k - 1.0) / (k + 1.0);
+        let e_l = 0.25 * PI * (sx + sy) / self.sum_w;
+        if ratio.abs() >= 0.95 {
+            return Err(Error::NotAnEllipse {
+                detail: " (axis ratio above 39: the readings are nearly a line)",
+            });
+        }
+        EllipsePhasors::new(self.origin, omega, ratio, e_l)
+    }
+}
+
+/// The seed's ellipse parameters of a full set about `origin` (claims 7–9). `full[i]` must
+/// be the locus at the centre direction `(i + ½)·2π/N` of bin `i`, as the calibrator's full
+/// set is; at most [`MAX_BINS`] of them.
+///
+/// - Ω_e minimises `S(θ) = Σ R_i² |cos(θ_i − θ)|` (a 1° scan of [0, π) refined by golden
+///   section). It finds the minor axis (see the `binned_ellipse` module documentation), so
+///   the ratio comes out negative about it.
+/// - Ratio: with `X'`, `Y'` the readings rotated by Ω_e (claim 9),
+///   `k = Σ R_i²|X'_i| / Σ R_i²|Y'_i|` and `E_R/E_L = (k − 1)/(k + 1)`; and
+///   `|E_L| = (π/4) Σ R_i²(|X'_i| + |Y'_i|) / Σ R_i²`.
+///
+/// Each bin stands for the arc of directions it covers: `|cos(θ_i − θ)|` is replaced by its
+/// mean over the bin. With a plain sum the kinks of `|cos|` make `S(θ)` ripple with the bin
+/// spacing (relative ripple ≈ (π/N)²/8, against a signal of only ≈ r(θ − Ω_e)² near the
+/// minimum), which moved Ω_e by about 1° for N = 64 and r = 0.13; the bin means are smooth.
+pub fn ellipse_parameters(full: &[Vector2<f64>], origin: &Vector2<f64>) -> Result<EllipsePhasors> {
+    if full.len() > MAX_BINS {
+        return Err(Error::OutOfRange {
+            what: "binned-ellipse full set length",
+            value: full.len() as f64,
+            min: 4.0,
+            max: MAX_BINS as f64,
+        });
+    }
+    let mut search = ParamSearch::new(full, origin)?;
+    loop {
+        if let Some(r) = search.step() {
+            return r;
+        }
+    }
+}
+
+/// Where a refresh stands.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Stage {
+    /// Building the full set of pass `pass` (passes `0..iterations` iterate the origin; pass
+    /// `iterations` is the final one): the polar form of the filled bins is computed when
+    /// `polar_ready` is false, then the output bins from `next`.
+    FullSet {
+        pass: usize,
+        polar_ready: bool,
+        next: usize,
+    },
+    /// Re-binning about the mean of the full set of pass `pass`.
+    Rebin { pass: usize, mean: Vector2<f64> },
+    /// Searching the ellipse parameters of the final full set.
+    Params,
+    /// Finished.
+    Done,
+}
+
+/// A refresh in progress on its own copy of the bins (see the module documentation).
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct RefreshJob {
+    n: usize,
+    iterations: usize,
+    min_filled: usize,
+    /// The bins being refreshed and their origin.
+    pub bins: Bins,
+    pub origin: Vector2<f64>,
+    polar: [(f64, f64); MAX_BINS],
+    k: usize,
+    /// For each bin, the index in `polar` of the reading it holds (`NO_READING` if none),
+    /// and of the last reading in the bins at or before it, going round.
+    slot: [u8; MAX_BINS],
+    last_at_or_before: [u8; MAX_BINS],
+    full: [Vector2<f64>; MAX_BINS],
+    search: Option<ParamSearch>,
+    stage: Stage,
+    /// The outcome, once [`Self::advance`] returned `true`.
+    pub result: Option<Result<EllipsePhasors>>,
+}
+
+impl RefreshJob {
+    /// Upper bound of the bin operations of a refresh of `n` bins with `iterations` origin
+    /// iterations (every pass with all bins filled).
+    pub fn work_bound(n: usize, iterations: usize) -> usize {
+        let passes = iterations + 1;
+        passes * (TRIG_COST * n + TRIG_COST * n) + iterations * TRIG_COST * n + EVALUATIONS * n
+    }
+
+    /// A refresh of `bins` (the first `n` in use) about `origin`; `min_filled` is the count
+    /// of filled bins a refusal for too few says is needed.
+    pub fn start(
+        bins: &Bins,
+        n: usize,
+        origin: &Vector2<f64>,
+        iterations: usize,
+        min_filled: usize,
+    ) -> Self {
+        Self {
+            n,
+            iterations,
+            min_filled,
+            bins: *bins,
+            origin: *origin,
+            polar: [(0.0, 0.0); MAX_BINS],
+            k: 0,
+            slot: [NO_READING; MAX_BINS],
+            last_at_or_before: [0; MAX_BINS],
+            full: [Vector2::zeros(); MAX_BINS],
+            search: None,
+            stage: Stage::FullSet {
+                pass: 0,
+                polar_ready: false,
+                next: 0,
+            },
+            result: None,
+        }
+    }
+
+    /// Whether the refresh is over ([`Self::result`] is set).
+    pub fn done(&self) -> bool {
+        self.stage == Stage::Done
+    }
+
+    /// Does at least `budget` bin operations of work (or what is left), in whole units of
+    /// at most `n` operations; returns whether the refresh is over.
+    pub fn advance(&mut self, budget: usize) -> bool {
+        let mut spent = 0usize;
+        while spent < budget && !self.done() {
+            spent += self.unit();
+        }
+        self.done()
+    }
+
+    /// Runs the refresh to its end.
+    pub fn finish(&mut self) {
+        while !self.done() {
+            self.unit();
+        }
+    }
+
+    /// One unit of work; returns its cost in bin operations.
+    fn unit(&mut self) -> usize {
+        let n = self.n;
+        match self.stage {
+            Stage::FullSet {
+                pass,
+                polar_ready: false,
+                ..
+            } => {
+                // (angle, magnitude) of each filled bin's reading about the origin, in bin
+                // order, and where each bin's nearest readings are in that list.
+                let mut k = 0;
+                for (i, b) in self.bins[..n].iter().enumerate() {
+                    self.slot[i] = NO_READING;
+                    if b.state == BinState::Empty {
+                        continue;
+                    }
+                    let d = b.value - self.origin;
+                    if d.norm() > 0.0 {
+                        self.polar[k] = (d.y.atan2(d.x), d.norm());
+                        self.slot[i] = k as u8;
+                        k += 1;
+                    }
+                }
+                self.k = k;
+                if k > 0 {
+                    // Before the first reading (going round) the last one is the latest.
+                    let mut last = (k - 1) as u8;
+                    for i in 0..n {
+                        if self.slot[i] != NO_READING {
+                            last = self.slot[i];
+                        }
+                        self.last_at_or_before[i] = last;
+                    }
+                }
+                self.stage = if k < 2 {
+                    self.no_full_set()
+                } else {
+                    Stage::FullSet {
+                        pass,
+                        polar_ready: true,
+                        next: 0,
+                    }
+                };
+                TRIG_COST * n
+            }
+            Stage::FullSet { pass, next, .. } => {
+                self.full[next] = self.full_set_bin(next);
+                self.stage = if next + 1 < n {
+                    Stage::FullSet {
+                        pass,
+                        polar_ready: true,
+                        next: next + 1,
+                    }
+                } else {
+                    self.full_set_done(pass)
+                };
+                TRIG_COST
+            }
+            Stage::Rebin { pass, mean } => {
+                rebin(&mut self.bins, n, &mean);
+                self.origin = mean;
+                self.stage = Stage::FullSet {
+                    pass: pass + 1,
+                    polar_ready: false,
+                    next: 0,
+                };
+                TRIG_COST * n
+            }
+            Stage::Params => {
+                let r = match self.search.as_mut() {
+                    Some(s) => s.step(),
+                    None => Some(Err(Error::NotReady {
+                        what: "the binned-ellipse parameter search",
+                        hint: "push more readings",
+                    })),
+                };
+                if let Some(r) = r {
+                    self.result = Some(r);
+                    self.stage = Stage::Done;
+                }
+                n
+            }
+            Stage::Done => 0,
+        }
+    }
+
+    /// No full set (fewer than two readings off the origin). In an iteration pass this ends
+    /// the iteration, and the final pass would see the same bins about the same origin, so
+    /// either way the refresh ends here.
+    fn no_full_set(&mut self) -> Stage {
+        self.result = Some(Err(Error::TooFewPoints {
+            got: filled(&self.bins, self.n),
+            need: self.min_filled,
+        }));
+        Stage::Done
+    }
+
+    /// The full set of pass `pass` is complete.
+    fn full_set_done(&mut self, pass: usize) -> Stage {
+        let n = self.n;
+        if pass < self.iterations {
+            let mean = self.full[..n].iter().sum::<Vector2<f64>>() / n as f64;
+            if mean.x.is_finite() && mean.y.is_finite() {
+                return Stage::Rebin { pass, mean };
+            }
+            // The iteration stops; the final pass would rebuild this very set.
+        }
+        match ParamSearch::new(&self.full[..n], &self.origin) {
+            Ok(s) => {
+                self.search = Some(s);
+                Stage::Params
+            }
+            Err(e) => {
+                self.result = Some(Err(e));
+                Stage::Done
+            }
+        }
+    }
+
+    /// The full set (claim 1) at the centre direction of bin `i`: the magnitude there is
+    /// interpolated linearly, in direction, between the two nearest stored readings on
+    /// either side (claim 2) — for an empty bin these are its filled neighbours; for a
+    /// filled bin its own reading is one of them. Placing every value at its bin's direction
+    /// keeps the set uniform in direction whatever the readings' positions within their bins,
+    /// which the mean (claim 5) and the R²-weighted sums of the parameters rely on.
+    fn full_set_bin(&self, i: usize) -> Vector2<f64> {
+        let dir = (i as f64 + 0.5) * TAU / self.n as f64;
+        // Nearest reading at or before `dir` (within half a turn) and nearest after it,
+        // going round the circle. Each reading lies in its own bin's sector about the
+        // origin (it was binned about it), so the list is in order of direction and the
+        // nearest ones are the neighbours of `dir` in it: the candidate on each side is
+        // the first reading met going that way, and if it is more than half a turn away
+        // (its wrapped difference has the other sign) no reading is within half a turn.
+        let k = self.k;
+        let (jb, ja) = match self.slot[i] {
+            NO_READING => {
+                let j = usize::from(self.last_at_or_before[i]);
+                (j, (j + 1) % k)
+            }
+            j => {
+                let j = usize::from(j);
+                if angle_diff(self.polar[j].0, dir) <= 0.0 {
+                    (j, (j + 1) % k)
+                } else {
+                    ((j + k - 1) % k, j)
+                }
+            }
+        };
+        let (mut before, mut after) = ((-TAU, 0.0), (TAU, 0.0));
+        let (ab, rb) = self.polar[jb];
+        let delta_b = angle_diff(ab, dir);
+        if delta_b <= 0.0 {
+            before = (delta_b, rb);
+        }
+        let (aa, ra) = self.polar[ja];
+        let delta_a = angle_diff(aa, dir);
+        if delta_a > 0.0 {
+            after = (delta_a, ra);
+        }
+        // With k ≥ 2 readings at distinct angles both exist; if all share one angle, use it.
+        if before.0 <= -TAU {
+            before = (after.0 - TAU, after.1);
+        }
+        if after.0 >= TAU {
+            after = (before.0 + TAU, before.1);
+        }
+        let span = after.0 - before.0;
+        let r = if span > 0.0 {
+            before.1 + (after.1 - before.1) * (-before.0) / span
+        } else {
+            before.1
+        };
+        self.origin + Vector2::new(dir.cos(), dir.sin()) * r
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    /// The full-set update in one go, as a plain loop (the reference the sliced job must
+    /// reproduce bit for bit).
+    fn refresh_at_once(
+        bins: &mut Bins,
+        n: usize,
+        origin: &mut Vector2<f64>,
+        iterations: usize,
+    ) -> Result<EllipsePhasors> {
+        let full_set = |bins: &Bins, origin: &Vector2<f64>| {
+            let mut job = RefreshJob::start(bins, n, origin, 0, 0);
+            job.unit();
+            (job.k >= 2).then(|| {
+                let mut out = [Vector2::zeros(); MAX_BINS];
+                for (i, o) in out[..n].iter_mut().enumerate() {
+                    *o = job.full_set_bin(i);
+                }
+                out
+            })
+        };
+        for _ in 0..iterations {
+            let Some(full) = full_set(bins, origin) else {
+                break;
+            };
+            let mean = full[..n].iter().sum::<Vector2<f64>>() / n as f64;
+            if !(mean.x.is_finite() && mean.y.is_finite()) {
+                break;
+            }
+            rebin(bins, n, &mean);
+            *origin = mean;
+        }
+        let full = full_set(bins, origin).ok_or(Error::TooFewPoints { got: 0, need: 0 })?;
+        ellipse_parameters(&full[..n], origin)
+    }
+
+    fn bins_of(points: &[(f64, f64)], n: usize, origin: &Vector2<f64>) -> Bins {
+        let mut bins = [EMPTY; MAX_BINS];
+        for &(a, r) in points {
+            let p = origin + Vector2::new(a.cos(), a.sin()) * r;
+            bin_reading(&mut bins, n, origin, &p, 1);
+        }
+        bins
+    }
+
+    /// The full-set value of bin `i` by searching every reading for the nearest on either
+    /// side (the definition the neighbour lookup of `full_set_bin` must agree with).
+    fn full_set_bin_by_search(job: &RefreshJob, i: usize) -> Vector2<f64> {
+        let dir = (i as f64 + 0.5) * TAU / job.n as f64;
+        let (mut before, mut after) = ((-TAU, 0.0), (TAU, 0.0));
+        for &(a, r) in &job.polar[..job.k] {
+            let delta = angle_diff(a, dir);
+            if delta <= 0.0 && delta > before.0 {
+                before = (delta, r);
+            }
+            if delta > 0.0 && delta < after.0 {
+                after = (delta, r);
+            }
+        }
+        if before.0 <= -TAU {
+            before = (after.0 - TAU, after.1);
+        }
+        if after.0 >= TAU {
+            after = (before.0 + TAU, before.1);
+        }
+        let span = after.0 - before.0;
+        let r = if span > 0.0 {
+            before.1 + (after.1 - before.1) * (-before.0) / span
+        } else {
+            before.1
+        };
+        job.origin + Vector2::new(dir.cos(), dir.sin()) * r
+    }
+
+    proptest! {
+        /// On bins filled about the job's origin (as a calibrator's are), the neighbour
+        /// lookup finds exactly the readings a search of all of them finds, on any arc.
+        #[test]
+        fn neighbour_lookup_equals_the_full_search(
+            pts in proptest::collection::vec((0.0f64..6.3, 0.5f64..1.5), 2..200),
+            half_bins in 4usize..=64, arc in 0.05f64..1.0,
+            ox in -0.5f64..0.5, oy in -0.5f64..0.5,
+        ) {
+            let n = 2 * half_bins;
+            let origin = Vector2::new(ox, oy);
+            let pts: Vec<_> = pts.iter().map(|&(a, r)| (a * arc, r)).collect();
+            let bins = bins_of(&pts, n, &origin);
+            let mut job = RefreshJob::start(&bins, n, &origin, 0, 0);
+            job.unit();
+            prop_assume!(job.k >= 2);
+            for i in 0..n {
+                prop_assert_eq!(job.full_set_bin(i), full_set_bin_by_search(&job, i), "bin {}", i);
+            }
+        }
+    }
+
+    proptest! {
+        /// Sliced with any budget, the job gives exactly the bins, origin and parameters of
+        /// the update done at once.
+        #[test]
+        fn slices_reproduce_the_update_at_once(
+            pts in proptest::collection::vec((0.0f64..6.3, 0.5f64..1.5), 2..200),
+            half_bins in 4usize..=64, iterations in 0usize..6, budget in 1usize..5000,
+            ox in -0.5f64..0.5, oy in -0.5f64..0.5,
+        ) {
+            let n = 2 * half_bins;
+            let start_origin = Vector2::new(ox, oy);
+            let bins = bins_of(&pts, n, &Vector2::zeros());
+            let (mut ref_bins, mut ref_origin) = (bins, start_origin);
+            let expect = refresh_at_once(&mut ref_bins, n, &mut ref_origin, iterations);
+            let mut job = RefreshJob::start(&bins, n, &start_origin, iterations, 0);
+            let mut pushes = 0usize;
+            while !job.advance(budget) {
+                pushes += 1;
+            }
+            let bound = RefreshJob::work_bound(n, iterations);
+            prop_assert!(pushes <= bound.div_ceil(budget));
+            prop_assert_eq!(job.origin, ref_origin);
+            prop_assert_eq!(&job.bins[..n], &ref_bins[..n]);
+            match (job.result.unwrap(), expect) {
+                (Ok(a), Ok(b)) => prop_assert_eq!(a, b),
+                (Err(_), Err(_)) => {}
+                (a, b) => prop_assert!(false, "{:?} vs {:?}", a, b),
+            }
+        }
+    }
+}

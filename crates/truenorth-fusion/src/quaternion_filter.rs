@@ -1,0 +1,496 @@
+//! A quaternion orientation filter for 6-D (gyro + accelerometer) and 9-D (+ magnetometer)
+//! IMUs, with gyro-bias estimation at rest and in motion and magnetic-disturbance rejection.
+//!
+//! Per sample (body → NED quaternion `q`, Hamilton, scalar first):
+//! 1. **Strapdown**: `q ← q ⊗ exp((ω − b̂) dt / 2)` with the rate at the sample time (the
+//!    workspace's gyro sample convention; the step uses the mean of the previous and the
+//!    current rate, the trapezoid rule).
+//! 2. **Inclination**: the specific force rotated into NED and low-passed there (its mean
+//!    over a swing is gravity alone) should point up, `(0, 0, −1)`; `q` is turned about the
+//!    horizontal axis by `dt/τ_acc` times the horizontal part of it over g — a
+//!    complementary filter (Mahony, Hamel & Pflimlin, IEEE TAC 53(5), 2008) with the error
+//!    formed in the reference frame so that heading is untouched, and the low-pass of the
+//!    reference-frame acceleration that VQF introduced (Laidig & Seel, Information Fusion
+//!    91, 2023). The low-passed vector is turned with every correction so that it stays in
+//!    the frame of `q`.
+//!    The correction is linear in the specific force (its horizontal part over g), so the
+//!    body's own accelerations, which average to zero over any swing, cancel; weighting
+//!    readings by how far |a| is from g, or using the angle, biases the average (on BROAD's
+//!    fast-translation trial 16 either one doubles the inclination error).
+//! 3. **Heading**: the magnetometer rotated into NED should point north; `q` is turned about
+//!    the vertical only, by `dt/τ_mag` of the horizontal angle, so a disturbed field can
+//!    never tilt the inclination (the decoupling of Madgwick's and VQF's heading updates).
+//!    Readings judged disturbed by [`crate::MagReference`] (norm or dip off) are skipped.
+//! 4. **Gyro bias**: at rest ([`crate::RestDetector`]) the bias follows the mean of the raw
+//!    rate; in motion, each correction's implied rate is integrated into the bias (the
+//!    integral term of Mahony et al.), along the axes the corrections observe.
+//!
+//! The 6-D attitude is the same rotation with every heading correction undone:
+//! `q₆ = Rz(−H) ⊗ q` with `H` the sum of the heading corrections, exact because each
+//! correction acts on the left (in the reference frame) and the inclination correction
+//! commutes with a rotation about the vertical.
+
+use nalgebra::{Quaternion, UnitQuaternion, Vector3};
+use serde::{Deserialize, Serialize};
+use truenorth_core::{
+    AttitudeEstimate, AttitudeStatus, Error, ImuSample, OrientationEstimator, Result,
+    STANDARD_GRAVITY_MPS2, TimeStep, Validate, check_positive, check_range,
+};
+
+use crate::{MagReference, MagReferenceConfig, RestConfig, RestDetector};
+
+#[allow(unused_imports)]
+use truenorth_core::Float as _;
+
+/// Parameters of the [`QuaternionFilter`]. Times in seconds, rates in rad/s.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct QuaternionFilterConfig {
+    /// Time constant of the inclination correction, s (default 3).
+    pub tau_acc_s: f64,
+    /// Time constant of the low-pass applied to the specific force in the reference frame
+    /// before the inclination correction, s (default 1).
+    pub acc_lowpass_s: f64,
+    /// Time constant of the heading correction, s (default 15).
+    pub tau_mag_s: f64,
+    /// Time constant of the in-motion bias estimate, s (default 400): long against
+    /// `tau_acc_s` so the bias loop cannot ring, and long enough that the body's own
+    /// accelerations, which leak into every correction, average out of it (at 60 s the
+    /// bias wandered by 2°/s on BROAD trial 16, `tests/broad.rs`).
+    pub bias_tau_motion_s: f64,
+    /// Time constant of the bias estimate at rest, s (default 2).
+    pub bias_tau_rest_s: f64,
+    /// Largest bias the filter may estimate on any axis, rad/s (default 20°/s).
+    pub max_bias_rps: f64,
+    /// Time after the first sample with fast corrections, s (default 1): the attitude
+    /// converges from the first reading before the slow filter takes over.
+    pub startup_s: f64,
+    /// Rest detection.
+    pub rest: RestConfig,
+    /// Magnetic-disturbance detection.
+    pub mag: MagReferenceConfig,
+    /// Use the magnetometer when the samples have one (default `true`; `false` gives 6-D).
+    pub use_mag: bool,
+    /// Initial attitude, body → NED; `None` (default) starts from the first accelerometer
+    /// (and magnetometer) reading.
+    pub initial_attitude: Option<[f64; 4]>,
+}
+
+impl Default for QuaternionFilterConfig {
+    fn default() -> Self {
+        Self {
+            tau_acc_s: 3.0,
+            acc_lowpass_s: 1.0,
+            tau_mag_s: 15.0,
+            bias_tau_motion_s: 400.0,
+            bias_tau_rest_s: 2.0,
+            max_bias_rps: 20f64.to_radians(),
+            startup_s: 1.0,
+            rest: RestConfig::default(),
+            mag: MagReferenceConfig::default(),
+            use_mag: true,
+            initial_attitude: None,
+        }
+    }
+}
+
+impl Validate for QuaternionFilterConfig {
+    fn validate(&self) -> Result<()> {
+        check_positive("tau_acc_s", self.tau_acc_s)?;
+        check_positive("acc_lowpass_s", self.acc_lowpass_s)?;
+        check_positive("tau_mag_s", self.tau_mag_s)?;
+        check_range(
+            "bias_tau_motion_s",
+            self.bias_tau_motion_s,
+            2.0 * self.tau_acc_s,
+            1e9,
+        )?;
+        check_positive("bias_tau_rest_s", self.bias_tau_rest_s)?;
+        check_range("max_bias_rps", self.max_bias_rps, 0.0, 10.0)?;
+        check_range("startup_s", self.startup_s, 0.0, 1e9)?;
+        check_positive("rest.gyro_dev_rps", self.rest.gyro_dev_rps)?;
+        check_positive("rest.acc_dev_mps2", self.rest.acc_dev_mps2)?;
+        check_positive("rest.mag_turn_rad", self.rest.mag_turn_rad)?;
+        check_range("rest.min_time_s", self.rest.min_time_s, 0.0, 1e9)?;
+        check_positive("rest.mean_tau_s", self.rest.mean_tau_s)?;
+        check_positive("mag.norm_tol_rel", self.mag.norm_tol_rel)?;
+        check_positive("mag.dip_tol_rad", self.mag.dip_tol_rad)?;
+        check_positive("mag.reference_tau_s", self.mag.reference_tau_s)?;
+        check_positive("mag.new_reference_s", self.mag.new_reference_s)?;
+        check_range(
+            "mag.new_reference_min_rate_rps",
+            self.mag.new_reference_min_rate_rps,
+            0.0,
+            1e3,
+        )?;
+        if let Some(q) = self.initial_attitude {
+            for v in q {
+                check_range("initial_attitude component", v, -1e3, 1e3)?;
+            }
+            let n = q.iter().map(|v| v * v).sum::<f64>().sqrt();
+            check_range("initial_attitude norm", n, 1e-6, 1e3)?;
+        }
+        Ok(())
+    }
+}
+
+/// What the filter has learned.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+struct State {
+    q: UnitQuaternion<f64>,
+    heading_correction_rad: f64,
+    bias_rps: Vector3<f64>,
+    acc_lp_ned: Option<Vector3<f64>>,
+    last_gyr_rps: Option<Vector3<f64>>,
+    since_start_s: f64,
+    initialised: bool,
+    estimate: AttitudeEstimate,
+}
+
+/// The quaternion orientation filter (see the module documentation).
+///
+/// ```
+/// use nalgebra::Vector3;
+/// use truenorth_core::{ImuSample, OrientationEstimator};
+/// use truenorth_fusion::{QuaternionFilter, QuaternionFilterConfig};
+///
+/// let mut f = QuaternionFilter::new(QuaternionFilterConfig::default())?;
+/// // A minute level and still, facing magnetic north, with a 1°/s gyro bias on z.
+/// for k in 0..6000 {
+///     let s = ImuSample::new_9d(
+///         0.01 * k as f64,
+///         Vector3::new(0.0, 0.0, 1f64.to_radians()),
+///         Vector3::new(0.0, 0.0, -9.81),
+///         Vector3::new(20.0, 0.0, 45.0),
+///     );
+///     f.update(&s)?;
+/// }
+/// let est = f.estimate();
+/// assert!(est.status.at_rest);
+/// assert!((est.gyro_bias_rps.z - 1f64.to_radians()).abs() < 0.05f64.to_radians());
+/// assert!(est.attitude.angle() < 0.5f64.to_radians());
+/// # Ok::<(), truenorth_core::Error>(())
+/// ```
+#[derive(Debug, Clone)]
+pub struct QuaternionFilter {
+    config: QuaternionFilterConfig,
+    state: State,
+    clock: TimeStep,
+    rest: RestDetector,
+    mag_ref: MagReference,
+}
+
+impl QuaternionFilter {
+    /// A filter with the given parameters.
+    pub fn new(config: QuaternionFilterConfig) -> Result<Self> {
+        config.validate()?;
+        let q0 = initial_attitude(&config);
+        Ok(Self {
+            config,
+            state: State {
+                q: q0,
+                heading_correction_rad: 0.0,
+                bias_rps: Vector3::zeros(),
+                acc_lp_ned: None,
+                last_gyr_rps: None,
+                since_start_s: 0.0,
+                initialised: config.initial_attitude.is_some(),
+                estimate: AttitudeEstimate::initial(q0),
+            },
+            clock: TimeStep::new(),
+            rest: RestDetector::new(config.rest),
+            mag_ref: MagReference::new(config.mag),
+        })
+    }
+
+    /// The parameters in use.
+    pub fn config(&self) -> &QuaternionFilterConfig {
+        &self.config
+    }
+
+    fn step(
+        &mut self,
+        t_s: f64,
+        dt_s: f64,
+        gyr: Vector3<f64>,
+        acc: Option<Vector3<f64>>,
+        mag: Option<Vector3<f64>>,
+    ) {
+        let cfg = &self.config;
+        let s = &mut self.state;
+        s.since_start_s += dt_s;
+        let startup = s.since_start_s < cfg.startup_s;
+        let fast = |tau: f64| if startup { tau.min(0.1) } else { tau };
+
+        // 1. Strapdown, trapezoid rule on the bias-corrected rate.
+        let prev = s.last_gyr_rps.unwrap_or(gyr);
+        let omega = 0.5 * (prev + gyr) - s.bias_rps;
+        s.last_gyr_rps = Some(gyr);
+        s.q *= UnitQuaternion::from_scaled_axis(omega * dt_s);
+
+        let at_rest = match acc {
+            Some(a) => self.rest.update(&gyr, &a, mag.as_ref(), dt_s),
+            None => false,
+        };
+        let mut status = AttitudeStatus {
+            at_rest,
+            ..AttitudeStatus::default()
+        };
+        // Body-frame rate implied by this step's corrections, for the bias integral.
+        let mut correction_rate = Vector3::zeros();
+
+        // 2. Inclination.
+        if let Some(a) = acc {
+            if a.norm() > 1e-6 {
+                // Linear in the specific force: the body's own accelerations average out
+                // over a swing, where an angle (atan of horizontal over vertical) would not.
+                // A first low-pass in the reference frame before the proportional
+                // correction makes the response to acceleration second order.
+                let f = s.q * a;
+                let kl = (dt_s / fast(cfg.acc_lowpass_s)).min(1.0);
+                s.acc_lp_ned = match s.acc_lp_ned {
+                    Some(lp) => Some(lp + (f - lp) * kl),
+                    None => Some(f),
+                };
+                let down = -s.acc_lp_ned.unwrap_or(f) / STANDARD_GRAVITY_MPS2;
+                let k = (dt_s / fast(cfg.tau_acc_s)).min(1.0);
+                let rot = down.cross(&Vector3::z()) * k;
+                let c = UnitQuaternion::from_scaled_axis(rot);
+                s.q = c * s.q;
+                s.acc_lp_ned = s.acc_lp_ned.map(|lp| c * lp);
+                correction_rate += s.q.inverse_transform_vector(&rot) / dt_s;
+                status.accel_used = true;
+            }
+        }
+
+        // 3. Heading.
+        if let Some(m) = mag {
+            let norm = m.norm();
+            if norm > 0.0 {
+                let m_ned = s.q * m;
+                let horizontal = m_ned.xy().norm();
+                let dip = m_ned.z.atan2(horizontal);
+                let rate = omega.norm();
+                let undisturbed = self.mag_ref.update(norm, dip, rate, dt_s);
+                status.mag_disturbed = !undisturbed;
+                if undisturbed && horizontal > 1e-9 * norm {
+                    // Angle of the horizontal field east of north: the heading error.
+                    let err = m_ned.y.atan2(m_ned.x);
+                    let k = (dt_s / fast(cfg.tau_mag_s)).min(1.0);
+                    let rot = Vector3::new(0.0, 0.0, -k * err);
+                    let c = UnitQuaternion::from_scaled_axis(rot);
+                    s.q = c * s.q;
+                    s.acc_lp_ned = s.acc_lp_ned.map(|lp| c * lp);
+                    s.heading_correction_rad += rot.z;
+                    correction_rate += s.q.inverse_transform_vector(&rot) / dt_s;
+                    status.mag_used = true;
+                }
+            }
+        }
+
+        // 4. Gyro bias.
+        if !startup {
+            if at_rest {
+                let k = (dt_s / cfg.bias_tau_rest_s).min(1.0);
+                s.bias_rps += (self.rest.gyro_mean() - s.bias_rps) * k;
+            } else {
+                // A bias the estimate lacks makes the strapdown drift, and the corrections
+                // turn against the drift: integrating their rate removes it.
+                s.bias_rps -= correction_rate * (dt_s / cfg.bias_tau_motion_s);
+            }
+            let lim = cfg.max_bias_rps;
+            s.bias_rps = s.bias_rps.map(|b| b.clamp(-lim, lim));
+        }
+
+        let q6 =
+            UnitQuaternion::from_axis_angle(&Vector3::z_axis(), -s.heading_correction_rad) * s.q;
+        s.estimate = AttitudeEstimate {
+            t_s,
+            attitude: s.q,
+            attitude_6d: q6,
+            gyro_bias_rps: s.bias_rps,
+            sigma_rad: None,
+            status,
+        };
+    }
+}
+
+impl OrientationEstimator for QuaternionFilter {
+    /// Needs a gyro triad; the accelerometer and magnetometer triads may be absent on any
+    /// sample (a slower sensor). A non-finite value or a timestamp that does not increase
+    /// is an error and changes nothing.
+    fn update(&mut self, sample: &ImuSample) -> Result<AttitudeEstimate> {
+        sample.check_finite()?;
+        let gyr = sample.gyr_rps.as_xyz().ok_or(Error::Unsupported {
+            reason: "the quaternion filter needs a three-axis gyro; use the Euler detector for two gyros",
+        })?;
+        let acc = sample.acc_mps2.as_xyz();
+        let mag = if self.config.use_mag {
+            sample.mag.as_xyz()
+        } else {
+            None
+        };
+        let clock_before = self.clock;
+        let Some(dt_s) = self.clock.dt_s(sample.t_s)? else {
+            if !self.state.initialised
+                && let Some(q) = acc.and_then(|a| attitude_from(&a, mag.as_ref()))
+            {
+                self.state.q = q;
+                self.state.initialised = true;
+            }
+            self.state.last_gyr_rps = Some(gyr);
+            self.state.estimate = AttitudeEstimate {
+                t_s: sample.t_s,
+                ..AttitudeEstimate::initial(self.state.q)
+            };
+            return Ok(self.state.estimate);
+        };
+        let saved = (self.state, self.rest, self.mag_ref);
+        self.step(sample.t_s, dt_s, gyr, acc, mag);
+        if !(self.state.q.coords.iter().all(|v| v.is_finite())
+            && self.state.bias_rps.iter().all(|v| v.is_finite()))
+        {
+            // Finite readings so large that the update overflowed: keep the last good state.
+            (self.state, self.rest, self.mag_ref) = saved;
+            self.clock = clock_before;
+            return Err(Error::OutOfRange {
+                what: "IMU reading (the update overflowed)",
+                value: gyr.norm(),
+                min: 0.0,
+                max: 1e6,
+            });
+        }
+        Ok(self.state.estimate)
+    }
+
+    fn estimate(&self) -> AttitudeEstimate {
+        self.state.estimate
+    }
+
+    fn reset(&mut self) {
+        if let Ok(f) = Self::new(self.config) {
+            *self = f;
+        }
+    }
+}
+
+fn initial_attitude(config: &QuaternionFilterConfig) -> UnitQuaternion<f64> {
+    match config.initial_attitude {
+        Some([w, x, y, z]) => UnitQuaternion::from_quaternion(Quaternion::new(w, x, y, z)),
+        None => UnitQuaternion::identity(),
+    }
+}
+
+/// The attitude whose NED up is the measured specific force and, with a magnetometer,
+/// whose north is the horizontal part of the field (the TRIAD construction, Black 1964).
+fn attitude_from(acc: &Vector3<f64>, mag: Option<&Vector3<f64>>) -> Option<UnitQuaternion<f64>> {
+    // Body-frame directions of NED down, and of north when a field is given. Scaling by
+    // the largest component first keeps the norms finite for any finite reading.
+    let unit = |v: &Vector3<f64>| {
+        let scale = v.amax();
+        (scale > 0.0 && scale.is_finite())
+            .then(|| (v / scale).try_normalize(1e-12))
+            .flatten()
+    };
+    let down = -unit(acc)?;
+    let east_hint = mag
+        .and_then(unit)
+        .and_then(|m| down.cross(&m).try_normalize(1e-9))
+        .unwrap_or_else(|| {
+            // No field: any heading; take the body x axis as north when it is not vertical.
+            down.cross(&Vector3::x())
+                .try_normalize(1e-9)
+                .unwrap_or_else(|| down.cross(&Vector3::y()).normalize())
+        });
+    let north = east_hint.cross(&down);
+    // Rows of the body → NED rotation are the NED axes in body coordinates.
+    let r =
+        nalgebra::Matrix3::from_rows(&[north.transpose(), east_hint.transpose(), down.transpose()]);
+    Some(UnitQuaternion::from_matrix(&r))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+    use truenorth_core::EulerZyx;
+
+    fn field_ned() -> Vector3<f64> {
+        Vector3::new(20.0, 0.0, 45.0)
+    }
+
+    proptest! {
+        #[test]
+        fn first_reading_gives_the_attitude(yaw in -3.1f64..3.1, pitch in -1.4f64..1.4, roll in -3.1f64..3.1) {
+            let truth = EulerZyx { yaw_rad: yaw, pitch_rad: pitch, roll_rad: roll }.to_quaternion();
+            let acc = truth.inverse_transform_vector(&Vector3::new(0.0, 0.0, -9.81));
+            let mag = truth.inverse_transform_vector(&field_ned());
+            let q = attitude_from(&acc, Some(&mag)).unwrap();
+            prop_assert!(q.angle_to(&truth) < 1e-9);
+        }
+
+        #[test]
+        fn still_sensor_with_constant_bias_converges(
+            yaw in -3.1f64..3.1, pitch in -1.2f64..1.2, roll in -3.1f64..3.1,
+            bias in proptest::array::uniform3(-0.1f64..0.1),
+        ) {
+            let truth = EulerZyx { yaw_rad: yaw, pitch_rad: pitch, roll_rad: roll }.to_quaternion();
+            let acc = truth.inverse_transform_vector(&Vector3::new(0.0, 0.0, -9.81));
+            let mag = truth.inverse_transform_vector(&field_ned());
+            // |bias| ≤ 0.17 rad/s drifts the attitude for `rest.min_time_s` (1.5 s) before
+            // rest is recognised and for about `bias_tau_rest_s` (2 s) more while the bias
+            // estimate settles: at most 0.17 · 3.5 ≈ 0.6 rad, which then decays with the
+            // slowest correction, `tau_mag_s`, from t ≈ 5.5 s.
+            let cfg = QuaternionFilterConfig::default();
+            let t_end = 120.0;
+            let bound_deg = (0.6 * (-(t_end - 5.5) / cfg.tau_mag_s).exp()).to_degrees().max(0.01);
+            let mut f = QuaternionFilter::new(cfg).unwrap();
+            for k in 0..(t_end * 100.0) as usize {
+                f.update(&ImuSample::new_9d(0.01 * k as f64, Vector3::from(bias), acc, mag)).unwrap();
+            }
+            let e = f.estimate();
+            let err_deg = e.attitude.angle_to(&truth).to_degrees();
+            let bias_err_dps = (e.gyro_bias_rps - Vector3::from(bias)).norm().to_degrees();
+            prop_assert!(err_deg < bound_deg && bias_err_dps < 0.01, "attitude {err_deg}° (bound {bound_deg}), bias {bias_err_dps}°/s");
+        }
+
+        #[test]
+        fn no_panic_and_unit_norm_on_any_input(
+            vals in proptest::collection::vec(proptest::array::uniform10(proptest::num::f64::ANY), 1..40)
+        ) {
+            let mut f = QuaternionFilter::new(QuaternionFilterConfig::default()).unwrap();
+            for v in vals {
+                let s = ImuSample::new_9d(v[0], Vector3::new(v[1], v[2], v[3]), Vector3::new(v[4], v[5], v[6]), Vector3::new(v[7], v[8], v[9]));
+                let before = f.estimate();
+                match f.update(&s) {
+                    Ok(e) => prop_assert!((e.attitude.norm() - 1.0).abs() < 1e-9),
+                    Err(_) => prop_assert_eq!(format!("{:?}", f.estimate()), format!("{before:?}")),
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn invalid_configs_are_refused() {
+        for c in [
+            QuaternionFilterConfig {
+                tau_acc_s: 0.0,
+                ..Default::default()
+            },
+            QuaternionFilterConfig {
+                tau_mag_s: f64::NAN,
+                ..Default::default()
+            },
+            QuaternionFilterConfig {
+                bias_tau_motion_s: 1.0,
+                ..Default::default()
+            },
+            QuaternionFilterConfig {
+                initial_attitude: Some([0.0; 4]),
+                ..Default::default()
+            },
+        ] {
+            assert!(QuaternionFilter::new(c).is_err());
+        }
+    }
+}
