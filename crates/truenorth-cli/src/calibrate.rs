@@ -18,6 +18,7 @@ use truenorth::core::{Calibrator, CompassQuality, Mag2Sample, Mag3Sample, Soluti
 use crate::field::Place;
 use crate::io::{
     CALIBRATION_FORMAT, CALIBRATION_VERSION, CalibrationFile, CliError, CliResult, Table,
+    check_distinct,
 };
 
 /// Calibration methods.
@@ -150,6 +151,7 @@ fn expected_field(args: &Args, dimensions: usize) -> CliResult<Option<f64>> {
 
 /// Runs the subcommand.
 pub fn run(args: &Args) -> CliResult {
+    check_distinct(&args.output, &[&args.input])?;
     if let Some(e) = args.expected_field
         && !(e.is_finite() && e > 0.0)
     {

@@ -6,7 +6,9 @@ use nalgebra::{Vector2, Vector3};
 use truenorth::core::{Declination, MagneticHeading, Tilt, rad_to_deg};
 
 use crate::field::Place;
-use crate::io::{CalibrationFile, CliError, CliResult, CompassCalibration, Table, write_csv};
+use crate::io::{
+    CalibrationFile, CliError, CliResult, CompassCalibration, Table, check_distinct, write_csv,
+};
 
 /// Arguments of `truenorth heading`.
 ///
@@ -51,6 +53,7 @@ fn declination(args: &Args) -> CliResult<Option<Declination>> {
 
 /// Runs the subcommand.
 pub fn run(args: &Args) -> CliResult {
+    check_distinct(&args.output, &[&args.input, &args.calibration])?;
     let (_, cal) = CalibrationFile::read(&args.calibration)?;
     let declination = declination(args)?;
     let needed: &[&str] = match cal {

@@ -194,22 +194,73 @@ impl Table {
     }
 }
 
-/// Writes a CSV with a header row and rows of numbers.
+/// Writes a CSV with a header row and rows of numbers. The file appears whole or not at
+/// all: it is written beside `path` under a temporary name and renamed over it at the end.
 pub fn write_csv(
     path: &Path,
     header: &[&str],
     rows: impl IntoIterator<Item = Vec<f64>>,
 ) -> CliResult {
-    let mut w = csv::Writer::from_path(path)
-        .map_err(|e| CliError::file(path, format!("cannot create: {e}")))?;
-    w.write_record(header)
-        .map_err(|e| CliError::file(path, format!("cannot write: {e}")))?;
-    for r in rows {
-        w.write_record(r.iter().map(|v| format!("{v}")))
-            .map_err(|e| CliError::file(path, format!("cannot write: {e}")))?;
+    write_atomically(path, |file| {
+        let mut w = csv::Writer::from_writer(file);
+        w.write_record(header)?;
+        for r in rows {
+            w.write_record(r.iter().map(|v| format!("{v}")))?;
+        }
+        w.flush()?;
+        Ok(())
+    })
+}
+
+/// Writes `path` through `fill` into a temporary file beside it, then renames it into
+/// place, so a run that fails or is killed never leaves a truncated output and never
+/// touches an existing file before it has the whole new one.
+pub fn write_atomically(
+    path: &Path,
+    fill: impl FnOnce(&mut std::fs::File) -> Result<(), Box<dyn std::error::Error>>,
+) -> CliResult {
+    let name = path
+        .file_name()
+        .ok_or_else(|| CliError::file(path, "not a file name"))?;
+    let mut tmp_name = std::ffi::OsString::from(".");
+    tmp_name.push(name);
+    tmp_name.push(format!(".tmp-{}", std::process::id()));
+    let tmp = path.with_file_name(tmp_name);
+    let result = std::fs::File::create(&tmp)
+        .map_err(|e| CliError::file(path, format!("cannot create: {e}")))
+        .and_then(|mut f| {
+            fill(&mut f).map_err(|e| CliError::file(path, format!("cannot write: {e}")))?;
+            f.sync_all()
+                .map_err(|e| CliError::file(path, format!("cannot write: {e}")))
+        })
+        .and_then(|()| {
+            std::fs::rename(&tmp, path)
+                .map_err(|e| CliError::file(path, format!("cannot replace: {e}")))
+        });
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
     }
-    w.flush()
-        .map_err(|e| CliError::file(path, format!("cannot write: {e}")))
+    result
+}
+
+/// Refuses an output path that names one of the inputs (it would destroy the recording).
+pub fn check_distinct(output: &Path, inputs: &[&Path]) -> CliResult {
+    let same = |a: &Path, b: &Path| match (a.canonicalize(), b.canonicalize()) {
+        (Ok(a), Ok(b)) => a == b,
+        _ => a == b,
+    };
+    for input in inputs {
+        if same(output, input) {
+            return Err(CliError::file(
+                output,
+                format!(
+                    "the output would overwrite the input {}; choose another output path",
+                    input.display()
+                ),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// The `format` tag of a calibration file written by `truenorth calibrate`.
@@ -311,12 +362,16 @@ pub enum CompassCalibration {
 }
 
 impl CalibrationFile {
-    /// Writes the file as pretty-printed JSON.
+    /// Writes the file as pretty-printed JSON (whole or not at all, see
+    /// [`write_atomically`]).
     pub fn write(&self, path: &Path) -> CliResult {
         let text = serde_json::to_string_pretty(self)
             .map_err(|e| CliError::file(path, format!("cannot encode the calibration: {e}")))?;
-        std::fs::write(path, text + "\n")
-            .map_err(|e| CliError::file(path, format!("cannot write: {e}")))
+        write_atomically(path, |f| {
+            use std::io::Write as _;
+            f.write_all((text + "\n").as_bytes())?;
+            Ok(())
+        })
     }
 
     /// Reads and checks a calibration file.

@@ -8,6 +8,7 @@ mod demo;
 mod field;
 mod heading;
 mod io;
+mod orientation;
 mod svg;
 
 use std::process::ExitCode;
@@ -36,6 +37,9 @@ enum Command {
     Heading(heading::Args),
     /// The World Magnetic Model 2025 field at a place and date.
     Field(field::Args),
+    /// Estimate orientation from an IMU recording (gyro, accelerometer, optional
+    /// magnetometer).
+    Orientation(orientation::Args),
 }
 
 fn main() -> ExitCode {
@@ -45,6 +49,7 @@ fn main() -> ExitCode {
         Command::Calibrate(a) => calibrate::run(&a),
         Command::Heading(a) => heading::run(&a),
         Command::Field(a) => field::run(&a),
+        Command::Orientation(a) => orientation::run(&a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -1,0 +1,165 @@
+//! `truenorth orientation`: run an orientation estimator over an IMU recording and write the
+//! attitude.
+
+use std::path::PathBuf;
+
+use nalgebra::{Quaternion, UnitQuaternion, Vector3};
+use truenorth::core::{Axes, EulerZyx, ImuSample, OrientationEstimator, rad_to_deg};
+use truenorth::fusion::{QuaternionFilter, QuaternionFilterConfig};
+
+use crate::io::{CliError, CliResult, Table, check_distinct, write_csv};
+
+/// Orientation methods.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum Method {
+    /// Quaternion filter: gyro strapdown, inclination from the low-passed specific force,
+    /// heading from the magnetometer with disturbance rejection, gyro bias at rest and in
+    /// motion.
+    Quaternion,
+}
+
+/// Reference frame of the output quaternion.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum Frame {
+    /// North, east, down (the library's frame).
+    Ned,
+    /// East, north, up (e.g. the BROAD benchmark's frame).
+    Enu,
+}
+
+/// Arguments of `truenorth orientation`.
+///
+/// Input: CSV with `t_s` (s, strictly increasing), `gyr_x,gyr_y,gyr_z` (rad/s) and
+/// `acc_x,acc_y,acc_z` (m/s², specific force: about +9.81 on the upward axis at rest), and
+/// optionally `mag_x,mag_y,mag_z` (any unit, calibrated). Rows whose three magnetometer
+/// cells are empty have no magnetometer reading (a magnetometer slower than the gyro); other
+/// columns are ignored.
+///
+/// Output: CSV `t_s,qw,qx,qy,qz,yaw_deg,pitch_deg,roll_deg`. The quaternion (Hamilton,
+/// scalar first) rotates sensor-frame vectors into the reference frame chosen with
+/// `--frame`: NED (north, east, down; default) or ENU (east, north, up). North is magnetic
+/// north. Yaw, pitch and roll are always the Z-Y-X angles of the sensor relative to NED
+/// (yaw clockwise from north, pitch nose up, roll right side down), whatever `--frame`.
+/// With `--status` the columns `bias_x_rps,bias_y_rps,bias_z_rps,at_rest,mag_used,
+/// mag_disturbed` follow (estimated gyro bias; 1/0 flags).
+///
+/// Exit status 1 with one line on stderr naming the file and row of the first unusable
+/// sample (non-finite value, time not increasing).
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// Orientation method.
+    #[arg(long, value_enum, default_value = "quaternion")]
+    pub method: Method,
+    /// Input CSV.
+    #[arg(long)]
+    pub input: PathBuf,
+    /// Output CSV.
+    #[arg(long)]
+    pub output: PathBuf,
+    /// Reference frame of the output quaternion.
+    #[arg(long, value_enum, default_value = "ned")]
+    pub frame: Frame,
+    /// Ignore the magnetometer (6-D: heading relative to the start, drifting).
+    #[arg(long)]
+    pub no_mag: bool,
+    /// Append the estimated gyro bias and the rest / magnetometer flags.
+    #[arg(long)]
+    pub status: bool,
+}
+
+const HEADER: [&str; 8] = [
+    "t_s",
+    "qw",
+    "qx",
+    "qy",
+    "qz",
+    "yaw_deg",
+    "pitch_deg",
+    "roll_deg",
+];
+const STATUS_HEADER: [&str; 6] = [
+    "bias_x_rps",
+    "bias_y_rps",
+    "bias_z_rps",
+    "at_rest",
+    "mag_used",
+    "mag_disturbed",
+];
+
+/// Runs the subcommand.
+pub fn run(args: &Args) -> CliResult {
+    check_distinct(&args.output, &[&args.input])?;
+    let table = Table::read(
+        &args.input,
+        &["t_s", "gyr_x", "gyr_y", "gyr_z", "acc_x", "acc_y", "acc_z"],
+        &["mag_x", "mag_y", "mag_z"],
+    )?;
+    table.require_rows()?;
+    table.check_increasing_time()?;
+    let col = |n: &str| table.req(n);
+    let (t, gx, gy, gz) = (col("t_s")?, col("gyr_x")?, col("gyr_y")?, col("gyr_z")?);
+    let (ax, ay, az) = (col("acc_x")?, col("acc_y")?, col("acc_z")?);
+    let mag = match (table.col("mag_x"), table.col("mag_y"), table.col("mag_z")) {
+        (Some(x), Some(y), Some(z)) if !args.no_mag => Some((x, y, z)),
+        _ => None,
+    };
+    let mut estimator = match args.method {
+        Method::Quaternion => QuaternionFilter::new(QuaternionFilterConfig {
+            use_mag: !args.no_mag,
+            ..Default::default()
+        })
+        .map_err(|e| CliError::msg(e.to_string()))?,
+    };
+    let to_frame = match args.frame {
+        Frame::Ned => UnitQuaternion::identity(),
+        // ENU = (NED y, NED x, −NED z): 180° about (1, 1, 0)/√2.
+        Frame::Enu => {
+            let h = std::f64::consts::FRAC_1_SQRT_2;
+            UnitQuaternion::from_quaternion(Quaternion::new(0.0, h, h, 0.0))
+        }
+    };
+    let mut rows = Vec::with_capacity(table.len());
+    for k in 0..table.len() {
+        let m = match mag {
+            Some((x, y, z)) if x[k].is_nan() && y[k].is_nan() && z[k].is_nan() => Axes::NONE,
+            Some((x, y, z)) => Axes::xyz(Vector3::new(x[k], y[k], z[k])),
+            None => Axes::NONE,
+        };
+        let sample = ImuSample {
+            t_s: t[k],
+            gyr_rps: Axes::xyz(Vector3::new(gx[k], gy[k], gz[k])),
+            acc_mps2: Axes::xyz(Vector3::new(ax[k], ay[k], az[k])),
+            mag: m,
+        };
+        let est = estimator
+            .update(&sample)
+            .map_err(|e| CliError::row(&args.input, k + 2, e.to_string()))?;
+        let q = to_frame * est.attitude;
+        let e = EulerZyx::from_quaternion(&est.attitude);
+        let mut row = vec![
+            t[k],
+            q.w,
+            q.i,
+            q.j,
+            q.k,
+            rad_to_deg(e.yaw_rad),
+            rad_to_deg(e.pitch_rad),
+            rad_to_deg(e.roll_rad),
+        ];
+        if args.status {
+            let flag = |b: bool| f64::from(u8::from(b));
+            row.extend(est.gyro_bias_rps.iter());
+            row.extend([
+                flag(est.status.at_rest),
+                flag(est.status.mag_used),
+                flag(est.status.mag_disturbed),
+            ]);
+        }
+        rows.push(row);
+    }
+    let mut header: Vec<&str> = HEADER.to_vec();
+    if args.status {
+        header.extend(STATUS_HEADER);
+    }
+    write_csv(&args.output, &header, rows)
+}
