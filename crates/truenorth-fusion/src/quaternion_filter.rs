@@ -138,7 +138,8 @@ impl Validate for QuaternionFilterConfig {
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 struct State {
     q: UnitQuaternion<f64>,
-    heading_correction_rad: f64,
+    /// `Rz(−H)`, `H` the sum of the heading corrections (see the module documentation).
+    undo_heading: UnitQuaternion<f64>,
     bias_rps: Vector3<f64>,
     acc_lp_ned: Option<Vector3<f64>>,
     last_gyr_rps: Option<Vector3<f64>>,
@@ -189,7 +190,7 @@ impl QuaternionFilter {
             config,
             state: State {
                 q: q0,
-                heading_correction_rad: 0.0,
+                undo_heading: UnitQuaternion::identity(),
                 bias_rps: Vector3::zeros(),
                 acc_lp_ned: None,
                 last_gyr_rps: None,
@@ -255,7 +256,7 @@ impl QuaternionFilter {
                 let down = -s.acc_lp_ned.unwrap_or(f) / STANDARD_GRAVITY_MPS2;
                 let k = (dt_s / fast(cfg.tau_acc_s)).min(1.0);
                 let rot = down.cross(&Vector3::z()) * k;
-                let c = UnitQuaternion::from_scaled_axis(rot);
+                let c = small_rotation(&rot);
                 s.q = c * s.q;
                 s.acc_lp_ned = s.acc_lp_ned.map(|lp| c * lp);
                 correction_rate += s.q.inverse_transform_vector(&rot) / dt_s;
@@ -278,10 +279,10 @@ impl QuaternionFilter {
                     let err = m_ned.y.atan2(m_ned.x);
                     let k = (dt_s / fast(cfg.tau_mag_s)).min(1.0);
                     let rot = Vector3::new(0.0, 0.0, -k * err);
-                    let c = UnitQuaternion::from_scaled_axis(rot);
+                    let c = small_rotation(&rot);
                     s.q = c * s.q;
                     s.acc_lp_ned = s.acc_lp_ned.map(|lp| c * lp);
-                    s.heading_correction_rad += rot.z;
+                    s.undo_heading = small_rotation(&-rot) * s.undo_heading;
                     correction_rate += s.q.inverse_transform_vector(&rot) / dt_s;
                     status.mag_used = true;
                 }
@@ -302,8 +303,7 @@ impl QuaternionFilter {
             s.bias_rps = s.bias_rps.map(|b| b.clamp(-lim, lim));
         }
 
-        let q6 =
-            UnitQuaternion::from_axis_angle(&Vector3::z_axis(), -s.heading_correction_rad) * s.q;
+        let q6 = s.undo_heading * s.q;
         s.estimate = AttitudeEstimate {
             t_s,
             attitude: s.q,
@@ -372,6 +372,19 @@ impl OrientationEstimator for QuaternionFilter {
             *self = f;
         }
     }
+}
+
+/// The rotation by the rotation vector `v` for the small angles of one correction step:
+/// `(1, v/2)` normalised, whose angle differs from |v| by |v|³/12 — under 10⁻¹⁰ rad for the
+/// at most 10⁻³ rad a correction turns per sample — at a fraction of the cost of the exact
+/// exponential's sine and cosine. A step is limited to 0.1 rad: only a reading far outside
+/// any sensor's range asks for more, and it must not flip the attitude in one sample.
+#[inline]
+fn small_rotation(v: &Vector3<f64>) -> UnitQuaternion<f64> {
+    const MAX_STEP_RAD: f64 = 0.1;
+    let n = v.norm();
+    let v = if n > MAX_STEP_RAD { v * (MAX_STEP_RAD / n) } else { *v };
+    UnitQuaternion::new_normalize(Quaternion::new(1.0, 0.5 * v.x, 0.5 * v.y, 0.5 * v.z))
 }
 
 fn initial_attitude(config: &QuaternionFilterConfig) -> UnitQuaternion<f64> {

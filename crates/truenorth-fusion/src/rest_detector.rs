@@ -102,7 +102,11 @@ impl RestDetector {
             _ => {}
         }
         if still && let (Some(start), Some(mean)) = (self.mag_at_start, self.mag_mean) {
-            still = start.angle(&mean) < self.config.mag_turn_rad;
+            // angle < θ ⇔ dot > 0 and |a × b|² < sin²θ |a|² |b|² (θ < 90°): no arccosine.
+            let sin = self.config.mag_turn_rad.min(1.5).sin();
+            still = start.dot(&mean) > 0.0
+                && start.cross(&mean).norm_squared()
+                    < sin * sin * start.norm_squared() * mean.norm_squared();
         }
         if still {
             if self.still_s == 0.0 {
