@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 use nalgebra::{SMatrix, SVector, Vector2, Vector3};
 use truenorth::calib::{
     BinnedEllipseCalibrator, EllipseCalibrator, EllipsoidCalibrator, MeritCircleCalibrator,
-    TurnCompassCalibrator, quality,
+    OnlineEllipseCalibrator, OnlineEllipsoidCalibrator, TurnCompassCalibrator, quality,
 };
 use truenorth::compass::{CompassCalibration2d, CompassCalibration3d};
 use truenorth::core::{Calibrator, CompassQuality, Mag2Sample, Mag3Sample, Solution};
@@ -28,6 +28,11 @@ pub enum Method {
     Ellipse,
     /// Least-squares ellipsoid (3-D, needs mag_z): hard iron + full symmetric soft iron.
     Ellipsoid,
+    /// Online least-squares ellipse (2-D): the same direct fit from running sums, in
+    /// constant memory, as a vehicle would run it while driving.
+    OnlineEllipse,
+    /// Online least-squares ellipsoid (3-D, needs mag_z), in constant memory.
+    OnlineEllipsoid,
     /// Binned ellipse (EP 0634001): heading bins, origin iteration, ellipse phasors.
     BinnedEllipse,
     /// Merit circle (US 5,297,063): merit-weighted circumcentres; hard iron only.
@@ -42,6 +47,8 @@ impl Method {
         match self {
             Method::Ellipse => "ellipse",
             Method::Ellipsoid => "ellipsoid",
+            Method::OnlineEllipse => "online-ellipse",
+            Method::OnlineEllipsoid => "online-ellipsoid",
             Method::BinnedEllipse => "binned-ellipse",
             Method::MeritCircle => "merit-circle",
             Method::Turn => "turn",
@@ -162,6 +169,14 @@ pub fn run(args: &Args) -> CliResult {
     let file = match args.method {
         Method::Ellipse => calibrate_2d(args, EllipseCalibrator::default())?,
         Method::Ellipsoid => calibrate_3d(args, EllipsoidCalibrator::default())?,
+        Method::OnlineEllipse => calibrate_2d(
+            args,
+            OnlineEllipseCalibrator::new(Default::default()).map_err(library)?,
+        )?,
+        Method::OnlineEllipsoid => calibrate_3d(
+            args,
+            OnlineEllipsoidCalibrator::new(Default::default()).map_err(library)?,
+        )?,
         Method::BinnedEllipse => calibrate_2d(args, BinnedEllipseCalibrator::default())?,
         Method::MeritCircle => calibrate_2d(args, MeritCircleCalibrator::default())?,
         // The compass half of the turn method (METHODS.md §A.4-5); `gyr_z` is accepted so
@@ -169,6 +184,11 @@ pub fn run(args: &Args) -> CliResult {
         Method::Turn => calibrate_2d(args, TurnCompassCalibrator::default())?,
     };
     file.write(&args.output)
+}
+
+/// A library error outside any file (an invalid built-in configuration).
+fn library(e: truenorth::core::Error) -> CliError {
+    CliError::msg(e.to_string())
 }
 
 /// Reads the 2-D input, after checking time order.

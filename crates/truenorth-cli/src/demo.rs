@@ -3,7 +3,8 @@
 use std::path::PathBuf;
 
 use truenorth::calib::{
-    BinnedEllipseCalibrator, EllipseCalibrator, MeritCircleCalibrator, TurnCompassCalibrator,
+    BinnedEllipseCalibrator, EllipseCalibrator, MeritCircleCalibrator, OnlineEllipseCalibrator,
+    OnlineEllipseConfig, TurnCompassCalibrator,
 };
 use truenorth::compass::CompassCalibration2d;
 use truenorth::core::{
@@ -302,8 +303,8 @@ fn compass_section(d: &DemoDrive, out: &std::path::Path) -> CliResult {
         p.compass_noise / p.horizontal_field * 100.0
     );
     println!(
-        "{:<26} {:>9} {:>9} {:>11} {:>9} {:>11}",
-        "method", "RMS deg", "max deg", "cal 3sd deg", "coverage", "residual %"
+        "{:<26} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>11}",
+        "method", "RMS deg", "max deg", "3sd deg", "sys deg", "noise deg", "coverage", "residual %"
     );
     let heading_rms = |cal: &CompassCalibration2d| {
         let est: Vec<f64> = d
@@ -319,13 +320,20 @@ fn compass_section(d: &DemoDrive, out: &std::path::Path) -> CliResult {
     };
     let floor = heading_rms(&truth_cal);
     println!(
-        "{:<26} {:>9.2} {:>9.2} {:>11} {:>9} {:>11}",
-        "(noise floor: true cal.)", floor.rms_deg, floor.max_deg, "-", "-", "-"
+        "{:<26} {:>9.2} {:>9.2} {:>9} {:>9} {:>9} {:>9} {:>11}",
+        "(noise floor: true cal.)", floor.rms_deg, floor.max_deg, "-", "-", "-", "-", "-"
     );
     let mut methods: Vec<(&str, Box<Compass2dCalibrator>)> = vec![
         (
             "least-squares ellipse",
             Box::new(EllipseCalibrator::default()),
+        ),
+        (
+            "online least squares",
+            Box::new(
+                OnlineEllipseCalibrator::new(OnlineEllipseConfig::default())
+                    .map_err(|e| CliError::msg(e.to_string()))?,
+            ),
         ),
         (
             "binned ellipse (EP0634001)",
@@ -350,11 +358,13 @@ fn compass_section(d: &DemoDrive, out: &std::path::Path) -> CliResult {
             Ok(sol) => {
                 let e = heading_rms(&sol.params);
                 println!(
-                    "{:<26} {:>9.2} {:>9.2} {:>11.2} {:>8.0}% {:>11.2}",
+                    "{:<26} {:>9.2} {:>9.2} {:>9.2} {:>9.2} {:>9.2} {:>8.0}% {:>11.2}",
                     name,
                     e.rms_deg,
                     e.max_deg,
-                    sol.quality.heading_error_bound_deg(),
+                    sol.quality.heading_error_3sigma_deg,
+                    sol.quality.heading_error_systematic_deg,
+                    sol.quality.heading_noise_rms_deg,
                     sol.quality.fit.coverage * 100.0,
                     sol.quality.fit.residual_rms_rel * 100.0
                 );
@@ -381,9 +391,10 @@ fn compass_section(d: &DemoDrive, out: &std::path::Path) -> CliResult {
         refused += usize::from(cal.solve().is_err());
     }
     println!(
-        "RMS/max: heading error on the whole drive, noise included. cal 3sd: the solve's own predicted bound on\n\
-         the calibration's heading error (per-sample noise excluded). residual: RMS distance from the fitted\n\
-         circle divided by the field."
+        "RMS/max: heading error on the whole drive, noise included. 3sd: three standard deviations of the\n\
+         heading error from the fitted parameters' uncertainty; sys: the error the method's model leaves\n\
+         whatever the data; noise: RMS noise of one calibrated reading. residual: RMS distance from the\n\
+         fitted circle divided by the field."
     );
     println!(
         "half circle (< 180 deg of turn): {refused} of {} methods refuse, as they must",

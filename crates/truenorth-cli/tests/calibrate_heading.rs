@@ -376,9 +376,16 @@ fn every_2d_method_calibrates_a_full_turn_and_refuses_a_half() {
     let dir = scratch("all_methods");
     // A little over one turn, so the turn method sees a complete revolution.
     let (csv, _) = turn_csv(400);
-    let input = dir.join("turn.csv");
+    // Not `turn.csv`: that is the `turn` method's heading output below.
+    let input = dir.join("recording.csv");
     std::fs::write(&input, csv).unwrap();
-    for method in ["ellipse", "binned-ellipse", "merit-circle", "turn"] {
+    for method in [
+        "ellipse",
+        "online-ellipse",
+        "binned-ellipse",
+        "merit-circle",
+        "turn",
+    ] {
         let cal = dir.join(format!("{method}.json"));
         ok(&[
             "calibrate",

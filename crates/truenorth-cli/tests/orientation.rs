@@ -160,4 +160,14 @@ fn refusals_name_the_file_and_row() {
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(err.contains("row 6"), "{err}");
     assert!(!out.exists());
+    // A failed run leaves an existing output as it was.
+    std::fs::write(&out, "kept\n").unwrap();
+    let o = run(&[
+        "--input",
+        bad.to_str().unwrap(),
+        "--output",
+        out.to_str().unwrap(),
+    ]);
+    assert!(!o.status.success());
+    assert_eq!(std::fs::read_to_string(&out).unwrap(), "kept\n");
 }
