@@ -1,8 +1,9 @@
 //! Compass calibration and heading costs.
 //!
 //! * 2-D least-squares fit of 10,000 readings (goal ≤ 50 µs): the direct fit alone, the
-//!   direct fit with the quality report, and the full `fit_ellipse` (direct fit, Sampson
-//!   refinement, quality report and refusal checks).
+//!   direct fit with the quality report and refusal checks (`refine: false`), and the
+//!   default `fit_ellipse` (which refines on the Sampson distance only where that could
+//!   change the answer; on this full, evenly covered turn it does not).
 //! * Per-sample heading, `CompassCalibration2d::heading_rad` (goal ≤ 20 ns).
 //! * 3-D least-squares fit of 10,000 readings, direct and refined.
 //! * Per-push cost of the binned-ellipse calibrator (criterion's mean over pushes, and the

@@ -6,6 +6,8 @@
 //!   max / p99.9 / p99 / median. The maximum includes whatever the operating system does to
 //!   the thread meanwhile (an interrupt, a preemption), so p99.9 is the better figure of the
 //!   code itself; both are printed.
+//! * Breakdowns: the binned ellipse's pushes by the phase of its update, and the online
+//!   ellipsoid's by the refresh stage they ran, to show where the worst pushes come from.
 //!
 //! Streams: a level compass turning round and round (2-D; hard iron 0.5 × field, soft-iron
 //! axis ratio 1.3 at 30°, noise 1 %), and a tumble over the sphere (3-D, noise 1 %).
@@ -133,6 +135,34 @@ fn binned_breakdown(stream: &[Mag2Sample]) {
     }
 }
 
+/// The online ellipsoid's pushes grouped by the refresh stage they ran, max / p99 / median.
+fn ellipsoid_breakdown(stream: &[Mag3Sample]) {
+    let mut cal = OnlineEllipsoidCalibrator::new(OnlineEllipsoidConfig::default()).unwrap();
+    let mut groups: Vec<Vec<u64>> = vec![Vec::new(); 64];
+    for s in stream {
+        let g = cal.refresh_stage().map_or(63, |k| usize::from(k).min(62));
+        let t0 = Instant::now();
+        let r = cal.push(black_box(s));
+        let dt = t0.elapsed();
+        black_box(r).ok();
+        groups[g].push(dt.as_nanos() as u64);
+    }
+    for (k, mut ns) in groups.into_iter().enumerate() {
+        if ns.is_empty() {
+            continue;
+        }
+        ns.sort_unstable();
+        let q = |p: f64| ns[((ns.len() - 1) as f64 * p) as usize];
+        println!(
+            "online_ellipsoid stage {k}: {} pushes, max {:.2} µs, p99 {:.2} µs, median {} ns",
+            ns.len(),
+            q(1.0) as f64 / 1e3,
+            q(0.99) as f64 / 1e3,
+            q(0.5)
+        );
+    }
+}
+
 /// Criterion bench of one push, going round the stream.
 fn median_push<C: Calibrator>(c: &mut Criterion, name: &str, mut cal: C, stream: &[C::Sample]) {
     let mut k = 0usize;
@@ -162,6 +192,7 @@ fn bench(c: &mut Criterion) {
     worst_push("online_ellipse", online2(), &s2);
     worst_push("online_ellipse (forgetting)", forgetful2(), &s2);
     worst_push("online_ellipsoid", online3(), &s3);
+    ellipsoid_breakdown(&s3);
     worst_push("merit_circle", merit(), &s2);
     worst_push("binned_ellipse", binned(), &s2);
     binned_breakdown(&s2);

@@ -149,9 +149,9 @@ impl Assessor<'_> {
             return None;
         }
         let (mut ss, mut k) = (0.0, 0usize);
-        for i in 0..n {
-            if let (Some(r), true) = (self.reference[i], bins[i].state != BinState::Empty) {
-                ss += (bins[i].value - r).norm_squared();
+        for (r, b) in self.reference[..n].iter().zip(&bins[..n]) {
+            if let (Some(r), true) = (r, b.state != BinState::Empty) {
+                ss += (b.value - r).norm_squared();
                 k += 1;
             }
         }

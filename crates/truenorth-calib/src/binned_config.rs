@@ -7,7 +7,7 @@ use crate::binned_ellipse::MAX_INIT_SAMPLES;
 use crate::binned_refresh::MAX_BINS;
 use crate::quality::MIN_ARC_DEG;
 
-/// Configuration of the [`BinnedEllipseCalibrator`] (defaults in brackets).
+/// Configuration of the [`crate::BinnedEllipseCalibrator`] (defaults in brackets).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct BinnedEllipseConfig {

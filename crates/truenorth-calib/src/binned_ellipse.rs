@@ -49,13 +49,17 @@
 //!    sensor moves every bin visited and trips it.
 //!
 //! ## Cost per push, estimate, solve
-//! A full-set update (steps 3–5) is about 40,000 bin operations for 64 bins, far more than a
-//! push may cost. So push starts it on a copy of the bins and does one bounded slice of it
-//! per push (the `binned_refresh` module): the work is spread evenly over at most
-//! `min(update_interval, 128)` pushes. The readings that arrive meanwhile are kept and, when
-//! the update completes, binned about the new origin, exactly as if the update had been done
-//! at once when it started; the estimate ([`truenorth_core::OnlineCalibrator::estimate`],
-//! O(1)) is replaced only then, and that push returns [`Pushed::NewEstimate`].
+//! A full-set update (steps 3–5) is about 20,000 bin operations for 64 bins, far more than a
+//! push may cost. So push starts it on a copy of the bins (the `binned_update` module) and
+//! advances it by one bounded slice on every second push only, over at most
+//! `min(update_interval, 96)` pushes (the `binned_refresh` module); the pushes between do
+//! no update work at all. The finished refresh is then assessed over two pushes (the
+//! restart check and the locus's turning; the quality report and the other acceptance
+//! tests) and applied at a third, which swaps in its bins, origin and estimate together
+//! (so the published estimate is always one update's) and bins the readings that arrived
+//! meanwhile about the new origin, exactly as if the update had been done at once when it
+//! started. The estimate ([`truenorth_core::OnlineCalibrator::estimate`], O(1)) changes
+//! only then, and that push returns [`Pushed::NewEstimate`].
 //!
 //! `solve` leaves the calibrator unchanged: it completes any update in progress and runs a
 //! full update on a copy, then applies the acceptance tests (origin, filled bins, arc about
@@ -66,14 +70,13 @@
 //! Push, solve and progress allocate nothing.
 
 use nalgebra::Vector2;
-use serde::{Deserialize, Serialize};
 use truenorth_compass::{CompassCalibration2d, EllipsePhasors};
 use truenorth_core::{
     Calibrator, CompassQuality, Error, Mag2Sample, OnlineCalibrator, Progress, Pushed, Result,
     Solution, Validate, check_finite, check_finite2,
 };
 
-use crate::binned_assess::{Assessor, Precheck, Verdict};
+use crate::binned_assess::{Assessor, Verdict};
 pub use crate::binned_config::BinnedEllipseConfig;
 use crate::binned_refresh::{
     Bin, BinState, Bins, EMPTY, MAX_BINS, RefreshJob, bin_reading, filled,
@@ -81,91 +84,14 @@ use crate::binned_refresh::{
 
 use core::f64::consts::TAU;
 
+pub use crate::binned_update::{MAX_UPDATE_PUSHES, UpdatePhase};
+use crate::binned_update::{REFRESH_PUSHES, REFRESH_STRIDE, Update};
+
 #[allow(unused_imports)]
 use truenorth_core::Float as _;
 
 /// Most initial readings averaged for the first origin.
 pub const MAX_INIT_SAMPLES: usize = 64;
-
-/// Most readings kept while a full-set update is in progress (they are binned when it
-/// completes).
-pub const MAX_UPDATE_PUSHES: usize = 128;
-
-/// Most pushes the refresh of a full-set update is spread over; its assessment and its
-/// application take three pushes after it, so at most `REFRESH_PUSHES + 3` readings wait.
-pub(crate) const REFRESH_PUSHES: usize = 96;
-
-/// A refresh advances on every `REFRESH_STRIDE`-th push only, so that most pushes do no
-/// refresh work at all (and cost what binning one reading costs).
-pub(crate) const REFRESH_STRIDE: usize = 2;
-
-/// Where a full-set update stands.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-pub enum UpdatePhase {
-    /// The refresh job advances by one slice every `stride` pushes.
-    Refresh,
-    /// The refresh is over; the next push checks for a restart and measures the locus's
-    /// turning.
-    Precheck,
-    /// The next push completes the assessment (quality report and acceptance tests).
-    Assess,
-    /// The result is assessed; the next push applies it and bins the readings that waited.
-    Apply,
-}
-
-/// A full-set update in progress: the job on its copy of the bins, the bins and origin it
-/// started from (so that a saved state can replay it exactly), its work per working push
-/// and their spacing, how many pushes it has seen, its phase (and, once assessed, its
-/// verdict), and the readings that arrived since it started.
-#[derive(Debug, Clone, PartialEq)]
-pub(crate) struct Update {
-    pub job: RefreshJob,
-    pub start_bins: Bins,
-    pub start_origin: Vector2<f64>,
-    pub budget: usize,
-    pub stride: usize,
-    pub advanced: usize,
-    pub phase: UpdatePhase,
-    pub precheck: Option<Precheck>,
-    pub verdict: Option<Verdict>,
-    pub pending: [Vector2<f64>; MAX_UPDATE_PUSHES],
-    pub pending_len: usize,
-}
-
-impl Update {
-    /// The assessment's share of a push: its first half in phase `Precheck`, its second in
-    /// phase `Assess`.
-    pub(crate) fn advance_assessment(&mut self, assessor: &Assessor<'_>) {
-        match self.phase {
-            UpdatePhase::Precheck => {
-                self.precheck = Some(assessor.precheck(&self.job));
-                self.phase = UpdatePhase::Assess;
-            }
-            UpdatePhase::Assess => {
-                let pre = match self.precheck {
-                    Some(p) => p,
-                    None => assessor.precheck(&self.job),
-                };
-                self.verdict = Some(assessor.conclude(&self.job, pre));
-                self.phase = UpdatePhase::Apply;
-            }
-            UpdatePhase::Refresh | UpdatePhase::Apply => {}
-        }
-    }
-
-    /// One push's share of the work: advances the refresh on every `stride`-th push. The
-    /// assessment and application are the calibrator's, which owns the state they read.
-    /// (Replaying `advanced` pushes through this rebuilds a saved update exactly.)
-    pub(crate) fn step_refresh(&mut self) {
-        self.advanced += 1;
-        if self.phase == UpdatePhase::Refresh
-            && self.advanced.is_multiple_of(self.stride)
-            && self.job.advance(self.budget)
-        {
-            self.phase = UpdatePhase::Precheck;
-        }
-    }
-}
 
 /// The binned-ellipse calibrator (EP 0634001). See the module documentation.
 ///
@@ -713,6 +639,46 @@ mod tests {
         drive(&mut c, &mut magnet, 0.0, 450.0);
         let sol = c.solve().unwrap();
         assert!((sol.params.hard_iron - magnet.hard_iron()).norm() < 0.02 * H);
+    }
+
+    /// A snapshot taken at any push of a whole update cycle (every phase: refresh on idle
+    /// and working pushes, precheck, assessment, application) restores to a calibrator that
+    /// continues bit-identically.
+    #[test]
+    fn snapshot_at_every_phase_of_an_update_continues_identically() {
+        use truenorth_core::Persistent;
+        let mut m = reference();
+        let mut rng = SplitMix64::new(3);
+        let stream: Vec<_> = (0..900)
+            .map(|i| {
+                let truth = HeadingTruth {
+                    heading_rad: (i as f64 * 0.5).to_radians(),
+                    horizontal_field: H,
+                };
+                Mag2Sample {
+                    t_s: i as f64,
+                    mag: m.sample(&truth, 0.05, &mut rng).unwrap(),
+                }
+            })
+            .collect();
+        let mut straight = BinnedEllipseCalibrator::default();
+        let mut phases = std::collections::BTreeSet::new();
+        for (k, s) in stream.iter().enumerate() {
+            if k >= 600 {
+                phases.insert(format!("{:?}", straight.update_phase().map(|p| p.0)));
+                let mut resumed = BinnedEllipseCalibrator::restore(straight.snapshot()).unwrap();
+                assert_eq!(resumed, straight, "push {k}");
+                let mut copy = straight.clone();
+                for t in &stream[k..(k + 5).min(stream.len())] {
+                    assert_eq!(copy.push(t).unwrap(), resumed.push(t).unwrap(), "push {k}");
+                    assert_eq!(copy.estimate(), resumed.estimate());
+                }
+                assert_eq!(copy, resumed);
+            }
+            straight.push(s).unwrap();
+        }
+        // Every phase was visited.
+        assert_eq!(phases.len(), 5, "{phases:?}");
     }
 
     #[test]

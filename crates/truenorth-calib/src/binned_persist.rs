@@ -14,11 +14,9 @@ use truenorth_core::{
     Error, Persistent, Result, Snapshot, Solution, Validate, check_snapshot_version,
 };
 
-use crate::binned_ellipse::{
-    BinnedEllipseCalibrator, BinnedEllipseConfig, MAX_INIT_SAMPLES, MAX_UPDATE_PUSHES,
-    REFRESH_STRIDE, Update, UpdatePhase,
-};
+use crate::binned_ellipse::{BinnedEllipseCalibrator, BinnedEllipseConfig, MAX_INIT_SAMPLES};
 use crate::binned_refresh::{Bin, BinState, Bins, EMPTY, MAX_BINS, RefreshJob};
+use crate::binned_update::{MAX_UPDATE_PUSHES, REFRESH_STRIDE, Update, UpdatePhase};
 
 /// A full-set update in progress, as saved (opaque).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

@@ -20,8 +20,14 @@
 //!    definite square root (no arbitrary rotation) and `F = √(a·b)`, the geometric mean of
 //!    the semi-axes, so that `det(soft_iron) = 1`: the soft iron preserves area and the
 //!    fitted field is the radius of the circle with the ellipse's area.
-//! 7. Quality report and refusals on coverage (arc shorter than
-//!    [`EllipseConfig::min_arc_deg`]) and conditioning (see [`crate::quality`]).
+//!    It runs only when it could change the answer: when the direct fit's own noise level,
+//!    eccentricity and spread of readings say that one step could move the heading by more
+//!    than a quarter of the direct fit's heading-error bound (see `refinement_could_matter`),
+//!    or when the readings do not go all the way round.
+//! 7. Quality report from the monomial sums the direct fit already formed (see
+//!    [`crate::quality`]; one more pass over the readings for the coverage), and refusals
+//!    on coverage (arc shorter than [`EllipseConfig::min_arc_deg`] about the fitted centre,
+//!    or a raw locus that turns through less), conditioning, residual and heading bound.
 //!
 //! An ellipse fit cannot see a rotation of the soft iron (any rotation of the corrected
 //! circle is another circle); choosing the symmetric root assumes the soft iron has none,
@@ -44,11 +50,10 @@ use truenorth_core::{
     check_finite, check_finite2, check_positive, check_range,
 };
 
-use crate::conic_sums::t_factor;
 use crate::linalg::{constrained_min3, sym_eigen2, sym_eigen3, sym_sqrt2};
 use crate::lm::{self, BLOCK, NormalAccumulator, NormalEquations, blocks};
 use crate::normalise::Normaliser;
-use crate::quality::{self, MIN_ARC_DEG};
+use crate::quality::{self, Assessment2d, BOUND_SIGMAS, MIN_ARC_DEG, Moments2};
 
 #[allow(unused_imports)]
 use truenorth_core::Float as _;
@@ -57,12 +62,18 @@ use truenorth_core::Float as _;
 /// more leaves a residual to judge it by.
 pub const MIN_POINTS_2D: usize = 6;
 
+/// The fewest readings [`fit_ellipse`] accepts a calibration from: five for the ellipse and
+/// five residuals to judge it by (the direct fit alone, [`fit_ellipse_direct`], needs
+/// [`MIN_POINTS_2D`]).
+pub(crate) const MIN_POINTS_JUDGED_2D: usize = 10;
+
 /// Configuration of the least-squares ellipse fit (defaults in brackets).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct EllipseConfig {
-    /// Refine the direct fit geometrically (Sampson distance) (`true`); `false` keeps the
-    /// algebraic fit, which is faster and nearly as good at low noise.
+    /// Refine the direct fit geometrically (Sampson distance) where that could change the
+    /// answer (`true`; see the module documentation, step 5); `false` always keeps the
+    /// algebraic fit.
     pub refine: bool,
     /// Most Levenberg–Marquardt steps before refusing with [`Error::NoConvergence`], 1..=10⁶
     /// (100).
@@ -167,7 +178,7 @@ impl Ellipse {
 /// Fitzgibbon, Pilu & Fisher (1999) in the form of Halíř & Flusser (1998), on normalised
 /// data. Fast (a single pass over the points plus 3×3 algebra) and always an ellipse.
 pub fn fit_ellipse_direct(points: &[Vector2<f64>]) -> Result<Ellipse> {
-    let (norm, e) = direct_normalised(points, f64::INFINITY)?;
+    let (norm, e, _) = direct_normalised(points, f64::INFINITY)?;
     Ok(denormalise(&norm, &e))
 }
 
@@ -176,7 +187,7 @@ pub fn fit_ellipse_direct(points: &[Vector2<f64>]) -> Result<Ellipse> {
 fn direct_normalised(
     points: &[Vector2<f64>],
     max_axis_ratio: f64,
-) -> Result<(Normaliser<2>, Ellipse)> {
+) -> Result<(Normaliser<2>, Ellipse, Moments2)> {
     if points.len() < MIN_POINTS_2D {
         return Err(Error::TooFewPoints {
             got: points.len(),
@@ -184,7 +195,7 @@ fn direct_normalised(
         });
     }
     let norm = Normaliser::of_finite(points, "magnetometer reading")?;
-    let (s, cov) = moments(points, &norm);
+    let (s, cov, table) = moments(points, &norm);
     // Collinear: the spread across the best line is nil compared with the spread along it
     // (the trace of `cov` is 1 after normalisation).
     let (l, _) = sym_eigen2(&cov).ok_or(Error::Degenerate {
@@ -196,12 +207,16 @@ fn direct_normalised(
         });
     }
     let e = conic_to_ellipse(&solve_direct(&s)?, max_axis_ratio)?;
-    Ok((norm, e))
+    Ok((norm, e, table))
 }
 
 /// The moments `Σ qqᵀ`-style sums the direct fit needs, in normalised coordinates: the
-/// 6×6 scatter matrix of `(x², xy, y², x, y, 1)` and the 2×2 covariance.
-fn moments(points: &[Vector2<f64>], norm: &Normaliser<2>) -> (SMatrix<f64, 6, 6>, Matrix2<f64>) {
+/// 6×6 scatter matrix of `(x², xy, y², x, y, 1)`, the 2×2 covariance, and the same sums as
+/// a table `Σ xⁱ yʲ` for the quality report.
+fn moments(
+    points: &[Vector2<f64>],
+    norm: &Normaliser<2>,
+) -> (SMatrix<f64, 6, 6>, Matrix2<f64>, Moments2) {
     // The 15 distinct monomials of degree ≤ 4, accumulated separately so the loop is plain
     // arithmetic (the 10k-point benchmark lives here).
     let (mut x4, mut x3y, mut x2y2, mut xy3, mut y4) = (0.0, 0.0, 0.0, 0.0, 0.0);
@@ -237,7 +252,13 @@ fn moments(points: &[Vector2<f64>], norm: &Normaliser<2>) -> (SMatrix<f64, 6, 6>
         x2y,  xy2,  y3,   xy,  y2,  sy,
         x2,   xy,   y2,   sx,  sy,  n,
     ]);
-    (s, Matrix2::new(x2, xy, xy, y2) / n)
+    let mut table: Moments2 = [[0.0; 5]; 5];
+    table[0] = [n, sy, y2, y3, y4];
+    table[1][..4].copy_from_slice(&[sx, xy, xy2, xy3]);
+    table[2][..3].copy_from_slice(&[x2, x2y, x2y2]);
+    table[3][..2].copy_from_slice(&[x3, x3y]);
+    table[4][0] = x4;
+    (s, Matrix2::new(x2, xy, xy, y2) / n, table)
 }
 
 /// Halíř & Flusser (1998): split the scatter matrix into the quadratic (`S1`), mixed (`S2`)
@@ -417,7 +438,8 @@ fn square_jacobian(b: &Matrix2<f64>) -> SMatrix<f64, 5, 5> {
 /// The least-squares ellipse calibration of `points` (raw `(mag_x, mag_y)` readings of a
 /// level compass turning through at least [`EllipseConfig::min_arc_deg`]), with its
 /// quality report — or a typed refusal saying why the data cannot support one (an invalid
-/// `config` is refused first). See the module documentation for the steps.
+/// `config` is refused first; fewer than ten readings are refused as too few to judge the
+/// fit by). See the module documentation for the steps.
 pub fn fit_ellipse(
     points: &[Vector2<f64>],
     config: &EllipseConfig,
@@ -496,8 +518,39 @@ fn fit_unchecked(
     points: &[Vector2<f64>],
     config: &EllipseConfig,
 ) -> Result<Solution<CompassCalibration2d>> {
-    let (norm, direct) = direct_normalised(points, config.max_axis_ratio)?;
-    let e = if config.refine {
+    let (norm, direct, moments) = direct_normalised(points, config.max_axis_ratio)?;
+    // Fewer than five residuals cannot judge a fit: the chance that noise alone makes the
+    // residual standard deviation look ten times too small is P(χ²_ν < ν/100), 8 % for one
+    // residual degree of freedom, 0.5 % for two, 3·10⁻⁸ for five. A short noisy arc fitted
+    // by a small ellipse around itself is exactly such a fit.
+    if points.len() < MIN_POINTS_JUDGED_2D {
+        return Err(Error::TooFewPoints {
+            got: points.len(),
+            need: MIN_POINTS_JUDGED_2D,
+        });
+    }
+    // The report of an ellipse (in normalised coordinates) from the moments the direct fit
+    // already has, and one pass for the coverage.
+    let assess = |e: &Ellipse| -> Result<(CompassCalibration2d, Assessment2d)> {
+        let (cal, field) = denormalise(&norm, e).calibration();
+        if !(field.is_finite() && field > 0.0 && cal.soft_iron.iter().all(|x| x.is_finite())) {
+            return Err(Error::Degenerate {
+                reason: "the fitted ellipse is not finite; check the input scale",
+            });
+        }
+        let coverage = quality::calibrated_coverage_2d(points, &cal);
+        let a = quality::assess_2d_from_moments(
+            &moments,
+            points.len(),
+            &e.centre,
+            &e.unit_map,
+            coverage,
+            field,
+        );
+        Ok((cal, a))
+    };
+    let (mut cal, mut a) = assess(&direct)?;
+    if config.refine && refinement_could_matter(&moments, &direct, &a) {
         let out = lm::minimise(
             "ellipse geometric refinement",
             to_params(&direct),
@@ -515,19 +568,10 @@ fn fit_unchecked(
             unit_map,
         };
         check_axis_ratio(&e, config.max_axis_ratio)?;
-        e
-    } else {
-        direct
-    };
-    let (cal, field) = denormalise(&norm, &e).calibration();
-    if !(field.is_finite() && field > 0.0 && cal.soft_iron.iter().all(|x| x.is_finite())) {
-        return Err(Error::Degenerate {
-            reason: "the fitted ellipse is not finite; check the input scale",
-        });
+        (cal, a) = assess(&e)?;
     }
-    let a = quality::assess_2d(points, &cal, field);
     quality::require_arc(&a.coverage, config.min_arc_deg)?;
-    require_locus_turning(points, field, config.min_arc_deg)?;
+    require_locus_turning(points, a.quality.field_magnitude, config.min_arc_deg)?;
     if !(a.quality.fit.condition <= config.max_condition) {
         return Err(Error::Degenerate {
             reason: "the headings seen do not determine the ellipse (information matrix ill-conditioned); turn through a fuller circle",
@@ -542,7 +586,8 @@ fn fit_unchecked(
     // (the report keeps the plain 3σ): a fit of a few readings estimates σ from one or two
     // residuals and can look certain by chance.
     let dof = a.quality.fit.points as f64 - 5.0;
-    if !(a.quality.heading_error_bound_deg() * t_factor(dof) <= config.max_heading_error_bound_deg)
+    if !(a.quality.heading_error_bound_deg() * quality::t_factor_exact_small(dof)
+        <= config.max_heading_error_bound_deg)
     {
         return Err(Error::Degenerate {
             reason: "the predicted heading error exceeds max_heading_error_bound_deg: too few readings or too much noise for the part of the circle covered; record a full turn away from magnetic disturbances",
@@ -552,6 +597,68 @@ fn fit_unchecked(
         params: cal,
         quality: a.quality,
     })
+}
+
+/// Largest heading shift of the geometric refinement, as a share of the direct fit's own
+/// heading-error bound ([`CompassQuality::heading_error_3sigma_deg`]), for which the
+/// refinement is skipped: a quarter of the bound changes no heading by a statistically
+/// meaningful amount.
+const SKIPPED_STEP_SHARE_OF_BOUND: f64 = 0.25;
+
+/// Largest `h₁ + h₂` (first and second harmonics of the directions, see
+/// `refinement_could_matter`; 1 each for readings all in one direction, 0 for an even turn)
+/// for which the direct fit may stand unrefined: a tenth of their range, where the
+/// perturbation about an even turn still holds.
+const MAX_UNEVENNESS_UNREFINED: f64 = 0.1;
+
+/// Whether refining the direct fit `e` (normalised coordinates, moments `m`, report `a`)
+/// could move the heading by more than [`SKIPPED_STEP_SHARE_OF_BOUND`] of its bound.
+///
+/// In the frame of the calibrated circle, `w = B (q − c)`, isotropic sensor noise becomes
+/// anisotropic, with variances along the eigenvectors of `A = B²` in the ratio of its
+/// eigenvalues `λ₁ ≥ λ₂`; write `κ = (λ₁ − λ₂)/(λ₁ + λ₂)` and `σ` for the mean relative
+/// noise. The direct fit then differs from the geometric one in two ways:
+///
+/// * weighting: the algebraic residual `g = |w|² − 1 ≈ 2r` has a variance that varies round
+///   the circle as `1 + κ cos 2θ`, which the direct fit ignores and the Sampson distance
+///   corrects. Both are unbiased to first order; the weighted one has the smaller variance,
+///   so their difference has the variance of the excess, `E[v]·E[1/v] − 1 ≈ κ²/2` of the
+///   heading variance `s²` (`s` the 1σ heading error of the calibration);
+/// * bias: to second order in the noise the algebraic fit of a unit circle whose points
+///   have variances `σ₁², σ₂²` along the axes is the ellipse with semi-axis ratio
+///   `1 + 4(σ₁² − σ₂²)` (the expected scatter matrix gains `σ²` terms; eliminating the
+///   constant term and minimising under `4ac = 1` gives `a/c = √((1/8 + 2σ₂²)/(1/8 + 2σ₁²))`).
+///   That leaves a two-cycle heading error of amplitude `2(σ₁² − σ₂²) = 4σ²κ` radians. An
+///   uneven spread of the readings round the circle adds a bias of the same order; its
+///   first and second harmonics `h₁ = |Σu|/n`, `h₂ = |Σ(u_x² − u_y², 2u_xu_y)|/n` enter with
+///   the same factor, so `b = 4σ²(κ + h₁ + h₂)`.
+///
+/// The refinement is skipped when `√(b² + κ²s²/2) ≤ ¼ · 3s`. The bias term is a
+/// perturbation about readings spread evenly round the circle; it is not trusted, and the
+/// refinement always runs, when `h₁ + h₂` exceeds [`MAX_UNEVENNESS_UNREFINED`] (a partial
+/// arc, where the algebraic fit is known to shrink towards the arc, or a turn and a bit).
+/// Everything it needs comes from the moments and the report, without a pass over the
+/// readings.
+fn refinement_could_matter(m: &Moments2, e: &Ellipse, a: &Assessment2d) -> bool {
+    let q = &a.quality;
+    if q.fit.points <= 5 {
+        return true;
+    }
+    // Every quantity here is a rotation invariant of the readings (no heading bins), so
+    // rotating the input never changes the choice.
+    let (h1, h2) = quality::direction_harmonics(m, q.fit.points, &e.centre, &e.unit_map);
+    if !(h1 + h2 <= MAX_UNEVENNESS_UNREFINED) {
+        return true;
+    }
+    let sigma = q.heading_noise_rms_deg.to_radians();
+    let s = (q.heading_error_3sigma_deg / BOUND_SIGMAS).to_radians();
+    let Some((l, _)) = sym_eigen2(&(e.unit_map * e.unit_map)) else {
+        return true;
+    };
+    let kappa = ((l[0] - l[1]) / (l[0] + l[1])).abs();
+    let bias = 4.0 * sigma * sigma * (kappa + h1 + h2);
+    let step = (bias * bias + 0.5 * kappa * kappa * s * s).sqrt();
+    !(step <= SKIPPED_STEP_SHARE_OF_BOUND * BOUND_SIGMAS * s)
 }
 
 /// Least-squares ellipse calibrator (batch): stores every reading pushed and fits them all

@@ -40,7 +40,6 @@ use truenorth_core::{
     check_finite, check_finite3, check_positive, check_range,
 };
 
-use crate::conic_sums::t_factor;
 use crate::linalg::{constrained_min6, sym_eigen3, sym_eigen6, sym_sqrt3};
 use crate::lm::{self, BLOCK, NormalAccumulator, NormalEquations, blocks, dot_block};
 use crate::normalise::Normaliser;
@@ -302,7 +301,7 @@ fn moments(points: &[Vector3<f64>], norm: &Normaliser<3>) -> (SMatrix<f64, 10, 1
 
 /// The constraint `4J − I² = a₁ᵀ C₁ a₁` on `a₁ = (a, b, c, f, g, h)` (Li & Griffiths 2004,
 /// eq. 7 with k = 4).
-fn li_griffiths_constraint() -> SMatrix<f64, 6, 6> {
+pub(crate) fn li_griffiths_constraint() -> SMatrix<f64, 6, 6> {
     let mut c = SMatrix::<f64, 6, 6>::zeros();
     for i in 0..3 {
         for j in 0..3 {
@@ -352,7 +351,7 @@ pub(crate) fn solve_direct(s: &SMatrix<f64, 10, 10>) -> Result<SVector<f64, 10>>
 }
 
 /// The symmetric matrix `Q` of the quadratic part `xᵀQx` from `(a, b, c, f, g, h)`.
-fn quadratic_part<S: nalgebra::Storage<f64, nalgebra::U6>>(
+pub(crate) fn quadratic_part<S: nalgebra::Storage<f64, nalgebra::U6>>(
     a: &nalgebra::Vector<f64, nalgebra::U6, S>,
 ) -> Matrix3<f64> {
     Matrix3::new(a[0], a[5], a[4], a[5], a[1], a[3], a[4], a[3], a[2])
@@ -557,7 +556,9 @@ fn fit_unchecked(
     }
     // Widened to the Student-t quantile of σ's degrees of freedom, as the 2-D fit's.
     let dof = q.fit.points as f64 - 9.0;
-    if !(q.heading_error_bound_deg() * t_factor(dof) <= config.max_heading_error_bound_deg) {
+    if !(q.heading_error_bound_deg() * quality::t_factor_exact_small(dof)
+        <= config.max_heading_error_bound_deg)
+    {
         return Err(Error::Degenerate {
             reason: "the predicted heading error exceeds max_heading_error_bound_deg: too few readings or too much noise for the part of the sphere covered; record a full tumble away from magnetic disturbances",
         });

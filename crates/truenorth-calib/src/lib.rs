@@ -74,15 +74,23 @@ mod normalise;
 
 // Online least-squares calibrators from running monomial sums.
 mod conic_sums;
+mod online_conic;
 mod online_ellipse;
+mod online_ellipse_config;
+mod online_ellipse_refresh;
 mod online_ellipsoid;
+mod online_ellipsoid_config;
+mod online_ellipsoid_refresh;
+mod retained;
 
 // Seed calibrators (turn, merit circle, binned ellipse) and their helpers.
 mod binned_assess;
 mod binned_config;
 mod binned_ellipse;
+mod binned_params;
 mod binned_persist;
 mod binned_refresh;
+mod binned_update;
 mod circumcentre;
 mod direction_slots;
 mod merit_circle;
@@ -108,8 +116,8 @@ pub use merit_circle::{
     MeritCircleState, RING,
 };
 pub use online_ellipse::{
-    ONLINE_SLOTS_2D, OnlineEllipseCalibrator, OnlineEllipseConfig, OnlineEllipseState,
-    PendingRefresh,
+    ONLINE_SLOTS_2D, OnlineConicState, OnlineEllipseCalibrator, OnlineEllipseConfig,
+    OnlineEllipseState, PendingRefresh,
 };
 pub use online_ellipsoid::{
     OnlineEllipsoidCalibrator, OnlineEllipsoidConfig, OnlineEllipsoidState,

@@ -207,6 +207,10 @@ pub struct MeritCircleCalibrator {
     centre_m2: f64,
     slots: DirectionSlots,
     estimate: Option<Solution<CompassCalibration2d>>,
+    /// A data point was taken at the previous push; the estimate is refreshed at the start
+    /// of this one (from the state that push left), so that the triple search and the
+    /// refresh, each a few microseconds, never fall on one push.
+    refresh_due: bool,
 }
 
 impl Default for MeritCircleCalibrator {
@@ -247,6 +251,7 @@ impl MeritCircleCalibrator {
             centre_m2: 0.0,
             slots: DirectionSlots::new(),
             estimate: None,
+            refresh_due: false,
         }
     }
 
@@ -389,12 +394,22 @@ impl Calibrator for MeritCircleCalibrator {
     type Quality = CompassQuality;
 
     /// Refuses a non-finite reading or timestamp (and changes nothing). Returns
-    /// [`Pushed::NewEstimate`] when the reading was a heading data point that changed the
-    /// estimate.
+    /// [`Pushed::NewEstimate`] on the push after a heading data point, when the estimate
+    /// refreshed from the state that data point left has changed.
     fn push(&mut self, sample: &Mag2Sample) -> Result<Pushed> {
         let p = sample.mag;
         check_finite("timestamp t_s", sample.t_s)?;
         check_finite2("magnetometer reading", &p)?;
+        let mut pushed = Pushed::Accepted;
+        if self.refresh_due {
+            // Bounded: at most 72 kept readings.
+            self.refresh_due = false;
+            let estimate = self.solve().ok();
+            if estimate != self.estimate {
+                self.estimate = estimate;
+                pushed = Pushed::NewEstimate;
+            }
+        }
         if let Some(prev) = self.prev {
             self.step_sum += (p - prev).norm();
         }
@@ -405,7 +420,7 @@ impl Calibrator for MeritCircleCalibrator {
         let slot_centre = self.state.centre.unwrap_or((self.lo + self.hi) * 0.5);
         self.slots.push(&p, &slot_centre);
         if self.samples <= self.config.warmup_samples || !self.heading_changed(&p) {
-            return Ok(Pushed::Accepted);
+            return Ok(pushed);
         }
         // A new heading data point (step d).
         self.state.data_points += 1;
@@ -419,15 +434,10 @@ impl Calibrator for MeritCircleCalibrator {
         self.ring[self.ring_next] = p;
         self.ring_next = (self.ring_next + 1) % RING;
         self.ring_len = (self.ring_len + 1).min(RING);
-        // The estimate is refreshed once per data point (every `min_turn_rad` of turn): a
-        // bounded pass over the kept readings, never per sample.
-        let estimate = self.solve().ok();
-        if estimate == self.estimate {
-            Ok(Pushed::Accepted)
-        } else {
-            self.estimate = estimate;
-            Ok(Pushed::NewEstimate)
-        }
+        // The estimate is refreshed once per data point (every `min_turn_rad` of turn), at
+        // the next push: a bounded pass over the kept readings, never per sample.
+        self.refresh_due = true;
+        Ok(pushed)
     }
 
     /// Runs the acceptance tests of [`Calibrator::solve`] (bounded: at most 72 kept
@@ -501,6 +511,9 @@ pub struct MeritCircleSaved {
     pub slots: Vec<Option<Vector2<f64>>>,
     /// The current estimate.
     pub estimate: Option<Solution<CompassCalibration2d>>,
+    /// Whether the estimate is refreshed at the next push (a data point was just taken).
+    #[serde(default)]
+    pub refresh_due: bool,
 }
 
 fn finite2(v: &Vector2<f64>) -> bool {
@@ -527,6 +540,7 @@ impl Persistent for MeritCircleCalibrator {
                 centre_m2: self.centre_m2,
                 slots: self.slots.to_vec(),
                 estimate: self.estimate,
+                refresh_due: self.refresh_due,
             },
         }
     }
@@ -596,6 +610,7 @@ impl Persistent for MeritCircleCalibrator {
         c.centre_m2 = s.centre_m2;
         c.slots = slots;
         c.estimate = s.estimate;
+        c.refresh_due = s.refresh_due;
         Ok(c)
     }
 }

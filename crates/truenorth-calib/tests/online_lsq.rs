@@ -13,7 +13,7 @@ use nalgebra::{Matrix2, Matrix3, Rotation3, Vector2, Vector3};
 use proptest::prelude::*;
 use truenorth_calib::{
     EllipseCalibrator, EllipseConfig, OnlineEllipseCalibrator, OnlineEllipseConfig,
-    OnlineEllipsoidCalibrator, OnlineEllipsoidConfig,
+    OnlineEllipsoidCalibrator, OnlineEllipsoidConfig, fit_ellipsoid_direct,
 };
 use truenorth_compass::CompassCalibration2d;
 use truenorth_core::{
@@ -197,6 +197,30 @@ proptest! {
         let refused = matches!(r, Err(Error::InsufficientCoverage { .. }) | Err(Error::NotAnEllipse { .. }) | Err(Error::Degenerate { .. }));
         prop_assert!(refused, "span {span}: {r:?}");
         prop_assert!(!cal.progress().ready);
+    }
+
+    /// The published estimate obeys the acceptance of `solve`: over half a turn or less,
+    /// however noisy and distorted, no refresh publishes one at any push, with or without
+    /// forgetting and however often refreshes run.
+    #[test]
+    fn arcs_of_half_a_turn_or_less_never_publish_an_estimate(
+        span in 20.0f64..=180.0, start in 0.0f64..360.0,
+        ratio in 1.0f64..1.6, angle in 0.0f64..PI,
+        noise in 0.0f64..0.05, n in 40usize..400, seed in 0u64..1000,
+        interval in 1u32..64, forget in proptest::option::of(50.0f64..500.0),
+    ) {
+        let m = Model2::new(Vector2::new(0.5, -0.3), ratio, angle, 1.0);
+        let config = OnlineEllipseConfig {
+            refresh_interval_samples: interval,
+            forgetting_half_life_samples: forget,
+            ..Default::default()
+        };
+        let mut cal = OnlineEllipseCalibrator::new(config).unwrap();
+        for (k, (_, s)) in m.turn(n, start, span, noise, seed).iter().enumerate() {
+            let pushed = cal.push(s).unwrap();
+            prop_assert!(pushed != Pushed::NewEstimate, "push {}: {:?}", k, cal.estimate());
+            prop_assert!(cal.estimate().is_none(), "push {}: {:?}", k, cal.estimate());
+        }
     }
 
     /// `progress().ready` is `solve().is_ok()` after every push of random arcs, noise levels
@@ -441,6 +465,42 @@ proptest! {
         prop_assert!((sol.params.soft_iron - truth).amax() <= 1e-7);
         prop_assert!((sol.quality.field_magnitude / field - 1.0).abs() <= 1e-7);
         prop_assert_eq!(cal.progress().ready, true);
+    }
+
+    /// The staged refresh (the direct fit split over three pushes, the condition number by a
+    /// Jacobi solver over several) gives the batch direct fit of the same readings, to
+    /// rounding, on noisy data.
+    #[test]
+    fn ellipsoid_staged_refresh_equals_the_batch_direct_fit(
+        h in (-3.0f64..3.0, -3.0f64..3.0, -3.0f64..3.0), rot in any_rotation(),
+        a in 0.8f64..1.25, b in 0.8f64..1.25, noise in 0.0f64..0.03, n in 100usize..600,
+        seed in 0u64..1000,
+    ) {
+        let w = soft3(&rot, a, b);
+        let stream = sphere_turn(Vector3::new(h.0, h.1, h.2), &w, 1.0, n, noise, seed);
+        let mut cal = OnlineEllipsoidCalibrator::new(OnlineEllipsoidConfig::default()).unwrap();
+        for s in &stream {
+            cal.push(s).unwrap();
+        }
+        let points: Vec<_> = stream.iter().map(|s| s.mag).collect();
+        let (batch, batch_field) = fit_ellipsoid_direct(&points).unwrap().calibration();
+        let sol = cal.solve().unwrap();
+        prop_assert!((sol.params.hard_iron - batch.hard_iron).norm() <= 1e-9, "{:?} vs {:?}", sol.params, batch);
+        prop_assert!((sol.params.soft_iron - batch.soft_iron).amax() <= 1e-9);
+        prop_assert!((sol.quality.field_magnitude / batch_field - 1.0).abs() <= 1e-9);
+        // The estimate published by the staged refresh is the batch direct fit of the
+        // readings up to the start of that refresh (a refresh starts every 64 readings).
+        // (None when that refresh was refused, e.g. too early in the tumble.)
+        if let Some(est) = cal.estimate() {
+            let matches = (n.saturating_sub(100)..=n).any(|k| {
+                fit_ellipsoid_direct(&points[..k]).is_ok_and(|e| {
+                    let (c, _) = e.calibration();
+                    (est.params.hard_iron - c.hard_iron).norm() <= 1e-9
+                        && (est.params.soft_iron - c.soft_iron).amax() <= 1e-9
+                })
+            });
+            prop_assert!(matches, "the estimate is no batch fit of the last 100 prefixes");
+        }
     }
 
     #[test]

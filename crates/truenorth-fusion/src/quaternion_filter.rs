@@ -241,27 +241,27 @@ impl QuaternionFilter {
         let mut correction_rate = Vector3::zeros();
 
         // 2. Inclination.
-        if let Some(a) = acc {
-            if a.norm() > 1e-6 {
-                // Linear in the specific force: the body's own accelerations average out
-                // over a swing, where an angle (atan of horizontal over vertical) would not.
-                // A first low-pass in the reference frame before the proportional
-                // correction makes the response to acceleration second order.
-                let f = s.q * a;
-                let kl = (dt_s / fast(cfg.acc_lowpass_s)).min(1.0);
-                s.acc_lp_ned = match s.acc_lp_ned {
-                    Some(lp) => Some(lp + (f - lp) * kl),
-                    None => Some(f),
-                };
-                let down = -s.acc_lp_ned.unwrap_or(f) / STANDARD_GRAVITY_MPS2;
-                let k = (dt_s / fast(cfg.tau_acc_s)).min(1.0);
-                let rot = down.cross(&Vector3::z()) * k;
-                let c = small_rotation(&rot);
-                s.q = c * s.q;
-                s.acc_lp_ned = s.acc_lp_ned.map(|lp| c * lp);
-                correction_rate += s.q.inverse_transform_vector(&rot) / dt_s;
-                status.accel_used = true;
-            }
+        if let Some(a) = acc
+            && a.norm() > 1e-6
+        {
+            // Linear in the specific force: the body's own accelerations average out
+            // over a swing, where an angle (atan of horizontal over vertical) would not.
+            // A first low-pass in the reference frame before the proportional
+            // correction makes the response to acceleration second order.
+            let f = s.q * a;
+            let kl = (dt_s / fast(cfg.acc_lowpass_s)).min(1.0);
+            s.acc_lp_ned = match s.acc_lp_ned {
+                Some(lp) => Some(lp + (f - lp) * kl),
+                None => Some(f),
+            };
+            let down = -s.acc_lp_ned.unwrap_or(f) / STANDARD_GRAVITY_MPS2;
+            let k = (dt_s / fast(cfg.tau_acc_s)).min(1.0);
+            let rot = down.cross(&Vector3::z()) * k;
+            let c = small_rotation(&rot);
+            s.q = c * s.q;
+            s.acc_lp_ned = s.acc_lp_ned.map(|lp| c * lp);
+            correction_rate += s.q.inverse_transform_vector(&rot) / dt_s;
+            status.accel_used = true;
         }
 
         // 3. Heading.
@@ -383,7 +383,11 @@ impl OrientationEstimator for QuaternionFilter {
 fn small_rotation(v: &Vector3<f64>) -> UnitQuaternion<f64> {
     const MAX_STEP_RAD: f64 = 0.1;
     let n = v.norm();
-    let v = if n > MAX_STEP_RAD { v * (MAX_STEP_RAD / n) } else { *v };
+    let v = if n > MAX_STEP_RAD {
+        v * (MAX_STEP_RAD / n)
+    } else {
+        *v
+    };
     UnitQuaternion::new_normalize(Quaternion::new(1.0, 0.5 * v.x, 0.5 * v.y, 0.5 * v.z))
 }
 

@@ -161,5 +161,15 @@ fn quaternion_filter_on_broad() {
             m[1],
             m[2]
         );
+        // VQF 2.1 with its defaults, causal, scores 2.52° total over these 20 trials
+        // (shared/data/README.md): a real-time filter worth choosing over it must do better
+        // on the whole set and on each group. Experiments with BROAD_CONFIG are not judged.
+        if std::env::var_os("BROAD_CONFIG").is_none() {
+            assert!(
+                m[0] < VQF_TOTAL_DEG,
+                "{name}: total {:.2}° is not below VQF's {VQF_TOTAL_DEG}°",
+                m[0]
+            );
+        }
     }
 }

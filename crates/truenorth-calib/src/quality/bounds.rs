@@ -1,0 +1,236 @@
+//! Heading-error bounds: the information matrices of the 2-D and 3-D calibration models,
+//! built from monomial sums, and the worst-direction bounds of the module documentation.
+
+use core::f64::consts::TAU;
+
+use nalgebra::{SMatrix, SVector, Vector3};
+
+use super::BOUND_SIGMAS;
+
+#[allow(unused_imports)]
+use truenorth_core::Float as _;
+
+/// For an information matrix `A = L Lᵀ` of `P` parameters fitted to `n` points with residual
+/// sum of squares `sum_sq`: `L⁻¹`, formed once so that every test direction costs one small
+/// product instead of two triangular solves, and the residual standard deviation
+/// `σ = √(sum_sq / (n − P))`. `None` when `n ≤ P` or `A` is not positive definite.
+pub(super) fn whitened<const P: usize>(
+    info: &SMatrix<f64, P, P>,
+    sum_sq: f64,
+    n: usize,
+) -> Option<(SMatrix<f64, P, P>, f64)> {
+    if n <= P {
+        return None;
+    }
+    let l_inv = info
+        .cholesky()?
+        .l()
+        .solve_lower_triangular(&SMatrix::<f64, P, P>::identity())?;
+    Some((l_inv, (sum_sq / (n - P) as f64).sqrt()))
+}
+
+/// `3 σ max_u √(gᵀA⁻¹g)` in degrees over 72 headings; infinite when `A` is singular or
+/// there are no more points than parameters.
+pub(super) fn bound_2d(info: &SMatrix<f64, 5, 5>, sum_sq: f64, n: usize) -> f64 {
+    // gᵀA⁻¹g = ‖L⁻¹g‖²: each heading costs one small matrix-vector product.
+    let Some((l_inv, sigma)) = whitened(info, sum_sq, n) else {
+        return f64::INFINITY;
+    };
+    let mut worst: f64 = 0.0;
+    for k in 0..72 {
+        let th = TAU * k as f64 / 72.0;
+        let (s, c) = th.sin_cos();
+        let (ux, uy, px, py) = (c, s, -s, c);
+        let g = SVector::<f64, 5>::new(-px, -py, px * ux, px * uy + py * ux, py * uy);
+        worst = worst.max((l_inv * g).norm_squared());
+    }
+    let b = (BOUND_SIGMAS * sigma * worst.sqrt()).to_degrees();
+    if b.is_finite() { b } else { f64::INFINITY }
+}
+
+/// Per-reading noise, degrees: the residual standard deviation `√(sum_sq / (n − p))` of a
+/// fit of `p` parameters (relative to the field, so radians of heading; see the module
+/// documentation), or the plain RMS when there are no more points than parameters.
+pub(super) fn noise_rms_deg(sum_sq: f64, n: usize, p: usize) -> f64 {
+    let dof = if n > p { n - p } else { n.max(1) };
+    (sum_sq / dof as f64).sqrt().to_degrees()
+}
+
+/// Number of distinct monomials of degree 2 to 4 in `(u_x, u_y)`.
+pub(super) const MONOMIALS_2D: usize = 12;
+
+/// The 2-D information matrix `A = Σ φ(u)φ(u)ᵀ`, `φ = (−u_x, −u_y, u_x², 2u_xu_y, u_y²)`,
+/// from the sums over the points of the monomials it is made of, in the order
+/// `(x², xy, y², x³, x²y, xy², y³, x⁴, x³y, x²y², xy³, y⁴)` of `u = (x, y)`.
+///
+/// Every entry of `φφᵀ` is a monomial of degree 2, 3 or 4 in `u` times a constant, and 12
+/// distinct monomials fill its 15 distinct entries: summing those is the same matrix with
+/// fewer products per point. NaN if a sum overflowed, which makes the condition and the
+/// bound infinite.
+pub(super) fn information_2d(m: &[f64; MONOMIALS_2D]) -> SMatrix<f64, 5, 5> {
+    let [x2, xy, y2, x3, x2y, xy2, y3, x4, x3y, x2y2, xy3, y4] = *m;
+    #[rustfmt::skip]
+    let a = SMatrix::<f64, 5, 5>::from_row_slice(&[
+        x2,         xy,         -x3,        -2.0 * x2y, -xy2,
+        xy,         y2,         -x2y,       -2.0 * xy2, -y3,
+        -x3,        -x2y,       x4,         2.0 * x3y,  x2y2,
+        -2.0 * x2y, -2.0 * xy2, 2.0 * x3y,  4.0 * x2y2, 2.0 * xy3,
+        -xy2,       -y3,        x2y2,       2.0 * xy3,  y4,
+    ]);
+    finite_or_nan(a)
+}
+
+/// Number of distinct monomials of degree 2 to 4 in `(u_x, u_y, u_z)`: 6 + 10 + 15.
+pub(super) const MONOMIALS_3D: usize = 31;
+
+/// The index pairs `(a, b)` of the quadratic terms `u_a u_b` of `φ` in the 3-D model, in
+/// the parameter order `(e₁₁, e₁₂, e₁₃, e₂₂, e₂₃, e₃₃)` of the module documentation.
+pub(super) const QUAD_3D: [(usize, usize); 6] = [(0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)];
+
+/// The monomials of degree 2, 3 and 4 in `u = (u₀, u₁, u₂)`, each once, as sorted index
+/// tuples `(a, b)`, `(a, b, c)`, `(a, b, c, d)` (unused places zero) with their degree, in
+/// lexicographic order within each degree: the order of the sums behind
+/// [`information_3d`].
+pub(super) fn monomial_tuples_3d() -> [([usize; 4], usize); MONOMIALS_3D] {
+    let mut out = [([0; 4], 0); MONOMIALS_3D];
+    let mut k = 0;
+    for a in 0..3 {
+        for b in a..3 {
+            out[k] = ([a, b, 0, 0], 2);
+            k += 1;
+        }
+    }
+    for a in 0..3 {
+        for b in a..3 {
+            for c in b..3 {
+                out[k] = ([a, b, c, 0], 3);
+                k += 1;
+            }
+        }
+    }
+    for a in 0..3 {
+        for b in a..3 {
+            for c in b..3 {
+                for d in c..3 {
+                    out[k] = ([a, b, c, d], 4);
+                    k += 1;
+                }
+            }
+        }
+    }
+    out
+}
+
+/// For each monomial of [`monomial_tuples_3d`], two columns of the quality pass whose
+/// product it is (columns 0–2: `u_a`; 3–8: `u_a u_b` in the order of [`QUAD_3D`]): degree 2
+/// is `u_a · u_b`, degree 3 `(u_a u_b) · u_c`, degree 4 `(u_a u_b) · (u_c u_d)`.
+pub(super) fn monomial_plan_3d() -> [(usize, usize); MONOMIALS_3D] {
+    let quad = |a: usize, b: usize| 3 + QUAD_3D.iter().position(|&p| p == (a, b)).unwrap_or(0);
+    monomial_tuples_3d().map(|(t, deg)| match deg {
+        2 => (t[0], t[1]),
+        3 => (quad(t[0], t[1]), t[2]),
+        _ => (quad(t[0], t[1]), quad(t[2], t[3])),
+    })
+}
+
+/// The 3-D information matrix `A = Σ φ(u)φ(u)ᵀ`,
+/// `φ = (−u_x, −u_y, −u_z, u_x², 2u_xu_y, 2u_xu_z, u_y², 2u_yu_z, u_z²)`, from the sums of
+/// the monomials of [`monomial_tuples_3d`]: 31 distinct monomials fill its 45 distinct
+/// entries (see [`information_2d`]). NaN if a sum overflowed.
+pub(super) fn information_3d(m: &[f64; MONOMIALS_3D]) -> SMatrix<f64, 9, 9> {
+    // φ_i = factor_i · (the monomial with indices idx_i): −u_a for i < 3, then the
+    // quadratic terms, with factor 1 on the diagonal pairs and 2 off it.
+    let term = |i: usize| -> (f64, [usize; 2], usize) {
+        if i < 3 {
+            (-1.0, [i, 0], 1)
+        } else {
+            let (a, b) = QUAD_3D[i - 3];
+            (if a == b { 1.0 } else { 2.0 }, [a, b], 2)
+        }
+    };
+    let tuples = monomial_tuples_3d();
+    let mut a = SMatrix::<f64, 9, 9>::zeros();
+    for i in 0..9 {
+        for j in i..9 {
+            let (si, ii, ni) = term(i);
+            let (sj, ij, nj) = term(j);
+            let mut idx = [0usize; 4];
+            idx[..ni].copy_from_slice(&ii[..ni]);
+            idx[ni..ni + nj].copy_from_slice(&ij[..nj]);
+            idx[..ni + nj].sort_unstable();
+            let k = tuples
+                .iter()
+                .position(|&(t, deg)| deg == ni + nj && t[..deg] == idx[..deg])
+                .unwrap_or(0);
+            let v = si * sj * m[k];
+            a[(i, j)] = v;
+            a[(j, i)] = v;
+        }
+    }
+    finite_or_nan(a)
+}
+
+/// `a`, or all NaN if any entry is not finite.
+pub(super) fn finite_or_nan<const P: usize>(a: SMatrix<f64, P, P>) -> SMatrix<f64, P, P> {
+    if a.iter().all(|x| x.is_finite()) {
+        a
+    } else {
+        SMatrix::from_element(f64::NAN)
+    }
+}
+
+/// Number of test directions (a Fibonacci lattice) over which the 3-D bound takes its worst.
+pub(super) const BOUND_DIRECTIONS_3D: usize = 256;
+
+/// `3 σ max_u √trace(G(u) A⁻¹ G(u)ᵀ)` in degrees, `G(u)` the 3×9 Jacobian of the direction
+/// error `(I − uuᵀ)(E u − d)`; infinite when `A` is singular or `N ≤ 9`.
+pub(super) fn bound_3d(info: &SMatrix<f64, 9, 9>, sum_sq: f64, n: usize) -> f64 {
+    // trace(G A⁻¹ Gᵀ) = ‖L⁻¹ Gᵀ‖²_F: each direction costs one small matrix product.
+    let Some((l_inv, sigma)) = whitened(info, sum_sq, n) else {
+        return f64::INFINITY;
+    };
+    let golden = core::f64::consts::PI * (3.0 - 5.0_f64.sqrt());
+    let mut worst: f64 = 0.0;
+    for k in 0..BOUND_DIRECTIONS_3D {
+        let z = 1.0 - (2.0 * k as f64 + 1.0) / BOUND_DIRECTIONS_3D as f64;
+        let r = (1.0 - z * z).max(0.0).sqrt();
+        let (s, c) = (golden * k as f64).sin_cos();
+        let u = Vector3::new(r * c, r * s, z);
+        let proj = nalgebra::Matrix3::identity() - u * u.transpose();
+        let mut g = SMatrix::<f64, 3, 9>::zeros();
+        for kk in 0..3 {
+            g.set_column(kk, &(-proj.column(kk)));
+        }
+        // E_kl u for (11, 12, 13, 22, 23, 33): the symmetric basis matrices applied to u.
+        let pairs = [(0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)];
+        for (j, &(a, b)) in pairs.iter().enumerate() {
+            let mut eu = Vector3::zeros();
+            eu[a] += u[b];
+            if a != b {
+                eu[b] += u[a];
+            }
+            g.set_column(3 + j, &(proj * eu));
+        }
+        worst = worst.max((l_inv * g.transpose()).norm_squared());
+    }
+    let b = (BOUND_SIGMAS * sigma * worst.sqrt()).to_degrees();
+    if b.is_finite() { b } else { f64::INFINITY }
+}
+
+/// The Student-t widening of a 3σ bound whose σ comes from `dof` degrees of freedom (see
+/// `crate::conic_sums::t_factor`, the Cornish–Fisher series), with the exact quantile for
+/// one and two degrees of freedom, where the series falls far short (96 against 236 for
+/// one): the two-sided 99.73 % point is `tan(π(p − ½))` for one and
+/// `(2p − 1)/√(2p(1 − p))` for two, `p = Φ(3)` (Student 1908; e.g. Johnson, Kotz &
+/// Balakrishnan, *Continuous Univariate Distributions* 2, §28.2).
+pub(crate) fn t_factor_exact_small(dof: f64) -> f64 {
+    // Φ(3), the normal distribution function at 3.
+    const P: f64 = 0.998_650_101_968_369_9;
+    if dof == 1.0 {
+        (core::f64::consts::PI * (P - 0.5)).tan() / BOUND_SIGMAS
+    } else if dof == 2.0 {
+        (2.0 * P - 1.0) / (2.0 * P * (1.0 - P)).sqrt() / BOUND_SIGMAS
+    } else {
+        crate::conic_sums::t_factor(dof)
+    }
+}

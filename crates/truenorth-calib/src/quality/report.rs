@@ -1,0 +1,368 @@
+//! Report assembly: the 2-D and 3-D [`CompassQuality`] of a calibration, from one pass
+//! over the readings or (2-D) from the monomial sums of the fit.
+
+// `!(x <= limit)` and `!(x > 0.0)` are deliberate: they are true for NaN, so a NaN fails
+// every check instead of slipping through one.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
+use nalgebra::Vector2;
+use nalgebra::Vector3;
+use truenorth_compass::{CompassCalibration2d, CompassCalibration3d};
+use truenorth_core::{CompassQuality, FitQuality};
+
+use super::SPHERE_CELLS;
+use super::bounds::{
+    MONOMIALS_2D, MONOMIALS_3D, QUAD_3D, bound_2d, bound_3d, information_2d, information_3d,
+    monomial_plan_3d, noise_rms_deg,
+};
+use super::coverage::{AngleBins, Coverage, mark_sphere_cells, turns};
+use crate::linalg::{condition_from_eigenvalues, sym_eigen5, sym_eigen9};
+use crate::lm::{BLOCK, blocks, dot_block, sum_block};
+
+#[allow(unused_imports)]
+use truenorth_core::Float as _;
+
+/// A 2-D quality report and the coverage behind it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Assessment2d {
+    /// The report to return with the solution.
+    pub quality: CompassQuality,
+    /// Coverage of the calibrated headings (seen from the origin of the calibrated circle).
+    pub coverage: Coverage,
+}
+
+/// Everything the 2-D report needs, in one pass over the raw readings: the calibrated
+/// readings' residuals against `field`, their heading bins, and the information matrix
+/// of the module documentation. `field` is the radius of the calibrated circle (for a
+/// calibrator that does not define one, pass [`super::mean_corrected_norm_2d`]).
+///
+/// Non-finite readings are skipped. Allocates nothing.
+pub fn assess_2d(points: &[Vector2<f64>], cal: &CompassCalibration2d, field: f64) -> Assessment2d {
+    let mut bins = AngleBins::new();
+    // Sums of the squared residuals and of the monomials of `u` that make up the
+    // information matrix (see `information_2d`).
+    let mut sums = [0.0; MONOMIALS_2D];
+    let mut ss = 0.0;
+    let mut n = 0usize;
+    let inv_f = 1.0 / field;
+    let (s, c) = (&cal.soft_iron, &cal.hard_iron);
+    // A block of points at a time (see `crate::lm::BLOCK`): first every point's direction,
+    // its products, its residual and its heading, then the sums and the bins.
+    let mut ux = [0.0; BLOCK];
+    let mut uy = [0.0; BLOCK];
+    let mut xx = [0.0; BLOCK];
+    let mut xy = [0.0; BLOCK];
+    let mut yy = [0.0; BLOCK];
+    let mut r2 = [0.0; BLOCK];
+    let mut t = [0.0; BLOCK];
+    for ([px, py], len) in blocks(points) {
+        for i in 0..BLOCK {
+            // h = soft_iron · (p − hard_iron), as `CompassCalibration2d::correct`.
+            let (dx, dy) = (px[i] - c.x, py[i] - c.y);
+            let (hx, hy) = (
+                s[(0, 0)] * dx + s[(0, 1)] * dy,
+                s[(1, 0)] * dx + s[(1, 1)] * dy,
+            );
+            let rho = (hx * hx + hy * hy).sqrt();
+            // Non-finite readings are skipped, and the rows past the end of the data: their
+            // direction is set to zero, which adds nothing to the sums and marks the row
+            // as skipped for the bins (a kept row's direction is a unit vector).
+            let keep = rho > 0.0 && rho.is_finite() && i < len;
+            let inv_rho = 1.0 / rho;
+            let (x, y) = if keep {
+                (hx * inv_rho, hy * inv_rho)
+            } else {
+                (0.0, 0.0)
+            };
+            let r = rho * inv_f - 1.0;
+            ux[i] = x;
+            uy[i] = y;
+            xx[i] = x * x;
+            xy[i] = x * y;
+            yy[i] = y * y;
+            r2[i] = if keep { r * r } else { 0.0 };
+            t[i] = turns(hy, hx);
+        }
+        // In the order of `information_2d`: x², xy, y², x³, x²y, xy², y³, x⁴, x³y, x²y²,
+        // xy³, y⁴.
+        let products = [
+            (&ux, &ux),
+            (&ux, &uy),
+            (&uy, &uy),
+            (&xx, &ux),
+            (&xx, &uy),
+            (&yy, &ux),
+            (&yy, &uy),
+            (&xx, &xx),
+            (&xx, &xy),
+            (&xx, &yy),
+            (&xy, &yy),
+            (&yy, &yy),
+        ];
+        for (sk, (a, b)) in sums.iter_mut().zip(products) {
+            *sk += dot_block(a, b);
+        }
+        ss += sum_block(&r2);
+        for i in 0..len {
+            if ux[i] != 0.0 || uy[i] != 0.0 {
+                bins.mark(t[i]);
+                n += 1;
+            }
+        }
+    }
+    report_2d(&sums, ss, n, bins.coverage(), field)
+}
+
+/// Sums `Σ xⁱ yʲ` (`i + j ≤ 4`) of a set of 2-D points, `m[i][j]` (entries with
+/// `i + j > 4` unused): everything the 2-D report needs besides the coverage, for any
+/// ellipse, without another pass over the points.
+pub(crate) type Moments2 = [[f64; 5]; 5];
+
+/// A polynomial in `(x, y)` of degree ≤ 4, `p[i][j]` the coefficient of `xⁱ yʲ`.
+type Poly2 = [[f64; 5]; 5];
+
+/// The product of two polynomials, truncated to degree 4 (the callers' products never
+/// exceed it).
+fn poly_mul(a: &Poly2, b: &Poly2) -> Poly2 {
+    let mut out = [[0.0; 5]; 5];
+    for i in 0..5 {
+        for j in 0..5 - i {
+            if a[i][j] == 0.0 {
+                continue;
+            }
+            for k in 0..5 - i - j {
+                for l in 0..5 - i - j - k {
+                    out[i + k][j + l] += a[i][j] * b[k][l];
+                }
+            }
+        }
+    }
+    out
+}
+
+/// `Σ p(x, y)` over the points whose moments are `m`.
+fn poly_sum(p: &Poly2, m: &Moments2) -> f64 {
+    let mut s = 0.0;
+    for i in 0..5 {
+        for j in 0..5 - i {
+            s += p[i][j] * m[i][j];
+        }
+    }
+    s
+}
+
+/// The 2-D report of the ellipse `{ q : |B (q − c)| = 1 }` from the moments `m` of the `n`
+/// points `q` it was fitted to (in the same coordinates), with `coverage` measured
+/// separately and `field` the radius of the calibrated circle in the caller's unit.
+///
+/// The calibrated reading is `field · w` with `w = B (q − c)`, so every quantity of
+/// [`assess_2d`] is a sum over the points of a function of `w`, and `w` is affine in `q`:
+/// a polynomial in `w` of degree ≤ 4 is one in `q`, summed exactly by the moments. Two are
+/// replaced by polynomials to first order in the residual `r = |w| − 1` (a few per cent at
+/// most for any accepted fit): the squared residual by `g²/4`, `g = |w|² − 1 = r (2 + r)`
+/// (relative error about `r`, which averages out over a turn), and the direction
+/// `u = w/|w|` in the monomials of the information matrix by `w` (relative error
+/// `deg · r`, likewise). The sums of the moments cancel to `Σ g²`, so the residual has a
+/// rounding floor of about `√ε ≈ 10⁻⁸` relative to the field.
+pub(crate) fn assess_2d_from_moments(
+    m: &Moments2,
+    n: usize,
+    centre: &Vector2<f64>,
+    unit_map: &nalgebra::Matrix2<f64>,
+    coverage: Coverage,
+    field: f64,
+) -> Assessment2d {
+    let b = unit_map;
+    let t = -(b * centre);
+    let mut wx: Poly2 = [[0.0; 5]; 5];
+    let mut wy: Poly2 = [[0.0; 5]; 5];
+    wx[0][0] = t.x;
+    wx[1][0] = b[(0, 0)];
+    wx[0][1] = b[(0, 1)];
+    wy[0][0] = t.y;
+    wy[1][0] = b[(1, 0)];
+    wy[0][1] = b[(1, 1)];
+    let mut one: Poly2 = [[0.0; 5]; 5];
+    one[0][0] = 1.0;
+    // Powers w_x^a and w_y^b, a, b ≤ 4.
+    let mut px = [one; 5];
+    let mut py = [one; 5];
+    for k in 1..5 {
+        px[k] = poly_mul(&px[k - 1], &wx);
+        py[k] = poly_mul(&py[k - 1], &wy);
+    }
+    let sum = |a: usize, bb: usize| poly_sum(&poly_mul(&px[a], &py[bb]), m);
+    // In the order of `information_2d`.
+    let sums = [
+        sum(2, 0),
+        sum(1, 1),
+        sum(0, 2),
+        sum(3, 0),
+        sum(2, 1),
+        sum(1, 2),
+        sum(0, 3),
+        sum(4, 0),
+        sum(3, 1),
+        sum(2, 2),
+        sum(1, 3),
+        sum(0, 4),
+    ];
+    // Σ g² = Σ (|w|² − 1)² = Σ |w|⁴ − 2 Σ |w|² + n.
+    let w4 = sums[7] + 2.0 * sums[9] + sums[11];
+    let w2 = sums[0] + sums[2];
+    let ss = if n > 0 {
+        (0.25 * (w4 - 2.0 * w2 + n as f64)).max(0.0)
+    } else {
+        0.0
+    };
+    report_2d(&sums, ss, n, coverage, field)
+}
+
+/// The first and second harmonics of the calibrated directions `w = B (q − c)` of the `n`
+/// points with moments `m`: `|Σw|/n` and `|Σ(w_x² − w_y², 2w_xw_y)|/n` (0 for readings
+/// spread evenly round the circle; `w` stands in for `u = w/|w|` as in
+/// [`assess_2d_from_moments`]).
+pub(crate) fn direction_harmonics(
+    m: &Moments2,
+    n: usize,
+    centre: &Vector2<f64>,
+    unit_map: &nalgebra::Matrix2<f64>,
+) -> (f64, f64) {
+    let t = -(unit_map * centre);
+    let mut wx: Poly2 = [[0.0; 5]; 5];
+    let mut wy: Poly2 = [[0.0; 5]; 5];
+    wx[0][0] = t.x;
+    wx[1][0] = unit_map[(0, 0)];
+    wx[0][1] = unit_map[(0, 1)];
+    wy[0][0] = t.y;
+    wy[1][0] = unit_map[(1, 0)];
+    wy[0][1] = unit_map[(1, 1)];
+    let inv = 1.0 / n.max(1) as f64;
+    let (sx, sy) = (poly_sum(&wx, m), poly_sum(&wy, m));
+    let (xx, yy, xy) = (
+        poly_sum(&poly_mul(&wx, &wx), m),
+        poly_sum(&poly_mul(&wy, &wy), m),
+        poly_sum(&poly_mul(&wx, &wy), m),
+    );
+    (
+        (sx * sx + sy * sy).sqrt() * inv,
+        ((xx - yy).powi(2) + 4.0 * xy * xy).sqrt() * inv,
+    )
+}
+
+/// The report from the sums of the information matrix's monomials and of the squared
+/// residuals of `n` readings (shared by [`assess_2d`] and [`assess_2d_from_moments`]).
+fn report_2d(
+    sums: &[f64; MONOMIALS_2D],
+    ss: f64,
+    n: usize,
+    coverage: Coverage,
+    field: f64,
+) -> Assessment2d {
+    let info = information_2d(sums);
+    let residual_rms_rel = if n > 0 { (ss / n as f64).sqrt() } else { 0.0 };
+    let condition = sym_eigen5(&info)
+        .map(|(l, _)| condition_from_eigenvalues(l.as_slice()))
+        .unwrap_or(f64::INFINITY);
+    Assessment2d {
+        quality: CompassQuality {
+            fit: FitQuality {
+                points: n,
+                coverage: coverage.fraction,
+                residual_rms_rel,
+                condition,
+            },
+            heading_error_3sigma_deg: bound_2d(&info, ss, n),
+            heading_error_systematic_deg: 0.0,
+            heading_noise_rms_deg: noise_rms_deg(ss, n, 5),
+            field_magnitude: field,
+            field_ratio_to_expected: None,
+        },
+        coverage,
+    }
+}
+
+/// The 2-D quality report of `cal` on `points` (see [`assess_2d`]).
+pub fn quality_2d(
+    points: &[Vector2<f64>],
+    cal: &CompassCalibration2d,
+    field: f64,
+) -> CompassQuality {
+    assess_2d(points, cal, field).quality
+}
+
+/// The 3-D quality report of `cal` on `points`: share of the sphere's direction cells
+/// filled, residual RMS relative to `field` (the radius of the calibrated sphere; see
+/// [`super::mean_corrected_norm_3d`] if the calibrator defines none), the condition number of the
+/// 9-parameter information matrix and the direction-error bound of the module
+/// documentation. Non-finite readings are skipped. Allocates nothing.
+pub fn quality_3d(
+    points: &[Vector3<f64>],
+    cal: &CompassCalibration3d,
+    field: f64,
+) -> CompassQuality {
+    let mut filled = [false; SPHERE_CELLS];
+    // Sums of the squared residuals and of the monomials of `u` that make up the
+    // information matrix (see `information_3d`).
+    let mut sums = [0.0; MONOMIALS_3D];
+    let mut ss = 0.0;
+    let mut n = 0usize;
+    let inv_f = 1.0 / field;
+    let (s, c) = (&cal.soft_iron, &cal.hard_iron);
+    let plan = monomial_plan_3d();
+    // A block of points at a time (see `crate::lm::BLOCK`): first every point's direction,
+    // its products and its residual, then the sums and the cells. `cols` holds `u_a` in
+    // columns 0–2 and the products `u_a u_b` of `QUAD_3D` in columns 3–8.
+    let mut cols = [[0.0; BLOCK]; 9];
+    let mut h = [[0.0; BLOCK]; 3];
+    let mut rho = [0.0; BLOCK];
+    let mut r2 = [0.0; BLOCK];
+    for (p, len) in blocks(points) {
+        for i in 0..BLOCK {
+            // h = soft_iron · (p − hard_iron), as `CompassCalibration3d::correct`.
+            let d = [p[0][i] - c.x, p[1][i] - c.y, p[2][i] - c.z];
+            let hi: [f64; 3] =
+                core::array::from_fn(|a| s[(a, 0)] * d[0] + s[(a, 1)] * d[1] + s[(a, 2)] * d[2]);
+            let rh = (hi[0] * hi[0] + hi[1] * hi[1] + hi[2] * hi[2]).sqrt();
+            // Non-finite readings are skipped, and the rows past the end of the data: a row
+            // of zeros adds nothing.
+            let k = rh > 0.0 && rh.is_finite() && i < len;
+            let inv_rho = 1.0 / rh;
+            let ui = hi.map(|x| if k { x * inv_rho } else { 0.0 });
+            for a in 0..3 {
+                cols[a][i] = ui[a];
+                h[a][i] = hi[a];
+            }
+            for (j, &(a, b)) in QUAD_3D.iter().enumerate() {
+                cols[3 + j][i] = ui[a] * ui[b];
+            }
+            let r = rh * inv_f - 1.0;
+            r2[i] = if k { r * r } else { 0.0 };
+            rho[i] = rh;
+        }
+        for (sk, &(a, b)) in sums.iter_mut().zip(&plan) {
+            *sk += dot_block(&cols[a], &cols[b]);
+        }
+        ss += sum_block(&r2);
+        n += mark_sphere_cells(&h, &rho, len, &mut filled);
+    }
+    let info = information_3d(&sums);
+    let coverage = filled.iter().filter(|&&f| f).count() as f64 / SPHERE_CELLS as f64;
+    let residual_rms_rel = if n > 0 { (ss / n as f64).sqrt() } else { 0.0 };
+    let condition = sym_eigen9(&info)
+        .map(|(l, _)| condition_from_eigenvalues(l.as_slice()))
+        .unwrap_or(f64::INFINITY);
+    CompassQuality {
+        fit: FitQuality {
+            points: n,
+            coverage,
+            residual_rms_rel,
+            condition,
+        },
+        heading_error_3sigma_deg: bound_3d(&info, ss, n),
+        heading_error_systematic_deg: 0.0,
+        heading_noise_rms_deg: noise_rms_deg(ss, n, 9),
+        field_magnitude: field,
+        field_ratio_to_expected: None,
+    }
+}
