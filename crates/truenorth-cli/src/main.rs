@@ -5,6 +5,7 @@
 
 mod calibrate;
 mod demo;
+mod demo_orientation;
 mod field;
 mod heading;
 mod io;
