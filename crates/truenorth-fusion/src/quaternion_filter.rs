@@ -58,6 +58,11 @@ pub struct QuaternionFilterConfig {
     /// accelerations, which leak into every correction, average out of it (at 60 s the
     /// bias wandered by 2°/s on BROAD trial 16, `tests/broad.rs`).
     pub bias_tau_motion_s: f64,
+    /// Time constant of the in-motion bias estimate before any rest has measured the bias,
+    /// s (default 60); it moves to `bias_tau_motion_s` as rest time accumulates.
+    pub bias_tau_unknown_s: f64,
+    /// Rest time after which the bias counts as known, s (default 5).
+    pub bias_known_after_rest_s: f64,
     /// Time constant of the bias estimate at rest, s (default 2).
     pub bias_tau_rest_s: f64,
     /// Largest bias the filter may estimate on any axis, rad/s (default 20°/s).
@@ -83,6 +88,8 @@ impl Default for QuaternionFilterConfig {
             acc_lowpass_s: 1.0,
             tau_mag_s: 15.0,
             bias_tau_motion_s: 400.0,
+            bias_tau_unknown_s: 60.0,
+            bias_known_after_rest_s: 5.0,
             bias_tau_rest_s: 2.0,
             max_bias_rps: 20f64.to_radians(),
             startup_s: 1.0,
@@ -105,6 +112,13 @@ impl Validate for QuaternionFilterConfig {
             2.0 * self.tau_acc_s,
             1e9,
         )?;
+        check_range(
+            "bias_tau_unknown_s",
+            self.bias_tau_unknown_s,
+            2.0 * self.tau_acc_s,
+            1e9,
+        )?;
+        check_positive("bias_known_after_rest_s", self.bias_known_after_rest_s)?;
         check_positive("bias_tau_rest_s", self.bias_tau_rest_s)?;
         check_range("max_bias_rps", self.max_bias_rps, 0.0, 10.0)?;
         check_range("startup_s", self.startup_s, 0.0, 1e9)?;
@@ -142,6 +156,8 @@ struct State {
     undo_heading: UnitQuaternion<f64>,
     bias_rps: Vector3<f64>,
     acc_lp_ned: Option<Vector3<f64>>,
+    /// Time spent at rest since the start, s: how well the bias is known.
+    rest_s: f64,
     last_gyr_rps: Option<Vector3<f64>>,
     since_start_s: f64,
     initialised: bool,
@@ -193,6 +209,7 @@ impl QuaternionFilter {
                 undo_heading: UnitQuaternion::identity(),
                 bias_rps: Vector3::zeros(),
                 acc_lp_ned: None,
+                rest_s: 0.0,
                 last_gyr_rps: None,
                 since_start_s: 0.0,
                 initialised: config.initial_attitude.is_some(),
@@ -294,10 +311,16 @@ impl QuaternionFilter {
             if at_rest {
                 let k = (dt_s / cfg.bias_tau_rest_s).min(1.0);
                 s.bias_rps += (self.rest.gyro_mean() - s.bias_rps) * k;
+                s.rest_s += dt_s;
             } else {
                 // A bias the estimate lacks makes the strapdown drift, and the corrections
-                // turn against the drift: integrating their rate removes it.
-                s.bias_rps -= correction_rate * (dt_s / cfg.bias_tau_motion_s);
+                // turn against the drift: integrating their rate removes it. Until a rest
+                // has measured the bias, it is learned faster, accepting more of the
+                // accelerations that leak into the corrections.
+                let known = (s.rest_s / cfg.bias_known_after_rest_s).min(1.0);
+                let tau = cfg.bias_tau_unknown_s
+                    + known * (cfg.bias_tau_motion_s - cfg.bias_tau_unknown_s);
+                s.bias_rps -= correction_rate * (dt_s / tau);
             }
             let lim = cfg.max_bias_rps;
             s.bias_rps = s.bias_rps.map(|b| b.clamp(-lim, lim));
