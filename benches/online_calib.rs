@@ -6,7 +6,8 @@
 //!   max / p99.9 / p99 / median. The maximum includes whatever the operating system does to
 //!   the thread meanwhile (an interrupt, a preemption), so p99.9 is the better figure of the
 //!   code itself; both are printed.
-//! * Breakdowns: the binned ellipse's pushes by the phase of its update, and the online
+//! * Breakdowns: the binned ellipse's pushes by the phase of its update (and the step of its
+//!   assessment), the merit circle's by the share of its estimate refresh, and the online
 //!   ellipsoid's by the refresh stage they ran, to show where the worst pushes come from.
 //!
 //! Streams: a level compass turning round and round (2-D; hard iron 0.5 × field, soft-iron
@@ -92,26 +93,68 @@ fn worst_push<C: Calibrator>(name: &str, mut cal: C, stream: &[C::Sample]) {
     );
 }
 
+/// Groups of the binned ellipse's assessment pushes (by step; the last holds any later).
+const ASSESS_GROUPS: usize = 5;
+
+/// The merit circle's pushes grouped by the share of an estimate refresh they did (see
+/// `MeritCircleCalibrator::refresh_stage`), max / p99 / median.
+fn merit_breakdown(stream: &[Mag2Sample]) {
+    let mut cal = MeritCircleCalibrator::new(MeritCircleConfig::default()).unwrap();
+    let mut groups: Vec<Vec<u64>> = vec![Vec::new(); 8];
+    for s in stream {
+        let g = cal.refresh_stage().map_or(7, |k| k.min(6));
+        let t0 = Instant::now();
+        let r = cal.push(black_box(s));
+        let dt = t0.elapsed();
+        black_box(r).ok();
+        groups[g].push(dt.as_nanos() as u64);
+    }
+    for (k, mut ns) in groups.into_iter().enumerate() {
+        if ns.is_empty() {
+            continue;
+        }
+        ns.sort_unstable();
+        let q = |p: f64| ns[((ns.len() - 1) as f64 * p) as usize];
+        let name = match k {
+            0 => "acceptance tests".to_string(),
+            7 => "no refresh".to_string(),
+            k => format!("report step {k}"),
+        };
+        println!(
+            "merit_circle {name}: {} pushes, max {:.2} µs, p99 {:.2} µs, median {} ns",
+            ns.len(),
+            q(1.0) as f64 / 1e3,
+            q(0.99) as f64 / 1e3,
+            q(0.5)
+        );
+    }
+}
+
 /// The binned ellipse's pushes grouped by what they did (the phase of its update at the
 /// start of the push, and whether the refresh advanced), as max / p99 per group.
 fn binned_breakdown(stream: &[Mag2Sample]) {
     let mut cal = BinnedEllipseCalibrator::new(BinnedEllipseConfig::default()).unwrap();
-    let mut groups: [(&str, Vec<u64>); 6] = [
-        ("no update", Vec::new()),
-        ("refresh, idle push", Vec::new()),
-        ("refresh, working push", Vec::new()),
-        ("precheck", Vec::new()),
-        ("assess", Vec::new()),
-        ("apply", Vec::new()),
-    ];
+    let mut groups: Vec<(String, Vec<u64>)> = [
+        "no update",
+        "binning waiting readings",
+        "refresh, idle push",
+        "refresh, working push",
+        "precheck",
+    ]
+    .iter()
+    .map(|n| (n.to_string(), Vec::new()))
+    .chain((0..ASSESS_GROUPS).map(|k| (format!("assess step {k}"), Vec::new())))
+    .chain(core::iter::once(("apply".to_string(), Vec::new())))
+    .collect();
     for s in stream {
         let g = match cal.update_phase() {
+            None if cal.waiting_readings() > 0 => 1,
             None => 0,
-            Some((UpdatePhase::Refresh, k)) if (k + 1) % 2 != 0 => 1,
-            Some((UpdatePhase::Refresh, _)) => 2,
-            Some((UpdatePhase::Precheck, _)) => 3,
-            Some((UpdatePhase::Assess, _)) => 4,
-            Some((UpdatePhase::Apply, _)) => 5,
+            Some((UpdatePhase::Refresh, k)) if (k + 1) % 2 != 0 => 2,
+            Some((UpdatePhase::Refresh, _)) => 3,
+            Some((UpdatePhase::Precheck, _)) => 4,
+            Some((UpdatePhase::Assess, _)) => 5 + cal.assessment_steps().min(ASSESS_GROUPS - 1),
+            Some((UpdatePhase::Apply, _)) => 5 + ASSESS_GROUPS,
         };
         let t0 = Instant::now();
         let r = cal.push(black_box(s));
@@ -126,9 +169,10 @@ fn binned_breakdown(stream: &[Mag2Sample]) {
         ns.sort_unstable();
         let q = |p: f64| ns[((ns.len() - 1) as f64 * p) as usize];
         println!(
-            "binned_ellipse {name}: {} pushes, max {:.2} µs, p99 {:.2} µs, median {} ns",
+            "binned_ellipse {name}: {} pushes, max {:.2} µs, p99.9 {:.2} µs, p99 {:.2} µs, median {} ns",
             ns.len(),
             q(1.0) as f64 / 1e3,
+            q(0.999) as f64 / 1e3,
             q(0.99) as f64 / 1e3,
             q(0.5)
         );
@@ -194,6 +238,7 @@ fn bench(c: &mut Criterion) {
     worst_push("online_ellipsoid", online3(), &s3);
     ellipsoid_breakdown(&s3);
     worst_push("merit_circle", merit(), &s2);
+    merit_breakdown(&s2);
     worst_push("binned_ellipse", binned(), &s2);
     binned_breakdown(&s2);
 

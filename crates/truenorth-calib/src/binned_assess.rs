@@ -2,7 +2,8 @@
 //! (EP 0634001 claim 15) and the acceptance tests a solve applies (arc about the origin,
 //! the locus's own turning, residual), on any set of bins. It reads only what stays fixed
 //! while an update is in progress (the configuration, the restart reference and the
-//! sample count), so an update can be assessed in one push and applied in the next.
+//! sample count), so an update can be assessed over a few pushes (the quality report in
+//! the bounded steps of [`SeedJob`]) and applied in the next.
 
 use nalgebra::Vector2;
 use truenorth_compass::{CompassCalibration2d, EllipsePhasors};
@@ -10,8 +11,8 @@ use truenorth_core::{Error, Result, Solution};
 
 use crate::binned_config::BinnedEllipseConfig;
 use crate::binned_refresh::{BinState, Bins, MAX_BINS, RefreshJob, filled};
-use crate::quality::{locus_turning_rad, require_arc};
-use crate::seed_quality::seed_assessment;
+use crate::quality::{Assessment2d, locus_turning_rad, require_arc};
+use crate::seed_quality::{SeedJob, seed_assessment};
 
 #[allow(unused_imports)]
 use truenorth_core::Float as _;
@@ -106,6 +107,19 @@ impl Assessor<'_> {
         params: &EllipsePhasors,
         turned_deg: f64,
     ) -> Result<Solution<CompassCalibration2d>> {
+        let job = self.seed_job(bins, params);
+        let a = seed_assessment(
+            job.points(),
+            job.calibration(),
+            job.field(),
+            job.samples_used(),
+        );
+        self.judge(&a, job.calibration(), turned_deg)
+    }
+
+    /// The quality report of a solution with `params` on `bins`, not yet run (see
+    /// [`SeedJob`]): it reads the bins holding readings.
+    pub(crate) fn seed_job(&self, bins: &Bins, params: &EllipsePhasors) -> SeedJob {
         let cal = params.to_calibration();
         let n = self.config.bins;
         let mut pts = [Vector2::zeros(); MAX_BINS];
@@ -114,7 +128,16 @@ impl Assessor<'_> {
             pts[k] = b.value;
             k += 1;
         }
-        let a = seed_assessment(&pts[..k], &cal, params.earth_magnitude, self.samples);
+        SeedJob::start(&pts[..k], &cal, params.earth_magnitude, self.samples)
+    }
+
+    /// The acceptance tests on the report `a` of `cal`, given the locus's turning.
+    pub(crate) fn judge(
+        &self,
+        a: &Assessment2d,
+        cal: &CompassCalibration2d,
+        turned_deg: f64,
+    ) -> Result<Solution<CompassCalibration2d>> {
         require_arc(&a.coverage, self.config.min_arc_deg)?;
         // The arc above is seen from the method's own origin, which a short arc pulls towards
         // itself (so the arc looks longer than it is); the locus's own turning cannot be
@@ -134,7 +157,7 @@ impl Assessor<'_> {
             });
         }
         Ok(Solution {
-            params: cal,
+            params: *cal,
             quality: a.quality,
         })
     }

@@ -53,13 +53,15 @@
 //! push may cost. So push starts it on a copy of the bins (the `binned_update` module) and
 //! advances it by one bounded slice on every second push only, over at most
 //! `min(update_interval, 96)` pushes (the `binned_refresh` module); the pushes between do
-//! no update work at all. The finished refresh is then assessed over two pushes (the
-//! restart check and the locus's turning; the quality report and the other acceptance
-//! tests) and applied at a third, which swaps in its bins, origin and estimate together
+//! no update work at all. The finished refresh is then assessed over a few pushes (the
+//! restart check and the locus's turning; the quality report in bounded steps, one per push,
+//! and the other acceptance tests) and applied at the next, which swaps in its bins, origin and estimate together
 //! (so the published estimate is always one update's) and bins the readings that arrived
 //! meanwhile about the new origin, exactly as if the update had been done at once when it
-//! started. The estimate ([`truenorth_core::OnlineCalibrator::estimate`], O(1)) changes
-//! only then, and that push returns [`Pushed::NewEstimate`].
+//! started; at most 16 of them in that push and as many in each of the next (readings
+//! pushed meanwhile queue behind them), which bins them exactly as binning them at once
+//! would. The estimate ([`truenorth_core::OnlineCalibrator::estimate`], O(1)) changes
+//! only at the application, and that push returns [`Pushed::NewEstimate`].
 //!
 //! `solve` leaves the calibrator unchanged: it completes any update in progress and runs a
 //! full update on a copy, then applies the acceptance tests (origin, filled bins, arc about
@@ -84,8 +86,8 @@ use crate::binned_refresh::{
 
 use core::f64::consts::TAU;
 
+use crate::binned_update::{DRAIN_PER_PUSH, REFRESH_PUSHES, REFRESH_STRIDE, Update};
 pub use crate::binned_update::{MAX_UPDATE_PUSHES, UpdatePhase};
-use crate::binned_update::{REFRESH_PUSHES, REFRESH_STRIDE, Update};
 
 #[allow(unused_imports)]
 use truenorth_core::Float as _;
@@ -131,6 +133,10 @@ pub struct BinnedEllipseCalibrator {
     pub(crate) restarts: usize,
     pub(crate) estimate: Option<Solution<CompassCalibration2d>>,
     pub(crate) update: Option<Update>,
+    /// Readings that waited for an applied update and are not binned yet (the front
+    /// `backlog_len`; never while an update is in progress).
+    pub(crate) backlog: [Vector2<f64>; MAX_UPDATE_PUSHES],
+    pub(crate) backlog_len: usize,
 }
 
 impl Default for BinnedEllipseCalibrator {
@@ -161,6 +167,8 @@ impl BinnedEllipseCalibrator {
             restarts: 0,
             estimate: None,
             update: None,
+            backlog: [Vector2::zeros(); MAX_UPDATE_PUSHES],
+            backlog_len: 0,
         }
     }
 
@@ -225,6 +233,21 @@ impl BinnedEllipseCalibrator {
     /// Whether a full-set update is in progress.
     pub fn updating(&self) -> bool {
         self.update.is_some()
+    }
+
+    /// Readings that waited for the last applied update and are still to be binned (a
+    /// bounded number are binned per push; see the module documentation).
+    pub fn waiting_readings(&self) -> usize {
+        self.backlog_len
+    }
+
+    /// How many pushes the assessment of the update in progress has had (0 outside phase
+    /// [`UpdatePhase::Assess`] and at its start).
+    pub fn assessment_steps(&self) -> usize {
+        self.update
+            .as_ref()
+            .filter(|u| u.phase == UpdatePhase::Assess)
+            .map_or(0, |u| u.assess_steps)
     }
 
     /// The phase of the full-set update in progress, if any, and how many pushes it has
@@ -322,6 +345,8 @@ impl BinnedEllipseCalibrator {
             phase: UpdatePhase::Refresh,
             precheck: None,
             verdict: None,
+            seed: None,
+            assess_steps: 0,
             pending: [Vector2::zeros(); MAX_UPDATE_PUSHES],
             pending_len: 0,
         });
@@ -329,9 +354,10 @@ impl BinnedEllipseCalibrator {
 
     /// Applies a finished, assessed update: its bins and origin, then the verdict (restart,
     /// or new parameters, reference and estimate), all in this one push so that what is
-    /// published is always one update's; then bins the readings that arrived meanwhile.
-    /// Returns whether the estimate changed.
-    fn complete_update(&mut self, mut u: Update) -> bool {
+    /// published is always one update's; then bins the readings that arrived meanwhile
+    /// (with `spread`, a bounded number of them now and the rest on the next pushes, see
+    /// [`Self::drain`]). Returns whether the estimate changed.
+    fn complete_update(&mut self, mut u: Update, spread: bool) -> bool {
         u.job.finish();
         let verdict = match u.verdict {
             Some(v) => v,
@@ -352,16 +378,43 @@ impl BinnedEllipseCalibrator {
                 self.estimate = estimate;
             }
         }
-        for p in &u.pending[..u.pending_len] {
-            self.ingest(p);
-        }
+        // No backlog while an update is in progress, and a restart above cleared it anyway.
+        self.backlog[..u.pending_len].copy_from_slice(&u.pending[..u.pending_len]);
+        self.backlog_len = u.pending_len;
+        self.drain(spread);
         self.estimate != before
+    }
+
+    /// Bins waiting readings in the order they arrived: with `spread`, at most
+    /// `DRAIN_PER_PUSH` of them, else all. Binning them over several pushes gives exactly
+    /// the bins of binning them at once as long as none of them starts the next update
+    /// (the readings pushed meanwhile queue behind them, so the order is the same): each
+    /// reading raises the count towards `update_interval` by at most one, so while the
+    /// count plus the backlog is below it none can, and once it reaches it only the latest
+    /// reading can, and all are binned in that push — exactly when the update would start
+    /// if nothing had waited.
+    fn drain(&mut self, spread: bool) {
+        let len = self.backlog_len;
+        if len == 0 {
+            return;
+        }
+        let all = !spread || self.since_update + len >= self.config.update_interval;
+        let k = if all { len } else { len.min(DRAIN_PER_PUSH) };
+        for i in 0..k {
+            let p = self.backlog[i];
+            self.ingest(&p);
+        }
+        self.backlog.copy_within(k..len, 0);
+        // Unused entries stay zero, so equal states compare equal.
+        self.backlog[len - k..len].fill(Vector2::zeros());
+        self.backlog_len = len - k;
     }
 
     /// Runs any update in progress to its end and applies it.
     fn finish_update(&mut self) {
+        self.drain(false);
         if let Some(u) = self.update.take() {
-            self.complete_update(u);
+            self.complete_update(u, false);
         }
     }
 
@@ -454,6 +507,12 @@ impl Calibrator for BinnedEllipseCalibrator {
         if let Some(u) = self.update.as_mut() {
             u.pending[u.pending_len] = p;
             u.pending_len += 1;
+        } else if self.backlog_len > 0 {
+            // Behind the readings still waiting from the last update (never full: it only
+            // shrinks by more than one a push).
+            self.backlog[self.backlog_len] = p;
+            self.backlog_len += 1;
+            self.drain(true);
         } else {
             self.ingest(&p);
         }
@@ -484,10 +543,10 @@ impl Calibrator for BinnedEllipseCalibrator {
         let Some(u) = self.update.take() else {
             return Ok(Pushed::Accepted);
         };
-        // The refresh ends within `REFRESH_PUSHES` and three more pushes complete it, well
+        // The refresh ends within `REFRESH_PUSHES` and a few more pushes complete it, well
         // within the pending buffer; completing at once when it is full is a safeguard that
         // does not change the result.
-        if self.complete_update(u) {
+        if self.complete_update(u, !full) {
             Ok(Pushed::NewEstimate)
         } else {
             Ok(Pushed::Accepted)
@@ -525,184 +584,5 @@ impl OnlineCalibrator for BinnedEllipseCalibrator {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use truenorth_compass::{
-        Disturbance, DisturbanceShape, HeadingTruth, MagnetometerModel2d, soft_iron_from_axes,
-    };
-    use truenorth_core::{SensorModel, SplitMix64, angle_diff};
-
-    const H: f64 = 20.0;
-
-    fn reference() -> MagnetometerModel2d {
-        MagnetometerModel2d::new(
-            Vector2::new(10.0, -4.0),
-            soft_iron_from_axes(1.3, 1.0, 30f64.to_radians()),
-            0.01 * H,
-        )
-        .unwrap()
-    }
-
-    /// Turns of `deg` degrees at 2 samples per degree.
-    fn drive(c: &mut BinnedEllipseCalibrator, m: &mut MagnetometerModel2d, from: f64, deg: f64) {
-        let mut rng = SplitMix64::new(from.to_bits());
-        let n = (2.0 * deg) as usize;
-        for i in 0..n {
-            let truth = HeadingTruth {
-                heading_rad: (from + i as f64 * 0.5).to_radians(),
-                horizontal_field: H,
-            };
-            c.push(&Mag2Sample {
-                t_s: i as f64,
-                mag: m.sample(&truth, 0.05, &mut rng).unwrap(),
-            })
-            .unwrap();
-        }
-    }
-
-    #[test]
-    fn s_theta_finds_the_minor_axis_and_the_ratio_is_negative_about_it() {
-        let mut m = reference();
-        let mut c = BinnedEllipseCalibrator::default();
-        drive(&mut c, &mut m, 0.0, 450.0);
-        c.solve().unwrap();
-        let p = c.solve_phasors().unwrap();
-        // Major axis at 30°: Ω_e is 120° (mod 180°), r ≈ −0.3/2.3.
-        assert!(angle_diff(2.0 * p.omega_e_rad, 2.0 * 120f64.to_radians()).abs() < 0.02);
-        assert!((p.ratio + 0.3 / 2.3).abs() < 0.01, "{}", p.ratio);
-        assert!((p.earth_magnitude - 1.15 * H).abs() < 0.02 * H);
-        let n = p.normalised();
-        assert!(angle_diff(2.0 * n.omega_e_rad, 60f64.to_radians()).abs() < 0.02);
-    }
-
-    #[test]
-    fn stored_parameters_regenerate_the_bins() {
-        let mut m = reference();
-        let mut c = BinnedEllipseCalibrator::default();
-        drive(&mut c, &mut m, 0.0, 60.0);
-        // Not enough readings yet to store (claim 14).
-        assert!(c.parameters_to_store().is_none());
-        drive(&mut c, &mut m, 60.0, 400.0);
-        let before = c.solve().unwrap().params;
-        let stored = c.parameters_to_store().unwrap();
-        let mut on = BinnedEllipseCalibrator::from_stored_parameters(
-            BinnedEllipseConfig::default(),
-            &stored,
-        )
-        .unwrap();
-        assert_eq!(on.filled_bins(), 64);
-        assert!(on.bin_states().all(|s| s == BinState::Regenerated));
-        let after = on.solve().unwrap().params;
-        assert!((after.hard_iron - before.hard_iron).norm() < 1e-3 * H);
-        assert!((after.soft_iron - before.soft_iron).norm() < 5e-3);
-        // New readings replace regenerated values bin by bin.
-        drive(&mut on, &mut m, 0.0, 30.0);
-        assert!(on.bin_states().any(|s| s == BinState::Measured));
-        assert!(
-            BinnedEllipseCalibrator::from_stored_parameters(
-                BinnedEllipseConfig::default(),
-                &EllipsePhasors {
-                    ratio: 2.0,
-                    ..stored
-                }
-            )
-            .is_err()
-        );
-    }
-
-    #[test]
-    fn a_new_magnet_restarts_a_passing_lorry_does_not() {
-        let mut m = reference();
-        let mut c = BinnedEllipseCalibrator::default();
-        drive(&mut c, &mut m, 0.0, 720.0);
-        assert_eq!(c.restarts(), 0);
-        // A lorry passes for a few seconds: a field of half the earth's, briefly.
-        let mut lorry = m
-            .with_disturbance(Disturbance {
-                start_s: m.time_s() + 1.0,
-                duration_s: 3.0,
-                field_ned: nalgebra::Vector3::new(0.0, 0.5 * H, 0.0),
-                shape: DisturbanceShape::RaisedCosine,
-            })
-            .unwrap();
-        drive(&mut c, &mut lorry, 0.0, 720.0);
-        assert_eq!(c.restarts(), 0, "a transient restarted calibration");
-        // A magnet is fixed near the sensor: the hard iron moves by 0.6 H.
-        let mut magnet = MagnetometerModel2d::new(
-            m.hard_iron() + Vector2::new(0.6 * H, 0.0),
-            m.soft_iron(),
-            m.noise_sigma(),
-        )
-        .unwrap();
-        drive(&mut c, &mut magnet, 0.0, 360.0);
-        assert!(c.restarts() >= 1, "the magnet went unnoticed");
-        drive(&mut c, &mut magnet, 0.0, 450.0);
-        let sol = c.solve().unwrap();
-        assert!((sol.params.hard_iron - magnet.hard_iron()).norm() < 0.02 * H);
-    }
-
-    /// A snapshot taken at any push of a whole update cycle (every phase: refresh on idle
-    /// and working pushes, precheck, assessment, application) restores to a calibrator that
-    /// continues bit-identically.
-    #[test]
-    fn snapshot_at_every_phase_of_an_update_continues_identically() {
-        use truenorth_core::Persistent;
-        let mut m = reference();
-        let mut rng = SplitMix64::new(3);
-        let stream: Vec<_> = (0..900)
-            .map(|i| {
-                let truth = HeadingTruth {
-                    heading_rad: (i as f64 * 0.5).to_radians(),
-                    horizontal_field: H,
-                };
-                Mag2Sample {
-                    t_s: i as f64,
-                    mag: m.sample(&truth, 0.05, &mut rng).unwrap(),
-                }
-            })
-            .collect();
-        let mut straight = BinnedEllipseCalibrator::default();
-        let mut phases = std::collections::BTreeSet::new();
-        for (k, s) in stream.iter().enumerate() {
-            if k >= 600 {
-                phases.insert(format!("{:?}", straight.update_phase().map(|p| p.0)));
-                let mut resumed = BinnedEllipseCalibrator::restore(straight.snapshot()).unwrap();
-                assert_eq!(resumed, straight, "push {k}");
-                let mut copy = straight.clone();
-                for t in &stream[k..(k + 5).min(stream.len())] {
-                    assert_eq!(copy.push(t).unwrap(), resumed.push(t).unwrap(), "push {k}");
-                    assert_eq!(copy.estimate(), resumed.estimate());
-                }
-                assert_eq!(copy, resumed);
-            }
-            straight.push(s).unwrap();
-        }
-        // Every phase was visited.
-        assert_eq!(phases.len(), 5, "{phases:?}");
-    }
-
-    #[test]
-    fn config_is_validated() {
-        let bad = [
-            BinnedEllipseConfig {
-                bins: 63,
-                ..Default::default()
-            },
-            BinnedEllipseConfig {
-                bins: 256,
-                ..Default::default()
-            },
-            BinnedEllipseConfig {
-                init_samples: 0,
-                ..Default::default()
-            },
-            BinnedEllipseConfig {
-                restart_threshold: f64::NAN,
-                ..Default::default()
-            },
-        ];
-        for cfg in bad {
-            assert!(BinnedEllipseCalibrator::new(cfg).is_err(), "{cfg:?}");
-        }
-    }
-}
+#[path = "binned_ellipse_tests.rs"]
+mod tests;

@@ -1,7 +1,8 @@
 //! Saving and restoring a [`BinnedEllipseCalibrator`] exactly ([`Persistent`]): the
 //! configuration, the bins, the origin and restart reference, the estimate, and any
 //! full-set update in progress (as the bins it started from, how many pushes advanced it
-//! and the readings that arrived since, so restoring replays it to the same point).
+//! and the readings that arrived since, so restoring replays it to the same point), and the
+//! readings still waiting to be binned after an update was applied.
 
 extern crate alloc;
 
@@ -17,6 +18,7 @@ use truenorth_core::{
 use crate::binned_ellipse::{BinnedEllipseCalibrator, BinnedEllipseConfig, MAX_INIT_SAMPLES};
 use crate::binned_refresh::{Bin, BinState, Bins, EMPTY, MAX_BINS, RefreshJob};
 use crate::binned_update::{MAX_UPDATE_PUSHES, REFRESH_STRIDE, Update, UpdatePhase};
+use crate::seed_quality::SeedJob;
 
 /// A full-set update in progress, as saved (opaque).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -27,6 +29,7 @@ pub struct BinnedUpdateSaved {
     stride: usize,
     advanced: usize,
     phase: UpdatePhase,
+    assess_steps: usize,
     pending: Vec<Vector2<f64>>,
 }
 
@@ -52,6 +55,7 @@ pub struct BinnedEllipseSaved {
     /// The current estimate.
     pub estimate: Option<Solution<CompassCalibration2d>>,
     update: Option<BinnedUpdateSaved>,
+    backlog: Vec<Vector2<f64>>,
 }
 
 fn finite2(v: &Vector2<f64>) -> bool {
@@ -85,7 +89,7 @@ fn bins_from(saved: &[Bin], n: usize) -> Result<Bins> {
 
 impl Persistent for BinnedEllipseCalibrator {
     type State = BinnedEllipseSaved;
-    const SNAPSHOT_VERSION: u32 = 2;
+    const SNAPSHOT_VERSION: u32 = 3;
 
     fn snapshot(&self) -> Snapshot<BinnedEllipseSaved> {
         let n = self.config.bins;
@@ -110,8 +114,10 @@ impl Persistent for BinnedEllipseCalibrator {
                     stride: u.stride,
                     advanced: u.advanced,
                     phase: u.phase,
+                    assess_steps: u.assess_steps,
                     pending: u.pending[..u.pending_len].to_vec(),
                 }),
+                backlog: self.backlog[..self.backlog_len].to_vec(),
             },
         }
     }
@@ -166,6 +172,15 @@ impl Persistent for BinnedEllipseCalibrator {
         c.restored = s.restored;
         c.restarts = s.restarts;
         c.estimate = s.estimate;
+        // Readings wait only after an update was applied, never during one.
+        if s.backlog.len() >= MAX_UPDATE_PUSHES
+            || (!s.backlog.is_empty() && s.update.is_some())
+            || !s.backlog.iter().all(finite2)
+        {
+            return invalid("the saved binned-ellipse waiting readings are inconsistent");
+        }
+        c.backlog[..s.backlog.len()].copy_from_slice(&s.backlog);
+        c.backlog_len = s.backlog.len();
         if let Some(u) = s.update {
             let start_bins = bins_from(&u.start_bins, n)?;
             if !(finite2(&u.start_origin) && u.pending.iter().all(finite2)) {
@@ -201,6 +216,8 @@ impl Persistent for BinnedEllipseCalibrator {
                 phase: UpdatePhase::Refresh,
                 precheck: None,
                 verdict: None,
+                seed: None,
+                assess_steps: 0,
                 pending,
                 pending_len: u.pending.len(),
             };
@@ -216,8 +233,20 @@ impl Persistent for BinnedEllipseCalibrator {
             if update.phase != replayed {
                 return invalid("the saved update in progress does not match its phase");
             }
-            while update.phase != u.phase {
+            // Precheck, the steps of the assessment, then the application: a saved update is
+            // at most that many assessment pushes past its refresh.
+            let mut left = 2 + SeedJob::STEPS;
+            while update.phase != u.phase
+                || (u.phase == UpdatePhase::Assess && update.assess_steps < u.assess_steps)
+            {
+                if left == 0 {
+                    return invalid("the saved update in progress does not match its phase");
+                }
+                left -= 1;
                 update.advance_assessment(&c.assessor());
+            }
+            if update.assess_steps != u.assess_steps {
+                return invalid("the saved update in progress does not match its phase");
             }
             c.update = Some(update);
         }

@@ -103,24 +103,34 @@ pub(crate) fn bin_reading(
 }
 
 /// Moves every stored reading to its bin about `new_origin`, merging readings that land in
-/// one bin (weighted by their counts) — the "adjusting" of claim 1.
+/// one bin (weighted by their counts) — the "adjusting" of claim 1. (The job does it an old
+/// bin at a time; this is the reference its tests compare with.)
+#[cfg(test)]
 pub(crate) fn rebin(bins: &mut Bins, n: usize, new_origin: &Vector2<f64>) {
     let old = *bins;
     *bins = [EMPTY; MAX_BINS];
-    for b in old[..n].iter().filter(|b| b.state != BinState::Empty) {
-        let Some(i) = bin_index(&(b.value - new_origin), n) else {
-            continue;
-        };
-        let t = &mut bins[i];
-        if t.state == BinState::Empty {
-            *t = *b;
-        } else {
-            let (wa, wb) = (f64::from(t.count.max(1)), f64::from(b.count.max(1)));
-            t.value = (t.value * wa + b.value * wb) / (wa + wb);
-            t.count = t.count.saturating_add(b.count);
-            if b.state == BinState::Measured {
-                t.state = BinState::Measured;
-            }
+    for b in &old[..n] {
+        rebin_one(bins, n, b, new_origin);
+    }
+}
+
+/// One old bin's share of [`rebin`]: moves `b` (if it holds a reading) into `bins`.
+fn rebin_one(bins: &mut Bins, n: usize, b: &Bin, new_origin: &Vector2<f64>) {
+    if b.state == BinState::Empty {
+        return;
+    }
+    let Some(i) = bin_index(&(b.value - new_origin), n) else {
+        return;
+    };
+    let t = &mut bins[i];
+    if t.state == BinState::Empty {
+        *t = *b;
+    } else {
+        let (wa, wb) = (f64::from(t.count.max(1)), f64::from(b.count.max(1)));
+        t.value = (t.value * wa + b.value * wb) / (wa + wb);
+        t.count = t.count.saturating_add(b.count);
+        if b.state == BinState::Measured {
+            t.state = BinState::Measured;
         }
     }
 }
@@ -137,15 +147,20 @@ pub(crate) fn filled(bins: &Bins, n: usize) -> usize {
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum Stage {
     /// Building the full set of pass `pass` (passes `0..iterations` iterate the origin; pass
-    /// `iterations` is the final one): the polar form of the filled bins is computed when
-    /// `polar_ready` is false, then the output bins from `next`.
+    /// `iterations` is the final one): while `polar_ready` is false the polar form of the
+    /// filled bins, a bin at a time from `next`, then the output bins from `next`.
     FullSet {
         pass: usize,
         polar_ready: bool,
         next: usize,
     },
-    /// Re-binning about the mean of the full set of pass `pass`.
-    Rebin { pass: usize, mean: Vector2<f64> },
+    /// Re-binning about the mean of the full set of pass `pass`, an old bin at a time from
+    /// `next`.
+    Rebin {
+        pass: usize,
+        mean: Vector2<f64>,
+        next: usize,
+    },
     /// Searching the ellipse parameters of the final full set.
     Params,
     /// Finished.
@@ -168,6 +183,8 @@ pub(crate) struct RefreshJob {
     slot: [u8; MAX_BINS],
     last_at_or_before: [u8; MAX_BINS],
     full: [Vector2<f64>; MAX_BINS],
+    /// The bins before the re-binning in progress.
+    rebin_from: Bins,
     search: Option<ParamSearch>,
     stage: Stage,
     /// The outcome, once [`Self::advance`] returned `true`.
@@ -202,6 +219,7 @@ impl RefreshJob {
             slot: [NO_READING; MAX_BINS],
             last_at_or_before: [0; MAX_BINS],
             full: [Vector2::zeros(); MAX_BINS],
+            rebin_from: [EMPTY; MAX_BINS],
             search: None,
             stage: Stage::FullSet {
                 pass: 0,
@@ -241,24 +259,32 @@ impl RefreshJob {
             Stage::FullSet {
                 pass,
                 polar_ready: false,
-                ..
+                next: i,
             } => {
                 // (angle, magnitude) of each filled bin's reading about the origin, in bin
                 // order, and where each bin's nearest readings are in that list.
-                let mut k = 0;
-                for (i, b) in self.bins[..n].iter().enumerate() {
-                    self.slot[i] = NO_READING;
-                    if b.state == BinState::Empty {
-                        continue;
-                    }
+                if i == 0 {
+                    self.k = 0;
+                }
+                let b = self.bins[i];
+                self.slot[i] = NO_READING;
+                if b.state != BinState::Empty {
                     let d = b.value - self.origin;
                     if d.norm() > 0.0 {
-                        self.polar[k] = (d.y.atan2(d.x), d.norm());
-                        self.slot[i] = k as u8;
-                        k += 1;
+                        self.polar[self.k] = (d.y.atan2(d.x), d.norm());
+                        self.slot[i] = self.k as u8;
+                        self.k += 1;
                     }
                 }
-                self.k = k;
+                if i + 1 < n {
+                    self.stage = Stage::FullSet {
+                        pass,
+                        polar_ready: false,
+                        next: i + 1,
+                    };
+                    return TRIG_COST;
+                }
+                let k = self.k;
                 if k > 0 {
                     // Before the first reading (going round) the last one is the latest.
                     let mut last = (k - 1) as u8;
@@ -278,7 +304,7 @@ impl RefreshJob {
                         next: 0,
                     }
                 };
-                TRIG_COST * n
+                TRIG_COST
             }
             Stage::FullSet { pass, next, .. } => {
                 self.full[next] = self.full_set_bin(next);
@@ -293,15 +319,29 @@ impl RefreshJob {
                 };
                 TRIG_COST
             }
-            Stage::Rebin { pass, mean } => {
-                rebin(&mut self.bins, n, &mean);
-                self.origin = mean;
-                self.stage = Stage::FullSet {
-                    pass: pass + 1,
-                    polar_ready: false,
-                    next: 0,
+            Stage::Rebin { pass, mean, next } => {
+                // As `rebin`, an old bin at a time.
+                if next == 0 {
+                    self.rebin_from = self.bins;
+                    self.bins = [EMPTY; MAX_BINS];
+                }
+                let b = self.rebin_from[next];
+                rebin_one(&mut self.bins, n, &b, &mean);
+                self.stage = if next + 1 < n {
+                    Stage::Rebin {
+                        pass,
+                        mean,
+                        next: next + 1,
+                    }
+                } else {
+                    self.origin = mean;
+                    Stage::FullSet {
+                        pass: pass + 1,
+                        polar_ready: false,
+                        next: 0,
+                    }
                 };
-                TRIG_COST * n
+                TRIG_COST
             }
             Stage::Params => {
                 let r = match self.search.as_mut() {
@@ -338,7 +378,11 @@ impl RefreshJob {
         if pass < self.iterations {
             let mean = self.full[..n].iter().sum::<Vector2<f64>>() / n as f64;
             if mean.x.is_finite() && mean.y.is_finite() {
-                return Stage::Rebin { pass, mean };
+                return Stage::Rebin {
+                    pass,
+                    mean,
+                    next: 0,
+                };
             }
             // The iteration stops; the final pass would rebuild this very set.
         }
@@ -426,7 +470,7 @@ mod tests {
     ) -> Result<EllipsePhasors> {
         let full_set = |bins: &Bins, origin: &Vector2<f64>| {
             let mut job = RefreshJob::start(bins, n, origin, 0, 0);
-            job.unit();
+            job.polar();
             (job.k >= 2).then(|| {
                 let mut out = [Vector2::zeros(); MAX_BINS];
                 for (i, o) in out[..n].iter_mut().enumerate() {
@@ -448,6 +492,21 @@ mod tests {
         }
         let full = full_set(bins, origin).ok_or(Error::TooFewPoints { got: 0, need: 0 })?;
         ellipse_parameters(&full[..n], origin)
+    }
+
+    impl RefreshJob {
+        /// Runs the polar pass of the first full set.
+        fn polar(&mut self) {
+            while matches!(
+                self.stage,
+                Stage::FullSet {
+                    polar_ready: false,
+                    ..
+                }
+            ) {
+                self.unit();
+            }
+        }
     }
 
     fn bins_of(points: &[(f64, f64)], n: usize, origin: &Vector2<f64>) -> Bins {
@@ -502,7 +561,7 @@ mod tests {
             let pts: Vec<_> = pts.iter().map(|&(a, r)| (a * arc, r)).collect();
             let bins = bins_of(&pts, n, &origin);
             let mut job = RefreshJob::start(&bins, n, &origin, 0, 0);
-            job.unit();
+            job.polar();
             prop_assume!(job.k >= 2);
             for i in 0..n {
                 prop_assert_eq!(job.full_set_bin(i), full_set_bin_by_search(&job, i), "bin {}", i);

@@ -1,6 +1,6 @@
 //! A binned-ellipse full-set update in progress and its schedule: the refresh on a copy of
-//! the bins, advanced by one bounded slice on every few pushes, then its assessment in two
-//! pushes and its application in one, with the readings that arrive meanwhile kept for
+//! the bins, advanced by one bounded slice on every few pushes, then its assessment over a few
+//! pushes (one bounded step each) and its application in one, with the readings that arrive meanwhile kept for
 //! binning when it is applied (so the published estimate is always one update's).
 
 use nalgebra::Vector2;
@@ -8,6 +8,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::binned_assess::{Assessor, Precheck, Verdict};
 use crate::binned_refresh::{Bins, RefreshJob};
+use crate::seed_quality::SeedJob;
 
 #[allow(unused_imports)]
 use truenorth_core::Float as _;
@@ -17,8 +18,14 @@ use truenorth_core::Float as _;
 pub const MAX_UPDATE_PUSHES: usize = 128;
 
 /// Most pushes the refresh of a full-set update is spread over; its assessment and its
-/// application take three pushes after it, so at most `REFRESH_PUSHES + 3` readings wait.
+/// application take `2 + SeedJob::STEPS` pushes after it, so at most
+/// `REFRESH_PUSHES + 2 + SeedJob::STEPS` readings wait.
 pub(crate) const REFRESH_PUSHES: usize = 96;
+
+/// Most waiting readings binned per push once an update is applied (the rest wait for the
+/// next pushes; at most `MAX_UPDATE_PUSHES` wait, so they are all binned within
+/// `MAX_UPDATE_PUSHES / (DRAIN_PER_PUSH - 1)` pushes).
+pub(crate) const DRAIN_PER_PUSH: usize = 16;
 
 /// A refresh advances on every `REFRESH_STRIDE`-th push only, so that most pushes do no
 /// refresh work at all (and cost what binning one reading costs).
@@ -32,7 +39,8 @@ pub enum UpdatePhase {
     /// The refresh is over; the next push checks for a restart and measures the locus's
     /// turning.
     Precheck,
-    /// The next push completes the assessment (quality report and acceptance tests).
+    /// The next pushes complete the assessment: the quality report, one bounded step per
+    /// push, then the acceptance tests.
     Assess,
     /// The result is assessed; the next push applies it and bins the readings that waited.
     Apply,
@@ -53,6 +61,9 @@ pub(crate) struct Update {
     pub phase: UpdatePhase,
     pub precheck: Option<Precheck>,
     pub verdict: Option<Verdict>,
+    /// The quality report in progress (phase `Assess`), and the pushes of that phase so far.
+    pub seed: Option<SeedJob>,
+    pub assess_steps: usize,
     pub pending: [Vector2<f64>; MAX_UPDATE_PUSHES],
     pub pending_len: usize,
 }
@@ -71,8 +82,25 @@ impl Update {
                     Some(p) => p,
                     None => assessor.precheck(&self.job),
                 };
-                self.verdict = Some(assessor.conclude(&self.job, pre));
-                self.phase = UpdatePhase::Apply;
+                self.assess_steps += 1;
+                match pre {
+                    Precheck::Turned(params, turned_deg) => {
+                        let bins = &self.job.bins;
+                        let seed = self
+                            .seed
+                            .get_or_insert_with(|| assessor.seed_job(bins, &params));
+                        if let Some(a) = seed.step() {
+                            let estimate = assessor.judge(&a, seed.calibration(), turned_deg).ok();
+                            self.verdict = Some(Verdict::Accept(params, estimate));
+                            self.seed = None;
+                            self.phase = UpdatePhase::Apply;
+                        }
+                    }
+                    other => {
+                        self.verdict = Some(assessor.conclude(&self.job, other));
+                        self.phase = UpdatePhase::Apply;
+                    }
+                }
             }
             UpdatePhase::Refresh | UpdatePhase::Apply => {}
         }

@@ -43,7 +43,11 @@
 //! ## Online estimate, readiness and persistence
 //! At every new heading data point the calibrator runs its own `solve` and keeps the result
 //! as the current estimate ([`OnlineCalibrator::estimate`], O(1)); the push that changed it
-//! returns [`Pushed::NewEstimate`]. `progress().ready` runs the acceptance tests of `solve`
+//! returns [`Pushed::NewEstimate`]. The solve is spread over the pushes that follow, one
+//! bounded share each: the acceptance tests at the next push, then the quality report in
+//! four steps on a copy of the kept readings (the published estimate stays
+//! the previous one until the last step, and equals `solve` of the state the refresh
+//! started from bit for bit). `progress().ready` runs the acceptance tests of `solve`
 //! (centres, field, arc) on the same data, so the two always agree. The whole learned state,
 //! configuration included, is saved and restored through [`Persistent`].
 
@@ -64,7 +68,7 @@ use truenorth_core::{
 use crate::circumcentre::{BEST_AMPLIFICATION_SQ, Circumcircle, circumcircle};
 use crate::direction_slots::{DirectionSlots, SLOTS};
 use crate::quality::{Coverage, MIN_ARC_DEG, coverage, mean_corrected_norm_2d, require_arc};
-use crate::seed_quality::seed_assessment;
+use crate::seed_quality::{SeedJob, seed_assessment};
 
 #[allow(unused_imports)]
 use truenorth_core::Float as _;
@@ -209,8 +213,13 @@ pub struct MeritCircleCalibrator {
     estimate: Option<Solution<CompassCalibration2d>>,
     /// A data point was taken at the previous push; the estimate is refreshed at the start
     /// of this one (from the state that push left), so that the triple search and the
-    /// refresh, each a few microseconds, never fall on one push.
+    /// refresh, each a few microseconds, never fall on one push (unless a data point falls
+    /// on a refresh step).
     refresh_due: bool,
+    /// The quality report of that refresh in progress, one bounded step per push (on a copy
+    /// of the kept readings, so the published estimate stays the previous refresh's until
+    /// it completes).
+    seed: Option<SeedJob>,
 }
 
 impl Default for MeritCircleCalibrator {
@@ -252,6 +261,17 @@ impl MeritCircleCalibrator {
             slots: DirectionSlots::new(),
             estimate: None,
             refresh_due: false,
+            seed: None,
+        }
+    }
+
+    /// The share of an estimate refresh the next push does: `Some(0)` the acceptance tests
+    /// (which start the quality report), `Some(k)` step `k` of the report (`1..=4`), `None`
+    /// none.
+    pub fn refresh_stage(&self) -> Option<usize> {
+        match &self.seed {
+            Some(job) => Some(1 + job.steps()),
+            None => self.refresh_due.then_some(0),
         }
     }
 
@@ -401,14 +421,38 @@ impl Calibrator for MeritCircleCalibrator {
         check_finite("timestamp t_s", sample.t_s)?;
         check_finite2("magnetometer reading", &p)?;
         let mut pushed = Pushed::Accepted;
-        if self.refresh_due {
+        // One bounded share of the refresh per push: the acceptance tests (which start the
+        // quality report), or one step of the report. The result is exactly `solve` of the
+        // state the refresh started from.
+        let refreshed = if let Some(job) = self.seed.as_mut() {
+            let done = job.step().map(|a| {
+                Some(Solution {
+                    params: *job.calibration(),
+                    quality: a.quality,
+                })
+            });
+            if done.is_some() {
+                self.seed = None;
+            }
+            done
+        } else if self.refresh_due {
             // Bounded: at most 72 kept readings.
             self.refresh_due = false;
-            let estimate = self.solve().ok();
-            if estimate != self.estimate {
-                self.estimate = estimate;
-                pushed = Pushed::NewEstimate;
+            match self.accepted() {
+                Ok((cal, field, buf, n, _)) => {
+                    self.seed = Some(SeedJob::start(&buf[..n], &cal, field, self.samples));
+                    None
+                }
+                Err(_) => Some(None),
             }
+        } else {
+            None
+        };
+        if let Some(estimate) = refreshed
+            && estimate != self.estimate
+        {
+            self.estimate = estimate;
+            pushed = Pushed::NewEstimate;
         }
         if let Some(prev) = self.prev {
             self.step_sum += (p - prev).norm();
@@ -514,6 +558,20 @@ pub struct MeritCircleSaved {
     /// Whether the estimate is refreshed at the next push (a data point was just taken).
     #[serde(default)]
     pub refresh_due: bool,
+    /// The quality report of a refresh in progress (opaque).
+    #[serde(default)]
+    refresh: Option<MeritRefreshSaved>,
+}
+
+/// A refresh of the merit-circle estimate in progress, as saved: what its quality report
+/// assesses and how many of its steps are done (restoring replays them).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MeritRefreshSaved {
+    points: Vec<Vector2<f64>>,
+    calibration: CompassCalibration2d,
+    field: f64,
+    samples_used: usize,
+    steps: usize,
 }
 
 fn finite2(v: &Vector2<f64>) -> bool {
@@ -522,7 +580,7 @@ fn finite2(v: &Vector2<f64>) -> bool {
 
 impl Persistent for MeritCircleCalibrator {
     type State = MeritCircleSaved;
-    const SNAPSHOT_VERSION: u32 = 1;
+    const SNAPSHOT_VERSION: u32 = 2;
 
     fn snapshot(&self) -> Snapshot<MeritCircleSaved> {
         Snapshot {
@@ -541,6 +599,13 @@ impl Persistent for MeritCircleCalibrator {
                 slots: self.slots.to_vec(),
                 estimate: self.estimate,
                 refresh_due: self.refresh_due,
+                refresh: self.seed.as_ref().map(|j| MeritRefreshSaved {
+                    points: j.points().to_vec(),
+                    calibration: *j.calibration(),
+                    field: j.field(),
+                    samples_used: j.samples_used(),
+                    steps: j.steps(),
+                }),
             },
         }
     }
@@ -611,100 +676,32 @@ impl Persistent for MeritCircleCalibrator {
         c.slots = slots;
         c.estimate = s.estimate;
         c.refresh_due = s.refresh_due;
+        if let Some(r) = &s.refresh {
+            let cal = &r.calibration;
+            if !(r.points.iter().all(finite2)
+                && cal
+                    .hard_iron
+                    .iter()
+                    .chain(cal.soft_iron.iter())
+                    .all(|x| x.is_finite())
+                && r.field > 0.0
+                && r.field.is_finite())
+                || r.points.len() > SLOTS
+                || r.steps >= SeedJob::STEPS
+                || r.samples_used > s.samples
+            {
+                return invalid("the saved merit-circle refresh in progress is inconsistent");
+            }
+            let mut job = SeedJob::start(&r.points, cal, r.field, r.samples_used);
+            for _ in 0..r.steps {
+                job.step();
+            }
+            c.seed = Some(job);
+        }
         Ok(c)
     }
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use truenorth_core::{NoiseSource, SplitMix64};
-
-    fn feed(c: &mut MeritCircleCalibrator, pts: impl Iterator<Item = Vector2<f64>>) {
-        for (i, p) in pts.enumerate() {
-            c.push(&Mag2Sample {
-                t_s: i as f64,
-                mag: p,
-            })
-            .unwrap();
-        }
-    }
-
-    fn circle(c: Vector2<f64>, r: f64, from: f64, deg: f64) -> impl Iterator<Item = Vector2<f64>> {
-        (0..(deg * 2.0) as usize).map(move |i| {
-            let a = (from + i as f64 * 0.5).to_radians();
-            c + Vector2::new(a.cos(), a.sin()) * r
-        })
-    }
-
-    #[test]
-    fn on_a_circle_every_centre_is_exact_and_the_merit_falls_as_weight_builds() {
-        let ctr = Vector2::new(7.0, -3.0);
-        let mut c = MeritCircleCalibrator::default();
-        feed(&mut c, circle(ctr, 20.0, 0.0, 120.0));
-        let first = *c.state();
-        assert!(first.centres >= 1);
-        assert!((first.centre.unwrap() - ctr).norm() < 1e-9);
-        feed(&mut c, circle(ctr, 20.0, 120.0, 600.0));
-        let s = c.state();
-        assert!(s.centres > first.centres);
-        assert!(s.last_merit < 0.3, "{}", s.last_merit);
-        assert!(s.centre_mse < 1e-18);
-        assert!((c.solve().unwrap().params.hard_iron - ctr).norm() < 1e-9);
-    }
-
-    #[test]
-    fn noise_on_a_stationary_compass_makes_no_data_points() {
-        let mut rng = SplitMix64::new(4);
-        let mut c = MeritCircleCalibrator::default();
-        feed(
-            &mut c,
-            (0..2000).map(|_| Vector2::new(20.0 + rng.normal(0.2), rng.normal(0.2))),
-        );
-        assert!(c.state().data_points <= 1, "{:?}", c.state());
-        assert!(matches!(c.solve(), Err(Error::TooFewPoints { .. })));
-    }
-
-    #[test]
-    fn an_outlying_centre_gets_a_small_merit() {
-        let ctr = Vector2::new(0.0, 0.0);
-        let mut c = MeritCircleCalibrator::default();
-        feed(&mut c, circle(ctr, 20.0, 0.0, 720.0));
-        let mut rng = SplitMix64::new(8);
-        // Add scatter so the MSE is not zero, then one reading far off the circle.
-        feed(
-            &mut c,
-            circle(ctr, 20.0, 0.0, 360.0)
-                .map(|p| p + Vector2::new(rng.normal(0.2), rng.normal(0.2))),
-        );
-        let before = c.state().centre.unwrap();
-        let mut out = c.clone();
-        feed(&mut out, core::iter::once(Vector2::new(60.0, 60.0)));
-        let after = out.state().centre.unwrap();
-        assert!(
-            (after - before).norm() < 0.5,
-            "moved {}",
-            (after - before).norm()
-        );
-    }
-
-    #[test]
-    fn config_is_validated() {
-        for cfg in [
-            MeritCircleConfig {
-                min_turn_rad: -1.0,
-                ..Default::default()
-            },
-            MeritCircleConfig {
-                weight_memory: 0.0,
-                ..Default::default()
-            },
-            MeritCircleConfig {
-                max_amplification: 0.5,
-                ..Default::default()
-            },
-        ] {
-            assert!(MeritCircleCalibrator::new(cfg).is_err());
-        }
-    }
-}
+#[path = "merit_circle_tests.rs"]
+mod tests;

@@ -16,7 +16,7 @@
 use nalgebra::{Matrix3, Vector2, Vector3};
 use truenorth_compass::CompassCalibration2d;
 
-use crate::quality::{Assessment2d, assess_2d};
+use crate::quality::{Assessment2d, Coverage, assess_2d};
 
 #[allow(unused_imports)]
 use truenorth_core::Float as _;
@@ -85,8 +85,142 @@ pub(crate) fn seed_assessment(
     field: f64,
     samples_used: usize,
 ) -> Assessment2d {
-    let mut a = assess_2d(points, cal, field);
-    let (amplitude, sigma) = two_cycle_fit(points, cal, field);
+    let a = assess_2d(points, cal, field);
+    seed_report(a, two_cycle_fit(points, cal, field), samples_used)
+}
+
+/// What the one pass over the readings of [`assess_2d`] leaves for the report: the sums of
+/// the information matrix's twelve monomials, the sum of the squared residuals, the count of
+/// usable readings and their coverage.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct ReportSums {
+    pub sums: [f64; 12],
+    pub ss: f64,
+    pub n: usize,
+    pub coverage: Coverage,
+}
+
+/// Most readings a [`SeedJob`] holds (the binned ellipse's most bins).
+pub(crate) const SEED_POINTS: usize = 128;
+
+/// Where a [`SeedJob`] stands: each variant holds what the steps before it computed.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum SeedStage {
+    /// Next: the pass of [`assess_2d`] over the readings.
+    Sums,
+    /// Next: the two-cycle fit.
+    TwoCycle(ReportSums),
+    /// Next: the condition number of the information matrix.
+    Condition(ReportSums, (f64, Option<f64>)),
+    /// Next: the error bound and the report.
+    Report(ReportSums, (f64, Option<f64>), f64),
+    /// Finished.
+    Done(Assessment2d),
+}
+
+/// [`seed_assessment`] split into [`SeedJob::STEPS`] bounded steps that can run on
+/// consecutive pushes: the pass of the shared report over the readings, the two-cycle fit,
+/// the condition number, then the error bound and the report. The job holds a copy of its
+/// readings, so the caller's may change meanwhile (double buffering); the steps do exactly
+/// the arithmetic of the call in one go, in the same order, so the result is the same bit
+/// for bit, and replaying a count of steps from [`SeedJob::start`] rebuilds a job exactly.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct SeedJob {
+    points: [Vector2<f64>; SEED_POINTS],
+    len: usize,
+    cal: CompassCalibration2d,
+    field: f64,
+    samples_used: usize,
+    steps: usize,
+    stage: SeedStage,
+}
+
+impl SeedJob {
+    /// Steps from [`Self::start`] to the result.
+    pub(crate) const STEPS: usize = 4;
+
+    /// The assessment of `cal` on `points` (at most [`SEED_POINTS`]; any beyond are not
+    /// used), as [`seed_assessment`] with the same arguments.
+    pub(crate) fn start(
+        points: &[Vector2<f64>],
+        cal: &CompassCalibration2d,
+        field: f64,
+        samples_used: usize,
+    ) -> Self {
+        let len = points.len().min(SEED_POINTS);
+        let mut buf = [Vector2::zeros(); SEED_POINTS];
+        buf[..len].copy_from_slice(&points[..len]);
+        Self {
+            points: buf,
+            len,
+            cal: *cal,
+            field,
+            samples_used,
+            steps: 0,
+            stage: SeedStage::Sums,
+        }
+    }
+
+    /// The readings assessed.
+    pub(crate) fn points(&self) -> &[Vector2<f64>] {
+        &self.points[..self.len]
+    }
+
+    /// The calibration assessed.
+    pub(crate) fn calibration(&self) -> &CompassCalibration2d {
+        &self.cal
+    }
+
+    /// The field the residuals are relative to.
+    pub(crate) fn field(&self) -> f64 {
+        self.field
+    }
+
+    /// The sample count the report gives as `points`.
+    pub(crate) fn samples_used(&self) -> usize {
+        self.samples_used
+    }
+
+    /// Steps done so far.
+    pub(crate) fn steps(&self) -> usize {
+        self.steps
+    }
+
+    /// Does the next step; returns the assessment once the job is over (and on every call
+    /// after).
+    pub(crate) fn step(&mut self) -> Option<Assessment2d> {
+        let pts = &self.points[..self.len];
+        let next = match self.stage {
+            SeedStage::Sums => SeedStage::TwoCycle(Assessment2d::sums(pts, &self.cal, self.field)),
+            SeedStage::TwoCycle(s) => {
+                SeedStage::Condition(s, two_cycle_fit(pts, &self.cal, self.field))
+            }
+            SeedStage::Condition(s, fit) => {
+                SeedStage::Report(s, fit, Assessment2d::condition_of(&s))
+            }
+            SeedStage::Report(s, fit, condition) => SeedStage::Done(seed_report(
+                Assessment2d::from_sums(&s, condition, self.field),
+                fit,
+                self.samples_used,
+            )),
+            SeedStage::Done(a) => return Some(a),
+        };
+        self.steps += 1;
+        self.stage = next;
+        match next {
+            SeedStage::Done(a) => Some(a),
+            _ => None,
+        }
+    }
+}
+
+/// The shared report `a` with the two-cycle fit's amplitude and noise, and `points` the
+/// samples used (the end of [`seed_assessment`]).
+fn seed_report(
+    mut a: Assessment2d,
+    (amplitude, sigma): (f64, Option<f64>),
+    samples_used: usize,
+) -> Assessment2d {
     a.quality.heading_error_systematic_deg = amplitude.to_degrees();
     if let Some(sigma) = sigma {
         a.quality.heading_noise_rms_deg = sigma.to_degrees();
@@ -98,6 +232,41 @@ pub(crate) fn seed_assessment(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use proptest::prelude::*;
+
+    proptest! {
+        /// The staged job gives exactly the assessment of the call in one go, for any
+        /// readings and calibration, and a job rebuilt by replaying its steps equals it
+        /// at every step.
+        #[test]
+        fn staged_assessment_equals_the_one_shot(
+            pts in proptest::collection::vec((-30.0f64..30.0, -30.0f64..30.0), 0..140),
+            hx in -5.0f64..5.0, hy in -5.0f64..5.0,
+            s00 in 0.5f64..1.5, s01 in -0.3f64..0.3, s11 in 0.5f64..1.5,
+            field in 0.1f64..40.0, samples in 0usize..10_000,
+        ) {
+            let pts: Vec<_> = pts.iter().map(|&(x, y)| Vector2::new(x, y)).collect();
+            let cal = CompassCalibration2d {
+                hard_iron: Vector2::new(hx, hy),
+                soft_iron: nalgebra::Matrix2::new(s00, s01, s01, s11),
+            };
+            let used = &pts[..pts.len().min(SEED_POINTS)];
+            let expect = seed_assessment(used, &cal, field, samples);
+            let mut job = SeedJob::start(&pts, &cal, field, samples);
+            let mut got = None;
+            for k in 0..SeedJob::STEPS {
+                prop_assert!(got.is_none(), "finished early at step {}", k);
+                let mut replay = SeedJob::start(&pts, &cal, field, samples);
+                for _ in 0..job.steps() {
+                    replay.step();
+                }
+                prop_assert_eq!(format!("{replay:?}"), format!("{job:?}"));
+                got = job.step();
+            }
+            prop_assert_eq!(format!("{:?}", got), format!("{:?}", Some(expect)));
+            prop_assert_eq!(format!("{:?}", job.step()), format!("{:?}", Some(expect)));
+        }
+    }
     use truenorth_compass::{HeadingTruth, MagnetometerModel2d, soft_iron_from_axes};
     use truenorth_core::{SensorModel, angle_diff};
 

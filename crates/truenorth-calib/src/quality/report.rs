@@ -18,6 +18,7 @@ use super::bounds::{
 use super::coverage::{AngleBins, Coverage, mark_sphere_cells, turns};
 use crate::linalg::{condition_from_eigenvalues, sym_eigen5, sym_eigen9};
 use crate::lm::{BLOCK, blocks, dot_block, sum_block};
+use crate::seed_quality::ReportSums;
 
 #[allow(unused_imports)]
 use truenorth_core::Float as _;
@@ -38,6 +39,37 @@ pub struct Assessment2d {
 ///
 /// Non-finite readings are skipped. Allocates nothing.
 pub fn assess_2d(points: &[Vector2<f64>], cal: &CompassCalibration2d, field: f64) -> Assessment2d {
+    let s = Assessment2d::sums(points, cal, field);
+    report_2d(&s.sums, s.ss, s.n, s.coverage, field)
+}
+
+impl Assessment2d {
+    /// The one pass over the readings of [`assess_2d`], without the report built from it
+    /// (so that a caller can spread the two over separate steps; see
+    /// [`Self::condition_of`] and [`Self::from_sums`]).
+    pub(crate) fn sums(
+        points: &[Vector2<f64>],
+        cal: &CompassCalibration2d,
+        field: f64,
+    ) -> ReportSums {
+        sums_2d(points, cal, field)
+    }
+
+    /// The condition number of the information matrix of `s` (the costlier half of the
+    /// report built from the sums).
+    pub(crate) fn condition_of(s: &ReportSums) -> f64 {
+        condition_2d(&information_2d(&s.sums))
+    }
+
+    /// The report from the sums `s` and their [`Self::condition_of`]: exactly what
+    /// [`assess_2d`] returns.
+    pub(crate) fn from_sums(s: &ReportSums, condition: f64, field: f64) -> Self {
+        report_2d_with(&s.sums, s.ss, s.n, s.coverage, field, condition)
+    }
+}
+
+/// The pass of [`assess_2d`].
+fn sums_2d(points: &[Vector2<f64>], cal: &CompassCalibration2d, field: f64) -> ReportSums {
     let mut bins = AngleBins::new();
     // Sums of the squared residuals and of the monomials of `u` that make up the
     // information matrix (see `information_2d`).
@@ -110,7 +142,12 @@ pub fn assess_2d(points: &[Vector2<f64>], cal: &CompassCalibration2d, field: f64
             }
         }
     }
-    report_2d(&sums, ss, n, bins.coverage(), field)
+    ReportSums {
+        sums,
+        ss,
+        n,
+        coverage: bins.coverage(),
+    }
 }
 
 /// Sums `Σ xⁱ yʲ` (`i + j ≤ 4`) of a set of 2-D points, `m[i][j]` (entries with
@@ -259,11 +296,29 @@ fn report_2d(
     coverage: Coverage,
     field: f64,
 ) -> Assessment2d {
+    let condition = condition_2d(&information_2d(sums));
+    report_2d_with(sums, ss, n, coverage, field, condition)
+}
+
+/// The condition number of a 2-D information matrix (infinite when its eigenvalues cannot
+/// be found).
+fn condition_2d(info: &nalgebra::SMatrix<f64, 5, 5>) -> f64 {
+    sym_eigen5(info)
+        .map(|(l, _)| condition_from_eigenvalues(l.as_slice()))
+        .unwrap_or(f64::INFINITY)
+}
+
+/// [`report_2d`] given the condition number of its information matrix.
+fn report_2d_with(
+    sums: &[f64; MONOMIALS_2D],
+    ss: f64,
+    n: usize,
+    coverage: Coverage,
+    field: f64,
+    condition: f64,
+) -> Assessment2d {
     let info = information_2d(sums);
     let residual_rms_rel = if n > 0 { (ss / n as f64).sqrt() } else { 0.0 };
-    let condition = sym_eigen5(&info)
-        .map(|(l, _)| condition_from_eigenvalues(l.as_slice()))
-        .unwrap_or(f64::INFINITY);
     Assessment2d {
         quality: CompassQuality {
             fit: FitQuality {
