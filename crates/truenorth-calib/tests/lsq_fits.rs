@@ -2,84 +2,23 @@
 //! equivariance, model → calibrator round trips, refusals, no panics, and the heading error
 //! against the noise floor.
 //!
-//! The forward model here is a deliberately tiny local one (raw = hard + W·h + noise, W
-//! symmetric), independent of the compass crate's model, so these tests check the fits
-//! against first principles.
+//! The forward model is the tiny one in `common/` (raw = hard + W·h + noise, W symmetric),
+//! independent of the compass crate's model, so these tests check the fits against first
+//! principles.
 
 use std::f64::consts::{PI, TAU};
 
-use nalgebra::{Matrix2, Matrix3, Rotation3, Vector2, Vector3};
+use nalgebra::{Rotation3, Vector2, Vector3};
 use proptest::prelude::*;
 use truenorth_calib::{
     EllipseCalibrator, EllipseConfig, EllipsoidCalibrator, EllipsoidConfig, fit_ellipse,
     fit_ellipse_direct, fit_ellipsoid, quality,
 };
 use truenorth_compass::CompassCalibration2d;
-use truenorth_core::{
-    Calibrator, Error, Mag2Sample, Mag3Sample, NoiseSource, SplitMix64, angle_diff,
-};
+use truenorth_core::{Calibrator, Error, Mag2Sample, Mag3Sample, SplitMix64, angle_diff};
 
-fn rot2(a: f64) -> Matrix2<f64> {
-    let (s, c) = a.sin_cos();
-    Matrix2::new(c, -s, s, c)
-}
-
-/// A level two-axis compass: `raw = hard + W·h(ψ) + noise`, `h = H (cos ψ, −sin ψ)`,
-/// W symmetric positive definite (induced soft iron).
-#[derive(Debug, Clone, Copy)]
-struct Model2 {
-    hard: Vector2<f64>,
-    w: Matrix2<f64>,
-    field: f64,
-}
-
-impl Model2 {
-    /// W with semi-axis ratio `ratio`, major axis at `angle` from x, unit determinant.
-    fn new(hard: Vector2<f64>, ratio: f64, angle: f64, field: f64) -> Self {
-        let d = Matrix2::new(ratio.sqrt(), 0.0, 0.0, 1.0 / ratio.sqrt());
-        Self {
-            hard,
-            w: rot2(angle) * d * rot2(angle).transpose(),
-            field,
-        }
-    }
-
-    fn raw(&self, psi: f64, noise: &mut impl NoiseSource, sigma: f64) -> Vector2<f64> {
-        let h = Vector2::new(self.field * psi.cos(), -self.field * psi.sin());
-        self.hard + self.w * h + Vector2::new(noise.normal(sigma), noise.normal(sigma))
-    }
-
-    /// The exact calibration, in the fits' convention (det soft iron = 1).
-    fn truth(&self) -> (CompassCalibration2d, f64) {
-        let s = self.w.try_inverse().unwrap();
-        let s = s / s.determinant().sqrt();
-        (
-            CompassCalibration2d {
-                hard_iron: self.hard,
-                soft_iron: s,
-            },
-            self.field * self.w.determinant().sqrt(),
-        )
-    }
-
-    /// `n` headings evenly over `span_deg` from `start_deg`, with noise.
-    fn turn(
-        &self,
-        n: usize,
-        start_deg: f64,
-        span_deg: f64,
-        sigma: f64,
-        seed: u64,
-    ) -> Vec<(f64, Vector2<f64>)> {
-        let mut rng = SplitMix64::new(seed);
-        (0..n)
-            .map(|k| {
-                let psi = (start_deg + span_deg * k as f64 / n as f64).to_radians();
-                (psi, self.raw(psi, &mut rng, sigma))
-            })
-            .collect()
-    }
-}
+mod common;
+use common::*;
 
 fn points(turn: &[(f64, Vector2<f64>)]) -> Vec<Vector2<f64>> {
     turn.iter().map(|t| t.1).collect()
@@ -93,7 +32,7 @@ fn heading_rms_deg(cal: &CompassCalibration2d, turn: &[(f64, Vector2<f64>)]) -> 
     (ss / turn.len() as f64).sqrt().to_degrees()
 }
 
-/// The measure: full turn, hard iron 0.5 × field, soft-iron axis ratio 1.3 rotated
+/// The reference turn: full turn, hard iron 0.5 × field, soft-iron axis ratio 1.3 rotated
 /// 30°, noise 1 % of the field (per axis). Heading RMS of the least-squares fit against the
 /// noise floor (the true calibration applied to the same noisy samples).
 #[test]
@@ -195,35 +134,6 @@ fn calibrator_lifecycle() {
     assert_eq!(cal.progress().samples, 0);
 }
 
-/// `n` Fibonacci-sphere directions of a field `field` seen through `raw = hard + W·h`.
-fn sphere_turn(
-    hard: Vector3<f64>,
-    w: &Matrix3<f64>,
-    field: f64,
-    n: usize,
-    sigma: f64,
-    seed: u64,
-) -> Vec<Vector3<f64>> {
-    let mut rng = SplitMix64::new(seed);
-    let golden = PI * (3.0 - 5.0_f64.sqrt());
-    (0..n)
-        .map(|k| {
-            let z = 1.0 - (2.0 * k as f64 + 1.0) / n as f64;
-            let r = (1.0 - z * z).sqrt();
-            let (s, c) = (golden * k as f64).sin_cos();
-            let h = Vector3::new(r * c, r * s, z) * field;
-            hard + w * h + Vector3::new(rng.normal(sigma), rng.normal(sigma), rng.normal(sigma))
-        })
-        .collect()
-}
-
-/// A symmetric positive-definite soft iron with semi-axis ratios up to `1 + spread`,
-/// oriented by `rot`, unit determinant.
-fn soft3(rot: &Rotation3<f64>, a: f64, b: f64) -> Matrix3<f64> {
-    let d = Matrix3::from_diagonal(&Vector3::new(a, b, 1.0 / (a * b)));
-    rot.matrix() * d * rot.matrix().transpose()
-}
-
 #[test]
 fn ellipsoid_calibrator_lifecycle_and_single_axis_refusal() {
     let rot = Rotation3::from_euler_angles(0.3, -0.2, 0.7);
@@ -254,10 +164,6 @@ fn ellipsoid_calibrator_lifecycle_and_single_axis_refusal() {
         .collect();
     let r = fit_ellipsoid(&ring, &EllipsoidConfig::default());
     assert!(r.is_err(), "{r:?}");
-}
-
-fn any_rotation() -> impl Strategy<Value = Rotation3<f64>> {
-    (-PI..PI, -1.5f64..1.5, -PI..PI).prop_map(|(r, p, y)| Rotation3::from_euler_angles(r, p, y))
 }
 
 proptest! {

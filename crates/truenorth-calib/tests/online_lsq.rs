@@ -4,12 +4,12 @@
 //! persistence, forgetting, and the heading error on the reference turn against the batch
 //! least-squares calibrator.
 //!
-//! The forward model is the same tiny local one as in `lsq_fits.rs` (raw = hard + W·h +
-//! noise, W symmetric), independent of the compass crate's model.
+//! The forward model is the tiny one in `common/` that `lsq_fits.rs` also uses (raw =
+//! hard + W·h + noise, W symmetric), independent of the compass crate's model.
 
 use std::f64::consts::PI;
 
-use nalgebra::{Matrix2, Matrix3, Rotation3, Vector2, Vector3};
+use nalgebra::{Rotation3, Vector2, Vector3};
 use proptest::prelude::*;
 use truenorth_calib::{
     EllipseCalibrator, EllipseConfig, OnlineEllipseCalibrator, OnlineEllipseConfig,
@@ -21,64 +21,8 @@ use truenorth_core::{
     SplitMix64, angle_diff,
 };
 
-fn rot2(a: f64) -> Matrix2<f64> {
-    let (s, c) = a.sin_cos();
-    Matrix2::new(c, -s, s, c)
-}
-
-/// A level two-axis compass: `raw = hard + W·h(ψ) + noise`, `h = H (cos ψ, −sin ψ)`, W
-/// symmetric positive definite with semi-axis ratio `ratio` along `angle`, unit determinant.
-#[derive(Debug, Clone, Copy)]
-struct Model2 {
-    hard: Vector2<f64>,
-    w: Matrix2<f64>,
-    field: f64,
-}
-
-impl Model2 {
-    fn new(hard: Vector2<f64>, ratio: f64, angle: f64, field: f64) -> Self {
-        let d = Matrix2::new(ratio.sqrt(), 0.0, 0.0, 1.0 / ratio.sqrt());
-        Self {
-            hard,
-            w: rot2(angle) * d * rot2(angle).transpose(),
-            field,
-        }
-    }
-
-    /// The exact calibration in the fits' convention (det soft iron = 1) and its field.
-    fn truth(&self) -> (CompassCalibration2d, f64) {
-        let s = self.w.try_inverse().unwrap();
-        let s = s / s.determinant().sqrt();
-        (
-            CompassCalibration2d {
-                hard_iron: self.hard,
-                soft_iron: s,
-            },
-            self.field * self.w.determinant().sqrt(),
-        )
-    }
-
-    /// `n` headings evenly over `span_deg` from `start_deg`, with per-axis noise `sigma`.
-    fn turn(
-        &self,
-        n: usize,
-        start_deg: f64,
-        span_deg: f64,
-        sigma: f64,
-        seed: u64,
-    ) -> Vec<(f64, Mag2Sample)> {
-        let mut rng = SplitMix64::new(seed);
-        (0..n)
-            .map(|k| {
-                let psi = (start_deg + span_deg * k as f64 / n as f64).to_radians();
-                let h = Vector2::new(self.field * psi.cos(), -self.field * psi.sin());
-                let mag =
-                    self.hard + self.w * h + Vector2::new(rng.normal(sigma), rng.normal(sigma));
-                (psi, Mag2Sample { t_s: k as f64, mag })
-            })
-            .collect()
-    }
-}
+mod common;
+use common::*;
 
 fn heading_rms_deg(cal: &CompassCalibration2d, turn: &[(f64, Mag2Sample)]) -> f64 {
     let ss: f64 = turn
@@ -120,7 +64,7 @@ fn online_heading_rms_matches_the_batch_fit_on_the_reference_turn() {
     let (trials, n) = (200, 360);
     let (mut sum_online, mut sum_batch, mut sum_estimate) = (0.0, 0.0, 0.0);
     for seed in 0..trials {
-        let turn = m.turn(n, 0.0, 360.0, 0.01 * field, seed);
+        let turn = m.samples(n, 0.0, 360.0, 0.01 * field, seed);
         let online = online2(OnlineEllipseConfig::default(), &turn);
         let mut batch = EllipseCalibrator::new(EllipseConfig::default()).unwrap();
         for (_, s) in &turn {
@@ -155,7 +99,7 @@ proptest! {
         let field = 10f64.powf(log_field);
         let m = Model2::new(Vector2::new(hx, hy) * field, ratio, angle, field);
         let (truth, true_field) = m.truth();
-        let sol = online2(OnlineEllipseConfig::default(), &m.turn(n, start, span, 0.0, 1)).solve().unwrap();
+        let sol = online2(OnlineEllipseConfig::default(), &m.samples(n, start, span, 0.0, 1)).solve().unwrap();
         prop_assert!((sol.params.hard_iron - truth.hard_iron).norm() <= 1e-7 * field, "{:?} vs {:?}", sol.params, truth);
         prop_assert!((sol.params.soft_iron - truth.soft_iron).amax() <= 1e-7);
         prop_assert!((sol.quality.field_magnitude / true_field - 1.0).abs() <= 1e-7);
@@ -170,7 +114,7 @@ proptest! {
         seed in 0u64..1000,
     ) {
         let m = Model2::new(Vector2::new(0.4, -0.2), 1.25, 0.7, 1.0);
-        let turn = m.turn(300, 0.0, 360.0, 0.01, seed);
+        let turn = m.samples(300, 0.0, 360.0, 0.01, seed);
         let k = 10f64.powf(log_scale);
         let t = Vector2::new(tx, ty);
         let moved: Vec<_> = turn.iter().map(|(psi, s)| (*psi, Mag2Sample { t_s: s.t_s, mag: s.mag * k + t })).collect();
@@ -192,7 +136,7 @@ proptest! {
         noise in 0.0f64..0.03, n in 40usize..400, seed in 0u64..1000,
     ) {
         let m = Model2::new(Vector2::new(0.5, -0.3), ratio, angle, 1.0);
-        let cal = online2(OnlineEllipseConfig::default(), &m.turn(n, start, span, noise, seed));
+        let cal = online2(OnlineEllipseConfig::default(), &m.samples(n, start, span, noise, seed));
         let r = cal.solve();
         let refused = matches!(r, Err(Error::InsufficientCoverage { .. }) | Err(Error::NotAnEllipse { .. }) | Err(Error::Degenerate { .. }));
         prop_assert!(refused, "span {span}: {r:?}");
@@ -216,7 +160,7 @@ proptest! {
             ..Default::default()
         };
         let mut cal = OnlineEllipseCalibrator::new(config).unwrap();
-        for (k, (_, s)) in m.turn(n, start, span, noise, seed).iter().enumerate() {
+        for (k, (_, s)) in m.samples(n, start, span, noise, seed).iter().enumerate() {
             let pushed = cal.push(s).unwrap();
             prop_assert!(pushed != Pushed::NewEstimate, "push {}: {:?}", k, cal.estimate());
             prop_assert!(cal.estimate().is_none(), "push {}: {:?}", k, cal.estimate());
@@ -233,7 +177,7 @@ proptest! {
         let m = Model2::new(Vector2::new(0.5, 0.1), ratio, angle, 1.0);
         let config = OnlineEllipseConfig { forgetting_half_life_samples: forget, ..Default::default() };
         let mut cal = OnlineEllipseCalibrator::new(config).unwrap();
-        for (_, s) in m.turn(200, 0.0, span, noise, seed) {
+        for (_, s) in m.samples(200, 0.0, span, noise, seed) {
             cal.push(&s).unwrap();
             prop_assert_eq!(cal.progress().ready, cal.solve().is_ok());
         }
@@ -246,7 +190,7 @@ proptest! {
         which in 0usize..3, after in 0usize..100,
     ) {
         let m = Model2::new(Vector2::new(0.5, 0.1), 1.2, 0.3, 1.0);
-        let mut cal = online2(OnlineEllipseConfig::default(), &m.turn(after, 0.0, 360.0, 0.01, 3));
+        let mut cal = online2(OnlineEllipseConfig::default(), &m.samples(after, 0.0, 360.0, 0.01, 3));
         let before = cal.snapshot();
         let mut s = Mag2Sample { t_s: 1.0, mag: Vector2::new(0.3, 0.2) };
         match which {
@@ -274,7 +218,7 @@ proptest! {
         interval in 1u32..50, seed in 0u64..1000,
     ) {
         let m = Model2::new(Vector2::new(0.5, 0.1), 1.3, 0.5, 1.0);
-        let turn = m.turn(400, 0.0, 400.0, 0.01, seed);
+        let turn = m.samples(400, 0.0, 400.0, 0.01, seed);
         let config = OnlineEllipseConfig { forgetting_half_life_samples: forget, refresh_interval_samples: interval, ..Default::default() };
         let mut straight = OnlineEllipseCalibrator::new(config).unwrap();
         let mut first = OnlineEllipseCalibrator::new(config).unwrap();
@@ -323,7 +267,7 @@ fn invalid_configs_and_snapshots_are_refused() {
     let m = Model2::new(Vector2::new(0.5, 0.1), 1.3, 0.5, 1.0);
     let cal = online2(
         OnlineEllipseConfig::default(),
-        &m.turn(100, 0.0, 360.0, 0.01, 1),
+        &m.samples(100, 0.0, 360.0, 0.01, 1),
     );
     let mut snap = cal.snapshot();
     snap.version += 1;
@@ -356,7 +300,7 @@ fn lifecycle_estimate_and_reset() {
     assert!(!cal.progress().ready);
     assert!(matches!(cal.solve(), Err(Error::TooFewPoints { .. })));
     let mut new_estimates = 0;
-    for (_, s) in m.turn(360, 0.0, 360.0, 0.01 * 20.0, 4) {
+    for (_, s) in m.samples(360, 0.0, 360.0, 0.01 * 20.0, 4) {
         if cal.push(&s).unwrap() == Pushed::NewEstimate {
             new_estimates += 1;
             assert!(cal.estimate().is_some());
@@ -386,9 +330,9 @@ fn forgetting_follows_a_changed_hard_iron() {
     let before = Model2::new(Vector2::new(0.5, 0.0), 1.2, 0.3, 1.0);
     let after = Model2::new(Vector2::new(-0.3, 0.4), 1.2, 0.3, 1.0);
     let stream: Vec<_> = before
-        .turn(720, 0.0, 720.0, 0.01, 1)
+        .samples(720, 0.0, 720.0, 0.01, 1)
         .into_iter()
-        .chain(after.turn(2000, 0.0, 2000.0, 0.01, 2))
+        .chain(after.samples(2000, 0.0, 2000.0, 0.01, 2))
         .collect();
     let forgetful = online2(
         OnlineEllipseConfig {
@@ -408,40 +352,6 @@ fn forgetting_follows_a_changed_hard_iron() {
     assert!(hard.is_err() || (hard.unwrap() - after.hard).norm() > 0.05);
 }
 
-/// `n` Fibonacci-sphere directions of a field `field` seen through `raw = hard + W·h`.
-fn sphere_turn(
-    hard: Vector3<f64>,
-    w: &Matrix3<f64>,
-    field: f64,
-    n: usize,
-    sigma: f64,
-    seed: u64,
-) -> Vec<Mag3Sample> {
-    let mut rng = SplitMix64::new(seed);
-    let golden = PI * (3.0 - 5.0_f64.sqrt());
-    (0..n)
-        .map(|k| {
-            let z = 1.0 - (2.0 * k as f64 + 1.0) / n as f64;
-            let r = (1.0 - z * z).sqrt();
-            let (s, c) = (golden * k as f64).sin_cos();
-            let noise = Vector3::new(rng.normal(sigma), rng.normal(sigma), rng.normal(sigma));
-            Mag3Sample {
-                t_s: k as f64,
-                mag: hard + w * Vector3::new(r * c, r * s, z) * field + noise,
-            }
-        })
-        .collect()
-}
-
-fn soft3(rot: &Rotation3<f64>, a: f64, b: f64) -> Matrix3<f64> {
-    let d = Matrix3::from_diagonal(&Vector3::new(a, b, 1.0 / (a * b)));
-    rot.matrix() * d * rot.matrix().transpose()
-}
-
-fn any_rotation() -> impl Strategy<Value = Rotation3<f64>> {
-    (-PI..PI, -1.5f64..1.5, -PI..PI).prop_map(|(r, p, y)| Rotation3::from_euler_angles(r, p, y))
-}
-
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(32))]
 
@@ -456,7 +366,7 @@ proptest! {
         let w = soft3(&rot, a, b);
         let hard = Vector3::new(h.0, h.1, h.2) * field;
         let mut cal = OnlineEllipsoidCalibrator::new(OnlineEllipsoidConfig::default()).unwrap();
-        for s in sphere_turn(hard, &w, field, n, 0.0, 1) {
+        for s in sphere_samples(hard, &w, field, n, 0.0, 1) {
             cal.push(&s).unwrap();
         }
         let sol = cal.solve().unwrap();
@@ -477,7 +387,7 @@ proptest! {
         seed in 0u64..1000,
     ) {
         let w = soft3(&rot, a, b);
-        let stream = sphere_turn(Vector3::new(h.0, h.1, h.2), &w, 1.0, n, noise, seed);
+        let stream = sphere_samples(Vector3::new(h.0, h.1, h.2), &w, 1.0, n, noise, seed);
         let mut cal = OnlineEllipsoidCalibrator::new(OnlineEllipsoidConfig::default()).unwrap();
         for s in &stream {
             cal.push(s).unwrap();
@@ -508,7 +418,7 @@ proptest! {
         cut in 0usize..600, forget in proptest::option::of(50.0f64..300.0), seed in 0u64..1000,
     ) {
         let w = soft3(&Rotation3::from_euler_angles(0.3, -0.2, 1.0), 1.1, 0.9);
-        let stream = sphere_turn(Vector3::new(0.3, -0.5, 0.2), &w, 1.0, 600, 0.01, seed);
+        let stream = sphere_samples(Vector3::new(0.3, -0.5, 0.2), &w, 1.0, 600, 0.01, seed);
         let config = OnlineEllipsoidConfig { forgetting_half_life_samples: forget, refresh_interval_samples: 20, ..Default::default() };
         let mut straight = OnlineEllipsoidCalibrator::new(config).unwrap();
         let mut first = OnlineEllipsoidCalibrator::new(config).unwrap();
@@ -537,7 +447,7 @@ proptest! {
                 Mag3Sample { t_s: k as f64, mag: w * Vector3::new(a.cos(), a.sin(), 0.5) + noise }
             }).collect()
         } else {
-            sphere_turn(Vector3::new(0.3, -0.5, 0.2), &w, 1.0, n, noise, seed)
+            sphere_samples(Vector3::new(0.3, -0.5, 0.2), &w, 1.0, n, noise, seed)
         };
         let mut cal = OnlineEllipsoidCalibrator::new(OnlineEllipsoidConfig::default()).unwrap();
         for s in &stream {
@@ -554,7 +464,7 @@ proptest! {
 fn ellipsoid_report_matches_the_noise() {
     let w = soft3(&Rotation3::from_euler_angles(0.3, -0.2, 1.0), 1.1, 0.9);
     let mut cal = OnlineEllipsoidCalibrator::new(OnlineEllipsoidConfig::default()).unwrap();
-    for s in sphere_turn(Vector3::new(0.3, -0.5, 0.2), &w, 1.0, 4000, 0.01, 5) {
+    for s in sphere_samples(Vector3::new(0.3, -0.5, 0.2), &w, 1.0, 4000, 0.01, 5) {
         cal.push(&s).unwrap();
     }
     let sol = cal.solve().unwrap();

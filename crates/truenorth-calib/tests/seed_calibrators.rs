@@ -96,7 +96,7 @@ fn reference_model(seed: u64) -> MagnetometerModel2d {
     .unwrap()
 }
 
-/// The measurement the issue asks for: heading RMS per method on the reference turn.
+/// Heading RMS per method on the reference turn, the figures the README quotes.
 #[test]
 fn measure_heading_rms_on_the_reference_turn() {
     let seeds = 20u64;
