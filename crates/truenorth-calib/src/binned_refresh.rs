@@ -438,21 +438,34 @@ impl RefreshJob {
         if delta_a > 0.0 {
             after = (delta_a, ra);
         }
-        // With k ≥ 2 readings at distinct angles both exist; if all share one angle, use it.
-        if before.0 <= -TAU {
-            before = (after.0 - TAU, after.1);
-        }
-        if after.0 >= TAU {
-            after = (before.0 + TAU, before.1);
-        }
-        let span = after.0 - before.0;
-        let r = if span > 0.0 {
-            before.1 + (after.1 - before.1) * (-before.0) / span
-        } else {
-            before.1
-        };
-        self.origin + Vector2::new(dir.cos(), dir.sin()) * r
+        interpolate(self.origin, dir, before, after)
     }
+}
+
+/// The point at direction `dir` from `origin` whose radius is interpolated linearly in
+/// angle between the nearest readings `before` (angle offset ≤ 0, radius) and `after`
+/// (offset > 0). A side with no reading (offset ∓2π) takes the other side's, a full turn
+/// away: with k ≥ 2 readings at distinct angles both exist; if all share one angle, it is
+/// used.
+fn interpolate(
+    origin: Vector2<f64>,
+    dir: f64,
+    mut before: (f64, f64),
+    mut after: (f64, f64),
+) -> Vector2<f64> {
+    if before.0 <= -TAU {
+        before = (after.0 - TAU, after.1);
+    }
+    if after.0 >= TAU {
+        after = (before.0 + TAU, before.1);
+    }
+    let span = after.0 - before.0;
+    let r = if span > 0.0 {
+        before.1 + (after.1 - before.1) * (-before.0) / span
+    } else {
+        before.1
+    };
+    origin + Vector2::new(dir.cos(), dir.sin()) * r
 }
 
 #[cfg(test)]
@@ -532,19 +545,7 @@ mod tests {
                 after = (delta, r);
             }
         }
-        if before.0 <= -TAU {
-            before = (after.0 - TAU, after.1);
-        }
-        if after.0 >= TAU {
-            after = (before.0 + TAU, before.1);
-        }
-        let span = after.0 - before.0;
-        let r = if span > 0.0 {
-            before.1 + (after.1 - before.1) * (-before.0) / span
-        } else {
-            before.1
-        };
-        job.origin + Vector2::new(dir.cos(), dir.sin()) * r
+        interpolate(job.origin, dir, before, after)
     }
 
     proptest! {
