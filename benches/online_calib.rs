@@ -71,20 +71,24 @@ fn tumble_3d() -> Vec<Mag3Sample> {
         .collect()
 }
 
-/// Times every push of `stream` into a fresh calibrator and prints the distribution.
-fn worst_push<C: Calibrator>(name: &str, mut cal: C, stream: &[C::Sample]) {
-    let mut ns: Vec<u64> = Vec::with_capacity(stream.len());
-    for s in stream {
-        let t0 = Instant::now();
-        let r = cal.push(black_box(s));
-        let dt = t0.elapsed();
-        black_box(r).ok();
-        ns.push(dt.as_nanos() as u64);
+/// The time one push takes, nanoseconds.
+fn timed_push<C: Calibrator>(cal: &mut C, s: &C::Sample) -> u64 {
+    let t0 = Instant::now();
+    let r = cal.push(black_box(s));
+    let dt = t0.elapsed();
+    black_box(r).ok();
+    dt.as_nanos() as u64
+}
+
+/// Prints the distribution of push times `ns` (nothing for an empty group).
+fn print_quantiles(label: &str, mut ns: Vec<u64>) {
+    if ns.is_empty() {
+        return;
     }
     ns.sort_unstable();
     let q = |p: f64| ns[((ns.len() - 1) as f64 * p) as usize];
     println!(
-        "{name}: per push over {} pushes: max {:.2} µs, p99.9 {:.2} µs, p99 {:.3} µs, median {} ns",
+        "{label}: {} pushes, max {:.2} µs, p99.9 {:.2} µs, p99 {:.3} µs, median {} ns",
         ns.len(),
         q(1.0) as f64 / 1e3,
         q(0.999) as f64 / 1e3,
@@ -93,48 +97,52 @@ fn worst_push<C: Calibrator>(name: &str, mut cal: C, stream: &[C::Sample]) {
     );
 }
 
+/// Times every push of `stream` into `cal`, filing each under the group `group_of` gives
+/// the calibrator's state before the push, and prints each group's distribution.
+fn grouped_pushes<C: Calibrator>(
+    mut cal: C,
+    stream: &[C::Sample],
+    labels: &[String],
+    group_of: impl Fn(&C) -> usize,
+) {
+    let mut groups: Vec<Vec<u64>> = vec![Vec::new(); labels.len()];
+    for s in stream {
+        let g = group_of(&cal);
+        groups[g].push(timed_push(&mut cal, s));
+    }
+    for (label, ns) in labels.iter().zip(groups) {
+        print_quantiles(label, ns);
+    }
+}
+
+/// Times every push of `stream` into a fresh calibrator and prints the distribution.
+fn worst_push<C: Calibrator>(name: &str, cal: C, stream: &[C::Sample]) {
+    grouped_pushes(cal, stream, &[format!("{name}: per push")], |_| 0);
+}
+
 /// Groups of the binned ellipse's assessment pushes (by step; the last holds any later).
 const ASSESS_GROUPS: usize = 5;
 
 /// The merit circle's pushes grouped by the share of an estimate refresh they did (see
-/// `MeritCircleCalibrator::refresh_stage`), max / p99 / median.
+/// `MeritCircleCalibrator::refresh_stage`).
 fn merit_breakdown(stream: &[Mag2Sample]) {
-    let mut cal = MeritCircleCalibrator::new(MeritCircleConfig::default()).unwrap();
-    let mut groups: Vec<Vec<u64>> = vec![Vec::new(); 8];
-    for s in stream {
-        let g = cal.refresh_stage().map_or(7, |k| k.min(6));
-        let t0 = Instant::now();
-        let r = cal.push(black_box(s));
-        let dt = t0.elapsed();
-        black_box(r).ok();
-        groups[g].push(dt.as_nanos() as u64);
-    }
-    for (k, mut ns) in groups.into_iter().enumerate() {
-        if ns.is_empty() {
-            continue;
-        }
-        ns.sort_unstable();
-        let q = |p: f64| ns[((ns.len() - 1) as f64 * p) as usize];
-        let name = match k {
-            0 => "acceptance tests".to_string(),
-            7 => "no refresh".to_string(),
-            k => format!("report step {k}"),
-        };
-        println!(
-            "merit_circle {name}: {} pushes, max {:.2} µs, p99 {:.2} µs, median {} ns",
-            ns.len(),
-            q(1.0) as f64 / 1e3,
-            q(0.99) as f64 / 1e3,
-            q(0.5)
-        );
-    }
+    let labels: Vec<String> = (0..8)
+        .map(|k| match k {
+            0 => "merit_circle acceptance tests".to_string(),
+            7 => "merit_circle no refresh".to_string(),
+            k => format!("merit_circle report step {k}"),
+        })
+        .collect();
+    let cal = MeritCircleCalibrator::new(MeritCircleConfig::default()).unwrap();
+    grouped_pushes(cal, stream, &labels, |c| {
+        c.refresh_stage().map_or(7, |k| k.min(6))
+    });
 }
 
 /// The binned ellipse's pushes grouped by what they did (the phase of its update at the
-/// start of the push, and whether the refresh advanced), as max / p99 per group.
+/// start of the push, and whether the refresh advanced).
 fn binned_breakdown(stream: &[Mag2Sample]) {
-    let mut cal = BinnedEllipseCalibrator::new(BinnedEllipseConfig::default()).unwrap();
-    let mut groups: Vec<(String, Vec<u64>)> = [
+    let labels: Vec<String> = [
         "no update",
         "binning waiting readings",
         "refresh, idle push",
@@ -142,69 +150,32 @@ fn binned_breakdown(stream: &[Mag2Sample]) {
         "precheck",
     ]
     .iter()
-    .map(|n| (n.to_string(), Vec::new()))
-    .chain((0..ASSESS_GROUPS).map(|k| (format!("assess step {k}"), Vec::new())))
-    .chain(core::iter::once(("apply".to_string(), Vec::new())))
+    .map(|n| n.to_string())
+    .chain((0..ASSESS_GROUPS).map(|k| format!("assess step {k}")))
+    .chain(core::iter::once("apply".to_string()))
+    .map(|n| format!("binned_ellipse {n}"))
     .collect();
-    for s in stream {
-        let g = match cal.update_phase() {
-            None if cal.waiting_readings() > 0 => 1,
-            None => 0,
-            Some((UpdatePhase::Refresh, k)) if (k + 1) % 2 != 0 => 2,
-            Some((UpdatePhase::Refresh, _)) => 3,
-            Some((UpdatePhase::Precheck, _)) => 4,
-            Some((UpdatePhase::Assess, _)) => 5 + cal.assessment_steps().min(ASSESS_GROUPS - 1),
-            Some((UpdatePhase::Apply, _)) => 5 + ASSESS_GROUPS,
-        };
-        let t0 = Instant::now();
-        let r = cal.push(black_box(s));
-        let dt = t0.elapsed();
-        black_box(r).ok();
-        groups[g].1.push(dt.as_nanos() as u64);
-    }
-    for (name, mut ns) in groups {
-        if ns.is_empty() {
-            continue;
-        }
-        ns.sort_unstable();
-        let q = |p: f64| ns[((ns.len() - 1) as f64 * p) as usize];
-        println!(
-            "binned_ellipse {name}: {} pushes, max {:.2} µs, p99.9 {:.2} µs, p99 {:.2} µs, median {} ns",
-            ns.len(),
-            q(1.0) as f64 / 1e3,
-            q(0.999) as f64 / 1e3,
-            q(0.99) as f64 / 1e3,
-            q(0.5)
-        );
-    }
+    let cal = BinnedEllipseCalibrator::new(BinnedEllipseConfig::default()).unwrap();
+    grouped_pushes(cal, stream, &labels, |c| match c.update_phase() {
+        None if c.waiting_readings() > 0 => 1,
+        None => 0,
+        Some((UpdatePhase::Refresh, k)) if (k + 1) % 2 != 0 => 2,
+        Some((UpdatePhase::Refresh, _)) => 3,
+        Some((UpdatePhase::Precheck, _)) => 4,
+        Some((UpdatePhase::Assess, _)) => 5 + c.assessment_steps().min(ASSESS_GROUPS - 1),
+        Some((UpdatePhase::Apply, _)) => 5 + ASSESS_GROUPS,
+    });
 }
 
-/// The online ellipsoid's pushes grouped by the refresh stage they ran, max / p99 / median.
+/// The online ellipsoid's pushes grouped by the refresh stage they ran.
 fn ellipsoid_breakdown(stream: &[Mag3Sample]) {
-    let mut cal = OnlineEllipsoidCalibrator::new(OnlineEllipsoidConfig::default()).unwrap();
-    let mut groups: Vec<Vec<u64>> = vec![Vec::new(); 64];
-    for s in stream {
-        let g = cal.refresh_stage().map_or(63, |k| usize::from(k).min(62));
-        let t0 = Instant::now();
-        let r = cal.push(black_box(s));
-        let dt = t0.elapsed();
-        black_box(r).ok();
-        groups[g].push(dt.as_nanos() as u64);
-    }
-    for (k, mut ns) in groups.into_iter().enumerate() {
-        if ns.is_empty() {
-            continue;
-        }
-        ns.sort_unstable();
-        let q = |p: f64| ns[((ns.len() - 1) as f64 * p) as usize];
-        println!(
-            "online_ellipsoid stage {k}: {} pushes, max {:.2} µs, p99 {:.2} µs, median {} ns",
-            ns.len(),
-            q(1.0) as f64 / 1e3,
-            q(0.99) as f64 / 1e3,
-            q(0.5)
-        );
-    }
+    let labels: Vec<String> = (0..64)
+        .map(|k| format!("online_ellipsoid stage {k}"))
+        .collect();
+    let cal = OnlineEllipsoidCalibrator::new(OnlineEllipsoidConfig::default()).unwrap();
+    grouped_pushes(cal, stream, &labels, |c| {
+        c.refresh_stage().map_or(63, |k| usize::from(k).min(62))
+    });
 }
 
 /// Criterion bench of one push, going round the stream.
