@@ -9,6 +9,7 @@
 //! to the sensor) never becomes consistent and stays rejected.
 
 use serde::{Deserialize, Serialize};
+use truenorth_core::{Result, Validate, check_positive, check_range};
 
 #[allow(unused_imports)]
 use truenorth_core::Float as _;
@@ -41,6 +42,23 @@ impl Default for MagReferenceConfig {
             new_reference_s: 20.0,
             new_reference_min_rate_rps: 20f64.to_radians(),
         }
+    }
+}
+
+impl Validate for MagReferenceConfig {
+    /// Every tolerance and time positive, the minimum rate in [0, 1000] rad/s.
+    fn validate(&self) -> Result<()> {
+        check_positive("mag.norm_tol_rel", self.norm_tol_rel)?;
+        check_positive("mag.dip_tol_rad", self.dip_tol_rad)?;
+        check_positive("mag.reference_tau_s", self.reference_tau_s)?;
+        check_positive("mag.new_reference_s", self.new_reference_s)?;
+        check_range(
+            "mag.new_reference_min_rate_rps",
+            self.new_reference_min_rate_rps,
+            0.0,
+            1e3,
+        )?;
+        Ok(())
     }
 }
 
@@ -129,5 +147,41 @@ impl MagReference {
         self.candidate_s = 0.0;
         self.candidate_moving_s = 0.0;
         self.valid = true;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    proptest! {
+        #[test]
+        fn the_learned_field_is_never_disturbed(norm in 1.0f64..100.0, dip in -1.4f64..1.4, n in 1usize..500) {
+            let mut r = MagReference::new(MagReferenceConfig::default());
+            for _ in 0..n {
+                prop_assert!(r.update(norm, dip, 1.0, 0.01));
+            }
+        }
+
+        #[test]
+        fn a_field_that_changes_with_orientation_is_never_adopted(
+            norm in 10.0f64..100.0, dip in -1.0f64..1.0, swing in 0.3f64..1.0, seconds in 30.0f64..120.0,
+        ) {
+            // An attached magnet: the norm swings by ±swing of itself as the sensor turns,
+            // never consistent for `new_reference_s`, so it stays rejected.
+            let cfg = MagReferenceConfig::default();
+            let mut r = MagReference::new(cfg);
+            r.update(norm, dip, 0.0, 0.01);
+            let steps = (seconds / 0.01) as usize;
+            for k in 0..steps {
+                let t = k as f64 * 0.01;
+                let seen = norm * (1.0 + swing * (t * 2.0).sin().signum() * (0.5 + 0.5 * (t * 7.0).sin().abs()));
+                let ok = r.update(seen, dip, 1.0, 0.01);
+                if (seen - norm).abs() > cfg.norm_tol_rel * norm * 1.5 {
+                    prop_assert!(!ok, "adopted a swinging field at t = {t}");
+                }
+            }
+        }
     }
 }

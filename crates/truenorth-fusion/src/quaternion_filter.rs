@@ -122,21 +122,8 @@ impl Validate for QuaternionFilterConfig {
         check_positive("bias_tau_rest_s", self.bias_tau_rest_s)?;
         check_range("max_bias_rps", self.max_bias_rps, 0.0, 10.0)?;
         check_range("startup_s", self.startup_s, 0.0, 1e9)?;
-        check_positive("rest.gyro_dev_rps", self.rest.gyro_dev_rps)?;
-        check_positive("rest.acc_dev_mps2", self.rest.acc_dev_mps2)?;
-        check_positive("rest.mag_turn_rad", self.rest.mag_turn_rad)?;
-        check_range("rest.min_time_s", self.rest.min_time_s, 0.0, 1e9)?;
-        check_positive("rest.mean_tau_s", self.rest.mean_tau_s)?;
-        check_positive("mag.norm_tol_rel", self.mag.norm_tol_rel)?;
-        check_positive("mag.dip_tol_rad", self.mag.dip_tol_rad)?;
-        check_positive("mag.reference_tau_s", self.mag.reference_tau_s)?;
-        check_positive("mag.new_reference_s", self.mag.new_reference_s)?;
-        check_range(
-            "mag.new_reference_min_rate_rps",
-            self.mag.new_reference_min_rate_rps,
-            0.0,
-            1e3,
-        )?;
+        self.rest.validate()?;
+        self.mag.validate()?;
         if let Some(q) = self.initial_attitude {
             for v in q {
                 check_range("initial_attitude component", v, -1e3, 1e3)?;

@@ -15,6 +15,7 @@
 
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
+use truenorth_core::{Result, Validate, check_positive, check_range};
 
 #[allow(unused_imports)]
 use truenorth_core::Float as _;
@@ -46,6 +47,18 @@ impl Default for RestConfig {
             min_time_s: 1.5,
             mean_tau_s: 0.5,
         }
+    }
+}
+
+impl Validate for RestConfig {
+    /// Every threshold and time constant positive, the minimum time ≥ 0.
+    fn validate(&self) -> Result<()> {
+        check_positive("rest.gyro_dev_rps", self.gyro_dev_rps)?;
+        check_positive("rest.acc_dev_mps2", self.acc_dev_mps2)?;
+        check_positive("rest.mag_turn_rad", self.mag_turn_rad)?;
+        check_range("rest.min_time_s", self.min_time_s, 0.0, 1e9)?;
+        check_positive("rest.mean_tau_s", self.mean_tau_s)?;
+        Ok(())
     }
 }
 
@@ -123,5 +136,45 @@ impl RestDetector {
     /// Running mean of the raw gyro, rad/s: the bias while at rest.
     pub fn gyro_mean(&self) -> Vector3<f64> {
         self.gyr_mean
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    proptest! {
+        #[test]
+        fn constant_readings_with_any_bias_are_rest(
+            bias in proptest::array::uniform3(-1.0f64..1.0),
+            acc in proptest::array::uniform3(-10.0f64..10.0),
+            mag in proptest::array::uniform3(-50.0f64..50.0),
+        ) {
+            let cfg = RestConfig::default();
+            let mut r = RestDetector::new(cfg);
+            let (g, a, m) = (Vector3::from(bias), Vector3::from(acc), Vector3::from(mag));
+            let mut rest = false;
+            for _ in 0..((cfg.min_time_s / 0.01) as usize + 2) {
+                rest = r.update(&g, &a, Some(&m), 0.01);
+            }
+            prop_assert!(rest);
+            prop_assert!((r.gyro_mean() - g).norm() < 1e-12);
+        }
+
+        #[test]
+        fn a_steady_turn_is_not_rest(rate_dps in 5.0f64..90.0) {
+            // Constant gyro and specific force (a turn about the vertical), but the field's
+            // direction turns: the magnetometer tells it from a bias.
+            let cfg = RestConfig::default();
+            let mut r = RestDetector::new(cfg);
+            let g = Vector3::new(0.0, 0.0, rate_dps.to_radians());
+            let a = Vector3::new(0.0, 0.0, -9.81);
+            for k in 0..300 {
+                let psi = rate_dps.to_radians() * 0.01 * k as f64;
+                let m = Vector3::new(20.0 * psi.cos(), -20.0 * psi.sin(), 40.0);
+                prop_assert!(!r.update(&g, &a, Some(&m), 0.01), "rest at k = {k}");
+            }
+        }
     }
 }
