@@ -9,8 +9,9 @@ use truenorth_core::{Error, Result, check_finite, check_finite3};
 #[allow(unused_imports)]
 use truenorth_core::Float as _;
 
-/// Most disturbances one model holds (a fixed array keeps the model allocation-free).
-pub const MAX_DISTURBANCES: usize = 4;
+/// Most disturbances one model holds (a fixed array keeps the model allocation-free): enough
+/// for a simulated hour on the road.
+pub const MAX_DISTURBANCES: usize = 32;
 
 /// How a disturbance rises and falls within its window.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]

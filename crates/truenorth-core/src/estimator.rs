@@ -74,6 +74,24 @@ pub trait OrientationEstimator {
     fn reset(&mut self);
 }
 
+/// What a vehicle heading estimator currently believes about its heading and sensors.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct NavStatus {
+    /// The heading is referred to magnetic north. While false (no calibrated compass yet, or
+    /// none fitted) it is the heading change since the start, and the track is drawn as if
+    /// the vehicle had started facing north.
+    pub heading_absolute: bool,
+    /// The vehicle is judged to be standing still (gyro bias is being learned from it).
+    pub at_rest: bool,
+    /// A compass calibration is available.
+    pub compass_calibrated: bool,
+    /// A compass reading corrected the heading at this sample.
+    pub compass_used: bool,
+    /// The compass is judged disturbed (its readings disagree with the dead-reckoned
+    /// heading or its field magnitude is off); heading runs on the gyro or wheels meanwhile.
+    pub compass_disturbed: bool,
+}
+
 /// Position, heading and speed of a land vehicle relative to its start point, with their
 /// uncertainty.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -94,6 +112,9 @@ pub struct NavEstimate {
     pub speed_mps: f64,
     /// Distance travelled since the start, metres.
     pub distance_m: f64,
+    /// Heading reference, rest and compass flags.
+    #[serde(default)]
+    pub status: NavStatus,
 }
 
 impl NavEstimate {
@@ -108,6 +129,7 @@ impl NavEstimate {
             position_cov_m2: Matrix2::zeros(),
             speed_mps: 0.0,
             distance_m: 0.0,
+            status: NavStatus::default(),
         }
     }
 }

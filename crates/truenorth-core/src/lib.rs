@@ -46,7 +46,8 @@ pub use calibrator::{
 };
 pub use error::Error;
 pub use estimator::{
-    AttitudeEstimate, AttitudeStatus, HeadingEstimator, NavEstimate, OrientationEstimator,
+    AttitudeEstimate, AttitudeStatus, HeadingEstimator, NavEstimate, NavStatus,
+    OrientationEstimator,
 };
 pub use heading::{Declination, MagneticHeading, TrueHeading};
 pub use heading_source::{

@@ -32,7 +32,9 @@
 mod mag_reference;
 mod quaternion_filter;
 mod rest_detector;
+pub mod vehicle;
 
 pub use mag_reference::{MagReference, MagReferenceConfig};
 pub use quaternion_filter::{QuaternionFilter, QuaternionFilterConfig};
 pub use rest_detector::{RestConfig, RestDetector};
+pub use vehicle::{CompassGates, SensorPriors, VehicleConfig, VehicleEstimator, VehicleMethod};

@@ -28,6 +28,7 @@
 //! # Ok::<(), truenorth_core::Error>(())
 //! ```
 
+mod drive;
 mod handheld;
 mod route;
 pub mod scenario;
@@ -35,10 +36,11 @@ pub mod shared_data;
 mod streams;
 mod vehicle;
 
+pub use drive::{DriveSpec, DriveWheels, SimulatedDrive};
 pub use handheld::{HandheldParams, MotionTruth, handheld_motion};
 pub use route::{Command, Route, RouteBuilder};
 pub use streams::{
     ImuSensorParams, VehicleSensorParams, imu_streams, rotated_soft_iron, vehicle_accel_stream,
-    vehicle_streams,
+    vehicle_streams, vehicle_streams_disturbed,
 };
 pub use vehicle::{MAX_SAMPLES, VehicleTruth, simulate};

@@ -12,8 +12,20 @@ pub struct Command {
     pub duration_s: f64,
     /// Longitudinal acceleration, m/s².
     pub accel_mps2: f64,
-    /// Path curvature of the rear-axle centre, 1/m, positive for a right turn.
+    /// Path curvature of the rear-axle centre at the start of the command, 1/m, positive
+    /// for a right turn.
     pub curvature_per_m: f64,
+    /// Rate of change of the curvature, 1/(m·s): non-zero while the steering wheel turns
+    /// (a clothoid at constant speed). The curvature must not change sign within a command.
+    #[serde(default)]
+    pub curvature_rate_per_m_s: f64,
+}
+
+impl Command {
+    /// Curvature at the end of the command, 1/m.
+    pub fn end_curvature_per_m(&self) -> f64 {
+        self.curvature_per_m + self.curvature_rate_per_m_s * self.duration_s
+    }
 }
 
 /// A route: the commands and the speed it starts at.
@@ -32,9 +44,14 @@ impl Route {
         let mut v = self.start_speed_mps;
         let mut turned = 0.0;
         for c in &self.commands {
-            let d = v * c.duration_s + 0.5 * c.accel_mps2 * c.duration_s * c.duration_s;
-            turned += c.curvature_per_m.abs() * d;
-            v = (v + c.accel_mps2 * c.duration_s).max(0.0);
+            let t = c.duration_s;
+            // ∫ (κ₀ + κ̇τ)(v + aτ) dτ over the command; κ keeps its sign within one.
+            let k0 = c.curvature_per_m;
+            let kr = c.curvature_rate_per_m_s;
+            let a = c.accel_mps2;
+            let turn = k0 * v * t + (k0 * a + kr * v) * t * t / 2.0 + kr * a * t * t * t / 3.0;
+            turned += turn.abs();
+            v = (v + a * t).max(0.0);
         }
         turned
     }
@@ -107,6 +124,7 @@ impl RouteBuilder {
             duration_s: distance_m / v,
             accel_mps2: 0.0,
             curvature_per_m: 0.0,
+            curvature_rate_per_m_s: 0.0,
         });
         Ok(self)
     }
@@ -121,6 +139,43 @@ impl RouteBuilder {
             duration_s: angle_rad.abs() * radius_m / v,
             accel_mps2: 0.0,
             curvature_per_m: angle_rad.signum() / radius_m,
+            curvature_rate_per_m_s: 0.0,
+        });
+        Ok(self)
+    }
+
+    /// Turns through `angle_rad` (positive right) at the current speed as a road is built:
+    /// the curvature rises linearly to `1/radius_m` over `ease_s` seconds (a clothoid, the
+    /// steering wheel turning), holds, and falls back over `ease_s`. The easing is shortened
+    /// when the turn is too small to hold the full curvature at all.
+    pub fn eased_turn(mut self, angle_rad: f64, radius_m: f64, ease_s: f64) -> Result<Self> {
+        check_positive("radius_m", radius_m)?;
+        check_positive("|angle_rad|", angle_rad.abs())?;
+        check_positive("ease_s", ease_s)?;
+        let v = self.moving()?;
+        let k = angle_rad.signum() / radius_m;
+        // Each easing turns through k·v·T/2; together they may take at most the whole angle.
+        let ease = ease_s.min(angle_rad.abs() * radius_m / v);
+        let held = (angle_rad.abs() - ease * v / radius_m) * radius_m / v;
+        self.route.commands.push(Command {
+            duration_s: ease,
+            accel_mps2: 0.0,
+            curvature_per_m: 0.0,
+            curvature_rate_per_m_s: k / ease,
+        });
+        if held > 0.0 {
+            self.route.commands.push(Command {
+                duration_s: held,
+                accel_mps2: 0.0,
+                curvature_per_m: k,
+                curvature_rate_per_m_s: 0.0,
+            });
+        }
+        self.route.commands.push(Command {
+            duration_s: ease,
+            accel_mps2: 0.0,
+            curvature_per_m: k,
+            curvature_rate_per_m_s: -k / ease,
         });
         Ok(self)
     }
@@ -142,6 +197,7 @@ impl RouteBuilder {
                 duration_s: dv.abs() / accel_mps2.abs(),
                 accel_mps2: dv.signum() * accel_mps2.abs(),
                 curvature_per_m: 0.0,
+                curvature_rate_per_m_s: 0.0,
             });
             self.speed_mps = to_mps;
         }
@@ -161,6 +217,7 @@ impl RouteBuilder {
             duration_s,
             accel_mps2: 0.0,
             curvature_per_m: 0.0,
+            curvature_rate_per_m_s: 0.0,
         });
         Ok(self)
     }

@@ -9,7 +9,8 @@ use nalgebra::{Matrix2, Matrix3, Rotation2, Vector2, Vector3};
 use serde::{Deserialize, Serialize};
 use truenorth_accel::{AccelModel, AccelParams, AccelTruth};
 use truenorth_compass::{
-    AttitudeTruth, HeadingTruth, MagnetometerModel2d, MagnetometerModel3d, earth_field_ned,
+    AttitudeTruth, Disturbance, HeadingTruth, MagnetometerModel2d, MagnetometerModel3d,
+    earth_field_ned,
 };
 use truenorth_core::{
     AccelSample, EulerZyx, ImuSample, Result, SensorModel, SplitMix64, Validate, VehicleSample,
@@ -111,6 +112,18 @@ pub fn vehicle_streams(
     params: &VehicleSensorParams,
     seed: u64,
 ) -> Result<Vec<VehicleSample>> {
+    vehicle_streams_disturbed(truth, params, &[], seed)
+}
+
+/// [`vehicle_streams`] with magnetic `disturbances` added to the field the compass sees
+/// (world-fixed fields in time windows, at most
+/// [`truenorth_compass::MAX_DISTURBANCES`]).
+pub fn vehicle_streams_disturbed(
+    truth: &[VehicleTruth],
+    params: &VehicleSensorParams,
+    disturbances: &[Disturbance],
+    seed: u64,
+) -> Result<Vec<VehicleSample>> {
     params.validate()?;
     let mut rng = SplitMix64::new(seed);
     let mut gyro = GyroAxisModel::new(params.gyro)?;
@@ -120,6 +133,9 @@ pub fn vehicle_streams(
         params.compass_soft_iron,
         params.compass_noise,
     )?;
+    for d in disturbances {
+        compass = compass.with_disturbance(*d)?;
+    }
     let mut out = Vec::with_capacity(truth.len());
     let mut prev: Option<&VehicleTruth> = None;
     for s in truth {

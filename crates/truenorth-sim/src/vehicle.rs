@@ -69,7 +69,7 @@ pub fn simulate(route: &Route, heading0_rad: f64, rate_hz: f64) -> Result<Vec<Ve
     let mut planned_v = route.start_speed_mps;
     let mut cmd_idx = 0;
     let mut cmd_end = route.commands.first().map_or(0.0, |c| c.duration_s);
-    set_command(&mut s, route, cmd_idx);
+    let mut rate = set_command(&mut s, route, cmd_idx);
     out.push(s);
     let times = (1..=whole)
         .map(|k| k as f64 * dt)
@@ -90,14 +90,14 @@ pub fn simulate(route: &Route, heading0_rad: f64, rate_hz: f64) -> Result<Vec<Ve
                 }
                 cmd_idx += 1;
                 cmd_end += route.commands.get(cmd_idx).map_or(0.0, |c| c.duration_s);
-                set_command(&mut s, route, cmd_idx);
+                rate = set_command(&mut s, route, cmd_idx);
             }
             let h = if cmd_idx < route.commands.len() {
                 (t1.min(cmd_end)) - t
             } else {
                 t1 - t
             };
-            advance(&mut s, h);
+            advance(&mut s, h, rate);
             t += h;
         }
         s.t_s = t1;
@@ -107,21 +107,50 @@ pub fn simulate(route: &Route, heading0_rad: f64, rate_hz: f64) -> Result<Vec<Ve
     Ok(out)
 }
 
-fn set_command(s: &mut VehicleTruth, route: &Route, idx: usize) {
-    match route.commands.get(idx) {
+/// Takes the command's acceleration and curvature (and returns its curvature rate).
+fn set_command(s: &mut VehicleTruth, route: &Route, idx: usize) -> f64 {
+    let rate = match route.commands.get(idx) {
         Some(c) => {
             s.accel_mps2 = c.accel_mps2;
             s.curvature_per_m = c.curvature_per_m;
+            c.curvature_rate_per_m_s
         }
         None => {
             s.accel_mps2 = 0.0;
             s.curvature_per_m = 0.0;
+            0.0
         }
-    }
+    };
     s.yaw_rate_rps = s.speed_mps * s.curvature_per_m;
+    rate
 }
 
-fn advance(s: &mut VehicleTruth, h: f64) {
+/// Sub-steps of a step in which the curvature changes: the heading is exact, the position
+/// exact to third order in the sub-step's turn.
+const CLOTHOID_SUBSTEPS: usize = 8;
+
+fn advance(s: &mut VehicleTruth, h: f64, curvature_rate: f64) {
+    if curvature_rate == 0.0 {
+        advance_arc(s, h);
+        return;
+    }
+    let sub = h / CLOTHOID_SUBSTEPS as f64;
+    for _ in 0..CLOTHOID_SUBSTEPS {
+        // Heading change over the sub-step, exactly: ∫ (κ₀ + κ̇τ)(v₀ + aτ) dτ.
+        let (k0, v0, a) = (s.curvature_per_m, s.speed_mps, s.accel_mps2);
+        let dpsi = k0 * v0 * sub
+            + (k0 * a + curvature_rate * v0) * sub * sub / 2.0
+            + curvature_rate * a * sub * sub * sub / 3.0;
+        let v1 = (v0 + a * sub).max(0.0);
+        let ds = 0.5 * (v0 + v1) * sub;
+        // The arc with the sub-step's mean curvature has the same heading change.
+        s.curvature_per_m = if ds > 0.0 { dpsi / ds } else { k0 };
+        advance_arc(s, sub);
+        s.curvature_per_m = k0 + curvature_rate * sub;
+    }
+}
+
+fn advance_arc(s: &mut VehicleTruth, h: f64) {
     let v0 = s.speed_mps;
     let v1 = (v0 + s.accel_mps2 * h).max(0.0);
     let ds = 0.5 * (v0 + v1) * h;

@@ -38,6 +38,7 @@ fn route() -> Route {
         duration_s,
         accel_mps2,
         curvature_per_m: CURVATURE_PER_M,
+        curvature_rate_per_m_s: 0.0,
     };
     Route {
         start_speed_mps: 5.0,

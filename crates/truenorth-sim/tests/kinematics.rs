@@ -143,3 +143,35 @@ proptest! {
         }
     }
 }
+
+proptest! {
+    /// An eased turn turns through exactly the angle asked, its yaw rate never jumps by more
+    /// than the easing allows in one sample, and a clothoid's heading is exact at any rate.
+    #[test]
+    fn eased_turns_turn_exactly_and_smoothly(
+        angle in prop_oneof![-7.0f64..-0.05, 0.05f64..7.0],
+        radius in 5.0f64..200.0,
+        speed in 2.0f64..30.0,
+        ease in 0.2f64..3.0,
+        rate_hz in 5.0f64..100.0,
+    ) {
+        let route = RouteBuilder::at_speed(speed)
+            .unwrap()
+            .eased_turn(angle, radius, ease)
+            .unwrap()
+            .straight(10.0)
+            .unwrap()
+            .build();
+        prop_assert!((route.turned_rad() - angle.abs()).abs() < 1e-9 * angle.abs().max(1.0));
+        let truth = simulate(&route, 0.0, rate_hz).unwrap();
+        let last = truth.last().unwrap();
+        prop_assert!((last.heading_unwrapped_rad - angle).abs() < 1e-9, "{}", last.heading_unwrapped_rad);
+        // The yaw rate ramps: between samples it changes by at most (v/R)·dt/ease.
+        let dt = 1.0 / rate_hz;
+        let effective_ease = ease.min(angle.abs() * radius / speed);
+        let max_jump = speed / radius * dt / effective_ease * (1.0 + 1e-9) + 1e-12;
+        for w in truth.windows(2) {
+            prop_assert!((w[1].yaw_rate_rps - w[0].yaw_rate_rps).abs() <= max_jump);
+        }
+    }
+}
