@@ -14,15 +14,10 @@
 //!   two stands out of it within seconds; while it does the compass counts as disturbed and
 //!   none of its readings is used.
 //!
-//! Readings reach the calibrator only when they pass all gates (before the heading is
-//! referred to north, when nothing can be judged, all do), and only once the heading has
-//! moved on since the last one: long straights would otherwise crowd one direction.
+//! The calibration itself is learned by [`super::compass_learning`].
 
-use truenorth_calib::OnlineEllipseCalibrator;
 use truenorth_compass::CompassCalibration2d;
-use truenorth_core::{
-    Calibrator, CompassQuality, Mag2Sample, OnlineCalibrator, Pushed, Result, Solution, wrap_pi,
-};
+use truenorth_core::{CompassQuality, Solution};
 
 use super::config::CompassGates;
 
@@ -47,12 +42,17 @@ pub struct CompassFix {
     pub field: f64,
     /// Standard deviation of one reading's heading, rad.
     pub noise_rad: f64,
+    /// Standard deviation of the heading error the calibration itself leaves (its
+    /// parameters' uncertainty and what its model cannot remove), rad. It depends on the
+    /// heading, so it changes as the vehicle turns.
+    pub calibration_sigma_rad: f64,
     /// The calibration's quality report.
     pub quality: CompassQuality,
 }
 
 impl CompassFix {
-    fn from_solution(s: &Solution<CompassCalibration2d>) -> Self {
+    /// The fix for a calibrator's solution.
+    pub fn from_solution(s: &Solution<CompassCalibration2d>) -> Self {
         Self {
             calibration: s.params,
             field: s.quality.field_magnitude,
@@ -61,6 +61,9 @@ impl CompassFix {
                 .heading_noise_rms_deg
                 .to_radians()
                 .max(MIN_NOISE_RAD),
+            calibration_sigma_rad: (s.quality.heading_error_3sigma_deg / 3.0
+                + s.quality.heading_error_systematic_deg)
+                .to_radians(),
             quality: s.quality,
         }
     }
@@ -73,70 +76,44 @@ pub enum Verdict {
     Unusable,
     /// Judged disturbed (innovation or averaged innovation).
     Rejected,
-    /// Taken into the current average; no correction yet.
-    Taken,
-    /// Taken, completing an average: correct the heading by `innovation_rad` with noise
-    /// variance `variance_rad2`.
-    Correct {
-        /// Mean innovation of the readings averaged, rad.
-        innovation_rad: f64,
-        /// Its noise variance, rad².
+    /// Use it: correct the heading with noise variance `variance_rad2`.
+    Use {
+        /// The reading's noise variance, rad².
         variance_rad2: f64,
     },
 }
 
-/// The online calibration, its decimation and the gates.
-#[derive(Debug, Clone)]
+/// The calibration in use and the gates.
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CompassMonitor {
     gates: CompassGates,
-    calibrator: OnlineEllipseCalibrator,
     fix: Option<CompassFix>,
-    last_push: Option<(f64, f64)>,
     last_t_s: Option<f64>,
     average_rad: f64,
     disturbed: bool,
-    window_sum_rad: f64,
-    window_n: u32,
 }
 
 impl CompassMonitor {
     /// A monitor with no calibration yet.
-    pub fn new(gates: CompassGates) -> Result<Self> {
-        Ok(Self {
+    pub fn new(gates: CompassGates) -> Self {
+        Self {
             gates,
-            calibrator: OnlineEllipseCalibrator::new(gates.calibrator)?,
             fix: None,
-            last_push: None,
             last_t_s: None,
             average_rad: 0.0,
             disturbed: false,
-            window_sum_rad: 0.0,
-            window_n: 0,
-        })
+        }
     }
 
-    /// Starts from a calibration found earlier (kept until the online calibrator, which
-    /// starts empty, has one of its own).
-    pub fn with_fix(mut self, fix: Option<CompassFix>) -> Self {
-        self.fix = fix;
-        self
-    }
-
-    /// Forgets everything learned.
-    pub fn reset(&mut self) {
-        self.calibrator.reset();
-        self.fix = None;
-        self.last_push = None;
-        self.last_t_s = None;
-        self.restart_gates();
+    /// Uses `fix` from now on.
+    pub fn set_fix(&mut self, fix: CompassFix) {
+        self.fix = Some(fix);
     }
 
     /// Forgets the gates' memory (after the heading was re-referred).
     pub fn restart_gates(&mut self) {
         self.average_rad = 0.0;
         self.disturbed = false;
-        self.window_sum_rad = 0.0;
-        self.window_n = 0;
     }
 
     /// The calibration in use.
@@ -161,32 +138,10 @@ impl CompassMonitor {
         (ratio - 1.0).abs() <= self.gates.field_tolerance
     }
 
-    /// Offers a reading to the calibrator if the heading `psi_rad` has moved on since the
-    /// last one (or enough time has passed). Returns whether the calibration in use changed.
-    pub fn offer(&mut self, raw: &nalgebra::Vector2<f64>, t_s: f64, psi_rad: f64) -> bool {
-        if let Some((t0, psi0)) = self.last_push {
-            let moved =
-                wrap_pi(psi_rad - psi0).abs() >= self.gates.calibrator_spacing_deg.to_radians();
-            if !moved && t_s - t0 < self.gates.calibrator_interval_s {
-                return false;
-            }
-        }
-        self.last_push = Some((t_s, psi_rad));
-        match self.calibrator.push(&Mag2Sample { t_s, mag: *raw }) {
-            Ok(Pushed::NewEstimate) => match self.calibrator.estimate() {
-                Some(s) => {
-                    self.fix = Some(CompassFix::from_solution(&s));
-                    true
-                }
-                None => false,
-            },
-            _ => false,
-        }
-    }
-
-    /// Judges one calibrated reading with innovation `nu_rad` (reading minus dead-reckoned
-    /// heading, wrapped) and field ratio `ratio`, given the heading's variance `p_psi` now.
-    pub fn judge(&mut self, t_s: f64, nu_rad: f64, ratio: f64, p_psi: f64) -> Verdict {
+    /// Judges one calibrated reading with innovation `nu_rad` (reading minus predicted
+    /// reading, wrapped) and field ratio `ratio`, given the innovation's variance without
+    /// the reading's own noise, `p_nu` (heading and compass-bias errors together).
+    pub fn judge(&mut self, t_s: f64, nu_rad: f64, ratio: f64, p_nu: f64) -> Verdict {
         let Some(fix) = self.fix else {
             return Verdict::Unusable;
         };
@@ -196,37 +151,19 @@ impl CompassMonitor {
             return Verdict::Unusable;
         }
         let r = fix.noise_rad * fix.noise_rad;
-        let floor = self.gates.systematic_floor_deg.to_radians();
         // Exponential average of the innovations: for white noise of variance r its
-        // variance settles at r·α/(2 − α).
+        // variance settles at r·α/(2 − α); the state's error is common to all readings.
         let alpha = (dt / self.gates.slow_gate_tau_s).min(1.0);
         self.average_rad += alpha * (nu_rad - self.average_rad);
-        let spread = (p_psi + r * alpha / (2.0 - alpha) + floor * floor).sqrt();
+        let spread = (p_nu + r * alpha / (2.0 - alpha)).sqrt();
         let limit = self.gates.slow_gate_sigma * spread;
-        if self.disturbed {
-            self.disturbed = self.average_rad.abs() > RELEASE_SHARE * limit;
-        } else {
-            self.disturbed = self.average_rad.abs() > limit;
-        }
-        let gate = self.gates.innovation_gate_sigma * (p_psi + r + floor * floor).sqrt();
+        let release = if self.disturbed { RELEASE_SHARE } else { 1.0 };
+        self.disturbed = self.average_rad.abs() > release * limit;
+        let gate = self.gates.innovation_gate_sigma * (p_nu + r).sqrt();
         if self.disturbed || nu_rad.abs() > gate {
-            self.window_sum_rad = 0.0;
-            self.window_n = 0;
             return Verdict::Rejected;
         }
-        self.window_sum_rad += nu_rad;
-        self.window_n += 1;
-        if self.window_n < self.gates.readings_per_update {
-            return Verdict::Taken;
-        }
-        let n = f64::from(self.window_n);
-        let innovation_rad = self.window_sum_rad / n;
-        self.window_sum_rad = 0.0;
-        self.window_n = 0;
-        Verdict::Correct {
-            innovation_rad,
-            variance_rad2: r / n + floor * floor,
-        }
+        Verdict::Use { variance_rad2: r }
     }
 }
 
@@ -236,17 +173,21 @@ mod tests {
     use nalgebra::Vector2;
 
     fn calibrated() -> CompassMonitor {
-        let mut m = CompassMonitor::new(CompassGates::default()).unwrap();
+        use super::super::compass_learning::CompassLearner;
+        let mut learner = CompassLearner::new(CompassGates::default()).unwrap();
+        let mut m = CompassMonitor::new(CompassGates::default());
         for k in 0..720 {
             let psi = (k as f64 * 0.5).to_radians();
             let raw = Vector2::new(5.0 + 20.0 * psi.cos(), -3.0 - 20.0 * psi.sin());
-            m.offer(&raw, k as f64 * 0.1, psi);
+            if let Some(s) = learner.offer(&raw, k as f64 * 0.1, psi, false) {
+                m.set_fix(CompassFix::from_solution(&s));
+            }
         }
         m
     }
 
     #[test]
-    fn learns_a_calibration_from_a_turn() {
+    fn measures_with_the_calibration_it_was_given() {
         let m = calibrated();
         let fix = m.fix().expect("calibrated after two turns");
         assert!((fix.calibration.hard_iron - Vector2::new(5.0, -3.0)).norm() < 1e-6);
@@ -259,7 +200,7 @@ mod tests {
         let mut m = calibrated();
         // A compass with 1 % noise (0.57° per reading) at 10 Hz.
         m.fix.as_mut().unwrap().noise_rad = 0.57f64.to_radians();
-        let p = 0.1f64.to_radians().powi(2);
+        let p = 0.3f64.to_radians().powi(2);
         // 0.5°/s of drift: the averaged innovation marks the compass disturbed before any
         // single reading is past its gate.
         let mut caught = None;
@@ -288,7 +229,7 @@ mod tests {
     fn a_strong_field_change_is_unusable() {
         let mut m = calibrated();
         assert_eq!(m.judge(1.0, 0.0, 1.3, 1e-4), Verdict::Unusable);
-        let mut n = CompassMonitor::new(CompassGates::default()).unwrap();
+        let mut n = CompassMonitor::new(CompassGates::default());
         assert_eq!(n.judge(1.0, 0.0, 1.0, 1e-4), Verdict::Unusable);
     }
 }

@@ -52,6 +52,10 @@ pub struct SensorPriors {
     /// Standard deviation of the odometer's mean scale, which no sensor here observes; it
     /// makes the reported along-track uncertainty (0.003).
     pub wheel_scale_sigma: f64,
+    /// Standard deviation of the relative error of the wheels' effective track before it is
+    /// learned (0.02): the contact patches' spacing differs from the nominal track, and the
+    /// mean scale error scales the wheels' heading too.
+    pub wheel_track_sigma: f64,
     /// Initial speed coefficient `a`, s²/m² (0).
     pub speed_coeff_s2_per_m2: f64,
     /// Standard deviation of `a` before it is learned, s²/m² (1e-4).
@@ -73,6 +77,7 @@ impl Default for SensorPriors {
             gyro_gain_sigma: 0.05,
             wheel_diff_sigma: 0.01,
             wheel_scale_sigma: 0.003,
+            wheel_track_sigma: 0.02,
             speed_coeff_s2_per_m2: 0.0,
             speed_coeff_sigma: 1e-4,
             wheel_heading_noise_deg_per_sqrt_m: 0.01,
@@ -95,6 +100,7 @@ impl Validate for SensorPriors {
         check_range("gyro_gain_sigma", self.gyro_gain_sigma, 1e-9, 0.5)?;
         check_range("wheel_diff_sigma", self.wheel_diff_sigma, 1e-9, 0.2)?;
         check_range("wheel_scale_sigma", self.wheel_scale_sigma, 0.0, 0.5)?;
+        check_range("wheel_track_sigma", self.wheel_track_sigma, 1e-9, 0.3)?;
         check_range(
             "speed_coeff_s2_per_m2",
             self.speed_coeff_s2_per_m2,
@@ -133,12 +139,13 @@ pub struct CompassGates {
     /// The compass counts as disturbed while the averaged innovation exceeds this many of
     /// its standard deviations (3).
     pub slow_gate_sigma: f64,
-    /// Heading error that the calibration and the road (grade, camber) leave in every
-    /// reading alike, degrees (0.3): added to the averaged innovation's spread so that the
-    /// slow gate does not take them for a disturbance.
-    pub systematic_floor_deg: f64,
-    /// Readings averaged into one heading correction (5).
-    pub readings_per_update: u32,
+    /// Standard deviation of the heading error that the calibration and the road (grade,
+    /// camber) leave in every reading alike for a while, degrees (0.3): the filter carries
+    /// it as a state, so that it is not averaged away as if it were noise.
+    pub systematic_deg: f64,
+    /// Correlation time of that error, s (20): it changes as the vehicle turns and the road
+    /// changes.
+    pub systematic_tau_s: f64,
     /// Readings that must agree before the heading is first referred to north (20).
     pub alignment_readings: u32,
 }
@@ -153,8 +160,8 @@ impl Default for CompassGates {
             innovation_gate_sigma: 3.5,
             slow_gate_tau_s: 1.5,
             slow_gate_sigma: 3.0,
-            systematic_floor_deg: 0.3,
-            readings_per_update: 5,
+            systematic_deg: 0.3,
+            systematic_tau_s: 20.0,
             alignment_readings: 20,
         }
     }
@@ -179,13 +186,8 @@ impl Validate for CompassGates {
         )?;
         check_positive("slow_gate_tau_s", self.slow_gate_tau_s)?;
         check_range("slow_gate_sigma", self.slow_gate_sigma, 1.0, 100.0)?;
-        check_range("systematic_floor_deg", self.systematic_floor_deg, 0.0, 45.0)?;
-        check_range(
-            "readings_per_update",
-            f64::from(self.readings_per_update),
-            1.0,
-            1e4,
-        )?;
+        check_range("systematic_deg", self.systematic_deg, 1e-3, 45.0)?;
+        check_positive("systematic_tau_s", self.systematic_tau_s)?;
         check_range(
             "alignment_readings",
             f64::from(self.alignment_readings),

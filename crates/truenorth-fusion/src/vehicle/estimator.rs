@@ -28,13 +28,14 @@ use truenorth_core::{
     check_finite, wrap_pi,
 };
 
+use super::compass_learning::CompassLearner;
 use super::compass_monitor::{CompassFix, CompassMonitor, Verdict};
 use super::config::{VehicleConfig, VehicleMethod};
 use super::nav_filter::{
-    BIAS, Coupling, DIM, EAST, GAIN_NEG, GAIN_POS, NORTH, NavFilter, PSI, PSI_ODO, SPEED_COEFF,
-    WHEEL_DIFF,
+    BIAS, COMPASS_BIAS, Coupling, DIM, EAST, GAIN_NEG, GAIN_POS, NORTH, NavFilter, PSI, PSI_ODO,
+    SPEED_COEFF, TRACK_SCALE, WHEEL_DIFF,
 };
-use super::wheel_odometry::WheelOdometry;
+use super::wheel_odometry::{WheelCalibration, WheelOdometry};
 
 #[allow(unused_imports)]
 use truenorth_core::Float as _;
@@ -71,6 +72,9 @@ struct Coefficients {
     wheel_noise_rad2_per_m: f64,
     /// Variance of the wheels' heading from the pulses at each end of a comparison, rad².
     wheel_quantisation_rad2: f64,
+    /// Variance of the road's and the installation's share of the compass's systematic
+    /// error, rad² (the calibration's share comes with each calibration).
+    compass_floor_var: f64,
 }
 
 impl Coefficients {
@@ -88,6 +92,7 @@ impl Coefficients {
             // Each wheel's reading is off by up to half a pulse, uniformly, at each end of
             // the comparison: 4 · q²/12 in the difference.
             wheel_quantisation_rad2: q * q / 3.0,
+            compass_floor_var: c.compass.systematic_deg.to_radians().powi(2),
         }
     }
 }
@@ -113,9 +118,15 @@ struct Rest {
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 struct Alignment {
     done: bool,
-    sin_sum: f64,
-    cos_sum: f64,
+    /// First reading's time and innovation: the others are taken relative to them, so
+    /// the sums below stay well conditioned and the innovations unwrapped.
+    first: Option<(f64, f64)>,
     n: u32,
+    s_t: f64,
+    s_tt: f64,
+    s_v: f64,
+    s_tv: f64,
+    s_vv: f64,
 }
 
 /// The fused vehicle estimator. See the module documentation.
@@ -145,7 +156,7 @@ pub struct VehicleEstimator {
     filter: NavFilter,
     wheels: WheelOdometry,
     compass: CompassMonitor,
-    initial_fix: Option<CompassFix>,
+    learner: CompassLearner,
     clock: TimeStep,
     gyro: GyroTrack,
     rest: Rest,
@@ -164,14 +175,15 @@ impl VehicleEstimator {
         let mut sigma = [0.0; DIM];
         sigma[WHEEL_DIFF] = p.wheel_diff_sigma;
         sigma[SPEED_COEFF] = p.speed_coeff_sigma;
+        sigma[TRACK_SCALE] = p.wheel_track_sigma;
         let filter = NavFilter::new(x, sigma);
         Ok(Self {
             coeffs: Coefficients::new(&config),
             initial: filter,
             filter,
             wheels: WheelOdometry::new(config.wheels)?,
-            compass: CompassMonitor::new(config.compass)?,
-            initial_fix: None,
+            compass: CompassMonitor::new(config.compass),
+            learner: CompassLearner::new(config.compass)?,
             clock: TimeStep::new(),
             gyro: GyroTrack::default(),
             rest: Rest::default(),
@@ -190,6 +202,16 @@ impl VehicleEstimator {
     /// The filter's nominal state and covariance (indices in [`super::nav_filter`]).
     pub fn filter(&self) -> &NavFilter {
         &self.filter
+    }
+
+    /// The compass monitor (calibration in use and gates).
+    pub fn compass(&self) -> &CompassMonitor {
+        &self.compass
+    }
+
+    /// The compass calibrators.
+    pub fn compass_learner(&self) -> &CompassLearner {
+        &self.learner
     }
 
     /// The compass calibration in use, if any.
@@ -213,13 +235,12 @@ impl VehicleEstimator {
 
     fn step(&mut self, sample: &VehicleSample, dt: f64) {
         let x = self.filter.x;
-        let Some(wheel) = self.wheels.step(
-            sample.dist_l_m,
-            sample.dist_r_m,
-            dt,
-            x[WHEEL_DIFF],
-            x[SPEED_COEFF],
-        ) else {
+        let cal = WheelCalibration {
+            diff: x[WHEEL_DIFF],
+            speed_coeff: x[SPEED_COEFF],
+            track_scale: x[TRACK_SCALE],
+        };
+        let Some(wheel) = self.wheels.step(sample.dist_l_m, sample.dist_r_m, dt, &cal) else {
             return;
         };
         self.rest.still_s = if wheel.moved {
@@ -231,7 +252,7 @@ impl VehicleEstimator {
         self.start_gyro(sample);
         let raw = sample.gyr_z_rps.unwrap_or(self.gyro.last_raw_rps);
 
-        let mut couplings: [Coupling; 6] = [(0, 0, 0.0); 6];
+        let mut couplings: [Coupling; 8] = [(0, 0, 0.0); 8];
         let mut q = [0.0; DIM];
         let c = &self.coeffs;
         let dpsi = self.heading_change(&wheel, raw, dt, at_rest);
@@ -254,6 +275,7 @@ impl VehicleEstimator {
             }
             couplings[4] = (PSI_ODO, WHEEL_DIFF, wheel.d_heading_d_diff);
             couplings[5] = (PSI_ODO, SPEED_COEFF, wheel.d_heading_d_speed_coeff);
+            couplings[6] = (PSI_ODO, TRACK_SCALE, wheel.d_heading_d_track_scale);
             q[PSI_ODO] = wheel_q;
             q[BIAS] = c.bias_walk_rad2_per_s3 * dt;
             q[GAIN_POS] = GAIN_WALK * GAIN_WALK * dt;
@@ -262,11 +284,21 @@ impl VehicleEstimator {
         } else {
             couplings[2] = (PSI, WHEEL_DIFF, wheel.d_heading_d_diff);
             couplings[3] = (PSI, SPEED_COEFF, wheel.d_heading_d_speed_coeff);
+            couplings[4] = (PSI, TRACK_SCALE, wheel.d_heading_d_track_scale);
             q[PSI] = wheel_q;
         }
+        let decay = (-dt / self.config.compass.systematic_tau_s).exp();
+        couplings[7] = (COMPASS_BIAS, COMPASS_BIAS, decay - 1.0);
+        // A calibration's error depends on the heading: turning changes it by up to its
+        // size per radian (the slope of a one-cycle error A·sin ψ is at most A).
+        let cal_sigma = self.compass.fix().map_or(0.0, |f| f.calibration_sigma_rad);
+        q[COMPASS_BIAS] =
+            self.compass_bias_var() * (1.0 - decay * decay) + (cal_sigma * dpsi).powi(2);
+        self.filter.x[COMPASS_BIAS] *= decay;
         if self.learns_wheels() {
             q[WHEEL_DIFF] = DIFF_WALK * DIFF_WALK * dt;
             q[SPEED_COEFF] = SPEED_COEFF_WALK * SPEED_COEFF_WALK * dt;
+            q[TRACK_SCALE] = GAIN_WALK * GAIN_WALK * dt;
         }
         self.filter.x[NORTH] += wheel.ds_m * co;
         self.filter.x[EAST] += wheel.ds_m * s;
@@ -387,67 +419,89 @@ impl VehicleEstimator {
             return;
         };
         let reading = self.compass.measure(&raw);
-        let trusted = match reading {
+        let gated = match reading {
             Some((heading, ratio)) if self.alignment.done => {
-                let nu = wrap_pi(heading - self.filter.x[PSI]);
-                let verdict = self
-                    .compass
-                    .judge(sample.t_s, nu, ratio, self.filter.p[PSI][PSI]);
-                if let Verdict::Correct {
-                    innovation_rad,
-                    variance_rad2,
-                } = verdict
-                {
-                    // The average of the innovations was taken against headings that the
-                    // filter has since moved on from by no more than its own updates.
+                let f = &self.filter;
+                let nu = wrap_pi(heading - f.x[PSI] - f.x[COMPASS_BIAS]);
+                let p_nu =
+                    f.p[PSI][PSI] + 2.0 * f.p[PSI][COMPASS_BIAS] + f.p[COMPASS_BIAS][COMPASS_BIAS];
+                let verdict = self.compass.judge(sample.t_s, nu, ratio, p_nu);
+                if let Verdict::Use { variance_rad2 } = verdict {
                     self.filter
-                        .update(&[(PSI, 1.0)], innovation_rad, variance_rad2);
+                        .update(&[(PSI, 1.0), (COMPASS_BIAS, 1.0)], nu, variance_rad2);
                     self.est.status.compass_used = true;
                 }
-                matches!(verdict, Verdict::Taken | Verdict::Correct { .. })
+                matches!(verdict, Verdict::Use { .. })
             }
             Some((heading, ratio)) => {
                 if self.compass.field_ok(ratio) {
-                    self.align_step(heading);
+                    self.align_step(sample.t_s, heading);
                 }
-                true
+                false
             }
-            None => true,
+            None => false,
         };
-        if trusted {
-            self.compass.offer(&raw, sample.t_s, self.filter.x[PSI]);
+        if let Some(s) = self
+            .learner
+            .offer(&raw, sample.t_s, self.filter.x[PSI], gated)
+        {
+            self.compass.set_fix(CompassFix::from_solution(&s));
+            // A new calibration makes a new systematic error, and the averaged
+            // innovation was taken against the old one.
+            self.compass.restart_gates();
+            self.filter.x[COMPASS_BIAS] = 0.0;
+            self.filter
+                .reset_state(COMPASS_BIAS, self.compass_bias_var().sqrt());
         }
         self.est.status.compass_calibrated = self.compass.fix().is_some();
         self.est.status.compass_disturbed = self.compass.disturbed();
     }
 
     /// Gathers consistent readings and, once there are enough, refers the heading to north.
-    fn align_step(&mut self, heading: f64) {
+    ///
+    /// The dead-reckoned heading may drift while the readings are gathered (wheels whose
+    /// scales are not known yet turn the heading by up to a few degrees a second), so the
+    /// innovations are fitted with a straight line in time and the offset is taken where
+    /// the line ends, at the last reading; the line's residuals say whether the readings
+    /// agree.
+    fn align_step(&mut self, t_s: f64, heading: f64) {
         let Some(fix) = self.compass.fix().copied() else {
             return;
         };
         let nu = wrap_pi(heading - self.filter.x[PSI]);
         let a = &mut self.alignment;
-        a.sin_sum += nu.sin();
-        a.cos_sum += nu.cos();
+        let (t0, nu0) = *a.first.get_or_insert((t_s, nu));
+        let (t, v) = (t_s - t0, wrap_pi(nu - nu0));
         a.n += 1;
+        a.s_t += t;
+        a.s_tt += t * t;
+        a.s_v += v;
+        a.s_tv += t * v;
+        a.s_vv += v * v;
         if a.n < self.config.compass.alignment_readings {
             return;
         }
         let n = f64::from(a.n);
-        let resultant = (a.sin_sum.hypot(a.cos_sum) / n).min(1.0);
-        let spread = (-2.0 * resultant.ln()).sqrt();
-        let floor = self.config.compass.systematic_floor_deg.to_radians();
-        let offset = a.sin_sum.atan2(a.cos_sum);
+        let (mt, mv) = (a.s_t / n, a.s_v / n);
+        let stt = a.s_tt - n * mt * mt;
+        let stv = a.s_tv - n * mt * mv;
+        let svv = a.s_vv - n * mv * mv;
+        let slope = if stt > 0.0 { stv / stt } else { 0.0 };
+        let residual_var = ((svv - slope * stv) / (n - 2.0).max(1.0)).max(0.0);
+        let offset = wrap_pi(nu0 + mv + slope * (t - mt));
+        // Variance of a fitted line's value at its end: σ²(1/n + (t_end − t̄)²/Stt).
+        let r = fix.noise_rad * fix.noise_rad;
+        let lever = if stt > 0.0 {
+            (t - mt).powi(2) / stt
+        } else {
+            0.0
+        };
         *a = Alignment::default();
-        if spread > 3.0 * (fix.noise_rad + floor) {
+        if residual_var.sqrt() > 3.0 * fix.noise_rad {
             // Not consistent (a disturbance, or the calibration is off): gather again.
             return;
         }
-        self.align(
-            offset,
-            (fix.noise_rad * fix.noise_rad / n + floor * floor).sqrt(),
-        );
+        self.align(offset, (r * (1.0 / n + lever)).sqrt());
     }
 
     /// Refers the heading to north: turns heading, wheel heading and track by `offset`,
@@ -458,6 +512,7 @@ impl VehicleEstimator {
     /// uncorrelated with the calibration states, and the track turned about the start by the
     /// same error. The wheels' heading keeps its difference from the gyro's.
     fn align(&mut self, offset: f64, sigma: f64) {
+        let bias_var = self.compass_bias_var();
         let f = &mut self.filter;
         f.x[PSI] += offset;
         f.x[PSI_ODO] += offset;
@@ -488,8 +543,28 @@ impl VehicleEstimator {
         g[NORTH] = -f.x[EAST];
         g[EAST] = f.x[NORTH];
         f.add_common_error(&g, sigma);
+        // The readings the offset came from carried the compass's systematic error too:
+        // the heading's error is minus it, until the filter learns otherwise.
+        f.reset_state(COMPASS_BIAS, bias_var.sqrt());
+        for (k, gk) in g.iter().enumerate() {
+            f.p[COMPASS_BIAS][k] -= bias_var * gk;
+            f.p[k][COMPASS_BIAS] -= bias_var * gk;
+        }
+        f.p[COMPASS_BIAS][COMPASS_BIAS] = bias_var;
+        for (i, gi) in g.iter().enumerate() {
+            for (j, gj) in g.iter().enumerate() {
+                f.p[i][j] += bias_var * gi * gj;
+            }
+        }
         self.alignment.done = true;
         self.compass.restart_gates();
+    }
+
+    /// Stationary variance of the compass's systematic error: the road's floor plus what
+    /// the calibration in use leaves, rad².
+    fn compass_bias_var(&self) -> f64 {
+        let cal = self.compass.fix().map_or(0.0, |f| f.calibration_sigma_rad);
+        self.coeffs.compass_floor_var + cal * cal
     }
 
     fn publish(&mut self, t_s: f64) -> NavEstimate {
@@ -525,8 +600,12 @@ impl HeadingEstimator for VehicleEstimator {
         Self::check(sample)?;
         match self.clock.dt_s(sample.t_s)? {
             None => {
-                self.wheels
-                    .step(sample.dist_l_m, sample.dist_r_m, 1.0, 0.0, 0.0);
+                self.wheels.step(
+                    sample.dist_l_m,
+                    sample.dist_r_m,
+                    1.0,
+                    &WheelCalibration::default(),
+                );
                 self.start_gyro(sample);
             }
             Some(dt) => self.step(sample, dt),
@@ -542,8 +621,8 @@ impl HeadingEstimator for VehicleEstimator {
     fn reset(&mut self) {
         self.filter = self.initial;
         self.wheels.reset();
-        self.compass.reset();
-        self.compass = self.compass.clone().with_fix(self.initial_fix);
+        self.compass = CompassMonitor::new(self.config.compass);
+        self.learner.reset();
         self.clock.reset();
         self.gyro = GyroTrack::default();
         self.rest = Rest::default();

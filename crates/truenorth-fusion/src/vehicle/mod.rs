@@ -1,14 +1,16 @@
 //! Vehicle heading and dead reckoning from a gyro, wheel odometers and a compass, each
 //! calibrated online from the drive itself.
 
+mod compass_learning;
 mod compass_monitor;
 mod config;
 mod estimator;
 pub mod nav_filter;
 mod wheel_odometry;
 
+pub use compass_learning::CompassLearner;
 pub use compass_monitor::{CompassFix, CompassMonitor, Verdict};
 pub use config::{CompassGates, SensorPriors, VehicleConfig, VehicleMethod};
 pub use estimator::VehicleEstimator;
 pub use nav_filter::NavFilter;
-pub use wheel_odometry::{WheelOdometry, WheelStep};
+pub use wheel_odometry::{WheelCalibration, WheelOdometry, WheelStep};

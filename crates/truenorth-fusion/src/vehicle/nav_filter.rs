@@ -28,8 +28,15 @@ pub const WHEEL_DIFF: usize = 6;
 pub const SPEED_COEFF: usize = 7;
 /// Heading integrated from the wheels alone, rad (used when a gyro carries the heading).
 pub const PSI_ODO: usize = 8;
+/// Relative error ε of the wheels' effective track: the wheels' heading change is divided
+/// by `T(1 + ε)`. It also takes up the odometer's mean scale error, which scales both
+/// wheels and so their difference.
+pub const TRACK_SCALE: usize = 9;
+/// The compass's slowly varying heading error, rad: what its calibration and the road
+/// (grade, camber) leave in every reading alike for a while (first-order Gauss-Markov).
+pub const COMPASS_BIAS: usize = 10;
 /// Number of states.
-pub const DIM: usize = 9;
+pub const DIM: usize = 11;
 
 /// The nominal state and the error covariance.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -65,7 +72,8 @@ impl NavFilter {
     /// Couplings are applied in order, each reading the rows and columns it couples from as
     /// they were before it, so a state that is both coupled from and coupled to (the
     /// heading: position is coupled from it, it is coupled from the gyro states) must have
-    /// its own couplings listed after those that read it.
+    /// its own couplings listed after those that read it. A coupling of a state to itself,
+    /// `(i, i, f)`, scales it by `1 + f` (a decay).
     pub fn predict(&mut self, couplings: &[Coupling], q: &[f64; DIM]) {
         for &(i, j, f) in couplings {
             if f != 0.0 {
@@ -153,7 +161,9 @@ mod tests {
 
     #[test]
     fn predict_matches_the_dense_product() {
-        let mut f = filter([0.1, 1.0, 2.0, 0.01, 0.02, 0.03, 0.004, 1e-4, 0.2]);
+        let mut f = filter([
+            0.1, 1.0, 2.0, 0.01, 0.02, 0.03, 0.004, 1e-4, 0.2, 0.01, 0.005,
+        ]);
         f.p[BIAS][GAIN_POS] = 1e-4;
         f.p[GAIN_POS][BIAS] = 1e-4;
         let couplings = [
@@ -162,10 +172,11 @@ mod tests {
             (PSI, BIAS, -0.1),
             (PSI, GAIN_POS, -0.5),
             (PSI_ODO, WHEEL_DIFF, -7.0),
+            (COMPASS_BIAS, COMPASS_BIAS, -0.1),
         ];
         let mut dense = nalgebra::SMatrix::<f64, DIM, DIM>::identity();
         for &(i, j, v) in &couplings {
-            dense[(i, j)] = v;
+            dense[(i, j)] += v;
         }
         let p = nalgebra::SMatrix::<f64, DIM, DIM>::from_fn(|i, j| f.p[i][j]);
         let expect = dense * p * dense.transpose();
@@ -180,7 +191,7 @@ mod tests {
     proptest! {
         #[test]
         fn an_update_never_raises_a_variance_and_keeps_p_symmetric(
-            sig in proptest::array::uniform9(1e-3f64..10.0),
+            sig in proptest::array::uniform11(1e-3f64..10.0),
             corr in -0.9f64..0.9,
             c in -3.0f64..3.0,
             nu in -10.0f64..10.0,
@@ -214,7 +225,7 @@ mod tests {
 
     #[test]
     fn a_measurement_pulls_towards_it_in_proportion_to_trust() {
-        let mut f = filter([1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]);
+        let mut f = filter([1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]);
         f.update(&[(PSI, 1.0)], 2.0, 1.0).unwrap();
         // Equal trust: half way, variance halved.
         assert!((f.x[PSI] - 1.0).abs() < 1e-12);

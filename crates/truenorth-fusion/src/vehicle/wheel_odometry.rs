@@ -37,10 +37,23 @@ pub struct WheelStep {
     pub d_heading_d_diff: f64,
     /// ∂(heading change)/∂a, rad·m²/s².
     pub d_heading_d_speed_coeff: f64,
+    /// ∂(heading change)/∂ε, the track's relative error, rad.
+    pub d_heading_d_track_scale: f64,
     /// Mean speed of the odometer wheels, m/s.
     pub speed_mps: f64,
     /// Whether either wheel's reading changed.
     pub moved: bool,
+}
+
+/// The wheel calibration states a step is computed with.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct WheelCalibration {
+    /// Differential scale δ: left gain `1 + δ/2`, right `1 − δ/2`.
+    pub diff: f64,
+    /// Speed coefficient `a`, s²/m².
+    pub speed_coeff: f64,
+    /// Relative error ε of the effective track.
+    pub track_scale: f64,
 }
 
 /// Cumulative wheel distances → [`WheelStep`]s.
@@ -81,16 +94,21 @@ impl WheelOdometry {
     }
 
     /// The step from the previous cumulative reading to this one (`None` for the first),
-    /// with differential scale `diff` and speed coefficient `speed_coeff`. Inputs are
-    /// finite and `dt_s > 0` (checked by the caller).
+    /// with differential scale `diff`, speed coefficient `speed_coeff` and the track's
+    /// relative error `track_scale`. Inputs are finite and `dt_s > 0` (checked by the
+    /// caller).
     pub fn step(
         &mut self,
         dist_l_m: f64,
         dist_r_m: f64,
         dt_s: f64,
-        diff: f64,
-        speed_coeff: f64,
+        cal: &WheelCalibration,
     ) -> Option<WheelStep> {
+        let WheelCalibration {
+            diff,
+            speed_coeff,
+            track_scale,
+        } = *cal;
         let (l0, r0) = self.last.replace((dist_l_m, dist_r_m))?;
         let (raw_l, raw_r) = (dist_l_m - l0, dist_r_m - r0);
         let moved = raw_l != 0.0 || raw_r != 0.0;
@@ -110,7 +128,8 @@ impl WheelOdometry {
                 s.table.effective_track_m(c).unwrap_or(self.track_m)
             }
         };
-        let heading = delta / track_m;
+        let scale = (1.0 + track_scale).max(0.5);
+        let heading = delta / (track_m * scale);
         let ds_m = match &self.steered {
             None => mean,
             Some(s) => {
@@ -122,8 +141,9 @@ impl WheelOdometry {
             ds_m,
             heading_change_rad: heading,
             // u_l − u_r falls by the mean distance per unit δ (first order).
-            d_heading_d_diff: -mean / (factor * track_m),
+            d_heading_d_diff: -mean / (factor * track_m * scale),
             d_heading_d_speed_coeff: -heading * speed_mps * speed_mps / factor,
+            d_heading_d_track_scale: -heading / scale,
             speed_mps,
             moved,
         })
@@ -135,11 +155,17 @@ mod tests {
     use super::*;
     use truenorth_odometer::AckermannParams;
 
+    const NONE: WheelCalibration = WheelCalibration {
+        diff: 0.0,
+        speed_coeff: 0.0,
+        track_scale: 0.0,
+    };
+
     #[test]
     fn rear_wheels_give_the_plain_formula_and_its_derivatives() {
         let mut w = WheelOdometry::new(OdometerWheels::Rear { track_m: 1.5 }).unwrap();
-        assert!(w.step(0.0, 0.0, 0.1, 0.0, 0.0).is_none());
-        let s = w.step(1.03, 0.97, 0.1, 0.0, 0.0).unwrap();
+        assert!(w.step(0.0, 0.0, 0.1, &NONE).is_none());
+        let s = w.step(1.03, 0.97, 0.1, &NONE).unwrap();
         assert!((s.heading_change_rad - 0.04).abs() < 1e-12);
         assert!((s.ds_m - 1.0).abs() < 1e-12);
         assert!((s.speed_mps - 10.0).abs() < 1e-12);
@@ -147,12 +173,40 @@ mod tests {
         let h = 1e-7;
         let mut a = WheelOdometry::new(OdometerWheels::Rear { track_m: 1.5 }).unwrap();
         let mut b = a;
-        a.step(0.0, 0.0, 0.1, 0.0, 0.0);
-        b.step(0.0, 0.0, 0.1, 0.0, 0.0);
-        let up = a.step(1.03, 0.97, 0.1, h, 0.0).unwrap().heading_change_rad;
+        a.step(0.0, 0.0, 0.1, &NONE);
+        b.step(0.0, 0.0, 0.1, &NONE);
+        let mut c = b;
+        let up = a
+            .step(1.03, 0.97, 0.1, &WheelCalibration { diff: h, ..NONE })
+            .unwrap()
+            .heading_change_rad;
         assert!(((up - s.heading_change_rad) / h - s.d_heading_d_diff).abs() < 1e-5);
-        let up = b.step(1.03, 0.97, 0.1, 0.0, h).unwrap().heading_change_rad;
+        let up = b
+            .step(
+                1.03,
+                0.97,
+                0.1,
+                &WheelCalibration {
+                    speed_coeff: h,
+                    ..NONE
+                },
+            )
+            .unwrap()
+            .heading_change_rad;
         assert!(((up - s.heading_change_rad) / h - s.d_heading_d_speed_coeff).abs() < 1e-4);
+        let up = c
+            .step(
+                1.03,
+                0.97,
+                0.1,
+                &WheelCalibration {
+                    track_scale: h,
+                    ..NONE
+                },
+            )
+            .unwrap()
+            .heading_change_rad;
+        assert!(((up - s.heading_change_rad) / h - s.d_heading_d_track_scale).abs() < 1e-5);
     }
 
     #[test]
@@ -166,8 +220,8 @@ mod tests {
         let radius = 8.0;
         let paths = geometry.wheel_paths_m(10.0, 1.0 / radius).unwrap();
         let mut w = WheelOdometry::new(OdometerWheels::Front(car)).unwrap();
-        w.step(0.0, 0.0, 1.0, 0.0, 0.0);
-        let s = w.step(paths.left_m, paths.right_m, 1.0, 0.0, 0.0).unwrap();
+        w.step(0.0, 0.0, 1.0, &NONE);
+        let s = w.step(paths.left_m, paths.right_m, 1.0, &NONE).unwrap();
         // True heading change 10/8 rad; the patent's track is within 0.1 % at this radius.
         assert!(
             (s.heading_change_rad / 1.25 - 1.0).abs() < 1e-3,
@@ -177,7 +231,7 @@ mod tests {
         assert!((s.ds_m / 10.0 - 1.0).abs() < 2e-3, "{}", s.ds_m);
         // A ratio past full lock is clamped, never NaN.
         let s = w
-            .step(paths.left_m + 0.06, paths.right_m, 1.0, 0.0, 0.0)
+            .step(paths.left_m + 0.06, paths.right_m, 1.0, &NONE)
             .unwrap();
         assert!(s.heading_change_rad.is_finite() && s.ds_m.is_finite());
     }
