@@ -1,6 +1,7 @@
 //! The vehicle estimator on simulated mixed drives.
 
-use truenorth_core::{HeadingEstimator, angle_diff};
+use truenorth_core::{HeadingEstimator, NavEstimate, VehicleSample, angle_diff};
+use truenorth_fusion::vehicle::{TwoPassConfig, TwoPassStart};
 use truenorth_fusion::{VehicleConfig, VehicleEstimator};
 use truenorth_odometer::OdometerWheels;
 use truenorth_sim::{DriveSpec, DriveWheels, SimulatedDrive};
@@ -28,16 +29,32 @@ fn run(spec: DriveSpec, gyro: bool) -> Outcome {
         ..VehicleConfig::default()
     })
     .unwrap();
+    let samples: Vec<_> = drive
+        .samples
+        .iter()
+        .map(|s| VehicleSample {
+            gyr_z_rps: if gyro { s.gyr_z_rps } else { None },
+            ..*s
+        })
+        .collect();
+    let estimates: Vec<NavEstimate> = if std::env::var("TWO_PASS").is_ok() {
+        let mut two = TwoPassStart::new(nav.clone(), TwoPassConfig::default());
+        let mut out = Vec::new();
+        for s in &samples {
+            two.push(s, |_, e| out.push(*e)).unwrap();
+        }
+        two.finish(|_, e| out.push(*e)).unwrap();
+        nav = two.estimator().clone();
+        out
+    } else {
+        samples.iter().map(|s| nav.update(s).unwrap()).collect()
+    };
     let (mut sum, mut n, mut max) = (0.0, 0usize, 0.0f64);
     let (mut dsum, mut dn, mut flagged) = (0.0, 0usize, 0usize);
     let mut aligned_at_s = f64::NAN;
     let mut last = None;
-    for (s, t) in drive.samples.iter().zip(&drive.truth) {
-        let mut s = *s;
-        if !gyro {
-            s.gyr_z_rps = None;
-        }
-        let e = nav.update(&s).unwrap();
+    for (e, t) in estimates.iter().zip(&drive.truth) {
+        let e = *e;
         if e.status.heading_absolute {
             if aligned_at_s.is_nan() {
                 aligned_at_s = t.t_s;

@@ -31,6 +31,7 @@ use truenorth_core::{
 use super::compass_learning::CompassLearner;
 use super::compass_monitor::{CompassFix, CompassMonitor, Verdict};
 use super::config::{VehicleConfig, VehicleMethod};
+use super::learned::VehicleCalibration;
 use super::nav_filter::{
     BIAS, COMPASS_BIAS, Coupling, DIM, EAST, GAIN_NEG, GAIN_POS, NORTH, NavFilter, PSI, PSI_ODO,
     SPEED_COEFF, TRACK_SCALE, WHEEL_DIFF,
@@ -102,6 +103,8 @@ impl Coefficients {
 struct GyroTrack {
     /// The gyro carries the heading (a reading has been seen and the method uses it).
     active: bool,
+    /// The gyro's states come from a stored calibration rather than the priors.
+    restored: bool,
     last_raw_rps: f64,
 }
 
@@ -156,14 +159,23 @@ pub struct VehicleEstimator {
     filter: NavFilter,
     wheels: WheelOdometry,
     compass: CompassMonitor,
+    /// The compass calibration the estimator started with (restored), if any.
+    initial_fix: Option<CompassFix>,
     learner: CompassLearner,
     clock: TimeStep,
     gyro: GyroTrack,
     rest: Rest,
     wheel_check_s: f64,
     alignment: Alignment,
+    /// Readings up to this time are not offered to the compass learner (it has them
+    /// already: the estimator is replaying them).
+    learned_until_s: f64,
     est: NavEstimate,
 }
+
+/// Factor by which a restored calibration's sigmas are widened: between drives the sensors
+/// drift, and a replay must not count the same readings' information twice.
+const RESTORE_WIDEN: f64 = 2.0;
 
 impl VehicleEstimator {
     /// An estimator that knows nothing yet beyond `config`'s priors.
@@ -183,15 +195,55 @@ impl VehicleEstimator {
             filter,
             wheels: WheelOdometry::new(config.wheels)?,
             compass: CompassMonitor::new(config.compass),
+            initial_fix: None,
             learner: CompassLearner::new(config.compass)?,
             clock: TimeStep::new(),
             gyro: GyroTrack::default(),
             rest: Rest::default(),
             wheel_check_s: 0.0,
             alignment: Alignment::default(),
+            learned_until_s: f64::NEG_INFINITY,
             est: NavEstimate::at_start(f64::NAN, MagneticHeading::new(0.0), f64::INFINITY),
             config,
         })
+    }
+
+    /// An estimator that starts from what an earlier drive learned (see
+    /// [`VehicleEstimator::calibration`]): the compass calibrated, the gyro and wheels
+    /// with their learned errors (sigmas widened by 2, for drift since). A calibration
+    /// with a non-finite value, a gain or scale beyond ±50 % or a singular soft iron is
+    /// refused.
+    pub fn with_calibration(
+        config: VehicleConfig,
+        calibration: &VehicleCalibration,
+    ) -> Result<Self> {
+        calibration.validate()?;
+        let mut e = Self::new(config)?;
+        calibration.to_filter(&mut e.filter, RESTORE_WIDEN);
+        e.initial = e.filter;
+        e.gyro.restored = calibration.gyro_bias_rps.sigma > 0.0;
+        e.initial_fix = calibration.compass_fix();
+        if let Some(fix) = e.initial_fix {
+            e.compass.set_fix(fix);
+        }
+        Ok(e)
+    }
+
+    /// What the estimator has learned about its sensors so far, to store and give back to
+    /// [`VehicleEstimator::with_calibration`] at the next start.
+    pub fn calibration(&self) -> VehicleCalibration {
+        VehicleCalibration::from_filter(&self.filter, self.compass.fix())
+    }
+
+    /// A fresh start at the beginning of the samples this estimator has seen, knowing what
+    /// it has learned: the two-pass start replays the head of a drive through it. The
+    /// compass learner carries on from where this one is, and is not offered the readings
+    /// again.
+    pub(crate) fn replay_start(&self) -> Result<Self> {
+        let mut e = Self::with_calibration(self.config, &self.calibration())?;
+        e.learner = self.learner.clone();
+        e.learned_until_s = self.est.t_s;
+        Ok(e)
     }
 
     /// The configuration in use.
@@ -359,15 +411,15 @@ impl VehicleEstimator {
         if self.gyro.active || !self.config.method.uses_gyro() {
             return;
         }
-        self.gyro = GyroTrack {
-            active: true,
-            last_raw_rps: raw,
-        };
-        let p = &self.config.priors;
-        self.filter
-            .reset_state(BIAS, p.gyro_bias_sigma_dps.to_radians());
-        self.filter.reset_state(GAIN_POS, p.gyro_gain_sigma);
-        self.filter.reset_state(GAIN_NEG, p.gyro_gain_sigma);
+        self.gyro.active = true;
+        self.gyro.last_raw_rps = raw;
+        if !self.gyro.restored {
+            let p = &self.config.priors;
+            self.filter
+                .reset_state(BIAS, p.gyro_bias_sigma_dps.to_radians());
+            self.filter.reset_state(GAIN_POS, p.gyro_gain_sigma);
+            self.filter.reset_state(GAIN_NEG, p.gyro_gain_sigma);
+        }
         self.filter.x[PSI_ODO] = self.filter.x[PSI];
         for k in 0..DIM {
             self.filter.p[PSI_ODO][k] = self.filter.p[PSI][k];
@@ -441,9 +493,13 @@ impl VehicleEstimator {
             }
             None => false,
         };
-        if let Some(s) = self
-            .learner
-            .offer(&raw, sample.t_s, self.filter.x[PSI], gated)
+        let learn = sample.t_s > self.learned_until_s;
+        if let Some(s) = learn
+            .then(|| {
+                self.learner
+                    .offer(&raw, sample.t_s, self.filter.x[PSI], gated)
+            })
+            .flatten()
         {
             self.compass.set_fix(CompassFix::from_solution(&s));
             // A new calibration makes a new systematic error, and the averaged
@@ -622,9 +678,16 @@ impl HeadingEstimator for VehicleEstimator {
         self.filter = self.initial;
         self.wheels.reset();
         self.compass = CompassMonitor::new(self.config.compass);
+        if let Some(fix) = self.initial_fix {
+            self.compass.set_fix(fix);
+        }
         self.learner.reset();
+        self.learned_until_s = f64::NEG_INFINITY;
         self.clock.reset();
-        self.gyro = GyroTrack::default();
+        self.gyro = GyroTrack {
+            restored: self.gyro.restored,
+            ..GyroTrack::default()
+        };
         self.rest = Rest::default();
         self.wheel_check_s = 0.0;
         self.alignment = Alignment::default();

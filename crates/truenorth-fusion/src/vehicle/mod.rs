@@ -5,12 +5,16 @@ mod compass_learning;
 mod compass_monitor;
 mod config;
 mod estimator;
+mod learned;
 pub mod nav_filter;
+mod two_pass;
 mod wheel_odometry;
 
 pub use compass_learning::CompassLearner;
 pub use compass_monitor::{CompassFix, CompassMonitor, Verdict};
 pub use config::{CompassGates, SensorPriors, VehicleConfig, VehicleMethod};
 pub use estimator::VehicleEstimator;
+pub use learned::{Learned, LearnedCompass, VehicleCalibration};
 pub use nav_filter::NavFilter;
+pub use two_pass::{TwoPassConfig, TwoPassStart};
 pub use wheel_odometry::{WheelCalibration, WheelOdometry, WheelStep};

@@ -1,0 +1,149 @@
+//! What the vehicle estimator has learned about its sensors, as plain data: saved when the
+//! ignition goes off and given back at the next start (EP 0634001 claims 13-14 store the
+//! compass's ellipse the same way), so a drive starts calibrated.
+
+use serde::{Deserialize, Serialize};
+use truenorth_compass::CompassCalibration2d;
+use truenorth_core::{
+    CompassQuality, Error, Result, Validate, check_finite, check_positive, check_range,
+};
+
+use super::compass_monitor::CompassFix;
+use super::nav_filter::{
+    BIAS, GAIN_NEG, GAIN_POS, NavFilter, SPEED_COEFF, TRACK_SCALE, WHEEL_DIFF,
+};
+
+/// A learned value and its standard deviation (0: never learned, the prior stands).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Learned {
+    /// The value.
+    pub value: f64,
+    /// Its standard deviation (> 0).
+    pub sigma: f64,
+}
+
+impl Learned {
+    fn of(filter: &NavFilter, i: usize) -> Self {
+        Self {
+            value: filter.x[i],
+            sigma: filter.sigma(i),
+        }
+    }
+
+    fn check(&self, what: &'static str) -> Result<()> {
+        check_finite(what, self.value)?;
+        check_range(what, self.sigma, 0.0, f64::MAX)?;
+        Ok(())
+    }
+}
+
+/// The compass calibration learned, with its quality report.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct LearnedCompass {
+    /// Hard and soft iron.
+    pub calibration: CompassCalibration2d,
+    /// The quality report of the fit.
+    pub quality: CompassQuality,
+}
+
+/// Everything the vehicle estimator learns about its sensors. Units: rad/s for the gyro
+/// bias, dimensionless for gains and scales, s²/m² for the speed coefficient.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct VehicleCalibration {
+    /// The compass's hard and soft iron, if learned.
+    pub compass: Option<LearnedCompass>,
+    /// Gyro bias, rad/s (it wanders with temperature: restored with a wider sigma).
+    pub gyro_bias_rps: Learned,
+    /// Gyro gain error for right turns (gain `1 + this`).
+    pub gyro_gain_error_right: Learned,
+    /// Gyro gain error for left turns.
+    pub gyro_gain_error_left: Learned,
+    /// Differential wheel scale δ (left gain `1 + δ/2`, right `1 − δ/2`).
+    pub wheel_diff: Learned,
+    /// Relative error of the wheels' effective track.
+    pub track_scale: Learned,
+    /// Speed coefficient `a` of `1 + aV²` (US 4,788,645 eq. 8), s²/m².
+    pub speed_coeff_s2_per_m2: Learned,
+}
+
+impl VehicleCalibration {
+    /// The calibration states of `filter` and the compass calibration in use.
+    pub fn from_filter(filter: &NavFilter, compass: Option<&CompassFix>) -> Self {
+        Self {
+            compass: compass.map(|f| LearnedCompass {
+                calibration: f.calibration,
+                quality: f.quality,
+            }),
+            gyro_bias_rps: Learned::of(filter, BIAS),
+            gyro_gain_error_right: Learned::of(filter, GAIN_POS),
+            gyro_gain_error_left: Learned::of(filter, GAIN_NEG),
+            wheel_diff: Learned::of(filter, WHEEL_DIFF),
+            track_scale: Learned::of(filter, TRACK_SCALE),
+            speed_coeff_s2_per_m2: Learned::of(filter, SPEED_COEFF),
+        }
+    }
+
+    /// Writes the learned calibration states into `filter`, uncorrelated, each sigma
+    /// multiplied by `widen` (≥ 1: what was learned may have drifted since). States never
+    /// learned (sigma 0) keep the filter's prior.
+    pub fn to_filter(&self, filter: &mut NavFilter, widen: f64) {
+        for (i, l) in [
+            (BIAS, self.gyro_bias_rps),
+            (GAIN_POS, self.gyro_gain_error_right),
+            (GAIN_NEG, self.gyro_gain_error_left),
+            (WHEEL_DIFF, self.wheel_diff),
+            (TRACK_SCALE, self.track_scale),
+            (SPEED_COEFF, self.speed_coeff_s2_per_m2),
+        ] {
+            if l.sigma > 0.0 {
+                filter.x[i] = l.value;
+                filter.reset_state(i, l.sigma * widen);
+            }
+        }
+    }
+
+    /// The compass calibration as the estimator uses it.
+    pub fn compass_fix(&self) -> Option<CompassFix> {
+        self.compass.map(|c| {
+            CompassFix::from_solution(&truenorth_core::Solution {
+                params: c.calibration,
+                quality: c.quality,
+            })
+        })
+    }
+}
+
+impl Validate for VehicleCalibration {
+    /// Every value finite, every sigma positive, gains and scales within ±50 %, and the
+    /// compass's soft iron invertible with a finite field.
+    fn validate(&self) -> Result<()> {
+        self.gyro_bias_rps.check("gyro_bias_rps")?;
+        for (what, l) in [
+            ("gyro_gain_error_right", self.gyro_gain_error_right),
+            ("gyro_gain_error_left", self.gyro_gain_error_left),
+            ("wheel_diff", self.wheel_diff),
+            ("track_scale", self.track_scale),
+        ] {
+            l.check(what)?;
+            check_range(what, l.value, -0.5, 0.5)?;
+        }
+        self.speed_coeff_s2_per_m2.check("speed_coeff_s2_per_m2")?;
+        if let Some(c) = &self.compass {
+            for v in c
+                .calibration
+                .hard_iron
+                .iter()
+                .chain(c.calibration.soft_iron.iter())
+            {
+                check_finite("compass calibration", *v)?;
+            }
+            check_positive("compass field_magnitude", c.quality.field_magnitude)?;
+            if c.calibration.soft_iron.determinant().abs() < f64::EPSILON {
+                return Err(Error::Degenerate {
+                    reason: "the stored compass soft iron is singular; recalibrate the compass",
+                });
+            }
+        }
+        Ok(())
+    }
+}
