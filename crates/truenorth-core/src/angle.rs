@@ -18,6 +18,11 @@ fn rem_two_pi(x: f64) -> f64 {
 /// caller's validation can report it.
 #[inline]
 pub fn wrap_pi(angle_rad: f64) -> f64 {
+    // Most angles wrapped are differences of wrapped angles, already in range or one turn
+    // out: no division for those.
+    if angle_rad > -PI && angle_rad <= PI {
+        return angle_rad;
+    }
     if !angle_rad.is_finite() {
         return angle_rad;
     }

@@ -159,16 +159,18 @@ impl CompassLearner {
         psi_rad: f64,
         gated: bool,
     ) -> Option<Solution<CompassCalibration2d>> {
-        let consistent = self.consistency.check(raw, psi_rad, t_s);
-        if !(consistent || gated) {
-            return None;
-        }
+        // Decimation first: it is cheap, and only readings that would be taken need the
+        // consistency test.
         if let Some((t0, psi0)) = self.last_push {
             let moved =
                 wrap_pi(psi_rad - psi0).abs() >= self.gates.calibrator_spacing_deg.to_radians();
             if !moved && t_s - t0 < self.gates.calibrator_interval_s {
                 return None;
             }
+        }
+        let consistent = self.consistency.check(raw, psi_rad, t_s);
+        if !(consistent || gated) {
+            return None;
         }
         self.last_push = Some((t_s, psi_rad));
         let sample = Mag2Sample { t_s, mag: *raw };

@@ -126,11 +126,12 @@ impl CompassMonitor {
         self.disturbed
     }
 
-    /// Calibrated heading (rad) and field magnitude over the fitted one, if calibrated.
-    pub fn measure(&self, raw: &nalgebra::Vector2<f64>) -> Option<(f64, f64)> {
+    /// The calibrated horizontal field and its magnitude over the fitted one, if
+    /// calibrated.
+    pub fn measure(&self, raw: &nalgebra::Vector2<f64>) -> Option<(nalgebra::Vector2<f64>, f64)> {
         let fix = self.fix.as_ref()?;
         let u = fix.calibration.correct(raw);
-        Some(((-u.y).atan2(u.x), u.norm() / fix.field))
+        Some((u, u.norm() / fix.field))
     }
 
     /// Whether a field magnitude ratio is within the tolerance.
@@ -191,8 +192,8 @@ mod tests {
         let m = calibrated();
         let fix = m.fix().expect("calibrated after two turns");
         assert!((fix.calibration.hard_iron - Vector2::new(5.0, -3.0)).norm() < 1e-6);
-        let (h, ratio) = m.measure(&Vector2::new(25.0, -3.0)).unwrap();
-        assert!(h.abs() < 1e-6 && (ratio - 1.0).abs() < 1e-6);
+        let (u, ratio) = m.measure(&Vector2::new(25.0, -3.0)).unwrap();
+        assert!((-u.y).atan2(u.x).abs() < 1e-6 && (ratio - 1.0).abs() < 1e-6);
     }
 
     #[test]

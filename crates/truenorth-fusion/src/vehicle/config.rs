@@ -121,7 +121,10 @@ impl Validate for SensorPriors {
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct CompassGates {
-    /// The online least-squares calibrator the compass learns its hard and soft iron with.
+    /// The online least-squares calibrators the compass learns its hard and soft iron with
+    /// (defaults as [`OnlineEllipseConfig`], but refreshed every 64 readings taken: a
+    /// vehicle's calibration changes slowly, and a refresh costs as much as a few hundred
+    /// samples' filtering).
     pub calibrator: OnlineEllipseConfig,
     /// A reading goes to the calibrator once the heading has moved this far since the last
     /// one it took, degrees (2): even coverage, and a small per-sample cost on straights.
@@ -146,6 +149,9 @@ pub struct CompassGates {
     /// Correlation time of that error, s (20): it changes as the vehicle turns and the road
     /// changes.
     pub systematic_tau_s: f64,
+    /// Readings averaged into one heading correction (5): the covariance is carried
+    /// forward once per correction rather than at every sample.
+    pub readings_per_update: u32,
     /// Readings that must agree before the heading is first referred to north (20).
     pub alignment_readings: u32,
 }
@@ -153,7 +159,10 @@ pub struct CompassGates {
 impl Default for CompassGates {
     fn default() -> Self {
         Self {
-            calibrator: OnlineEllipseConfig::default(),
+            calibrator: OnlineEllipseConfig {
+                refresh_interval_samples: 64,
+                ..OnlineEllipseConfig::default()
+            },
             calibrator_spacing_deg: 2.0,
             calibrator_interval_s: 10.0,
             field_tolerance: 0.1,
@@ -162,6 +171,7 @@ impl Default for CompassGates {
             slow_gate_sigma: 3.0,
             systematic_deg: 0.3,
             systematic_tau_s: 20.0,
+            readings_per_update: 10,
             alignment_readings: 20,
         }
     }
@@ -188,6 +198,12 @@ impl Validate for CompassGates {
         check_range("slow_gate_sigma", self.slow_gate_sigma, 1.0, 100.0)?;
         check_range("systematic_deg", self.systematic_deg, 1e-3, 45.0)?;
         check_positive("systematic_tau_s", self.systematic_tau_s)?;
+        check_range(
+            "readings_per_update",
+            f64::from(self.readings_per_update),
+            1.0,
+            100.0,
+        )?;
         check_range(
             "alignment_readings",
             f64::from(self.alignment_readings),

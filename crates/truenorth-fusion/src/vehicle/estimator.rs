@@ -31,11 +31,13 @@ use truenorth_core::{
 use super::compass_learning::CompassLearner;
 use super::compass_monitor::{CompassFix, CompassMonitor, Verdict};
 use super::config::{VehicleConfig, VehicleMethod};
+use super::heading_trig::{HeadingTrig, small_atan2};
 use super::learned::VehicleCalibration;
 use super::nav_filter::{
-    BIAS, COMPASS_BIAS, Coupling, DIM, EAST, GAIN_NEG, GAIN_POS, NORTH, NavFilter, PSI, PSI_ODO,
-    SPEED_COEFF, TRACK_SCALE, WHEEL_DIFF,
+    BIAS, COMPASS_BIAS, DIM, EAST, GAIN_NEG, GAIN_POS, NORTH, NavFilter, PSI, PSI_ODO, SPEED_COEFF,
+    TRACK_SCALE, WHEEL_DIFF,
 };
+use super::step_batch::{Step, StepBatch};
 use super::wheel_odometry::{WheelCalibration, WheelOdometry};
 
 #[allow(unused_imports)]
@@ -58,6 +60,10 @@ const WHEEL_TURN_NOISE: f64 = 5e-3;
 const GAIN_WALK: f64 = 1e-5;
 const DIFF_WALK: f64 = 2e-7;
 const SPEED_COEFF_WALK: f64 = 1e-8;
+
+/// Most steps composed before the covariance is carried forward (it is carried forward at
+/// every measurement too): keeps the reported uncertainty fresh without a compass.
+const MAX_BATCH_STEPS: u32 = 20;
 
 /// Position noise per metre travelled, m²/m (lateral creep, bumps).
 const POSITION_NOISE_M2_PER_M: f64 = 1e-6;
@@ -117,6 +123,28 @@ struct Rest {
     span_s: f64,
 }
 
+/// Compass readings taken since the last heading correction, averaged into one.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct CompassWindow {
+    n: u32,
+    sum_nu: f64,
+    /// Σ over the readings of the heading's accumulated couplings `A_k` at each reading,
+    /// counted from the start of the current batch.
+    sum_psi_from: [f64; DIM],
+    variance_rad2: f64,
+}
+
+impl Default for CompassWindow {
+    fn default() -> Self {
+        Self {
+            n: 0,
+            sum_nu: 0.0,
+            sum_psi_from: [0.0; DIM],
+            variance_rad2: 0.0,
+        }
+    }
+}
+
 /// Alignment: the first run of consistent compass readings.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 struct Alignment {
@@ -167,6 +195,14 @@ pub struct VehicleEstimator {
     rest: Rest,
     wheel_check_s: f64,
     alignment: Alignment,
+    batch: StepBatch,
+    window: CompassWindow,
+    /// Sine and cosine of the mid-step heading and of the predicted compass reading.
+    trig: HeadingTrig,
+    trig_compass: HeadingTrig,
+    /// The last step length and the compass error's decay over it (an `exp` saved per
+    /// sample when the rate is steady).
+    decay_cache: (f64, f64),
     /// Readings up to this time are not offered to the compass learner (it has them
     /// already: the estimator is replaying them).
     learned_until_s: f64,
@@ -202,6 +238,11 @@ impl VehicleEstimator {
             rest: Rest::default(),
             wheel_check_s: 0.0,
             alignment: Alignment::default(),
+            batch: StepBatch::default(),
+            window: CompassWindow::default(),
+            trig: HeadingTrig::new(0.0),
+            trig_compass: HeadingTrig::new(0.0),
+            decay_cache: (f64::NAN, 1.0),
             learned_until_s: f64::NEG_INFINITY,
             est: NavEstimate::at_start(f64::NAN, MagneticHeading::new(0.0), f64::INFINITY),
             config,
@@ -304,73 +345,102 @@ impl VehicleEstimator {
         self.start_gyro(sample);
         let raw = sample.gyr_z_rps.unwrap_or(self.gyro.last_raw_rps);
 
-        let mut couplings: [Coupling; 8] = [(0, 0, 0.0); 8];
-        let mut q = [0.0; DIM];
-        let c = &self.coeffs;
         let dpsi = self.heading_change(&wheel, raw, dt, at_rest);
-        // Position first: it is coupled from the heading, whose own couplings follow.
-        let (s, co) = (x[PSI] + 0.5 * dpsi).sin_cos();
-        couplings[0] = (NORTH, PSI, -wheel.ds_m * s);
-        couplings[1] = (EAST, PSI, wheel.ds_m * co);
+        let (s, co) = self.trig.at(x[PSI] + 0.5 * dpsi);
+        let c = &self.coeffs;
+        let mut step = Step {
+            north_from_psi: -wheel.ds_m * s,
+            east_from_psi: wheel.ds_m * co,
+            ..Step::default()
+        };
+        let q = &mut step.q;
         q[NORTH] = POSITION_NOISE_M2_PER_M * wheel.ds_m.abs();
         q[EAST] = q[NORTH];
         let wheel_q = c.wheel_noise_rad2_per_m * wheel.ds_m.abs()
             + (WHEEL_TURN_NOISE * wheel.heading_change_rad).powi(2);
+        let wheel_from = [
+            (WHEEL_DIFF, wheel.d_heading_d_diff),
+            (SPEED_COEFF, wheel.d_heading_d_speed_coeff),
+            (TRACK_SCALE, wheel.d_heading_d_track_scale),
+        ];
         if self.gyro.active {
             if !at_rest {
                 let increment = 0.5 * (self.gyro.last_raw_rps + raw) * dt - x[BIAS] * dt;
                 let gain_state = if increment >= 0.0 { GAIN_POS } else { GAIN_NEG };
                 let gain = 1.0 + x[gain_state];
-                couplings[2] = (PSI, BIAS, -dt / gain);
-                couplings[3] = (PSI, gain_state, -dpsi / gain);
+                step.psi_from[0] = (BIAS, -dt / gain);
+                step.psi_from[1] = (gain_state, -dpsi / gain);
                 q[PSI] = c.gyro_noise_rad2_per_s * dt + (GYRO_GAIN_NOISE * dpsi).powi(2);
             }
-            couplings[4] = (PSI_ODO, WHEEL_DIFF, wheel.d_heading_d_diff);
-            couplings[5] = (PSI_ODO, SPEED_COEFF, wheel.d_heading_d_speed_coeff);
-            couplings[6] = (PSI_ODO, TRACK_SCALE, wheel.d_heading_d_track_scale);
+            step.odo_from = wheel_from;
             q[PSI_ODO] = wheel_q;
             q[BIAS] = c.bias_walk_rad2_per_s3 * dt;
             q[GAIN_POS] = GAIN_WALK * GAIN_WALK * dt;
             q[GAIN_NEG] = q[GAIN_POS];
             self.filter.x[PSI_ODO] += wheel.heading_change_rad;
         } else {
-            couplings[2] = (PSI, WHEEL_DIFF, wheel.d_heading_d_diff);
-            couplings[3] = (PSI, SPEED_COEFF, wheel.d_heading_d_speed_coeff);
-            couplings[4] = (PSI, TRACK_SCALE, wheel.d_heading_d_track_scale);
+            step.psi_from = wheel_from;
             q[PSI] = wheel_q;
         }
-        let decay = (-dt / self.config.compass.systematic_tau_s).exp();
-        couplings[7] = (COMPASS_BIAS, COMPASS_BIAS, decay - 1.0);
+        let decay = self.compass_decay(dt);
+        step.compass_decay = decay;
         // A calibration's error depends on the heading: turning changes it by up to its
         // size per radian (the slope of a one-cycle error A·sin ψ is at most A).
         let cal_sigma = self.compass.fix().map_or(0.0, |f| f.calibration_sigma_rad);
+        let q = &mut step.q;
         q[COMPASS_BIAS] =
             self.compass_bias_var() * (1.0 - decay * decay) + (cal_sigma * dpsi).powi(2);
-        self.filter.x[COMPASS_BIAS] *= decay;
         if self.learns_wheels() {
             q[WHEEL_DIFF] = DIFF_WALK * DIFF_WALK * dt;
             q[SPEED_COEFF] = SPEED_COEFF_WALK * SPEED_COEFF_WALK * dt;
             q[TRACK_SCALE] = GAIN_WALK * GAIN_WALK * dt;
         }
+        self.filter.x[COMPASS_BIAS] *= decay;
         self.filter.x[NORTH] += wheel.ds_m * co;
         self.filter.x[EAST] += wheel.ds_m * s;
-        self.filter.x[PSI] += dpsi;
-        self.filter.predict(&couplings, &q);
+        // Heading kept in (−π, π]: differences of headings stay in range, and the wheels'
+        // heading is wrapped with it so that their difference keeps its meaning.
+        let wrapped = wrap_pi(self.filter.x[PSI] + dpsi);
+        self.filter.x[PSI_ODO] += wrapped - (self.filter.x[PSI] + dpsi);
+        self.filter.x[PSI] = wrapped;
+        self.batch.add(&step);
 
         if self.gyro.active {
-            self.rest_update(at_rest, raw, dt);
+            self.rest_accumulate(at_rest, raw, dt);
             if !at_rest {
                 self.wheel_check_s += dt;
-                if self.wheel_check_s >= WHEEL_CHECK_S {
-                    self.wheel_check_s = 0.0;
-                    self.wheels_against_gyro();
-                }
             }
             self.gyro.last_raw_rps = raw;
         }
         self.est.speed_mps = wheel.speed_mps;
         self.est.distance_m += wheel.ds_m.abs();
         self.est.status.at_rest = at_rest;
+    }
+
+    /// Carries the covariance forward through the steps composed so far: before any
+    /// measurement or change of the covariance.
+    fn flush(&mut self) {
+        // The window's readings are tied to the heading through the couplings accumulated
+        // since the batch began; the next batch begins now, so refer them to now:
+        // A_k − A_now for each reading.
+        let n = f64::from(self.window.n);
+        for (s, a) in self
+            .window
+            .sum_psi_from
+            .iter_mut()
+            .zip(self.batch.psi_from())
+        {
+            *s -= n * a;
+        }
+        self.batch.apply(&mut self.filter);
+    }
+
+    /// `exp(−dt/τ)` for the compass error, recomputed only when the step length changes.
+    fn compass_decay(&mut self, dt: f64) -> f64 {
+        if self.decay_cache.0 != dt {
+            self.decay_cache = (dt, (-dt / self.config.compass.systematic_tau_s).exp());
+        }
+        self.decay_cache.1
     }
 
     /// The heading change of this step from the sensor that carries the heading.
@@ -430,16 +500,23 @@ impl VehicleEstimator {
 
     /// At rest the raw rate is the bias plus noise: averaged a second at a time, it
     /// measures the bias directly (EP 0640207 claims 8-9 do the same once, before the turn).
-    fn rest_update(&mut self, at_rest: bool, raw: f64, dt: f64) {
-        if !at_rest {
+    fn rest_accumulate(&mut self, at_rest: bool, raw: f64, dt: f64) {
+        if at_rest {
+            self.rest.sum_raw += raw;
+            self.rest.n += 1;
+            self.rest.span_s += dt;
+        } else {
             self.rest.sum_raw = 0.0;
             self.rest.n = 0;
             self.rest.span_s = 0.0;
-            return;
         }
-        self.rest.sum_raw += raw;
-        self.rest.n += 1;
-        self.rest.span_s += dt;
+    }
+
+    /// A measurement epoch: the covariance is carried forward once, then every measurement
+    /// that is due corrects the state — the compass's averaged readings, the wheels'
+    /// heading against the gyro's once a second of driving, the bias once a second of rest.
+    fn epoch(&mut self) {
+        self.flush();
         if self.rest.span_s >= REST_AVERAGE_S {
             let mean = self.rest.sum_raw / f64::from(self.rest.n);
             let r = self.coeffs.gyro_noise_rad2_per_s / self.rest.span_s
@@ -450,6 +527,13 @@ impl VehicleEstimator {
             self.rest.n = 0;
             self.rest.span_s = 0.0;
         }
+        if self.wheel_check_s >= WHEEL_CHECK_S {
+            self.wheel_check_s = 0.0;
+            self.wheels_against_gyro();
+        }
+        if self.window.n >= self.config.compass.readings_per_update {
+            self.correct_with_compass();
+        }
     }
 
     /// The wheels' heading minus the gyro's, measured against zero.
@@ -457,7 +541,7 @@ impl VehicleEstimator {
         if !self.learns_wheels() {
             return;
         }
-        let nu = self.filter.x[PSI_ODO] - self.filter.x[PSI];
+        let nu = wrap_pi(self.filter.x[PSI_ODO] - self.filter.x[PSI]);
         self.filter.update(
             &[(PSI, 1.0), (PSI_ODO, -1.0)],
             nu,
@@ -472,22 +556,25 @@ impl VehicleEstimator {
         };
         let reading = self.compass.measure(&raw);
         let gated = match reading {
-            Some((heading, ratio)) if self.alignment.done => {
+            Some((u, ratio)) if self.alignment.done => {
+                // Innovation: the angle from the predicted reading's direction to the
+                // reading's, without an arctangent per reading when it is small.
                 let f = &self.filter;
-                let nu = wrap_pi(heading - f.x[PSI] - f.x[COMPASS_BIAS]);
-                let p_nu =
-                    f.p[PSI][PSI] + 2.0 * f.p[PSI][COMPASS_BIAS] + f.p[COMPASS_BIAS][COMPASS_BIAS];
+                let (sp, cp) = self.trig_compass.at(f.x[PSI] + f.x[COMPASS_BIAS]);
+                let nu = small_atan2(-u.y * cp - u.x * sp, u.x * cp - u.y * sp);
+                let p_nu = f.p[PSI][PSI]
+                    + 2.0 * f.p[PSI][COMPASS_BIAS]
+                    + f.p[COMPASS_BIAS][COMPASS_BIAS]
+                    + self.batch.psi_noise();
                 let verdict = self.compass.judge(sample.t_s, nu, ratio, p_nu);
                 if let Verdict::Use { variance_rad2 } = verdict {
-                    self.filter
-                        .update(&[(PSI, 1.0), (COMPASS_BIAS, 1.0)], nu, variance_rad2);
-                    self.est.status.compass_used = true;
+                    self.take_compass(nu, variance_rad2);
                 }
                 matches!(verdict, Verdict::Use { .. })
             }
-            Some((heading, ratio)) => {
+            Some((u, ratio)) => {
                 if self.compass.field_ok(ratio) {
-                    self.align_step(sample.t_s, heading);
+                    self.align_step(sample.t_s, (-u.y).atan2(u.x));
                 }
                 false
             }
@@ -503,14 +590,56 @@ impl VehicleEstimator {
         {
             self.compass.set_fix(CompassFix::from_solution(&s));
             // A new calibration makes a new systematic error, and the averaged
-            // innovation was taken against the old one.
+            // innovations were taken against the old one.
             self.compass.restart_gates();
+            self.flush();
+            self.window = CompassWindow::default();
             self.filter.x[COMPASS_BIAS] = 0.0;
             self.filter
                 .reset_state(COMPASS_BIAS, self.compass_bias_var().sqrt());
         }
         self.est.status.compass_calibrated = self.compass.fix().is_some();
         self.est.status.compass_disturbed = self.compass.disturbed();
+    }
+
+    /// Adds a reading's innovation to the window; a full window corrects the heading once.
+    ///
+    /// Reading `k` was taken against the heading then, whose error differs from the error
+    /// now by the steps since: `e_k = e_now − (A_now − A_k)·cal`, with `A` the heading's
+    /// accumulated couplings to the calibration states. So the window's mean innovation
+    /// measures `e_now − (A_now − mean A_k)·cal + b_c`, which is the measurement row used —
+    /// averaging while the heading drifts (uncalibrated wheels turn it by degrees a
+    /// second) biases nothing.
+    fn take_compass(&mut self, nu: f64, variance_rad2: f64) {
+        let w = &mut self.window;
+        w.n += 1;
+        w.sum_nu += nu;
+        w.variance_rad2 = variance_rad2;
+        for (s, a) in w.sum_psi_from.iter_mut().zip(self.batch.psi_from()) {
+            *s += a;
+        }
+    }
+
+    /// Corrects the heading with the window's readings, right after the covariance was
+    /// carried forward to now (so `A_now = 0` and each reading's row is `−A_k` on the
+    /// calibration states).
+    fn correct_with_compass(&mut self) {
+        let w = self.window;
+        self.window = CompassWindow::default();
+        let n = f64::from(w.n);
+        let mut h = [(0, 0.0); DIM];
+        h[0] = (PSI, 1.0);
+        h[1] = (COMPASS_BIAS, 1.0);
+        let mut len = 2;
+        for (j, s) in w.sum_psi_from.iter().enumerate() {
+            if *s != 0.0 {
+                h[len] = (j, s / n);
+                len += 1;
+            }
+        }
+        self.filter
+            .update(&h[..len], w.sum_nu / n, w.variance_rad2 / n);
+        self.est.status.compass_used = true;
     }
 
     /// Gathers consistent readings and, once there are enough, refers the heading to north.
@@ -568,10 +697,13 @@ impl VehicleEstimator {
     /// uncorrelated with the calibration states, and the track turned about the start by the
     /// same error. The wheels' heading keeps its difference from the gyro's.
     fn align(&mut self, offset: f64, sigma: f64) {
+        self.flush();
+        self.window = CompassWindow::default();
         let bias_var = self.compass_bias_var();
         let f = &mut self.filter;
-        f.x[PSI] += offset;
-        f.x[PSI_ODO] += offset;
+        let turned = wrap_pi(f.x[PSI] + offset);
+        f.x[PSI_ODO] += turned - f.x[PSI];
+        f.x[PSI] = turned;
         let (s, c) = offset.sin_cos();
         let (n, e) = (f.x[NORTH], f.x[EAST]);
         f.x[NORTH] = n * c - e * s;
@@ -631,7 +763,9 @@ impl VehicleEstimator {
         e.east_m = f.x[EAST];
         e.heading = MagneticHeading::new(wrap_pi(f.x[PSI]));
         e.heading_sigma_rad = if self.alignment.done {
-            f.sigma(PSI)
+            // The covariance is carried forward a few times a second; the noise since then
+            // is added here, the calibration states' share waits for the next time.
+            (f.p[PSI][PSI] + self.batch.psi_noise()).max(0.0).sqrt()
         } else {
             f64::INFINITY
         };
@@ -667,6 +801,11 @@ impl HeadingEstimator for VehicleEstimator {
             Some(dt) => self.step(sample, dt),
         }
         self.compass_step(sample);
+        if self.window.n >= self.config.compass.readings_per_update
+            || self.batch.steps() >= MAX_BATCH_STEPS
+        {
+            self.epoch();
+        }
         Ok(self.publish(sample.t_s))
     }
 
@@ -691,6 +830,8 @@ impl HeadingEstimator for VehicleEstimator {
         self.rest = Rest::default();
         self.wheel_check_s = 0.0;
         self.alignment = Alignment::default();
+        self.batch = StepBatch::default();
+        self.window = CompassWindow::default();
         self.est = NavEstimate::at_start(f64::NAN, MagneticHeading::new(0.0), f64::INFINITY);
     }
 }

@@ -5,8 +5,10 @@ mod compass_learning;
 mod compass_monitor;
 mod config;
 mod estimator;
+mod heading_trig;
 mod learned;
 pub mod nav_filter;
+mod step_batch;
 mod two_pass;
 mod wheel_odometry;
 

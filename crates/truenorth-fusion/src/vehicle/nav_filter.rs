@@ -100,29 +100,29 @@ impl NavFilter {
     /// positive and finite.
     pub fn update(&mut self, h: &[(usize, f64)], nu: f64, r: f64) -> Option<f64> {
         let mut ph = [0.0; DIM];
-        for (k, phk) in ph.iter_mut().enumerate() {
-            *phk = h.iter().map(|&(j, c)| self.p[k][j] * c).sum();
+        for &(j, c) in h {
+            for (phk, row) in ph.iter_mut().zip(&self.p) {
+                *phk += row[j] * c;
+            }
         }
         let s: f64 = h.iter().map(|&(j, c)| c * ph[j]).sum::<f64>() + r;
         if !(s.is_finite() && s > 0.0) {
             return None;
         }
         let inv = 1.0 / s;
-        for (i, &phi) in ph.iter().enumerate() {
-            let ki = phi * inv;
-            self.x[i] += ki * nu;
-            // P ← P − K (P hᵀ)ᵀ, one triangle, then mirrored: stays exactly symmetric.
-            for (j, &phj) in ph.iter().enumerate().skip(i) {
-                self.p[i][j] -= ki * phj;
-            }
-        }
-        for i in 0..DIM {
-            for j in 0..i {
-                self.p[i][j] = self.p[j][i];
+        // P ← P − (P hᵀ)(P hᵀ)ᵀ/s as w wᵀ with w = P hᵀ/√s: each product w_i·w_j is the
+        // same float as w_j·w_i, so P stays exactly symmetric.
+        let root = inv.sqrt();
+        let w = ph.map(|v| v * root);
+        for (i, row) in self.p.iter_mut().enumerate() {
+            self.x[i] += ph[i] * inv * nu;
+            let wi = w[i];
+            for (pij, wj) in row.iter_mut().zip(&w) {
+                *pij -= wi * wj;
             }
             // Rounding may take a variance a hair below zero after a very precise update.
-            if self.p[i][i] < 0.0 {
-                self.p[i][i] = 0.0;
+            if row[i] < 0.0 {
+                row[i] = 0.0;
             }
         }
         Some(s)
