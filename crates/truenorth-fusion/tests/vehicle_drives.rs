@@ -105,7 +105,7 @@ fn measure() {
         (false, DriveWheels::Front),
         (true, DriveWheels::Front),
     ] {
-        for seed in 0..8 {
+        for seed in 0..std::env::var("SEEDS").map_or(8, |s| s.parse().unwrap()) {
             let o = run(
                 DriveSpec {
                     wheels,
@@ -143,8 +143,14 @@ fn trace() {
         .map(|s| s.parse().unwrap())
         .unwrap_or(1);
     let gyro = std::env::var("GYRO").is_ok();
+    let wheels = if std::env::var("FRONT").is_ok() {
+        DriveWheels::Front
+    } else {
+        DriveWheels::Rear
+    };
     let spec = DriveSpec {
         opening_turn: std::env::var("NO_TURN").is_err(),
+        wheels,
         ..DriveSpec::new(seed)
     };
     let drive = SimulatedDrive::new(spec).unwrap();
@@ -157,7 +163,11 @@ fn trace() {
             d.field_ned
         );
     }
-    let mut nav = VehicleEstimator::new(VehicleConfig::default()).unwrap();
+    let mut nav = VehicleEstimator::new(VehicleConfig {
+        wheels: wheels.odometer_wheels(),
+        ..VehicleConfig::default()
+    })
+    .unwrap();
     for (k, (s, t)) in drive.samples.iter().zip(&drive.truth).enumerate() {
         let mut s = *s;
         if !gyro {

@@ -2,14 +2,15 @@
 //!
 //! Two online least-squares calibrators, because a calibration cannot be trusted to judge
 //! the readings it is learned from:
-//! * the **bootstrap** calibrator takes every reading that is consistent with the
-//!   dead-reckoned heading, a test that needs no calibration: the raw vector can move by at
-//!   most the locus's largest radius times the heading change since the last reading taken
-//!   (plus an allowance for noise), so a reading that jumps while the vehicle drives
-//!   straight — a lorry, a bridge — is left out. Its calibration is used until the clean one
-//!   has its own, and keeps improving meanwhile, so a first calibration spoilt by a
-//!   disturbance that slipped in during a turn is outgrown rather than trusted for good.
-//!   A bootstrap that cannot fit at all after covering most of the circle starts again;
+//! * the **bootstrap** calibrator learns while nothing can be judged against a compass
+//!   heading — before the heading is referred to north, or after the calibration in use
+//!   has been found wanting — from every reading that is consistent with the dead-reckoned
+//!   heading, a test that needs no calibration: the raw vector can move by at most the
+//!   locus's largest radius times the heading change since the last reading taken (plus an
+//!   allowance for noise), so a reading that jumps while the vehicle drives straight — a
+//!   lorry, a bridge — is left out. A bootstrap that cannot fit at all after covering most
+//!   of the circle starts again. Once the gates work, it takes gated readings only, so that
+//!   the slow disturbances the consistency test cannot see do not creep into it;
 //! * the **clean** calibrator takes only readings that passed every gate of
 //!   [`super::compass_monitor`], and replaces the bootstrap's calibration as soon as it has
 //!   one of its own.
@@ -44,6 +45,18 @@ const LASTING_CHANGE_S: f64 = 30.0;
 /// calibration that can be checked needs, since nothing checks this one and a locus seen
 /// over little more than half a turn extrapolates poorly to the rest.
 const BOOTSTRAP_MIN_ARC_DEG: f64 = 240.0;
+
+/// How the estimator judged a reading it offers.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Judged {
+    /// Nothing could be judged (no heading referred to north, or the calibration in use
+    /// was found wanting): the bootstrap decides by the consistency test.
+    Unjudged,
+    /// Passed every gate.
+    Gated,
+    /// Rejected by a gate.
+    Rejected,
+}
 
 /// Pushes to the bootstrap between checks of whether it should start again.
 const RESTART_CHECK_PUSHES: u32 = 64;
@@ -135,6 +148,16 @@ impl CompassLearner {
         self.bootstrap_pushes = 0;
     }
 
+    /// Starts learning afresh, for when the calibration in use has been found wanting: the
+    /// clean calibrator is emptied and the bootstrap's calibration is used until it has one
+    /// again.
+    pub fn relearn(&mut self) {
+        self.clean.reset();
+        self.clean_in_use = false;
+        self.bootstrap.reset();
+        self.bootstrap_pushes = 0;
+    }
+
     /// The calibrator whose calibration is in use.
     pub fn calibrator(&self) -> &OnlineEllipseCalibrator {
         if self.clean_in_use {
@@ -149,16 +172,18 @@ impl CompassLearner {
         self.clean_in_use
     }
 
-    /// Offers reading `raw` at dead-reckoned heading `psi_rad`; `gated` when it passed
-    /// every gate of the calibration in use. Returns a new calibration to use, if this
-    /// reading brought one.
+    /// Offers reading `raw` at dead-reckoned heading `psi_rad`, judged as `judged`. Returns
+    /// a new calibration to use, if this reading brought one.
     pub fn offer(
         &mut self,
         raw: &Vector2<f64>,
         t_s: f64,
         psi_rad: f64,
-        gated: bool,
+        judged: Judged,
     ) -> Option<Solution<CompassCalibration2d>> {
+        if judged == Judged::Rejected {
+            return None;
+        }
         // Decimation first: it is cheap, and only readings that would be taken need the
         // consistency test.
         if let Some((t0, psi0)) = self.last_push {
@@ -168,8 +193,8 @@ impl CompassLearner {
                 return None;
             }
         }
-        let consistent = self.consistency.check(raw, psi_rad, t_s);
-        if !(consistent || gated) {
+        let gated = judged == Judged::Gated;
+        if !gated && !self.consistency.check(raw, psi_rad, t_s) {
             return None;
         }
         self.last_push = Some((t_s, psi_rad));
@@ -213,7 +238,7 @@ mod tests {
         for k in 0..=n {
             let psi = (from_deg + span_deg * k as f64 / n as f64).to_radians();
             let raw = Vector2::new(5.0 + 20.0 * psi.cos(), -3.0 - 14.0 * psi.sin());
-            if let Some(s) = learner.offer(&raw, t0 + 0.1 * k as f64, psi, false) {
+            if let Some(s) = learner.offer(&raw, t0 + 0.1 * k as f64, psi, Judged::Unjudged) {
                 last = Some(s);
             }
         }
@@ -255,7 +280,9 @@ mod tests {
         for k in 0..800 {
             let psi = (k as f64 * 0.5).to_radians();
             let raw = Vector2::new(5.0 + 20.0 * psi.cos(), -3.0 - 14.0 * psi.sin());
-            took_over |= l.offer(&raw, 100.0 + 0.1 * k as f64, psi, true).is_some();
+            took_over |= l
+                .offer(&raw, 100.0 + 0.1 * k as f64, psi, Judged::Gated)
+                .is_some();
         }
         assert!(took_over && l.clean_in_use());
     }

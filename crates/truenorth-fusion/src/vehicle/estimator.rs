@@ -28,10 +28,11 @@ use truenorth_core::{
     check_finite, wrap_pi,
 };
 
-use super::compass_learning::CompassLearner;
+use super::compass_learning::{CompassLearner, Judged};
 use super::compass_monitor::{CompassFix, CompassMonitor, Verdict};
 use super::config::{VehicleConfig, VehicleMethod};
 use super::heading_trig::{HeadingTrig, small_atan2};
+use super::innovation_line::InnovationLine;
 use super::learned::VehicleCalibration;
 use super::nav_filter::{
     BIAS, COMPASS_BIAS, DIM, EAST, GAIN_NEG, GAIN_POS, NORTH, NavFilter, PSI, PSI_ODO, SPEED_COEFF,
@@ -67,6 +68,22 @@ const MAX_BATCH_STEPS: u32 = 20;
 
 /// Position noise per metre travelled, m²/m (lateral creep, bumps).
 const POSITION_NOISE_M2_PER_M: f64 = 1e-6;
+
+/// Drift of the dead-reckoned heading that its variance may leave out, rad/s: while the
+/// compass is rejected its gates widen by this rate times the outage's length, so that a
+/// dead reckoning that drifted faster than its model says is corrected once the field is
+/// clean again instead of being locked out for good (0.02°/s).
+const OUTAGE_DRIFT_RPS: f64 = 0.02 * core::f64::consts::PI / 180.0;
+
+/// A compass rejected for this long while the vehicle turned through
+/// [`SUSPECT_TURN_RAD`] is taken to have a calibration that is wrong rather than a field
+/// that is disturbed, s: disturbances on
+/// the road are local and the vehicle leaves them, while a wrong calibration disagrees
+/// everywhere.
+const SUSPECT_AFTER_S: f64 = 120.0;
+
+/// Turning that must accompany [`SUSPECT_AFTER_S`] of rejection, rad (90°).
+const SUSPECT_TURN_RAD: f64 = core::f64::consts::FRAC_PI_2;
 
 /// Smallest bias-measurement noise at rest, rad/s (vibration of an idling engine).
 const REST_NOISE_FLOOR_RPS: f64 = 2e-5;
@@ -123,6 +140,43 @@ struct Rest {
     span_s: f64,
 }
 
+/// How long the compass has been rejected, and how far the vehicle turned meanwhile.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+struct Outage {
+    rejected_s: f64,
+    turned_rad: f64,
+    last: Option<(f64, f64)>,
+    /// The calibration in use was found wanting: a new one is being learned from readings
+    /// the gates cannot judge.
+    relearning: bool,
+}
+
+impl Outage {
+    /// Counts one judged reading at time `t_s` and heading `psi`; returns whether the
+    /// calibration in use should now be taken as wrong.
+    fn count(&mut self, t_s: f64, psi: f64, used: bool) -> bool {
+        if let Some((t0, psi0)) = self.last {
+            if !used {
+                self.rejected_s += t_s - t0;
+                self.turned_rad += wrap_pi(psi - psi0).abs();
+            }
+        }
+        self.last = Some((t_s, psi));
+        if used {
+            self.rejected_s = 0.0;
+            self.turned_rad = 0.0;
+        }
+        if !self.relearning
+            && self.rejected_s >= SUSPECT_AFTER_S
+            && self.turned_rad >= SUSPECT_TURN_RAD
+        {
+            self.relearning = true;
+            return true;
+        }
+        false
+    }
+}
+
 /// Compass readings taken since the last heading correction, averaged into one.
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct CompassWindow {
@@ -149,15 +203,7 @@ impl Default for CompassWindow {
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 struct Alignment {
     done: bool,
-    /// First reading's time and innovation: the others are taken relative to them, so
-    /// the sums below stay well conditioned and the innovations unwrapped.
-    first: Option<(f64, f64)>,
-    n: u32,
-    s_t: f64,
-    s_tt: f64,
-    s_v: f64,
-    s_tv: f64,
-    s_vv: f64,
+    line: InnovationLine,
 }
 
 /// The fused vehicle estimator. See the module documentation.
@@ -195,6 +241,7 @@ pub struct VehicleEstimator {
     rest: Rest,
     wheel_check_s: f64,
     alignment: Alignment,
+    outage: Outage,
     batch: StepBatch,
     window: CompassWindow,
     /// Sine and cosine of the mid-step heading and of the predicted compass reading.
@@ -238,6 +285,7 @@ impl VehicleEstimator {
             rest: Rest::default(),
             wheel_check_s: 0.0,
             alignment: Alignment::default(),
+            outage: Outage::default(),
             batch: StepBatch::default(),
             window: CompassWindow::default(),
             trig: HeadingTrig::new(0.0),
@@ -555,40 +603,52 @@ impl VehicleEstimator {
             return;
         };
         let reading = self.compass.measure(&raw);
-        let gated = match reading {
+        let judged = match reading {
             Some((u, ratio)) if self.alignment.done => {
                 // Innovation: the angle from the predicted reading's direction to the
                 // reading's, without an arctangent per reading when it is small.
                 let f = &self.filter;
                 let (sp, cp) = self.trig_compass.at(f.x[PSI] + f.x[COMPASS_BIAS]);
                 let nu = small_atan2(-u.y * cp - u.x * sp, u.x * cp - u.y * sp);
+                let drift = OUTAGE_DRIFT_RPS * self.outage.rejected_s;
                 let p_nu = f.p[PSI][PSI]
                     + 2.0 * f.p[PSI][COMPASS_BIAS]
                     + f.p[COMPASS_BIAS][COMPASS_BIAS]
-                    + self.batch.psi_noise();
+                    + self.batch.psi_noise()
+                    + drift * drift;
                 let verdict = self.compass.judge(sample.t_s, nu, ratio, p_nu);
+                let used = matches!(verdict, Verdict::Use { .. });
                 if let Verdict::Use { variance_rad2 } = verdict {
                     self.take_compass(nu, variance_rad2);
                 }
-                matches!(verdict, Verdict::Use { .. })
+                if self.outage.count(sample.t_s, self.filter.x[PSI], used) {
+                    self.learner.relearn();
+                }
+
+                match (self.outage.relearning, used) {
+                    (true, _) => Judged::Unjudged,
+                    (false, true) => Judged::Gated,
+                    (false, false) => Judged::Rejected,
+                }
             }
             Some((u, ratio)) => {
                 if self.compass.field_ok(ratio) {
                     self.align_step(sample.t_s, (-u.y).atan2(u.x));
                 }
-                false
+                Judged::Unjudged
             }
-            None => false,
+            None => Judged::Unjudged,
         };
         let learn = sample.t_s > self.learned_until_s;
         if let Some(s) = learn
             .then(|| {
                 self.learner
-                    .offer(&raw, sample.t_s, self.filter.x[PSI], gated)
+                    .offer(&raw, sample.t_s, self.filter.x[PSI], judged)
             })
             .flatten()
         {
             self.compass.set_fix(CompassFix::from_solution(&s));
+            self.outage = Outage::default();
             // A new calibration makes a new systematic error, and the averaged
             // innovations were taken against the old one.
             self.compass.restart_gates();
@@ -653,40 +713,20 @@ impl VehicleEstimator {
         let Some(fix) = self.compass.fix().copied() else {
             return;
         };
-        let nu = wrap_pi(heading - self.filter.x[PSI]);
-        let a = &mut self.alignment;
-        let (t0, nu0) = *a.first.get_or_insert((t_s, nu));
-        let (t, v) = (t_s - t0, wrap_pi(nu - nu0));
-        a.n += 1;
-        a.s_t += t;
-        a.s_tt += t * t;
-        a.s_v += v;
-        a.s_tv += t * v;
-        a.s_vv += v * v;
-        if a.n < self.config.compass.alignment_readings {
+        let line = &mut self.alignment.line;
+        line.push(t_s, wrap_pi(heading - self.filter.x[PSI]));
+        if line.len() < self.config.compass.alignment_readings {
             return;
         }
-        let n = f64::from(a.n);
-        let (mt, mv) = (a.s_t / n, a.s_v / n);
-        let stt = a.s_tt - n * mt * mt;
-        let stv = a.s_tv - n * mt * mv;
-        let svv = a.s_vv - n * mv * mv;
-        let slope = if stt > 0.0 { stv / stt } else { 0.0 };
-        let residual_var = ((svv - slope * stv) / (n - 2.0).max(1.0)).max(0.0);
-        let offset = wrap_pi(nu0 + mv + slope * (t - mt));
-        // Variance of a fitted line's value at its end: σ²(1/n + (t_end − t̄)²/Stt).
-        let r = fix.noise_rad * fix.noise_rad;
-        let lever = if stt > 0.0 {
-            (t - mt).powi(2) / stt
-        } else {
-            0.0
-        };
-        *a = Alignment::default();
-        if residual_var.sqrt() > 3.0 * fix.noise_rad {
+        let fit = line.fit(fix.noise_rad);
+        *line = InnovationLine::default();
+        match fit {
+            Some(f) if f.residual_rad <= 3.0 * fix.noise_rad => {
+                self.align(f.offset_rad, f.sigma_rad);
+            }
             // Not consistent (a disturbance, or the calibration is off): gather again.
-            return;
+            _ => {}
         }
-        self.align(offset, (r * (1.0 / n + lever)).sqrt());
     }
 
     /// Refers the heading to north: turns heading, wheel heading and track by `offset`,
@@ -830,6 +870,7 @@ impl HeadingEstimator for VehicleEstimator {
         self.rest = Rest::default();
         self.wheel_check_s = 0.0;
         self.alignment = Alignment::default();
+        self.outage = Outage::default();
         self.batch = StepBatch::default();
         self.window = CompassWindow::default();
         self.est = NavEstimate::at_start(f64::NAN, MagneticHeading::new(0.0), f64::INFINITY);

@@ -6,13 +6,14 @@ mod compass_monitor;
 mod config;
 mod estimator;
 mod heading_trig;
+mod innovation_line;
 mod learned;
 pub mod nav_filter;
 mod step_batch;
 mod two_pass;
 mod wheel_odometry;
 
-pub use compass_learning::CompassLearner;
+pub use compass_learning::{CompassLearner, Judged};
 pub use compass_monitor::{CompassFix, CompassMonitor, Verdict};
 pub use config::{CompassGates, SensorPriors, VehicleConfig, VehicleMethod};
 pub use estimator::VehicleEstimator;
