@@ -177,7 +177,7 @@ mod tests {
         use super::super::compass_learning::{CompassLearner, Judged};
         let mut learner = CompassLearner::new(CompassGates::default()).unwrap();
         let mut m = CompassMonitor::new(CompassGates::default());
-        for k in 0..720 {
+        for k in 0..1440 {
             let psi = (k as f64 * 0.5).to_radians();
             let raw = Vector2::new(5.0 + 20.0 * psi.cos(), -3.0 - 20.0 * psi.sin());
             if let Some(s) = learner.offer(&raw, k as f64 * 0.1, psi, Judged::Unjudged) {

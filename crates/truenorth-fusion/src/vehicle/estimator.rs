@@ -155,11 +155,9 @@ impl Outage {
     /// Counts one judged reading at time `t_s` and heading `psi`; returns whether the
     /// calibration in use should now be taken as wrong.
     fn count(&mut self, t_s: f64, psi: f64, used: bool) -> bool {
-        if let Some((t0, psi0)) = self.last {
-            if !used {
-                self.rejected_s += t_s - t0;
-                self.turned_rad += wrap_pi(psi - psi0).abs();
-            }
+        if let (Some((t0, psi0)), false) = (self.last, used) {
+            self.rejected_s += t_s - t0;
+            self.turned_rad += wrap_pi(psi - psi0).abs();
         }
         self.last = Some((t_s, psi));
         if used {
