@@ -96,6 +96,7 @@ mod direction_slots;
 mod merit_circle;
 mod seed_quality;
 mod turn;
+mod turn_gyro;
 
 pub use binned_ellipse::{
     BinnedEllipseCalibrator, BinnedEllipseConfig, MAX_INIT_SAMPLES, MAX_UPDATE_PUSHES, UpdatePhase,
@@ -125,4 +126,7 @@ pub use online_ellipsoid::{
 pub use turn::{
     MIN_TURN_SAMPLES, TurnCompassCalibrator, TurnConfig, TurnEllipse, TurnExtrema,
     TurnExtremaSaved, TurnSaved, TurnTag,
+};
+pub use turn_gyro::{
+    MIN_REST_S, RawHeading, TurnCalibration, TurnCalibrator, TurnQuality, TurnSample,
 };
