@@ -84,15 +84,6 @@ fn gain_and_centre_on_simulated_opening_turns() {
     let (mut g_max, mut c_max) = (0.0f64, 0.0f64);
     for seed in 0..seeds {
         let e = calibrate(seed);
-            println!(
-                "seed {seed}: gain {:.3} % zero {:.4} centre {:.2} % hdg {:.2}",
-                100.0 * e.gain_rel,
-                e.zero_dps,
-                100.0 * e.centre_rel,
-                e.heading_rms_deg
-            );
-            continue;
-        }
         assert!(
             e.gain_rel.abs() < 0.003,
             "seed {seed}: gain off by {:.3} %",
