@@ -9,7 +9,10 @@ use std::hint::black_box;
 
 use criterion::{BatchSize, Criterion, Throughput, criterion_group, criterion_main};
 use truenorth::core::{HeadingEstimator, VehicleSample};
-use truenorth::fusion::{VehicleConfig, VehicleEstimator, VehicleMethod};
+use truenorth::fusion::vehicle::{
+    SeedGyroCompass, SeedGyroCompassConfig, SeedOdometerCompass, SeedOdometerCompassConfig,
+};
+use truenorth::fusion::{VehicleConfig, VehicleEstimator};
 use truenorth_sim::{DriveSpec, SimulatedDrive};
 
 fn bench(c: &mut Criterion) {
@@ -42,39 +45,18 @@ fn bench(c: &mut Criterion) {
         drive.truth.last().map_or(0.0, |t| t.distance_m)
     );
     let mut g = c.benchmark_group("vehicle");
-    for (name, method, stream) in [
-        (
-            "fused, 50 Hz, compass 10 Hz",
-            VehicleMethod::Fused,
-            &compass_at_10_hz,
-        ),
-        (
-            "fused, gyro + wheels + compass",
-            VehicleMethod::Fused,
-            &samples,
-        ),
-        ("fused, wheels + compass", VehicleMethod::Fused, &no_gyro),
-        (
-            "seed US 4,788,645 (wheels + compass)",
-            VehicleMethod::SeedOdometerCompass,
-            &samples,
-        ),
-        (
-            "seed EP 0640207 (gyro + compass)",
-            VehicleMethod::SeedGyroCompass,
-            &samples,
-        ),
-    ] {
-        let config = VehicleConfig {
-            method,
-            ..VehicleConfig::default()
-        };
+    fn run<E: HeadingEstimator>(
+        g: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
+        name: &str,
+        stream: &[VehicleSample],
+        make: impl Fn() -> E,
+    ) {
         g.throughput(Throughput::Elements(stream.len() as u64));
         g.bench_function(name, |b| {
             b.iter_batched(
-                || VehicleEstimator::new(config).expect("valid config"),
+                &make,
                 |mut nav| {
-                    for s in stream.iter() {
+                    for s in stream {
                         black_box(nav.update(black_box(s)).expect("valid sample"));
                     }
                     nav
@@ -83,6 +65,24 @@ fn bench(c: &mut Criterion) {
             )
         });
     }
+    let fused = || VehicleEstimator::new(VehicleConfig::default()).expect("valid config");
+    run(
+        &mut g,
+        "fused, 50 Hz, compass 10 Hz",
+        &compass_at_10_hz,
+        fused,
+    );
+    run(&mut g, "fused, gyro + wheels + compass", &samples, fused);
+    run(&mut g, "fused, wheels + compass", &no_gyro, fused);
+    run(
+        &mut g,
+        "seed US 4,788,645 (wheels + compass)",
+        &samples,
+        || SeedOdometerCompass::new(SeedOdometerCompassConfig::default()).expect("valid config"),
+    );
+    run(&mut g, "seed EP 0640207 (gyro + compass)", &samples, || {
+        SeedGyroCompass::new(SeedGyroCompassConfig::default()).expect("valid config")
+    });
     g.finish();
 }
 

@@ -95,6 +95,7 @@ mod circumcentre;
 mod direction_slots;
 mod merit_circle;
 mod seed_quality;
+mod speed_coefficient;
 mod turn;
 mod turn_gyro;
 
@@ -123,6 +124,7 @@ pub use online_ellipse::{
 pub use online_ellipsoid::{
     OnlineEllipsoidCalibrator, OnlineEllipsoidConfig, OnlineEllipsoidState,
 };
+pub use speed_coefficient::{SpeedCoefficientCalibrator, SpeedCoefficientConfig, SpeedStep};
 pub use turn::{
     MIN_TURN_SAMPLES, TurnCompassCalibrator, TurnConfig, TurnEllipse, TurnExtrema,
     TurnExtremaSaved, TurnSaved, TurnTag,

@@ -37,4 +37,4 @@ pub mod vehicle;
 pub use mag_reference::{MagReference, MagReferenceConfig};
 pub use quaternion_filter::{QuaternionFilter, QuaternionFilterConfig};
 pub use rest_detector::{RestConfig, RestDetector};
-pub use vehicle::{CompassGates, SensorPriors, VehicleConfig, VehicleEstimator, VehicleMethod};
+pub use vehicle::{CompassGates, SensorPriors, VehicleConfig, VehicleEstimator};

@@ -37,7 +37,28 @@ fn run(spec: DriveSpec, gyro: bool) -> Outcome {
             ..*s
         })
         .collect();
-    let estimates: Vec<NavEstimate> = if std::env::var("TWO_PASS").is_ok() {
+    let seed_method = std::env::var("SEED_METHOD").ok();
+    let estimates: Vec<NavEstimate> = if let Some(m) = seed_method {
+        use truenorth_fusion::vehicle::*;
+        let mut e: Box<dyn HeadingEstimator> = if m == "B" {
+            Box::new(
+                SeedOdometerCompass::new(SeedOdometerCompassConfig {
+                    wheels,
+                    ..Default::default()
+                })
+                .unwrap(),
+            )
+        } else {
+            Box::new(
+                SeedGyroCompass::new(SeedGyroCompassConfig {
+                    wheels,
+                    ..Default::default()
+                })
+                .unwrap(),
+            )
+        };
+        samples.iter().map(|s| e.update(s).unwrap()).collect()
+    } else if std::env::var("TWO_PASS").is_ok() {
         let mut two = TwoPassStart::new(nav.clone(), TwoPassConfig::default());
         let mut out = Vec::new();
         for s in &samples {

@@ -7,33 +7,6 @@ use truenorth_calib::OnlineEllipseConfig;
 use truenorth_core::{Result, Validate, check_positive, check_range};
 use truenorth_odometer::OdometerWheels;
 
-/// Which sensors carry the heading and what is learned online.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum VehicleMethod {
-    /// Gyro (when fitted), wheels and compass in one filter that learns the gyro's bias and
-    /// both gains, each wheel's scale, the speed coefficient `a` and the compass's hard and
-    /// soft iron while it drives.
-    #[default]
-    Fused,
-    /// The configuration of US 4,788,645 (METHODS §B): heading from the wheels with the
-    /// speed correction and the Ackermann effective track, `a` refined by the patent's
-    /// adaptive rule against the compass (eqs. 9-13), compass corrections; the gyro is
-    /// ignored and no wheel scale is learned.
-    SeedOdometerCompass,
-    /// The configuration of EP 0640207 (METHODS §A): heading from the gyro, its zero
-    /// measured at rest and its gain from the compass extrema of the first full turn, the
-    /// compass calibrated from the same extrema; the wheels give distance and rest only.
-    SeedGyroCompass,
-}
-
-impl VehicleMethod {
-    /// Whether this method lets a gyro carry the heading.
-    pub fn uses_gyro(self) -> bool {
-        !matches!(self, Self::SeedOdometerCompass)
-    }
-}
-
 /// What the sensors are believed to do before anything is learned (the filter's prior and
 /// process noise). Defaults suit automotive MEMS gyros and ABS wheel sensors.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -221,8 +194,6 @@ pub struct VehicleConfig {
     /// Which wheels carry the odometer and the vehicle's dimensions (default: rear wheels,
     /// track 1.55 m).
     pub wheels: OdometerWheels,
-    /// Which sensors carry the heading and what is learned ([`VehicleMethod::Fused`]).
-    pub method: VehicleMethod,
     /// Prior beliefs about the sensors.
     pub priors: SensorPriors,
     /// Compass calibration and gates.
@@ -235,7 +206,6 @@ impl Default for VehicleConfig {
     fn default() -> Self {
         Self {
             wheels: OdometerWheels::Rear { track_m: 1.55 },
-            method: VehicleMethod::default(),
             priors: SensorPriors::default(),
             compass: CompassGates::default(),
             standstill_s: 0.5,

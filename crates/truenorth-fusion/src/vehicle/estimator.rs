@@ -30,7 +30,7 @@ use truenorth_core::{
 
 use super::compass_learning::{CompassLearner, Judged};
 use super::compass_monitor::{CompassFix, CompassMonitor, Verdict};
-use super::config::{VehicleConfig, VehicleMethod};
+use super::config::VehicleConfig;
 use super::heading_trig::{HeadingTrig, small_atan2};
 use super::innovation_line::InnovationLine;
 use super::learned::VehicleCalibration;
@@ -436,11 +436,9 @@ impl VehicleEstimator {
         let q = &mut step.q;
         q[COMPASS_BIAS] =
             self.compass_bias_var() * (1.0 - decay * decay) + (cal_sigma * dpsi).powi(2);
-        if self.learns_wheels() {
-            q[WHEEL_DIFF] = DIFF_WALK * DIFF_WALK * dt;
-            q[SPEED_COEFF] = SPEED_COEFF_WALK * SPEED_COEFF_WALK * dt;
-            q[TRACK_SCALE] = GAIN_WALK * GAIN_WALK * dt;
-        }
+        q[WHEEL_DIFF] = DIFF_WALK * DIFF_WALK * dt;
+        q[SPEED_COEFF] = SPEED_COEFF_WALK * SPEED_COEFF_WALK * dt;
+        q[TRACK_SCALE] = GAIN_WALK * GAIN_WALK * dt;
         self.filter.x[COMPASS_BIAS] *= decay;
         self.filter.x[NORTH] += wheel.ds_m * co;
         self.filter.x[EAST] += wheel.ds_m * s;
@@ -514,17 +512,13 @@ impl VehicleEstimator {
         increment / gain
     }
 
-    fn learns_wheels(&self) -> bool {
-        matches!(self.config.method, VehicleMethod::Fused)
-    }
-
-    /// Switches the heading to the gyro at its first reading (when the method uses one):
+    /// Switches the heading to the gyro at its first reading:
     /// the wheels' heading starts equal to it, fully correlated.
     fn start_gyro(&mut self, sample: &VehicleSample) {
         let Some(raw) = sample.gyr_z_rps else {
             return;
         };
-        if self.gyro.active || !self.config.method.uses_gyro() {
+        if self.gyro.active {
             return;
         }
         self.gyro.active = true;
@@ -584,9 +578,6 @@ impl VehicleEstimator {
 
     /// The wheels' heading minus the gyro's, measured against zero.
     fn wheels_against_gyro(&mut self) {
-        if !self.learns_wheels() {
-            return;
-        }
         let nu = wrap_pi(self.filter.x[PSI_ODO] - self.filter.x[PSI]);
         self.filter.update(
             &[(PSI, 1.0), (PSI_ODO, -1.0)],

@@ -1,0 +1,171 @@
+//! What the seed configurations share: a heading carried by one relative source and pulled
+//! towards a calibrated compass by a fixed-gain complementary filter — the way the
+//! navigation computers of the seed patents' time combined them — and the track drawn
+//! from it.
+//!
+//! Per calibrated compass reading: its field magnitude must be within
+//! [`SeedBlendConfig::field_tolerance`] of the fitted one, and its heading within
+//! [`SeedBlendConfig::outlier_deg`] of the carried one; then the heading moves by `dt/τ` of
+//! the difference (a first-order low-pass of the compass with the relative source's changes
+//! passed through). The first readings refer the heading to north.
+
+use nalgebra::Vector2;
+use serde::{Deserialize, Serialize};
+use truenorth_core::{Result, Validate, check_positive, check_range, wrap_pi};
+
+#[allow(unused_imports)]
+use truenorth_core::Float as _;
+
+/// Settings shared by the seed configurations.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct SeedBlendConfig {
+    /// Time constant of the pull towards the compass, s (20).
+    pub tau_s: f64,
+    /// Largest relative departure of the calibrated field magnitude (0.15).
+    pub field_tolerance: f64,
+    /// Largest difference from the carried heading a reading may have, degrees (20).
+    pub outlier_deg: f64,
+    /// Readings averaged to refer the heading to north (10).
+    pub alignment_readings: u32,
+    /// The wheels must stand still this long before the vehicle counts as at rest, s (0.5).
+    pub standstill_s: f64,
+}
+
+impl Default for SeedBlendConfig {
+    fn default() -> Self {
+        Self {
+            tau_s: 20.0,
+            field_tolerance: 0.15,
+            outlier_deg: 20.0,
+            alignment_readings: 10,
+            standstill_s: 0.5,
+        }
+    }
+}
+
+impl Validate for SeedBlendConfig {
+    fn validate(&self) -> Result<()> {
+        check_positive("tau_s", self.tau_s)?;
+        check_range("field_tolerance", self.field_tolerance, 1e-3, 1.0)?;
+        check_range("outlier_deg", self.outlier_deg, 0.1, 180.0)?;
+        check_range(
+            "alignment_readings",
+            f64::from(self.alignment_readings),
+            1.0,
+            1e4,
+        )?;
+        check_range("standstill_s", self.standstill_s, 0.0, 60.0)?;
+        Ok(())
+    }
+}
+
+/// The blended heading and the track.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SeedBlend {
+    config: SeedBlendConfig,
+    /// Heading, rad (from the start heading until aligned).
+    pub psi: f64,
+    /// Position, m (north, east).
+    pub position: Vector2<f64>,
+    /// Distance travelled, m.
+    pub distance_m: f64,
+    aligned: bool,
+    sin_sum: f64,
+    cos_sum: f64,
+    n: u32,
+    still_s: f64,
+    last_compass_t: Option<f64>,
+}
+
+impl SeedBlend {
+    /// At the start point, heading unknown.
+    pub fn new(config: SeedBlendConfig) -> Result<Self> {
+        config.validate()?;
+        Ok(Self {
+            config,
+            psi: 0.0,
+            position: Vector2::zeros(),
+            distance_m: 0.0,
+            aligned: false,
+            sin_sum: 0.0,
+            cos_sum: 0.0,
+            n: 0,
+            still_s: 0.0,
+            last_compass_t: None,
+        })
+    }
+
+    /// Whether the heading is referred to north.
+    pub fn aligned(&self) -> bool {
+        self.aligned
+    }
+
+    /// Advances by heading change `dpsi` and rear-axle distance `ds_m` over `dt`; returns
+    /// whether the vehicle is at rest (`moved` false for the standstill time).
+    pub fn step(&mut self, dpsi: f64, ds_m: f64, dt: f64, moved: bool) -> bool {
+        let mid = self.psi + 0.5 * dpsi;
+        let (s, c) = mid.sin_cos();
+        self.position += Vector2::new(c, s) * ds_m;
+        self.distance_m += ds_m.abs();
+        self.psi = wrap_pi(self.psi + dpsi);
+        self.still_s = if moved { 0.0 } else { self.still_s + dt };
+        self.still_s >= self.config.standstill_s && self.still_s > 0.0
+    }
+
+    /// Takes a calibrated reading with heading `heading` and field ratio `ratio` (its
+    /// magnitude over the fitted one) at `t_s`. Returns the heading if the reading was used.
+    pub fn compass(&mut self, t_s: f64, heading: f64, ratio: f64) -> Option<f64> {
+        let dt = self.last_compass_t.map_or(0.0, |t0| (t_s - t0).max(0.0));
+        self.last_compass_t = Some(t_s);
+        if (ratio - 1.0).abs() > self.config.field_tolerance {
+            return None;
+        }
+        let d = wrap_pi(heading - self.psi);
+        if !self.aligned {
+            self.sin_sum += d.sin();
+            self.cos_sum += d.cos();
+            self.n += 1;
+            if self.n >= self.config.alignment_readings {
+                let offset = self.sin_sum.atan2(self.cos_sum);
+                let (s, c) = offset.sin_cos();
+                self.position = Vector2::new(
+                    c * self.position.x - s * self.position.y,
+                    s * self.position.x + c * self.position.y,
+                );
+                self.psi = wrap_pi(self.psi + offset);
+                self.aligned = true;
+            }
+            return None;
+        }
+        if d.abs() > self.config.outlier_deg.to_radians() {
+            return None;
+        }
+        self.psi = wrap_pi(self.psi + (dt / self.config.tau_s).min(1.0) * d);
+        Some(heading)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn aligns_then_follows_the_compass_slowly() {
+        let mut b = SeedBlend::new(SeedBlendConfig::default()).unwrap();
+        b.step(0.0, 10.0, 1.0, true);
+        for k in 0..10 {
+            b.compass(k as f64 * 0.1, 1.0, 1.0);
+        }
+        assert!(b.aligned() && (b.psi - 1.0).abs() < 1e-12);
+        // The start-to-here track turned with the heading: 10 m along heading 1 rad.
+        assert!((b.position - Vector2::new(1f64.cos(), 1f64.sin()) * 10.0).norm() < 1e-9);
+        // A reading 10° off pulls by dt/τ of it; one 30° off is ignored.
+        b.compass(1.1, 1.0 + 10f64.to_radians(), 1.0);
+        assert!((b.psi - (1.0 + 10f64.to_radians() * 0.1 / 20.0)).abs() < 1e-9);
+        let before = b.psi;
+        assert!(b.compass(1.2, 1.0 + 30f64.to_radians(), 1.0).is_none());
+        assert!(b.compass(1.3, 1.0, 1.3).is_none());
+        assert_eq!(b.psi, before);
+    }
+}

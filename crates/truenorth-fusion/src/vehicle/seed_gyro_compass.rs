@@ -1,0 +1,213 @@
+//! The configuration of EP 0640207 (METHODS.md §A): heading from the gyro, whose zero is
+//! measured at rest and whose conversion constant comes from the compass extrema of the
+//! drive's first full turn ([`truenorth_calib::TurnCalibrator`]); the compass calibrated from
+//! the same extrema pulls the heading through a fixed-gain complementary filter
+//! ([`super::seed_blend`]); the wheels give distance and rest only. Until the first turn is
+//! complete the heading is relative to the start.
+
+use serde::{Deserialize, Serialize};
+use truenorth_calib::{TurnCalibration, TurnCalibrator, TurnConfig, TurnSample};
+use truenorth_core::{
+    Calibrator, HeadingEstimator, MagneticHeading, NavEstimate, Result, TimeStep, Validate,
+    VehicleSample, check_finite,
+};
+use truenorth_odometer::OdometerWheels;
+
+use super::seed_blend::{SeedBlend, SeedBlendConfig};
+use super::wheel_odometry::{WheelCalibration, WheelOdometry};
+
+#[allow(unused_imports)]
+use truenorth_core::Float as _;
+
+/// Samples between two checks of whether the turn calibration can be solved.
+const SOLVE_EVERY: u32 = 10;
+
+/// Configuration of [`SeedGyroCompass`].
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct SeedGyroCompassConfig {
+    /// The odometer wheels (distance and rest only).
+    pub wheels: OdometerWheels,
+    /// The compass blend (default time constant 60 s: the gyro is good for minutes).
+    pub blend: SeedBlendConfig,
+    /// The turn calibrator.
+    pub turn: TurnConfig,
+}
+
+impl Default for SeedGyroCompassConfig {
+    fn default() -> Self {
+        Self {
+            wheels: OdometerWheels::Rear { track_m: 1.55 },
+            blend: SeedBlendConfig {
+                tau_s: 60.0,
+                ..SeedBlendConfig::default()
+            },
+            turn: TurnConfig::default(),
+        }
+    }
+}
+
+impl Validate for SeedGyroCompassConfig {
+    fn validate(&self) -> Result<()> {
+        self.wheels.validate()?;
+        self.blend.validate()?;
+        self.turn.validate()
+    }
+}
+
+/// The gyro-and-compass estimator of EP 0640207. See the module documentation.
+#[derive(Debug, Clone)]
+pub struct SeedGyroCompass {
+    config: SeedGyroCompassConfig,
+    wheels: WheelOdometry,
+    blend: SeedBlend,
+    turn: Option<TurnCalibrator>,
+    calibration: Option<(TurnCalibration, f64)>,
+    /// Zero reading: the calibration's, then each standstill's mean (claims 8-9).
+    zero_rps: f64,
+    rest_sum: f64,
+    rest_n: u32,
+    last_raw: Option<f64>,
+    since_solve: u32,
+    clock: TimeStep,
+    est: NavEstimate,
+}
+
+impl SeedGyroCompass {
+    /// An estimator that knows nothing yet.
+    pub fn new(config: SeedGyroCompassConfig) -> Result<Self> {
+        config.validate()?;
+        Ok(Self {
+            config,
+            wheels: WheelOdometry::new(config.wheels)?,
+            blend: SeedBlend::new(config.blend)?,
+            turn: Some(TurnCalibrator::new(config.turn)?),
+            calibration: None,
+            zero_rps: 0.0,
+            rest_sum: 0.0,
+            rest_n: 0,
+            last_raw: None,
+            since_solve: 0,
+            clock: TimeStep::new(),
+            est: NavEstimate::at_start(f64::NAN, MagneticHeading::new(0.0), f64::INFINITY),
+        })
+    }
+
+    /// The turn calibration, once the first full turn has been driven.
+    pub fn calibration(&self) -> Option<&TurnCalibration> {
+        self.calibration.as_ref().map(|(c, _)| c)
+    }
+
+    fn learn_turn(&mut self, sample: &VehicleSample) {
+        let (Some(turn), Some(gyr), Some(mag)) = (&mut self.turn, sample.gyr_z_rps, sample.mag)
+        else {
+            return;
+        };
+        if turn
+            .push(&TurnSample {
+                t_s: sample.t_s,
+                gyr_z_rps: gyr,
+                mag,
+            })
+            .is_err()
+        {
+            return;
+        }
+        self.since_solve += 1;
+        if self.since_solve < SOLVE_EVERY {
+            return;
+        }
+        self.since_solve = 0;
+        if let Ok(s) = turn.solve() {
+            self.zero_rps = s.params.gyro.zero_rps;
+            self.calibration = Some((s.params, s.quality.compass.field_magnitude));
+            self.turn = None;
+        }
+    }
+}
+
+impl HeadingEstimator for SeedGyroCompass {
+    /// Takes one sample. A non-finite value or a timestamp that does not increase is a
+    /// typed error and changes nothing.
+    fn update(&mut self, sample: &VehicleSample) -> Result<NavEstimate> {
+        check_finite("timestamp t_s", sample.t_s)?;
+        check_finite("dist_l_m", sample.dist_l_m)?;
+        check_finite("dist_r_m", sample.dist_r_m)?;
+        if let Some(g) = sample.gyr_z_rps {
+            check_finite("gyr_z", g)?;
+        }
+        if let Some(m) = sample.mag {
+            check_finite("mag_x", m.x)?;
+            check_finite("mag_y", m.y)?;
+        }
+        let dt = self.clock.dt_s(sample.t_s)?;
+        let wheel = self.wheels.step(
+            sample.dist_l_m,
+            sample.dist_r_m,
+            dt.unwrap_or(1.0),
+            &WheelCalibration::default(),
+        );
+        let raw = sample.gyr_z_rps.or(self.last_raw);
+        let mut at_rest = false;
+        if let (Some(w), Some(dt)) = (wheel, dt) {
+            let (zero, gain) = self.calibration.map_or((self.zero_rps, 1.0), |(c, _)| {
+                (c.gyro.zero_rps, c.gyro.gain_pos)
+            });
+            let rest_now = !w.moved;
+            let dpsi = match (raw, self.last_raw) {
+                (Some(r), Some(p)) if !rest_now => (0.5 * (r + p) - zero) / gain * dt,
+                _ => 0.0,
+            };
+            at_rest = self.blend.step(dpsi, w.ds_m, dt, w.moved);
+            self.est.speed_mps = w.speed_mps;
+            // The zero reading is taken again at every standstill (claims 8-9).
+            match (at_rest, raw, &mut self.calibration) {
+                (true, Some(r), Some((c, _))) => {
+                    self.rest_sum += r;
+                    self.rest_n += 1;
+                    c.gyro.zero_rps = self.rest_sum / f64::from(self.rest_n);
+                }
+                _ => {
+                    self.rest_sum = 0.0;
+                    self.rest_n = 0;
+                }
+            }
+        }
+        self.last_raw = raw;
+        self.learn_turn(sample);
+        let mut used = false;
+        if let (Some(mag), Some((c, field))) = (sample.mag, self.calibration) {
+            let u = c.compass.correct(&mag);
+            used = self
+                .blend
+                .compass(sample.t_s, (-u.y).atan2(u.x), u.norm() / field)
+                .is_some();
+        }
+        let e = &mut self.est;
+        e.t_s = sample.t_s;
+        e.north_m = self.blend.position.x;
+        e.east_m = self.blend.position.y;
+        e.heading = MagneticHeading::new(self.blend.psi);
+        e.heading_sigma_rad = if self.blend.aligned() {
+            f64::NAN
+        } else {
+            f64::INFINITY
+        };
+        e.distance_m = self.blend.distance_m;
+        e.status.heading_absolute = self.blend.aligned();
+        e.status.compass_calibrated = self.calibration.is_some();
+        e.status.compass_used = used;
+        e.status.at_rest = at_rest;
+        Ok(*e)
+    }
+
+    fn estimate(&self) -> NavEstimate {
+        self.est
+    }
+
+    fn reset(&mut self) {
+        if let Ok(fresh) = Self::new(self.config) {
+            *self = fresh;
+        }
+    }
+}

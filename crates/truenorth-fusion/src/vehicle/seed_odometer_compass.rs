@@ -1,0 +1,174 @@
+//! The configuration of US 4,788,645 (METHODS.md §B): heading from two wheels with the
+//! speed correction `ΔD/(T(1 + aV²))` and, on steered front wheels, the Ackermann effective
+//! track from the patent's look-up table; `a` refined turn by turn against the compass
+//! (eqs. 9-13); a compass calibrated by the binned ellipse of EP 0634001 pulling the heading
+//! through a fixed-gain complementary filter ([`super::seed_blend`]). No gyro, and no wheel
+//! scale is learned: the comparison with [`crate::VehicleEstimator`] shows what those add.
+
+use serde::{Deserialize, Serialize};
+use truenorth_calib::{
+    BinnedEllipseCalibrator, BinnedEllipseConfig, SpeedCoefficientCalibrator,
+    SpeedCoefficientConfig, SpeedStep,
+};
+use truenorth_compass::CompassCalibration2d;
+use truenorth_core::{
+    Calibrator, HeadingEstimator, Mag2Sample, MagneticHeading, NavEstimate, OnlineCalibrator,
+    Result, TimeStep, Validate, VehicleSample, check_finite,
+};
+use truenorth_odometer::OdometerWheels;
+
+use super::seed_blend::{SeedBlend, SeedBlendConfig};
+use super::wheel_odometry::{WheelCalibration, WheelOdometry};
+
+#[allow(unused_imports)]
+use truenorth_core::Float as _;
+
+/// Configuration of [`SeedOdometerCompass`].
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct SeedOdometerCompassConfig {
+    /// The odometer wheels and the vehicle's dimensions.
+    pub wheels: OdometerWheels,
+    /// The compass blend.
+    pub blend: SeedBlendConfig,
+    /// The binned-ellipse compass calibrator.
+    pub compass: BinnedEllipseConfig,
+    /// The adaptive speed coefficient.
+    pub speed_coefficient: SpeedCoefficientConfig,
+}
+
+impl Default for SeedOdometerCompassConfig {
+    fn default() -> Self {
+        Self {
+            wheels: OdometerWheels::Rear { track_m: 1.55 },
+            blend: SeedBlendConfig::default(),
+            compass: BinnedEllipseConfig::default(),
+            speed_coefficient: SpeedCoefficientConfig::default(),
+        }
+    }
+}
+
+impl Validate for SeedOdometerCompassConfig {
+    fn validate(&self) -> Result<()> {
+        self.wheels.validate()?;
+        self.blend.validate()?;
+        self.compass.validate()?;
+        self.speed_coefficient.validate()
+    }
+}
+
+/// The wheels-and-compass estimator of US 4,788,645. See the module documentation.
+#[derive(Debug, Clone)]
+pub struct SeedOdometerCompass {
+    config: SeedOdometerCompassConfig,
+    wheels: WheelOdometry,
+    blend: SeedBlend,
+    calibrator: BinnedEllipseCalibrator,
+    compass: Option<(CompassCalibration2d, f64)>,
+    refiner: SpeedCoefficientCalibrator,
+    clock: TimeStep,
+    est: NavEstimate,
+}
+
+impl SeedOdometerCompass {
+    /// An estimator that knows nothing yet.
+    pub fn new(config: SeedOdometerCompassConfig) -> Result<Self> {
+        config.validate()?;
+        Ok(Self {
+            config,
+            wheels: WheelOdometry::new(config.wheels)?,
+            blend: SeedBlend::new(config.blend)?,
+            calibrator: BinnedEllipseCalibrator::new(config.compass)?,
+            compass: None,
+            refiner: SpeedCoefficientCalibrator::new(config.speed_coefficient)?,
+            clock: TimeStep::new(),
+            est: NavEstimate::at_start(f64::NAN, MagneticHeading::new(0.0), f64::INFINITY),
+        })
+    }
+
+    /// The speed coefficient refiner.
+    pub fn speed_coefficient(&self) -> &SpeedCoefficientCalibrator {
+        &self.refiner
+    }
+}
+
+impl HeadingEstimator for SeedOdometerCompass {
+    /// Takes one sample (the gyro, if any, is ignored). A non-finite value or a timestamp
+    /// that does not increase is a typed error and changes nothing.
+    fn update(&mut self, sample: &VehicleSample) -> Result<NavEstimate> {
+        check_finite("timestamp t_s", sample.t_s)?;
+        check_finite("dist_l_m", sample.dist_l_m)?;
+        check_finite("dist_r_m", sample.dist_r_m)?;
+        if let Some(m) = sample.mag {
+            check_finite("mag_x", m.x)?;
+            check_finite("mag_y", m.y)?;
+        }
+        let dt = self.clock.dt_s(sample.t_s)?;
+        let cal = WheelCalibration {
+            speed_coeff: self.refiner.coefficient(),
+            ..WheelCalibration::default()
+        };
+        let wheel = self
+            .wheels
+            .step(sample.dist_l_m, sample.dist_r_m, dt.unwrap_or(1.0), &cal);
+        let mut at_rest = false;
+        if let (Some(w), Some(dt)) = (wheel, dt) {
+            at_rest = self.blend.step(w.heading_change_rad, w.ds_m, dt, w.moved);
+            self.est.speed_mps = w.speed_mps;
+        }
+        let mut used = None;
+        if let Some(raw) = sample.mag {
+            let reading = Mag2Sample {
+                t_s: sample.t_s,
+                mag: raw,
+            };
+            if let Ok(truenorth_core::Pushed::NewEstimate) = self.calibrator.push(&reading) {
+                self.compass = self
+                    .calibrator
+                    .estimate()
+                    .map(|s| (s.params, s.quality.field_magnitude));
+            }
+            if let Some((c, field)) = self.compass {
+                let u = c.correct(&raw);
+                used = self
+                    .blend
+                    .compass(sample.t_s, (-u.y).atan2(u.x), u.norm() / field);
+            }
+        }
+        if let (Some(w), Some(_)) = (wheel, dt) {
+            // Every sample here was accepted above, so the refiner accepts it too.
+            self.refiner.push(&SpeedStep {
+                t_s: sample.t_s,
+                wheel_heading_change_rad: w.heading_change_rad,
+                speed_mps: w.speed_mps,
+                compass_heading_rad: used,
+            })?;
+        }
+        let e = &mut self.est;
+        e.t_s = sample.t_s;
+        e.north_m = self.blend.position.x;
+        e.east_m = self.blend.position.y;
+        e.heading = MagneticHeading::new(self.blend.psi);
+        e.heading_sigma_rad = if self.blend.aligned() {
+            f64::NAN
+        } else {
+            f64::INFINITY
+        };
+        e.distance_m = self.blend.distance_m;
+        e.status.heading_absolute = self.blend.aligned();
+        e.status.compass_calibrated = self.compass.is_some();
+        e.status.compass_used = used.is_some();
+        e.status.at_rest = at_rest;
+        Ok(*e)
+    }
+
+    fn estimate(&self) -> NavEstimate {
+        self.est
+    }
+
+    fn reset(&mut self) {
+        if let Ok(fresh) = Self::new(self.config) {
+            *self = fresh;
+        }
+    }
+}
