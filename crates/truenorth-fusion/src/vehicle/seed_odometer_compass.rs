@@ -29,7 +29,11 @@ use truenorth_core::Float as _;
 pub struct SeedOdometerCompassConfig {
     /// The odometer wheels and the vehicle's dimensions.
     pub wheels: OdometerWheels,
-    /// The compass blend.
+    /// The compass blend (default time constant 2 s and outlier gate 45°: wheels whose
+    /// scales differ by a few tenths of a percent turn the heading by a tenth of a degree
+    /// per metre, which a slower blend cannot hold; on the simulated drives of
+    /// `tests/vehicle_drives.rs` longer time constants or a tighter gate lost the heading
+    /// more often).
     pub blend: SeedBlendConfig,
     /// The binned-ellipse compass calibrator.
     pub compass: BinnedEllipseConfig,
@@ -41,7 +45,11 @@ impl Default for SeedOdometerCompassConfig {
     fn default() -> Self {
         Self {
             wheels: OdometerWheels::Rear { track_m: 1.55 },
-            blend: SeedBlendConfig::default(),
+            blend: SeedBlendConfig {
+                tau_s: 2.0,
+                outlier_deg: 45.0,
+                ..SeedBlendConfig::default()
+            },
             compass: BinnedEllipseConfig::default(),
             speed_coefficient: SpeedCoefficientConfig::default(),
         }
