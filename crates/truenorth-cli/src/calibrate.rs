@@ -5,7 +5,7 @@
 //! so adding one is one arm in [`run`]; the 3-D method is the same with `Mag3Sample` and
 //! `CompassCalibration3d`.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use nalgebra::{SMatrix, SVector, Vector2, Vector3};
 use truenorth::calib::{
@@ -17,8 +17,8 @@ use truenorth::core::{Calibrator, CompassQuality, Mag2Sample, Mag3Sample, Soluti
 
 use crate::field::Place;
 use crate::io::{
-    CALIBRATION_FORMAT, CALIBRATION_VERSION, CalibrationFile, CliError, CliResult, Table,
-    check_distinct,
+    CALIBRATION_FORMAT, CALIBRATION_VERSION, CalibrationFile, CliError, CliResult, InputOptions,
+    InputPath, ReadSpec, Table, check_distinct,
 };
 
 /// Calibration methods.
@@ -86,10 +86,10 @@ pub struct Args {
     /// Calibration method.
     #[arg(long, value_enum)]
     pub method: Method,
-    /// Input CSV.
+    /// Input CSV (`-`: standard input; `.gz` or gzip data read as such).
     #[arg(long)]
     pub input: PathBuf,
-    /// Output JSON.
+    /// Output JSON (`-`: standard output).
     #[arg(long)]
     pub output: PathBuf,
     /// Expected field in the input unit (horizontal for 2-D methods, total for
@@ -105,6 +105,9 @@ pub struct Args {
     /// Where and when the recording was made (for the expected field).
     #[command(flatten)]
     pub place: Place,
+    /// How to read the input.
+    #[command(flatten)]
+    pub input_options: InputOptions,
 }
 
 /// Units a magnetometer may report in.
@@ -183,7 +186,22 @@ pub fn run(args: &Args) -> CliResult {
         // that one recording serves both halves, and ignored here.
         Method::Turn => calibrate_2d(args, TurnCompassCalibrator::default())?,
     };
-    file.write(&args.output)
+    file.write(&args.output)?;
+    eprintln!("truenorth: {}", summary(&file));
+    Ok(())
+}
+
+/// The one line on stderr after a successful calibration.
+fn summary(file: &CalibrationFile) -> String {
+    let q = file.quality.as_ref();
+    let num = |v: Option<f64>| v.map_or("unbounded".to_string(), |v| format!("{v:.3}"));
+    format!(
+        "calibrate: method {}, {} points, field {:.6} (input unit), heading error bound {} deg (3 sigma + systematic)",
+        file.method,
+        q.map_or(0, |q| q.points),
+        file.field,
+        num(q.and_then(|q| q.heading_error_bound_deg)),
+    )
 }
 
 /// A library error outside any file (an invalid built-in configuration).
@@ -191,12 +209,23 @@ fn library(e: truenorth::core::Error) -> CliError {
     CliError::msg(e.to_string())
 }
 
-/// Reads the 2-D input, after checking time order.
-fn read_2d(path: &Path) -> CliResult<Vec<Mag2Sample>> {
-    let table = Table::read(path, &["t_s", "mag_x", "mag_y"], &[])?;
+/// Reads the `columns` of the input, and `t_s` (strictly increasing) where present. Without
+/// `t_s`, the rows are taken as one second apart (the batch methods do not use time).
+fn read_input(args: &Args, columns: &[&str]) -> CliResult<(Table, Vec<f64>)> {
+    let spec = ReadSpec::new(columns).optional(&["t_s"]).increasing("t_s");
+    let table = Table::read_with(&InputPath::new(&args.input), &args.input_options, &spec)?;
     table.require_rows()?;
-    table.check_increasing_time()?;
-    let (t, x, y) = (table.req("t_s")?, table.req("mag_x")?, table.req("mag_y")?);
+    let t = match table.col("t_s") {
+        Some(t) => t.to_vec(),
+        None => (0..table.len()).map(|k| k as f64).collect(),
+    };
+    Ok((table, t))
+}
+
+/// Reads the 2-D input.
+fn read_2d(args: &Args) -> CliResult<Vec<Mag2Sample>> {
+    let (table, t) = read_input(args, &["mag_x", "mag_y"])?;
+    let (x, y) = (table.req("mag_x")?, table.req("mag_y")?);
     let samples = (0..table.len())
         .map(|k| Mag2Sample {
             t_s: t[k],
@@ -211,7 +240,7 @@ fn calibrate_2d<C>(args: &Args, mut cal: C) -> CliResult<CalibrationFile>
 where
     C: Calibrator<Sample = Mag2Sample, Params = CompassCalibration2d, Quality = CompassQuality>,
 {
-    let samples = read_2d(&args.input)?;
+    let samples = read_2d(args)?;
     let sol = feed_and_solve(args, &mut cal, &samples, expected_field(args, 2)?)?;
     Ok(file_for(
         args,
@@ -226,10 +255,8 @@ fn calibrate_3d<C>(args: &Args, mut cal: C) -> CliResult<CalibrationFile>
 where
     C: Calibrator<Sample = Mag3Sample, Params = CompassCalibration3d, Quality = CompassQuality>,
 {
-    let table = Table::read(&args.input, &["t_s", "mag_x", "mag_y", "mag_z"], &[])?;
-    table.require_rows()?;
-    table.check_increasing_time()?;
-    let (t, x) = (table.req("t_s")?, table.req("mag_x")?);
+    let (table, t) = read_input(args, &["mag_x", "mag_y", "mag_z"])?;
+    let x = table.req("mag_x")?;
     let (y, z) = (table.req("mag_y")?, table.req("mag_z")?);
     let samples: Vec<_> = (0..table.len())
         .map(|k| Mag3Sample {

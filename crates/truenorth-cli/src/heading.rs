@@ -7,7 +7,8 @@ use truenorth::core::{Declination, MagneticHeading, Tilt, rad_to_deg};
 
 use crate::field::Place;
 use crate::io::{
-    CalibrationFile, CliError, CliResult, CompassCalibration, Table, check_distinct, write_csv,
+    CalibrationFile, CliError, CliResult, CompassCalibration, CsvOutput, InputOptions, InputPath,
+    ReadSpec, RowReader, check_distinct,
 };
 
 /// Arguments of `truenorth heading`.
@@ -27,15 +28,18 @@ pub struct Args {
     /// Calibration JSON written by `truenorth calibrate`.
     #[arg(long)]
     pub calibration: PathBuf,
-    /// Input CSV.
+    /// Input CSV (`-`: standard input; `.gz` or gzip data read as such).
     #[arg(long)]
     pub input: PathBuf,
-    /// Output CSV.
+    /// Output CSV (`-`: standard output; `*.gz`: compressed).
     #[arg(long)]
     pub output: PathBuf,
     /// Where and when the recording was made, for true heading.
     #[command(flatten)]
     pub place: Place,
+    /// How to read the input.
+    #[command(flatten)]
+    pub input_options: InputOptions,
 }
 
 /// The declination that turns magnetic into true heading, if a place was given.
@@ -60,20 +64,19 @@ pub fn run(args: &Args) -> CliResult {
         CompassCalibration::TwoD(_) => &["t_s", "mag_x", "mag_y"],
         CompassCalibration::ThreeD(_) => &["t_s", "mag_x", "mag_y", "mag_z"],
     };
-    let table = Table::read(&args.input, needed, &[])?;
-    table.require_rows()?;
-    table.check_increasing_time()?;
-    let (t, x, y) = (table.req("t_s")?, table.req("mag_x")?, table.req("mag_y")?);
-    let z = match cal {
-        CompassCalibration::ThreeD(_) => Some(table.req("mag_z")?),
-        CompassCalibration::TwoD(_) => None,
-    };
-    let rows = (0..table.len()).map(|k| {
+    let spec = ReadSpec::new(needed).increasing("t_s");
+    let mut rows = RowReader::open(&InputPath::new(&args.input), &args.input_options, &spec)?;
+    let ix = |n: &str| rows.index(n).unwrap_or(0);
+    let (t, x, y) = (ix("t_s"), ix("mag_x"), ix("mag_y"));
+    let z = rows.index("mag_z");
+    let mut out = CsvOutput::create(&args.output, &["t_s", "heading_deg"])?;
+    let mut count = 0usize;
+    while let Some(row) = rows.next_row()? {
         let magnetic = match (&cal, z) {
-            (CompassCalibration::TwoD(c), _) => c.magnetic_heading(&Vector2::new(x[k], y[k])),
+            (CompassCalibration::TwoD(c), _) => c.magnetic_heading(&Vector2::new(row[x], row[y])),
             // Level: zero pitch and roll, i.e. the corrected x and y.
             (CompassCalibration::ThreeD(c), Some(z)) => {
-                c.magnetic_heading(&Vector3::new(x[k], y[k], z[k]), &Tilt::default())
+                c.magnetic_heading(&Vector3::new(row[x], row[y], row[z]), &Tilt::default())
             }
             (CompassCalibration::ThreeD(_), None) => MagneticHeading::new(f64::NAN),
         };
@@ -81,7 +84,17 @@ pub fn run(args: &Args) -> CliResult {
             Some(d) => magnetic.to_true(d).rad(),
             None => magnetic.rad(),
         };
-        vec![t[k], rad_to_deg(rad)]
-    });
-    write_csv(&args.output, &["t_s", "heading_deg"], rows)
+        out.row(&[row[t], rad_to_deg(rad)])?;
+        count += 1;
+    }
+    if count == 0 {
+        return Err(CliError::row(
+            rows.path(),
+            2,
+            "no data rows after the header",
+        ));
+    }
+    out.commit()?;
+    eprintln!("truenorth: heading: {count} rows");
+    Ok(())
 }

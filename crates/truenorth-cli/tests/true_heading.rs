@@ -150,10 +150,12 @@ fn calibrate_compares_the_fit_with_the_wmm_field() {
     };
     let ok = calibrate("uT");
     assert!(ok.status.success());
+    // One summary line, no warning.
+    let summary = String::from_utf8_lossy(&ok.stderr);
+    assert_eq!(summary.lines().count(), 1, "{summary}");
     assert!(
-        ok.stderr.is_empty(),
-        "{}",
-        String::from_utf8_lossy(&ok.stderr)
+        summary.starts_with("truenorth: calibrate:") && !summary.contains("warning"),
+        "{summary}"
     );
     let json = std::fs::read_to_string(&cal).unwrap();
     let ratio: f64 = json
@@ -168,7 +170,7 @@ fn calibrate_compares_the_fit_with_the_wmm_field() {
     let wrong = calibrate("mG");
     assert!(wrong.status.success());
     let err = String::from_utf8_lossy(&wrong.stderr);
-    assert_eq!(err.lines().count(), 1, "{err}");
+    assert_eq!(err.lines().count(), 2, "{err}");
     assert!(err.contains("warning") && err.contains("0.10 x"), "{err}");
     std::fs::remove_dir_all(&dir).ok();
 }
