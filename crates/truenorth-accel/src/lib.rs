@@ -45,9 +45,11 @@ mod calibration;
 mod quasi_static;
 mod specific_force;
 mod static_tilt;
+mod triad_calibration;
 
 pub use accel_model::{AccelCoefficients, AccelModel, AccelParams, MIN_SCALE_ERROR};
 pub use calibration::AccelCalibration;
 pub use quasi_static::{QuasiStaticConfig, QuasiStaticDetector};
 pub use specific_force::{AccelTruth, gravity_ned_mps2, specific_force_body_mps2};
 pub use static_tilt::{MIN_SPECIFIC_FORCE_MPS2, pitch_from_forward_axis_rad, static_tilt};
+pub use triad_calibration::{AccelTriadCalibration, MAX_TRIAD_CONDITION};

@@ -72,6 +72,11 @@ mod linalg;
 mod lm;
 mod normalise;
 
+// Joint magnetometer + accelerometer calibration.
+mod mag_accel;
+mod mag_accel_runs;
+mod mag_accel_solve;
+
 // Online least-squares calibrators from running monomial sums.
 mod conic_sums;
 mod online_conic;
@@ -110,6 +115,10 @@ pub use ellipse_fit::{
 pub use ellipsoid_fit::{
     Ellipsoid, EllipsoidCalibrator, EllipsoidConfig, MIN_POINTS_3D, fit_ellipsoid,
     fit_ellipsoid_direct,
+};
+pub use mag_accel::{
+    INITIAL_FIT_BOUND_DEG, MIN_MAG_ACCEL_READINGS, MagAccelCalibration, MagAccelCalibrator,
+    MagAccelConfig, MagAccelQuality, MagAccelSample, fit_mag_accel,
 };
 pub use merit_circle::{
     MERIT_CIRCLE_MIN_ARC_DEG, MeritCircleCalibrator, MeritCircleConfig, MeritCircleSaved,

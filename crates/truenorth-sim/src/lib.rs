@@ -28,6 +28,7 @@
 //! # Ok::<(), truenorth_core::Error>(())
 //! ```
 
+mod few_shot;
 mod handheld;
 mod route;
 pub mod scenario;
@@ -35,6 +36,9 @@ pub mod shared_data;
 mod streams;
 mod vehicle;
 
+pub use few_shot::{
+    FewShotInstrument, Shot, pointing_ned, protocol_shots, random_attitude, rolled_run,
+};
 pub use handheld::{HandheldParams, MotionTruth, handheld_motion};
 pub use route::{Command, Route, RouteBuilder};
 pub use streams::{
