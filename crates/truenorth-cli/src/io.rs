@@ -29,7 +29,8 @@ mod table;
 #[allow(unused_imports)]
 pub use atomic_write::{AtomicOutput, CsvOutput, check_distinct, write_atomically, write_csv};
 pub use calibration_file::{
-    CALIBRATION_FORMAT, CALIBRATION_VERSION, CalibrationFile, CompassCalibration,
+    AccelPart, CALIBRATION_FORMAT, CALIBRATION_VERSION, CalibrationFile, CompassCalibration,
+    QualityReport, finite, matrix_rows, units_block,
 };
 #[allow(unused_imports)]
 pub use columns::{AxisConvention, ColumnMapping, ColumnSource, Delimiter, Header, InputOptions};

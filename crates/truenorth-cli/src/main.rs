@@ -9,6 +9,7 @@ mod demo_orientation;
 mod field;
 mod heading;
 mod io;
+mod mag_unit;
 mod orientation;
 mod svg;
 
