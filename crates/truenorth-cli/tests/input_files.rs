@@ -392,3 +392,86 @@ fn a_failed_run_leaves_the_old_output() {
         .collect();
     assert!(stray.is_empty(), "{stray:?}");
 }
+
+/// A run killed while it writes (here: stopped half way through a recording streamed on
+/// standard input) leaves the existing output exactly as it was: the new one was going to a
+/// temporary file beside it.
+#[test]
+fn a_killed_run_leaves_the_old_output() {
+    let dir = scratch("killed_run");
+    let good = dir.join("turn.csv");
+    std::fs::write(&good, csv("t_s,mag_x,mag_y", ",", &turn(60))).unwrap();
+    let cal = dir.join("cal.json");
+    ok(
+        &[
+            "calibrate",
+            "--method",
+            "ellipse",
+            "--input",
+            p(&good),
+            "--output",
+            p(&cal),
+        ],
+        None,
+    );
+    let out = dir.join("heading.csv");
+    ok(
+        &[
+            "heading",
+            "--calibration",
+            p(&cal),
+            "--input",
+            p(&good),
+            "--output",
+            p(&out),
+        ],
+        None,
+    );
+    let before = std::fs::read(&out).unwrap();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_truenorth"))
+        .args([
+            "heading",
+            "--calibration",
+            p(&cal),
+            "--input",
+            "-",
+            "--output",
+            p(&out),
+        ])
+        .stdin(Stdio::piped())
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let mut stdin = child.stdin.take().unwrap();
+    // Enough rows to pass the output's buffer, then the stream stalls.
+    let mut text = String::from("t_s,mag_x,mag_y\n");
+    for k in 0..20_000 {
+        text += &format!("{k},{},{}\n", 20.0 + (k % 7) as f64, -3.0 + (k % 5) as f64);
+    }
+    stdin.write_all(text.as_bytes()).unwrap();
+    stdin.flush().unwrap();
+    // Wait until the temporary output has data in it, then kill the run.
+    let started = std::time::Instant::now();
+    let temp_written = || {
+        std::fs::read_dir(&dir)
+            .unwrap()
+            .filter_map(|e| e.ok())
+            .any(|e| {
+                e.file_name().to_string_lossy().contains(".tmp-")
+                    && e.metadata().map(|m| m.len() > 0).unwrap_or(false)
+            })
+    };
+    while !temp_written() && started.elapsed().as_secs() < 20 {
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    assert!(temp_written(), "the run was writing its temporary output");
+    child.kill().unwrap();
+    child.wait().unwrap();
+    drop(stdin);
+    assert_eq!(
+        std::fs::read(&out).unwrap(),
+        before,
+        "the old output is untouched"
+    );
+}
