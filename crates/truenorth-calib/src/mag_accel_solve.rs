@@ -167,37 +167,14 @@ fn add_row(
     *cost += r * r;
 }
 
-/// The gradient row of `|B(x − c)| − 1` with respect to `(c, B)` at the parameter offsets
-/// `c0`, `b0`, with `d = x − c`, `u = B d`, `û = u/|u|`: `∂/∂c = −B û`,
-/// `∂/∂B_rs = û_r d_s + û_s d_r` (`û_r d_r` on the diagonal).
-fn radial_row(
-    row: &mut SVector<f64, P>,
-    c0: usize,
-    b0: usize,
-    b: &Matrix3<f64>,
-    d: &Vector3<f64>,
-    u_hat: &Vector3<f64>,
-) {
-    let bc = -(b * u_hat);
-    for k in 0..3 {
-        row[c0 + k] = bc[k];
-    }
-    for (k, &(r, s)) in PAIRS.iter().enumerate() {
-        row[b0 + k] = if r == s {
-            u_hat[r] * d[r]
-        } else {
-            u_hat[r] * d[s] + u_hat[s] * d[r]
-        };
-    }
-}
-
 /// `∂x̂/∂x = (I − x̂x̂ᵀ)/|x|` applied to the row vector `g` (gives `(g − (g·x̂)x̂)/|x|`).
 fn unit_gradient(g: &Vector3<f64>, x_hat: &Vector3<f64>, norm: f64) -> Vector3<f64> {
     (g - x_hat * g.dot(x_hat)) / norm
 }
 
 /// Adds to `row` the gradient with respect to `(c, B)` of a function of `u = B(x − c)`
-/// whose gradient in `u` is `gu`: `∂/∂c = −B gu`, `∂/∂B_rs = gu_r d_s + gu_s d_r`.
+/// whose gradient in `u` is `gu`: `∂/∂c = −B gu`, `∂/∂B_rs = gu_r d_s + gu_s d_r`
+/// (`gu_r d_r` on the diagonal), `d = x − c`. For `|u| − 1`, `gu = û`.
 fn chain_to_ellipsoid(
     row: &mut SVector<f64, P>,
     c0: usize,
@@ -248,14 +225,14 @@ pub(crate) fn normal_equations(
         let (u_hat, v_hat) = (u / nu, v / nv);
         // |u| − 1.
         let mut row = SVector::<f64, P>::zeros();
-        radial_row(&mut row, CA, BA, &m.b_a, &da, &u_hat);
+        chain_to_ellipsoid(&mut row, CA, BA, &m.b_a, &da, &u_hat);
         let r = nu - 1.0;
         add_row(&mut jtj, &mut jtr, &mut cost, &(row * w.acc), r * w.acc);
         sums.acc.0 += r * r;
         sums.acc.1 += 1;
         // |v| − 1.
         let mut row = SVector::<f64, P>::zeros();
-        radial_row(&mut row, CM, BM, &m.b_m, &dm, &v_hat);
+        chain_to_ellipsoid(&mut row, CM, BM, &m.b_m, &dm, &v_hat);
         let r = nv - 1.0;
         add_row(&mut jtj, &mut jtr, &mut cost, &(row * w.mag), r * w.mag);
         sums.mag.0 += r * r;

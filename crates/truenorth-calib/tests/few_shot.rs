@@ -4,6 +4,9 @@
 //! calibration against a magnetometer-only ellipsoid (with the raw accelerometer, and with
 //! the accelerometer's own ellipsoid), over many instruments and protocols.
 
+mod common;
+
+use common::circular_std;
 use nalgebra::Vector3;
 use truenorth_accel::static_tilt;
 use truenorth_calib::{
@@ -83,15 +86,6 @@ impl Methods {
             tilt_compensated_heading(&true_h, &static_tilt(&true_f).unwrap()),
         ]
     }
-}
-
-/// Circular standard deviation of angles, radians: √(−2 ln R̄).
-fn circular_std(a: &[f64]) -> f64 {
-    let (s, c) = a
-        .iter()
-        .fold((0.0, 0.0), |(s, c), x| (s + x.sin(), c + x.cos()));
-    let r = (s * s + c * c).sqrt() / a.len() as f64;
-    (-2.0 * r.ln()).max(0.0).sqrt()
 }
 
 /// What [`measure`] finds, per method, degrees.

@@ -4,7 +4,10 @@
 //! turns under the calibration fitted to the full-sphere recording. Each test prints what
 //! it measured; the README's figures are asserted by `readme_figure`.
 
+mod common;
 mod recordings;
+
+use common::circular_std;
 
 use nalgebra::Vector3;
 use recordings::{read_rows, readme_figure, recording, rel_std};
@@ -154,15 +157,6 @@ fn full_sphere_with_quality() -> Option<(
         still.len(),
     );
     Some((ellipsoid, joint.params, q, all))
-}
-
-/// Circular standard deviation of angles, radians: √(−2 ln R̄).
-fn circular_std(a: &[f64]) -> f64 {
-    let (s, c) = a
-        .iter()
-        .fold((0.0, 0.0), |(s, c), x| (s + x.sin(), c + x.cos()));
-    let r = (s * s + c * c).sqrt() / a.len() as f64;
-    (-2.0 * r.ln()).max(0.0).sqrt()
 }
 
 /// The heading error of a calibration on a recording, against the gyro: the attitude is

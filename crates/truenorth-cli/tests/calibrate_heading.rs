@@ -2,41 +2,16 @@
 //! CSV files, checking exit codes, the JSON and CSV they write, and the one-line reason on
 //! stderr when the input cannot support a calibration.
 
+mod common;
+
 use std::f64::consts::TAU;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
-/// A fresh scratch folder for one test.
+use common::{ok, p, truenorth};
+
 fn scratch(name: &str) -> PathBuf {
-    let d = Path::new(env!("CARGO_TARGET_TMPDIR"))
-        .join("cli_calibrate_heading")
-        .join(name);
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-fn truenorth(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_truenorth"))
-        .args(args)
-        .output()
-        .expect("the truenorth binary runs")
-}
-
-/// Runs the binary and asserts that it succeeded, showing the arguments and stderr if not.
-fn ok(args: &[&str]) -> Output {
-    let out = truenorth(args);
-    assert!(
-        out.status.success(),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    out
-}
-
-fn p(path: &Path) -> &str {
-    path.to_str().unwrap()
+    common::scratch("cli_calibrate_heading", name)
 }
 
 /// Deterministic pseudo-noise in [−1, 1] (no RNG dependency needed for a fixture).

@@ -1,41 +1,18 @@
 //! `calibrate --method ellipsoid-accel` and tilt-compensated `heading`, run as a user runs
 //! them on a simulated 24-shot protocol of a hand-held instrument with known truth.
 
+mod common;
+
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::path::PathBuf;
+
+use common::{ok, p, truenorth};
 
 use truenorth::core::{SplitMix64, angle_diff};
 use truenorth_sim::{FewShotInstrument, Shot, protocol_shots, random_attitude};
 
 fn scratch(name: &str) -> PathBuf {
-    let d = Path::new(env!("CARGO_TARGET_TMPDIR"))
-        .join("cli_ellipsoid_accel")
-        .join(name);
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-fn truenorth(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_truenorth"))
-        .args(args)
-        .output()
-        .expect("the truenorth binary runs")
-}
-
-fn ok(args: &[&str]) -> Output {
-    let out = truenorth(args);
-    assert!(
-        out.status.success(),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    out
-}
-
-fn p(path: &Path) -> &str {
-    path.to_str().unwrap()
+    common::scratch("cli_ellipsoid_accel", name)
 }
 
 /// Shots as a CSV in the sensors' raw axes; `gravity` writes the accelerometer negated, as

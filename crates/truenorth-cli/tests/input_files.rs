@@ -3,44 +3,21 @@
 //! that keep a recording safe (a duplicated column, an output that is an input, a failed
 //! run that must leave the old output as it was).
 
+mod common;
+
 use std::f64::consts::TAU;
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output, Stdio};
+use std::process::{Command, Stdio};
+
+use common::{p, run};
 
 fn scratch(name: &str) -> PathBuf {
-    let d = Path::new(env!("CARGO_TARGET_TMPDIR"))
-        .join("cli_input_files")
-        .join(name);
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+    common::scratch("cli_input_files", name)
 }
 
-fn run(args: &[&str], stdin: Option<&[u8]>) -> Output {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_truenorth"))
-        .args(args)
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("the truenorth binary runs");
-    let mut pipe = child.stdin.take().unwrap();
-    if let Some(bytes) = stdin {
-        pipe.write_all(bytes).unwrap();
-    }
-    drop(pipe);
-    child.wait_with_output().unwrap()
-}
-
-fn ok(args: &[&str], stdin: Option<&[u8]>) -> Output {
-    let out = run(args, stdin);
-    assert!(
-        out.status.success(),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    out
+fn ok(args: &[&str], stdin: Option<&[u8]>) -> std::process::Output {
+    common::ok_with(args, stdin)
 }
 
 fn failed(args: &[&str]) -> String {
@@ -49,10 +26,6 @@ fn failed(args: &[&str]) -> String {
     let err = String::from_utf8(out.stderr).unwrap();
     assert_eq!(err.lines().count(), 1, "one line on stderr: {err:?}");
     err
-}
-
-fn p(path: &Path) -> &str {
-    path.to_str().unwrap()
 }
 
 /// A level compass turning clockwise through a full circle in a field of 20 with hard
@@ -336,11 +309,10 @@ fn output_naming_an_input_is_refused() {
     assert_eq!(std::fs::read_to_string(&cal).unwrap(), cal_text);
 }
 
-/// A run that fails half way through the input (a bad row near the end) leaves the
-/// existing output as it was, and no temporary file behind.
-#[test]
-fn a_failed_run_leaves_the_old_output() {
-    let dir = scratch("failed_run");
+/// A folder with a calibration (`cal`) of a turn and the heading output (`out`) of that
+/// turn: (folder, cal, out).
+fn calibrated_with_output(name: &str) -> (PathBuf, PathBuf, PathBuf) {
+    let dir = scratch(name);
     let good = dir.join("turn.csv");
     std::fs::write(&good, csv("t_s,mag_x,mag_y", ",", &turn(60))).unwrap();
     let cal = dir.join("cal.json");
@@ -369,6 +341,14 @@ fn a_failed_run_leaves_the_old_output() {
         ],
         None,
     );
+    (dir, cal, out)
+}
+
+/// A run that fails half way through the input (a bad row near the end) leaves the
+/// existing output as it was, and no temporary file behind.
+#[test]
+fn a_failed_run_leaves_the_old_output() {
+    let (dir, cal, out) = calibrated_with_output("failed_run");
     let before = std::fs::read_to_string(&out).unwrap();
     let bad = dir.join("bad.csv");
     let mut text = csv("t_s,mag_x,mag_y", ",", &turn(60));
@@ -398,35 +378,7 @@ fn a_failed_run_leaves_the_old_output() {
 /// temporary file beside it.
 #[test]
 fn a_killed_run_leaves_the_old_output() {
-    let dir = scratch("killed_run");
-    let good = dir.join("turn.csv");
-    std::fs::write(&good, csv("t_s,mag_x,mag_y", ",", &turn(60))).unwrap();
-    let cal = dir.join("cal.json");
-    ok(
-        &[
-            "calibrate",
-            "--method",
-            "ellipse",
-            "--input",
-            p(&good),
-            "--output",
-            p(&cal),
-        ],
-        None,
-    );
-    let out = dir.join("heading.csv");
-    ok(
-        &[
-            "heading",
-            "--calibration",
-            p(&cal),
-            "--input",
-            p(&good),
-            "--output",
-            p(&out),
-        ],
-        None,
-    );
+    let (dir, cal, out) = calibrated_with_output("killed_run");
     let before = std::fs::read(&out).unwrap();
     let mut child = Command::new(env!("CARGO_BIN_EXE_truenorth"))
         .args([
