@@ -74,50 +74,53 @@ impl Method {
     }
 }
 
-/// Arguments of `truenorth calibrate`.
-///
-/// Input: CSV with a header row and columns `mag_x,mag_y` (plus `mag_z` for the 3-D
-/// methods, and `acc_x,acc_y,acc_z` for `ellipsoid-accel`); `t_s` (strictly increasing) is
-/// read where present and needed only by the online methods (without it rows are one
-/// second apart); other columns are ignored. Magnetometer in any unit; accelerometer in any
-/// unit, reading specific force (about +1 g on the upward axis at rest: an accelerometer
-/// that reports gravity instead is negated with `--column acc_x=-acc_x,...`). `turn`
-/// accepts `gyr_z` (rad/s) and ignores it. The readings should cover a full turn (2-D,
-/// level) or orientations that determine the ellipsoid (3-D: a tumble, or a few dozen
-/// shots in assorted directions and rolled about a target).
-///
-/// Output: JSON, version 2:
-/// `{"format": "truenorth-compass-calibration", "version": 2, "method": M,
-///   "dimensions": 2|3, "units": {...}, "hard_iron": [..], "soft_iron": [[..], ..] (row by
-///   row), "field": F, ["mag_to_body": [[..]], "accelerometer": {"bias", "matrix",
-///   "gravity"}, "dip_deg"] (ellipsoid-accel), "quality": {"verdict", "verdict_reason",
-///   "points", "coverage", "residual_rms_rel", "condition", "geometry_dilution",
-///   "heading_error_bound_deg", "heading_error_3sigma_deg", "heading_error_systematic_deg",
-///   "heading_noise_rms_deg", "hard_iron_sigma", "soft_iron_sigma_rel",
-///   "field_ratio_to_expected", ...}, "input": FILE}`
-/// with `corrected = soft_iron · (raw − hard_iron)`, a circle (sphere) of radius `field` in
-/// the input unit. The `units` block says what every number is in and means.
-/// `heading_error_bound_deg` bounds the heading error the calibration itself adds to every
-/// later heading (3-D: the field direction error; ellipsoid-accel: the heading of the body
-/// x axis): 3 standard deviations of the parameters' uncertainty plus what the method's
-/// model cannot remove; each reading's own noise (`heading_noise_rms_deg`) comes on top.
-/// `verdict`: `good` (bound ≤ 1°, noise ≤ 2°), `usable` (both ≤ 5°) or `poor`, with the
-/// number that decided it in `verdict_reason`.
-///
-/// A `poor` calibration is refused (exit 1) unless `--accept-poor`. With `--mag-unit`, a
-/// fitted field that is not a plausible Earth field in that unit (or, with --lat/--lon, more
-/// than 15 % from the World Magnetic Model's) is refused with the unit the data are
-/// probably in, unless `--accept-field-mismatch`. On success one summary line goes to
-/// stderr. Exit status 1 with one line on stderr when the file is bad or the data cannot
-/// support a calibration (too few points, orientations that do not determine it,
-/// degenerate, not an ellipse).
-///
-/// Example: a logger's file with columns `time;mx;my;mz;ax;ay;az`, sensor axes x forward,
-/// y left, z up, field in µT, recorded in London:
-/// `truenorth calibrate --method ellipsoid-accel --input log.csv.gz --output cal.json
-///  --column t_s=time,mag_x=mx,mag_y=my,mag_z=mz,acc_x=ax,acc_y=ay,acc_z=az --axes flu
-///  --mag-unit uT --lat 51.5 --lon -0.13`
+/// The long help of the command (after the options).
+const AFTER_HELP: &str =
+    "Input: CSV with a header row and columns `mag_x,mag_y` (plus `mag_z` for the 3-D
+methods, and `acc_x,acc_y,acc_z` for `ellipsoid-accel`); `t_s` (strictly increasing) is
+read where present and needed only by the online methods (without it rows are one
+second apart); other columns are ignored. Magnetometer in any unit; accelerometer in any
+unit, reading specific force (about +1 g on the upward axis at rest: an accelerometer
+that reports gravity instead is negated with `--column acc_x=-acc_x,...`). `turn`
+accepts `gyr_z` (rad/s) and ignores it. The readings should cover a full turn (2-D,
+level) or orientations that determine the ellipsoid (3-D: a tumble, or a few dozen
+shots in assorted directions and rolled about a target).
+
+Output: JSON, version 2:
+`{\"format\": \"truenorth-compass-calibration\", \"version\": 2, \"method\": M,
+  \"dimensions\": 2|3, \"units\": {...}, \"hard_iron\": [..], \"soft_iron\": [[..], ..] (row by
+  row), \"field\": F, [\"mag_to_body\": [[..]], \"accelerometer\": {\"bias\", \"matrix\",
+  \"gravity\"}, \"dip_deg\"] (ellipsoid-accel), \"quality\": {\"verdict\", \"verdict_reason\",
+  \"points\", \"coverage\", \"residual_rms_rel\", \"condition\", \"geometry_dilution\",
+  \"heading_error_bound_deg\", \"heading_error_3sigma_deg\", \"heading_error_systematic_deg\",
+  \"heading_noise_rms_deg\", \"hard_iron_sigma\", \"soft_iron_sigma_rel\",
+  \"field_ratio_to_expected\", ...}, \"input\": FILE}`
+with `corrected = soft_iron · (raw − hard_iron)`, a circle (sphere) of radius `field` in
+the input unit. The `units` block says what every number is in and means.
+`heading_error_bound_deg` bounds the heading error the calibration itself adds to every
+later heading (3-D: the field direction error; ellipsoid-accel: the heading of the body
+x axis): 3 standard deviations of the parameters' uncertainty plus what the method's
+model cannot remove; each reading's own noise (`heading_noise_rms_deg`) comes on top.
+`verdict`: `good` (bound ≤ 1°, noise ≤ 2°), `usable` (both ≤ 5°) or `poor`, with the
+number that decided it in `verdict_reason`.
+
+A `poor` calibration is refused (exit 1) unless `--accept-poor`. With `--mag-unit`, a
+fitted field that is not a plausible Earth field in that unit (or, with --lat/--lon, more
+than 15 % from the World Magnetic Model's) is refused with the unit the data are
+probably in, unless `--accept-field-mismatch`. On success one summary line goes to
+stderr. Exit status 1 with one line on stderr when the file is bad or the data cannot
+support a calibration (too few points, orientations that do not determine it,
+degenerate, not an ellipse).
+
+Example: a logger's file with columns `time;mx;my;mz;ax;ay;az`, sensor axes x forward,
+y left, z up, field in µT, recorded in London:
+`truenorth calibrate --method ellipsoid-accel --input log.csv.gz --output cal.json
+ --column t_s=time,mag_x=mx,mag_y=my,mag_z=mz,acc_x=ax,acc_y=ay,acc_z=az --axes flu
+ --mag-unit uT --lat 51.5 --lon -0.13`";
+
+/// Arguments of `truenorth calibrate` (the details are in `AFTER_HELP`, shown by `--help`).
 #[derive(Debug, clap::Args)]
+#[command(after_long_help = AFTER_HELP)]
 pub struct Args {
     /// Calibration method.
     #[arg(long, value_enum)]

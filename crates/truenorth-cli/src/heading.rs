@@ -13,25 +13,28 @@ use crate::io::{
     ReadSpec, RowReader, check_distinct,
 };
 
-/// Arguments of `truenorth heading`.
-///
-/// Input: CSV with `t_s,mag_x,mag_y` (plus `mag_z` for a 3-D calibration), strictly
-/// increasing time, and optionally `acc_x,acc_y,acc_z` (accelerometer reading specific
-/// force: about +1 g on the upward axis at rest, any unit); other columns are ignored.
-/// Output: CSV `t_s,heading_deg`, in degrees clockwise in [0, 360): from magnetic north,
-/// or, with `--lat` and `--lon` (and optionally `--date`, default today), from true north —
-/// magnetic heading plus the World Magnetic Model 2025 declination at that place and date.
-///
-/// Tilt: with a 3-D calibration and `acc_x,acc_y,acc_z` in the input, the heading is that
-/// of the body x axis tilt-compensated with the pitch and roll the accelerometer gives (the
-/// sensor at rest or moving slowly), and the columns `pitch_deg,roll_deg` follow (pitch
-/// nose up, roll right side down). A calibration from `ellipsoid-accel` calibrates the
-/// accelerometer and aligns it with the magnetometer; with a plain `ellipsoid` calibration
-/// the raw accelerometer is used, assumed to share the magnetometer's axes. Without the
-/// accelerometer columns, or with a 2-D calibration, the heading ASSUMES A LEVEL SENSOR
-/// (body x forward, y right, z down, horizontal): a tilt of a few degrees then errs by
-/// several degrees where the field dips steeply; the summary line on stderr says so.
+/// The long help of the command (after the options).
+const AFTER_HELP: &str =
+    "Input: CSV with `t_s,mag_x,mag_y` (plus `mag_z` for a 3-D calibration), strictly
+increasing time, and optionally `acc_x,acc_y,acc_z` (accelerometer reading specific
+force: about +1 g on the upward axis at rest, any unit); other columns are ignored.
+Output: CSV `t_s,heading_deg`, in degrees clockwise in [0, 360): from magnetic north,
+or, with `--lat` and `--lon` (and optionally `--date`, default today), from true north —
+magnetic heading plus the World Magnetic Model 2025 declination at that place and date.
+
+Tilt: with a 3-D calibration and `acc_x,acc_y,acc_z` in the input, the heading is that
+of the body x axis tilt-compensated with the pitch and roll the accelerometer gives (the
+sensor at rest or moving slowly), and the columns `pitch_deg,roll_deg` follow (pitch
+nose up, roll right side down). A calibration from `ellipsoid-accel` calibrates the
+accelerometer and aligns it with the magnetometer; with a plain `ellipsoid` calibration
+the raw accelerometer is used, assumed to share the magnetometer's axes. Without the
+accelerometer columns, or with a 2-D calibration, the heading ASSUMES A LEVEL SENSOR
+(body x forward, y right, z down, horizontal): a tilt of a few degrees then errs by
+several degrees where the field dips steeply; the summary line on stderr says so.";
+
+/// Arguments of `truenorth heading` (the details are in `AFTER_HELP`, shown by `--help`).
 #[derive(Debug, clap::Args)]
+#[command(after_long_help = AFTER_HELP)]
 pub struct Args {
     /// Calibration JSON written by `truenorth calibrate` (`-`: standard input).
     #[arg(long)]
