@@ -1,7 +1,8 @@
 //! # truenorth-accel
 //!
 //! The accelerometer: a forward model (gravity plus the vehicle's own acceleration, with bias,
-//! scale error and noise) for the simulator and round-trip tests, its calibration, static
+//! scale error and noise) for the simulator and round-trip tests, its calibration (per axis,
+//! or with cross-axis terms: [`AccelTriadCalibration`]), static
 //! tilt (pitch and roll from gravity) and the quasi-static test that says when static tilt
 //! can be trusted (the accelerometer parts of WO 00/36376, METHODS §E.3 and §E.5(7)).
 //!

@@ -12,7 +12,11 @@
 //! [`EllipseCalibrator`] (two-axis compass: hard iron and symmetric soft iron from a direct
 //! ellipse fit refined on the Sampson distance) and [`EllipsoidCalibrator`] (three-axis
 //! magnetometer: hard iron and full symmetric soft iron from a direct ellipsoid fit refined
-//! by Levenberg–Marquardt). The [`quality`] module holds the report every calibrator shares.
+//! by Levenberg–Marquardt), and [`MagAccelCalibrator`] (a magnetometer and an
+//! accelerometer together: both ellipsoids, the rotation between the sensors from the
+//! constant dip, and the pointing axis from runs of shots aimed at one target). The
+//! [`quality`] module holds the report every calibrator shares: what the readings determine
+//! (not how much of the sphere they fill), the predicted uncertainty and a verdict.
 //!
 //! The seed calibrators learn online, sample by sample, without allocating:
 //! [`MeritCircleCalibrator`] (US 5,297,063: circumcentres of reading triples, merged by a

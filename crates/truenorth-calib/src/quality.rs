@@ -8,8 +8,11 @@
 //! monomial sums of its direct fit instead of a second pass over the readings.
 //!
 //! The parts live in submodules: coverage (heading bins, sphere cells, the locus's turning),
-//! bounds (information matrices and heading-error bounds), report (assembly of the
-//! [`CompassQuality`](truenorth_core::CompassQuality)) and field (the fitted field against an expected one).
+//! bounds (information matrices and heading-error bounds), uncertainty (what the readings
+//! determine: the dilution of the information matrix, the predicted parameter σ, and the
+//! determination test that replaces a share of direction cells), verdict (good / usable /
+//! poor), report (assembly of the [`CompassQuality`](truenorth_core::CompassQuality)) and
+//! field (the fitted field against an expected one).
 //!
 //! # The three parts of the heading error
 //!
@@ -141,12 +144,13 @@ pub const SPHERE_CELLS: usize = SPHERE_BANDS * SPHERE_SECTORS;
 /// to a little beyond 180°; the margin keeps a noisy half circle from slipping through.
 pub const MIN_ARC_DEG: f64 = 200.0;
 
-/// The smallest share of the direction cells on the sphere ([`SPHERE_CELLS`]) from which a
-/// 3-D calibration is accepted.
+/// The smallest share of the direction cells on the sphere ([`SPHERE_CELLS`]) from which the
+/// online ellipsoid calibrator accepts a calibration (the batch ellipsoid fit and the joint
+/// calibration judge instead what the readings determine, see [`require_determined`]).
 ///
 /// One turn about a single axis traces a great circle, which passes through about 20–25 %
 /// of the cells and does not determine an ellipsoid; turns about two or more axes reach
-/// well beyond this.
+/// well beyond this. Few-shot protocols fill less and are refused by this test.
 pub const MIN_SPHERE_COVERAGE: f64 = 0.3;
 
 /// How many standard deviations the heading-error bound spans.
