@@ -78,6 +78,7 @@ mod normalise;
 
 // Joint magnetometer + accelerometer calibration.
 mod mag_accel;
+mod mag_accel_report;
 mod mag_accel_runs;
 mod mag_accel_solve;
 
