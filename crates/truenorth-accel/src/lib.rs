@@ -1,7 +1,8 @@
 //! # truenorth-accel
 //!
 //! The accelerometer: a forward model (gravity plus the vehicle's own acceleration, with bias,
-//! scale error and noise) for the simulator and round-trip tests, its calibration, static
+//! scale error and noise) for the simulator and round-trip tests, its calibration (per axis,
+//! or with cross-axis terms: [`AccelTriadCalibration`]), static
 //! tilt (pitch and roll from gravity) and the quasi-static test that says when static tilt
 //! can be trusted (the accelerometer parts of WO 00/36376, METHODS §E.3 and §E.5(7)).
 //!
@@ -45,9 +46,11 @@ mod calibration;
 mod quasi_static;
 mod specific_force;
 mod static_tilt;
+mod triad_calibration;
 
 pub use accel_model::{AccelCoefficients, AccelModel, AccelParams, MIN_SCALE_ERROR};
 pub use calibration::AccelCalibration;
 pub use quasi_static::{QuasiStaticConfig, QuasiStaticDetector};
 pub use specific_force::{AccelTruth, gravity_ned_mps2, specific_force_body_mps2};
 pub use static_tilt::{MIN_SPECIFIC_FORCE_MPS2, pitch_from_forward_axis_rad, static_tilt};
+pub use triad_calibration::{AccelTriadCalibration, MAX_TRIAD_CONDITION};

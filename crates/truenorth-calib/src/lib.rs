@@ -12,7 +12,11 @@
 //! [`EllipseCalibrator`] (two-axis compass: hard iron and symmetric soft iron from a direct
 //! ellipse fit refined on the Sampson distance) and [`EllipsoidCalibrator`] (three-axis
 //! magnetometer: hard iron and full symmetric soft iron from a direct ellipsoid fit refined
-//! by Levenberg–Marquardt). The [`quality`] module holds the report every calibrator shares.
+//! by Levenberg–Marquardt), and [`MagAccelCalibrator`] (a magnetometer and an
+//! accelerometer together: both ellipsoids, the rotation between the sensors from the
+//! constant dip, and the pointing axis from runs of shots aimed at one target). The
+//! [`quality`] module holds the report every calibrator shares: what the readings determine
+//! (not how much of the sphere they fill), the predicted uncertainty and a verdict.
 //!
 //! The seed calibrators learn online, sample by sample, without allocating:
 //! [`MeritCircleCalibrator`] (US 5,297,063: circumcentres of reading triples, merged by a
@@ -72,6 +76,12 @@ mod linalg;
 mod lm;
 mod normalise;
 
+// Joint magnetometer + accelerometer calibration.
+mod mag_accel;
+mod mag_accel_report;
+mod mag_accel_runs;
+mod mag_accel_solve;
+
 // Online least-squares calibrators from running monomial sums.
 mod conic_sums;
 mod online_conic;
@@ -112,6 +122,10 @@ pub use ellipse_fit::{
 pub use ellipsoid_fit::{
     Ellipsoid, EllipsoidCalibrator, EllipsoidConfig, MIN_POINTS_3D, fit_ellipsoid,
     fit_ellipsoid_direct,
+};
+pub use mag_accel::{
+    INITIAL_FIT_BOUND_DEG, MIN_MAG_ACCEL_READINGS, MagAccelCalibration, MagAccelCalibrator,
+    MagAccelConfig, MagAccelQuality, MagAccelSample, fit_mag_accel,
 };
 pub use merit_circle::{
     MERIT_CIRCLE_MIN_ARC_DEG, MeritCircleCalibrator, MeritCircleConfig, MeritCircleSaved,

@@ -1,25 +1,29 @@
 //! `truenorth calibrate`: fit a compass calibration to a recording and write it, with its
-//! quality report, as JSON.
+//! quality report and verdict, as JSON.
 //!
 //! Every 2-D method is a `Calibrator<Sample = Mag2Sample, Params = CompassCalibration2d>`,
-//! so adding one is one arm in [`run`]; the 3-D method is the same with `Mag3Sample` and
-//! `CompassCalibration3d`.
+//! so adding one is one arm in [`run`]; the 3-D methods are the same with `Mag3Sample` and
+//! `CompassCalibration3d`, and `ellipsoid-accel` fits both sensors together.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use nalgebra::{SMatrix, SVector, Vector2, Vector3};
+use truenorth::calib::quality::{self, Grade, Uncertainty, Verdict};
 use truenorth::calib::{
-    BinnedEllipseCalibrator, EllipseCalibrator, EllipsoidCalibrator, MeritCircleCalibrator,
-    OnlineEllipseCalibrator, OnlineEllipsoidCalibrator, TurnCompassCalibrator, quality,
+    BinnedEllipseCalibrator, EllipseCalibrator, EllipsoidCalibrator, MagAccelCalibrator,
+    MagAccelConfig, MagAccelQuality, MagAccelSample, MeritCircleCalibrator,
+    OnlineEllipseCalibrator, OnlineEllipsoidCalibrator, TurnCompassCalibrator,
 };
 use truenorth::compass::{CompassCalibration2d, CompassCalibration3d};
 use truenorth::core::{Calibrator, CompassQuality, Mag2Sample, Mag3Sample, Solution};
 
 use crate::field::Place;
 use crate::io::{
-    CALIBRATION_FORMAT, CALIBRATION_VERSION, CalibrationFile, CliError, CliResult, Table,
-    check_distinct,
+    AccelPart, CALIBRATION_FORMAT, CALIBRATION_VERSION, CalibrationFile, CliError, CliResult,
+    InputOptions, InputPath, QualityReport, ReadSpec, Table, check_distinct, finite, matrix_rows,
+    units_block,
 };
+use crate::mag_unit::{MagUnit, check_field};
 
 /// Calibration methods.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -28,6 +32,11 @@ pub enum Method {
     Ellipse,
     /// Least-squares ellipsoid (3-D, needs mag_z): hard iron + full symmetric soft iron.
     Ellipsoid,
+    /// Magnetometer and accelerometer together (needs mag_x,mag_y,mag_z,acc_x,acc_y,acc_z,
+    /// static or slow readings): accelerometer bias, scale and cross-axis, magnetometer hard
+    /// and soft iron, the rotation between the two (from the constant dip), and the pointing
+    /// axis from runs of shots aimed at one target while rolling (found automatically).
+    EllipsoidAccel,
     /// Online least-squares ellipse (2-D): the same direct fit from running sums, in
     /// constant memory, as a vehicle would run it while driving.
     OnlineEllipse,
@@ -47,6 +56,7 @@ impl Method {
         match self {
             Method::Ellipse => "ellipse",
             Method::Ellipsoid => "ellipsoid",
+            Method::EllipsoidAccel => "ellipsoid-accel",
             Method::OnlineEllipse => "online-ellipse",
             Method::OnlineEllipsoid => "online-ellipsoid",
             Method::BinnedEllipse => "binned-ellipse",
@@ -54,85 +64,95 @@ impl Method {
             Method::Turn => "turn",
         }
     }
+
+    /// 2 or 3.
+    fn dimensions(self) -> usize {
+        match self {
+            Method::Ellipsoid | Method::EllipsoidAccel | Method::OnlineEllipsoid => 3,
+            _ => 2,
+        }
+    }
 }
 
-/// Arguments of `truenorth calibrate`.
-///
-/// Input: CSV with a header row and columns `t_s,mag_x,mag_y` (plus `mag_z` for
-/// `ellipsoid`); other columns are ignored; magnetometer in any unit; `turn` also accepts
-/// `gyr_z` (rad/s) and ignores it (the method calibrates the compass). Time must increase strictly. The readings should cover a full turn (2-D, level) or
-/// many orientations (3-D).
-///
-/// Output: JSON
-/// `{"format": "truenorth-compass-calibration", "version": 1, "method": M,
-///   "dimensions": 2|3, "hard_iron": [..], "soft_iron": [[..], ..] (row by row),
-///   "field": F, "quality": {"points", "coverage", "residual_rms_rel", "condition",
-///   "heading_error_bound_deg", "heading_error_3sigma_deg", "heading_error_systematic_deg",
-///   "heading_noise_rms_deg", "field_magnitude", "field_ratio_to_expected"}, "input": FILE}`
-/// with `corrected = soft_iron · (raw − hard_iron)`, a circle (sphere) of radius `field` in
-/// the input unit. `coverage`: share of 10° heading bins (3-D: of 128 equal-area direction
-/// cells) filled; `residual_rms_rel`: RMS of |corrected|/field − 1; `condition`: condition
-/// number of the calibration's information matrix (2 = a full, even circle);
-/// `heading_error_bound_deg`: bound on the heading error the calibration adds (3-D: on the
-/// field direction error), the sum of `heading_error_3sigma_deg` (3-sigma, from the
-/// uncertainty of the fitted parameters) and `heading_error_systematic_deg` (what the
-/// method's model cannot remove, e.g. a rotated soft iron under `merit-circle` or `turn`);
-/// `heading_noise_rms_deg`: the noise of each calibrated reading, which comes on top.
-///
-/// Exit status 1 with one line on stderr when the file is bad or the data cannot support a
-/// calibration (too few points, too little of the circle, degenerate, not an ellipse).
+/// The long help of the command (after the options).
+const AFTER_HELP: &str =
+    "Input: CSV with a header row and columns `mag_x,mag_y` (plus `mag_z` for the 3-D
+methods, and `acc_x,acc_y,acc_z` for `ellipsoid-accel`); `t_s` (strictly increasing) is
+read where present and needed only by the online methods (without it rows are one
+second apart); other columns are ignored. Magnetometer in any unit; accelerometer in any
+unit, reading specific force (about +1 g on the upward axis at rest: an accelerometer
+that reports gravity instead is negated with `--column acc_x=-acc_x,...`). `turn`
+accepts `gyr_z` (rad/s) and ignores it. The readings should cover a full turn (2-D,
+level) or orientations that determine the ellipsoid (3-D: a tumble, or a few dozen
+shots in assorted directions and rolled about a target).
+
+Output: JSON, version 2:
+`{\"format\": \"truenorth-compass-calibration\", \"version\": 2, \"method\": M,
+  \"dimensions\": 2|3, \"units\": {...}, \"hard_iron\": [..], \"soft_iron\": [[..], ..] (row by
+  row), \"field\": F, [\"mag_to_body\": [[..]], \"accelerometer\": {\"bias\", \"matrix\",
+  \"gravity\"}, \"dip_deg\"] (ellipsoid-accel), \"quality\": {\"verdict\", \"verdict_reason\",
+  \"points\", \"coverage\", \"residual_rms_rel\", \"condition\", \"geometry_dilution\",
+  \"heading_error_bound_deg\", \"heading_error_3sigma_deg\", \"heading_error_systematic_deg\",
+  \"heading_noise_rms_deg\", \"hard_iron_sigma\", \"soft_iron_sigma_rel\",
+  \"field_ratio_to_expected\", ...}, \"input\": FILE}`
+with `corrected = soft_iron · (raw − hard_iron)`, a circle (sphere) of radius `field` in
+the input unit. The `units` block says what every number is in and means.
+`heading_error_bound_deg` bounds the heading error the calibration itself adds to every
+later heading (3-D: the field direction error; ellipsoid-accel: the heading of the body
+x axis): 3 standard deviations of the parameters' uncertainty plus what the method's
+model cannot remove; each reading's own noise (`heading_noise_rms_deg`) comes on top.
+`verdict`: `good` (bound ≤ 1°, noise ≤ 2°), `usable` (both ≤ 5°) or `poor`, with the
+number that decided it in `verdict_reason`.
+
+A `poor` calibration is refused (exit 1) unless `--accept-poor`. With `--mag-unit`, a
+fitted field that is not a plausible Earth field in that unit (or, with --lat/--lon, more
+than 15 % from the World Magnetic Model's) is refused with the unit the data are
+probably in, unless `--accept-field-mismatch`. On success one summary line goes to
+stderr. Exit status 1 with one line on stderr when the file is bad or the data cannot
+support a calibration (too few points, orientations that do not determine it,
+degenerate, not an ellipse).
+
+Example: a logger's file with columns `time;mx;my;mz;ax;ay;az`, sensor axes x forward,
+y left, z up, field in µT, recorded in London:
+`truenorth calibrate --method ellipsoid-accel --input log.csv.gz --output cal.json
+ --column t_s=time,mag_x=mx,mag_y=my,mag_z=mz,acc_x=ax,acc_y=ay,acc_z=az --axes flu
+ --mag-unit uT --lat 51.5 --lon -0.13`";
+
+/// Arguments of `truenorth calibrate` (the details are in `AFTER_HELP`, shown by `--help`).
 #[derive(Debug, clap::Args)]
+#[command(after_long_help = AFTER_HELP)]
 pub struct Args {
     /// Calibration method.
     #[arg(long, value_enum)]
     pub method: Method,
-    /// Input CSV.
+    /// Input CSV (`-`: standard input; `.gz` or gzip data read as such).
     #[arg(long)]
     pub input: PathBuf,
-    /// Output JSON.
+    /// Output JSON (`-`: standard output).
     #[arg(long)]
     pub output: PathBuf,
-    /// Expected field in the input unit (horizontal for 2-D methods, total for
-    /// `ellipsoid`), e.g. from `truenorth field`; the report then gives
-    /// `field_ratio_to_expected`.
+    /// Expected field in the input unit (horizontal for 2-D methods, total for 3-D), e.g.
+    /// from `truenorth field`; the report then gives `field_ratio_to_expected`.
     #[arg(long, value_name = "FIELD")]
     pub expected_field: Option<f64>,
-    /// Unit of the readings; with --lat/--lon the World Magnetic Model field there (horizontal
-    /// for 2-D methods, total for `ellipsoid`) becomes the expected field. A fit more than
-    /// 15 % away from it prints a warning on stderr.
+    /// Unit of the magnetometer readings. Alone, the fitted field must be a plausible Earth
+    /// field in it; with --lat/--lon, within 15 % of the World Magnetic Model's field there
+    /// (horizontal for 2-D methods, total for 3-D).
     #[arg(long, value_enum, value_name = "UNIT")]
     pub mag_unit: Option<MagUnit>,
     /// Where and when the recording was made (for the expected field).
     #[command(flatten)]
     pub place: Place,
-}
-
-/// Units a magnetometer may report in.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum MagUnit {
-    /// Nanotesla.
-    #[value(name = "nT")]
-    NanoTesla,
-    /// Microtesla.
-    #[value(name = "uT")]
-    MicroTesla,
-    /// Milligauss (= 100 nT).
-    #[value(name = "mG")]
-    MilliGauss,
-    /// Gauss (= 100 000 nT).
-    #[value(name = "G")]
-    Gauss,
-}
-
-impl MagUnit {
-    fn nanotesla(self) -> f64 {
-        match self {
-            Self::NanoTesla => 1.0,
-            Self::MicroTesla => 1e3,
-            Self::MilliGauss => 1e2,
-            Self::Gauss => 1e5,
-        }
-    }
+    /// Write a `poor` calibration anyway (with a warning) instead of refusing it.
+    #[arg(long)]
+    pub accept_poor: bool,
+    /// Write the calibration even when its field does not match --mag-unit or the World
+    /// Magnetic Model (with a warning).
+    #[arg(long)]
+    pub accept_field_mismatch: bool,
+    /// How to read the input.
+    #[command(flatten)]
+    pub input_options: InputOptions,
 }
 
 /// The field the fit should find, in the input unit: given directly, or from the World
@@ -156,6 +176,12 @@ fn expected_field(args: &Args, dimensions: usize) -> CliResult<Option<f64>> {
     Ok(Some(nt / unit.nanotesla()))
 }
 
+/// A fitted calibration on its way to the file, with what the checks need.
+struct Fitted {
+    file: CalibrationFile,
+    quality: CompassQuality,
+}
+
 /// Runs the subcommand.
 pub fn run(args: &Args) -> CliResult {
     check_distinct(&args.output, &[&args.input])?;
@@ -166,24 +192,88 @@ pub fn run(args: &Args) -> CliResult {
             "--expected-field must be a positive number, got {e}"
         )));
     }
-    let file = match args.method {
-        Method::Ellipse => calibrate_2d(args, EllipseCalibrator::default())?,
-        Method::Ellipsoid => calibrate_3d(args, EllipsoidCalibrator::default())?,
+    let expected = expected_field(args, args.method.dimensions())?;
+    let fitted = match args.method {
+        Method::Ellipse => calibrate_2d(args, EllipseCalibrator::default(), expected)?,
+        Method::Ellipsoid => calibrate_3d(args, EllipsoidCalibrator::default(), expected)?,
+        Method::EllipsoidAccel => calibrate_joint(args, expected)?,
         Method::OnlineEllipse => calibrate_2d(
             args,
             OnlineEllipseCalibrator::new(Default::default()).map_err(library)?,
+            expected,
         )?,
         Method::OnlineEllipsoid => calibrate_3d(
             args,
             OnlineEllipsoidCalibrator::new(Default::default()).map_err(library)?,
+            expected,
         )?,
-        Method::BinnedEllipse => calibrate_2d(args, BinnedEllipseCalibrator::default())?,
-        Method::MeritCircle => calibrate_2d(args, MeritCircleCalibrator::default())?,
+        Method::BinnedEllipse => calibrate_2d(args, BinnedEllipseCalibrator::default(), expected)?,
+        Method::MeritCircle => calibrate_2d(args, MeritCircleCalibrator::default(), expected)?,
         // The compass half of the turn method (METHODS.md §A.4-5); `gyr_z` is accepted so
         // that one recording serves both halves, and ignored here.
-        Method::Turn => calibrate_2d(args, TurnCompassCalibrator::default())?,
+        Method::Turn => calibrate_2d(args, TurnCompassCalibrator::default(), expected)?,
     };
-    file.write(&args.output)
+    let input = InputPath::new(&args.input).display_path();
+    let warn = |w: &str| eprintln!("truenorth: warning: {}: {w}", input.display());
+    if let Some(problem) = check_field(
+        fitted.quality.field_magnitude,
+        args.mag_unit,
+        expected.filter(|_| args.place.is_given()),
+        args.method.dimensions(),
+    ) {
+        if args.accept_field_mismatch {
+            warn(&problem);
+        } else {
+            return Err(CliError::file(
+                &input,
+                format!("{problem} (write it anyway with --accept-field-mismatch)"),
+            ));
+        }
+    } else if let Some(w) = expected.and_then(|e| quality::field_mismatch(&fitted.quality, e)) {
+        // An expected field given directly: a warning, as the numbers are the user's.
+        warn(&w.to_string());
+    }
+    let verdict = Verdict::of(&fitted.quality);
+    if verdict.grade == Grade::Poor {
+        let what = format!(
+            "the calibration with method `{}` is poor: {verdict}",
+            args.method.name()
+        );
+        if args.accept_poor {
+            warn(&what);
+        } else {
+            return Err(CliError::file(
+                &input,
+                format!("{what}; refused (write it anyway with --accept-poor)"),
+            ));
+        }
+    }
+    fitted.file.write(&args.output)?;
+    eprintln!("truenorth: {}", summary(&fitted.file, &verdict));
+    Ok(())
+}
+
+/// The one line on stderr after a successful calibration.
+fn summary(file: &CalibrationFile, verdict: &Verdict) -> String {
+    let q = file.quality.as_ref();
+    let num = |v: Option<f64>| v.map_or("unbounded".to_string(), |v| format!("{v:.2}"));
+    let mut s = format!(
+        "calibrate: method {}, {} points, verdict {}, field {:.6} (input unit), heading error bound {} deg (3 sigma + systematic), per-reading noise {} deg RMS",
+        file.method,
+        q.map_or(0, |q| q.points),
+        verdict.grade,
+        file.field,
+        num(q.and_then(|q| q.heading_error_bound_deg)),
+        num(q.and_then(|q| q.heading_noise_rms_deg)),
+    );
+    if let (Some(q), Some(d)) = (q, file.dip_deg) {
+        s += &format!(
+            ", dip {d:.2} deg (spread {} deg), {} runs",
+            num(q.dip_spread_deg),
+            q.runs.unwrap_or(0)
+        );
+    }
+    s
 }
 
 /// A library error outside any file (an invalid built-in configuration).
@@ -191,76 +281,179 @@ fn library(e: truenorth::core::Error) -> CliError {
     CliError::msg(e.to_string())
 }
 
-/// Reads the 2-D input, after checking time order.
-fn read_2d(path: &Path) -> CliResult<Vec<Mag2Sample>> {
-    let table = Table::read(path, &["t_s", "mag_x", "mag_y"], &[])?;
+/// Reads the `columns` of the input, and `t_s` (strictly increasing) where present. Without
+/// `t_s`, the rows are taken as one second apart.
+fn read_input(args: &Args, columns: &[&str]) -> CliResult<(Table, Vec<f64>)> {
+    let spec = ReadSpec::new(columns).optional(&["t_s"]).increasing("t_s");
+    let table = Table::read_with(&InputPath::new(&args.input), &args.input_options, &spec)?;
     table.require_rows()?;
-    table.check_increasing_time()?;
-    let (t, x, y) = (table.req("t_s")?, table.req("mag_x")?, table.req("mag_y")?);
-    let samples = (0..table.len())
+    let t = match table.col("t_s") {
+        Some(t) => t.to_vec(),
+        None => (0..table.len()).map(|k| k as f64).collect(),
+    };
+    Ok((table, t))
+}
+
+/// Three columns of a table as vectors.
+fn vectors(table: &Table, names: [&str; 3]) -> CliResult<Vec<Vector3<f64>>> {
+    let (x, y, z) = (
+        table.req(names[0])?,
+        table.req(names[1])?,
+        table.req(names[2])?,
+    );
+    Ok((0..table.len())
+        .map(|k| Vector3::new(x[k], y[k], z[k]))
+        .collect())
+}
+
+/// Feeds every row to a 2-D calibrator, solves, and builds the output file.
+fn calibrate_2d<C>(args: &Args, mut cal: C, expected: Option<f64>) -> CliResult<Fitted>
+where
+    C: Calibrator<Sample = Mag2Sample, Params = CompassCalibration2d, Quality = CompassQuality>,
+{
+    let (table, t) = read_input(args, &["mag_x", "mag_y"])?;
+    let (x, y) = (table.req("mag_x")?, table.req("mag_y")?);
+    let samples: Vec<Mag2Sample> = (0..table.len())
         .map(|k| Mag2Sample {
             t_s: t[k],
             mag: Vector2::new(x[k], y[k]),
         })
         .collect();
-    Ok(samples)
-}
-
-/// Feeds every row to a 2-D calibrator, solves, and builds the output file.
-fn calibrate_2d<C>(args: &Args, mut cal: C) -> CliResult<CalibrationFile>
-where
-    C: Calibrator<Sample = Mag2Sample, Params = CompassCalibration2d, Quality = CompassQuality>,
-{
-    let samples = read_2d(&args.input)?;
-    let sol = feed_and_solve(args, &mut cal, &samples, expected_field(args, 2)?)?;
-    Ok(file_for(
+    let sol = feed_and_solve(args, &table, &mut cal, &samples, expected)?;
+    let points: Vec<Vector2<f64>> = samples.iter().map(|s| s.mag).collect();
+    let u = quality::assess_2d(&points, &sol.params, sol.quality.field_magnitude).uncertainty;
+    Ok(fitted(
         args,
         &sol.params.hard_iron,
         &sol.params.soft_iron,
         sol.quality,
+        &u,
     ))
 }
 
 /// Feeds every row to a 3-D calibrator, solves, and builds the output file.
-fn calibrate_3d<C>(args: &Args, mut cal: C) -> CliResult<CalibrationFile>
+fn calibrate_3d<C>(args: &Args, mut cal: C, expected: Option<f64>) -> CliResult<Fitted>
 where
     C: Calibrator<Sample = Mag3Sample, Params = CompassCalibration3d, Quality = CompassQuality>,
 {
-    let table = Table::read(&args.input, &["t_s", "mag_x", "mag_y", "mag_z"], &[])?;
-    table.require_rows()?;
-    table.check_increasing_time()?;
-    let (t, x) = (table.req("t_s")?, table.req("mag_x")?);
-    let (y, z) = (table.req("mag_y")?, table.req("mag_z")?);
-    let samples: Vec<_> = (0..table.len())
-        .map(|k| Mag3Sample {
-            t_s: t[k],
-            mag: Vector3::new(x[k], y[k], z[k]),
-        })
+    let (table, t) = read_input(args, &["mag_x", "mag_y", "mag_z"])?;
+    let mags = vectors(&table, ["mag_x", "mag_y", "mag_z"])?;
+    let samples: Vec<Mag3Sample> = mags
+        .iter()
+        .zip(&t)
+        .map(|(m, &t_s)| Mag3Sample { t_s, mag: *m })
         .collect();
-    let sol = feed_and_solve(args, &mut cal, &samples, expected_field(args, 3)?)?;
-    Ok(file_for(
+    let sol = feed_and_solve(args, &table, &mut cal, &samples, expected)?;
+    let u = quality::assess_3d(&mags, &sol.params, sol.quality.field_magnitude).uncertainty;
+    Ok(fitted(
         args,
         &sol.params.hard_iron,
         &sol.params.soft_iron,
         sol.quality,
+        &u,
     ))
+}
+
+/// The joint magnetometer + accelerometer calibration.
+fn calibrate_joint(args: &Args, expected: Option<f64>) -> CliResult<Fitted> {
+    let (table, t) = read_input(
+        args,
+        &["mag_x", "mag_y", "mag_z", "acc_x", "acc_y", "acc_z"],
+    )?;
+    let mags = vectors(&table, ["mag_x", "mag_y", "mag_z"])?;
+    let accs = vectors(&table, ["acc_x", "acc_y", "acc_z"])?;
+    let samples: Vec<MagAccelSample> = (0..table.len())
+        .map(|k| MagAccelSample {
+            t_s: t[k],
+            mag: mags[k],
+            acc: accs[k],
+        })
+        .collect();
+    let mut cal = MagAccelCalibrator::new(MagAccelConfig {
+        expected_field: expected,
+        ..MagAccelConfig::default()
+    })
+    .map_err(library)?;
+    let sol = feed_and_solve(args, &table, &mut cal, &samples, None)?;
+    let (c, q) = (sol.params, sol.quality);
+    let mut f = fitted(
+        args,
+        &c.mag.hard_iron,
+        &c.mag.soft_iron,
+        q.mag,
+        &q.mag_uncertainty,
+    );
+    f.file.units = units_block(true);
+    f.file.mag_to_body = Some(matrix_rows(&c.mag_to_body));
+    f.file.accelerometer = Some(AccelPart {
+        bias: c.accel.bias.iter().copied().collect(),
+        matrix: matrix_rows(&c.accel.matrix),
+        gravity: c.gravity,
+    });
+    f.file.dip_deg = Some(q.dip_deg);
+    if let Some(r) = f.file.quality.as_mut() {
+        joint_report(r, &q);
+    }
+    Ok(f)
+}
+
+/// The joint calibration's own figures in the report.
+fn joint_report(r: &mut QualityReport, q: &MagAccelQuality) {
+    r.accel_residual_rms_rel = finite(q.accel_residual_rms_rel);
+    r.accel_bias_sigma = Some(q.accel_bias_sigma.iter().map(|&s| finite(s)).collect());
+    r.dip_spread_deg = finite(q.dip_spread_deg);
+    r.alignment_deg = finite(q.alignment_deg);
+    r.alignment_sigma_deg = finite(q.alignment_sigma_deg);
+    r.runs = Some(q.runs);
+    r.run_shots = Some(q.run_shots);
+    r.pointing_offset_deg = finite(q.pointing_offset_deg);
+    r.aim_rms_deg = finite(q.aim_rms_deg);
+}
+
+/// The quality report of any calibrator: its compass report inside.
+trait HasCompassQuality {
+    fn compass(&self) -> &CompassQuality;
+    fn compass_mut(&mut self) -> &mut CompassQuality;
+}
+
+impl HasCompassQuality for CompassQuality {
+    fn compass(&self) -> &CompassQuality {
+        self
+    }
+    fn compass_mut(&mut self) -> &mut CompassQuality {
+        self
+    }
+}
+
+impl HasCompassQuality for MagAccelQuality {
+    fn compass(&self) -> &CompassQuality {
+        &self.mag
+    }
+    fn compass_mut(&mut self) -> &mut CompassQuality {
+        &mut self.mag
+    }
 }
 
 /// Pushes the samples (a rejected one names its row) and solves; a refusal names the file
 /// and the reason.
-fn feed_and_solve<C: Calibrator<Quality = CompassQuality>>(
+fn feed_and_solve<C>(
     args: &Args,
+    table: &Table,
     cal: &mut C,
     samples: &[C::Sample],
     expected: Option<f64>,
-) -> CliResult<Solution<C::Params>> {
+) -> CliResult<Solution<C::Params, C::Quality>>
+where
+    C: Calibrator,
+    C::Quality: HasCompassQuality,
+{
     for (k, s) in samples.iter().enumerate() {
         cal.push(s)
-            .map_err(|e| CliError::row(&args.input, k + 2, e.to_string()))?;
+            .map_err(|e| CliError::row(&table.path, table.row_number(k), e.to_string()))?;
     }
     let mut sol = cal.solve().map_err(|e| {
         CliError::file(
-            &args.input,
+            &table.path,
             format!(
                 "cannot calibrate with method `{}`: {}",
                 args.method.name(),
@@ -268,32 +461,39 @@ fn feed_and_solve<C: Calibrator<Quality = CompassQuality>>(
             ),
         )
     })?;
-    sol.quality = quality::with_expected_field(sol.quality, expected);
-    if let Some(w) = expected.and_then(|e| quality::field_mismatch(&sol.quality, e)) {
-        eprintln!("truenorth: warning: {}: {w}", args.input.display());
+    if expected.is_some() {
+        let q = *sol.quality.compass();
+        *sol.quality.compass_mut() = quality::with_expected_field(q, expected);
     }
     Ok(sol)
 }
 
-fn file_for<const D: usize>(
+/// The output file of a magnetometer calibration and its report.
+fn fitted<const D: usize>(
     args: &Args,
     hard_iron: &SVector<f64, D>,
     soft_iron: &SMatrix<f64, D, D>,
     q: CompassQuality,
-) -> CalibrationFile {
-    CalibrationFile {
+    u: &Uncertainty,
+) -> Fitted {
+    let file = CalibrationFile {
         format: CALIBRATION_FORMAT.into(),
         version: CALIBRATION_VERSION,
         method: args.method.name().into(),
         dimensions: D,
+        units: units_block(false),
         hard_iron: hard_iron.iter().copied().collect(),
         // Row by row, as the file format says.
-        soft_iron: soft_iron
-            .row_iter()
-            .map(|r| r.iter().copied().collect())
-            .collect(),
+        soft_iron: matrix_rows(soft_iron),
         field: q.field_magnitude,
-        quality: Some(q.into()),
-        input: args.input.display().to_string(),
-    }
+        mag_to_body: None,
+        accelerometer: None,
+        dip_deg: None,
+        quality: Some(QualityReport::new(&q, Some(u), D)),
+        input: InputPath::new(&args.input)
+            .display_path()
+            .display()
+            .to_string(),
+    };
+    Fitted { file, quality: q }
 }

@@ -85,14 +85,38 @@ impl Place {
         if let Some(w) = field.extrapolated {
             eprintln!("truenorth: warning: {w}");
         }
+        if let Some(w) = weak_horizontal_field(&field) {
+            eprintln!("truenorth: warning: {w}");
+        }
         Ok(field)
     }
+}
+
+/// Below this horizontal intensity, nT, a magnetic compass is unreliable: the World
+/// Magnetic Model's own "blackout zone" around the magnetic poles (Chulliat et al., *The
+/// US/UK World Magnetic Model for 2020-2025*, NOAA technical report, 2020: blackout zones
+/// where H < 2000 nT, caution zones where H < 6000 nT).
+pub const WEAK_HORIZONTAL_NT: f64 = 2000.0;
+
+/// A warning when the horizontal field is too weak for a compass.
+fn weak_horizontal_field(f: &MagneticField) -> Option<String> {
+    (f.h_nt < WEAK_HORIZONTAL_NT).then(|| {
+        format!(
+            "the horizontal field here is {:.0} nT, below {WEAK_HORIZONTAL_NT:.0} nT (the World Magnetic Model's blackout zone near a magnetic pole): a magnetic compass is unreliable, and the declination changes fast with position",
+            f.h_nt
+        )
+    })
 }
 
 /// The field for the parsed arguments at decimal year `year`.
 fn evaluate(args: &Place, year: f64) -> CliResult<MagneticField> {
     let lat = parse_number("--lat", required("--lat", &args.lat)?)?;
     let lon = parse_number("--lon", required("--lon", &args.lon)?)?;
+    if !((-180.0..360.0).contains(&lon)) {
+        return Err(CliError::msg(format!(
+            "--lon: {lon} is outside [-180, 360) degrees east (west is negative, or 180-360)"
+        )));
+    }
     let alt_km = match &args.alt_km {
         Some(text) => parse_number("--alt-km", text)?,
         None => 0.0,
@@ -219,11 +243,31 @@ mod tests {
             one_line(evaluate(&args("abc", "0"), 2026.0).unwrap_err()).contains("not a number")
         );
         assert!(one_line(evaluate(&args("91", "0"), 2026.0).unwrap_err()).contains("latitude"));
+        for lon in ["360", "-180.5", "720", "nan", "inf"] {
+            let e = evaluate(&args("10", lon), 2026.0).unwrap_err().to_string();
+            assert!(
+                e.contains("--lon") && e.contains("[-180, 360)"),
+                "{lon}: {e}"
+            );
+        }
+        assert!(evaluate(&args("10", "-180"), 2026.0).is_ok());
+        assert!(evaluate(&args("10", "359.9"), 2026.0).is_ok());
         assert!(one_line(evaluate(&args("nan", "0"), 2026.0).unwrap_err()).contains("not finite"));
         let late = one_line(evaluate(&args("10", "0"), 2031.0).unwrap_err());
         assert!(late.contains("--allow-extrapolation"), "{late}");
         assert!(one_line(parse_date("20x6").unwrap_err()).contains("--date"));
         assert!(one_line(parse_date("2026-02-30").unwrap_err()).contains("day of month"));
+    }
+
+    /// Near the north magnetic pole (86° N, 140° E in 2026) the horizontal field is too
+    /// weak for a compass, and a warning says so; at mid-latitudes there is none.
+    #[test]
+    fn weak_horizontal_field_near_the_poles_warns() {
+        let polar = evaluate(&args("86", "140"), 2026.0).unwrap();
+        let w = weak_horizontal_field(&polar).expect("a warning near the pole");
+        assert!(w.contains("blackout"), "{w}");
+        let london = evaluate(&args("51.5", "-0.13"), 2026.0).unwrap();
+        assert!(weak_horizontal_field(&london).is_none());
     }
 
     #[test]

@@ -1,41 +1,56 @@
-//! `truenorth heading`: apply a compass calibration to a recording and write the heading.
+//! `truenorth heading`: apply a compass calibration to a recording and write the heading,
+//! tilt-compensated when the recording has the accelerometer and the calibration is 3-D.
 
 use std::path::PathBuf;
 
 use nalgebra::{Vector2, Vector3};
+use truenorth::accel::static_tilt;
 use truenorth::core::{Declination, MagneticHeading, Tilt, rad_to_deg};
 
 use crate::field::Place;
 use crate::io::{
-    CalibrationFile, CliError, CliResult, CompassCalibration, Table, check_distinct, write_csv,
+    CalibrationFile, CliError, CliResult, CompassCalibration, CsvOutput, InputOptions, InputPath,
+    ReadSpec, RowReader, check_distinct,
 };
 
-/// Arguments of `truenorth heading`.
-///
-/// Input: CSV with `t_s,mag_x,mag_y` (plus `mag_z` for a 3-D calibration), strictly
-/// increasing time, other columns ignored. Output: CSV `t_s,heading_deg`, in degrees
-/// clockwise in [0, 360): from magnetic north, or, with `--lat` and `--lon` (and optionally
-/// `--date`, default today), from true north — magnetic heading plus the World Magnetic
-/// Model 2025 declination at that place and date.
-///
-/// A 2-D calibration gives `heading = atan2(−y, x)` of the corrected (x, y). A 3-D
-/// calibration corrects all three axes and takes the heading from the corrected x and y,
-/// which is right for a level sensor only (body x forward, y right, z down); a tilted
-/// sensor needs tilt compensation, which this command does not do.
+/// The long help of the command (after the options).
+const AFTER_HELP: &str =
+    "Input: CSV with `t_s,mag_x,mag_y` (plus `mag_z` for a 3-D calibration), strictly
+increasing time, and optionally `acc_x,acc_y,acc_z` (accelerometer reading specific
+force: about +1 g on the upward axis at rest, any unit); other columns are ignored.
+Output: CSV `t_s,heading_deg`, in degrees clockwise in [0, 360): from magnetic north,
+or, with `--lat` and `--lon` (and optionally `--date`, default today), from true north —
+magnetic heading plus the World Magnetic Model 2025 declination at that place and date.
+
+Tilt: with a 3-D calibration and `acc_x,acc_y,acc_z` in the input, the heading is that
+of the body x axis tilt-compensated with the pitch and roll the accelerometer gives (the
+sensor at rest or moving slowly), and the columns `pitch_deg,roll_deg` follow (pitch
+nose up, roll right side down). A calibration from `ellipsoid-accel` calibrates the
+accelerometer and aligns it with the magnetometer; with a plain `ellipsoid` calibration
+the raw accelerometer is used, assumed to share the magnetometer's axes. Without the
+accelerometer columns, or with a 2-D calibration, the heading ASSUMES A LEVEL SENSOR
+(body x forward, y right, z down, horizontal): a tilt of a few degrees then errs by
+several degrees where the field dips steeply; the summary line on stderr says so.";
+
+/// Arguments of `truenorth heading` (the details are in `AFTER_HELP`, shown by `--help`).
 #[derive(Debug, clap::Args)]
+#[command(after_long_help = AFTER_HELP)]
 pub struct Args {
-    /// Calibration JSON written by `truenorth calibrate`.
+    /// Calibration JSON written by `truenorth calibrate` (`-`: standard input).
     #[arg(long)]
     pub calibration: PathBuf,
-    /// Input CSV.
+    /// Input CSV (`-`: standard input; `.gz` or gzip data read as such).
     #[arg(long)]
     pub input: PathBuf,
-    /// Output CSV.
+    /// Output CSV (`-`: standard output; `*.gz`: compressed).
     #[arg(long)]
     pub output: PathBuf,
     /// Where and when the recording was made, for true heading.
     #[command(flatten)]
     pub place: Place,
+    /// How to read the input.
+    #[command(flatten)]
+    pub input_options: InputOptions,
 }
 
 /// The declination that turns magnetic into true heading, if a place was given.
@@ -51,37 +66,109 @@ fn declination(args: &Args) -> CliResult<Option<Declination>> {
     }
 }
 
+const ACC: [&str; 3] = ["acc_x", "acc_y", "acc_z"];
+
 /// Runs the subcommand.
 pub fn run(args: &Args) -> CliResult {
     check_distinct(&args.output, &[&args.input, &args.calibration])?;
+    if args.input.as_os_str() == "-" && args.calibration.as_os_str() == "-" {
+        return Err(CliError::msg(
+            "heading: --input and --calibration cannot both be standard input",
+        ));
+    }
     let (_, cal) = CalibrationFile::read(&args.calibration)?;
     let declination = declination(args)?;
-    let needed: &[&str] = match cal {
-        CompassCalibration::TwoD(_) => &["t_s", "mag_x", "mag_y"],
-        CompassCalibration::ThreeD(_) => &["t_s", "mag_x", "mag_y", "mag_z"],
+    let (needed, optional): (&[&str], &[&str]) = match cal {
+        CompassCalibration::TwoD(_) => (&["t_s", "mag_x", "mag_y"], &[]),
+        _ => (&["t_s", "mag_x", "mag_y", "mag_z"], &ACC),
     };
-    let table = Table::read(&args.input, needed, &[])?;
-    table.require_rows()?;
-    table.check_increasing_time()?;
-    let (t, x, y) = (table.req("t_s")?, table.req("mag_x")?, table.req("mag_y")?);
-    let z = match cal {
-        CompassCalibration::ThreeD(_) => Some(table.req("mag_z")?),
-        CompassCalibration::TwoD(_) => None,
+    let spec = ReadSpec::new(needed).optional(optional).increasing("t_s");
+    let mut rows = RowReader::open(&InputPath::new(&args.input), &args.input_options, &spec)?;
+    let ix = |n: &str| rows.index(n).unwrap_or(0);
+    let (t, x, y) = (ix("t_s"), ix("mag_x"), ix("mag_y"));
+    let z = rows.index("mag_z");
+    let acc = match ACC.map(|n| rows.index(n)) {
+        [Some(a), Some(b), Some(c)] => Some([a, b, c]),
+        [None, None, None] => None,
+        _ => {
+            return Err(CliError::row(
+                rows.path(),
+                1,
+                "the input has some of acc_x, acc_y, acc_z but not all three; give all three for tilt compensation, or none to assume a level sensor",
+            ));
+        }
     };
-    let rows = (0..table.len()).map(|k| {
-        let magnetic = match (&cal, z) {
-            (CompassCalibration::TwoD(c), _) => c.magnetic_heading(&Vector2::new(x[k], y[k])),
-            // Level: zero pitch and roll, i.e. the corrected x and y.
-            (CompassCalibration::ThreeD(c), Some(z)) => {
-                c.magnetic_heading(&Vector3::new(x[k], y[k], z[k]), &Tilt::default())
+    let mut header = vec!["t_s", "heading_deg"];
+    if acc.is_some() {
+        header.extend(["pitch_deg", "roll_deg"]);
+    }
+    let mut out = CsvOutput::create(&args.output, &header)?;
+    let mut count = 0usize;
+    let path = rows.path().to_path_buf();
+    while let Some(row) = rows.next_row()? {
+        let mag3 = || Vector3::new(row[x], row[y], z.map_or(f64::NAN, |z| row[z]));
+        let acc3 = acc.map(|[a, b, c]| Vector3::new(row[a], row[b], row[c]));
+        let bad = |e: truenorth::core::Error| CliError::row(&path, row.number, e.to_string());
+        let (magnetic, tilt): (MagneticHeading, Option<Tilt>) = match (&cal, acc3) {
+            (CompassCalibration::TwoD(c), _) => {
+                (c.magnetic_heading(&Vector2::new(row[x], row[y])), None)
             }
-            (CompassCalibration::ThreeD(_), None) => MagneticHeading::new(f64::NAN),
+            (CompassCalibration::ThreeD(c), Some(a)) => {
+                let tilt = static_tilt(&a).map_err(bad)?;
+                (c.magnetic_heading(&mag3(), &tilt), Some(tilt))
+            }
+            // Level: zero pitch and roll, i.e. the corrected x and y.
+            (CompassCalibration::ThreeD(c), None) => {
+                (c.magnetic_heading(&mag3(), &Tilt::default()), None)
+            }
+            (CompassCalibration::Joint(c), Some(a)) => {
+                let (h, tilt) = c.attitude(&mag3(), &a).map_err(bad)?;
+                (h, Some(tilt))
+            }
+            (CompassCalibration::Joint(c), None) => {
+                let level = truenorth::compass::tilt_compensated_heading(
+                    &c.field_body(&mag3()),
+                    &Tilt::default(),
+                );
+                (MagneticHeading::new(level), None)
+            }
         };
         let rad = match declination {
             Some(d) => magnetic.to_true(d).rad(),
             None => magnetic.rad(),
         };
-        vec![t[k], rad_to_deg(rad)]
-    });
-    write_csv(&args.output, &["t_s", "heading_deg"], rows)
+        match tilt {
+            Some(tilt) => out.row(&[
+                row[t],
+                rad_to_deg(rad),
+                rad_to_deg(tilt.pitch_rad),
+                rad_to_deg(tilt.roll_rad),
+            ])?,
+            None => out.row(&[row[t], rad_to_deg(rad)])?,
+        }
+        count += 1;
+    }
+    if count == 0 {
+        return Err(CliError::row(&path, 2, "no data rows after the header"));
+    }
+    out.commit()?;
+    let north = if declination.is_some() {
+        "true"
+    } else {
+        "magnetic"
+    };
+    let how = match (&cal, acc.is_some()) {
+        (CompassCalibration::TwoD(_), _) => {
+            "level sensor assumed (a 2-axis calibration cannot compensate tilt)"
+        }
+        (CompassCalibration::ThreeD(_), true) => {
+            "tilt-compensated with the raw accelerometer (assumed in the magnetometer's axes; calibrate with ellipsoid-accel to align them)"
+        }
+        (CompassCalibration::Joint(_), true) => {
+            "tilt-compensated with the calibrated accelerometer"
+        }
+        (_, false) => "level sensor assumed (no acc_x,acc_y,acc_z in the input)",
+    };
+    eprintln!("truenorth: heading: {count} rows, {north} north, {how}");
+    Ok(())
 }

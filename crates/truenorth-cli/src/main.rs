@@ -9,6 +9,7 @@ mod demo_orientation;
 mod field;
 mod heading;
 mod io;
+mod mag_unit;
 mod orientation;
 mod svg;
 
@@ -31,10 +32,12 @@ struct Cli {
 enum Command {
     /// Run every method on a simulated drive and print a results table.
     Demo(demo::Args),
-    /// Fit a compass calibration to a recording.
+    /// Fit a compass calibration (or magnetometer and accelerometer together) to a
+    /// recording, with a verdict on its quality.
     Calibrate(calibrate::Args),
     /// Apply a compass calibration to a recording and output heading (from magnetic north;
-    /// from true north with --lat/--lon).
+    /// from true north with --lat/--lon), tilt-compensated when the input has
+    /// acc_x,acc_y,acc_z and the calibration is 3-D; otherwise for a level sensor.
     Heading(heading::Args),
     /// The World Magnetic Model 2025 field at a place and date.
     Field(field::Args),

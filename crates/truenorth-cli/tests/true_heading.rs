@@ -150,10 +150,12 @@ fn calibrate_compares_the_fit_with_the_wmm_field() {
     };
     let ok = calibrate("uT");
     assert!(ok.status.success());
+    // One summary line, no warning.
+    let summary = String::from_utf8_lossy(&ok.stderr);
+    assert_eq!(summary.lines().count(), 1, "{summary}");
     assert!(
-        ok.stderr.is_empty(),
-        "{}",
-        String::from_utf8_lossy(&ok.stderr)
+        summary.starts_with("truenorth: calibrate:") && !summary.contains("warning"),
+        "{summary}"
     );
     let json = std::fs::read_to_string(&cal).unwrap();
     let ratio: f64 = json
@@ -164,11 +166,45 @@ fn calibrate_compares_the_fit_with_the_wmm_field() {
         .unwrap();
     assert!((ratio - 1.0).abs() < 0.01, "{ratio}");
 
-    // Readings in µT declared as mG: ten times too small a field — a warning with the numbers.
+    // Readings in µT declared as mG: ten times too small a field, which no site makes. The
+    // calibration is refused, naming the unit the data are in; nothing is written.
+    std::fs::remove_file(&cal).unwrap();
     let wrong = calibrate("mG");
-    assert!(wrong.status.success());
+    assert_eq!(wrong.status.code(), Some(1));
     let err = String::from_utf8_lossy(&wrong.stderr);
     assert_eq!(err.lines().count(), 1, "{err}");
-    assert!(err.contains("warning") && err.contains("0.10 x"), "{err}");
+    assert!(
+        err.contains("probably in uT") && err.contains("--accept-field-mismatch"),
+        "{err}"
+    );
+    assert!(!cal.exists());
+    // Accepted on request, with the warning and the summary.
+    let forced = bin()
+        .args(["calibrate", "--method", "ellipse", "--input"])
+        .arg(&input)
+        .arg("--output")
+        .arg(&cal)
+        .args(place)
+        .args(["--mag-unit", "mG", "--accept-field-mismatch"])
+        .output()
+        .unwrap();
+    assert!(forced.status.success());
+    let err = String::from_utf8_lossy(&forced.stderr);
+    assert_eq!(err.lines().count(), 2, "{err}");
+    assert!(
+        err.contains("warning") && err.contains("probably in uT"),
+        "{err}"
+    );
+    // --mag-unit alone checks the field against the Earth's range.
+    let alone = bin()
+        .args(["calibrate", "--method", "ellipse", "--input"])
+        .arg(&input)
+        .arg("--output")
+        .arg(&cal)
+        .args(["--mag-unit", "nT"])
+        .output()
+        .unwrap();
+    assert_eq!(alone.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&alone.stderr).contains("probably in uT"));
     std::fs::remove_dir_all(&dir).ok();
 }

@@ -4,7 +4,8 @@
 //! A route of driving commands is integrated by a rear-axle kinematic model
 //! ([`simulate`]); named [`scenario`]s cover a calibration circle, city blocks with stops,
 //! a highway stretch and a parking manoeuvre; [`handheld_motion`] gives smooth 3-D motion
-//! for orientation filters. [`vehicle_streams`] and [`imu_streams`] run the truth through the
+//! for orientation filters; [`protocol_shots`] gives the few-shot calibration protocols of a
+//! hand-held pointing instrument ([`FewShotInstrument`]). [`vehicle_streams`] and [`imu_streams`] run the truth through the
 //! sensor crates' forward models (gyro, odometer, compass, accelerometer) with errors from
 //! [`VehicleSensorParams`] / [`ImuSensorParams`]. Everything is deterministic for a given seed.
 //! Gyro samples are the instantaneous rate at their timestamp (the convention of
@@ -29,6 +30,7 @@
 //! ```
 
 mod drive;
+mod few_shot;
 mod handheld;
 mod route;
 pub mod scenario;
@@ -37,6 +39,9 @@ mod streams;
 mod vehicle;
 
 pub use drive::{DriveSpec, DriveWheels, SimulatedDrive};
+pub use few_shot::{
+    FewShotInstrument, Shot, pointing_ned, protocol_shots, random_attitude, rolled_run,
+};
 pub use handheld::{HandheldParams, MotionTruth, handheld_motion};
 pub use route::{Command, Route, RouteBuilder};
 pub use streams::{

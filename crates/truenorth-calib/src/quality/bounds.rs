@@ -29,13 +29,9 @@ pub(super) fn whitened<const P: usize>(
     Some((l_inv, (sum_sq / (n - P) as f64).sqrt()))
 }
 
-/// `3 σ max_u √(gᵀA⁻¹g)` in degrees over 72 headings; infinite when `A` is singular or
-/// there are no more points than parameters.
-pub(super) fn bound_2d(info: &SMatrix<f64, 5, 5>, sum_sq: f64, n: usize) -> f64 {
-    // gᵀA⁻¹g = ‖L⁻¹g‖²: each heading costs one small matrix-vector product.
-    let Some((l_inv, sigma)) = whitened(info, sum_sq, n) else {
-        return f64::INFINITY;
-    };
+/// `max_u gᵀA⁻¹g = max_u ‖L⁻¹g‖²` over 72 headings, `g(u)` the heading error's gradient of
+/// the module documentation: each heading costs one small matrix-vector product.
+pub(super) fn worst_2d(l_inv: &SMatrix<f64, 5, 5>) -> f64 {
     let mut worst: f64 = 0.0;
     for k in 0..72 {
         let th = TAU * k as f64 / 72.0;
@@ -44,6 +40,11 @@ pub(super) fn bound_2d(info: &SMatrix<f64, 5, 5>, sum_sq: f64, n: usize) -> f64 
         let g = SVector::<f64, 5>::new(-px, -py, px * ux, px * uy + py * ux, py * uy);
         worst = worst.max((l_inv * g).norm_squared());
     }
+    worst
+}
+
+/// `3 σ √worst` in degrees, infinite when not finite.
+pub(super) fn bound_deg(sigma: f64, worst: f64) -> f64 {
     let b = (BOUND_SIGMAS * sigma * worst.sqrt()).to_degrees();
     if b.is_finite() { b } else { f64::INFINITY }
 }
@@ -184,11 +185,17 @@ pub(super) const BOUND_DIRECTIONS_3D: usize = 256;
 
 /// `3 σ max_u √trace(G(u) A⁻¹ G(u)ᵀ)` in degrees, `G(u)` the 3×9 Jacobian of the direction
 /// error `(I − uuᵀ)(E u − d)`; infinite when `A` is singular or `N ≤ 9`.
+#[cfg(test)]
 pub(super) fn bound_3d(info: &SMatrix<f64, 9, 9>, sum_sq: f64, n: usize) -> f64 {
-    // trace(G A⁻¹ Gᵀ) = ‖L⁻¹ Gᵀ‖²_F: each direction costs one small matrix product.
-    let Some((l_inv, sigma)) = whitened(info, sum_sq, n) else {
-        return f64::INFINITY;
-    };
+    match whitened(info, sum_sq, n) {
+        Some((l_inv, sigma)) => bound_deg(sigma, worst_3d(&l_inv)),
+        None => f64::INFINITY,
+    }
+}
+
+/// `max_u trace(G(u) A⁻¹ G(u)ᵀ) = max_u ‖L⁻¹ G(u)ᵀ‖²_F` over [`BOUND_DIRECTIONS_3D`]
+/// directions: each costs one small matrix product.
+pub(super) fn worst_3d(l_inv: &SMatrix<f64, 9, 9>) -> f64 {
     let golden = core::f64::consts::PI * (3.0 - 5.0_f64.sqrt());
     let mut worst: f64 = 0.0;
     for k in 0..BOUND_DIRECTIONS_3D {
@@ -202,8 +209,7 @@ pub(super) fn bound_3d(info: &SMatrix<f64, 9, 9>, sum_sq: f64, n: usize) -> f64 
             g.set_column(kk, &(-proj.column(kk)));
         }
         // E_kl u for (11, 12, 13, 22, 23, 33): the symmetric basis matrices applied to u.
-        let pairs = [(0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)];
-        for (j, &(a, b)) in pairs.iter().enumerate() {
+        for (j, &(a, b)) in QUAD_3D.iter().enumerate() {
             let mut eu = Vector3::zeros();
             eu[a] += u[b];
             if a != b {
@@ -213,8 +219,7 @@ pub(super) fn bound_3d(info: &SMatrix<f64, 9, 9>, sum_sq: f64, n: usize) -> f64 
         }
         worst = worst.max((l_inv * g.transpose()).norm_squared());
     }
-    let b = (BOUND_SIGMAS * sigma * worst.sqrt()).to_degrees();
-    if b.is_finite() { b } else { f64::INFINITY }
+    worst
 }
 
 /// The Student-t widening of a 3σ bound whose σ comes from `dof` degrees of freedom (see

@@ -10,12 +10,12 @@ use nalgebra::Vector3;
 use truenorth_compass::{CompassCalibration2d, CompassCalibration3d};
 use truenorth_core::{CompassQuality, FitQuality};
 
-use super::SPHERE_CELLS;
 use super::bounds::{
-    MONOMIALS_2D, MONOMIALS_3D, QUAD_3D, bound_2d, bound_3d, information_2d, information_3d,
-    monomial_plan_3d, noise_rms_deg,
+    MONOMIALS_2D, MONOMIALS_3D, QUAD_3D, information_2d, information_3d, monomial_plan_3d,
+    noise_rms_deg, worst_2d, worst_3d,
 };
-use super::coverage::{AngleBins, Coverage, mark_sphere_cells, turns};
+use super::coverage::{AngleBins, Coverage, turns};
+use super::uncertainty::{Uncertainty, bound_and_uncertainty};
 use crate::linalg::{condition_from_eigenvalues, sym_eigen5, sym_eigen9};
 use crate::lm::{BLOCK, blocks, dot_block, sum_block};
 use crate::seed_quality::ReportSums;
@@ -30,6 +30,18 @@ pub struct Assessment2d {
     pub quality: CompassQuality,
     /// Coverage of the calibrated headings (seen from the origin of the calibrated circle).
     pub coverage: Coverage,
+    /// What the readings determine.
+    pub uncertainty: Uncertainty,
+}
+
+/// A 3-D quality report and what the readings determine.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Assessment3d {
+    /// The report to return with the solution; its coverage is
+    /// [`Uncertainty::efficiency`].
+    pub quality: CompassQuality,
+    /// What the readings determine.
+    pub uncertainty: Uncertainty,
 }
 
 /// Everything the 2-D report needs, in one pass over the raw readings: the calibrated
@@ -319,6 +331,7 @@ fn report_2d_with(
 ) -> Assessment2d {
     let info = information_2d(sums);
     let residual_rms_rel = if n > 0 { (ss / n as f64).sqrt() } else { 0.0 };
+    let (bound, uncertainty) = bound_and_uncertainty(&info, ss, n, field, 2, worst_2d);
     Assessment2d {
         quality: CompassQuality {
             fit: FitQuality {
@@ -327,13 +340,14 @@ fn report_2d_with(
                 residual_rms_rel,
                 condition,
             },
-            heading_error_3sigma_deg: bound_2d(&info, ss, n),
+            heading_error_3sigma_deg: bound,
             heading_error_systematic_deg: 0.0,
             heading_noise_rms_deg: noise_rms_deg(ss, n, 5),
             field_magnitude: field,
             field_ratio_to_expected: None,
         },
         coverage,
+        uncertainty,
     }
 }
 
@@ -346,17 +360,22 @@ pub fn quality_2d(
     assess_2d(points, cal, field).quality
 }
 
-/// The 3-D quality report of `cal` on `points`: share of the sphere's direction cells
-/// filled, residual RMS relative to `field` (the radius of the calibrated sphere; see
-/// [`super::mean_corrected_norm_3d`] if the calibrator defines none), the condition number of the
-/// 9-parameter information matrix and the direction-error bound of the module
-/// documentation. Non-finite readings are skipped. Allocates nothing.
+/// The 3-D quality report of `cal` on `points` (see [`assess_3d`]).
 pub fn quality_3d(
     points: &[Vector3<f64>],
     cal: &CompassCalibration3d,
     field: f64,
 ) -> CompassQuality {
-    let mut filled = [false; SPHERE_CELLS];
+    assess_3d(points, cal, field).quality
+}
+
+/// The 3-D quality report of `cal` on `points` and what they determine: coverage as the
+/// information share of an evenly covered sphere ([`Uncertainty::efficiency`]), residual
+/// RMS relative to `field` (the radius of the calibrated sphere; see
+/// [`super::mean_corrected_norm_3d`] if the calibrator defines none), the condition number
+/// of the 9-parameter information matrix and the direction-error bound of the module
+/// documentation. Non-finite readings are skipped. Allocates nothing.
+pub fn assess_3d(points: &[Vector3<f64>], cal: &CompassCalibration3d, field: f64) -> Assessment3d {
     // Sums of the squared residuals and of the monomials of `u` that make up the
     // information matrix (see `information_3d`).
     let mut sums = [0.0; MONOMIALS_3D];
@@ -366,12 +385,11 @@ pub fn quality_3d(
     let (s, c) = (&cal.soft_iron, &cal.hard_iron);
     let plan = monomial_plan_3d();
     // A block of points at a time (see `crate::lm::BLOCK`): first every point's direction,
-    // its products and its residual, then the sums and the cells. `cols` holds `u_a` in
-    // columns 0–2 and the products `u_a u_b` of `QUAD_3D` in columns 3–8.
+    // its products and its residual, then the sums. `cols` holds `u_a` in columns 0–2 and
+    // the products `u_a u_b` of `QUAD_3D` in columns 3–8.
     let mut cols = [[0.0; BLOCK]; 9];
-    let mut h = [[0.0; BLOCK]; 3];
-    let mut rho = [0.0; BLOCK];
     let mut r2 = [0.0; BLOCK];
+    let mut kept = [0.0; BLOCK];
     for (p, len) in blocks(points) {
         for i in 0..BLOCK {
             // h = soft_iron · (p − hard_iron), as `CompassCalibration3d::correct`.
@@ -386,38 +404,40 @@ pub fn quality_3d(
             let ui = hi.map(|x| if k { x * inv_rho } else { 0.0 });
             for a in 0..3 {
                 cols[a][i] = ui[a];
-                h[a][i] = hi[a];
             }
             for (j, &(a, b)) in QUAD_3D.iter().enumerate() {
                 cols[3 + j][i] = ui[a] * ui[b];
             }
             let r = rh * inv_f - 1.0;
             r2[i] = if k { r * r } else { 0.0 };
-            rho[i] = rh;
+            kept[i] = if k { 1.0 } else { 0.0 };
         }
         for (sk, &(a, b)) in sums.iter_mut().zip(&plan) {
             *sk += dot_block(&cols[a], &cols[b]);
         }
         ss += sum_block(&r2);
-        n += mark_sphere_cells(&h, &rho, len, &mut filled);
+        n += sum_block(&kept) as usize;
     }
     let info = information_3d(&sums);
-    let coverage = filled.iter().filter(|&&f| f).count() as f64 / SPHERE_CELLS as f64;
     let residual_rms_rel = if n > 0 { (ss / n as f64).sqrt() } else { 0.0 };
     let condition = sym_eigen9(&info)
         .map(|(l, _)| condition_from_eigenvalues(l.as_slice()))
         .unwrap_or(f64::INFINITY);
-    CompassQuality {
-        fit: FitQuality {
-            points: n,
-            coverage,
-            residual_rms_rel,
-            condition,
+    let (bound, uncertainty) = bound_and_uncertainty(&info, ss, n, field, 3, worst_3d);
+    Assessment3d {
+        quality: CompassQuality {
+            fit: FitQuality {
+                points: n,
+                coverage: uncertainty.efficiency(3),
+                residual_rms_rel,
+                condition,
+            },
+            heading_error_3sigma_deg: bound,
+            heading_error_systematic_deg: 0.0,
+            heading_noise_rms_deg: noise_rms_deg(ss, n, 9),
+            field_magnitude: field,
+            field_ratio_to_expected: None,
         },
-        heading_error_3sigma_deg: bound_3d(&info, ss, n),
-        heading_error_systematic_deg: 0.0,
-        heading_noise_rms_deg: noise_rms_deg(ss, n, 9),
-        field_magnitude: field,
-        field_ratio_to_expected: None,
+        uncertainty,
     }
 }

@@ -141,3 +141,13 @@ pub fn soft3(rot: &Rotation3<f64>, a: f64, b: f64) -> Matrix3<f64> {
 pub fn any_rotation() -> impl Strategy<Value = Rotation3<f64>> {
     (-PI..PI, -1.5f64..1.5, -PI..PI).prop_map(|(r, p, y)| Rotation3::from_euler_angles(r, p, y))
 }
+
+/// Circular standard deviation of angles (radians): `√(−2 ln R̄)`, `R̄` the length of their
+/// mean unit vector (Mardia & Jupp 2000, *Directional Statistics*).
+pub fn circular_std(a: &[f64]) -> f64 {
+    let (s, c) = a
+        .iter()
+        .fold((0.0, 0.0), |(s, c), x| (s + x.sin(), c + x.cos()));
+    let r = (s * s + c * c).sqrt() / a.len() as f64;
+    (-2.0 * r.ln()).max(0.0).sqrt()
+}

@@ -1,0 +1,163 @@
+//! A verdict on a calibration's quality report: `good`, `usable` or `poor`, with the reason.
+//!
+//! It reads two numbers of the report, each in degrees of heading so that one scale judges
+//! both:
+//! * the bound on the error the calibration itself adds
+//!   ([`CompassQuality::heading_error_bound_deg`]: 3σ of the parameter uncertainty plus the
+//!   method's systematic error), which every later heading carries;
+//! * the per-reading heading noise ([`CompassQuality::heading_noise_rms_deg`]), which is the
+//!   residual of the fit in angle: large when the readings do not lie on the fitted circle or
+//!   ellipsoid (a disturbed site, a sensor that moved against its mount, the wrong model).
+//!
+//! `good`: both within [`GOOD_DEG`] (bound) and [`GOOD_NOISE_DEG`] (noise); `usable`: within
+//! [`USABLE_DEG`]; `poor`: beyond — a heading that can be off by more than that is not worth
+//! writing down, and the command line refuses it unless asked. The limits are judgements: 1°
+//! is what a good hand bearing compass reads to, 5° the accuracy class of the vehicle
+//! compasses in the seed patents.
+
+use core::fmt;
+
+use serde::{Deserialize, Serialize};
+use truenorth_core::CompassQuality;
+
+/// Largest calibration bound of a `good` calibration, degrees.
+pub const GOOD_DEG: f64 = 1.0;
+
+/// Largest per-reading heading noise of a `good` calibration, degrees (readings are
+/// usually averaged, so twice [`GOOD_DEG`]).
+pub const GOOD_NOISE_DEG: f64 = 2.0;
+
+/// Largest calibration bound and per-reading noise of a `usable` calibration, degrees.
+pub const USABLE_DEG: f64 = 5.0;
+
+/// How far to trust a calibration.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Grade {
+    /// Within [`GOOD_DEG`] and [`GOOD_NOISE_DEG`].
+    Good,
+    /// Within [`USABLE_DEG`].
+    Usable,
+    /// Beyond [`USABLE_DEG`]: not worth using.
+    Poor,
+}
+
+impl fmt::Display for Grade {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Self::Good => "good",
+            Self::Usable => "usable",
+            Self::Poor => "poor",
+        })
+    }
+}
+
+/// A grade and the numbers behind it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Verdict {
+    /// The grade.
+    pub grade: Grade,
+    /// The calibration bound, degrees (3σ plus systematic).
+    pub bound_deg: f64,
+    /// The per-reading heading noise, degrees.
+    pub noise_deg: f64,
+}
+
+impl Verdict {
+    /// The verdict on a report.
+    pub fn of(q: &CompassQuality) -> Self {
+        let bound_deg = q.heading_error_bound_deg();
+        let noise_deg = q.heading_noise_rms_deg;
+        // Written so that NaN is poor.
+        let grade = if bound_deg <= GOOD_DEG && noise_deg <= GOOD_NOISE_DEG {
+            Grade::Good
+        } else if bound_deg <= USABLE_DEG && noise_deg <= USABLE_DEG {
+            Grade::Usable
+        } else {
+            Grade::Poor
+        };
+        Self {
+            grade,
+            bound_deg,
+            noise_deg,
+        }
+    }
+}
+
+impl fmt::Display for Verdict {
+    /// The reason, one line: which number decided the grade.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let (b, n) = (self.bound_deg, self.noise_deg);
+        match self.grade {
+            Grade::Good => write!(
+                f,
+                "the calibration adds at most {b:.2} deg (3 sigma + systematic, limit {GOOD_DEG}) and each reading scatters {n:.2} deg RMS about it (limit {GOOD_NOISE_DEG})"
+            ),
+            _ => {
+                let limit = if self.grade == Grade::Usable {
+                    GOOD_DEG
+                } else {
+                    USABLE_DEG
+                };
+                let noise_limit = if self.grade == Grade::Usable {
+                    GOOD_NOISE_DEG
+                } else {
+                    USABLE_DEG
+                };
+                if !(b <= limit) {
+                    write!(
+                        f,
+                        "the calibration itself may err by up to {b:.2} deg (3 sigma + systematic), more than {limit} deg: too few readings, too little of the circle or sphere, or a method that cannot model this soft iron"
+                    )
+                } else {
+                    write!(
+                        f,
+                        "each reading scatters {n:.2} deg RMS about the fit, more than {noise_limit} deg: the readings do not lie on one circle or ellipsoid (a magnetically disturbed site, a sensor moving against its mount, or a tilted 2-axis compass)"
+                    )
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    extern crate alloc;
+    use alloc::string::ToString;
+    use proptest::prelude::*;
+
+    fn report(bound: f64, noise: f64) -> CompassQuality {
+        CompassQuality {
+            heading_error_3sigma_deg: bound,
+            heading_noise_rms_deg: noise,
+            ..CompassQuality::default()
+        }
+    }
+
+    #[test]
+    fn a_useless_merit_circle_fit_is_poor() {
+        // A real recording under the merit circle: 73 % residual, 42.9° bound.
+        let v = Verdict::of(&report(42.9, 41.8));
+        assert_eq!(v.grade, Grade::Poor);
+        assert!(v.to_string().contains("42.90 deg"), "{v}");
+        let v = Verdict::of(&report(0.5, 8.0));
+        assert_eq!(v.grade, Grade::Poor);
+        assert!(v.to_string().contains("scatters 8.00 deg"), "{v}");
+        assert_eq!(Verdict::of(&report(0.04, 0.26)).grade, Grade::Good);
+        assert_eq!(Verdict::of(&report(2.0, 0.3)).grade, Grade::Usable);
+        assert_eq!(Verdict::of(&report(f64::NAN, 0.3)).grade, Grade::Poor);
+        assert_eq!(Verdict::of(&report(f64::INFINITY, 0.3)).grade, Grade::Poor);
+    }
+
+    proptest! {
+        /// The grade never improves as either number grows, and the reason is one line.
+        #[test]
+        fn grades_are_monotone(b in 0.0f64..20.0, n in 0.0f64..20.0, db in 0.0f64..5.0, dn in 0.0f64..5.0) {
+            let a = Verdict::of(&report(b, n));
+            let worse = Verdict::of(&report(b + db, n + dn));
+            prop_assert!(worse.grade >= a.grade);
+            prop_assert!(!a.to_string().contains('\n'));
+        }
+    }
+}

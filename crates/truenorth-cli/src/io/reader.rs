@@ -1,0 +1,509 @@
+//! The streaming CSV reader: opens a file or standard input (gzip or not), resolves the
+//! requested columns through the header, the column mapping and the axis convention, and
+//! yields one row at a time as numbers, so that memory does not grow with the file.
+//!
+//! ```ignore
+//! let spec = ReadSpec::new(&["t_s", "mag_x", "mag_y"]).optional(&["gyr_z"]).increasing("t_s");
+//! let mut rows = RowReader::open(&InputPath::new(path), &opts, &spec)?;
+//! let (t, x) = (rows.index("t_s").unwrap(), rows.index("mag_x").unwrap());
+//! while let Some(row) = rows.next_row()? {
+//!     use_reading(row.number, row[t], row[x]);
+//! }
+//! ```
+
+use std::io::{BufRead, Read};
+use std::path::{Path, PathBuf};
+
+use super::columns::{ColumnSource, Delimiter, Header, InputOptions};
+use super::source::InputPath;
+use super::{CliError, CliResult};
+
+/// The columns a command reads.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct ReadSpec<'a> {
+    /// Columns that must be present; each cell must be a finite number.
+    pub required: &'a [&'a str],
+    /// Columns read when present; an empty cell reads as NaN.
+    pub optional: &'a [&'a str],
+    /// A column (required or optional) whose values must increase strictly, e.g. `t_s`.
+    pub increasing: Option<&'a str>,
+}
+
+impl<'a> ReadSpec<'a> {
+    /// Reads the `required` columns.
+    pub fn new(required: &'a [&'a str]) -> Self {
+        Self {
+            required,
+            ..Self::default()
+        }
+    }
+
+    /// Also reads the `optional` columns that are present.
+    pub fn optional(mut self, optional: &'a [&'a str]) -> Self {
+        self.optional = optional;
+        self
+    }
+
+    /// Requires the values of `column` to increase strictly from row to row.
+    pub fn increasing(mut self, column: &'a str) -> Self {
+        self.increasing = Some(column);
+        self
+    }
+}
+
+/// One data row: its number in the file (a header is row 1; comment lines count) and the
+/// values of the columns read, in [`RowReader::names`] order.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Row {
+    /// The 1-based line of the file it was read from.
+    pub number: usize,
+    /// The values, in the reader's column order.
+    pub values: Vec<f64>,
+}
+
+impl std::ops::Index<usize> for Row {
+    type Output = f64;
+
+    fn index(&self, i: usize) -> &f64 {
+        &self.values[i]
+    }
+}
+
+/// The records of a file, one line each: blank lines and lines starting with `#` are
+/// skipped (and counted, so that row numbers are the file's line numbers). A field may be
+/// enclosed in double quotes, which are dropped; a quoted field cannot span lines (sensor
+/// logs never need it).
+struct Records {
+    source: Box<dyn BufRead>,
+    delimiter: Delimiter,
+    line: String,
+    spans: Vec<(usize, usize)>,
+    line_number: usize,
+}
+
+impl Records {
+    fn new(source: Box<dyn BufRead>, delimiter: Delimiter) -> Self {
+        Self {
+            source,
+            delimiter,
+            line: String::new(),
+            spans: Vec::new(),
+            line_number: 0,
+        }
+    }
+
+    /// Advances to the next record; `Ok(false)` at the end.
+    fn advance(&mut self) -> Result<bool, String> {
+        loop {
+            self.line.clear();
+            let n = self
+                .source
+                .read_line(&mut self.line)
+                .map_err(|e| e.to_string())?;
+            if n == 0 {
+                return Ok(false);
+            }
+            self.line_number += 1;
+            let text = self.line.trim_start_matches('\u{feff}').trim();
+            if text.is_empty() || text.starts_with('#') {
+                continue;
+            }
+            self.split();
+            return Ok(true);
+        }
+    }
+
+    /// Finds the fields of the current line.
+    fn split(&mut self) {
+        self.spans.clear();
+        let line = self.line.trim_end_matches(['\n', '\r']);
+        match self.delimiter {
+            Delimiter::Byte(d) => {
+                let bytes = line.as_bytes();
+                let mut start = 0;
+                let mut quoted = false;
+                for (i, &b) in bytes.iter().enumerate() {
+                    if b == b'"' {
+                        quoted = !quoted;
+                    } else if b == d && !quoted {
+                        self.spans.push(field_span(line, start, i));
+                        start = i + 1;
+                    }
+                }
+                self.spans.push(field_span(line, start, bytes.len()));
+            }
+            _ => {
+                let base = line.as_ptr() as usize;
+                for field in line.split_whitespace() {
+                    let a = field.as_ptr() as usize - base;
+                    self.spans.push((a, a + field.len()));
+                }
+            }
+        }
+    }
+
+    /// Field `i` of the current record.
+    fn field(&self, i: usize) -> Option<&str> {
+        self.spans.get(i).map(|&(a, b)| &self.line[a..b])
+    }
+
+    /// Number of fields of the current record.
+    fn len(&self) -> usize {
+        self.spans.len()
+    }
+
+    /// The 1-based line of the current record.
+    fn line(&self) -> usize {
+        self.line_number
+    }
+
+    fn fields(&self) -> impl Iterator<Item = &str> {
+        (0..self.len()).map(|i| self.field(i).unwrap_or(""))
+    }
+}
+
+/// The byte range of the field `line[a..b]` without surrounding blanks and quotes.
+fn field_span(line: &str, a: usize, b: usize) -> (usize, usize) {
+    let s = &line[a..b];
+    let lead = s.len() - s.trim_start().len();
+    let t = s.trim();
+    let (mut a, mut b) = (a + lead, a + lead + t.len());
+    if t.len() >= 2 && t.starts_with('"') && t.ends_with('"') {
+        a += 1;
+        b -= 1;
+    }
+    (a, b)
+}
+
+/// A streaming reader of the requested numeric columns of a CSV (see the module
+/// documentation). It holds one row at a time.
+pub struct RowReader {
+    path: PathBuf,
+    records: Records,
+    columns: Vec<(ColumnSource, bool)>,
+    row: Row,
+    increasing: Option<usize>,
+    previous: Option<f64>,
+    /// The header's field count, to name a short row.
+    width: usize,
+}
+
+impl std::fmt::Debug for RowReader {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("RowReader")
+            .field("path", &self.path)
+            .field("columns", &self.columns)
+            .finish_non_exhaustive()
+    }
+}
+
+/// Reads the leading comment and blank lines and the first line after them (the header,
+/// or the first data row), and returns them with the rest of the input.
+fn first_line(
+    mut src: Box<dyn BufRead>,
+    name: &Path,
+) -> CliResult<(String, String, Box<dyn BufRead>)> {
+    let mut prefix = String::new();
+    loop {
+        let mut line = String::new();
+        let n = src
+            .read_line(&mut line)
+            .map_err(|e| CliError::file(name, format!("cannot read: {e}")))?;
+        if n == 0 {
+            return Ok((prefix, String::new(), src));
+        }
+        let t = line.trim_start_matches('\u{feff}').trim();
+        if t.is_empty() || t.starts_with('#') {
+            prefix.push_str(&line);
+            continue;
+        }
+        let first = line.clone();
+        prefix.push_str(&line);
+        return Ok((prefix, first, src));
+    }
+}
+
+impl RowReader {
+    /// Opens `input` and resolves the columns of `spec` through its header (or, with
+    /// `--no-header`, through the column numbers) under `opts`. Errors name the file and
+    /// row: a missing required column, a column named twice, a mapping to no column.
+    ///
+    /// A left-handed `--axes` (a mirror image of frd) is allowed, with a warning on stderr:
+    /// it reverses every turn.
+    pub fn open(input: &InputPath, opts: &InputOptions, spec: &ReadSpec<'_>) -> CliResult<Self> {
+        let path = input.display_path();
+        let (prefix, first, rest) = first_line(input.open()?, &path)?;
+        if first.is_empty() {
+            return Err(CliError::row(&path, 1, "empty file: no header row"));
+        }
+        let delimiter = match opts.delimiter {
+            Delimiter::Auto => Delimiter::detect(first.trim_end()),
+            d => d,
+        };
+        let chained: Box<dyn BufRead> = Box::new(std::io::BufReader::new(
+            std::io::Cursor::new(prefix.into_bytes()).chain(rest),
+        ));
+        let mut records = Records::new(chained, delimiter);
+        let header = if opts.no_header {
+            // The first record is data: count its fields, and read it again below.
+            Header::numbered(Delimiter::split_count(&first, delimiter))
+        } else {
+            records
+                .advance()
+                .map_err(|e| CliError::row(&path, 1, format!("cannot read the header: {e}")))?;
+            Header::new(records.fields())
+        };
+        let header_row = if opts.no_header {
+            0
+        } else {
+            records.line().max(1)
+        };
+        let mut columns = Vec::new();
+        for (names, required) in [(spec.required, true), (spec.optional, false)] {
+            for &name in names {
+                match header.resolve(name, opts) {
+                    Ok(Some(source)) => columns.push((source, required)),
+                    Ok(None) if required => {
+                        return Err(CliError::row(
+                            &path,
+                            header_row.max(1),
+                            header.missing(name, opts),
+                        ));
+                    }
+                    Ok(None) => {}
+                    Err(e) => return Err(CliError::row(&path, header_row.max(1), e)),
+                }
+            }
+        }
+        if !opts.axes.is_right_handed() {
+            eprintln!(
+                "truenorth: warning: {}: --axes {} is a mirror image of frd (left-handed): every turn reads reversed",
+                path.display(),
+                opts.axes
+            );
+        }
+        let increasing = spec
+            .increasing
+            .and_then(|n| columns.iter().position(|(c, _)| c.name == n));
+        let n = columns.len();
+        Ok(Self {
+            path,
+            records,
+            columns,
+            row: Row {
+                number: header_row,
+                values: vec![0.0; n],
+            },
+            increasing,
+            previous: None,
+            width: header.names().len(),
+        })
+    }
+
+    /// The file, for error messages (`<stdin>` for standard input).
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// The position of column `name` in each row's values; `None` for an optional column
+    /// the file does not have.
+    pub fn index(&self, name: &str) -> Option<usize> {
+        self.columns.iter().position(|(c, _)| c.name == name)
+    }
+
+    /// The names of the columns read, in row order.
+    pub fn names(&self) -> impl Iterator<Item = &str> {
+        self.columns.iter().map(|(c, _)| c.name.as_str())
+    }
+
+    /// The next row, or `None` at the end of the file. The row is overwritten by the next
+    /// call (nothing is allocated per row); see the `Iterator` impl for owned rows.
+    pub fn next_row(&mut self) -> CliResult<Option<&Row>> {
+        let more = self.records.advance().map_err(|e| {
+            CliError::row(
+                &self.path,
+                self.row.number + 1,
+                format!("malformed CSV: {e}"),
+            )
+        })?;
+        if !more {
+            return Ok(None);
+        }
+        let number = self.records.line();
+        self.row.number = number;
+        for (k, (c, required)) in self.columns.iter().enumerate() {
+            let cell = self.records.field(c.index).ok_or_else(|| {
+                CliError::row(
+                    &self.path,
+                    number,
+                    format!(
+                        "has {} fields, the header {}: no value for `{}`",
+                        self.records.len(),
+                        self.width,
+                        c.name
+                    ),
+                )
+            })?;
+            let v = if cell.is_empty() && !required {
+                f64::NAN
+            } else {
+                cell.parse::<f64>().map_err(|_| {
+                    CliError::row(
+                        &self.path,
+                        number,
+                        format!("column `{}`: `{cell}` is not a number", c.header),
+                    )
+                })?
+            };
+            if *required && !v.is_finite() {
+                return Err(CliError::row(
+                    &self.path,
+                    number,
+                    format!("column `{}`: `{cell}` is not finite", c.header),
+                ));
+            }
+            self.row.values[k] = c.sign * v;
+        }
+        if let Some(k) = self.increasing {
+            let t = self.row.values[k];
+            if let Some(prev) = self.previous
+                && t.partial_cmp(&prev) != Some(std::cmp::Ordering::Greater)
+            {
+                return Err(CliError::row(
+                    &self.path,
+                    number,
+                    format!(
+                        "{} = {t} does not come after the previous row's {prev}; sort by time and drop duplicates",
+                        self.columns[k].0.name
+                    ),
+                ));
+            }
+            if !t.is_nan() {
+                self.previous = Some(t);
+            }
+        }
+        Ok(Some(&self.row))
+    }
+}
+
+impl Delimiter {
+    /// Number of fields of `line` split by `delimiter` (quotes not honoured: used only to
+    /// count the columns of a file without a header).
+    fn split_count(line: &str, delimiter: Delimiter) -> usize {
+        match delimiter {
+            Delimiter::Byte(b) => line.trim_end().split(b as char).count(),
+            _ => line.split_whitespace().count(),
+        }
+    }
+}
+
+impl Iterator for RowReader {
+    type Item = CliResult<Row>;
+
+    /// Owned rows (one small allocation each); stops after the first error.
+    fn next(&mut self) -> Option<CliResult<Row>> {
+        match self.next_row() {
+            Ok(Some(r)) => Some(Ok(r.clone())),
+            Ok(None) => None,
+            Err(e) => Some(Err(e)),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn file(tag: &str, text: &str) -> PathBuf {
+        let p = std::env::temp_dir().join(format!(
+            "truenorth-reader-{tag}-{}-{:?}",
+            std::process::id(),
+            std::thread::current().id()
+        ));
+        std::fs::write(&p, text).unwrap();
+        p
+    }
+
+    fn read_all(text: &str, opts: &InputOptions, spec: &ReadSpec<'_>) -> CliResult<Vec<Row>> {
+        let p = file("all", text);
+        let out = RowReader::open(&InputPath::new(&p), opts, spec).and_then(|r| r.collect());
+        std::fs::remove_file(&p).ok();
+        out
+    }
+
+    #[test]
+    fn streams_rows_with_their_line_numbers() {
+        let text = "# exported by a logger\nT_S;Mag_X;other\n0;1;a\n# pause\n1;2;b\n\n2;3;c\n";
+        let spec = ReadSpec::new(&["t_s", "mag_x"]).increasing("t_s");
+        let rows = read_all(text, &InputOptions::default(), &spec).unwrap();
+        let got: Vec<(usize, Vec<f64>)> = rows.into_iter().map(|r| (r.number, r.values)).collect();
+        assert_eq!(
+            got,
+            vec![
+                (3, vec![0.0, 1.0]),
+                (5, vec![1.0, 2.0]),
+                (7, vec![2.0, 3.0])
+            ]
+        );
+    }
+
+    #[test]
+    fn whitespace_files_without_a_header() {
+        let text = "-163 64 1\n  -168\t64 6\n";
+        let opts = InputOptions {
+            no_header: true,
+            columns: ["mag_x=1", "mag_y=2", "mag_z=-3"]
+                .iter()
+                .map(|c| c.parse().unwrap())
+                .collect(),
+            ..InputOptions::default()
+        };
+        let rows = read_all(text, &opts, &ReadSpec::new(&["mag_x", "mag_y", "mag_z"])).unwrap();
+        assert_eq!(rows[0].values, vec![-163.0, 64.0, -1.0]);
+        assert_eq!((rows[1].number, rows[1][2]), (2, -6.0));
+    }
+
+    #[test]
+    fn errors_name_the_row() {
+        let spec = ReadSpec::new(&["t_s", "mag_x"])
+            .optional(&["mag_z"])
+            .increasing("t_s");
+        let o = InputOptions::default();
+        let e = read_all("t_s,mag_x\n0,1\n0,2\n", &o, &spec).unwrap_err();
+        assert_eq!(e.row, Some(3));
+        assert!(e.message.contains("does not come after"), "{e}");
+        let e = read_all("t_s,mag_x\n0,x\n", &o, &spec).unwrap_err();
+        assert!(
+            e.row == Some(2) && e.message.contains("not a number"),
+            "{e}"
+        );
+        let e = read_all("t_s,mag_x\n0,inf\n", &o, &spec).unwrap_err();
+        assert!(e.message.contains("not finite"), "{e}");
+        let e = read_all("t_s,mag_x\n0\n", &o, &spec).unwrap_err();
+        assert!(e.message.contains("no value for `mag_x`"), "{e}");
+        let e = read_all("t_s,mag_y\n0,1\n", &o, &spec).unwrap_err();
+        assert!(
+            e.row == Some(1) && e.message.contains("missing column `mag_x`"),
+            "{e}"
+        );
+        let e = read_all("t_s,mag_x,MAG_X\n0,1,2\n", &o, &spec).unwrap_err();
+        assert!(e.message.contains("2 times"), "{e}");
+        let e = read_all("", &o, &spec).unwrap_err();
+        assert!(e.message.contains("empty file"), "{e}");
+        // An empty optional cell is NaN.
+        let rows = read_all("t_s,mag_x,mag_z\n0,1,\n", &o, &spec).unwrap();
+        assert!(rows[0][2].is_nan());
+    }
+
+    #[test]
+    fn the_axis_convention_turns_sensor_into_body_axes() {
+        let text = "mag_x,mag_y,mag_z,acc_x,acc_y,acc_z\n1,2,3,4,5,6\n";
+        let opts = InputOptions {
+            axes: "flu".parse().unwrap(),
+            ..InputOptions::default()
+        };
+        let names = ["mag_x", "mag_y", "mag_z", "acc_x", "acc_y", "acc_z"];
+        let rows = read_all(text, &opts, &ReadSpec::new(&names)).unwrap();
+        assert_eq!(rows[0].values, vec![1.0, -2.0, -3.0, 4.0, -5.0, -6.0]);
+    }
+}

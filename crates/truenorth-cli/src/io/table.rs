@@ -1,0 +1,112 @@
+//! The whole-table read, built on the streaming [`RowReader`]: every requested column in
+//! memory, for commands that need all the readings at once (a batch calibration).
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+
+use super::columns::InputOptions;
+use super::reader::{ReadSpec, RowReader};
+use super::source::InputPath;
+use super::{CliError, CliResult};
+
+/// A numeric CSV table read by column name. Extra columns are ignored.
+#[derive(Debug, Clone)]
+pub struct Table {
+    /// The file it came from (`<stdin>` for standard input).
+    pub path: PathBuf,
+    columns: HashMap<String, Vec<f64>>,
+    /// The file row of each data row (a header is row 1).
+    row_numbers: Vec<usize>,
+}
+
+impl Table {
+    /// Reads `path` (`-` for standard input, gzip or not) with the default input options,
+    /// keeping the `required` columns (error if missing) and any `optional` ones present.
+    /// Every kept cell must parse as a number; an empty optional cell is NaN.
+    pub fn read(path: &Path, required: &[&str], optional: &[&str]) -> CliResult<Self> {
+        let spec = ReadSpec::new(required).optional(optional);
+        Self::read_with(&InputPath::new(path), &InputOptions::default(), &spec)
+    }
+
+    /// Reads every row of `input` under `opts` (delimiter, column mapping, axis convention)
+    /// and `spec` (see [`RowReader::open`]).
+    pub fn read_with(
+        input: &InputPath,
+        opts: &InputOptions,
+        spec: &ReadSpec<'_>,
+    ) -> CliResult<Self> {
+        let mut reader = RowReader::open(input, opts, spec)?;
+        let names: Vec<String> = reader.names().map(String::from).collect();
+        let mut cols: Vec<Vec<f64>> = vec![Vec::new(); names.len()];
+        let mut row_numbers = Vec::new();
+        while let Some(row) = reader.next_row()? {
+            for (c, &v) in cols.iter_mut().zip(&row.values) {
+                c.push(v);
+            }
+            row_numbers.push(row.number);
+        }
+        Ok(Self {
+            path: reader.path().to_path_buf(),
+            columns: names.into_iter().zip(cols).collect(),
+            row_numbers,
+        })
+    }
+
+    /// Number of data rows.
+    pub fn len(&self) -> usize {
+        self.row_numbers.len()
+    }
+
+    /// Whether the table has no data rows.
+    pub fn is_empty(&self) -> bool {
+        self.row_numbers.is_empty()
+    }
+
+    /// The file row of data row `k` (for error messages).
+    pub fn row_number(&self, k: usize) -> usize {
+        self.row_numbers.get(k).copied().unwrap_or(k + 2)
+    }
+
+    /// A column, if it was read.
+    pub fn col(&self, name: &str) -> Option<&[f64]> {
+        self.columns.get(name).map(Vec::as_slice)
+    }
+
+    /// A required column (read with [`Table::read`]'s `required`, so always present).
+    pub fn req(&self, name: &str) -> CliResult<&[f64]> {
+        self.col(name)
+            .ok_or_else(|| CliError::file(&self.path, format!("missing column `{name}`")))
+    }
+
+    /// Refuses a table with a header but no data rows.
+    pub fn require_rows(&self) -> CliResult {
+        if self.is_empty() {
+            Err(CliError::row(
+                &self.path,
+                2,
+                "no data rows after the header",
+            ))
+        } else {
+            Ok(())
+        }
+    }
+
+    /// Checks that `t_s` increases strictly; names the first row where it does not.
+    pub fn check_increasing_time(&self) -> CliResult {
+        let t = self.req("t_s")?;
+        for k in 1..t.len() {
+            if t[k] <= t[k - 1] {
+                return Err(CliError::row(
+                    &self.path,
+                    self.row_number(k),
+                    format!(
+                        "t_s = {} does not come after the previous row's {}; sort by time and drop duplicates",
+                        t[k],
+                        t[k - 1]
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+}
