@@ -6,6 +6,7 @@
 mod calibrate;
 mod demo;
 mod demo_orientation;
+mod drive;
 mod field;
 mod heading;
 mod io;
@@ -44,6 +45,9 @@ enum Command {
     /// Estimate orientation from an IMU recording (gyro, accelerometer, optional
     /// magnetometer).
     Orientation(orientation::Args),
+    /// Vehicle heading and dead reckoning from wheels, an optional yaw gyro and an
+    /// uncalibrated compass, every sensor calibrated from the drive itself.
+    Drive(drive::Args),
 }
 
 fn main() -> ExitCode {
@@ -54,6 +58,7 @@ fn main() -> ExitCode {
         Command::Heading(a) => heading::run(&a),
         Command::Field(a) => field::run(&a),
         Command::Orientation(a) => orientation::run(&a),
+        Command::Drive(a) => drive::run(&a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -62,9 +62,9 @@ fn run(spec: DriveSpec, gyro: bool) -> Outcome {
         let mut two = TwoPassStart::new(nav.clone(), TwoPassConfig::default());
         let mut out = Vec::new();
         for s in &samples {
-            two.push(s, |_, e| out.push(*e)).unwrap();
+            two.push(s, |_, e, _| out.push(*e)).unwrap();
         }
-        two.finish(|_, e| out.push(*e)).unwrap();
+        two.finish(|_, e, _| out.push(*e)).unwrap();
         nav = two.estimator().clone();
         out
     } else {

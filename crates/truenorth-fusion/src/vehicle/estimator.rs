@@ -201,6 +201,8 @@ impl Default for CompassWindow {
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 struct Alignment {
     done: bool,
+    /// The turn applied to heading and track when they were referred to north, rad.
+    offset_rad: f64,
     line: InnovationLine,
 }
 
@@ -314,6 +316,13 @@ impl VehicleEstimator {
             e.compass.set_fix(fix);
         }
         Ok(e)
+    }
+
+    /// The turn applied to the heading and the track when they were referred to north
+    /// (`None` before): estimates made before then are relative to the start heading and
+    /// become absolute when turned by it.
+    pub fn alignment_offset_rad(&self) -> Option<f64> {
+        self.alignment.done.then_some(self.alignment.offset_rad)
     }
 
     /// What the estimator has learned about its sensors so far, to store and give back to
@@ -726,6 +735,7 @@ impl VehicleEstimator {
     /// uncorrelated with the calibration states, and the track turned about the start by the
     /// same error. The wheels' heading keeps its difference from the gyro's.
     fn align(&mut self, offset: f64, sigma: f64) {
+        self.alignment.offset_rad = offset;
         self.flush();
         self.window = CompassWindow::default();
         let bias_var = self.compass_bias_var();

@@ -8,13 +8,16 @@
 //! `truenorth drive` command has it) the head of the drive can be held back, in bounded
 //! memory, until the estimator has learned its sensors, and then run again from the start
 //! by an estimator that knows them ([`VehicleEstimator::with_calibration`]); everything
-//! after the head is estimated once, as it comes.
+//! after the head is estimated once, as it comes. The second pass knows the compass from
+//! its first reading, but refers the heading to north only after a few readings that
+//! agree; the estimates before that are turned by the offset it then finds, as they would
+//! have been had it known it from the start.
 
 extern crate alloc;
 
 use alloc::vec::Vec;
 
-use truenorth_core::{HeadingEstimator, NavEstimate, Result, VehicleSample};
+use truenorth_core::{HeadingEstimator, MagneticHeading, NavEstimate, Result, VehicleSample};
 
 use super::estimator::VehicleEstimator;
 
@@ -45,6 +48,9 @@ pub struct TwoPassStart {
     config: TwoPassConfig,
     estimator: VehicleEstimator,
     head: Vec<VehicleSample>,
+    /// The second pass's estimates of the head made before it referred the heading to
+    /// north.
+    held: Vec<NavEstimate>,
     replayed: bool,
     settled_since_s: Option<f64>,
 }
@@ -56,6 +62,7 @@ impl TwoPassStart {
             config,
             estimator,
             head: Vec::new(),
+            held: Vec::new(),
             replayed: false,
             settled_since_s: None,
         }
@@ -71,17 +78,18 @@ impl TwoPassStart {
         self.replayed
     }
 
-    /// Takes one sample; `emit` receives each sample with its final estimate, in order —
-    /// none while the head is held back, the whole head at once when it is run again. A
-    /// sample the estimator refuses is an error and is not held back.
+    /// Takes one sample; `emit` receives each sample with its final estimate and the
+    /// estimator that made it (for its calibration states), in order — none while the head
+    /// is held back, the whole head at once when it is run again. A sample the estimator
+    /// refuses is an error and is not held back.
     pub fn push(
         &mut self,
         sample: &VehicleSample,
-        mut emit: impl FnMut(&VehicleSample, &NavEstimate),
+        mut emit: impl FnMut(&VehicleSample, &NavEstimate, &VehicleEstimator),
     ) -> Result<()> {
         let estimate = self.estimator.update(sample)?;
         if self.replayed {
-            emit(sample, &estimate);
+            emit(sample, &estimate, &self.estimator);
             return Ok(());
         }
         self.head.push(*sample);
@@ -99,7 +107,10 @@ impl TwoPassStart {
     }
 
     /// Ends the drive: a head still held back is run again with what was learned.
-    pub fn finish(&mut self, mut emit: impl FnMut(&VehicleSample, &NavEstimate)) -> Result<()> {
+    pub fn finish(
+        &mut self,
+        mut emit: impl FnMut(&VehicleSample, &NavEstimate, &VehicleEstimator),
+    ) -> Result<()> {
         if self.replayed {
             Ok(())
         } else {
@@ -107,16 +118,56 @@ impl TwoPassStart {
         }
     }
 
-    fn replay(&mut self, emit: &mut impl FnMut(&VehicleSample, &NavEstimate)) -> Result<()> {
+    fn replay(
+        &mut self,
+        emit: &mut impl FnMut(&VehicleSample, &NavEstimate, &VehicleEstimator),
+    ) -> Result<()> {
         let mut second = self.estimator.replay_start()?;
-        for s in &self.head {
+        let mut waiting = 0;
+        for (k, s) in self.head.iter().enumerate() {
             // Every sample here was accepted by the first pass, which checks the same.
             let estimate = second.update(s)?;
-            emit(s, &estimate);
+            match second.alignment_offset_rad() {
+                None => waiting += 1,
+                Some(offset) => {
+                    for (w, earlier) in self.head[k - waiting..k].iter().enumerate() {
+                        let e = turned(&self.held[w], offset, estimate.heading_sigma_rad);
+                        emit(earlier, &e, &second);
+                    }
+                    waiting = 0;
+                    self.held.clear();
+                    emit(s, &estimate, &second);
+                    continue;
+                }
+            }
+            self.held.push(estimate);
         }
+        // Never referred to north: the estimates stay relative to the start.
+        for (earlier, e) in self.head[self.head.len() - waiting..]
+            .iter()
+            .zip(&self.held)
+        {
+            emit(earlier, e, &second);
+        }
+        self.held = Vec::new();
         self.estimator = second;
         self.head = Vec::new();
         self.replayed = true;
         Ok(())
     }
+}
+
+/// An estimate made relative to the start heading, turned by `offset` onto north (heading
+/// and track), with the heading uncertainty of the estimate that found the offset.
+fn turned(e: &NavEstimate, offset: f64, heading_sigma_rad: f64) -> NavEstimate {
+    let (s, c) = offset.sin_cos();
+    let mut t = *e;
+    t.north_m = c * e.north_m - s * e.east_m;
+    t.east_m = s * e.north_m + c * e.east_m;
+    t.heading = MagneticHeading::new(e.heading.rad() + offset);
+    t.heading_sigma_rad = heading_sigma_rad;
+    let r = nalgebra::Matrix2::new(c, -s, s, c);
+    t.position_cov_m2 = r * e.position_cov_m2 * r.transpose();
+    t.status.heading_absolute = true;
+    t
 }

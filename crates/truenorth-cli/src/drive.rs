@@ -1,0 +1,521 @@
+//! `truenorth drive`: vehicle heading and dead reckoning from a drive log — wheels, an
+//! optional yaw gyro and an uncalibrated compass — calibrating every sensor from the drive
+//! itself.
+
+use std::path::{Path, PathBuf};
+
+use nalgebra::Vector2;
+use serde::Deserialize;
+use truenorth::core::{
+    Declination, HeadingEstimator, MagneticHeading, NavEstimate, VehicleSample, rad_to_deg,
+    wrap_two_pi,
+};
+use truenorth::fusion::vehicle::{
+    NavFilter, SeedGyroCompass, SeedGyroCompassConfig, SeedOdometerCompass,
+    SeedOdometerCompassConfig, TwoPassConfig, TwoPassStart, VehicleCalibration,
+};
+use truenorth::fusion::{VehicleConfig, VehicleEstimator};
+use truenorth::odometer::{AckermannParams, OdometerWheels};
+
+use crate::field::Place;
+use crate::io::{
+    CliError, CliResult, CsvOutput, InputOptions, InputPath, ReadSpec, RowReader, check_distinct,
+    write_atomically,
+};
+
+/// The long help of the command (after the options).
+const AFTER_HELP: &str = "VEHICLE.json: {\"track_m\": 1.55, \"odometer_wheels\": \"rear\"} or
+{\"track_m\": 1.55, \"wheelbase_m\": 2.7, \"odometer_wheels\": \"front\", \"pitman_ratio\": 0.13}
+— track_m the odometer wheels' track, m; wheelbase_m rear axle to front kingpins, m;
+pitman_ratio P = 2p/T_F (kingpin offset p over half the front track; front wheels only).
+Optional: \"wheel_resolution_m\" (distance per odometer pulse, default 0.02; a few mm for
+wheel speeds integrated from a CAN bus).
+
+DRIVE.csv: `t_s` (strictly increasing) and either `dist_l_m,dist_r_m` (cumulative distance
+of the left and right odometer wheels as the odometer reports it) or
+`speed_l_mps,speed_r_mps` (wheel speeds, integrated by the trapezoid rule); optionally
+`gyr_z` (rad/s, raw, positive for a right turn) and `mag_x,mag_y` (any unit,
+uncalibrated; a level compass reads mag_x = H cos(heading), mag_y = -H sin(heading)).
+An empty gyr_z or mag cell means no reading on that row (sensors at different rates).
+Other columns are ignored. Frames: x forward, y right, z down.
+
+Output: `t_s,north_m,east_m,heading_deg` — the rear-axle centre from the start point, and
+the heading clockwise from magnetic north (true north with --lat/--lon: the track is
+turned with it), in [0, 360). `--extra sigma` adds heading_sigma_deg, north_sigma_m,
+east_sigma_m; `--extra status` adds heading_absolute, compass_used, compass_disturbed,
+at_rest (0/1); `--extra calibration` adds the learned gyro_bias_dps, gyro_gain_right,
+gyro_gain_left, wheel_diff, track_scale, speed_coeff_s2_per_m2 (fused method only).
+
+Nothing is assumed calibrated: a drive that begins with a full turn (or one that turns
+through a few corners soon) calibrates the compass from itself. Until then the heading is
+relative to the start (status heading_absolute 0). By default the head of the drive is
+held back (at most 2^17 rows) until the sensors are learned and then estimated again
+from the start, so that the first minutes are as good as the rest; --single-pass writes
+each row as it comes (a causal estimate, as a navigation unit would have it).
+--calibration-in/--calibration-out carry what was learned from one drive to the next.";
+
+/// How the heading is estimated.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum Method {
+    /// Gyro (if present), wheels and compass fused, every sensor calibrated online.
+    Fused,
+    /// US 4,788,645: wheels with the speed correction, compass blended in; no gyro.
+    SeedOdometerCompass,
+    /// EP 0640207: gyro calibrated by the first full turn, compass blended in.
+    SeedGyroCompass,
+}
+
+/// Optional output column groups.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum Extra {
+    /// heading_sigma_deg, north_sigma_m, east_sigma_m.
+    Sigma,
+    /// heading_absolute, compass_used, compass_disturbed, at_rest.
+    Status,
+    /// The learned sensor errors (fused method only).
+    Calibration,
+}
+
+/// Arguments of `truenorth drive` (the file layouts are in `AFTER_HELP`, shown by `--help`).
+#[derive(Debug, clap::Args)]
+#[command(after_long_help = AFTER_HELP)]
+pub struct Args {
+    /// Vehicle JSON: track_m, odometer_wheels ("rear" or "front"), wheelbase_m and
+    /// pitman_ratio for front wheels.
+    #[arg(long)]
+    pub vehicle: PathBuf,
+    /// Drive CSV (`-`: standard input; `.gz` or gzip data read as such).
+    #[arg(long)]
+    pub input: PathBuf,
+    /// Output CSV (`-`: standard output; `*.gz`: compressed).
+    #[arg(long)]
+    pub output: PathBuf,
+    /// Estimation method.
+    #[arg(long, value_enum, default_value = "fused")]
+    pub method: Method,
+    /// Extra output columns, after the contract's (comma-separated).
+    #[arg(long, value_enum, value_delimiter = ',')]
+    pub extra: Vec<Extra>,
+    /// Write each row as it comes instead of estimating the drive's head again once the
+    /// sensors are learned.
+    #[arg(long)]
+    pub single_pass: bool,
+    /// Start from what an earlier drive learned (a file written by --calibration-out).
+    #[arg(long, value_name = "JSON")]
+    pub calibration_in: Option<PathBuf>,
+    /// Write what this drive learned about the sensors.
+    #[arg(long, value_name = "JSON")]
+    pub calibration_out: Option<PathBuf>,
+    /// Where and when the drive was made, for true heading.
+    #[command(flatten)]
+    pub place: Place,
+    /// How to read the input.
+    #[command(flatten)]
+    pub input_options: InputOptions,
+}
+
+/// The vehicle file.
+#[derive(Debug, Deserialize)]
+struct VehicleFile {
+    track_m: f64,
+    odometer_wheels: String,
+    wheelbase_m: Option<f64>,
+    pitman_ratio: Option<f64>,
+    wheel_resolution_m: Option<f64>,
+}
+
+impl VehicleFile {
+    fn read(path: &Path) -> CliResult<Self> {
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| CliError::file(path, format!("cannot read: {e}")))?;
+        serde_json::from_str(&text)
+            .map_err(|e| CliError::file(path, format!("not a vehicle file: {e}")))
+    }
+
+    fn wheels(&self, path: &Path) -> CliResult<OdometerWheels> {
+        match self.odometer_wheels.to_ascii_lowercase().as_str() {
+            "rear" => Ok(OdometerWheels::Rear {
+                track_m: self.track_m,
+            }),
+            "front" => {
+                let (Some(b), Some(p)) = (self.wheelbase_m, self.pitman_ratio) else {
+                    return Err(CliError::file(
+                        path,
+                        "front odometer wheels need wheelbase_m and pitman_ratio (Ackermann geometry)",
+                    ));
+                };
+                Ok(OdometerWheels::Front(AckermannParams::from_pitman_ratio(
+                    b,
+                    self.track_m,
+                    p,
+                )))
+            }
+            other => Err(CliError::file(
+                path,
+                format!("odometer_wheels is `{other}`; it must be \"rear\" or \"front\""),
+            )),
+        }
+    }
+}
+
+/// The wheel columns, as cumulative distances or as speeds to integrate.
+#[derive(Debug, Clone, Copy)]
+enum Wheels {
+    Distances([usize; 2]),
+    Speeds {
+        columns: [usize; 2],
+        last: Option<(f64, [f64; 2])>,
+        dist: [f64; 2],
+    },
+}
+
+impl Wheels {
+    /// Cumulative distances at time `t` from row `values`.
+    fn cumulative(&mut self, t: f64, values: &[f64]) -> [f64; 2] {
+        match self {
+            Self::Distances([l, r]) => [values[*l], values[*r]],
+            Self::Speeds {
+                columns: [l, r],
+                last,
+                dist,
+            } => {
+                let v = [values[*l], values[*r]];
+                if let Some((t0, v0)) = *last {
+                    for k in 0..2 {
+                        dist[k] += 0.5 * (v0[k] + v[k]) * (t - t0);
+                    }
+                }
+                *last = Some((t, v));
+                *dist
+            }
+        }
+    }
+}
+
+/// The estimator the method asks for.
+enum Estimator {
+    Fused(Box<TwoPassStart>),
+    Causal(Box<VehicleEstimator>),
+    Seed(Box<dyn HeadingEstimator>),
+}
+
+/// The output columns and how each row is written.
+struct Writer {
+    out: CsvOutput,
+    extra: Vec<Extra>,
+    declination: Option<Declination>,
+    rows: usize,
+    error: Option<CliError>,
+    last: Option<NavEstimate>,
+}
+
+impl Writer {
+    fn header(extra: &[Extra]) -> Vec<&'static str> {
+        let mut h = vec!["t_s", "north_m", "east_m", "heading_deg"];
+        for e in extra {
+            h.extend_from_slice(match e {
+                Extra::Sigma => &["heading_sigma_deg", "north_sigma_m", "east_sigma_m"],
+                Extra::Status => &[
+                    "heading_absolute",
+                    "compass_used",
+                    "compass_disturbed",
+                    "at_rest",
+                ],
+                Extra::Calibration => &[
+                    "gyro_bias_dps",
+                    "gyro_gain_right",
+                    "gyro_gain_left",
+                    "wheel_diff",
+                    "track_scale",
+                    "speed_coeff_s2_per_m2",
+                ],
+            });
+        }
+        h
+    }
+
+    fn write(&mut self, e: &NavEstimate, filter: Option<&NavFilter>) {
+        if self.error.is_some() {
+            return;
+        }
+        let (mut n, mut east, mut heading) = (e.north_m, e.east_m, e.heading.rad());
+        if let Some(d) = self.declination {
+            // True north: the heading and the whole track turn by the declination.
+            heading = MagneticHeading::new(heading).to_true(d).rad();
+            let (s, c) = d.0.sin_cos();
+            (n, east) = (c * n - s * east, s * n + c * east);
+        }
+        let mut row = vec![e.t_s, n, east, rad_to_deg(wrap_two_pi(heading))];
+        for x in &self.extra {
+            match x {
+                Extra::Sigma => {
+                    let p = e.position_cov_m2;
+                    row.extend([
+                        rad_to_deg(e.heading_sigma_rad),
+                        p[(0, 0)].max(0.0).sqrt(),
+                        p[(1, 1)].max(0.0).sqrt(),
+                    ]);
+                }
+                Extra::Status => {
+                    let s = e.status;
+                    row.extend(
+                        [
+                            s.heading_absolute,
+                            s.compass_used,
+                            s.compass_disturbed,
+                            s.at_rest,
+                        ]
+                        .map(|b| f64::from(u8::from(b))),
+                    );
+                }
+                Extra::Calibration => match filter {
+                    Some(f) => {
+                        let x = &f.x;
+                        use truenorth::fusion::vehicle::nav_filter::*;
+                        row.extend([
+                            rad_to_deg(x[BIAS]),
+                            1.0 + x[GAIN_POS],
+                            1.0 + x[GAIN_NEG],
+                            x[WHEEL_DIFF],
+                            x[TRACK_SCALE],
+                            x[SPEED_COEFF],
+                        ]);
+                    }
+                    None => row.extend([f64::NAN; 6]),
+                },
+            }
+        }
+        if let Err(err) = self.out.row(&row) {
+            self.error = Some(err);
+        }
+        self.rows += 1;
+        self.last = Some(*e);
+    }
+}
+
+/// Runs the subcommand.
+pub fn run(args: &Args) -> CliResult {
+    let mut inputs: Vec<&Path> = vec![&args.input, &args.vehicle];
+    if let Some(c) = &args.calibration_in {
+        inputs.push(c);
+    }
+    check_distinct(&args.output, &inputs)?;
+    if let Some(c) = &args.calibration_out {
+        check_distinct(c, &inputs)?;
+        if c == &args.output {
+            return Err(CliError::msg(
+                "drive: --calibration-out and --output name the same file",
+            ));
+        }
+    }
+    if args.extra.contains(&Extra::Calibration) && args.method != Method::Fused {
+        return Err(CliError::msg(
+            "drive: --extra calibration needs --method fused (the seed methods learn other things)",
+        ));
+    }
+    let vehicle = VehicleFile::read(&args.vehicle)?;
+    let wheels = vehicle.wheels(&args.vehicle)?;
+    let declination = if args.place.is_given() {
+        Some(args.place.field()?.declination())
+    } else {
+        None
+    };
+    let mut config = VehicleConfig {
+        wheels,
+        ..VehicleConfig::default()
+    };
+    if let Some(r) = vehicle.wheel_resolution_m {
+        config.priors.wheel_resolution_m = r;
+    }
+    let bad_config = |e: truenorth::core::Error| CliError::file(&args.vehicle, e.to_string());
+    let fused = match &args.calibration_in {
+        Some(path) => {
+            let text = std::fs::read_to_string(path)
+                .map_err(|e| CliError::file(path, format!("cannot read: {e}")))?;
+            let learned: VehicleCalibration = serde_json::from_str(&text)
+                .map_err(|e| CliError::file(path, format!("not a drive calibration: {e}")))?;
+            VehicleEstimator::with_calibration(config, &learned)
+                .map_err(|e| CliError::file(path, e.to_string()))?
+        }
+        None => VehicleEstimator::new(config).map_err(bad_config)?,
+    };
+    let mut estimator = match args.method {
+        Method::Fused if args.single_pass => Estimator::Causal(Box::new(fused)),
+        Method::Fused => {
+            Estimator::Fused(Box::new(TwoPassStart::new(fused, TwoPassConfig::default())))
+        }
+        Method::SeedOdometerCompass => Estimator::Seed(Box::new(
+            SeedOdometerCompass::new(SeedOdometerCompassConfig {
+                wheels,
+                ..SeedOdometerCompassConfig::default()
+            })
+            .map_err(bad_config)?,
+        )),
+        Method::SeedGyroCompass => Estimator::Seed(Box::new(
+            SeedGyroCompass::new(SeedGyroCompassConfig {
+                wheels,
+                ..SeedGyroCompassConfig::default()
+            })
+            .map_err(bad_config)?,
+        )),
+    };
+
+    const OPTIONAL: [&str; 7] = [
+        "dist_l_m",
+        "dist_r_m",
+        "speed_l_mps",
+        "speed_r_mps",
+        "gyr_z",
+        "mag_x",
+        "mag_y",
+    ];
+    let spec = ReadSpec::new(&["t_s"])
+        .optional(&OPTIONAL)
+        .increasing("t_s");
+    let mut rows = RowReader::open(&InputPath::new(&args.input), &args.input_options, &spec)?;
+    let ix = |n: &str| rows.index(n);
+    let mut wheel_columns = match (
+        ix("dist_l_m"),
+        ix("dist_r_m"),
+        ix("speed_l_mps"),
+        ix("speed_r_mps"),
+    ) {
+        (Some(l), Some(r), _, _) => Wheels::Distances([l, r]),
+        (_, _, Some(l), Some(r)) => Wheels::Speeds {
+            columns: [l, r],
+            last: None,
+            dist: [0.0; 2],
+        },
+        _ => {
+            return Err(CliError::row(
+                rows.path(),
+                1,
+                "needs the wheels: `dist_l_m,dist_r_m` (cumulative distances) or `speed_l_mps,speed_r_mps` (wheel speeds)",
+            ));
+        }
+    };
+    let (t, gyr) = (ix("t_s").unwrap_or(0), ix("gyr_z"));
+    let mag = match (ix("mag_x"), ix("mag_y")) {
+        (Some(x), Some(y)) => Some([x, y]),
+        (None, None) => None,
+        _ => {
+            return Err(CliError::row(
+                rows.path(),
+                1,
+                "has one of mag_x, mag_y but not both; give both (any unit, uncalibrated) or neither",
+            ));
+        }
+    };
+    let mut writer = Writer {
+        out: CsvOutput::create(&args.output, &Writer::header(&args.extra))?,
+        extra: args.extra.clone(),
+        declination,
+        rows: 0,
+        error: None,
+        last: None,
+    };
+    let path = rows.path().to_path_buf();
+    let mut samples = 0usize;
+    while let Some(row) = rows.next_row()? {
+        let v = &row.values;
+        let number = row.number;
+        let [l, r] = wheel_columns.cumulative(v[t], v);
+        if !(l.is_finite() && r.is_finite()) {
+            return Err(CliError::row(
+                &path,
+                number,
+                "the wheel columns must have a value on every row (the estimator steps with the wheels)",
+            ));
+        }
+        let present = |x: f64| x.is_finite().then_some(x);
+        let sample = VehicleSample {
+            t_s: v[t],
+            dist_l_m: l,
+            dist_r_m: r,
+            gyr_z_rps: gyr.and_then(|g| present(v[g])),
+            mag: mag.and_then(|[x, y]| {
+                (v[x].is_finite() && v[y].is_finite()).then(|| Vector2::new(v[x], v[y]))
+            }),
+        };
+        let bad = |e: truenorth::core::Error| CliError::row(&path, number, e.to_string());
+        match &mut estimator {
+            Estimator::Fused(two) => two
+                .push(&sample, |_, e, est| writer.write(e, Some(est.filter())))
+                .map_err(bad)?,
+            Estimator::Causal(est) => {
+                let e = est.update(&sample).map_err(bad)?;
+                writer.write(&e, Some(est.filter()));
+            }
+            Estimator::Seed(est) => {
+                let e = est.update(&sample).map_err(bad)?;
+                writer.write(&e, None);
+            }
+        }
+        if let Some(e) = writer.error.take() {
+            return Err(e);
+        }
+        samples += 1;
+    }
+    if let Estimator::Fused(two) = &mut estimator {
+        two.finish(|_, e, est| writer.write(e, Some(est.filter())))
+            .map_err(|e| CliError::file(&path, e.to_string()))?;
+    }
+    if let Some(e) = writer.error.take() {
+        return Err(e);
+    }
+    if samples == 0 {
+        return Err(CliError::file(&path, "has no data rows"));
+    }
+    let learned = match &estimator {
+        Estimator::Fused(two) => Some(two.estimator().calibration()),
+        Estimator::Causal(est) => Some(est.calibration()),
+        Estimator::Seed(_) => None,
+    };
+    if let (Some(out), Some(learned)) = (&args.calibration_out, learned) {
+        let json = serde_json::to_string_pretty(&learned)
+            .map_err(|e| CliError::msg(format!("drive: cannot write the calibration: {e}")))?;
+        write_atomically(out, |w| Ok(w.write_all(json.as_bytes())?))?;
+    }
+    let Writer {
+        out,
+        last,
+        rows: written,
+        ..
+    } = writer;
+    out.commit()?;
+    summary(args, samples, written, last.as_ref(), learned.as_ref());
+    Ok(())
+}
+
+/// One line on stderr: what was done and what was learned.
+fn summary(
+    args: &Args,
+    samples: usize,
+    written: usize,
+    last: Option<&NavEstimate>,
+    learned: Option<&VehicleCalibration>,
+) {
+    let Some(e) = last else { return };
+    let reference = if !e.status.heading_absolute {
+        "relative to the start heading (the compass never calibrated)"
+    } else if args.place.is_given() {
+        "true north"
+    } else {
+        "magnetic north"
+    };
+    let mut line = format!(
+        "truenorth drive: {samples} rows → {written}, {:.0} m, heading {reference}",
+        e.distance_m
+    );
+    if e.status.heading_absolute {
+        line += &format!(", final heading σ {:.2}°", rad_to_deg(e.heading_sigma_rad));
+    }
+    if let Some(c) = learned {
+        line += &format!(
+            ", gyro bias {:.3}°/s, wheel scale difference {:.3} %",
+            rad_to_deg(c.gyro_bias_rps.value),
+            100.0 * c.wheel_diff.value
+        );
+    }
+    eprintln!("{line}");
+}
