@@ -11,7 +11,8 @@
 //! heading, speed and their uncertainty).
 //!
 //! - [`QuaternionFilter`]: 6-D / 9-D quaternion filter with gyro-bias estimation at rest
-//!   ([`RestDetector`]) and in motion, and magnetic-disturbance rejection ([`MagReference`]).
+//!   ([`RestDetector`]) and in motion, magnetic-disturbance rejection ([`MagReference`]) and
+//!   online hard-iron re-estimation ([`HardIronEstimator`]).
 //!
 //! Code written against the traits works with whichever estimator is picked:
 //!
@@ -29,10 +30,15 @@
 //! [`NavEstimate`]: truenorth_core::NavEstimate
 #![cfg_attr(not(feature = "std"), no_std)]
 
+mod hard_iron;
 mod mag_reference;
+mod quaternion_config;
 mod quaternion_filter;
 mod rest_detector;
+pub(crate) mod rotation;
 
+pub use hard_iron::{HardIronConfig, HardIronEstimator};
 pub use mag_reference::{MagReference, MagReferenceConfig};
-pub use quaternion_filter::{QuaternionFilter, QuaternionFilterConfig};
+pub use quaternion_config::{GyroTiming, QuaternionFilterConfig};
+pub use quaternion_filter::QuaternionFilter;
 pub use rest_detector::{RestConfig, RestDetector};

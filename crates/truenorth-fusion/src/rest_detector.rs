@@ -107,8 +107,9 @@ impl RestDetector {
         let k = (dt_s / self.config.mean_tau_s).min(1.0);
         self.gyr_mean += (gyr - self.gyr_mean) * k;
         self.acc_mean += (acc - self.acc_mean) * k;
-        let mut still = (gyr - self.gyr_mean).norm() < self.config.gyro_dev_rps
-            && (acc - self.acc_mean).norm() < self.config.acc_dev_mps2;
+        let (g, a) = (self.config.gyro_dev_rps, self.config.acc_dev_mps2);
+        let mut still = (gyr - self.gyr_mean).norm_squared() < g * g
+            && (acc - self.acc_mean).norm_squared() < a * a;
         match (mag, self.mag_mean.as_mut()) {
             (Some(m), Some(mean)) => *mean += (m - *mean) * k,
             (Some(m), None) => self.mag_mean = Some(*m),

@@ -12,8 +12,20 @@ use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 use truenorth_core::{ImuSample, OrientationEstimator};
 use truenorth_fusion::{QuaternionFilter, QuaternionFilterConfig};
 
-/// VQF 2.1 (defaults, causal): mean total RMSE over the 20 trials, degrees.
+/// VQF 2.1 (defaults, causal, the `vqf` Python package run on these CSV files and scored
+/// with `shared/data/broad/tools/broad_metrics.py`): mean total RMSE over the 20 trials,
+/// degrees.
 const VQF_TOTAL_DEG: f64 = 2.52;
+/// VQF 2.1: mean total RMSE of the 11 undisturbed trials (not yet beaten: see below).
+const VQF_UNDISTURBED_DEG: f64 = 2.05;
+/// VQF 2.1: mean total RMSE of the 9 disturbed trials.
+const VQF_DISTURBED_DEG: f64 = 3.09;
+/// VQF 2.1: mean heading RMSE of the attached-magnet trials 32, 33, 35, 36.
+const VQF_ATTACHED_MAGNET_HEADING_DEG: f64 = 3.61;
+/// VQF 2.1 6-D: mean inclination RMSE over the 20 trials (not yet beaten).
+const VQF_6D_INCLINATION_DEG: f64 = 0.79;
+/// The project's goal for the mean total RMSE, degrees.
+const GOAL_TOTAL_DEG: f64 = 2.2;
 /// VQF 2.1: mean heading RMSE over the 20 trials, degrees.
 const VQF_HEADING_DEG: f64 = 2.35;
 /// Madgwick with BROAD's trial-agnostic best β: mean inclination RMSE, degrees.
@@ -137,7 +149,7 @@ fn quaternion_filter_on_broad() {
         .filter(|p| p.to_string_lossy().ends_with(".csv.gz"))
         .collect();
     paths.sort();
-    let (mut all, mut und, mut dis) = (Vec::new(), Vec::new(), Vec::new());
+    let (mut all, mut und, mut dis, mut magnet) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for p in &paths {
         let trial = read_trial(p);
         let r = run(&trial, config());
@@ -146,6 +158,9 @@ fn quaternion_filter_on_broad() {
             trial.name, r[0], r[1], r[2]
         );
         all.push(r);
+        if trial.name.contains("attached_magnet") {
+            magnet.push(r);
+        }
         if trial.name.contains("undisturbed") {
             und.push(r)
         } else {
@@ -165,26 +180,49 @@ fn quaternion_filter_on_broad() {
             m[1],
             m[2]
         );
-        // VQF 2.1 with its defaults, causal, scores 2.52° total over these 20 trials
-        // (shared/data/README.md): a real-time filter worth choosing over it must do better
-        // on the whole set and on each group. Experiments with BROAD_CONFIG are not judged.
-        if std::env::var_os("BROAD_CONFIG").is_none() {
-            assert!(
-                m[0] < VQF_TOTAL_DEG,
-                "{name}: total {:.2}° is not below VQF's {VQF_TOTAL_DEG}°",
-                m[0]
-            );
-        }
     }
-    if std::env::var_os("BROAD_CONFIG").is_none() {
-        let m = mean(&all);
+    let judged = std::env::var_os("BROAD_CONFIG").is_none();
+    let m_und = mean(&und);
+    let m_dis = mean(&dis);
+    let m_all = mean(&all);
+    let m_magnet = mean(&magnet);
+    println!(
+        "attached magnet ({} trials) heading {:.2} (VQF {VQF_ATTACHED_MAGNET_HEADING_DEG})",
+        magnet.len(),
+        m_magnet[1]
+    );
+    // Experiments with BROAD_CONFIG are not judged.
+    if judged {
+        assert!(m_all[0] <= GOAL_TOTAL_DEG, "total {:.2}°", m_all[0]);
         assert!(
-            m[1] < VQF_HEADING_DEG,
+            m_all[1] < VQF_HEADING_DEG,
             "heading {:.2}° vs VQF's {VQF_HEADING_DEG}°",
-            m[1]
+            m_all[1]
+        );
+        assert!(
+            m_dis[0] < VQF_DISTURBED_DEG,
+            "disturbed: total {:.2}° vs VQF's {VQF_DISTURBED_DEG}°",
+            m_dis[0]
+        );
+        // The undisturbed group is below VQF's all-trial mean but not yet below VQF's
+        // 2.05° on the same group (fast rotation: trials 06, 08, 21).
+        assert!(
+            m_und[0] < VQF_TOTAL_DEG,
+            "undisturbed: total {:.2}° (VQF {VQF_UNDISTURBED_DEG}° on this group)",
+            m_und[0]
+        );
+        // Online hard-iron re-estimation against VQF, which only rejects the magnet.
+        assert!(
+            m_magnet[1] < VQF_ATTACHED_MAGNET_HEADING_DEG,
+            "attached magnet: heading {:.2}°",
+            m_magnet[1]
         );
         // Inclination is not yet as good as VQF's 0.79°; it must at least beat Madgwick's.
-        assert!(m[2] < MADGWICK_INCLINATION_DEG, "inclination {:.2}°", m[2]);
+        assert!(
+            m_all[2] < MADGWICK_INCLINATION_DEG,
+            "inclination {:.2}°",
+            m_all[2]
+        );
     }
 }
 
@@ -209,7 +247,10 @@ fn quaternion_filter_on_broad_6d() {
         .map(|p| run(&read_trial(p), config)[2])
         .collect();
     let mean = incl.iter().sum::<f64>() / incl.len() as f64;
-    println!("6-D inclination, mean of {} trials: {mean:.2}°", incl.len());
+    println!(
+        "6-D inclination, mean of {} trials: {mean:.2}° (VQF 6-D {VQF_6D_INCLINATION_DEG})",
+        incl.len()
+    );
     assert!(
         mean < MADGWICK_INCLINATION_DEG,
         "6-D inclination {mean:.2}°"
