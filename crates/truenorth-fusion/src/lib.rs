@@ -10,6 +10,8 @@
 //! [`truenorth_core::HeadingEstimator`] (vehicle samples → [`NavEstimate`]: position,
 //! heading, speed and their uncertainty).
 //!
+//! - [`EulerDetector`]: the orientation angle detector of WO 00/36376, every piece
+//!   selectable ([`EulerDetectorConfig`]).
 //! - [`QuaternionFilter`]: 6-D / 9-D quaternion filter with gyro-bias estimation at rest
 //!   ([`RestDetector`]) and in motion, magnetic-disturbance rejection ([`MagReference`]) and
 //!   online hard-iron re-estimation ([`HardIronEstimator`]).
@@ -30,6 +32,8 @@
 //! [`NavEstimate`]: truenorth_core::NavEstimate
 #![cfg_attr(not(feature = "std"), no_std)]
 
+mod euler_config;
+mod euler_detector;
 mod hard_iron;
 mod mag_reference;
 mod quaternion_config;
@@ -37,6 +41,11 @@ mod quaternion_filter;
 mod rest_detector;
 pub(crate) mod rotation;
 
+pub use euler_config::{
+    CorrectionDefinerConfig, EulerDetectorConfig, EulerVariant, GyroConditioning,
+    MAX_DEFINER_WINDOW, StartupField, coefficient_table,
+};
+pub use euler_detector::EulerDetector;
 pub use hard_iron::{HardIronConfig, HardIronEstimator};
 pub use mag_reference::{MagReference, MagReferenceConfig};
 pub use quaternion_config::{GyroTiming, QuaternionFilterConfig};

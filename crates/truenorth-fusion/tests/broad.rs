@@ -5,11 +5,9 @@
 //!
 //! Run with `cargo test --release -p truenorth-fusion --test broad -- --nocapture`.
 
-use std::io::{BufRead, BufReader};
-use std::path::Path;
+mod common;
 
-use nalgebra::{Quaternion, UnitQuaternion, Vector3};
-use truenorth_core::{ImuSample, OrientationEstimator};
+use common::{Trial, mean, read_trial, score, trial_paths};
 use truenorth_fusion::{QuaternionFilter, QuaternionFilterConfig};
 
 /// VQF 2.1 (defaults, causal, the `vqf` Python package run on these CSV files and scored
@@ -31,94 +29,6 @@ const VQF_HEADING_DEG: f64 = 2.35;
 /// Madgwick with BROAD's trial-agnostic best β: mean inclination RMSE, degrees.
 const MADGWICK_INCLINATION_DEG: f64 = 2.61;
 
-struct Trial {
-    name: String,
-    samples: Vec<ImuSample>,
-    truth: Vec<Option<UnitQuaternion<f64>>>,
-    movement: Vec<bool>,
-}
-
-fn read_trial(path: &Path) -> Trial {
-    let file = std::fs::File::open(path).unwrap();
-    let reader = BufReader::new(flate2::read::GzDecoder::new(file));
-    let mut lines = reader.lines();
-    let header: Vec<String> = lines
-        .next()
-        .unwrap()
-        .unwrap()
-        .split(',')
-        .map(str::to_string)
-        .collect();
-    let col = |n: &str| header.iter().position(|h| h == n).unwrap();
-    let c: Vec<usize> = [
-        "t_s", "gyr_x", "gyr_y", "gyr_z", "acc_x", "acc_y", "acc_z", "mag_x", "mag_y", "mag_z",
-        "qw", "qx", "qy", "qz", "movement",
-    ]
-    .iter()
-    .map(|n| col(n))
-    .collect();
-    let (mut samples, mut truth, mut movement) = (Vec::new(), Vec::new(), Vec::new());
-    for line in lines {
-        let line = line.unwrap();
-        let v: Vec<f64> = line
-            .split(',')
-            .map(|x| x.parse().unwrap_or(f64::NAN))
-            .collect();
-        let g = |i: usize| v[c[i]];
-        samples.push(ImuSample::new_9d(
-            g(0),
-            Vector3::new(g(1), g(2), g(3)),
-            Vector3::new(g(4), g(5), g(6)),
-            Vector3::new(g(7), g(8), g(9)),
-        ));
-        let q = Quaternion::new(g(10), g(11), g(12), g(13));
-        truth.push(
-            q.coords
-                .iter()
-                .all(|x| x.is_finite())
-                .then(|| UnitQuaternion::from_quaternion(q)),
-        );
-        movement.push(g(14) > 0.5);
-    }
-    Trial {
-        name: path
-            .file_name()
-            .unwrap()
-            .to_string_lossy()
-            .replace(".csv.gz", ""),
-        samples,
-        truth,
-        movement,
-    }
-}
-
-/// Body → NED into body → ENU: ENU = (east, north, up) = (NED y, NED x, −NED z), a proper
-/// rotation of 180° about (1, 1, 0)/√2.
-fn ned_to_enu() -> UnitQuaternion<f64> {
-    let h = core::f64::consts::FRAC_1_SQRT_2;
-    UnitQuaternion::from_quaternion(Quaternion::new(0.0, h, h, 0.0))
-}
-
-/// (total, heading, inclination) RMSE in degrees, BROAD's definition.
-fn rmse(est: &[UnitQuaternion<f64>], trial: &Trial) -> [f64; 3] {
-    let mut sum = [0.0; 3];
-    let mut n = 0usize;
-    for (k, q) in est.iter().enumerate() {
-        let (Some(r), true) = (trial.truth[k], trial.movement[k]) else {
-            continue;
-        };
-        let e = (q * r.inverse()).into_inner();
-        let total = 2.0 * e.w.abs().clamp(0.0, 1.0).acos();
-        let heading = 2.0 * (e.k / e.w).abs().atan();
-        let incl = 2.0 * (e.w * e.w + e.k * e.k).sqrt().clamp(0.0, 1.0).acos();
-        for (s, x) in sum.iter_mut().zip([total, heading, incl]) {
-            *s += x * x;
-        }
-        n += 1;
-    }
-    sum.map(|s| (s / n as f64).sqrt().to_degrees())
-}
-
 /// The filter's parameters: the defaults, or a JSON object in `BROAD_CONFIG` for experiments.
 fn config() -> QuaternionFilterConfig {
     std::env::var("BROAD_CONFIG").map_or_else(
@@ -128,27 +38,14 @@ fn config() -> QuaternionFilterConfig {
 }
 
 fn run(trial: &Trial, config: QuaternionFilterConfig) -> [f64; 3] {
-    let mut f = QuaternionFilter::new(config).unwrap();
-    let to_enu = ned_to_enu();
-    let est: Vec<_> = trial
-        .samples
-        .iter()
-        .map(|s| to_enu * f.update(s).unwrap().attitude)
-        .collect();
-    rmse(&est, trial)
+    score(trial, QuaternionFilter::new(config).unwrap())
 }
 
 #[test]
 fn quaternion_filter_on_broad() {
-    let Some(dir) = truenorth_sim::shared_data::folder("broad").unwrap() else {
+    let Some(paths) = trial_paths() else {
         return;
     };
-    let mut paths: Vec<_> = std::fs::read_dir(dir.join("trials"))
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.to_string_lossy().ends_with(".csv.gz"))
-        .collect();
-    paths.sort();
     let (mut all, mut und, mut dis, mut magnet) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for p in &paths {
         let trial = read_trial(p);
@@ -167,10 +64,6 @@ fn quaternion_filter_on_broad() {
             dis.push(r)
         }
     }
-    let mean = |v: &[[f64; 3]]| {
-        let n = v.len() as f64;
-        [0, 1, 2].map(|i| v.iter().map(|r| r[i]).sum::<f64>() / n)
-    };
     for (name, v) in [("undisturbed", &und), ("disturbed", &dis), ("all", &all)] {
         let m = mean(v);
         println!(
@@ -229,15 +122,9 @@ fn quaternion_filter_on_broad() {
 /// 6-D (no magnetometer): heading is relative and drifts, so only inclination is scored.
 #[test]
 fn quaternion_filter_on_broad_6d() {
-    let Some(dir) = truenorth_sim::shared_data::folder("broad").unwrap() else {
+    let Some(paths) = trial_paths() else {
         return;
     };
-    let mut paths: Vec<_> = std::fs::read_dir(dir.join("trials"))
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.to_string_lossy().ends_with(".csv.gz"))
-        .collect();
-    paths.sort();
     let config = QuaternionFilterConfig {
         use_mag: false,
         ..QuaternionFilterConfig::default()
