@@ -6,11 +6,13 @@
 mod calibrate;
 mod demo;
 mod demo_orientation;
+mod eval_broad;
 mod field;
 mod heading;
 mod io;
 mod orientation;
 mod svg;
+mod svg_timeseries;
 
 use std::process::ExitCode;
 
@@ -41,6 +43,15 @@ enum Command {
     /// Estimate orientation from an IMU recording (gyro, accelerometer, optional
     /// magnetometer).
     Orientation(orientation::Args),
+    /// Evaluate an orientation method on a benchmark with ground truth.
+    #[command(subcommand)]
+    Eval(EvalCommand),
+}
+
+#[derive(Debug, Subcommand)]
+enum EvalCommand {
+    /// The BROAD benchmark (its trial folder, BROAD's own error metric).
+    Broad(eval_broad::Args),
 }
 
 fn main() -> ExitCode {
@@ -51,6 +62,7 @@ fn main() -> ExitCode {
         Command::Heading(a) => heading::run(&a),
         Command::Field(a) => field::run(&a),
         Command::Orientation(a) => orientation::run(&a),
+        Command::Eval(EvalCommand::Broad(a)) => eval_broad::run(&a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
