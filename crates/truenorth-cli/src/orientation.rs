@@ -239,13 +239,17 @@ pub fn run(args: &Args) -> CliResult {
 /// Yaw, pitch and roll (columns 5–7 of the output rows) over time, disturbed samples shaded.
 fn plot(path: &std::path::Path, rows: &[Vec<f64>], disturbed: &[bool]) -> CliResult {
     let series = |i: usize| rows.iter().map(|r| (r[0], r[i])).collect::<Vec<_>>();
-    let mut bands = Vec::new();
+    let mut bands: Vec<Band> = Vec::new();
     let mut start = None;
     for (r, &d) in rows.iter().zip(disturbed) {
         match (d, start) {
             (true, None) => start = Some(r[0]),
             (false, Some(t0)) => {
-                bands.push(Band { from: t0, to: r[0] });
+                // A gap shorter than a few samples joins the bands on either side.
+                match bands.last_mut() {
+                    Some(b) if t0 - b.to < 0.2 => b.to = r[0],
+                    _ => bands.push(Band { from: t0, to: r[0] }),
+                }
                 start = None;
             }
             _ => {}
