@@ -163,8 +163,10 @@ impl MagReference {
     /// Norm within `norm_tol_rel` and dip within `dip_tol_rad` of the reference `(h0, v0)`:
     /// `|sin(dip − dip₀)| = |v·h₀ − h·v₀| / (|m| |m₀|)`, the dips being within ±90°.
     fn agrees(&self, h0: f64, v0: f64, h: f64, v: f64) -> bool {
-        let n0 = h0.hypot(v0);
-        let n = h.hypot(v);
+        // Components of real fields (and of the clamped readings the filter passes) are far
+        // from overflowing a square, so no `hypot` is needed.
+        let n0 = (h0 * h0 + v0 * v0).sqrt();
+        let n = (h * h + v * v).sqrt();
         (n - n0).abs() <= self.config.norm_tol_rel * n0
             && (v * h0 - h * v0).abs() <= self.sin_dip_tol * n * n0
     }

@@ -292,8 +292,9 @@ impl QuaternionFilter {
 
 impl OrientationEstimator for QuaternionFilter {
     /// Needs a gyro triad; the accelerometer and magnetometer triads may be absent on any
-    /// sample (a slower sensor). A non-finite value or a timestamp that does not increase
-    /// is an error and changes nothing.
+    /// sample (a slower sensor). A non-finite value, a reading beyond any sensor's range
+    /// (gyro 10⁴ rad/s, accelerometer 10⁶ m/s², field 10¹²), a timestamp that does not
+    /// increase or a gap over 10⁶ s is an error and changes nothing.
     fn update(&mut self, sample: &ImuSample) -> Result<AttitudeEstimate> {
         sample.check_finite()?;
         let gyr = sample.gyr_rps.as_xyz().ok_or(Error::Unsupported {
@@ -305,8 +306,13 @@ impl OrientationEstimator for QuaternionFilter {
         } else {
             None
         };
-        let clock_before = self.clock;
-        let Some(dt_s) = self.clock.dt_s(sample.t_s)? else {
+        // Readings beyond any sensor's range could overflow the update; they are refused
+        // before anything changes, so the update needs no copy of the state to fall back to.
+        let mut clock = self.clock;
+        let dt = clock.dt_s(sample.t_s)?;
+        check_bounds(&gyr, acc.as_ref(), mag.as_ref(), dt)?;
+        self.clock = clock;
+        let Some(dt_s) = dt else {
             if !self.state.initialised
                 && let Some(q) = acc.and_then(|a| attitude_from(&a, mag.as_ref()))
             {
@@ -320,21 +326,8 @@ impl OrientationEstimator for QuaternionFilter {
             };
             return Ok(self.state.estimate);
         };
-        let saved = (self.state, self.rest, self.mag_ref, self.hard_iron);
         self.step(sample.t_s, dt_s, gyr, acc, mag);
-        if !(self.state.q.coords.iter().all(|v| v.is_finite())
-            && self.state.bias_rps.iter().all(|v| v.is_finite()))
-        {
-            // Finite readings so large that the update overflowed: keep the last good state.
-            (self.state, self.rest, self.mag_ref, self.hard_iron) = saved;
-            self.clock = clock_before;
-            return Err(Error::OutOfRange {
-                what: "IMU reading (the update overflowed)",
-                value: gyr.norm(),
-                min: 0.0,
-                max: 1e6,
-            });
-        }
+        debug_assert!(self.state.q.coords.iter().all(|v| v.is_finite()));
         Ok(self.state.estimate)
     }
 
@@ -347,6 +340,56 @@ impl OrientationEstimator for QuaternionFilter {
             *self = f;
         }
     }
+}
+
+/// Largest gyro rate accepted, rad/s (far beyond any MEMS gyro's ±2000°/s = 35 rad/s).
+const MAX_RATE_RPS: f64 = 1e4;
+/// Largest specific force accepted, m/s² (10⁵ g).
+const MAX_ACCEL_MPS2: f64 = 1e6;
+/// Largest magnetometer component accepted (any unit: 10¹² nT is 1000 T).
+const MAX_FIELD: f64 = 1e12;
+/// Longest time between samples accepted, s.
+const MAX_DT_S: f64 = 1e6;
+
+/// Refuses readings and gaps beyond the limits above: within them no product in the update
+/// can overflow.
+fn check_bounds(
+    gyr: &Vector3<f64>,
+    acc: Option<&Vector3<f64>>,
+    mag: Option<&Vector3<f64>>,
+    dt_s: Option<f64>,
+) -> Result<()> {
+    let check = |what: &'static str, v: f64, max: f64| {
+        if v <= max {
+            Ok(())
+        } else {
+            Err(Error::OutOfRange {
+                what,
+                value: v,
+                min: 0.0,
+                max,
+            })
+        }
+    };
+    check(
+        "gyro rate (largest component, rad/s)",
+        gyr.amax(),
+        MAX_RATE_RPS,
+    )?;
+    if let Some(a) = acc {
+        check(
+            "specific force (largest component, m/s²)",
+            a.amax(),
+            MAX_ACCEL_MPS2,
+        )?;
+    }
+    if let Some(m) = mag {
+        check("magnetic field (largest component)", m.amax(), MAX_FIELD)?;
+    }
+    if let Some(dt) = dt_s {
+        check("time between samples, s", dt, MAX_DT_S)?;
+    }
+    Ok(())
 }
 
 fn initial_attitude(config: &QuaternionFilterConfig) -> UnitQuaternion<f64> {
