@@ -18,7 +18,7 @@
 //! direction of the earth's field. Filters such as VQF (Laidig & Seel, Information Fusion
 //! 91, 2023, §IV-D) and Fusion only reject such a field.
 
-use nalgebra::{UnitQuaternion, Vector3};
+use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 use truenorth_core::{Result, Validate, check_positive, check_range};
 
@@ -80,6 +80,8 @@ pub struct HardIronEstimator {
     consistent_s: f64,
     primed: bool,
     offset: Option<Vector3<f64>>,
+    /// The running statistics' gain for the last interval (recomputed when it changes).
+    gain: (f64, f64),
 }
 
 impl HardIronEstimator {
@@ -93,18 +95,19 @@ impl HardIronEstimator {
             consistent_s: 0.0,
             primed: false,
             offset: None,
+            gain: (0.0, 0.0),
         }
     }
 
-    /// Takes one raw field reading `m` (body frame), the attitude `q` (body → level frame of
-    /// magnetic north) at the time of the reading, the reference field in that frame, the
+    /// Takes one raw field reading `m` (body frame), the attitude `r` (body → level frame of
+    /// magnetic north, as a rotation matrix) at the time of the reading, the reference field in that frame, the
     /// body's rotation rate (pass 0 while the sensor is known to rest: a gyro bias not yet
     /// learned must not count as turning) and the time since the previous reading. Returns the offset to
     /// subtract from `m`, if one is adopted.
     pub fn update(
         &mut self,
         m: &Vector3<f64>,
-        q: &UnitQuaternion<f64>,
+        r: &Matrix3<f64>,
         reference_ned: &Vector3<f64>,
         rate_rps: f64,
         dt_s: f64,
@@ -112,13 +115,16 @@ impl HardIronEstimator {
         if !self.config.enabled {
             return None;
         }
-        let r = m - q.inverse_transform_vector(reference_ned);
+        let r = m - r.tr_mul(reference_ned);
         if !self.primed {
             self.mean = r;
             self.primed = true;
             return self.offset;
         }
-        let k = (dt_s / self.config.mean_tau_s).min(1.0);
+        if self.gain.0 != dt_s {
+            self.gain = (dt_s, (dt_s / self.config.mean_tau_s).min(1.0));
+        }
+        let k = self.gain.1;
         self.mean += (r - self.mean) * k;
         self.spread2 += ((r - self.mean).norm_squared() - self.spread2) * k;
         let n2 = reference_ned.norm_squared();
@@ -169,7 +175,7 @@ mod tests {
         Vector3::new(16.0, 0.0, 41.0)
     }
 
-    fn attitude(t: f64) -> UnitQuaternion<f64> {
+    fn attitude(t: f64) -> nalgebra::UnitQuaternion<f64> {
         EulerZyx {
             yaw_rad: 0.9 * t,
             pitch_rad: 0.5 * (0.7 * t).sin(),
@@ -194,7 +200,7 @@ mod tests {
                 let t = k as f64 * 0.01;
                 let q = attitude(t);
                 let m = q.inverse_transform_vector(&reference()) + b;
-                got = h.update(&m, &q, &reference(), 1.0, 0.01);
+                got = h.update(&m, q.to_rotation_matrix().matrix(), &reference(), 1.0, 0.01);
             }
             let got = got.expect("adopted");
             prop_assert!((got - b).norm() < 1e-6 * b.norm());
@@ -213,7 +219,7 @@ mod tests {
                 let t = k as f64 * 0.01;
                 let q = attitude(t);
                 let m = q.inverse_transform_vector(&(reference() + disturbance));
-                prop_assert!(h.update(&m, &q, &reference(), 1.0, 0.01).is_none(), "adopted at t = {t}");
+                prop_assert!(h.update(&m, q.to_rotation_matrix().matrix(), &reference(), 1.0, 0.01).is_none(), "adopted at t = {t}");
             }
         }
     }
@@ -228,7 +234,7 @@ mod tests {
             let q = attitude(t);
             let offset = if t < 30.0 { b } else { Vector3::zeros() };
             let m = q.inverse_transform_vector(&reference()) + offset;
-            let got = h.update(&m, &q, &reference(), 1.0, 0.01);
+            let got = h.update(&m, q.to_rotation_matrix().matrix(), &reference(), 1.0, 0.01);
             if (20.0..30.0).contains(&t) {
                 assert!(got.is_some(), "t = {t}");
             }

@@ -77,6 +77,8 @@ pub struct MagReference {
     candidate_s: f64,
     candidate_moving_s: f64,
     valid: bool,
+    /// The reference's gain for the last interval (recomputed when it changes).
+    gain: (f64, f64),
 }
 
 impl MagReference {
@@ -92,6 +94,7 @@ impl MagReference {
             candidate_s: 0.0,
             candidate_moving_s: 0.0,
             valid: false,
+            gain: (0.0, 0.0),
         }
     }
 
@@ -104,7 +107,10 @@ impl MagReference {
             self.adopt(horizontal, vertical);
             return true;
         }
-        let k = (dt_s / self.config.reference_tau_s).min(1.0);
+        if self.gain.0 != dt_s {
+            self.gain = (dt_s, (dt_s / self.config.reference_tau_s).min(1.0));
+        }
+        let k = self.gain.1;
         if self.agrees(self.horizontal, self.vertical, horizontal, vertical) {
             self.horizontal += (horizontal - self.horizontal) * k;
             self.vertical += (vertical - self.vertical) * k;

@@ -51,6 +51,41 @@ use crate::{GyroTiming, HardIronEstimator, MagReference, QuaternionFilterConfig,
 #[allow(unused_imports)]
 use truenorth_core::Float as _;
 
+/// The per-sample gains, derived from the parameters and the sample interval; recomputed
+/// only when the interval changes (never on a uniformly sampled stream), so that the
+/// per-sample path divides by no time constant.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Coefficients {
+    dt_s: f64,
+    /// Low-pass gain of the reference-frame specific force.
+    acc_lowpass: f64,
+    /// Inclination gain per m/s² of horizontal specific force.
+    acc: f64,
+    /// Heading gains in motion and at rest.
+    mag: f64,
+    mag_rest: f64,
+    /// Gain of the bias estimate at rest.
+    bias_rest: f64,
+}
+
+impl Coefficients {
+    /// The gains for interval `dt_s`; with `startup`, every time constant is cut to 0.1 s.
+    fn new(cfg: &QuaternionFilterConfig, dt_s: f64, startup: bool) -> Self {
+        let gain = |tau: f64| {
+            let tau = if startup { tau.min(0.1) } else { tau };
+            (dt_s / tau).min(1.0)
+        };
+        Self {
+            dt_s,
+            acc_lowpass: gain(cfg.acc_lowpass_s),
+            acc: gain(cfg.tau_acc_s) / STANDARD_GRAVITY_MPS2,
+            mag: gain(cfg.tau_mag_s),
+            mag_rest: gain(cfg.tau_mag_rest_s),
+            bias_rest: gain(cfg.bias_tau_rest_s),
+        }
+    }
+}
+
 /// What the filter has learned.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 struct State {
@@ -62,6 +97,8 @@ struct State {
     acc_lp_ned: Option<Vector3<f64>>,
     /// Time spent at rest since the start, s: how well the bias is known.
     rest_s: f64,
+    /// `1/τ` of the in-motion bias estimate for the rest time so far.
+    bias_inv_tau_motion: f64,
     last_gyr_rps: Option<Vector3<f64>>,
     /// Time since the last magnetometer reading, s.
     mag_dt_s: f64,
@@ -102,6 +139,7 @@ pub struct QuaternionFilter {
     rest: RestDetector,
     mag_ref: MagReference,
     hard_iron: HardIronEstimator,
+    coefficients: Coefficients,
 }
 
 impl QuaternionFilter {
@@ -117,6 +155,7 @@ impl QuaternionFilter {
                 bias_rps: Vector3::zeros(),
                 acc_lp_ned: None,
                 rest_s: 0.0,
+                bias_inv_tau_motion: 1.0 / config.bias_tau_unknown_s,
                 last_gyr_rps: None,
                 mag_dt_s: 0.0,
                 since_start_s: 0.0,
@@ -127,6 +166,7 @@ impl QuaternionFilter {
             rest: RestDetector::new(config.rest),
             mag_ref: MagReference::new(config.mag),
             hard_iron: HardIronEstimator::new(config.hard_iron),
+            coefficients: Coefficients::new(&config, 0.0, false),
         })
     }
 
@@ -153,7 +193,14 @@ impl QuaternionFilter {
         let s = &mut self.state;
         s.since_start_s += dt_s;
         let startup = s.since_start_s < cfg.startup_s;
-        let fast = |tau: f64| if startup { tau.min(0.1) } else { tau };
+        let c = if startup {
+            Coefficients::new(cfg, dt_s, true)
+        } else {
+            if self.coefficients.dt_s != dt_s {
+                self.coefficients = Coefficients::new(cfg, dt_s, false);
+            }
+            self.coefficients
+        };
 
         // 1. Strapdown.
         let rate = match cfg.gyro_timing {
@@ -190,13 +237,12 @@ impl QuaternionFilter {
             // A first low-pass in the reference frame before the proportional
             // correction makes the response to acceleration second order.
             let f = r * a;
-            let kl = (dt_s / fast(cfg.acc_lowpass_s)).min(1.0);
             let lp = match s.acc_lp_ned {
-                Some(lp) => lp + (f - lp) * kl,
+                Some(lp) => lp + (f - lp) * c.acc_lowpass,
                 None => f,
             };
             s.acc_lp_ned = Some(lp);
-            let k = (dt_s / fast(cfg.tau_acc_s)).min(1.0) / STANDARD_GRAVITY_MPS2;
+            let k = c.acc;
             // down × ẑ with down = −lp/g.
             correction.x = -lp.y * k;
             correction.y = lp.x * k;
@@ -211,7 +257,7 @@ impl QuaternionFilter {
                 Some(reference) => {
                     let turning_rps = if at_rest { 0.0 } else { rate_rps };
                     self.hard_iron
-                        .update(&m, &s.q, &reference, turning_rps, mag_dt_s)
+                        .update(&m, r, &reference, turning_rps, mag_dt_s)
                 }
                 None => None,
             };
@@ -232,12 +278,16 @@ impl QuaternionFilter {
                     } else {
                         1f64.copysign(m_ned.y)
                     };
-                    let tau = if at_rest {
-                        cfg.tau_mag_rest_s
-                    } else {
-                        cfg.tau_mag_s
+                    let k = match (at_rest, mag_dt_s == dt_s) {
+                        (true, true) => c.mag_rest,
+                        (false, true) => c.mag,
+                        // A reading after samples without one covers their time too.
+                        (rest, false) => {
+                            let g = Coefficients::new(cfg, mag_dt_s, startup);
+                            if rest { g.mag_rest } else { g.mag }
+                        }
                     };
-                    let dz = -(mag_dt_s / fast(tau)).min(1.0) * err;
+                    let dz = -k * err;
                     correction.z = dz;
                     // Rz(−H/2) ← Rz(−dz/2) Rz(−H/2), first order and renormalised.
                     let (c, sn) = s.undo_heading;
@@ -259,19 +309,21 @@ impl QuaternionFilter {
         // 4. Gyro bias.
         if !startup {
             if at_rest {
-                let k = (dt_s / cfg.bias_tau_rest_s).min(1.0);
-                s.bias_rps += (self.rest.gyro_mean() - s.bias_rps) * k;
-                s.rest_s += dt_s;
+                s.bias_rps += (self.rest.gyro_mean() - s.bias_rps) * c.bias_rest;
+                if s.rest_s < cfg.bias_known_after_rest_s {
+                    s.rest_s += dt_s;
+                    let known = (s.rest_s / cfg.bias_known_after_rest_s).min(1.0);
+                    let tau = cfg.bias_tau_unknown_s
+                        + known * (cfg.bias_tau_motion_s - cfg.bias_tau_unknown_s);
+                    s.bias_inv_tau_motion = 1.0 / tau;
+                }
             } else {
                 // A bias the estimate lacks makes the strapdown drift, and the corrections
                 // turn against the drift: integrating their rate removes it. Until a rest
                 // has measured the bias, it is learned faster, accepting more of the
                 // accelerations that leak into the corrections.
-                let known = (s.rest_s / cfg.bias_known_after_rest_s).min(1.0);
-                let tau = cfg.bias_tau_unknown_s
-                    + known * (cfg.bias_tau_motion_s - cfg.bias_tau_unknown_s);
                 // Body-frame rate of the correction, Rᵀ·correction/dt, times dt/τ.
-                s.bias_rps -= r.tr_mul(&correction) / tau;
+                s.bias_rps -= r.tr_mul(&correction) * s.bias_inv_tau_motion;
             }
             let lim = cfg.max_bias_rps;
             s.bias_rps = s.bias_rps.map(|b| b.clamp(-lim, lim));
@@ -296,7 +348,6 @@ impl OrientationEstimator for QuaternionFilter {
     /// (gyro 10⁴ rad/s, accelerometer 10⁶ m/s², field 10¹²), a timestamp that does not
     /// increase or a gap over 10⁶ s is an error and changes nothing.
     fn update(&mut self, sample: &ImuSample) -> Result<AttitudeEstimate> {
-        sample.check_finite()?;
         let gyr = sample.gyr_rps.as_xyz().ok_or(Error::Unsupported {
             reason: "the quaternion filter needs a three-axis gyro; use the Euler detector for two gyros",
         })?;
@@ -306,6 +357,18 @@ impl OrientationEstimator for QuaternionFilter {
         } else {
             None
         };
+        // The usual sample is a finite 9-D one: test it in one pass, and let the sample's
+        // own check name the offending reading otherwise.
+        let finite = sample.t_s.is_finite()
+            && gyr.iter().all(|v| v.is_finite())
+            && acc.is_some_and(|a| a.iter().all(|v| v.is_finite()))
+            && sample
+                .mag
+                .as_xyz()
+                .is_some_and(|m| m.iter().all(|v| v.is_finite()));
+        if !finite {
+            sample.check_finite()?;
+        }
         // Readings beyond any sensor's range could overflow the update; they are refused
         // before anything changes, so the update needs no copy of the state to fall back to.
         let mut clock = self.clock;
