@@ -5,25 +5,15 @@
 
 use std::path::Path;
 
-use nalgebra::UnitQuaternion;
 use truenorth::core::{AttitudeEstimate, OrientationEstimator, Result};
 use truenorth::fusion::{
-    EulerDetector, EulerDetectorConfig, GyroTiming, QuaternionFilter, QuaternionFilterConfig,
+    AttitudeError, EulerDetector, EulerDetectorConfig, GyroTiming, QuaternionFilter,
+    QuaternionFilterConfig,
 };
 use truenorth_sim::{HandheldParams, ImuSensorParams, handheld_motion, imu_streams};
 
 use crate::io::{CliError, CliResult};
 use crate::svg_timeseries::{Line, write_timeseries};
-
-/// Heading and inclination parts of the error between an estimate and the truth, radians:
-/// `e = q_est ⊗ q_true⁻¹` split into a rotation about the vertical and the rest (BROAD,
-/// Laidig et al. 2021).
-fn error_parts(est: &UnitQuaternion<f64>, truth: &UnitQuaternion<f64>) -> (f64, f64) {
-    let e = (est * truth.inverse()).into_inner();
-    let heading = 2.0 * (e.k / e.w).abs().atan();
-    let incl = 2.0 * (e.w * e.w + e.k * e.k).sqrt().clamp(0.0, 1.0).acos();
-    (heading, incl)
-}
 
 /// One estimator's run: RMS heading and inclination error (degrees) after `settle_s`, and
 /// the total error angle over time (s, degrees).
@@ -56,9 +46,9 @@ fn run(
         };
         error_deg.push((t.t_s, q.angle_to(&t.attitude).to_degrees()));
         if t.t_s >= settle_s {
-            let (h, i) = error_parts(&q, &t.attitude);
-            sh += h * h;
-            si += i * i;
+            let e = AttitudeError::between(&q, &t.attitude);
+            sh += e.heading_rad * e.heading_rad;
+            si += e.inclination_rad * e.inclination_rad;
             n += 1;
         }
     }

@@ -10,6 +10,8 @@
 //! [`truenorth_core::HeadingEstimator`] (vehicle samples → [`NavEstimate`]: position,
 //! heading, speed and their uncertainty).
 //!
+//! - [`AttitudeError`]: an estimate's error against a reference, split into heading and
+//!   inclination as the BROAD benchmark does.
 //! - [`EulerDetector`]: the orientation angle detector of WO 00/36376, every piece
 //!   selectable ([`EulerDetectorConfig`]).
 //! - [`QuaternionFilter`]: 6-D / 9-D quaternion filter with gyro-bias estimation at rest
@@ -32,6 +34,7 @@
 //! [`NavEstimate`]: truenorth_core::NavEstimate
 #![cfg_attr(not(feature = "std"), no_std)]
 
+mod attitude_error;
 mod euler_config;
 mod euler_detector;
 mod hard_iron;
@@ -41,6 +44,7 @@ mod quaternion_filter;
 mod rest_detector;
 pub(crate) mod rotation;
 
+pub use attitude_error::AttitudeError;
 pub use euler_config::{
     CorrectionDefinerConfig, EulerDetectorConfig, EulerVariant, GyroConditioning,
     MAX_DEFINER_WINDOW, StartupField, coefficient_table,

@@ -35,6 +35,20 @@ fn run_all(trials: &[Trial], config: EulerDetectorConfig) -> [f64; 3] {
     mean(&r)
 }
 
+/// `config` with the correction definer off: every static angle corrects.
+fn always_correcting(config: EulerDetectorConfig) -> EulerDetectorConfig {
+    EulerDetectorConfig {
+        definer: CorrectionDefinerConfig {
+            tilt_change_rad: None,
+            yaw_change_rad: None,
+            moving_average: None,
+            gravity_tol_mps2: None,
+            ..config.definer
+        },
+        ..config
+    }
+}
+
 fn trials() -> Option<Vec<Trial>> {
     Some(trial_paths()?.iter().map(|p| read_trial(p)).collect())
 }
@@ -102,19 +116,7 @@ fn euler_detector_on_broad() {
             ..config
         },
     );
-    let always = run_all(
-        &trials,
-        EulerDetectorConfig {
-            definer: CorrectionDefinerConfig {
-                tilt_change_rad: None,
-                yaw_change_rad: None,
-                moving_average: None,
-                gravity_tol_mps2: None,
-                ..config.definer
-            },
-            ..config
-        },
-    );
+    let always = run_all(&trials, always_correcting(config));
     println!(
         "gyro integration only: total {:.2}; always correcting: total {:.2}",
         gyro_only[0], always[0]
@@ -143,19 +145,7 @@ fn euler_detector_pieces() {
                 ..base
             },
         ),
-        (
-            "definer off (always correct)",
-            EulerDetectorConfig {
-                definer: CorrectionDefinerConfig {
-                    tilt_change_rad: None,
-                    yaw_change_rad: None,
-                    moving_average: None,
-                    gravity_tol_mps2: None,
-                    ..d
-                },
-                ..base
-            },
-        ),
+        ("definer off (always correct)", always_correcting(base)),
         (
             "without modes (1)(2) (tilt change)",
             EulerDetectorConfig {

@@ -10,6 +10,7 @@ use std::path::{Path, PathBuf};
 
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 use truenorth_core::{ImuSample, OrientationEstimator};
+use truenorth_fusion::AttitudeError;
 
 pub struct Trial {
     pub name: String,
@@ -87,10 +88,8 @@ pub fn rmse(est: &[UnitQuaternion<f64>], trial: &Trial) -> [f64; 3] {
         let (Some(r), true) = (trial.truth[k], trial.movement[k]) else {
             continue;
         };
-        let e = (q * r.inverse()).into_inner();
-        let total = 2.0 * e.w.abs().clamp(0.0, 1.0).acos();
-        let heading = 2.0 * (e.k / e.w).abs().atan();
-        let incl = 2.0 * (e.w * e.w + e.k * e.k).sqrt().clamp(0.0, 1.0).acos();
+        let e = AttitudeError::between(q, &r);
+        let (total, heading, incl) = (e.total_rad, e.heading_rad, e.inclination_rad);
         for (s, x) in sum.iter_mut().zip([total, heading, incl]) {
             *s += x * x;
         }
