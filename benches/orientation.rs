@@ -1,4 +1,5 @@
-//! Per-update cost of the orientation estimators (goal for the quaternion filter ≤ 150 ns),
+//! Per-update cost of the orientation estimators (goal for the quaternion filter ≤ 150 ns;
+//! the Euler detector of WO 00/36376 beside it),
 //! on real BROAD samples when `../shared/data/broad/` is present and on the simulator's
 //! hand-held motion otherwise (the bench says which).
 //!
@@ -10,7 +11,9 @@ use std::io::{BufRead, BufReader};
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use nalgebra::Vector3;
 use truenorth::core::{ImuSample, OrientationEstimator};
-use truenorth::fusion::{QuaternionFilter, QuaternionFilterConfig};
+use truenorth::fusion::{
+    EulerDetector, EulerDetectorConfig, QuaternionFilter, QuaternionFilterConfig,
+};
 use truenorth_sim::{HandheldParams, ImuSensorParams, handheld_motion, imu_streams};
 
 const N: usize = 20_000;
@@ -71,6 +74,14 @@ fn bench(c: &mut Criterion) {
             })
         });
     }
+    g.bench_function("Euler detector (WO 00/36376)", |b| {
+        b.iter(|| {
+            let mut d = EulerDetector::new(EulerDetectorConfig::default()).expect("valid config");
+            for s in &samples {
+                black_box(d.update(black_box(s)).expect("valid sample"));
+            }
+        })
+    });
     g.finish();
 }
 

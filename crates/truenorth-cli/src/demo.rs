@@ -49,7 +49,7 @@ pub fn run(args: &Args) -> CliResult {
     let drive = DemoDrive::new(args.seed)?;
     sensor_table(&drive);
     compass_section(&drive, &args.out)?;
-    crate::demo_orientation::orientation_section(args.seed)?;
+    crate::demo_orientation::orientation_section(args.seed, &args.out)?;
     Ok(())
 }
 

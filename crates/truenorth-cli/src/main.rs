@@ -7,12 +7,14 @@ mod calibrate;
 mod demo;
 mod demo_orientation;
 mod drive;
+mod eval_broad;
 mod field;
 mod heading;
 mod io;
 mod mag_unit;
 mod orientation;
 mod svg;
+mod svg_timeseries;
 
 use std::process::ExitCode;
 
@@ -48,6 +50,15 @@ enum Command {
     /// Vehicle heading and dead reckoning from wheels, an optional yaw gyro and an
     /// uncalibrated compass, every sensor calibrated from the drive itself.
     Drive(drive::Args),
+    /// Evaluate an orientation method on a benchmark with ground truth.
+    #[command(subcommand)]
+    Eval(EvalCommand),
+}
+
+#[derive(Debug, Subcommand)]
+enum EvalCommand {
+    /// The BROAD benchmark (its trial folder, BROAD's own error metric).
+    Broad(eval_broad::Args),
 }
 
 fn main() -> ExitCode {
@@ -59,6 +70,7 @@ fn main() -> ExitCode {
         Command::Field(a) => field::run(&a),
         Command::Orientation(a) => orientation::run(&a),
         Command::Drive(a) => drive::run(&a),
+        Command::Eval(EvalCommand::Broad(a)) => eval_broad::run(&a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

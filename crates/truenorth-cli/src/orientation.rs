@@ -4,18 +4,81 @@
 use std::path::PathBuf;
 
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
-use truenorth::core::{Axes, EulerZyx, ImuSample, OrientationEstimator, rad_to_deg};
-use truenorth::fusion::{QuaternionFilter, QuaternionFilterConfig};
+use truenorth::core::{
+    AttitudeEstimate, Axes, EulerZyx, ImuSample, OrientationEstimator, Result, rad_to_deg,
+};
+use truenorth::fusion::{
+    EulerDetector, EulerDetectorConfig, GyroTiming, QuaternionFilter, QuaternionFilterConfig,
+};
 
 use crate::io::{CliError, CliResult, Table, check_distinct, write_csv};
+use crate::svg_timeseries::{Band, Line, write_timeseries};
 
 /// Orientation methods.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum Method {
     /// Quaternion filter: gyro strapdown, inclination from the low-passed specific force,
-    /// heading from the magnetometer with disturbance rejection, gyro bias at rest and in
-    /// motion.
+    /// heading from the magnetometer with disturbance rejection and online hard-iron
+    /// re-estimation, gyro bias at rest and in motion.
     Quaternion,
+    /// The Euler orientation angle detector of WO 00/36376 (Euler-rate integration,
+    /// static tilt and tilt-compensated yaw, correction definer, coefficient table).
+    EulerDetector,
+}
+
+/// What a gyro sample's rate stands for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum Timing {
+    /// The mean rate over the interval ending at the sample (digital MEMS gyros).
+    IntervalMean,
+    /// The instantaneous rate at the sample (integrated by the trapezoid rule).
+    Instantaneous,
+}
+
+/// Either estimator, behind one `update`.
+pub enum Estimator {
+    /// The quaternion filter.
+    Quaternion(Box<QuaternionFilter>),
+    /// The Euler detector.
+    Euler(Box<EulerDetector>),
+}
+
+impl Estimator {
+    /// The estimator `method` with the magnetometer used or not and the gyro timing.
+    pub fn new(method: Method, use_mag: bool, timing: Timing) -> Result<Self> {
+        Ok(match method {
+            Method::Quaternion => {
+                Self::Quaternion(Box::new(QuaternionFilter::new(QuaternionFilterConfig {
+                    use_mag,
+                    gyro_timing: match timing {
+                        Timing::IntervalMean => GyroTiming::IntervalMean,
+                        Timing::Instantaneous => GyroTiming::Instantaneous,
+                    },
+                    ..Default::default()
+                })?))
+            }
+            Method::EulerDetector => {
+                Self::Euler(Box::new(EulerDetector::new(EulerDetectorConfig {
+                    use_mag,
+                    ..Default::default()
+                })?))
+            }
+        })
+    }
+
+    /// One sample.
+    pub fn update(&mut self, s: &ImuSample) -> Result<AttitudeEstimate> {
+        match self {
+            Self::Quaternion(f) => f.update(s),
+            Self::Euler(d) => d.update(s),
+        }
+    }
+}
+
+/// Body → NED into body → ENU: ENU = (NED y, NED x, −NED z), 180° about (1, 1, 0)/√2.
+pub fn ned_to_enu() -> UnitQuaternion<f64> {
+    let h = std::f64::consts::FRAC_1_SQRT_2;
+    UnitQuaternion::from_quaternion(Quaternion::new(0.0, h, h, 0.0))
 }
 
 /// Reference frame of the output quaternion.
@@ -41,7 +104,9 @@ pub enum Frame {
 /// north. Yaw, pitch and roll are always the Z-Y-X angles of the sensor relative to NED
 /// (yaw clockwise from north, pitch nose up, roll right side down), whatever `--frame`.
 /// With `--status` the columns `bias_x_rps,bias_y_rps,bias_z_rps,at_rest,mag_used,
-/// mag_disturbed` follow (estimated gyro bias; 1/0 flags).
+/// mag_disturbed,mag_calibrating` follow (estimated gyro bias; 1/0 flags; mag_calibrating:
+/// a hard-iron offset learned online is being subtracted). `--plot FILE.svg` draws yaw,
+/// pitch and roll over time with the samples judged magnetically disturbed shaded.
 ///
 /// Exit status 1 with one line on stderr naming the file and row of the first unusable
 /// sample (non-finite value, time not increasing).
@@ -65,6 +130,12 @@ pub struct Args {
     /// Append the estimated gyro bias and the rest / magnetometer flags.
     #[arg(long)]
     pub status: bool,
+    /// What a gyro sample's rate stands for (quaternion filter).
+    #[arg(long, value_enum, default_value = "interval-mean")]
+    pub gyro_timing: Timing,
+    /// Also draw yaw, pitch and roll over time, disturbed samples shaded, to this SVG.
+    #[arg(long)]
+    pub plot: Option<PathBuf>,
 }
 
 const HEADER: [&str; 8] = [
@@ -77,18 +148,22 @@ const HEADER: [&str; 8] = [
     "pitch_deg",
     "roll_deg",
 ];
-const STATUS_HEADER: [&str; 6] = [
+const STATUS_HEADER: [&str; 7] = [
     "bias_x_rps",
     "bias_y_rps",
     "bias_z_rps",
     "at_rest",
     "mag_used",
     "mag_disturbed",
+    "mag_calibrating",
 ];
 
 /// Runs the subcommand.
 pub fn run(args: &Args) -> CliResult {
     check_distinct(&args.output, &[&args.input])?;
+    if let Some(p) = &args.plot {
+        check_distinct(p, &[&args.input, &args.output])?;
+    }
     let table = Table::read(
         &args.input,
         &["t_s", "gyr_x", "gyr_y", "gyr_z", "acc_x", "acc_y", "acc_z"],
@@ -103,22 +178,14 @@ pub fn run(args: &Args) -> CliResult {
         (Some(x), Some(y), Some(z)) if !args.no_mag => Some((x, y, z)),
         _ => None,
     };
-    let mut estimator = match args.method {
-        Method::Quaternion => QuaternionFilter::new(QuaternionFilterConfig {
-            use_mag: !args.no_mag,
-            ..Default::default()
-        })
-        .map_err(|e| CliError::msg(e.to_string()))?,
-    };
+    let mut estimator = Estimator::new(args.method, !args.no_mag, args.gyro_timing)
+        .map_err(|e| CliError::msg(e.to_string()))?;
     let to_frame = match args.frame {
         Frame::Ned => UnitQuaternion::identity(),
-        // ENU = (NED y, NED x, −NED z): 180° about (1, 1, 0)/√2.
-        Frame::Enu => {
-            let h = std::f64::consts::FRAC_1_SQRT_2;
-            UnitQuaternion::from_quaternion(Quaternion::new(0.0, h, h, 0.0))
-        }
+        Frame::Enu => ned_to_enu(),
     };
     let mut rows = Vec::with_capacity(table.len());
+    let mut disturbed = Vec::with_capacity(table.len());
     for k in 0..table.len() {
         let m = match mag {
             Some((x, y, z)) if x[k].is_nan() && y[k].is_nan() && z[k].is_nan() => Axes::NONE,
@@ -153,13 +220,69 @@ pub fn run(args: &Args) -> CliResult {
                 flag(est.status.at_rest),
                 flag(est.status.mag_used),
                 flag(est.status.mag_disturbed),
+                flag(est.status.mag_calibrating),
             ]);
         }
+        disturbed.push(est.status.mag_disturbed);
         rows.push(row);
+    }
+    if let Some(p) = &args.plot {
+        plot(p, &rows, &disturbed)?;
     }
     let mut header: Vec<&str> = HEADER.to_vec();
     if args.status {
         header.extend(STATUS_HEADER);
     }
     write_csv(&args.output, &header, rows)
+}
+
+/// Yaw, pitch and roll (columns 5–7 of the output rows) over time, disturbed samples shaded.
+fn plot(path: &std::path::Path, rows: &[Vec<f64>], disturbed: &[bool]) -> CliResult {
+    let series = |i: usize| rows.iter().map(|r| (r[0], r[i])).collect::<Vec<_>>();
+    let mut bands: Vec<Band> = Vec::new();
+    let mut start = None;
+    for (r, &d) in rows.iter().zip(disturbed) {
+        match (d, start) {
+            (true, None) => start = Some(r[0]),
+            (false, Some(t0)) => {
+                // A gap shorter than a few samples joins the bands on either side.
+                match bands.last_mut() {
+                    Some(b) if t0 - b.to < 0.2 => b.to = r[0],
+                    _ => bands.push(Band { from: t0, to: r[0] }),
+                }
+                start = None;
+            }
+            _ => {}
+        }
+    }
+    if let (Some(t0), Some(last)) = (start, rows.last()) {
+        bands.push(Band {
+            from: t0,
+            to: last[0],
+        });
+    }
+    write_timeseries(
+        path,
+        "Orientation (shaded: magnetic field judged disturbed)",
+        "t (s)",
+        "angle (deg)",
+        &[
+            Line {
+                label: "yaw",
+                colour: "#1f77b4",
+                points: series(5),
+            },
+            Line {
+                label: "pitch",
+                colour: "#2ca02c",
+                points: series(6),
+            },
+            Line {
+                label: "roll",
+                colour: "#d62728",
+                points: series(7),
+            },
+        ],
+        &bands,
+    )
 }

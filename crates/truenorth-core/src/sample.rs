@@ -26,11 +26,12 @@ pub struct Mag3Sample {
 
 /// A three-axis rate-gyro reading.
 ///
-/// **Sample convention** (shared by the simulator and every integrator in truenorth): the
-/// rate is the instantaneous angular rate at `t_s`, as a MEMS gyro's filtered output
-/// approximates it, not the mean over the preceding interval. Integrators therefore use the
-/// trapezoid rule between consecutive samples, which is exact for a rate that changes
-/// linearly between them.
+/// **Sample convention**: the simulator writes the instantaneous angular rate at `t_s`, and
+/// the vehicle estimator and gyro integrators read it so, with the trapezoid rule between
+/// consecutive samples (exact for a rate that changes linearly between them). A digital
+/// MEMS gyro's output is closer to the mean over the interval ending at `t_s`; the
+/// quaternion filter reads it that way by default and takes the convention as a parameter
+/// (`truenorth_fusion::GyroTiming`).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct GyroSample {
     /// Timestamp, seconds.

@@ -10,8 +10,13 @@
 //! [`truenorth_core::HeadingEstimator`] (vehicle samples → [`NavEstimate`]: position,
 //! heading, speed and their uncertainty).
 //!
+//! - [`AttitudeError`]: an estimate's error against a reference, split into heading and
+//!   inclination as the BROAD benchmark does.
+//! - [`EulerDetector`]: the orientation angle detector of WO 00/36376, every piece
+//!   selectable ([`EulerDetectorConfig`]).
 //! - [`QuaternionFilter`]: 6-D / 9-D quaternion filter with gyro-bias estimation at rest
-//!   ([`RestDetector`]) and in motion, and magnetic-disturbance rejection ([`MagReference`]).
+//!   ([`RestDetector`]) and in motion, magnetic-disturbance rejection ([`MagReference`]) and
+//!   online hard-iron re-estimation ([`HardIronEstimator`]).
 //!
 //! Code written against the traits works with whichever estimator is picked:
 //!
@@ -29,12 +34,26 @@
 //! [`NavEstimate`]: truenorth_core::NavEstimate
 #![cfg_attr(not(feature = "std"), no_std)]
 
+mod attitude_error;
+mod euler_config;
+mod euler_detector;
+mod hard_iron;
 mod mag_reference;
+mod quaternion_config;
 mod quaternion_filter;
 mod rest_detector;
+pub(crate) mod rotation;
 pub mod vehicle;
 
+pub use attitude_error::AttitudeError;
+pub use euler_config::{
+    CorrectionDefinerConfig, EulerDetectorConfig, EulerVariant, GyroConditioning,
+    MAX_DEFINER_WINDOW, StartupField, coefficient_table,
+};
+pub use euler_detector::EulerDetector;
+pub use hard_iron::{HardIronConfig, HardIronEstimator};
 pub use mag_reference::{MagReference, MagReferenceConfig};
-pub use quaternion_filter::{QuaternionFilter, QuaternionFilterConfig};
+pub use quaternion_config::{GyroTiming, QuaternionFilterConfig};
+pub use quaternion_filter::QuaternionFilter;
 pub use rest_detector::{RestConfig, RestDetector};
 pub use vehicle::{CompassGates, SensorPriors, VehicleConfig, VehicleEstimator};

@@ -62,17 +62,23 @@ impl Validate for MagReferenceConfig {
     }
 }
 
-/// The learned field reference and the candidate for a new one.
+/// The learned field reference and the candidate for a new one, each kept as its horizontal
+/// and vertical components in the level frame (so that no angle has to be computed per
+/// sample: the dip test compares `sin(dip − dip_ref)`, a cross product of the two).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct MagReference {
     config: MagReferenceConfig,
-    norm: f64,
-    dip_rad: f64,
-    candidate_norm: f64,
-    candidate_dip_rad: f64,
+    /// `sin(dip_tol_rad)` (the tolerance is at most 90°).
+    sin_dip_tol: f64,
+    horizontal: f64,
+    vertical: f64,
+    candidate_horizontal: f64,
+    candidate_vertical: f64,
     candidate_s: f64,
     candidate_moving_s: f64,
     valid: bool,
+    /// The reference's gain for the last interval (recomputed when it changes).
+    gain: (f64, f64),
 }
 
 impl MagReference {
@@ -80,70 +86,100 @@ impl MagReference {
     pub fn new(config: MagReferenceConfig) -> Self {
         Self {
             config,
-            norm: 0.0,
-            dip_rad: 0.0,
-            candidate_norm: 0.0,
-            candidate_dip_rad: 0.0,
+            sin_dip_tol: config.dip_tol_rad.min(core::f64::consts::FRAC_PI_2).sin(),
+            horizontal: 0.0,
+            vertical: 0.0,
+            candidate_horizontal: 0.0,
+            candidate_vertical: 0.0,
             candidate_s: 0.0,
             candidate_moving_s: 0.0,
             valid: false,
+            gain: (0.0, 0.0),
         }
     }
 
-    /// Judges one field reading (norm in the sensor's unit, dip in the estimated level
-    /// frame) taken `dt_s` after the previous one, while rotating at `rate_rps`. Returns
-    /// `true` when it is undisturbed (and may correct heading).
-    pub fn update(&mut self, norm: f64, dip_rad: f64, rate_rps: f64, dt_s: f64) -> bool {
+    /// Judges one field reading, given as its horizontal magnitude and its vertical (down)
+    /// component in the estimated level frame (sensor unit), taken `dt_s` after the previous
+    /// one while rotating at `rate_rps`. Returns `true` when it is undisturbed (and may
+    /// correct heading).
+    pub fn update(&mut self, horizontal: f64, vertical: f64, rate_rps: f64, dt_s: f64) -> bool {
         if !self.valid {
-            self.adopt(norm, dip_rad);
+            self.adopt(horizontal, vertical);
             return true;
         }
-        let k = (dt_s / self.config.reference_tau_s).min(1.0);
-        if self.agrees(self.norm, self.dip_rad, norm, dip_rad) {
-            self.norm += (norm - self.norm) * k;
-            self.dip_rad += (dip_rad - self.dip_rad) * k;
+        if self.gain.0 != dt_s {
+            self.gain = (dt_s, (dt_s / self.config.reference_tau_s).min(1.0));
+        }
+        let k = self.gain.1;
+        if self.agrees(self.horizontal, self.vertical, horizontal, vertical) {
+            self.horizontal += (horizontal - self.horizontal) * k;
+            self.vertical += (vertical - self.vertical) * k;
             self.candidate_s = 0.0;
             self.candidate_moving_s = 0.0;
             return true;
         }
         if self.candidate_s > 0.0
-            && self.agrees(self.candidate_norm, self.candidate_dip_rad, norm, dip_rad)
+            && self.agrees(
+                self.candidate_horizontal,
+                self.candidate_vertical,
+                horizontal,
+                vertical,
+            )
         {
             self.candidate_s += dt_s;
             if rate_rps >= self.config.new_reference_min_rate_rps {
                 self.candidate_moving_s += dt_s;
             }
             let kc = (dt_s / self.config.new_reference_s).min(1.0);
-            self.candidate_norm += (norm - self.candidate_norm) * kc;
-            self.candidate_dip_rad += (dip_rad - self.candidate_dip_rad) * kc;
+            self.candidate_horizontal += (horizontal - self.candidate_horizontal) * kc;
+            self.candidate_vertical += (vertical - self.candidate_vertical) * kc;
         } else {
-            self.candidate_norm = norm;
-            self.candidate_dip_rad = dip_rad;
+            self.candidate_horizontal = horizontal;
+            self.candidate_vertical = vertical;
             self.candidate_s = dt_s.max(f64::MIN_POSITIVE);
             self.candidate_moving_s = 0.0;
         }
         if self.candidate_s >= self.config.new_reference_s
             && self.candidate_moving_s >= 0.2 * self.config.new_reference_s
         {
-            self.adopt(self.candidate_norm, self.candidate_dip_rad);
+            self.adopt(self.candidate_horizontal, self.candidate_vertical);
             return true;
         }
         false
     }
 
-    /// The reference field norm (sensor unit) and dip (rad), once one was learned.
+    /// The reference field norm (sensor unit) and dip (rad, positive down), once one was
+    /// learned.
     pub fn reference(&self) -> Option<(f64, f64)> {
-        self.valid.then_some((self.norm, self.dip_rad))
+        self.valid.then(|| {
+            (
+                self.horizontal.hypot(self.vertical),
+                self.vertical.atan2(self.horizontal),
+            )
+        })
     }
 
-    fn agrees(&self, ref_norm: f64, ref_dip: f64, norm: f64, dip: f64) -> bool {
-        (norm - ref_norm).abs() <= self.config.norm_tol_rel * ref_norm
-            && (dip - ref_dip).abs() <= self.config.dip_tol_rad
+    /// The reference field in the level frame of magnetic north, `(H, 0, Z)` (north, east,
+    /// down), once one was learned.
+    pub fn reference_ned(&self) -> Option<nalgebra::Vector3<f64>> {
+        self.valid
+            .then(|| nalgebra::Vector3::new(self.horizontal, 0.0, self.vertical))
     }
 
-    fn adopt(&mut self, norm: f64, dip_rad: f64) {
-        self.norm = norm;
-        self.dip_rad = dip_rad;
+    /// Norm within `norm_tol_rel` and dip within `dip_tol_rad` of the reference `(h0, v0)`:
+    /// `|sin(dip − dip₀)| = |v·h₀ − h·v₀| / (|m| |m₀|)`, the dips being within ±90°.
+    fn agrees(&self, h0: f64, v0: f64, h: f64, v: f64) -> bool {
+        // Components of real fields (and of the clamped readings the filter passes) are far
+        // from overflowing a square, so no `hypot` is needed.
+        let n0 = (h0 * h0 + v0 * v0).sqrt();
+        let n = (h * h + v * v).sqrt();
+        (n - n0).abs() <= self.config.norm_tol_rel * n0
+            && (v * h0 - h * v0).abs() <= self.sin_dip_tol * n * n0
+    }
+
+    fn adopt(&mut self, horizontal: f64, vertical: f64) {
+        self.horizontal = horizontal;
+        self.vertical = vertical;
         self.candidate_s = 0.0;
         self.candidate_moving_s = 0.0;
         self.valid = true;
@@ -160,8 +196,10 @@ mod tests {
         fn the_learned_field_is_never_disturbed(norm in 1.0f64..100.0, dip in -1.4f64..1.4, n in 1usize..500) {
             let mut r = MagReference::new(MagReferenceConfig::default());
             for _ in 0..n {
-                prop_assert!(r.update(norm, dip, 1.0, 0.01));
+                prop_assert!(r.update(norm * dip.cos(), norm * dip.sin(), 1.0, 0.01));
             }
+            let (n0, d0) = r.reference().unwrap();
+            prop_assert!((n0 - norm).abs() < 1e-9 * norm && (d0 - dip).abs() < 1e-9);
         }
 
         #[test]
@@ -172,12 +210,12 @@ mod tests {
             // never consistent for `new_reference_s`, so it stays rejected.
             let cfg = MagReferenceConfig::default();
             let mut r = MagReference::new(cfg);
-            r.update(norm, dip, 0.0, 0.01);
+            r.update(norm * dip.cos(), norm * dip.sin(), 0.0, 0.01);
             let steps = (seconds / 0.01) as usize;
             for k in 0..steps {
                 let t = k as f64 * 0.01;
                 let seen = norm * (1.0 + swing * (t * 2.0).sin().signum() * (0.5 + 0.5 * (t * 7.0).sin().abs()));
-                let ok = r.update(seen, dip, 1.0, 0.01);
+                let ok = r.update(seen * dip.cos(), seen * dip.sin(), 1.0, 0.01);
                 if (seen - norm).abs() > cfg.norm_tol_rel * norm * 1.5 {
                     prop_assert!(!ok, "adopted a swinging field at t = {t}");
                 }

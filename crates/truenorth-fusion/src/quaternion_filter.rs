@@ -1,10 +1,10 @@
 //! A quaternion orientation filter for 6-D (gyro + accelerometer) and 9-D (+ magnetometer)
-//! IMUs, with gyro-bias estimation at rest and in motion and magnetic-disturbance rejection.
+//! IMUs, with gyro-bias estimation at rest and in motion, magnetic-disturbance rejection and
+//! online hard-iron re-estimation.
 //!
 //! Per sample (body → NED quaternion `q`, Hamilton, scalar first):
-//! 1. **Strapdown**: `q ← q ⊗ exp((ω − b̂) dt / 2)` with the rate at the sample time (the
-//!    workspace's gyro sample convention; the step uses the mean of the previous and the
-//!    current rate, the trapezoid rule).
+//! 1. **Strapdown**: `q ← q ⊗ exp((ω − b̂) dt / 2)`, with the rate the gyro's timing calls
+//!    for ([`GyroTiming`]).
 //! 2. **Inclination**: the specific force rotated into NED and low-passed there (its mean
 //!    over a swing is gravity alone) should point up, `(0, 0, −1)`; `q` is turned about the
 //!    horizontal axis by `dt/τ_acc` times the horizontal part of it over g — a
@@ -17,10 +17,13 @@
 //!    body's own accelerations, which average to zero over any swing, cancel; weighting
 //!    readings by how far |a| is from g, or using the angle, biases the average (on BROAD's
 //!    fast-translation trial 16 either one doubles the inclination error).
-//! 3. **Heading**: the magnetometer rotated into NED should point north; `q` is turned about
-//!    the vertical only, by `dt/τ_mag` of the horizontal angle, so a disturbed field can
-//!    never tilt the inclination (the decoupling of Madgwick's and VQF's heading updates).
-//!    Readings judged disturbed by [`crate::MagReference`] (norm or dip off) are skipped.
+//! 3. **Heading**: the magnetometer, less any hard-iron offset learned online
+//!    ([`crate::HardIronEstimator`]), rotated into NED should point north; `q` is turned
+//!    about the vertical only, by `dt/τ_mag` of the horizontal angle, so a disturbed field
+//!    can never tilt the inclination (the decoupling of Madgwick's and VQF's heading
+//!    updates). Readings judged disturbed by [`crate::MagReference`] (norm or dip off) are
+//!    skipped. Samples without a reading (a magnetometer slower than the gyro) are skipped
+//!    and the next reading's correction covers the time since the last one.
 //! 4. **Gyro bias**: at rest ([`crate::RestDetector`]) the bias follows the mean of the raw
 //!    rate; in motion, each correction's implied rate is integrated into the bias (the
 //!    integral term of Mahony et al.), along the axes the corrections observe.
@@ -29,109 +32,57 @@
 //! `q₆ = Rz(−H) ⊗ q` with `H` the sum of the heading corrections, exact because each
 //! correction acts on the left (in the reference frame) and the inclination correction
 //! commutes with a rotation about the vertical.
+//!
+//! The per-sample path computes no trigonometric function: the strapdown step and the
+//! corrections use series that are exact to 10⁻¹⁰ rad at their step sizes
+//! ([`crate::rotation`]), the dip test compares sines, and the heading error is taken as
+//! `sin ε = y/|h|` of the horizontal field `h = (x, y)` (±1 beyond ±90°).
 
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 use serde::{Deserialize, Serialize};
 use truenorth_core::{
     AttitudeEstimate, AttitudeStatus, Error, ImuSample, OrientationEstimator, Result,
-    STANDARD_GRAVITY_MPS2, TimeStep, Validate, check_positive, check_range,
+    STANDARD_GRAVITY_MPS2, TimeStep, Validate,
 };
 
-use crate::{MagReference, MagReferenceConfig, RestConfig, RestDetector};
+use crate::rotation::{rotation_from_vector, small_rotation};
+use crate::{GyroTiming, HardIronEstimator, MagReference, QuaternionFilterConfig, RestDetector};
 
 #[allow(unused_imports)]
 use truenorth_core::Float as _;
 
-/// Parameters of the [`QuaternionFilter`]. Times in seconds, rates in rad/s.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(default)]
-pub struct QuaternionFilterConfig {
-    /// Time constant of the inclination correction, s (default 3).
-    pub tau_acc_s: f64,
-    /// Time constant of the low-pass applied to the specific force in the reference frame
-    /// before the inclination correction, s (default 1).
-    pub acc_lowpass_s: f64,
-    /// Time constant of the heading correction, s (default 15).
-    pub tau_mag_s: f64,
-    /// Time constant of the in-motion bias estimate, s (default 400): long against
-    /// `tau_acc_s` so the bias loop cannot ring, and long enough that the body's own
-    /// accelerations, which leak into every correction, average out of it (at 60 s the
-    /// bias wandered by 2°/s on BROAD trial 16, `tests/broad.rs`).
-    pub bias_tau_motion_s: f64,
-    /// Time constant of the in-motion bias estimate before any rest has measured the bias,
-    /// s (default 60); it moves to `bias_tau_motion_s` as rest time accumulates.
-    pub bias_tau_unknown_s: f64,
-    /// Rest time after which the bias counts as known, s (default 5).
-    pub bias_known_after_rest_s: f64,
-    /// Time constant of the bias estimate at rest, s (default 2).
-    pub bias_tau_rest_s: f64,
-    /// Largest bias the filter may estimate on any axis, rad/s (default 20°/s).
-    pub max_bias_rps: f64,
-    /// Time after the first sample with fast corrections, s (default 1): the attitude
-    /// converges from the first reading before the slow filter takes over.
-    pub startup_s: f64,
-    /// Rest detection.
-    pub rest: RestConfig,
-    /// Magnetic-disturbance detection.
-    pub mag: MagReferenceConfig,
-    /// Use the magnetometer when the samples have one (default `true`; `false` gives 6-D).
-    pub use_mag: bool,
-    /// Initial attitude, body → NED; `None` (default) starts from the first accelerometer
-    /// (and magnetometer) reading.
-    pub initial_attitude: Option<[f64; 4]>,
+/// The per-sample gains, derived from the parameters and the sample interval; recomputed
+/// only when the interval changes (never on a uniformly sampled stream), so that the
+/// per-sample path divides by no time constant.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Coefficients {
+    dt_s: f64,
+    /// Low-pass gain of the reference-frame specific force.
+    acc_lowpass: f64,
+    /// Inclination gain per m/s² of horizontal specific force.
+    acc: f64,
+    /// Heading gains in motion and at rest.
+    mag: f64,
+    mag_rest: f64,
+    /// Gain of the bias estimate at rest.
+    bias_rest: f64,
 }
 
-impl Default for QuaternionFilterConfig {
-    fn default() -> Self {
+impl Coefficients {
+    /// The gains for interval `dt_s`; with `startup`, every time constant is cut to 0.1 s.
+    fn new(cfg: &QuaternionFilterConfig, dt_s: f64, startup: bool) -> Self {
+        let gain = |tau: f64| {
+            let tau = if startup { tau.min(0.1) } else { tau };
+            (dt_s / tau).min(1.0)
+        };
         Self {
-            tau_acc_s: 3.0,
-            acc_lowpass_s: 1.0,
-            tau_mag_s: 15.0,
-            bias_tau_motion_s: 400.0,
-            bias_tau_unknown_s: 60.0,
-            bias_known_after_rest_s: 5.0,
-            bias_tau_rest_s: 2.0,
-            max_bias_rps: 20f64.to_radians(),
-            startup_s: 1.0,
-            rest: RestConfig::default(),
-            mag: MagReferenceConfig::default(),
-            use_mag: true,
-            initial_attitude: None,
+            dt_s,
+            acc_lowpass: gain(cfg.acc_lowpass_s),
+            acc: gain(cfg.tau_acc_s) / STANDARD_GRAVITY_MPS2,
+            mag: gain(cfg.tau_mag_s),
+            mag_rest: gain(cfg.tau_mag_rest_s),
+            bias_rest: gain(cfg.bias_tau_rest_s),
         }
-    }
-}
-
-impl Validate for QuaternionFilterConfig {
-    fn validate(&self) -> Result<()> {
-        check_positive("tau_acc_s", self.tau_acc_s)?;
-        check_positive("acc_lowpass_s", self.acc_lowpass_s)?;
-        check_positive("tau_mag_s", self.tau_mag_s)?;
-        check_range(
-            "bias_tau_motion_s",
-            self.bias_tau_motion_s,
-            2.0 * self.tau_acc_s,
-            1e9,
-        )?;
-        check_range(
-            "bias_tau_unknown_s",
-            self.bias_tau_unknown_s,
-            2.0 * self.tau_acc_s,
-            1e9,
-        )?;
-        check_positive("bias_known_after_rest_s", self.bias_known_after_rest_s)?;
-        check_positive("bias_tau_rest_s", self.bias_tau_rest_s)?;
-        check_range("max_bias_rps", self.max_bias_rps, 0.0, 10.0)?;
-        check_range("startup_s", self.startup_s, 0.0, 1e9)?;
-        self.rest.validate()?;
-        self.mag.validate()?;
-        if let Some(q) = self.initial_attitude {
-            for v in q {
-                check_range("initial_attitude component", v, -1e3, 1e3)?;
-            }
-            let n = q.iter().map(|v| v * v).sum::<f64>().sqrt();
-            check_range("initial_attitude norm", n, 1e-6, 1e3)?;
-        }
-        Ok(())
     }
 }
 
@@ -139,13 +90,18 @@ impl Validate for QuaternionFilterConfig {
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 struct State {
     q: UnitQuaternion<f64>,
-    /// `Rz(−H)`, `H` the sum of the heading corrections (see the module documentation).
-    undo_heading: UnitQuaternion<f64>,
+    /// `Rz(−H/2)` as (cos, sin) of `−H/2`, `H` the sum of the heading corrections (see the
+    /// module documentation).
+    undo_heading: (f64, f64),
     bias_rps: Vector3<f64>,
     acc_lp_ned: Option<Vector3<f64>>,
     /// Time spent at rest since the start, s: how well the bias is known.
     rest_s: f64,
+    /// `1/τ` of the in-motion bias estimate for the rest time so far.
+    bias_inv_tau_motion: f64,
     last_gyr_rps: Option<Vector3<f64>>,
+    /// Time since the last magnetometer reading, s.
+    mag_dt_s: f64,
     since_start_s: f64,
     initialised: bool,
     estimate: AttitudeEstimate,
@@ -182,6 +138,8 @@ pub struct QuaternionFilter {
     clock: TimeStep,
     rest: RestDetector,
     mag_ref: MagReference,
+    hard_iron: HardIronEstimator,
+    coefficients: Coefficients,
 }
 
 impl QuaternionFilter {
@@ -193,11 +151,13 @@ impl QuaternionFilter {
             config,
             state: State {
                 q: q0,
-                undo_heading: UnitQuaternion::identity(),
+                undo_heading: (1.0, 0.0),
                 bias_rps: Vector3::zeros(),
                 acc_lp_ned: None,
                 rest_s: 0.0,
+                bias_inv_tau_motion: 1.0 / config.bias_tau_unknown_s,
                 last_gyr_rps: None,
+                mag_dt_s: 0.0,
                 since_start_s: 0.0,
                 initialised: config.initial_attitude.is_some(),
                 estimate: AttitudeEstimate::initial(q0),
@@ -205,12 +165,20 @@ impl QuaternionFilter {
             clock: TimeStep::new(),
             rest: RestDetector::new(config.rest),
             mag_ref: MagReference::new(config.mag),
+            hard_iron: HardIronEstimator::new(config.hard_iron),
+            coefficients: Coefficients::new(&config, 0.0, false),
         })
     }
 
     /// The parameters in use.
     pub fn config(&self) -> &QuaternionFilterConfig {
         &self.config
+    }
+
+    /// The hard-iron offset currently subtracted from the magnetometer (body frame, the
+    /// magnetometer's unit), if one was learned.
+    pub fn hard_iron_offset(&self) -> Option<Vector3<f64>> {
+        self.hard_iron.offset()
     }
 
     fn step(
@@ -225,13 +193,25 @@ impl QuaternionFilter {
         let s = &mut self.state;
         s.since_start_s += dt_s;
         let startup = s.since_start_s < cfg.startup_s;
-        let fast = |tau: f64| if startup { tau.min(0.1) } else { tau };
+        let c = if startup {
+            Coefficients::new(cfg, dt_s, true)
+        } else {
+            if self.coefficients.dt_s != dt_s {
+                self.coefficients = Coefficients::new(cfg, dt_s, false);
+            }
+            self.coefficients
+        };
 
-        // 1. Strapdown, trapezoid rule on the bias-corrected rate.
-        let prev = s.last_gyr_rps.unwrap_or(gyr);
-        let omega = 0.5 * (prev + gyr) - s.bias_rps;
+        // 1. Strapdown.
+        let rate = match cfg.gyro_timing {
+            GyroTiming::IntervalMean => gyr,
+            GyroTiming::Instantaneous => 0.5 * (s.last_gyr_rps.unwrap_or(gyr) + gyr),
+        };
         s.last_gyr_rps = Some(gyr);
-        s.q *= UnitQuaternion::from_scaled_axis(omega * dt_s);
+        let omega = rate - s.bias_rps;
+        s.q =
+            UnitQuaternion::new_normalize(s.q.into_inner() * rotation_from_vector(&(omega * dt_s)));
+        let rate_rps = omega.norm();
 
         let at_rest = match acc {
             Some(a) => self.rest.update(&gyr, &a, mag.as_ref(), dt_s),
@@ -241,83 +221,120 @@ impl QuaternionFilter {
             at_rest,
             ..AttitudeStatus::default()
         };
-        // Body-frame rate implied by this step's corrections, for the bias integral.
-        let mut correction_rate = Vector3::zeros();
+        // One rotation matrix serves every vector rotated this step; the corrections of the
+        // step (at most 10⁻³ rad) are applied together at its end.
+        let r = s.q.to_rotation_matrix();
+        let r = r.matrix();
+        // The step's correction, a rotation vector in the reference frame.
+        let mut correction = Vector3::zeros();
 
         // 2. Inclination.
         if let Some(a) = acc
-            && a.norm() > 1e-6
+            && a.norm_squared() > 1e-12
         {
             // Linear in the specific force: the body's own accelerations average out
             // over a swing, where an angle (atan of horizontal over vertical) would not.
             // A first low-pass in the reference frame before the proportional
             // correction makes the response to acceleration second order.
-            let f = s.q * a;
-            let kl = (dt_s / fast(cfg.acc_lowpass_s)).min(1.0);
-            s.acc_lp_ned = match s.acc_lp_ned {
-                Some(lp) => Some(lp + (f - lp) * kl),
-                None => Some(f),
+            let f = r * a;
+            let lp = match s.acc_lp_ned {
+                Some(lp) => lp + (f - lp) * c.acc_lowpass,
+                None => f,
             };
-            let down = -s.acc_lp_ned.unwrap_or(f) / STANDARD_GRAVITY_MPS2;
-            let k = (dt_s / fast(cfg.tau_acc_s)).min(1.0);
-            let rot = down.cross(&Vector3::z()) * k;
-            let c = small_rotation(&rot);
-            s.q = c * s.q;
-            s.acc_lp_ned = s.acc_lp_ned.map(|lp| c * lp);
-            correction_rate += s.q.inverse_transform_vector(&rot) / dt_s;
+            s.acc_lp_ned = Some(lp);
+            let k = c.acc;
+            // down × ẑ with down = −lp/g.
+            correction.x = -lp.y * k;
+            correction.y = lp.x * k;
             status.accel_used = true;
         }
 
         // 3. Heading.
+        s.mag_dt_s += dt_s;
         if let Some(m) = mag {
-            let norm = m.norm();
-            if norm > 0.0 {
-                let m_ned = s.q * m;
-                let horizontal = m_ned.xy().norm();
-                let dip = m_ned.z.atan2(horizontal);
-                let rate = omega.norm();
-                let undisturbed = self.mag_ref.update(norm, dip, rate, dt_s);
+            let mag_dt_s = core::mem::take(&mut s.mag_dt_s);
+            let offset = match self.mag_ref.reference_ned() {
+                Some(reference) => {
+                    let turning_rps = if at_rest { 0.0 } else { rate_rps };
+                    self.hard_iron
+                        .update(&m, r, &reference, turning_rps, mag_dt_s)
+                }
+                None => None,
+            };
+            status.mag_calibrating = offset.is_some();
+            let m = m - offset.unwrap_or_default();
+            let m_ned = r * m;
+            let horizontal = m_ned.xy().norm();
+            if horizontal > 0.0 {
+                let undisturbed = self.mag_ref.update(horizontal, m_ned.z, rate_rps, mag_dt_s);
                 status.mag_disturbed = !undisturbed;
-                if undisturbed && horizontal > 1e-9 * norm {
-                    // Angle of the horizontal field east of north: the heading error.
-                    let err = m_ned.y.atan2(m_ned.x);
-                    let k = (dt_s / fast(cfg.tau_mag_s)).min(1.0);
-                    let rot = Vector3::new(0.0, 0.0, -k * err);
-                    let c = small_rotation(&rot);
-                    s.q = c * s.q;
-                    s.acc_lp_ned = s.acc_lp_ned.map(|lp| c * lp);
-                    s.undo_heading = small_rotation(&-rot) * s.undo_heading;
-                    correction_rate += s.q.inverse_transform_vector(&rot) / dt_s;
+                if undisturbed && horizontal > 1e-9 * m_ned.z.abs() {
+                    // sin ε of the angle ε of the horizontal field east of north, and ±1
+                    // beyond ±90°: equal to ε to 0.13 % for |ε| < 5°, and bounded, so a
+                    // disturbed reading that slips past the tests pulls no harder than a
+                    // 57° error (the angle itself would pull with up to 180°).
+                    let err = if m_ned.x >= 0.0 {
+                        m_ned.y / horizontal
+                    } else {
+                        1f64.copysign(m_ned.y)
+                    };
+                    let k = match (at_rest, mag_dt_s == dt_s) {
+                        (true, true) => c.mag_rest,
+                        (false, true) => c.mag,
+                        // A reading after samples without one covers their time too.
+                        (rest, false) => {
+                            let g = Coefficients::new(cfg, mag_dt_s, startup);
+                            if rest { g.mag_rest } else { g.mag }
+                        }
+                    };
+                    let dz = -k * err;
+                    correction.z = dz;
+                    // Rz(−H/2) ← Rz(−dz/2) Rz(−H/2), first order and renormalised.
+                    let (c, sn) = s.undo_heading;
+                    let h = 0.5 * dz;
+                    let (c, sn) = (c + sn * h, sn - c * h);
+                    let n = (c * c + sn * sn).sqrt();
+                    s.undo_heading = (c / n, sn / n);
                     status.mag_used = true;
                 }
             }
         }
 
+        if correction != Vector3::zeros() {
+            s.q = small_rotation(&correction) * s.q;
+            // Turn the low-passed vector with the frame (first order, as the step is small).
+            s.acc_lp_ned = s.acc_lp_ned.map(|lp| lp + correction.cross(&lp));
+        }
+
         // 4. Gyro bias.
         if !startup {
             if at_rest {
-                let k = (dt_s / cfg.bias_tau_rest_s).min(1.0);
-                s.bias_rps += (self.rest.gyro_mean() - s.bias_rps) * k;
-                s.rest_s += dt_s;
+                s.bias_rps += (self.rest.gyro_mean() - s.bias_rps) * c.bias_rest;
+                if s.rest_s < cfg.bias_known_after_rest_s {
+                    s.rest_s += dt_s;
+                    let known = (s.rest_s / cfg.bias_known_after_rest_s).min(1.0);
+                    let tau = cfg.bias_tau_unknown_s
+                        + known * (cfg.bias_tau_motion_s - cfg.bias_tau_unknown_s);
+                    s.bias_inv_tau_motion = 1.0 / tau;
+                }
             } else {
                 // A bias the estimate lacks makes the strapdown drift, and the corrections
                 // turn against the drift: integrating their rate removes it. Until a rest
                 // has measured the bias, it is learned faster, accepting more of the
                 // accelerations that leak into the corrections.
-                let known = (s.rest_s / cfg.bias_known_after_rest_s).min(1.0);
-                let tau = cfg.bias_tau_unknown_s
-                    + known * (cfg.bias_tau_motion_s - cfg.bias_tau_unknown_s);
-                s.bias_rps -= correction_rate * (dt_s / tau);
+                // Body-frame rate of the correction, Rᵀ·correction/dt, times dt/τ.
+                s.bias_rps -= r.tr_mul(&correction) * s.bias_inv_tau_motion;
             }
             let lim = cfg.max_bias_rps;
             s.bias_rps = s.bias_rps.map(|b| b.clamp(-lim, lim));
         }
 
-        let q6 = s.undo_heading * s.q;
+        let (c, sn) = s.undo_heading;
+        let undo = UnitQuaternion::new_unchecked(Quaternion::new(c, 0.0, 0.0, sn));
         s.estimate = AttitudeEstimate {
             t_s,
             attitude: s.q,
-            attitude_6d: q6,
+            attitude_6d: undo * s.q,
             gyro_bias_rps: s.bias_rps,
             sigma_rad: None,
             status,
@@ -327,10 +344,10 @@ impl QuaternionFilter {
 
 impl OrientationEstimator for QuaternionFilter {
     /// Needs a gyro triad; the accelerometer and magnetometer triads may be absent on any
-    /// sample (a slower sensor). A non-finite value or a timestamp that does not increase
-    /// is an error and changes nothing.
+    /// sample (a slower sensor). A non-finite value, a reading beyond any sensor's range
+    /// (gyro 10⁴ rad/s, accelerometer 10⁶ m/s², field 10¹²), a timestamp that does not
+    /// increase or a gap over 10⁶ s is an error and changes nothing.
     fn update(&mut self, sample: &ImuSample) -> Result<AttitudeEstimate> {
-        sample.check_finite()?;
         let gyr = sample.gyr_rps.as_xyz().ok_or(Error::Unsupported {
             reason: "the quaternion filter needs a three-axis gyro; use the Euler detector for two gyros",
         })?;
@@ -340,8 +357,25 @@ impl OrientationEstimator for QuaternionFilter {
         } else {
             None
         };
-        let clock_before = self.clock;
-        let Some(dt_s) = self.clock.dt_s(sample.t_s)? else {
+        // The usual sample is a finite 9-D one: test it in one pass, and let the sample's
+        // own check name the offending reading otherwise.
+        let finite = sample.t_s.is_finite()
+            && gyr.iter().all(|v| v.is_finite())
+            && acc.is_some_and(|a| a.iter().all(|v| v.is_finite()))
+            && sample
+                .mag
+                .as_xyz()
+                .is_some_and(|m| m.iter().all(|v| v.is_finite()));
+        if !finite {
+            sample.check_finite()?;
+        }
+        // Readings beyond any sensor's range could overflow the update; they are refused
+        // before anything changes, so the update needs no copy of the state to fall back to.
+        let mut clock = self.clock;
+        let dt = clock.dt_s(sample.t_s)?;
+        check_bounds(&gyr, acc.as_ref(), mag.as_ref(), dt)?;
+        self.clock = clock;
+        let Some(dt_s) = dt else {
             if !self.state.initialised
                 && let Some(q) = acc.and_then(|a| attitude_from(&a, mag.as_ref()))
             {
@@ -355,21 +389,8 @@ impl OrientationEstimator for QuaternionFilter {
             };
             return Ok(self.state.estimate);
         };
-        let saved = (self.state, self.rest, self.mag_ref);
         self.step(sample.t_s, dt_s, gyr, acc, mag);
-        if !(self.state.q.coords.iter().all(|v| v.is_finite())
-            && self.state.bias_rps.iter().all(|v| v.is_finite()))
-        {
-            // Finite readings so large that the update overflowed: keep the last good state.
-            (self.state, self.rest, self.mag_ref) = saved;
-            self.clock = clock_before;
-            return Err(Error::OutOfRange {
-                what: "IMU reading (the update overflowed)",
-                value: gyr.norm(),
-                min: 0.0,
-                max: 1e6,
-            });
-        }
+        debug_assert!(self.state.q.coords.iter().all(|v| v.is_finite()));
         Ok(self.state.estimate)
     }
 
@@ -384,21 +405,54 @@ impl OrientationEstimator for QuaternionFilter {
     }
 }
 
-/// The rotation by the rotation vector `v` for the small angles of one correction step:
-/// `(1, v/2)` normalised, whose angle differs from |v| by |v|³/12 — under 10⁻¹⁰ rad for the
-/// at most 10⁻³ rad a correction turns per sample — at a fraction of the cost of the exact
-/// exponential's sine and cosine. A step is limited to 0.1 rad: only a reading far outside
-/// any sensor's range asks for more, and it must not flip the attitude in one sample.
-#[inline]
-fn small_rotation(v: &Vector3<f64>) -> UnitQuaternion<f64> {
-    const MAX_STEP_RAD: f64 = 0.1;
-    let n = v.norm();
-    let v = if n > MAX_STEP_RAD {
-        v * (MAX_STEP_RAD / n)
-    } else {
-        *v
+/// Largest gyro rate accepted, rad/s (far beyond any MEMS gyro's ±2000°/s = 35 rad/s).
+const MAX_RATE_RPS: f64 = 1e4;
+/// Largest specific force accepted, m/s² (10⁵ g).
+const MAX_ACCEL_MPS2: f64 = 1e6;
+/// Largest magnetometer component accepted (any unit: 10¹² nT is 1000 T).
+const MAX_FIELD: f64 = 1e12;
+/// Longest time between samples accepted, s.
+const MAX_DT_S: f64 = 1e6;
+
+/// Refuses readings and gaps beyond the limits above: within them no product in the update
+/// can overflow.
+fn check_bounds(
+    gyr: &Vector3<f64>,
+    acc: Option<&Vector3<f64>>,
+    mag: Option<&Vector3<f64>>,
+    dt_s: Option<f64>,
+) -> Result<()> {
+    let check = |what: &'static str, v: f64, max: f64| {
+        if v <= max {
+            Ok(())
+        } else {
+            Err(Error::OutOfRange {
+                what,
+                value: v,
+                min: 0.0,
+                max,
+            })
+        }
     };
-    UnitQuaternion::new_normalize(Quaternion::new(1.0, 0.5 * v.x, 0.5 * v.y, 0.5 * v.z))
+    check(
+        "gyro rate (largest component, rad/s)",
+        gyr.amax(),
+        MAX_RATE_RPS,
+    )?;
+    if let Some(a) = acc {
+        check(
+            "specific force (largest component, m/s²)",
+            a.amax(),
+            MAX_ACCEL_MPS2,
+        )?;
+    }
+    if let Some(m) = mag {
+        check("magnetic field (largest component)", m.amax(), MAX_FIELD)?;
+    }
+    if let Some(dt) = dt_s {
+        check("time between samples, s", dt, MAX_DT_S)?;
+    }
+    Ok(())
 }
 
 fn initial_attitude(config: &QuaternionFilterConfig) -> UnitQuaternion<f64> {

@@ -72,6 +72,8 @@ pub struct RestDetector {
     mag_at_start: Option<Vector3<f64>>,
     still_s: f64,
     primed: bool,
+    /// The running means' gain for the last interval (recomputed when it changes).
+    gain: (f64, f64),
 }
 
 impl RestDetector {
@@ -85,6 +87,7 @@ impl RestDetector {
             mag_at_start: None,
             still_s: 0.0,
             primed: false,
+            gain: (0.0, 0.0),
         }
     }
 
@@ -104,11 +107,15 @@ impl RestDetector {
             self.primed = true;
             return false;
         }
-        let k = (dt_s / self.config.mean_tau_s).min(1.0);
+        if self.gain.0 != dt_s {
+            self.gain = (dt_s, (dt_s / self.config.mean_tau_s).min(1.0));
+        }
+        let k = self.gain.1;
         self.gyr_mean += (gyr - self.gyr_mean) * k;
         self.acc_mean += (acc - self.acc_mean) * k;
-        let mut still = (gyr - self.gyr_mean).norm() < self.config.gyro_dev_rps
-            && (acc - self.acc_mean).norm() < self.config.acc_dev_mps2;
+        let (g, a) = (self.config.gyro_dev_rps, self.config.acc_dev_mps2);
+        let mut still = (gyr - self.gyr_mean).norm_squared() < g * g
+            && (acc - self.acc_mean).norm_squared() < a * a;
         match (mag, self.mag_mean.as_mut()) {
             (Some(m), Some(mean)) => *mean += (m - *mean) * k,
             (Some(m), None) => self.mag_mean = Some(*m),

@@ -3,6 +3,12 @@
 //! The rate gyro: a forward model of its errors (for the simulator and for round-trip tests),
 //! its calibration (zero and scale), and the integration of yaw rate into heading change.
 //!
+//! Conditioning of a gyro's output as the orientation detector of WO 00/36376 does it
+//! (METHODS §E.8–9): a [`HighPassFilter`] with a variable cutoff removes the offset, a
+//! [`HighPassCorrection`] undoes the filter's distortion (with an offset-error compensator),
+//! an [`IirHighPass`] is the digital variant (buffer reset and input-offset correction), and
+//! an [`OscillationRemover`] zeroes hand tremor.
+//!
 //! A vehicle usually has one gyro, about the vertical axis (`gyr_z`, positive for a right
 //! turn). That case is the plain [`GyroAxisModel`], [`GyroCalibration`] and [`YawIntegrator`];
 //! the three-axis [`Gyro3Model`] and [`Gyro3Calibration`] are three of those side by side.
@@ -52,6 +58,10 @@
 
 mod axis_model;
 mod calibration;
+mod high_pass;
+mod high_pass_correction;
+mod iir_high_pass;
+mod oscillation_remover;
 mod triad_model;
 mod yaw_integrator;
 
@@ -59,6 +69,12 @@ pub use axis_model::{
     GyroAxisCoefficients, GyroAxisModel, GyroAxisParams, GyroAxisState, MIN_SCALE_ERROR, RateTruth,
 };
 pub use calibration::{Gyro3Calibration, GyroCalibration};
+pub use high_pass::{HighPassConfig, HighPassFilter};
+pub use high_pass_correction::{HighPassCorrection, HighPassCorrectionConfig};
+pub use iir_high_pass::{IirHighPass, IirHighPassConfig};
+pub use oscillation_remover::{
+    MAX_OSCILLATION_WINDOW, OscillationRemover, OscillationRemoverConfig,
+};
 pub use triad_model::{Gyro3Model, Gyro3Params, Rate3Truth};
 pub use yaw_integrator::{YawIntegrator, YawIntegratorConfig};
 

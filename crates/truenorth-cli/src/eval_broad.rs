@@ -1,0 +1,357 @@
+//! `truenorth eval broad DIR`: run an orientation method over the BROAD benchmark's trials
+//! (Laidig, Caruso, Cereatti & Seel, *Data* 6(7):72, 2021) and score it with BROAD's own
+//! metric.
+//!
+//! The metric (BROAD's `example_code/broad_utils.py`): per sample the total, heading and
+//! inclination error angles of [`AttitudeError`]; per trial the RMSE of each over the samples
+//! of the movement phase whose reference is valid; per group the mean of the trial RMSEs.
+
+use std::io::{BufRead, BufReader, IsTerminal, Write as _};
+use std::path::{Path, PathBuf};
+
+use nalgebra::{Quaternion, UnitQuaternion, Vector3};
+use serde::Serialize;
+use truenorth::core::ImuSample;
+use truenorth::fusion::AttitudeError;
+
+use crate::io::{CliError, CliResult};
+use crate::orientation::{Estimator, Method, Timing, ned_to_enu};
+
+/// Arguments of `truenorth eval broad`.
+///
+/// DIR is BROAD's folder (with `trials/`) or the trial folder itself: one
+/// `NN_<name>.csv.gz` per trial with the columns `t_s, gyr_x..z (rad/s), acc_x..z (m/s²),
+/// mag_x..z (µT), qw, qx, qy, qz` (reference orientation, sensor → ENU with magnetic
+/// north; NaN where invalid) and `movement` (1 in the scored phase). A trial whose name
+/// contains `undisturbed` belongs to the undisturbed group, every other to the disturbed
+/// group. Prints per-trial and per-group total, heading and inclination RMSE in degrees
+/// (with `--json`, one JSON document instead); progress goes to stderr.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// BROAD's folder or its `trials/` folder.
+    pub dir: PathBuf,
+    /// Orientation method.
+    #[arg(long, value_enum, default_value = "quaternion")]
+    pub method: Method,
+    /// Ignore the magnetometer (6-D: only inclination is meaningful).
+    #[arg(long)]
+    pub no_mag: bool,
+    /// What a gyro sample's rate stands for (quaternion filter).
+    #[arg(long, value_enum, default_value = "interval-mean")]
+    pub gyro_timing: Timing,
+    /// Print one JSON document (per-trial and per-group figures) instead of tables.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// One trial as read from its file.
+struct Trial {
+    samples: Vec<ImuSample>,
+    reference: Vec<Option<UnitQuaternion<f64>>>,
+    movement: Vec<bool>,
+}
+
+/// RMSE figures, degrees.
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct Rmse {
+    /// Total error angle.
+    pub total_deg: f64,
+    /// Heading error (rotation about the vertical).
+    pub heading_deg: f64,
+    /// Inclination error.
+    pub inclination_deg: f64,
+}
+
+#[derive(Serialize)]
+struct TrialResult {
+    trial: String,
+    group: &'static str,
+    #[serde(flatten)]
+    rmse: Rmse,
+}
+
+#[derive(Serialize)]
+struct GroupResult {
+    group: &'static str,
+    trials: usize,
+    #[serde(flatten)]
+    mean: Rmse,
+}
+
+#[derive(Serialize)]
+struct Report {
+    method: String,
+    use_mag: bool,
+    trials: Vec<TrialResult>,
+    groups: Vec<GroupResult>,
+}
+
+/// Runs the subcommand.
+pub fn run(args: &Args) -> CliResult {
+    let dir = if args.dir.join("trials").is_dir() {
+        args.dir.join("trials")
+    } else {
+        args.dir.clone()
+    };
+    let mut paths: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .map_err(|e| CliError::file(&dir, format!("cannot read the folder: {e}")))?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.to_string_lossy().ends_with(".csv.gz"))
+        .collect();
+    paths.sort();
+    if paths.is_empty() {
+        return Err(CliError::file(
+            &dir,
+            "no BROAD trial files (*.csv.gz) here; give BROAD's folder or its trials/ folder",
+        ));
+    }
+    let mut progress = Progress::new(paths.len());
+    let mut results = Vec::with_capacity(paths.len());
+    for p in &paths {
+        let name = p
+            .file_name()
+            .map(|n| n.to_string_lossy().replace(".csv.gz", ""))
+            .unwrap_or_default();
+        progress.show(&name);
+        let trial = read_trial(p)?;
+        let mut est = Estimator::new(args.method, !args.no_mag, args.gyro_timing)
+            .map_err(|e| CliError::msg(e.to_string()))?;
+        let to_enu = ned_to_enu();
+        let mut q = Vec::with_capacity(trial.samples.len());
+        for (k, s) in trial.samples.iter().enumerate() {
+            let e = est
+                .update(s)
+                .map_err(|e| CliError::row(p, k + 2, e.to_string()))?;
+            q.push(to_enu * e.attitude);
+        }
+        let rmse = broad_rmse(&q, &trial.reference, &trial.movement)
+            .ok_or_else(|| CliError::file(p, "no scored sample (movement phase empty)"))?;
+        let group = if name.contains("undisturbed") {
+            "undisturbed"
+        } else {
+            "disturbed"
+        };
+        results.push(TrialResult {
+            trial: name,
+            group,
+            rmse,
+        });
+    }
+    progress.finish();
+    let groups = ["undisturbed", "disturbed", "all"]
+        .into_iter()
+        .filter_map(|g| {
+            let members: Vec<&Rmse> = results
+                .iter()
+                .filter(|r| g == "all" || r.group == g)
+                .map(|r| &r.rmse)
+                .collect();
+            let n = members.len();
+            (n > 0).then(|| {
+                let mean =
+                    |f: fn(&Rmse) -> f64| members.iter().map(|r| f(r)).sum::<f64>() / n as f64;
+                GroupResult {
+                    group: g,
+                    trials: n,
+                    mean: Rmse {
+                        total_deg: mean(|r| r.total_deg),
+                        heading_deg: mean(|r| r.heading_deg),
+                        inclination_deg: mean(|r| r.inclination_deg),
+                    },
+                }
+            })
+        })
+        .collect();
+    let report = Report {
+        method: format!("{:?}", args.method),
+        use_mag: !args.no_mag,
+        trials: results,
+        groups,
+    };
+    if args.json {
+        let text = serde_json::to_string_pretty(&report)
+            .map_err(|e| CliError::msg(format!("cannot write JSON: {e}")))?;
+        println!("{text}");
+        return Ok(());
+    }
+    println!(
+        "BROAD, {} trials, method {}{} (RMSE in degrees, BROAD's metric)",
+        report.trials.len(),
+        report.method,
+        if args.no_mag { ", 6-D" } else { "" }
+    );
+    println!(
+        "{:<46} {:>8} {:>8} {:>12}",
+        "trial", "total", "heading", "inclination"
+    );
+    for r in &report.trials {
+        println!(
+            "{:<46} {:8.2} {:8.2} {:12.2}",
+            r.trial, r.rmse.total_deg, r.rmse.heading_deg, r.rmse.inclination_deg
+        );
+    }
+    println!();
+    for g in &report.groups {
+        println!(
+            "{:<46} {:8.2} {:8.2} {:12.2}",
+            format!("mean, {} ({} trials)", g.group, g.trials),
+            g.mean.total_deg,
+            g.mean.heading_deg,
+            g.mean.inclination_deg
+        );
+    }
+    Ok(())
+}
+
+/// BROAD's metric over the samples with `movement` and a valid reference (see the module
+/// documentation); `None` when there is none.
+pub fn broad_rmse(
+    estimate: &[UnitQuaternion<f64>],
+    reference: &[Option<UnitQuaternion<f64>>],
+    movement: &[bool],
+) -> Option<Rmse> {
+    let mut sum = [0.0; 3];
+    let mut n = 0usize;
+    for ((q, r), &m) in estimate.iter().zip(reference).zip(movement) {
+        let (Some(r), true) = (r, m) else {
+            continue;
+        };
+        let e = AttitudeError::between(q, r);
+        let (total, heading, incl) = (e.total_rad, e.heading_rad, e.inclination_rad);
+        for (s, x) in sum.iter_mut().zip([total, heading, incl]) {
+            *s += x * x;
+        }
+        n += 1;
+    }
+    (n > 0).then(|| {
+        let rms = |s: f64| (s / n as f64).sqrt().to_degrees();
+        Rmse {
+            total_deg: rms(sum[0]),
+            heading_deg: rms(sum[1]),
+            inclination_deg: rms(sum[2]),
+        }
+    })
+}
+
+/// Reads one gzip-compressed trial CSV (columns found by name in the header).
+fn read_trial(path: &Path) -> CliResult<Trial> {
+    let file =
+        std::fs::File::open(path).map_err(|e| CliError::file(path, format!("cannot open: {e}")))?;
+    let mut lines = BufReader::new(flate2::read::GzDecoder::new(file)).lines();
+    let header: Vec<String> = match lines.next() {
+        Some(Ok(h)) => h.split(',').map(|c| c.trim().to_string()).collect(),
+        _ => return Err(CliError::file(path, "no header row (not a gzip CSV?)")),
+    };
+    const COLUMNS: [&str; 15] = [
+        "t_s", "gyr_x", "gyr_y", "gyr_z", "acc_x", "acc_y", "acc_z", "mag_x", "mag_y", "mag_z",
+        "qw", "qx", "qy", "qz", "movement",
+    ];
+    let mut idx = [0usize; 15];
+    for (i, name) in COLUMNS.iter().enumerate() {
+        idx[i] = header
+            .iter()
+            .position(|h| h == name)
+            .ok_or_else(|| CliError::file(path, format!("missing column `{name}`")))?;
+    }
+    let mut t = Trial {
+        samples: Vec::new(),
+        reference: Vec::new(),
+        movement: Vec::new(),
+    };
+    let mut v = [0.0; 15];
+    for (k, line) in lines.enumerate() {
+        let row = k + 2;
+        let line = line.map_err(|e| CliError::row(path, row, format!("cannot read: {e}")))?;
+        if line.trim().is_empty() {
+            continue;
+        }
+        let cells: Vec<&str> = line.split(',').collect();
+        for (i, &c) in idx.iter().enumerate() {
+            let cell = cells
+                .get(c)
+                .ok_or_else(|| CliError::row(path, row, "too few cells"))?
+                .trim();
+            v[i] = if cell.eq_ignore_ascii_case("nan") {
+                f64::NAN
+            } else {
+                cell.parse()
+                    .map_err(|_| CliError::row(path, row, format!("`{cell}` is not a number")))?
+            };
+        }
+        t.samples.push(ImuSample::new_9d(
+            v[0],
+            Vector3::new(v[1], v[2], v[3]),
+            Vector3::new(v[4], v[5], v[6]),
+            Vector3::new(v[7], v[8], v[9]),
+        ));
+        let q = Quaternion::new(v[10], v[11], v[12], v[13]);
+        t.reference.push(
+            (q.coords.iter().all(|x| x.is_finite()) && q.norm() > 0.0)
+                .then(|| UnitQuaternion::from_quaternion(q)),
+        );
+        t.movement.push(v[14] > 0.5);
+    }
+    Ok(t)
+}
+
+/// A progress bar on stderr (redrawn on a terminal, one line per trial otherwise).
+struct Progress {
+    total: usize,
+    done: usize,
+    terminal: bool,
+}
+
+impl Progress {
+    fn new(total: usize) -> Self {
+        Self {
+            total,
+            done: 0,
+            terminal: std::io::stderr().is_terminal(),
+        }
+    }
+
+    fn show(&mut self, name: &str) {
+        const WIDTH: usize = 30;
+        let filled = WIDTH * self.done / self.total;
+        let bar = format!(
+            "[{}{}] {}/{} {name}",
+            "#".repeat(filled),
+            ".".repeat(WIDTH - filled),
+            self.done + 1,
+            self.total
+        );
+        let mut err = std::io::stderr();
+        if self.terminal {
+            let _ = write!(err, "\r\x1b[2K{bar}");
+        } else {
+            let _ = writeln!(err, "{bar}");
+        }
+        let _ = err.flush();
+        self.done += 1;
+    }
+
+    fn finish(&self) {
+        if self.terminal {
+            let _ = writeln!(std::io::stderr(), "\r\x1b[2K[{}] done", "#".repeat(30));
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn only_scored_samples_count() {
+        let q = UnitQuaternion::from_scaled_axis(Vector3::z() * 0.1);
+        let id = UnitQuaternion::identity();
+        let r = broad_rmse(
+            &[q, id, q],
+            &[Some(id), Some(id), None],
+            &[false, true, true],
+        )
+        .unwrap();
+        assert_eq!(r.total_deg, 0.0);
+        assert!(broad_rmse(&[q], &[Some(id)], &[false]).is_none());
+    }
+}
