@@ -1,288 +1,285 @@
-//! The vehicle estimator on simulated mixed drives.
+//! The vehicle estimators on simulated 8 km mixed drives (city blocks, curves, roundabouts,
+//! ramps, highway; gyro bias, drift and per-direction scale, wheel scale and quantisation,
+//! hard and soft iron, short strong and long slow field-turning disturbances; one parameter
+//! set for every seed).
+//!
+//! The suite holds the goals on eight seeds per configuration; the wider measurement is
+//! `cargo test --release -p truenorth-fusion --test vehicle_drives -- --ignored --nocapture`
+//! (`SEEDS=40` for more drives, `NO_TURN=1` for drives that open without a full turn).
 
 use truenorth_core::{HeadingEstimator, NavEstimate, VehicleSample, angle_diff};
-use truenorth_fusion::vehicle::{TwoPassConfig, TwoPassStart};
+use truenorth_fusion::vehicle::{
+    SeedGyroCompass, SeedGyroCompassConfig, SeedOdometerCompass, SeedOdometerCompassConfig,
+    TwoPassConfig, TwoPassStart,
+};
 use truenorth_fusion::{VehicleConfig, VehicleEstimator};
-use truenorth_odometer::OdometerWheels;
 use truenorth_sim::{DriveSpec, DriveWheels, SimulatedDrive};
 
+/// Which estimator runs the drive.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Method {
+    /// The fused estimator, streaming: heading is relative until the compass is learned.
+    Fused,
+    /// The fused estimator with the two-pass start (what `truenorth drive` does by default).
+    FusedTwoPass,
+    /// Gyro + compass, US 4,788,645's companion EP 0640207 configuration (METHODS.md §A).
+    SeedGyroCompass,
+    /// Compass + odometer, US 4,788,645 (METHODS.md §B).
+    SeedOdometerCompass,
+}
+
 struct Outcome {
-    disturbed_rms_deg: f64,
-    flagged_share: f64,
-    a_ratio: f64,
-    diff_err: f64,
-    gain_err: (f64, f64),
-    track_err: f64,
+    /// Heading RMS over the rows referred to north, degrees.
     heading_rms_deg: f64,
-    heading_max_deg: f64,
+    /// The same over the rows inside a simulated disturbance, degrees.
+    disturbed_rms_deg: f64,
+    /// Final position error, % of the distance driven.
     final_error_pct: f64,
-    scaled_error_pct: f64,
-    aligned_at_s: f64,
+    /// The final error with the mean wheel scale (unobservable without a position
+    /// reference) taken out, % of the distance.
+    scale_removed_pct: f64,
+    /// Time of the first row referred to north, s from the start.
+    absolute_from_s: f64,
     distance_m: f64,
 }
 
-fn run(spec: DriveSpec, gyro: bool) -> Outcome {
-    let drive = SimulatedDrive::new(spec).unwrap();
-    let wheels: OdometerWheels = spec.wheels.odometer_wheels();
-    let mut nav = VehicleEstimator::new(VehicleConfig {
-        wheels,
-        ..VehicleConfig::default()
-    })
-    .unwrap();
-    let samples: Vec<_> = drive
-        .samples
-        .iter()
-        .map(|s| VehicleSample {
-            gyr_z_rps: if gyro { s.gyr_z_rps } else { None },
-            ..*s
+fn run(drive: &SimulatedDrive, gyro: bool, method: Method) -> Outcome {
+    let wheels = drive.spec.wheels.odometer_wheels();
+    let samples = drive.samples.iter().map(|s| VehicleSample {
+        gyr_z_rps: if gyro { s.gyr_z_rps } else { None },
+        ..*s
+    });
+    let nav = || {
+        VehicleEstimator::new(VehicleConfig {
+            wheels,
+            ..VehicleConfig::default()
         })
-        .collect();
-    let seed_method = std::env::var("SEED_METHOD").ok();
-    let estimates: Vec<NavEstimate> = if let Some(m) = seed_method {
-        use truenorth_fusion::vehicle::*;
-        let mut e: Box<dyn HeadingEstimator> = if m == "B" {
-            Box::new(
-                SeedOdometerCompass::new(SeedOdometerCompassConfig {
-                    wheels,
-                    ..Default::default()
-                })
-                .unwrap(),
-            )
-        } else {
-            Box::new(
-                SeedGyroCompass::new(SeedGyroCompassConfig {
-                    wheels,
-                    ..Default::default()
-                })
-                .unwrap(),
-            )
-        };
-        samples.iter().map(|s| e.update(s).unwrap()).collect()
-    } else if std::env::var("TWO_PASS").is_ok() {
-        let mut two = TwoPassStart::new(nav.clone(), TwoPassConfig::default());
-        let mut out = Vec::new();
-        for s in &samples {
-            two.push(s, |_, e, _| out.push(*e)).unwrap();
-        }
-        two.finish(|_, e, _| out.push(*e)).unwrap();
-        nav = two.estimator().clone();
-        out
-    } else {
-        samples.iter().map(|s| nav.update(s).unwrap()).collect()
+        .unwrap()
     };
-    let (mut sum, mut n, mut max) = (0.0, 0usize, 0.0f64);
-    let (mut dsum, mut dn, mut flagged) = (0.0, 0usize, 0usize);
-    let mut aligned_at_s = f64::NAN;
-    let mut last = None;
-    for (e, t) in estimates.iter().zip(&drive.truth) {
-        let e = *e;
-        if e.status.heading_absolute {
-            if aligned_at_s.is_nan() {
-                aligned_at_s = t.t_s;
+    let estimates: Vec<NavEstimate> = match method {
+        Method::FusedTwoPass => {
+            let mut two = TwoPassStart::new(nav(), TwoPassConfig::default());
+            let mut out = Vec::new();
+            for s in samples {
+                two.push(&s, |_, e, _| out.push(*e)).unwrap();
             }
-            let d = angle_diff(e.heading.rad(), t.heading_rad).to_degrees();
-            sum += d * d;
-            n += 1;
-            if drive.disturbed_at(t.t_s) {
-                dsum += d * d;
-                dn += 1;
-            }
-            if e.status.compass_disturbed {
-                flagged += 1;
-            }
-            max = max.max(d.abs());
+            two.finish(|_, e, _| out.push(*e)).unwrap();
+            out
         }
-        last = Some((e, *t));
+        _ => {
+            let mut e: Box<dyn HeadingEstimator> = match method {
+                Method::Fused => Box::new(nav()),
+                Method::SeedGyroCompass => Box::new(
+                    SeedGyroCompass::new(SeedGyroCompassConfig {
+                        wheels,
+                        ..Default::default()
+                    })
+                    .unwrap(),
+                ),
+                _ => Box::new(
+                    SeedOdometerCompass::new(SeedOdometerCompassConfig {
+                        wheels,
+                        ..Default::default()
+                    })
+                    .unwrap(),
+                ),
+            };
+            samples.map(|s| e.update(&s).unwrap()).collect()
+        }
+    };
+    assert_eq!(
+        estimates.len(),
+        drive.truth.len(),
+        "one estimate per sample"
+    );
+    let (mut sum, mut n, mut dsum, mut dn) = (0.0, 0usize, 0.0, 0usize);
+    let mut absolute_from_s = f64::NAN;
+    for (e, t) in estimates.iter().zip(&drive.truth) {
+        if !e.status.heading_absolute {
+            continue;
+        }
+        if absolute_from_s.is_nan() {
+            absolute_from_s = t.t_s - drive.truth[0].t_s;
+        }
+        let d = angle_diff(e.heading.rad(), t.heading_rad).to_degrees();
+        sum += d * d;
+        n += 1;
+        if drive.disturbed_at(t.t_s) {
+            dsum += d * d;
+            dn += 1;
+        }
     }
-    let (e, t) = last.unwrap();
-    let err = (e.north_m - t.north_m).hypot(e.east_m - t.east_m);
+    let (e, t) = (estimates.last().unwrap(), drive.truth.last().unwrap());
     let o = drive.params.odometer;
     let k = 1.0 + 0.5 * (o.scale_error_l + o.scale_error_r);
-    let err_scaled = (e.north_m / k - t.north_m).hypot(e.east_m / k - t.east_m);
-    let x = nav.filter().x;
-    let g = drive.params.gyro;
+    let pct = |k: f64| 100.0 * (e.north_m / k - t.north_m).hypot(e.east_m / k - t.east_m);
     Outcome {
+        heading_rms_deg: if n == 0 {
+            f64::INFINITY
+        } else {
+            (sum / n as f64).sqrt()
+        },
         disturbed_rms_deg: (dsum / dn.max(1) as f64).sqrt(),
-        flagged_share: flagged as f64 / n.max(1) as f64,
-        a_ratio: x[7] / o.speed_coeff_s2_per_m2,
-        diff_err: x[6] - ((1.0 + o.scale_error_l) / (1.0 + o.scale_error_r) - 1.0),
-        gain_err: (x[4] - g.scale_error_pos, x[5] - g.scale_error_neg),
-        track_err: x[9] - (0.5 * (o.scale_error_l + o.scale_error_r)),
-        heading_rms_deg: (sum / n.max(1) as f64).sqrt(),
-        heading_max_deg: max,
-        final_error_pct: 100.0 * err / drive.distance_m(),
-        scaled_error_pct: 100.0 * err_scaled / drive.distance_m(),
-        aligned_at_s,
+        final_error_pct: pct(1.0) / drive.distance_m(),
+        scale_removed_pct: pct(k) / drive.distance_m(),
+        absolute_from_s,
         distance_m: drive.distance_m(),
     }
 }
 
+fn drive(seed: u64, wheels: DriveWheels, opening_turn: bool) -> SimulatedDrive {
+    SimulatedDrive::new(DriveSpec {
+        wheels,
+        opening_turn,
+        ..DriveSpec::new(seed)
+    })
+    .unwrap()
+}
+
+const CONFIGS: [(bool, DriveWheels); 4] = [
+    (true, DriveWheels::Rear),
+    (true, DriveWheels::Front),
+    (false, DriveWheels::Rear),
+    (false, DriveWheels::Front),
+];
+
+/// The goals of the fused estimator, as `truenorth drive` runs it: with a gyro, heading RMS
+/// ≤ 0.5° and final position error ≤ 0.3 % of the distance; compass and wheels alone,
+/// ≤ 1 % of the distance (the telematics norm is about 2.5 %).
 #[test]
-#[ignore]
-fn measure() {
-    for (gyro, wheels) in [
-        (true, DriveWheels::Rear),
-        (false, DriveWheels::Rear),
-        (false, DriveWheels::Front),
-        (true, DriveWheels::Front),
-    ] {
-        for seed in 0..std::env::var("SEEDS").map_or(8, |s| s.parse().unwrap()) {
-            let o = run(
-                DriveSpec {
-                    wheels,
-                    opening_turn: std::env::var("NO_TURN").is_err(),
-                    disturbances: std::env::var("CLEAN").is_err(),
-                    rate_hz: std::env::var("RATE").map_or(10.0, |r| r.parse().unwrap()),
-                    ..DriveSpec::new(seed)
-                },
-                gyro,
+fn fused_estimator_meets_its_goals_on_eight_mixed_drives_per_configuration() {
+    for (gyro, wheels) in CONFIGS {
+        for seed in 0..8 {
+            let d = drive(seed, wheels, true);
+            let o = run(&d, gyro, Method::FusedTwoPass);
+            let label = format!("gyro {gyro} {wheels:?} seed {seed}");
+            assert!(o.distance_m > 7500.0, "{label}: {} m", o.distance_m);
+            assert_eq!(
+                o.absolute_from_s, 0.0,
+                "{label}: every row referred to north"
             );
-            println!(
-                "gyro {gyro:5} {wheels:?} seed {seed}: {:.0} m, aligned {:.0} s, hdg RMS {:.2}° max {:.1}° (disturbed {:.2}°, flagged {:.1} %), final {:.3} % (scale removed {:.3} %), a/a_true {:.2}, δ err {:.1e}, gain err {:.1e} {:.1e} track err {:.1e}",
-                o.distance_m,
-                o.aligned_at_s,
-                o.heading_rms_deg,
-                o.heading_max_deg,
-                o.disturbed_rms_deg,
-                100.0 * o.flagged_share,
-                o.final_error_pct,
-                o.scaled_error_pct,
-                o.a_ratio,
-                o.diff_err,
-                o.gain_err.0,
-                o.gain_err.1,
-                o.track_err
-            );
+            if gyro {
+                assert!(
+                    o.heading_rms_deg <= 0.5,
+                    "{label}: heading RMS {:.2}°",
+                    o.heading_rms_deg
+                );
+                assert!(
+                    o.final_error_pct <= 0.3,
+                    "{label}: final {:.3} %",
+                    o.final_error_pct
+                );
+            } else {
+                assert!(
+                    o.final_error_pct <= 1.0,
+                    "{label}: final {:.3} %",
+                    o.final_error_pct
+                );
+            }
         }
     }
 }
 
+/// Streaming (no second pass): north is learned during the opening turn, and heading is
+/// absolute from then on; the disturbances (the simulator's slow ones turn the field by
+/// 10-25° at almost constant magnitude) leave the heading within 1° RMS, which a compass
+/// followed through them would not.
 #[test]
-#[ignore]
-fn trace() {
-    let seed: u64 = std::env::var("SEED")
-        .map(|s| s.parse().unwrap())
-        .unwrap_or(1);
-    let gyro = std::env::var("GYRO").is_ok();
-    let wheels = if std::env::var("FRONT").is_ok() {
-        DriveWheels::Front
-    } else {
-        DriveWheels::Rear
-    };
-    let spec = DriveSpec {
-        opening_turn: std::env::var("NO_TURN").is_err(),
-        wheels,
-        ..DriveSpec::new(seed)
-    };
-    let drive = SimulatedDrive::new(spec).unwrap();
-    println!("params {:?}", drive.params);
-    for d in &drive.disturbances {
-        println!(
-            "dist {:.0}..{:.0} {:?}",
-            d.start_s,
-            d.start_s + d.duration_s,
-            d.field_ned
+fn streaming_learns_north_in_the_opening_turn_and_rides_through_disturbances() {
+    for seed in 0..4 {
+        let d = drive(seed, DriveWheels::Rear, true);
+        assert!(!d.disturbances.is_empty());
+        let o = run(&d, true, Method::Fused);
+        // The opening turn takes well under two minutes: a full turn at walking pace.
+        assert!(
+            o.absolute_from_s < 120.0,
+            "seed {seed}: north after {:.0} s",
+            o.absolute_from_s
+        );
+        assert!(
+            o.heading_rms_deg <= 0.5,
+            "seed {seed}: {:.2}°",
+            o.heading_rms_deg
+        );
+        assert!(
+            o.disturbed_rms_deg <= 1.0,
+            "seed {seed}: {:.2}° inside disturbances",
+            o.disturbed_rms_deg
         );
     }
-    let mut nav = VehicleEstimator::new(VehicleConfig {
-        wheels: wheels.odometer_wheels(),
-        ..VehicleConfig::default()
-    })
-    .unwrap();
-    for (k, (s, t)) in drive.samples.iter().zip(&drive.truth).enumerate() {
-        let mut s = *s;
-        if !gyro {
-            s.gyr_z_rps = None;
-        }
-        let before = nav.compass().fix().map(|f| f.calibration);
-        let e = nav.update(&s).unwrap();
-        if nav.compass().fix().map(|f| f.calibration) != before {
-            let f = nav.compass().fix().unwrap();
-            let truth_cal = truenorth_compass::CompassCalibration2d {
-                hard_iron: drive.params.compass_hard_iron,
-                soft_iron: drive.params.compass_soft_iron.try_inverse().unwrap(),
-            };
-            let worst = (0..360)
-                .map(|d| {
-                    let psi = (d as f64).to_radians();
-                    let raw = drive.params.compass_soft_iron
-                        * nalgebra::Vector2::new(20.0 * psi.cos(), -20.0 * psi.sin())
-                        + drive.params.compass_hard_iron;
-                    angle_diff(f.calibration.heading_rad(&raw), psi)
-                        .to_degrees()
-                        .abs()
-                })
-                .fold(0.0, f64::max);
-            let _ = truth_cal;
-            println!(
-                "t {:.0} new fix clean {} 3σ {:.2} sys {:.2} noise {:.2} points {} cov {:.2} worst true heading error {:.2}°",
-                t.t_s,
-                nav.compass_learner().clean_in_use(),
-                f.quality.heading_error_3sigma_deg,
-                f.quality.heading_error_systematic_deg,
-                f.quality.heading_noise_rms_deg,
-                f.quality.fit.points,
-                f.quality.fit.coverage,
-                worst
-            );
-        }
-        if k % 300 == 0 && !e.status.heading_absolute {
-            use truenorth_core::Calibrator;
-            let c = nav.compass_learner().calibrator();
-            println!(
-                "t {:.0} progress {:?} solve {:?}",
-                t.t_s,
-                c.progress(),
-                c.solve().map(|s| s.quality)
-            );
-        }
-        if k % 10 == 0 && t.t_s < std::env::var("FINE").map_or(60.0, |v| v.parse().unwrap())
-            || k % 100 == 0
-        {
-            let x = nav.filter().x;
-            let d = angle_diff(e.heading.rad(), t.heading_rad).to_degrees();
-            println!(
-                "t {:6.1} err {:7.2} sig {:5.2} b {:6.3} s+ {:6.4}±{:6.4} s- {:6.4} diff {:8.5}±{:7.5} a {:9.2e}±{:8.1e} v {:4.1} k {:6.4} dist {} used {} cal {}",
-                t.t_s,
-                d,
-                e.heading_sigma_rad.to_degrees(),
-                x[3].to_degrees(),
-                x[4],
-                nav.filter().sigma(4),
-                x[5],
-                x[6],
-                nav.filter().sigma(6),
-                x[7],
-                nav.filter().sigma(7),
-                t.speed_mps,
-                t.curvature_per_m,
-                e.status.compass_disturbed as u8,
-                e.status.compass_used as u8,
-                e.status.compass_calibrated as u8
+}
+
+/// The seed configurations run on the same drives and refer heading to north, and the
+/// fused estimator does better than either on every drive (same sensors for the
+/// comparison: §A uses gyro + compass, §B compass + wheels).
+#[test]
+fn the_fused_estimator_beats_each_seed_configuration_on_the_same_drives() {
+    for seed in 0..3 {
+        let d = drive(seed, DriveWheels::Rear, true);
+        for (gyro, seed_method) in [
+            (true, Method::SeedGyroCompass),
+            (false, Method::SeedOdometerCompass),
+        ] {
+            let s = run(&d, gyro, seed_method);
+            let f = run(&d, gyro, Method::FusedTwoPass);
+            assert!(s.heading_rms_deg.is_finite(), "{seed_method:?} seed {seed}");
+            assert!(
+                f.heading_rms_deg < s.heading_rms_deg && f.final_error_pct < s.final_error_pct,
+                "{seed_method:?} seed {seed}: fused {:.2}° {:.2} %, seed {:.2}° {:.2} %",
+                f.heading_rms_deg,
+                f.final_error_pct,
+                s.heading_rms_deg,
+                s.final_error_pct
             );
         }
     }
 }
 
 #[test]
-#[ignore]
-fn dump_mag() {
-    let seed: u64 = std::env::var("SEED")
-        .map(|s| s.parse().unwrap())
-        .unwrap_or(4);
-    let drive = SimulatedDrive::new(DriveSpec {
-        opening_turn: false,
-        disturbances: false,
-        ..DriveSpec::new(seed)
-    })
-    .unwrap();
-    let mut out = String::new();
-    for (s, t) in drive.samples.iter().zip(&drive.truth) {
-        if t.t_s > 600.0 {
-            break;
+#[ignore = "measurement: run in release with --ignored --nocapture"]
+fn measure() {
+    let seeds = std::env::var("SEEDS").map_or(8, |s| s.parse().unwrap());
+    let opening_turn = std::env::var("NO_TURN").is_err();
+    let methods = [
+        Method::FusedTwoPass,
+        Method::Fused,
+        Method::SeedGyroCompass,
+        Method::SeedOdometerCompass,
+    ];
+    println!(
+        "method | gyro | wheels | heading RMS ° (median, worst) | final % (median, worst) | scale removed % (median) | fails"
+    );
+    for method in methods {
+        for (gyro, wheels) in CONFIGS {
+            if (method == Method::SeedGyroCompass && !gyro)
+                || (method == Method::SeedOdometerCompass && gyro)
+            {
+                continue;
+            }
+            let mut rows: Vec<Outcome> = (0..seeds)
+                .map(|seed| run(&drive(seed, wheels, opening_turn), gyro, method))
+                .collect();
+            let fails = rows
+                .iter()
+                .filter(|o| {
+                    if gyro {
+                        o.heading_rms_deg > 0.5 || o.final_error_pct > 0.3
+                    } else {
+                        o.final_error_pct > 1.0
+                    }
+                })
+                .count();
+            let median = |rows: &mut Vec<Outcome>, f: fn(&Outcome) -> f64| {
+                rows.sort_by(|a, b| f(a).total_cmp(&f(b)));
+                (f(&rows[rows.len() / 2]), f(rows.last().unwrap()))
+            };
+            let h = median(&mut rows, |o| o.heading_rms_deg);
+            let p = median(&mut rows, |o| o.final_error_pct);
+            let s = median(&mut rows, |o| o.scale_removed_pct);
+            println!(
+                "{method:?} | {gyro} | {wheels:?} | {:.2}, {:.2} | {:.3}, {:.3} | {:.3} | {fails}/{seeds}",
+                h.0, h.1, p.0, p.1, s.0
+            );
         }
-        let m = s.mag.unwrap();
-        out += &format!("{},{},{},{}\n", t.t_s, m.x, m.y, t.heading_rad.to_degrees());
     }
-    std::fs::write("/tmp/mag4.csv", out).unwrap();
 }

@@ -97,7 +97,9 @@ mod tests {
             let fit = line.fit(0.01).unwrap();
             prop_assert!(wrap_pi(fit.offset_rad - (offset + drift * 1.9)).abs() < 1e-9);
             prop_assert!((fit.slope_rps - drift).abs() < 1e-9);
-            prop_assert!(fit.residual_rad < 1e-9);
+            // The residual is the square root of a difference of sums of squares, so its
+            // rounding floor is √(ε·Σv²) ≈ 1e-9 here, not ε.
+            prop_assert!(fit.residual_rad < 1e-7);
         }
     }
 

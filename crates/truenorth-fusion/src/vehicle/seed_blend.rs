@@ -30,6 +30,12 @@ pub struct SeedBlendConfig {
     pub alignment_readings: u32,
     /// The wheels must stand still this long before the vehicle counts as at rest, s (0.5).
     pub standstill_s: f64,
+    /// Readings refused as outliers for this long, with nothing used between, mean the
+    /// carried heading is lost rather than the compass disturbed: the heading is referred
+    /// to north again from the next readings, s (30). Without it a heading that drifted
+    /// past the gate is never recovered (the wheels of US 4,788,645 drift a tenth of a
+    /// degree per metre with a few tenths of a percent of scale difference).
+    pub reacquire_s: f64,
 }
 
 impl Default for SeedBlendConfig {
@@ -40,6 +46,7 @@ impl Default for SeedBlendConfig {
             outlier_deg: 20.0,
             alignment_readings: 10,
             standstill_s: 0.5,
+            reacquire_s: 30.0,
         }
     }
 }
@@ -56,6 +63,7 @@ impl Validate for SeedBlendConfig {
             1e4,
         )?;
         check_range("standstill_s", self.standstill_s, 0.0, 60.0)?;
+        check_positive("reacquire_s", self.reacquire_s)?;
         Ok(())
     }
 }
@@ -76,6 +84,10 @@ pub struct SeedBlend {
     n: u32,
     still_s: f64,
     last_compass_t: Option<f64>,
+    /// Time of the first of the outliers refused since the last reading used.
+    outliers_since: Option<f64>,
+    /// Whether the heading was referred to north before (the track is then not turned).
+    lost: bool,
 }
 
 impl SeedBlend {
@@ -93,6 +105,8 @@ impl SeedBlend {
             n: 0,
             still_s: 0.0,
             last_compass_t: None,
+            outliers_since: None,
+            lost: false,
         })
     }
 
@@ -128,19 +142,29 @@ impl SeedBlend {
             self.n += 1;
             if self.n >= self.config.alignment_readings {
                 let offset = self.sin_sum.atan2(self.cos_sum);
-                let (s, c) = offset.sin_cos();
-                self.position = Vector2::new(
-                    c * self.position.x - s * self.position.y,
-                    s * self.position.x + c * self.position.y,
-                );
+                if !self.lost {
+                    let (s, c) = offset.sin_cos();
+                    self.position = Vector2::new(
+                        c * self.position.x - s * self.position.y,
+                        s * self.position.x + c * self.position.y,
+                    );
+                }
                 self.psi = wrap_pi(self.psi + offset);
                 self.aligned = true;
             }
             return None;
         }
         if d.abs() > self.config.outlier_deg.to_radians() {
+            let since = *self.outliers_since.get_or_insert(t_s);
+            if t_s - since >= self.config.reacquire_s {
+                self.aligned = false;
+                self.lost = true;
+                (self.sin_sum, self.cos_sum, self.n) = (0.0, 0.0, 0);
+                self.outliers_since = None;
+            }
             return None;
         }
+        self.outliers_since = None;
         self.psi = wrap_pi(self.psi + (dt / self.config.tau_s).min(1.0) * d);
         Some(heading)
     }
@@ -161,11 +185,23 @@ mod tests {
         // The start-to-here track turned with the heading: 10 m along heading 1 rad.
         assert!((b.position - Vector2::new(1f64.cos(), 1f64.sin()) * 10.0).norm() < 1e-9);
         // A reading 10° off pulls by dt/τ of it; one 30° off is ignored.
-        b.compass(1.1, 1.0 + 10f64.to_radians(), 1.0);
+        b.compass(1.0, 1.0 + 10f64.to_radians(), 1.0);
         assert!((b.psi - (1.0 + 10f64.to_radians() * 0.1 / 20.0)).abs() < 1e-9);
         let before = b.psi;
         assert!(b.compass(1.2, 1.0 + 30f64.to_radians(), 1.0).is_none());
         assert!(b.compass(1.3, 1.0, 1.3).is_none());
         assert_eq!(b.psi, before);
+        // Outliers for the re-acquisition time: the heading is lost and taken from the
+        // compass again, without turning the track already driven.
+        let position = b.position;
+        for k in 0..=300 {
+            assert!(b.compass(1.4 + k as f64 * 0.1, 2.0, 1.0).is_none());
+        }
+        assert!(!b.aligned());
+        for k in 0..10 {
+            b.compass(31.5 + k as f64 * 0.1, 2.0, 1.0);
+        }
+        assert!(b.aligned() && (b.psi - 2.0).abs() < 1e-12);
+        assert_eq!(b.position, position);
     }
 }
