@@ -101,12 +101,16 @@ impl SeedOdometerCompass {
 }
 
 impl HeadingEstimator for SeedOdometerCompass {
-    /// Takes one sample (the gyro, if any, is ignored). A non-finite value or a timestamp
-    /// that does not increase is a typed error and changes nothing.
+    /// Takes one sample (the gyro, if any, is not used, but a non-finite one is refused like
+    /// any other field, so that every estimator accepts the same input). A non-finite value
+    /// or a timestamp that does not increase is a typed error and changes nothing.
     fn update(&mut self, sample: &VehicleSample) -> Result<NavEstimate> {
         check_finite("timestamp t_s", sample.t_s)?;
         check_finite("dist_l_m", sample.dist_l_m)?;
         check_finite("dist_r_m", sample.dist_r_m)?;
+        if let Some(g) = sample.gyr_z_rps {
+            check_finite("gyr_z", g)?;
+        }
         if let Some(m) = sample.mag {
             check_finite("mag_x", m.x)?;
             check_finite("mag_y", m.y)?;
