@@ -139,10 +139,10 @@ impl HeadingEstimator for SeedOdometerCompass {
             // also triggers): without it the heading runs on the wheels alone, which drift
             // a tenth of a degree per metre (on the simulated drives of
             // `tests/vehicle_drives.rs`, seed 2 lost its compass for good after 90 s).
-            if let Ok(truenorth_core::Pushed::NewEstimate) = self.calibrator.push(&reading) {
-                if let Some(s) = self.calibrator.estimate() {
-                    self.compass = Some((s.params, s.quality.field_magnitude));
-                }
+            if let Ok(truenorth_core::Pushed::NewEstimate) = self.calibrator.push(&reading)
+                && let Some(s) = self.calibrator.estimate()
+            {
+                self.compass = Some((s.params, s.quality.field_magnitude));
             }
             if let Some((c, field)) = self.compass {
                 let u = c.correct(&raw);
