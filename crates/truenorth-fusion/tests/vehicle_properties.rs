@@ -87,19 +87,9 @@ fn finite_estimate(e: &NavEstimate) -> bool {
         && e.east_m.is_finite()
         && e.heading.rad().is_finite()
         && e.distance_m.is_finite()
-        && !e.heading_sigma_rad.is_nan_or_negative()
-}
-
-trait NanOrNegative {
-    fn is_nan_or_negative(self) -> bool;
-}
-
-impl NanOrNegative for f64 {
-    /// A σ may be infinite (heading not referred to north) or NaN where an estimator
-    /// reports none (the seed configurations), never negative.
-    fn is_nan_or_negative(self) -> bool {
-        self < 0.0
-    }
+        // A σ may be infinite (heading not referred to north) or NaN where an estimator
+        // reports none (the seed configurations), never negative.
+        && e.heading_sigma_rad.partial_cmp(&0.0) != Some(std::cmp::Ordering::Less)
 }
 
 /// Feeds `estimator` and checks the refusal contract on every sample.
