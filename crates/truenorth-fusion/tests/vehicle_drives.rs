@@ -7,13 +7,13 @@
 //! `cargo test --release -p truenorth-fusion --test vehicle_drives -- --ignored --nocapture`
 //! (`SEEDS=40` for more drives, `NO_TURN=1` for drives that open without a full turn).
 
-use truenorth_core::{HeadingEstimator, NavEstimate, VehicleSample, angle_diff};
+use truenorth_core::{HeadingEstimator, NavEstimate, VehicleSample};
 use truenorth_fusion::vehicle::{
     SeedGyroCompass, SeedGyroCompassConfig, SeedOdometerCompass, SeedOdometerCompassConfig,
     TwoPassConfig, TwoPassStart,
 };
 use truenorth_fusion::{VehicleConfig, VehicleEstimator};
-use truenorth_sim::{DriveSpec, DriveWheels, SimulatedDrive};
+use truenorth_sim::{DriveScore, DriveSpec, DriveWheels, SimulatedDrive};
 
 /// Which estimator runs the drive.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -28,22 +28,7 @@ enum Method {
     SeedOdometerCompass,
 }
 
-struct Outcome {
-    /// Heading RMS over the rows referred to north, degrees.
-    heading_rms_deg: f64,
-    /// The same over the rows inside a simulated disturbance, degrees.
-    disturbed_rms_deg: f64,
-    /// Final position error, % of the distance driven.
-    final_error_pct: f64,
-    /// The final error with the mean wheel scale (unobservable without a position
-    /// reference) taken out, % of the distance.
-    scale_removed_pct: f64,
-    /// Time of the first row referred to north, s from the start.
-    absolute_from_s: f64,
-    distance_m: f64,
-}
-
-fn run(drive: &SimulatedDrive, gyro: bool, method: Method) -> Outcome {
+fn run(drive: &SimulatedDrive, gyro: bool, method: Method) -> DriveScore {
     let wheels = drive.spec.wheels.odometer_wheels();
     let samples = drive.samples.iter().map(|s| VehicleSample {
         gyr_z_rps: if gyro { s.gyr_z_rps } else { None },
@@ -87,44 +72,7 @@ fn run(drive: &SimulatedDrive, gyro: bool, method: Method) -> Outcome {
             samples.map(|s| e.update(&s).unwrap()).collect()
         }
     };
-    assert_eq!(
-        estimates.len(),
-        drive.truth.len(),
-        "one estimate per sample"
-    );
-    let (mut sum, mut n, mut dsum, mut dn) = (0.0, 0usize, 0.0, 0usize);
-    let mut absolute_from_s = f64::NAN;
-    for (e, t) in estimates.iter().zip(&drive.truth) {
-        if !e.status.heading_absolute {
-            continue;
-        }
-        if absolute_from_s.is_nan() {
-            absolute_from_s = t.t_s - drive.truth[0].t_s;
-        }
-        let d = angle_diff(e.heading.rad(), t.heading_rad).to_degrees();
-        sum += d * d;
-        n += 1;
-        if drive.disturbed_at(t.t_s) {
-            dsum += d * d;
-            dn += 1;
-        }
-    }
-    let (e, t) = (estimates.last().unwrap(), drive.truth.last().unwrap());
-    let o = drive.params.odometer;
-    let k = 1.0 + 0.5 * (o.scale_error_l + o.scale_error_r);
-    let pct = |k: f64| 100.0 * (e.north_m / k - t.north_m).hypot(e.east_m / k - t.east_m);
-    Outcome {
-        heading_rms_deg: if n == 0 {
-            f64::INFINITY
-        } else {
-            (sum / n as f64).sqrt()
-        },
-        disturbed_rms_deg: (dsum / dn.max(1) as f64).sqrt(),
-        final_error_pct: pct(1.0) / drive.distance_m(),
-        scale_removed_pct: pct(k) / drive.distance_m(),
-        absolute_from_s,
-        distance_m: drive.distance_m(),
-    }
+    drive.score(&estimates).unwrap()
 }
 
 fn drive(seed: u64, wheels: DriveWheels, opening_turn: bool) -> SimulatedDrive {
@@ -153,7 +101,7 @@ fn fused_estimator_meets_its_goals_on_eight_mixed_drives_per_configuration() {
             let d = drive(seed, wheels, true);
             let o = run(&d, gyro, Method::FusedTwoPass);
             let label = format!("gyro {gyro} {wheels:?} seed {seed}");
-            assert!(o.distance_m > 7500.0, "{label}: {} m", o.distance_m);
+            assert!(d.distance_m() > 7500.0, "{label}: {} m", d.distance_m());
             assert_eq!(
                 o.absolute_from_s, 0.0,
                 "{label}: every row referred to north"
@@ -256,7 +204,7 @@ fn measure() {
             {
                 continue;
             }
-            let mut rows: Vec<Outcome> = (0..seeds)
+            let mut rows: Vec<DriveScore> = (0..seeds)
                 .map(|seed| run(&drive(seed, wheels, opening_turn), gyro, method))
                 .collect();
             let fails = rows
@@ -269,7 +217,7 @@ fn measure() {
                     }
                 })
                 .count();
-            let median = |rows: &mut Vec<Outcome>, f: fn(&Outcome) -> f64| {
+            let median = |rows: &mut Vec<DriveScore>, f: fn(&DriveScore) -> f64| {
                 rows.sort_by(|a, b| f(a).total_cmp(&f(b)));
                 (f(&rows[rows.len() / 2]), f(rows.last().unwrap()))
             };

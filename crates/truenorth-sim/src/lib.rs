@@ -30,6 +30,7 @@
 //! ```
 
 mod drive;
+mod drive_score;
 mod few_shot;
 mod handheld;
 mod route;
@@ -39,6 +40,7 @@ mod streams;
 mod vehicle;
 
 pub use drive::{DriveSpec, DriveWheels, SimulatedDrive};
+pub use drive_score::DriveScore;
 pub use few_shot::{
     FewShotInstrument, Shot, pointing_ned, protocol_shots, random_attitude, rolled_run,
 };
