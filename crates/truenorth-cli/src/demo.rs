@@ -19,7 +19,7 @@ use truenorth_sim::{
 };
 
 use crate::io::{CliError, CliResult};
-use crate::svg::{Series, write_plot};
+use crate::svg::{Series, Style, write_plot};
 
 /// Arguments of `truenorth demo`.
 #[derive(Debug, clap::Args)]
@@ -49,6 +49,7 @@ pub fn run(args: &Args) -> CliResult {
     let drive = DemoDrive::new(args.seed)?;
     sensor_table(&drive);
     compass_section(&drive, &args.out)?;
+    crate::demo_drive::drive_section(args.seed, &args.out)?;
     crate::demo_orientation::orientation_section(args.seed, &args.out)?;
     Ok(())
 }
@@ -431,19 +432,19 @@ fn compass_section(d: &DemoDrive, out: &std::path::Path) -> CliResult {
                     label: "raw readings",
                     colour: "#d62728",
                     points: raw,
-                    line: false,
+                    style: Style::Dots,
                 },
                 Series {
                     label: "fitted ellipse",
                     colour: "#1f77b4",
                     points: ellipse,
-                    line: true,
+                    style: Style::Closed,
                 },
                 Series {
                     label: "corrected",
                     colour: "#2ca02c",
                     points: corrected,
-                    line: false,
+                    style: Style::Dots,
                 },
             ],
         )?;

@@ -5,6 +5,7 @@
 
 mod calibrate;
 mod demo;
+mod demo_drive;
 mod demo_orientation;
 mod drive;
 mod eval_broad;

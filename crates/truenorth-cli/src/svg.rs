@@ -14,8 +14,19 @@ pub struct Series<'a> {
     pub colour: &'a str,
     /// (x, y) points.
     pub points: Vec<(f64, f64)>,
-    /// Joined as a closed line instead of dots.
-    pub line: bool,
+    /// How the points are drawn.
+    pub style: Style,
+}
+
+/// How a [`Series`] is drawn.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Style {
+    /// A dot per point (readings).
+    Dots,
+    /// Joined, last point back to the first (a fitted curve).
+    Closed,
+    /// Joined from first to last (a track).
+    Open,
 }
 
 /// Writes an equal-axes plot of `series` to `path`.
@@ -131,7 +142,7 @@ pub fn write_plot(
         );
     }
     for (k, s) in series.iter().enumerate() {
-        if s.line {
+        if s.style != Style::Dots {
             let pts: Vec<String> = s
                 .points
                 .iter()
@@ -139,7 +150,12 @@ pub fn write_plot(
                 .collect();
             let _ = writeln!(
                 svg,
-                r#"<polygon points="{}" fill="none" stroke="{}" stroke-width="2"/>"#,
+                r#"<{} points="{}" fill="none" stroke="{}" stroke-width="2"/>"#,
+                if s.style == Style::Closed {
+                    "polygon"
+                } else {
+                    "polyline"
+                },
                 pts.join(" "),
                 s.colour
             );
