@@ -1,5 +1,6 @@
 //! `truenorth calibrate`: fit a compass calibration to a recording and write it, with its
-//! quality report and verdict, as JSON.
+//! quality report and verdict, as JSON; the turn method with a yaw rate calibrates the
+//! gyro beside it.
 //!
 //! Every 2-D method is a `Calibrator<Sample = Mag2Sample, Params = CompassCalibration2d>`,
 //! so adding one is one arm in [`run`]; the 3-D methods are the same with `Mag3Sample` and
@@ -12,7 +13,8 @@ use truenorth::calib::quality::{self, Grade, Uncertainty, Verdict};
 use truenorth::calib::{
     BinnedEllipseCalibrator, EllipseCalibrator, EllipsoidCalibrator, MagAccelCalibrator,
     MagAccelConfig, MagAccelQuality, MagAccelSample, MeritCircleCalibrator,
-    OnlineEllipseCalibrator, OnlineEllipsoidCalibrator, TurnCompassCalibrator,
+    OnlineEllipseCalibrator, OnlineEllipsoidCalibrator, TurnCalibrator, TurnCompassCalibrator,
+    TurnConfig, TurnQuality, TurnSample,
 };
 use truenorth::compass::{CompassCalibration2d, CompassCalibration3d};
 use truenorth::core::{Calibrator, CompassQuality, Mag2Sample, Mag3Sample, Solution};
@@ -20,8 +22,8 @@ use truenorth::core::{Calibrator, CompassQuality, Mag2Sample, Mag3Sample, Soluti
 use crate::field::Place;
 use crate::io::{
     AccelPart, CALIBRATION_FORMAT, CALIBRATION_VERSION, CalibrationFile, CliError, CliResult,
-    InputOptions, InputPath, QualityReport, ReadSpec, Table, check_distinct, finite, matrix_rows,
-    units_block,
+    GyroPart, InputOptions, InputPath, QualityReport, ReadSpec, Table, check_distinct, finite,
+    gyro_units, matrix_rows, units_block,
 };
 use crate::mag_unit::{MagUnit, check_field};
 
@@ -46,7 +48,8 @@ pub enum Method {
     BinnedEllipse,
     /// Merit circle (US 5,297,063): merit-weighted circumcentres; hard iron only.
     MeritCircle,
-    /// One full turn (EP 0640207): centre and radii from the extrema.
+    /// One full turn (EP 0640207): compass centre and radii from the extrema; with `gyr_z`,
+    /// also the gyro's zero (from a standstill at the start) and scale.
     Turn,
 }
 
@@ -78,13 +81,22 @@ impl Method {
 const AFTER_HELP: &str =
     "Input: CSV with a header row and columns `mag_x,mag_y` (plus `mag_z` for the 3-D
 methods, and `acc_x,acc_y,acc_z` for `ellipsoid-accel`); `t_s` (strictly increasing) is
-read where present and needed only by the online methods (without it rows are one
-second apart); other columns are ignored. Magnetometer in any unit; accelerometer in any
-unit, reading specific force (about +1 g on the upward axis at rest: an accelerometer
-that reports gravity instead is negated with `--column acc_x=-acc_x,...`). `turn`
-accepts `gyr_z` (rad/s) and ignores it. The readings should cover a full turn (2-D,
-level) or orientations that determine the ellipsoid (3-D: a tumble, or a few dozen
-shots in assorted directions and rolled about a target).
+read where present and needed only by the online methods and by `turn` with `gyr_z`
+(without it rows are one second apart); other columns are ignored. Magnetometer in any
+unit; accelerometer in any unit, reading specific force (about +1 g on the upward axis at
+rest: an accelerometer that reports gravity instead is negated with
+`--column acc_x=-acc_x,...`). The readings should cover a full turn (2-D, level) or
+orientations that determine the ellipsoid (3-D: a tumble, or a few dozen shots in
+assorted directions and rolled about a target).
+
+`turn` with a `gyr_z` column (yaw rate, rad/s, positive turning right; needs `t_s`)
+calibrates the gyro too (EP 0640207): the record must start with the vehicle at rest for
+at least 1 s (the gyro's zero is its mean there) and then turn one way through at least
+one full revolution, with every compass maximum and minimum inside the record (a
+quarter turn more); the scale comes from the integrated rate between compass extrema
+half a turn apart. A record that does not qualify is refused with the reason; drop the
+`gyr_z` column to calibrate the compass alone. Without `gyr_z` only the compass is
+calibrated.
 
 Output: JSON, version 2:
 `{\"format\": \"truenorth-compass-calibration\", \"version\": 2, \"method\": M,
@@ -94,9 +106,11 @@ Output: JSON, version 2:
   \"points\", \"coverage\", \"residual_rms_rel\", \"condition\", \"geometry_dilution\",
   \"heading_error_bound_deg\", \"heading_error_3sigma_deg\", \"heading_error_systematic_deg\",
   \"heading_noise_rms_deg\", \"hard_iron_sigma\", \"soft_iron_sigma_rel\",
-  \"field_ratio_to_expected\", ...}, \"input\": FILE}`
+  \"field_ratio_to_expected\", ...}, [\"gyro\": {\"zero_rps\", \"scale\", \"zero_sigma_rps\",
+  \"scale_sigma\", \"rest_s\", \"pairs\", \"turned_deg\"}] (turn with gyr_z), \"input\": FILE}`
 with `corrected = soft_iron · (raw − hard_iron)`, a circle (sphere) of radius `field` in
-the input unit. The `units` block says what every number is in and means.
+the input unit, and `rate = (gyr_z − zero_rps) / scale`. The `units` block says what
+every number is in and means.
 `heading_error_bound_deg` bounds the heading error the calibration itself adds to every
 later heading (3-D: the field direction error; ellipsoid-accel: the heading of the body
 x axis): 3 standard deviations of the parameters' uncertainty plus what the method's
@@ -209,9 +223,7 @@ pub fn run(args: &Args) -> CliResult {
         )?,
         Method::BinnedEllipse => calibrate_2d(args, BinnedEllipseCalibrator::default(), expected)?,
         Method::MeritCircle => calibrate_2d(args, MeritCircleCalibrator::default(), expected)?,
-        // The compass half of the turn method (METHODS.md §A.4-5); `gyr_z` is accepted so
-        // that one recording serves both halves, and ignored here.
-        Method::Turn => calibrate_2d(args, TurnCompassCalibrator::default(), expected)?,
+        Method::Turn => calibrate_turn(args, expected)?,
     };
     let input = InputPath::new(&args.input).display_path();
     let warn = |w: &str| eprintln!("truenorth: warning: {}: {w}", input.display());
@@ -266,6 +278,15 @@ fn summary(file: &CalibrationFile, verdict: &Verdict) -> String {
         num(q.and_then(|q| q.heading_error_bound_deg)),
         num(q.and_then(|q| q.heading_noise_rms_deg)),
     );
+    if let Some(g) = &file.gyro {
+        s += &format!(
+            ", gyro zero {:.4} deg/s, scale {:.5} ({} pairs X, {} Y)",
+            g.zero_rps.to_degrees(),
+            g.scale,
+            g.pairs[0],
+            g.pairs[1]
+        );
+    }
     if let (Some(q), Some(d)) = (q, file.dip_deg) {
         s += &format!(
             ", dip {d:.2} deg (spread {} deg), {} runs",
@@ -284,7 +305,16 @@ fn library(e: truenorth::core::Error) -> CliError {
 /// Reads the `columns` of the input, and `t_s` (strictly increasing) where present. Without
 /// `t_s`, the rows are taken as one second apart.
 fn read_input(args: &Args, columns: &[&str]) -> CliResult<(Table, Vec<f64>)> {
-    let spec = ReadSpec::new(columns).optional(&["t_s"]).increasing("t_s");
+    read_input_with(args, columns, &["t_s"])
+}
+
+/// [`read_input`] with more `optional` columns (which must include `t_s`).
+fn read_input_with(
+    args: &Args,
+    columns: &[&str],
+    optional: &[&str],
+) -> CliResult<(Table, Vec<f64>)> {
+    let spec = ReadSpec::new(columns).optional(optional).increasing("t_s");
     let table = Table::read_with(&InputPath::new(&args.input), &args.input_options, &spec)?;
     table.require_rows()?;
     let t = match table.col("t_s") {
@@ -307,20 +337,38 @@ fn vectors(table: &Table, names: [&str; 3]) -> CliResult<Vec<Vector3<f64>>> {
 }
 
 /// Feeds every row to a 2-D calibrator, solves, and builds the output file.
-fn calibrate_2d<C>(args: &Args, mut cal: C, expected: Option<f64>) -> CliResult<Fitted>
+fn calibrate_2d<C>(args: &Args, cal: C, expected: Option<f64>) -> CliResult<Fitted>
 where
     C: Calibrator<Sample = Mag2Sample, Params = CompassCalibration2d, Quality = CompassQuality>,
 {
     let (table, t) = read_input(args, &["mag_x", "mag_y"])?;
+    solve_2d(args, &table, &t, cal, expected)
+}
+
+/// The magnetometer readings of a 2-D table.
+fn mag2(table: &Table) -> CliResult<Vec<Vector2<f64>>> {
     let (x, y) = (table.req("mag_x")?, table.req("mag_y")?);
-    let samples: Vec<Mag2Sample> = (0..table.len())
-        .map(|k| Mag2Sample {
-            t_s: t[k],
-            mag: Vector2::new(x[k], y[k]),
-        })
+    Ok((0..table.len()).map(|k| Vector2::new(x[k], y[k])).collect())
+}
+
+/// [`calibrate_2d`] on a table already read, with its times `t`.
+fn solve_2d<C>(
+    args: &Args,
+    table: &Table,
+    t: &[f64],
+    mut cal: C,
+    expected: Option<f64>,
+) -> CliResult<Fitted>
+where
+    C: Calibrator<Sample = Mag2Sample, Params = CompassCalibration2d, Quality = CompassQuality>,
+{
+    let points = mag2(table)?;
+    let samples: Vec<Mag2Sample> = points
+        .iter()
+        .zip(t)
+        .map(|(&mag, &t_s)| Mag2Sample { t_s, mag })
         .collect();
-    let sol = feed_and_solve(args, &table, &mut cal, &samples, expected)?;
-    let points: Vec<Vector2<f64>> = samples.iter().map(|s| s.mag).collect();
+    let sol = feed_and_solve(args, table, &mut cal, &samples, expected)?;
     let u = quality::assess_2d(&points, &sol.params, sol.quality.field_magnitude).uncertainty;
     Ok(fitted(
         args,
@@ -329,6 +377,54 @@ where
         sol.quality,
         &u,
     ))
+}
+
+/// The turn method (EP 0640207, METHODS.md §A). With `gyr_z`, the whole calibration of one
+/// turn ([`TurnCalibrator`]): the gyro's zero and scale, and the compass from the same
+/// extrema (placed by the sinusoid fit the gyro's relative heading allows). Without it, the
+/// compass half alone ([`TurnCompassCalibrator`]).
+fn calibrate_turn(args: &Args, expected: Option<f64>) -> CliResult<Fitted> {
+    let (table, t) = read_input_with(args, &["mag_x", "mag_y"], &["t_s", "gyr_z"])?;
+    let Some(gyr) = table.col("gyr_z") else {
+        return solve_2d(args, &table, &t, TurnCompassCalibrator::default(), expected);
+    };
+    if table.col("t_s").is_none() {
+        return Err(CliError::file(
+            &table.path,
+            "`gyr_z` needs a `t_s` column: the gyro's rate is integrated over time (or drop `gyr_z` to calibrate the compass alone)",
+        ));
+    }
+    let points = mag2(&table)?;
+    let samples: Vec<TurnSample> = (0..table.len())
+        .map(|k| TurnSample {
+            t_s: t[k],
+            gyr_z_rps: gyr[k],
+            mag: points[k],
+        })
+        .collect();
+    let mut cal = TurnCalibrator::new(TurnConfig::default()).map_err(library)?;
+    let sol = feed_and_solve(args, &table, &mut cal, &samples, expected)?;
+    let (c, q) = (sol.params, sol.quality);
+    let u = quality::assess_2d(&points, &c.compass, q.compass.field_magnitude).uncertainty;
+    let mut f = fitted(
+        args,
+        &c.compass.hard_iron,
+        &c.compass.soft_iron,
+        q.compass,
+        &u,
+    );
+    f.file.units.extend(gyro_units());
+    // One turn measures the gain of the direction turned; it stands for both.
+    f.file.gyro = Some(GyroPart {
+        zero_rps: c.gyro.zero_rps,
+        scale: c.gyro.gain_pos,
+        zero_sigma_rps: finite(q.gyro_zero_sigma_rps),
+        scale_sigma: finite(q.gyro_gain_sigma),
+        rest_s: q.rest_s,
+        pairs: [q.pairs.0, q.pairs.1],
+        turned_deg: q.turned_rad.to_degrees(),
+    });
+    Ok(f)
 }
 
 /// Feeds every row to a 3-D calibrator, solves, and builds the output file.
@@ -425,6 +521,15 @@ impl HasCompassQuality for CompassQuality {
     }
 }
 
+impl HasCompassQuality for TurnQuality {
+    fn compass(&self) -> &CompassQuality {
+        &self.compass
+    }
+    fn compass_mut(&mut self) -> &mut CompassQuality {
+        &mut self.compass
+    }
+}
+
 impl HasCompassQuality for MagAccelQuality {
     fn compass(&self) -> &CompassQuality {
         &self.mag
@@ -489,6 +594,7 @@ fn fitted<const D: usize>(
         mag_to_body: None,
         accelerometer: None,
         dip_deg: None,
+        gyro: None,
         quality: Some(QualityReport::new(&q, Some(u), D)),
         input: InputPath::new(&args.input)
             .display_path()

@@ -30,7 +30,7 @@ mod table;
 pub use atomic_write::{AtomicOutput, CsvOutput, check_distinct, write_atomically, write_csv};
 pub use calibration_file::{
     AccelPart, CALIBRATION_FORMAT, CALIBRATION_VERSION, CalibrationFile, CompassCalibration,
-    QualityReport, finite, matrix_rows, units_block,
+    GyroPart, QualityReport, finite, gyro_units, matrix_rows, units_block,
 };
 #[allow(unused_imports)]
 pub use columns::{AxisConvention, ColumnMapping, ColumnSource, Delimiter, Header, InputOptions};

@@ -24,7 +24,9 @@ pub const CALIBRATION_FORMAT: &str = "truenorth-compass-calibration";
 
 /// The version of the calibration file layout written: 2 adds the units block, the verdict,
 /// the predicted uncertainties and the accelerometer part, and drops
-/// `quality.field_magnitude` (the same number as `field`).
+/// `quality.field_magnitude` (the same number as `field`). The optional `gyro` part came
+/// later within version 2: a reader that does not know it skips it, and a file without it
+/// reads as before.
 pub const CALIBRATION_VERSION: u32 = 2;
 
 /// The layout versions this build reads.
@@ -74,6 +76,10 @@ pub struct CalibrationFile {
     /// `heading`, so a hand-written file may leave it out).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub quality: Option<QualityReport>,
+    /// The yaw gyro calibrated by the same turn (`turn` with `gyr_z` only). Not used by
+    /// `heading`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gyro: Option<GyroPart>,
     /// The recording it was fitted to (informational).
     #[serde(default)]
     pub input: String,
@@ -90,6 +96,27 @@ pub struct AccelPart {
     pub matrix: Vec<Vec<f64>>,
     /// Gravity in the accelerometer's input unit (1 for g, 9.81 for m/s²).
     pub gravity: f64,
+}
+
+/// The yaw gyro's calibration from one turn (EP 0640207 claims 1, 6-9):
+/// `rate_rps = (gyr_z − zero_rps) / scale`, positive turning right.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct GyroPart {
+    /// The gyro's reading at rest, rad/s: its mean over the standstill before the turn.
+    pub zero_rps: f64,
+    /// Raw rate per true rate (the conversion constant), from the integrated rate between
+    /// compass extrema half a turn apart; measured in the direction turned.
+    pub scale: f64,
+    /// 1σ of `zero_rps`, rad/s, from the spread of the standstill.
+    pub zero_sigma_rps: Option<f64>,
+    /// 1σ of `scale` from the spread of the half-turn pairs (0 with one pair per axis).
+    pub scale_sigma: Option<f64>,
+    /// Length of the standstill the zero came from, s.
+    pub rest_s: f64,
+    /// Half-turn pairs behind the scale on the X and the Y axis.
+    pub pairs: [usize; 2],
+    /// Angle turned, degrees, positive right.
+    pub turned_deg: f64,
 }
 
 /// The quality report as written to a calibration file: the library's
@@ -265,6 +292,25 @@ pub fn units_block(joint: bool) -> BTreeMap<String, String> {
     u.into_iter()
         .map(|(k, v)| (k.to_string(), v.to_string()))
         .collect()
+}
+
+/// The units block's entries for [`GyroPart`].
+pub fn gyro_units() -> BTreeMap<String, String> {
+    [
+        ("gyro.zero_rps", "rad/s: the gyro's reading at rest"),
+        (
+            "gyro.scale",
+            "raw rad/s per true rad/s: rate = (gyr_z - zero_rps) / scale, positive turning right",
+        ),
+        ("gyro.zero_sigma_rps", "rad/s, 1 sigma"),
+        ("gyro.scale_sigma", "dimensionless, 1 sigma"),
+        ("gyro.rest_s", "seconds of standstill behind zero_rps"),
+        ("gyro.pairs", "half-turn pairs of compass extrema, X and Y"),
+        ("gyro.turned_deg", "degrees turned, positive right"),
+    ]
+    .into_iter()
+    .map(|(k, v)| (k.to_string(), v.to_string()))
+    .collect()
 }
 
 /// A calibration read from a [`CalibrationFile`], checked and typed.
@@ -446,6 +492,7 @@ mod tests {
             mag_to_body: None,
             accelerometer: None,
             dip_deg: None,
+            gyro: None,
             quality: None,
             input: String::new(),
         }
