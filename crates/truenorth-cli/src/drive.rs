@@ -28,8 +28,8 @@ const AFTER_HELP: &str = "VEHICLE.json: {\"track_m\": 1.55, \"odometer_wheels\":
 {\"track_m\": 1.55, \"wheelbase_m\": 2.7, \"odometer_wheels\": \"front\", \"pitman_ratio\": 0.13}
 — track_m the odometer wheels' track, m; wheelbase_m rear axle to front kingpins, m;
 pitman_ratio P = 2p/T_F (kingpin offset p over half the front track; front wheels only).
-Optional: \"wheel_resolution_m\" (distance per odometer pulse, default 0.02; a few mm for
-wheel speeds integrated from a CAN bus).
+Optional: \"wheel_resolution_m\" (distance per odometer pulse, default 0.02 with distance
+columns and 0.003 with speed columns, a CAN bus's 0.01 km/h over one second).
 
 DRIVE.csv: `t_s` (strictly increasing) and either `dist_l_m,dist_r_m` (cumulative distance
 of the left and right odometer wheels as the odometer reports it) or
@@ -53,6 +53,12 @@ held back (at most 2^17 rows) until the sensors are learned and then estimated a
 from the start, so that the first minutes are as good as the rest; --single-pass writes
 each row as it comes (a causal estimate, as a navigation unit would have it).
 --calibration-in/--calibration-out carry what was learned from one drive to the next.";
+
+/// Distance resolution assumed for integrated wheel speeds, m: a CAN bus's 0.01 km/h over
+/// the one second in which the estimator compares wheels with gyro. The pulse default
+/// (2 cm) would make such wheels look a hundred times noisier than they are (on the real
+/// drive of `tests/comma2k19.rs` the heading then ended 4.7° off instead of 0.1°).
+const SPEED_RESOLUTION_M: f64 = 0.003;
 
 /// How the heading is estimated.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -313,53 +319,6 @@ pub fn run(args: &Args) -> CliResult {
             "drive: --extra calibration needs --method fused (the seed methods learn other things)",
         ));
     }
-    let vehicle = VehicleFile::read(&args.vehicle)?;
-    let wheels = vehicle.wheels(&args.vehicle)?;
-    let declination = if args.place.is_given() {
-        Some(args.place.field()?.declination())
-    } else {
-        None
-    };
-    let mut config = VehicleConfig {
-        wheels,
-        ..VehicleConfig::default()
-    };
-    if let Some(r) = vehicle.wheel_resolution_m {
-        config.priors.wheel_resolution_m = r;
-    }
-    let bad_config = |e: truenorth::core::Error| CliError::file(&args.vehicle, e.to_string());
-    let fused = match &args.calibration_in {
-        Some(path) => {
-            let text = std::fs::read_to_string(path)
-                .map_err(|e| CliError::file(path, format!("cannot read: {e}")))?;
-            let learned: VehicleCalibration = serde_json::from_str(&text)
-                .map_err(|e| CliError::file(path, format!("not a drive calibration: {e}")))?;
-            VehicleEstimator::with_calibration(config, &learned)
-                .map_err(|e| CliError::file(path, e.to_string()))?
-        }
-        None => VehicleEstimator::new(config).map_err(bad_config)?,
-    };
-    let mut estimator = match args.method {
-        Method::Fused if args.single_pass => Estimator::Causal(Box::new(fused)),
-        Method::Fused => {
-            Estimator::Fused(Box::new(TwoPassStart::new(fused, TwoPassConfig::default())))
-        }
-        Method::SeedOdometerCompass => Estimator::Seed(Box::new(
-            SeedOdometerCompass::new(SeedOdometerCompassConfig {
-                wheels,
-                ..SeedOdometerCompassConfig::default()
-            })
-            .map_err(bad_config)?,
-        )),
-        Method::SeedGyroCompass => Estimator::Seed(Box::new(
-            SeedGyroCompass::new(SeedGyroCompassConfig {
-                wheels,
-                ..SeedGyroCompassConfig::default()
-            })
-            .map_err(bad_config)?,
-        )),
-    };
-
     const OPTIONAL: [&str; 7] = [
         "dist_l_m",
         "dist_r_m",
@@ -394,6 +353,55 @@ pub fn run(args: &Args) -> CliResult {
             ));
         }
     };
+    let vehicle = VehicleFile::read(&args.vehicle)?;
+    let wheels = vehicle.wheels(&args.vehicle)?;
+    let declination = if args.place.is_given() {
+        Some(args.place.field()?.declination())
+    } else {
+        None
+    };
+    let mut config = VehicleConfig {
+        wheels,
+        ..VehicleConfig::default()
+    };
+    if let Some(r) = vehicle.wheel_resolution_m {
+        config.priors.wheel_resolution_m = r;
+    } else if matches!(wheel_columns, Wheels::Speeds { .. }) {
+        config.priors.wheel_resolution_m = SPEED_RESOLUTION_M;
+    }
+    let bad_config = |e: truenorth::core::Error| CliError::file(&args.vehicle, e.to_string());
+    let fused = match &args.calibration_in {
+        Some(path) => {
+            let text = std::fs::read_to_string(path)
+                .map_err(|e| CliError::file(path, format!("cannot read: {e}")))?;
+            let learned: VehicleCalibration = serde_json::from_str(&text)
+                .map_err(|e| CliError::file(path, format!("not a drive calibration: {e}")))?;
+            VehicleEstimator::with_calibration(config, &learned)
+                .map_err(|e| CliError::file(path, e.to_string()))?
+        }
+        None => VehicleEstimator::new(config).map_err(bad_config)?,
+    };
+    let mut estimator = match args.method {
+        Method::Fused if args.single_pass => Estimator::Causal(Box::new(fused)),
+        Method::Fused => {
+            Estimator::Fused(Box::new(TwoPassStart::new(fused, TwoPassConfig::default())))
+        }
+        Method::SeedOdometerCompass => Estimator::Seed(Box::new(
+            SeedOdometerCompass::new(SeedOdometerCompassConfig {
+                wheels,
+                ..SeedOdometerCompassConfig::default()
+            })
+            .map_err(bad_config)?,
+        )),
+        Method::SeedGyroCompass => Estimator::Seed(Box::new(
+            SeedGyroCompass::new(SeedGyroCompassConfig {
+                wheels,
+                ..SeedGyroCompassConfig::default()
+            })
+            .map_err(bad_config)?,
+        )),
+    };
+
     let (t, gyr) = (ix("t_s").unwrap_or(0), ix("gyr_z"));
     let mag = match (ix("mag_x"), ix("mag_y")) {
         (Some(x), Some(y)) => Some([x, y]),

@@ -27,12 +27,6 @@ const FOLDER: &str = "vehicle_comma2k19_example";
 /// The rear track of the XA40 RAV4, m (Toyota's published figure, about 1.57 m).
 const TRACK_M: f64 = 1.57;
 
-/// Resolution of the CAN wheel speeds, m/s (0.01 km/h, the folder's README).
-const SPEED_RESOLUTION_MPS: f64 = 0.01 / 3.6;
-
-/// The span over which the estimator compares the wheels' heading with the gyro's, s.
-const WHEEL_CHECK_S: f64 = 1.0;
-
 /// A CSV file of numbers with a header row.
 struct Table {
     header: Vec<String>,
@@ -245,15 +239,13 @@ impl Run {
     }
 }
 
-/// The vehicle file: the rear wheels, and the distance resolution of the wheel speeds
-/// integrated over one comparison of the wheels with the gyro (2.8 mm), not the 2 cm of ABS
-/// pulses.
+/// The vehicle file: the rear wheels only. The distance resolution is left to the
+/// command's default for speed columns, which should be that of the CAN speeds integrated
+/// over one comparison of the wheels with the gyro (0.01 km/h × 1 s = 2.8 mm), not the
+/// 2 cm of ABS pulses.
 fn write_vehicle(dir: &Path) -> std::path::PathBuf {
     let path = dir.join("vehicle.json");
-    let json = format!(
-        r#"{{"track_m": {TRACK_M}, "odometer_wheels": "rear", "wheel_resolution_m": {}}}"#,
-        SPEED_RESOLUTION_MPS * WHEEL_CHECK_S
-    );
+    let json = format!(r#"{{"track_m": {TRACK_M}, "odometer_wheels": "rear"}}"#);
     std::fs::write(&path, json).unwrap();
     path
 }
