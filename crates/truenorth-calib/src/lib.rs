@@ -28,6 +28,13 @@
 //! ([`truenorth_core::OnlineCalibrator::estimate`]); all three save and restore their state
 //! ([`truenorth_core::Persistent`]).
 //!
+//! Two calibrators learn a vehicle's other sensors against the compass:
+//! [`TurnCalibrator`] (EP 0640207, both halves: the gyro's zero from a standstill and its
+//! conversion constant from compass extrema half a turn apart, with the compass's centre and
+//! radii from the same turn) and [`SpeedCoefficientCalibrator`] (US 4,788,645 eqs. 9-13: the
+//! coefficient `a` of the wheels' speed correction, refined turn by turn against the
+//! compass with the patent's gating, clamp and filter constant).
+//!
 //! ```
 //! use nalgebra::{Matrix2, Vector2};
 //! use truenorth_calib::{EllipseCalibrator, EllipseConfig};

@@ -17,6 +17,10 @@
 //! - [`QuaternionFilter`]: 6-D / 9-D quaternion filter with gyro-bias estimation at rest
 //!   ([`RestDetector`]) and in motion, magnetic-disturbance rejection ([`MagReference`]) and
 //!   online hard-iron re-estimation ([`HardIronEstimator`]).
+//! - [`VehicleEstimator`]: vehicle heading and dead reckoning from wheels, an optional yaw
+//!   gyro and a raw compass, learning every sensor's errors while it drives (an 11-state
+//!   Kalman filter; [`vehicle`] also holds the two-pass start, the learned calibration
+//!   carried between drives, and the seed configurations of US 4,788,645 and EP 0640207).
 //!
 //! Code written against the traits works with whichever estimator is picked:
 //!

@@ -1,5 +1,39 @@
 //! Vehicle heading and dead reckoning from a gyro, wheel odometers and a compass, each
 //! calibrated online from the drive itself.
+//!
+//! [`VehicleEstimator`] is the fused estimator; [`SeedOdometerCompass`] (US 4,788,645) and
+//! [`SeedGyroCompass`] (EP 0640207) are the seed documents' configurations behind the same
+//! [`truenorth_core::HeadingEstimator`] trait. [`TwoPassStart`] runs the head of a drive
+//! again once the sensors are learned, and [`VehicleCalibration`] carries what was learned
+//! to the next drive.
+//!
+//! ```
+//! use nalgebra::Vector2;
+//! use truenorth_core::{HeadingEstimator, VehicleSample};
+//! use truenorth_fusion::{VehicleConfig, VehicleEstimator};
+//!
+//! let mut nav = VehicleEstimator::new(VehicleConfig::default())?;
+//! // Ten seconds straight ahead at 10 m/s, a raw gyro with its own bias, a raw compass.
+//! for k in 0..=100 {
+//!     let t_s = 0.1 * k as f64;
+//!     let e = nav.update(&VehicleSample {
+//!         t_s,
+//!         dist_l_m: 10.0 * t_s,
+//!         dist_r_m: 10.0 * t_s,
+//!         gyr_z_rps: Some(0.005),
+//!         mag: Some(Vector2::new(25.0, -3.0)),
+//!     })?;
+//!     // No turn yet, so no compass calibration: the heading is relative to the start.
+//!     assert!(!e.status.heading_absolute);
+//! }
+//! let e = nav.estimate();
+//! assert!((e.north_m.hypot(e.east_m) - 100.0).abs() < 1.0);
+//! // Time going backwards is refused, and changes nothing.
+//! let late = VehicleSample { t_s: 5.0, dist_l_m: 50.0, dist_r_m: 50.0, gyr_z_rps: None, mag: None };
+//! assert!(nav.update(&late).is_err());
+//! assert_eq!(nav.estimate(), e);
+//! # Ok::<(), truenorth_core::Error>(())
+//! ```
 
 mod compass_learning;
 mod compass_monitor;
