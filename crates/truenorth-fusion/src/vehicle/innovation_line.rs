@@ -8,6 +8,9 @@
 
 use truenorth_core::wrap_pi;
 
+#[allow(unused_imports)]
+use truenorth_core::Float as _;
+
 /// What a completed run of readings says.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LineFit {

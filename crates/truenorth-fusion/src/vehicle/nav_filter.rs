@@ -10,6 +10,9 @@
 
 use serde::{Deserialize, Serialize};
 
+#[allow(unused_imports)]
+use truenorth_core::Float as _;
+
 /// Heading, rad, clockwise from north (or from the start heading before alignment).
 pub const PSI: usize = 0;
 /// North position of the rear-axle centre, m.

@@ -21,6 +21,9 @@ use truenorth_core::{HeadingEstimator, MagneticHeading, NavEstimate, Result, Veh
 
 use super::estimator::VehicleEstimator;
 
+#[allow(unused_imports)]
+use truenorth_core::Float as _;
+
 /// When the head of the drive is run again.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TwoPassConfig {
