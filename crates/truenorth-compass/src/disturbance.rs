@@ -158,7 +158,8 @@ mod tests {
         assert!(Disturbances::new().add(bad).is_err());
         bad.duration_s = f64::NAN;
         assert!(Disturbances::new().add(bad).is_err());
-        let want: Vector3<f64> = Vector3::new(4.0, 8.0, 12.0);
+        // Every one of the full set counts.
+        let want: Vector3<f64> = Vector3::new(1.0, 2.0, 3.0) * MAX_DISTURBANCES as f64;
         assert!((s.field_at(12.0) - want).norm() < 1e-12);
     }
 }
