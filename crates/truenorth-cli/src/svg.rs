@@ -29,6 +29,25 @@ pub enum Style {
     Open,
 }
 
+/// The smallest and largest finite x and y of `points`, as (x0, x1, y0, y1); an error
+/// naming `path` if there is no finite point.
+pub fn bounds<'a>(
+    path: &Path,
+    points: impl Iterator<Item = &'a (f64, f64)>,
+) -> CliResult<(f64, f64, f64, f64)> {
+    let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
+    for &(x, y) in points.filter(|p| p.0.is_finite() && p.1.is_finite()) {
+        x0 = x0.min(x);
+        x1 = x1.max(x);
+        y0 = y0.min(y);
+        y1 = y1.max(y);
+    }
+    if x0 > x1 {
+        return Err(CliError::file(path, "nothing to plot"));
+    }
+    Ok((x0, x1, y0, y1))
+}
+
 /// Writes an equal-axes plot of `series` to `path`.
 pub fn write_plot(
     path: &Path,
@@ -39,20 +58,7 @@ pub fn write_plot(
 ) -> CliResult {
     const SIZE: f64 = 560.0;
     const MARGIN: f64 = 60.0;
-    let all = series
-        .iter()
-        .flat_map(|s| s.points.iter())
-        .filter(|p| p.0.is_finite() && p.1.is_finite());
-    let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
-    for &(x, y) in all {
-        x0 = x0.min(x);
-        x1 = x1.max(x);
-        y0 = y0.min(y);
-        y1 = y1.max(y);
-    }
-    if x0 > x1 {
-        return Err(CliError::file(path, "nothing to plot"));
-    }
+    let (x0, x1, y0, y1) = bounds(path, series.iter().flat_map(|s| s.points.iter()))?;
     // Equal scales on both axes so that a circle looks like a circle.
     let span = (x1 - x0).max(y1 - y0).max(1e-12) * 1.1;
     let (cx, cy) = (0.5 * (x0 + x1), 0.5 * (y0 + y1));

@@ -4,7 +4,7 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use crate::io::{CliError, CliResult, write_atomically};
+use crate::io::{CliResult, write_atomically};
 
 /// One line: (t, value) points joined in order.
 pub struct Line<'a> {
@@ -40,20 +40,7 @@ pub fn write_timeseries(
     const W: f64 = 900.0;
     const H: f64 = 420.0;
     const M: f64 = 60.0;
-    let finite = lines
-        .iter()
-        .flat_map(|l| l.points.iter())
-        .filter(|p| p.0.is_finite() && p.1.is_finite());
-    let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
-    for &(x, y) in finite {
-        x0 = x0.min(x);
-        x1 = x1.max(x);
-        y0 = y0.min(y);
-        y1 = y1.max(y);
-    }
-    if x0 > x1 {
-        return Err(CliError::file(path, "nothing to plot"));
-    }
+    let (x0, x1, y0, y1) = crate::svg::bounds(path, lines.iter().flat_map(|l| l.points.iter()))?;
     let (xs, ys) = ((x1 - x0).max(1e-12), (y1 - y0).max(1e-12) * 1.1);
     let yc = 0.5 * (y0 + y1);
     let sx = |x: f64| M + (x - x0) / xs * W;

@@ -201,6 +201,23 @@ pub struct VehicleSample {
     pub mag: Option<Vector2<f64>>,
 }
 
+impl VehicleSample {
+    /// Checks that the timestamp, the distances and every present reading are finite.
+    pub fn check_finite(&self) -> Result<()> {
+        check_finite("timestamp t_s", self.t_s)?;
+        check_finite("dist_l_m", self.dist_l_m)?;
+        check_finite("dist_r_m", self.dist_r_m)?;
+        if let Some(g) = self.gyr_z_rps {
+            check_finite("gyr_z", g)?;
+        }
+        if let Some(m) = self.mag {
+            check_finite("mag_x", m.x)?;
+            check_finite("mag_y", m.y)?;
+        }
+        Ok(())
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -25,7 +25,7 @@
 use nalgebra::{Matrix2, SMatrix, Vector2};
 use truenorth_core::{
     HeadingEstimator, MagneticHeading, NavEstimate, Result, TimeStep, Validate, VehicleSample,
-    check_finite, wrap_pi,
+    wrap_pi,
 };
 
 use super::compass_learning::{CompassLearner, Judged};
@@ -374,20 +374,6 @@ impl VehicleEstimator {
     /// The compass calibration in use, if any.
     pub fn compass_fix(&self) -> Option<&CompassFix> {
         self.compass.fix()
-    }
-
-    fn check(sample: &VehicleSample) -> Result<()> {
-        check_finite("timestamp t_s", sample.t_s)?;
-        check_finite("dist_l_m", sample.dist_l_m)?;
-        check_finite("dist_r_m", sample.dist_r_m)?;
-        if let Some(g) = sample.gyr_z_rps {
-            check_finite("gyr_z", g)?;
-        }
-        if let Some(m) = sample.mag {
-            check_finite("mag_x", m.x)?;
-            check_finite("mag_y", m.y)?;
-        }
-        Ok(())
     }
 
     fn step(&mut self, sample: &VehicleSample, dt: f64) {
@@ -841,7 +827,7 @@ impl HeadingEstimator for VehicleEstimator {
     /// typed error and changes nothing; a missing gyro or compass reading (`None`) is
     /// allowed on any sample (the last gyro reading is held).
     fn update(&mut self, sample: &VehicleSample) -> Result<NavEstimate> {
-        Self::check(sample)?;
+        sample.check_finite()?;
         match self.clock.dt_s(sample.t_s)? {
             None => {
                 self.wheels.step(

@@ -9,7 +9,7 @@ use serde::{Deserialize, Serialize};
 use truenorth_calib::{TurnCalibration, TurnCalibrator, TurnConfig, TurnSample};
 use truenorth_core::{
     Calibrator, HeadingEstimator, MagneticHeading, NavEstimate, Result, TimeStep, Validate,
-    VehicleSample, check_finite,
+    VehicleSample,
 };
 use truenorth_odometer::OdometerWheels;
 
@@ -130,16 +130,7 @@ impl HeadingEstimator for SeedGyroCompass {
     /// Takes one sample. A non-finite value or a timestamp that does not increase is a
     /// typed error and changes nothing.
     fn update(&mut self, sample: &VehicleSample) -> Result<NavEstimate> {
-        check_finite("timestamp t_s", sample.t_s)?;
-        check_finite("dist_l_m", sample.dist_l_m)?;
-        check_finite("dist_r_m", sample.dist_r_m)?;
-        if let Some(g) = sample.gyr_z_rps {
-            check_finite("gyr_z", g)?;
-        }
-        if let Some(m) = sample.mag {
-            check_finite("mag_x", m.x)?;
-            check_finite("mag_y", m.y)?;
-        }
+        sample.check_finite()?;
         let dt = self.clock.dt_s(sample.t_s)?;
         let wheel = self.wheels.step(
             sample.dist_l_m,

@@ -13,7 +13,7 @@ use truenorth_calib::{
 use truenorth_compass::CompassCalibration2d;
 use truenorth_core::{
     Calibrator, HeadingEstimator, Mag2Sample, MagneticHeading, NavEstimate, OnlineCalibrator,
-    Result, TimeStep, Validate, VehicleSample, check_finite,
+    Result, TimeStep, Validate, VehicleSample,
 };
 use truenorth_odometer::OdometerWheels;
 
@@ -105,16 +105,7 @@ impl HeadingEstimator for SeedOdometerCompass {
     /// any other field, so that every estimator accepts the same input). A non-finite value
     /// or a timestamp that does not increase is a typed error and changes nothing.
     fn update(&mut self, sample: &VehicleSample) -> Result<NavEstimate> {
-        check_finite("timestamp t_s", sample.t_s)?;
-        check_finite("dist_l_m", sample.dist_l_m)?;
-        check_finite("dist_r_m", sample.dist_r_m)?;
-        if let Some(g) = sample.gyr_z_rps {
-            check_finite("gyr_z", g)?;
-        }
-        if let Some(m) = sample.mag {
-            check_finite("mag_x", m.x)?;
-            check_finite("mag_y", m.y)?;
-        }
+        sample.check_finite()?;
         let dt = self.clock.dt_s(sample.t_s)?;
         let cal = WheelCalibration {
             speed_coeff: self.refiner.coefficient(),
