@@ -828,6 +828,7 @@ impl HeadingEstimator for VehicleEstimator {
     /// allowed on any sample (the last gyro reading is held).
     fn update(&mut self, sample: &VehicleSample) -> Result<NavEstimate> {
         sample.check_finite()?;
+        self.wheels.check_speed(sample, self.clock.last_s())?;
         match self.clock.dt_s(sample.t_s)? {
             None => {
                 self.wheels.step(

@@ -131,6 +131,7 @@ impl HeadingEstimator for SeedGyroCompass {
     /// typed error and changes nothing.
     fn update(&mut self, sample: &VehicleSample) -> Result<NavEstimate> {
         sample.check_finite()?;
+        self.wheels.check_speed(sample, self.clock.last_s())?;
         let dt = self.clock.dt_s(sample.t_s)?;
         let wheel = self.wheels.step(
             sample.dist_l_m,

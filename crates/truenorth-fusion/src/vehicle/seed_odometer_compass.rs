@@ -106,6 +106,7 @@ impl HeadingEstimator for SeedOdometerCompass {
     /// or a timestamp that does not increase is a typed error and changes nothing.
     fn update(&mut self, sample: &VehicleSample) -> Result<NavEstimate> {
         sample.check_finite()?;
+        self.wheels.check_speed(sample, self.clock.last_s())?;
         let dt = self.clock.dt_s(sample.t_s)?;
         let cal = WheelCalibration {
             speed_coeff: self.refiner.coefficient(),

@@ -8,13 +8,17 @@
 //! turn: the front-axle midpoint runs on radius `√(R² + B²)` where the rear-axle centre runs
 //! on `R`, so the rear-axle distance is `√(AD² − (B·Δθ)²)`.
 
-use truenorth_core::{Result, Validate};
+use truenorth_core::{Error, Result, Validate, VehicleSample};
 use truenorth_odometer::{
     EffectiveTrack, EffectiveTrackTable, OdometerWheels, PatentAckermannTrack,
 };
 
 #[allow(unused_imports)]
 use truenorth_core::Float as _;
+
+/// Fastest wheel speed a sample may imply, m/s (360 km/h, beyond any road vehicle):
+/// distances that jump further are a counter that wrapped or was reset, not motion.
+pub const MAX_WHEEL_SPEED_MPS: f64 = 100.0;
 
 /// Entries of the front-wheel effective-track table.
 const TABLE_ENTRIES: usize = 64;
@@ -91,6 +95,28 @@ impl WheelOdometry {
     /// Forgets the last reading.
     pub fn reset(&mut self) {
         self.last = None;
+    }
+
+    /// Refuses `sample` if its distances, against the previous reading taken at `last_t_s`,
+    /// imply a wheel faster than [`MAX_WHEEL_SPEED_MPS`]. Changes nothing either way; a
+    /// timestamp that does not increase is left to the caller's clock.
+    pub fn check_speed(&self, sample: &VehicleSample, last_t_s: Option<f64>) -> Result<()> {
+        let (Some((l0, r0)), Some(t0)) = (self.last, last_t_s) else {
+            return Ok(());
+        };
+        let dt = sample.t_s - t0;
+        let travel = (sample.dist_l_m - l0)
+            .abs()
+            .max((sample.dist_r_m - r0).abs());
+        if dt > 0.0 && travel > MAX_WHEEL_SPEED_MPS * dt {
+            return Err(Error::OutOfRange {
+                what: "wheel speed implied by the distances, m/s (a counter that wrapped or was reset: start a new drive there)",
+                value: travel / dt,
+                min: 0.0,
+                max: MAX_WHEEL_SPEED_MPS,
+            });
+        }
+        Ok(())
     }
 
     /// The step from the previous cumulative reading to this one (`None` for the first),
