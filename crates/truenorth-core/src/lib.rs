@@ -56,7 +56,8 @@ pub use heading_source::{
 pub use noise::{NoiseSource, SplitMix64, ZeroNoise};
 pub use persist::{Persistent, Snapshot, check_snapshot_version};
 pub use sample::{
-    AccelSample, Axes, GyroSample, ImuSample, Mag2Sample, Mag3Sample, VehicleSample, WheelSample,
+    AccelSample, Axes, GyroSample, ImuSample, MAX_YAW_RATE_RPS, Mag2Sample, Mag3Sample,
+    VehicleSample, WheelSample,
 };
 pub use sensor_model::SensorModel;
 pub use units::{STANDARD_GRAVITY_MPS2, deg_to_rad, mph_to_mps, mps_to_mph, rad_to_deg};

@@ -4,7 +4,7 @@
 use nalgebra::{Vector2, Vector3};
 use serde::{Deserialize, Serialize};
 
-use crate::{Result, check_finite};
+use crate::{Result, Validate, check_finite, check_range};
 
 /// A two-axis magnetometer reading (any unit; calibration removes it).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -201,14 +201,19 @@ pub struct VehicleSample {
     pub mag: Option<Vector2<f64>>,
 }
 
-impl VehicleSample {
-    /// Checks that the timestamp, the distances and every present reading are finite.
-    pub fn check_finite(&self) -> Result<()> {
+/// Largest yaw rate a vehicle sample may carry, rad/s (2000°/s, the widest range of MEMS
+/// rate gyros): a reading beyond it is a corrupted value, not a turn.
+pub const MAX_YAW_RATE_RPS: f64 = 2000.0 * core::f64::consts::PI / 180.0;
+
+impl Validate for VehicleSample {
+    /// Checks that the timestamp, the distances and every present reading are finite, and
+    /// the yaw rate within [`MAX_YAW_RATE_RPS`].
+    fn validate(&self) -> Result<()> {
         check_finite("timestamp t_s", self.t_s)?;
         check_finite("dist_l_m", self.dist_l_m)?;
         check_finite("dist_r_m", self.dist_r_m)?;
         if let Some(g) = self.gyr_z_rps {
-            check_finite("gyr_z", g)?;
+            check_range("gyr_z (rad/s)", g, -MAX_YAW_RATE_RPS, MAX_YAW_RATE_RPS)?;
         }
         if let Some(m) = self.mag {
             check_finite("mag_x", m.x)?;

@@ -827,7 +827,7 @@ impl HeadingEstimator for VehicleEstimator {
     /// typed error and changes nothing; a missing gyro or compass reading (`None`) is
     /// allowed on any sample (the last gyro reading is held).
     fn update(&mut self, sample: &VehicleSample) -> Result<NavEstimate> {
-        sample.check_finite()?;
+        sample.validate()?;
         self.wheels.check_speed(sample, self.clock.last_s())?;
         match self.clock.dt_s(sample.t_s)? {
             None => {

@@ -60,4 +60,4 @@ pub use seed_blend::{SeedBlend, SeedBlendConfig};
 pub use seed_gyro_compass::{SeedGyroCompass, SeedGyroCompassConfig};
 pub use seed_odometer_compass::{SeedOdometerCompass, SeedOdometerCompassConfig};
 pub use two_pass::{TwoPassConfig, TwoPassStart};
-pub use wheel_odometry::{WheelCalibration, WheelOdometry, WheelStep};
+pub use wheel_odometry::{MAX_WHEEL_SPEED_MPS, WheelCalibration, WheelOdometry, WheelStep};

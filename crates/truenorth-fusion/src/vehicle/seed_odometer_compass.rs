@@ -105,7 +105,7 @@ impl HeadingEstimator for SeedOdometerCompass {
     /// any other field, so that every estimator accepts the same input). A non-finite value
     /// or a timestamp that does not increase is a typed error and changes nothing.
     fn update(&mut self, sample: &VehicleSample) -> Result<NavEstimate> {
-        sample.check_finite()?;
+        sample.validate()?;
         self.wheels.check_speed(sample, self.clock.last_s())?;
         let dt = self.clock.dt_s(sample.t_s)?;
         let cal = WheelCalibration {
