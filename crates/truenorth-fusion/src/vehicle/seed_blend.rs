@@ -11,7 +11,9 @@
 
 use nalgebra::Vector2;
 use serde::{Deserialize, Serialize};
-use truenorth_core::{Result, Validate, check_positive, check_range, wrap_pi};
+use truenorth_core::{
+    MagneticHeading, NavEstimate, Result, Validate, check_positive, check_range, wrap_pi,
+};
 
 #[allow(unused_imports)]
 use truenorth_core::Float as _;
@@ -125,6 +127,29 @@ impl SeedBlend {
         self.psi = wrap_pi(self.psi + dpsi);
         self.still_s = if moved { 0.0 } else { self.still_s + dt };
         self.still_s >= self.config.standstill_s && self.still_s > 0.0
+    }
+
+    /// Takes a calibrated horizontal reading `u` (body axes: x forward, y right) from a
+    /// field of fitted magnitude `field` at `t_s`: its heading is `atan2(−u_y, u_x)`, since a
+    /// level compass reads `(H cos ψ, −H sin ψ)`. Returns the heading if it was used.
+    pub fn compass_vector(&mut self, t_s: f64, u: Vector2<f64>, field: f64) -> Option<f64> {
+        self.compass(t_s, (-u.y).atan2(u.x), u.norm() / field)
+    }
+
+    /// Writes the carried heading, track and distance into `e` at `t_s`. A fixed-gain blend
+    /// keeps no variance: σ is NaN once referred to north, infinite before.
+    pub fn write_estimate(&self, e: &mut NavEstimate, t_s: f64) {
+        e.t_s = t_s;
+        e.north_m = self.position.x;
+        e.east_m = self.position.y;
+        e.heading = MagneticHeading::new(self.psi);
+        e.heading_sigma_rad = if self.aligned {
+            f64::NAN
+        } else {
+            f64::INFINITY
+        };
+        e.distance_m = self.distance_m;
+        e.status.heading_absolute = self.aligned;
     }
 
     /// Takes a calibrated reading with heading `heading` and field ratio `ratio` (its

@@ -169,24 +169,13 @@ impl HeadingEstimator for SeedGyroCompass {
         self.learn_turn(sample);
         let mut used = false;
         if let (Some(mag), Some((c, field))) = (sample.mag, self.calibration) {
-            let u = c.compass.correct(&mag);
             used = self
                 .blend
-                .compass(sample.t_s, (-u.y).atan2(u.x), u.norm() / field)
+                .compass_vector(sample.t_s, c.compass.correct(&mag), field)
                 .is_some();
         }
+        self.blend.write_estimate(&mut self.est, sample.t_s);
         let e = &mut self.est;
-        e.t_s = sample.t_s;
-        e.north_m = self.blend.position.x;
-        e.east_m = self.blend.position.y;
-        e.heading = MagneticHeading::new(self.blend.psi);
-        e.heading_sigma_rad = if self.blend.aligned() {
-            f64::NAN
-        } else {
-            f64::INFINITY
-        };
-        e.distance_m = self.blend.distance_m;
-        e.status.heading_absolute = self.blend.aligned();
         e.status.compass_calibrated = self.calibration.is_some();
         e.status.compass_used = used;
         e.status.at_rest = at_rest;

@@ -137,10 +137,9 @@ impl HeadingEstimator for SeedOdometerCompass {
                 self.compass = Some((s.params, s.quality.field_magnitude));
             }
             if let Some((c, field)) = self.compass {
-                let u = c.correct(&raw);
                 used = self
                     .blend
-                    .compass(sample.t_s, (-u.y).atan2(u.x), u.norm() / field);
+                    .compass_vector(sample.t_s, c.correct(&raw), field);
             }
         }
         if let (Some(w), Some(_)) = (wheel, dt) {
@@ -152,18 +151,8 @@ impl HeadingEstimator for SeedOdometerCompass {
                 compass_heading_rad: used,
             })?;
         }
+        self.blend.write_estimate(&mut self.est, sample.t_s);
         let e = &mut self.est;
-        e.t_s = sample.t_s;
-        e.north_m = self.blend.position.x;
-        e.east_m = self.blend.position.y;
-        e.heading = MagneticHeading::new(self.blend.psi);
-        e.heading_sigma_rad = if self.blend.aligned() {
-            f64::NAN
-        } else {
-            f64::INFINITY
-        };
-        e.distance_m = self.blend.distance_m;
-        e.status.heading_absolute = self.blend.aligned();
         e.status.compass_calibrated = self.compass.is_some();
         e.status.compass_used = used.is_some();
         e.status.at_rest = at_rest;
