@@ -11,11 +11,19 @@ use truenorth_core::{Error, Result, Solution};
 
 use crate::binned_config::BinnedEllipseConfig;
 use crate::binned_refresh::{BinState, Bins, MAX_BINS, RefreshJob, filled};
-use crate::quality::{Assessment2d, locus_turning_rad, require_arc};
+use crate::quality::{Assessment2d, locus_turning_rad, require_arc, require_certain};
 use crate::seed_quality::{SeedJob, seed_assessment};
 
 #[allow(unused_imports)]
 use truenorth_core::Float as _;
+
+/// How many times the change that noise alone makes a restart needs (see
+/// `Assessor::precheck`): 2. The squared RMS change over `n` bins is a χ² with `2n` degrees
+/// of freedom over `2n`; with the 16 bins or more an update needs, twice its expectation
+/// in RMS (four times in square) has a chance below 10⁻¹⁰ (found necessary by
+/// `tests/more_data.rs`: at 7 % noise the default threshold of 10 % of the field restarted
+/// a good calibration on every update).
+const RESTART_NOISE_MULTIPLE: f64 = 2.0;
 
 /// What an assessed update will do when applied.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -45,6 +53,8 @@ pub(crate) enum Precheck {
 pub(crate) struct Assessor<'a> {
     pub config: &'a BinnedEllipseConfig,
     pub reference: &'a [Option<Vector2<f64>>; MAX_BINS],
+    /// The parameters in use, taken with the reference.
+    pub phasors: Option<&'a EllipsePhasors>,
     pub samples: usize,
 }
 
@@ -60,9 +70,18 @@ impl Assessor<'_> {
     pub(crate) fn precheck(&self, job: &RefreshJob) -> Precheck {
         match job.result {
             Some(Ok(params)) => {
+                // Noise alone moves single readings: two of them in one bin differ by a
+                // vector of RMS 2σ (relative to the field, σ per axis), so the RMS change
+                // over the bins is about 2σ with no change of the locus. A restart needs
+                // RESTART_NOISE_MULTIPLE times that as well as the configured threshold,
+                // σ taken from the reference (the new set may hold the change itself).
+                let threshold = self
+                    .config
+                    .restart_threshold
+                    .max(RESTART_NOISE_MULTIPLE * 2.0 * self.reference_noise());
                 if self
                     .change_since_reference(&job.bins, params.earth_magnitude)
-                    .is_some_and(|change| change > self.config.restart_threshold)
+                    .is_some_and(|change| change > threshold)
                 {
                     Precheck::Restart(params)
                 } else {
@@ -114,7 +133,7 @@ impl Assessor<'_> {
             job.field(),
             job.samples_used(),
         );
-        self.judge(&a, job.calibration(), turned_deg)
+        self.judge(&a, job.calibration(), turned_deg, job.points().len())
     }
 
     /// The quality report of a solution with `params` on `bins`, not yet run (see
@@ -131,20 +150,27 @@ impl Assessor<'_> {
         SeedJob::start(&pts[..k], &cal, params.earth_magnitude, self.samples)
     }
 
-    /// The acceptance tests on the report `a` of `cal`, given the locus's turning.
+    /// The acceptance tests on the report `a` of `cal` from `bins_used` bins, given the
+    /// locus's turning.
     pub(crate) fn judge(
         &self,
         a: &Assessment2d,
         cal: &CompassCalibration2d,
         turned_deg: f64,
+        bins_used: usize,
     ) -> Result<Solution<CompassCalibration2d>> {
-        require_arc(&a.coverage, self.config.min_arc_deg)?;
+        require_arc(
+            &a.coverage,
+            a.quality.heading_noise_rms_deg.to_radians(),
+            self.config.min_arc_deg,
+        )?;
         // The arc above is seen from the method's own origin, which a short arc pulls towards
         // itself (so the arc looks longer than it is); the locus's own turning cannot be
         // fooled that way.
         if turned_deg < self.config.min_arc_deg {
             return Err(Error::InsufficientCoverage {
                 covered_deg: turned_deg.floor(),
+                noise_deg: 0.0,
                 need_deg: self.config.min_arc_deg,
             });
         }
@@ -156,10 +182,42 @@ impl Assessor<'_> {
                 detail: " (the binned readings scatter by more than max_residual_rel about the fitted ellipse)",
             });
         }
+        // The bound comes from the binned readings: their count less the five parameters
+        // is the residual's degrees of freedom.
+        require_certain(
+            &a.quality,
+            bins_used as f64 - 5.0,
+            self.config.max_heading_error_bound_deg,
+        )?;
         Ok(Solution {
             params: *cal,
             quality: a.quality,
         })
+    }
+
+    /// The per-axis noise of a single reading, relative to the field: the RMS radial
+    /// residual of the reference's readings about the parameters taken with it (0 when
+    /// there are none, or too few readings to say).
+    fn reference_noise(&self) -> f64 {
+        let Some(params) = self.phasors else {
+            return 0.0;
+        };
+        let cal = params.to_calibration();
+        let field = params.earth_magnitude.abs();
+        let (mut ss, mut k) = (0.0, 0usize);
+        for r in self.reference[..self.config.bins].iter().flatten() {
+            let res = cal.correct(r).norm() / field - 1.0;
+            if res.is_finite() {
+                ss += res * res;
+                k += 1;
+            }
+        }
+        // Five parameters were fitted to these readings.
+        if k > 5 {
+            (ss / (k - 5) as f64).sqrt()
+        } else {
+            0.0
+        }
     }
 
     /// RMS change of the bins filled now and in the reference, relative to `|E_L|`, when

@@ -1,7 +1,7 @@
 //! The configuration of the [`crate::BinnedEllipseCalibrator`] and its validation.
 
 use serde::{Deserialize, Serialize};
-use truenorth_core::{Error, Result, Validate, check_range};
+use truenorth_core::{Error, Result, Validate, check_positive, check_range};
 
 use crate::binned_ellipse::MAX_INIT_SAMPLES;
 use crate::binned_refresh::MAX_BINS;
@@ -28,7 +28,10 @@ pub struct BinnedEllipseConfig {
     /// RMS change between successive full sets, relative to `|E_L|`, that restarts (0.1).
     /// On the reference turn noise and re-binning change the set by 0.01–0.03 between
     /// updates, a lorry passing (half the earth's field for 3 s) by no more, and a magnet
-    /// shifting the hard iron by 0.6 of the field by about 0.16 within one update.
+    /// shifting the hard iron by 0.6 of the field by about 0.16 within one update. With
+    /// noisy readings the threshold rises to four times the per-reading noise (the change
+    /// noise alone makes, twice: see the `binned_assess` module), so that noise does not
+    /// restart a good calibration; a magnet then has to move the set by that much.
     pub restart_threshold: f64,
     /// Share of bins holding readings before changes are monitored (0.75; re-binning about a
     /// moved origin merges a few readings, so a full turn typically leaves 50–64 of 64 filled).
@@ -45,6 +48,12 @@ pub struct BinnedEllipseConfig {
     /// accepts (0.1). The ellipse model leaves only noise; more means the readings are not a
     /// rotation in a constant field (a short arc lost in noise, a disturbance).
     pub max_residual_rel: f64,
+    /// Largest heading-error bound of the calibration accepted
+    /// ([`truenorth_core::CompassQuality::heading_error_bound_deg`] widened to the Student-t
+    /// quantile of the bins' residual degrees of freedom), degrees, > 0 (10, as the
+    /// least-squares fits'): a noisy arc can spread its binned readings over more headings
+    /// than it turned through, and this refuses what its arc tests let through.
+    pub max_heading_error_bound_deg: f64,
 }
 
 impl Default for BinnedEllipseConfig {
@@ -61,6 +70,7 @@ impl Default for BinnedEllipseConfig {
             min_samples_to_store: 256,
             min_arc_deg: MIN_ARC_DEG,
             max_residual_rel: 0.1,
+            max_heading_error_bound_deg: 10.0,
         }
     }
 }
@@ -129,6 +139,10 @@ impl Validate for BinnedEllipseConfig {
             self.max_residual_rel,
             0.0,
             f64::MAX,
+        )?;
+        check_positive(
+            "binned ellipse max_heading_error_bound_deg",
+            self.max_heading_error_bound_deg,
         )?;
         Ok(())
     }

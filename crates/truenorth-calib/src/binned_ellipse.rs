@@ -470,6 +470,7 @@ impl BinnedEllipseCalibrator {
         Assessor {
             config: &self.config,
             reference: &self.reference,
+            phasors: self.phasors.as_ref(),
             samples: self.samples,
         }
     }
@@ -531,6 +532,7 @@ impl Calibrator for BinnedEllipseCalibrator {
                 let assessor = Assessor {
                     config: &self.config,
                     reference: &self.reference,
+                    phasors: self.phasors.as_ref(),
                     samples: self.samples,
                 };
                 if let Some(u) = self.update.as_mut() {

@@ -90,7 +90,9 @@ impl Update {
                             .seed
                             .get_or_insert_with(|| assessor.seed_job(bins, &params));
                         if let Some(a) = seed.step() {
-                            let estimate = assessor.judge(&a, seed.calibration(), turned_deg).ok();
+                            let estimate = assessor
+                                .judge(&a, seed.calibration(), turned_deg, seed.points().len())
+                                .ok();
                             self.verdict = Some(Verdict::Accept(params, estimate));
                             self.seed = None;
                             self.phase = UpdatePhase::Apply;

@@ -26,8 +26,12 @@
 //!    or when the readings do not go all the way round.
 //! 7. Quality report from the monomial sums the direct fit already formed (see
 //!    [`crate::quality`]; one more pass over the readings for the coverage), and refusals
-//!    on coverage (arc shorter than [`EllipseConfig::min_arc_deg`] about the fitted centre,
-//!    or a raw locus that turns through less), conditioning, residual and heading bound.
+//!    on coverage (an arc shorter than [`EllipseConfig::min_arc_deg`] of calibrated
+//!    heading), on the residual and on the heading bound. None of them depends on the order
+//!    of the readings, and more readings consistent with the same calibration can only
+//!    widen the arc and shrink the bound. The condition number of the headings seen (each
+//!    0.5° once) is reported, not judged: a reading in a new direction adds information,
+//!    yet can raise the largest eigenvalue more than the smallest.
 //!
 //! An ellipse fit cannot see a rotation of the soft iron (any rotation of the corrected
 //! circle is another circle); choosing the symmetric root assumes the soft iron has none,
@@ -83,9 +87,6 @@ pub struct EllipseConfig {
     /// Largest ratio of the semi-axes accepted, ≥ 1 (10): flatter ellipses are refused as
     /// not an ellipse — no plausible soft iron squashes the field that much.
     pub max_axis_ratio: f64,
-    /// Largest condition number of the information matrix accepted, ≥ 1 (1e4; a full
-    /// circle gives 2): above it the geometry does not determine the calibration.
-    pub max_condition: f64,
     /// Largest residual RMS, relative to the fitted field, accepted, > 0 (0.2): readings
     /// that stray further from the best ellipse are not a rotation in a constant field
     /// (a static sensor, a disturbed site, a badly tilting mount).
@@ -106,7 +107,6 @@ impl Default for EllipseConfig {
             max_iterations: 100,
             min_arc_deg: MIN_ARC_DEG,
             max_axis_ratio: 10.0,
-            max_condition: 1e4,
             max_residual_rel: 0.2,
             max_heading_error_bound_deg: 10.0,
             expected_field: None,
@@ -124,7 +124,6 @@ impl Validate for EllipseConfig {
         )?;
         check_range("ellipse min_arc_deg", self.min_arc_deg, 0.0, 360.0)?;
         check_range("ellipse max_axis_ratio", self.max_axis_ratio, 1.0, f64::MAX)?;
-        check_range("ellipse max_condition", self.max_condition, 1.0, f64::MAX)?;
         check_positive("ellipse max_residual_rel", self.max_residual_rel)?;
         check_positive(
             "ellipse max_heading_error_bound_deg",
@@ -336,7 +335,7 @@ fn check_axis_ratio(e: &Ellipse, max_axis_ratio: f64) -> Result<()> {
 }
 
 /// Back from normalised coordinates: `q = (m − μ)/s` ⇒ centre `μ + s·c`, map `B/s`.
-fn denormalise(norm: &Normaliser<2>, e: &Ellipse) -> Ellipse {
+pub(crate) fn denormalise(norm: &Normaliser<2>, e: &Ellipse) -> Ellipse {
     Ellipse {
         centre: norm.centre + e.centre * norm.scale,
         unit_map: e.unit_map / norm.scale,
@@ -344,7 +343,7 @@ fn denormalise(norm: &Normaliser<2>, e: &Ellipse) -> Ellipse {
 }
 
 /// Parameter vector of the refinement: `(c_x, c_y, B₁₁, B₁₂, B₂₂)`.
-fn to_params(e: &Ellipse) -> SVector<f64, 5> {
+pub(crate) fn to_params(e: &Ellipse) -> SVector<f64, 5> {
     SVector::<f64, 5>::new(
         e.centre.x,
         e.centre.y,
@@ -354,7 +353,7 @@ fn to_params(e: &Ellipse) -> SVector<f64, 5> {
     )
 }
 
-fn from_params(p: &SVector<f64, 5>) -> Ellipse {
+pub(crate) fn from_params(p: &SVector<f64, 5>) -> Ellipse {
     Ellipse {
         centre: Vector2::new(p[0], p[1]),
         unit_map: Matrix2::new(p[2], p[3], p[3], p[4]),
@@ -372,7 +371,7 @@ fn from_params(p: &SVector<f64, 5>) -> Ellipse {
 /// through `A = B²`, a linear map of the parameter changes that is the same for every point,
 /// then gives the normal equations in the refinement's parameters `(c, B)` (see
 /// [`square_jacobian`]).
-fn sampson_normal_equations(
+pub(crate) fn sampson_normal_equations(
     points: &[Vector2<f64>],
     norm: &Normaliser<2>,
     p: &SVector<f64, 5>,
@@ -464,34 +463,11 @@ fn explain_short_arc(points: &[Vector2<f64>], config: &EllipseConfig, e: Error) 
     match circle_centre(points) {
         Some(c) => {
             let cov = quality::coverage(points, &c);
-            quality::require_arc(&cov, config.min_arc_deg)
+            quality::require_arc(&cov, 0.0, config.min_arc_deg)
                 .err()
                 .unwrap_or(e)
         }
         None => e,
-    }
-}
-
-/// Refuses readings whose raw locus, taken in the order given, turns through less than
-/// `need_deg` ([`quality::locus_turning_rad`], chords of at least a quarter of the fitted
-/// `field`), with [`Error::InsufficientCoverage`].
-///
-/// The coverage about the fitted centre cannot catch a short noisy arc on its own: a few
-/// readings a degree or two apart fit a small ellipse around themselves, and seen from its
-/// centre they cover the whole circle. The locus's own turning does not depend on any
-/// centre. Chords of a quarter of the field (about 14° of the fitted circle) are long
-/// compared with the noise of any reading the residual test accepts, so their directions
-/// follow the locus rather than the noise; the measure then errs short by up to one chord at
-/// each end (see [`quality::locus_turning_rad`]).
-fn require_locus_turning(points: &[Vector2<f64>], field: f64, need_deg: f64) -> Result<()> {
-    let turned_deg = quality::locus_turning_rad(points, 0.25 * field).to_degrees();
-    if turned_deg < need_deg {
-        Err(Error::InsufficientCoverage {
-            covered_deg: turned_deg.floor(),
-            need_deg,
-        })
-    } else {
-        Ok(())
     }
 }
 
@@ -538,13 +514,13 @@ fn fit_unchecked(
                 reason: "the fitted ellipse is not finite; check the input scale",
             });
         }
-        let coverage = quality::calibrated_coverage_2d(points, &cal);
+        let directions = quality::calibrated_directions_2d(points, &cal);
         let a = quality::assess_2d_from_moments(
             &moments,
             points.len(),
             &e.centre,
             &e.unit_map,
-            coverage,
+            directions,
             field,
         );
         Ok((cal, a))
@@ -555,6 +531,7 @@ fn fit_unchecked(
             "ellipse geometric refinement",
             to_params(&direct),
             config.max_iterations,
+            points.len(),
             |p| sampson_normal_equations(points, &norm, p),
         )?;
         let e = from_params(&out.params);
@@ -570,13 +547,11 @@ fn fit_unchecked(
         check_axis_ratio(&e, config.max_axis_ratio)?;
         (cal, a) = assess(&e)?;
     }
-    quality::require_arc(&a.coverage, config.min_arc_deg)?;
-    require_locus_turning(points, a.quality.field_magnitude, config.min_arc_deg)?;
-    if !(a.quality.fit.condition <= config.max_condition) {
-        return Err(Error::Degenerate {
-            reason: "the headings seen do not determine the ellipse (information matrix ill-conditioned); turn through a fuller circle",
-        });
-    }
+    quality::require_arc(
+        &a.coverage,
+        a.quality.heading_noise_rms_deg.to_radians(),
+        config.min_arc_deg,
+    )?;
     if !(a.quality.fit.residual_rms_rel <= config.max_residual_rel) {
         return Err(Error::NotAnEllipse {
             detail: " (the readings stray from the best ellipse by more than max_residual_rel of the field)",
@@ -585,14 +560,11 @@ fn fit_unchecked(
     // The refusal widens the bound to the Student-t quantile of its σ's degrees of freedom
     // (the report keeps the plain 3σ): a fit of a few readings estimates σ from one or two
     // residuals and can look certain by chance.
-    let dof = a.quality.fit.points as f64 - 5.0;
-    if !(a.quality.heading_error_bound_deg() * quality::t_factor_exact_small(dof)
-        <= config.max_heading_error_bound_deg)
-    {
-        return Err(Error::Degenerate {
-            reason: "the predicted heading error exceeds max_heading_error_bound_deg: too few readings or too much noise for the part of the circle covered; record a full turn away from magnetic disturbances",
-        });
-    }
+    quality::require_certain(
+        &a.quality,
+        a.quality.fit.points as f64 - 5.0,
+        config.max_heading_error_bound_deg,
+    )?;
     Ok(Solution {
         params: cal,
         quality: a.quality,

@@ -147,8 +147,8 @@ pub use online_ellipsoid::{
 };
 pub use speed_coefficient::{SpeedCoefficientCalibrator, SpeedCoefficientConfig, SpeedStep};
 pub use turn::{
-    MIN_TURN_SAMPLES, TurnCompassCalibrator, TurnConfig, TurnEllipse, TurnExtrema,
-    TurnExtremaSaved, TurnSaved, TurnTag,
+    DEFAULT_MAX_GAP_S, MIN_TURN_SAMPLES, TurnCompassCalibrator, TurnConfig, TurnEllipse,
+    TurnExtrema, TurnExtremaSaved, TurnSaved, TurnTag,
 };
 pub use turn_gyro::{
     MIN_REST_S, RawHeading, TurnCalibration, TurnCalibrator, TurnQuality, TurnSample,

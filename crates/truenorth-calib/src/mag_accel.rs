@@ -88,7 +88,11 @@ pub struct MagAccelSample {
 pub struct MagAccelConfig {
     /// The ellipsoid fits of step 1, one per sensor (their defaults).
     pub ellipsoid: EllipsoidConfig,
-    /// Most Levenberg–Marquardt steps of each joint refinement, 1..=10⁶ (200).
+    /// Most Levenberg–Marquardt steps of each joint refinement, 1..=10⁶ (1000: residual
+    /// groups of very different weights — a magnetometer far quieter than its accelerometer
+    /// — make a long curved valley that a recording of two turns and a long dwell took
+    /// about 700 steps to descend, in `tests/more_data.rs`; a well-spread recording
+    /// converges in a few dozen).
     pub max_iterations: usize,
     /// Look for runs of shots aimed at one target (`true`).
     pub find_runs: bool,
@@ -113,7 +117,7 @@ impl Default for MagAccelConfig {
     fn default() -> Self {
         Self {
             ellipsoid: EllipsoidConfig::default(),
-            max_iterations: 200,
+            max_iterations: 1000,
             find_runs: true,
             run_tolerance_deg: 10.0,
             run_min_roll_deg: 90.0,
@@ -412,6 +416,7 @@ pub fn fit_mag_accel(
     let no_runs: Vec<Range<usize>> = Vec::new();
     theta = refine(&data, &no_runs, &mut w, &r0, theta, config)?;
     // Step 4.
+    let (no_runs_theta, no_runs_w) = (theta, w);
     let mut runs = Vec::new();
     if config.find_runs {
         let frames: Vec<Option<Matrix3<f64>>> = (0..samples.len())
@@ -432,23 +437,67 @@ pub fn fit_mag_accel(
         }
     }
     // Step 5.
-    let (ne, sums) = normal_equations(&data, &runs, &w, &r0, &theta).ok_or(Error::Degenerate {
+    let with_runs = finish(
+        samples,
+        &data,
+        (&na, &nm),
+        &r0,
+        &theta,
+        &runs,
+        &w,
+        &mag,
+        config,
+    );
+    if runs.is_empty() || with_runs.is_ok() {
+        return with_runs;
+    }
+    // The runs are an option, not a condition: runs found by chance in a long recording
+    // (a few consecutive readings rolling about the pointing axis) can leave the pointing
+    // axis less certain than the calibration without them. Those readings still count as
+    // readings; only the pointing axis falls back to the accelerometer's x.
+    finish(
+        samples,
+        &data,
+        (&na, &nm),
+        &r0,
+        &no_runs_theta,
+        &[],
+        &no_runs_w,
+        &mag,
+        config,
+    )
+    .or(with_runs)
+}
+
+/// Step 5: the covariance, the calibration and its report, and the refusal on the heading
+/// bound (widened to the Student-t quantile of σ's degrees of freedom).
+#[allow(clippy::too_many_arguments)]
+fn finish(
+    samples: &[MagAccelSample],
+    data: &Data,
+    (na, nm): (&Normaliser<3>, &Normaliser<3>),
+    r0: &Rotation3<f64>,
+    theta: &SVector<f64, P>,
+    runs: &[Range<usize>],
+    w: &Weights,
+    mag: &[Vector3<f64>],
+    config: &MagAccelConfig,
+) -> Result<Solution<MagAccelCalibration, MagAccelQuality>> {
+    let (ne, sums) = normal_equations(data, runs, w, r0, theta).ok_or(Error::Degenerate {
         reason: "the joint fit left a reading at a sensor's centre; check the input",
     })?;
     let cov = ne.jtj.try_inverse().ok_or(Error::Degenerate {
         reason: "the readings do not determine the joint calibration (singular information); add readings in other orientations",
     })?;
     let out = assemble(
-        samples, &data, &na, &nm, &r0, &theta, &runs, &sums, &cov, &w, &mag, config,
+        samples, data, na, nm, r0, theta, runs, &sums, &cov, w, mag, config,
     )?;
     let dof = (3 * samples.len()) as f64 - (P - 2 * usize::from(runs.is_empty())) as f64;
-    if !(out.quality.mag.heading_error_bound_deg() * quality::t_factor_exact_small(dof.max(1.0))
-        <= config.max_heading_error_bound_deg)
-    {
-        return Err(Error::Degenerate {
-            reason: "the predicted heading error of the joint calibration exceeds max_heading_error_bound_deg: too few readings, too much noise, or orientations that do not determine it; add shots in other orientations",
-        });
-    }
+    quality::require_certain(
+        &out.quality.mag,
+        dof.max(1.0),
+        config.max_heading_error_bound_deg,
+    )?;
     Ok(out)
 }
 
@@ -568,6 +617,9 @@ fn refine(
             "joint magnetometer + accelerometer refinement",
             theta,
             config.max_iterations,
+            // Three residuals per reading (accelerometer, magnetometer, dip), and one per
+            // shot in a run.
+            3 * data.acc.len() + runs.iter().map(|r| r.len()).sum::<usize>(),
             |t| normal_equations(data, runs, w, r0, t).map(|(ne, _)| ne),
         )?;
         theta = out.params;

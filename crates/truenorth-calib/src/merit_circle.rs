@@ -403,7 +403,7 @@ impl MeritCircleCalibrator {
             });
         }
         let cov = coverage(&buf[..n], &centre);
-        require_arc(&cov, self.config.min_arc_deg)?;
+        require_arc(&cov, 0.0, self.config.min_arc_deg)?;
         Ok((cal, field, buf, n, cov))
     }
 }

@@ -8,12 +8,12 @@
 //! representative for coverage: O(1), no allocation. Every
 //! [`OnlineEllipseConfig::refresh_interval_samples`] readings a refresh of the estimate
 //! starts on a copy of the sums and runs one short stage per push (normalise; direct fit;
-//! coverage; residual, information matrix and the raw locus's own turning; heading-error
-//! bound and refusals; the `online_ellipse_refresh` module), so that no push pays for a
-//! whole solve. A refresh publishes only what [`Calibrator::solve`] would accept: both run
-//! the same stages and refusals, including the turning of the locus's tangent, which no arc
-//! of half a turn or less can pass whatever its noise (coverage about the fitted centre
-//! alone can: a short noisy arc pulls the fitted centre towards itself).
+//! coverage; residual, information matrix and the condition of the headings seen;
+//! heading-error bound and refusals; the `online_ellipse_refresh` module), so that no push
+//! pays for a whole solve. A refresh publishes only what [`Calibrator::solve`] would
+//! accept: both run the same stages and refusals, those of the batch fit. None depends on
+//! the order of the readings (the sums do not, and coverage is measured on the readings
+//! retained per direction, seen through the fitted calibration).
 //!
 //! What the sums cannot give exactly is approximated to first order in the residuals, which
 //! are small whenever a calibration is accepted:

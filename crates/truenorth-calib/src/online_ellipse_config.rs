@@ -28,8 +28,6 @@ pub struct OnlineEllipseConfig {
     pub forgetting_half_life_samples: Option<f64>,
     /// Largest ratio of the semi-axes accepted, ≥ 1 (10).
     pub max_axis_ratio: f64,
-    /// Largest condition number of the information matrix accepted, ≥ 1 (1e4).
-    pub max_condition: f64,
     /// Largest residual RMS, relative to the fitted field, accepted, > 0 (0.2).
     pub max_residual_rel: f64,
     /// Largest heading-error bound of the calibration accepted, degrees, > 0 (10).
@@ -47,7 +45,6 @@ impl Default for OnlineEllipseConfig {
             refresh_interval_samples: 32,
             forgetting_half_life_samples: None,
             max_axis_ratio: 10.0,
-            max_condition: 1e4,
             max_residual_rel: 0.2,
             max_heading_error_bound_deg: 10.0,
             expected_field: None,
@@ -76,12 +73,6 @@ impl Validate for OnlineEllipseConfig {
         check_range(
             "online ellipse max_axis_ratio",
             self.max_axis_ratio,
-            1.0,
-            f64::MAX,
-        )?;
-        check_range(
-            "online ellipse max_condition",
-            self.max_condition,
             1.0,
             f64::MAX,
         )?;

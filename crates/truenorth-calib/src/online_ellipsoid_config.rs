@@ -5,15 +5,17 @@ use truenorth_core::{Result, Validate, check_positive, check_range};
 
 use crate::ellipsoid_fit::MIN_POINTS_3D;
 use crate::online_conic::OnlineConfig;
-use crate::quality::MIN_SPHERE_COVERAGE;
+use crate::quality::{self, MIN_SPHERE_COVERAGE};
 
 /// Configuration of [`crate::OnlineEllipsoidCalibrator`]. The refusal limits are those of
 /// [`crate::EllipsoidConfig`], with the same defaults.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct OnlineEllipsoidConfig {
-    /// Smallest share of the sphere's direction cells accepted, 0..=1
-    /// ([`MIN_SPHERE_COVERAGE`]).
+    /// Share of the sphere's direction cells, 0..=1 ([`MIN_SPHERE_COVERAGE`]), below which
+    /// a fit that fails (a hyperboloid, a flat or collapsed quadric) is explained as too
+    /// little of the sphere seen. It refuses nothing on its own: whether the orientations
+    /// determine the calibration is judged by their dilution, as the batch fit's.
     pub min_coverage: f64,
     /// Fewest readings a solution is accepted from, MIN_POINTS_3D..=10⁶ (50). More than the
     /// fit's minimum ([`MIN_POINTS_3D`]): a refresh runs unattended, and with few residuals
@@ -28,12 +30,14 @@ pub struct OnlineEllipsoidConfig {
     pub forgetting_half_life_samples: Option<f64>,
     /// Largest ratio of longest to shortest semi-axis accepted, ≥ 1 (10).
     pub max_axis_ratio: f64,
-    /// Largest condition number of the information matrix accepted, ≥ 1 (1e4).
-    pub max_condition: f64,
     /// Largest residual RMS, relative to the fitted field, accepted, > 0 (0.2).
     pub max_residual_rel: f64,
     /// Largest direction-error bound of the calibration accepted, degrees, > 0 (10).
     pub max_heading_error_bound_deg: f64,
+    /// Largest per-reading noise (relative to the field) times the orientations' dilution
+    /// accepted, > 0 ([`quality::MAX_NOISE_DILUTION`]: beyond it the fit's own error figures
+    /// no longer hold; see [`quality::require_linear`]).
+    pub max_noise_dilution: f64,
     /// The expected total field, input unit, > 0, reported as
     /// [`truenorth_core::CompassQuality::field_ratio_to_expected`] (`None`).
     pub expected_field: Option<f64>,
@@ -47,9 +51,9 @@ impl Default for OnlineEllipsoidConfig {
             refresh_interval_samples: 64,
             forgetting_half_life_samples: None,
             max_axis_ratio: 10.0,
-            max_condition: 1e4,
             max_residual_rel: 0.2,
             max_heading_error_bound_deg: 10.0,
+            max_noise_dilution: quality::MAX_NOISE_DILUTION,
             expected_field: None,
         }
     }
@@ -84,16 +88,14 @@ impl Validate for OnlineEllipsoidConfig {
             1.0,
             f64::MAX,
         )?;
-        check_range(
-            "online ellipsoid max_condition",
-            self.max_condition,
-            1.0,
-            f64::MAX,
-        )?;
         check_positive("online ellipsoid max_residual_rel", self.max_residual_rel)?;
         check_positive(
             "online ellipsoid max_heading_error_bound_deg",
             self.max_heading_error_bound_deg,
+        )?;
+        check_positive(
+            "online ellipsoid max_noise_dilution",
+            self.max_noise_dilution,
         )?;
         if let Some(f) = self.expected_field {
             check_positive("online ellipsoid expected_field", f)?;

@@ -12,15 +12,17 @@ use nalgebra::{Matrix3, Matrix4, SMatrix, SVector, Vector3, Vector6};
 use truenorth_compass::CompassCalibration3d;
 use truenorth_core::{Error, FitQuality, Mag3Sample, Result, Solution};
 
+use crate::conic_sums::inverse_factor;
 use crate::conic_sums::{ConicSums, LAYOUT_3D, MONOMIALS_3D, Retained};
 use crate::ellipsoid_fit::{
-    Ellipsoid, li_griffiths_constraint, quadratic_part, quadric_to_ellipsoid,
+    Ellipsoid, ORIENTATION_HINT, li_griffiths_constraint, quadratic_part, quadric_to_ellipsoid,
 };
 use crate::linalg::{condition_from_eigenvalues, constrained_min6, sym_eigen3, sym_eigen6};
-use crate::quality::{self, SPHERE_BANDS, SPHERE_CELLS, SPHERE_SECTORS, turns};
+use crate::quality::Uncertainty;
+use crate::quality::{self, SPHERE_CELLS};
 
 use crate::online_conic::{
-    ConicRefresh, RefreshBase, Refusals, bound_deg, noise_factor, refuse_fit, report,
+    ConicRefresh, RefreshBase, bound_deg, direct_fit_bias_rad, noise_factor, refuse_fit, report,
 };
 use crate::online_ellipsoid_config::OnlineEllipsoidConfig;
 
@@ -29,28 +31,32 @@ use truenorth_core::Float as _;
 
 /// Parameters of the direction-error model (centre 3, symmetric soft iron 6).
 const PARAMS: usize = 9;
+/// Entries of the upper triangle of a `PARAMS × PARAMS` matrix.
+const UPPER: usize = PARAMS * (PARAMS + 1) / 2;
 
 /// Test directions of the bound (a Fibonacci lattice, as the batch report), and how many a
 /// refresh stage visits.
 const BOUND_DIRECTIONS: usize = 256;
-const BOUND_CHUNK: usize = 32;
+/// 16: each direction is visited for the bound and for the support's dilution.
+const BOUND_CHUNK: usize = 16;
 
 /// Stages of a refresh: pre-check, normalise, the direct fit in three (reduction, the
-/// constrained minimum, the ellipsoid), coverage, information matrix, its condition in
-/// sweeps of a Jacobi eigen-solver, the bound in chunks, and the report.
-const JACOBI_FIRST_STAGE: u8 = 7;
+/// constrained minimum, the ellipsoid), coverage, information matrix, the support's in two
+/// halves of the retained readings, its condition in sweeps of a Jacobi eigen-solver, the
+/// bound in chunks, and the report.
+const SUPPORT_FIRST_STAGE: u8 = 6;
+const SUPPORT_STAGES: u8 = 2;
+const JACOBI_FIRST_STAGE: u8 = SUPPORT_FIRST_STAGE + SUPPORT_STAGES;
+const _: () = assert!(SPHERE_CELLS.is_multiple_of(SUPPORT_STAGES as usize));
 const JACOBI_STAGES: u8 = 4;
 /// Jacobi sweeps per stage (a sweep is 36 rotations of two rows and columns).
 const SWEEPS_PER_STAGE: usize = 2;
 const BOUND_FIRST_STAGE: u8 = JACOBI_FIRST_STAGE + JACOBI_STAGES;
 pub(crate) const STAGES: u8 = BOUND_FIRST_STAGE + (BOUND_DIRECTIONS / BOUND_CHUNK) as u8 + 1;
 
-/// What the refusals of an ill-conditioned, stray or too uncertain ellipsoid say.
-const REFUSALS: Refusals = Refusals {
-    ill_conditioned: "the orientations seen do not determine the ellipsoid (information matrix ill-conditioned); tumble the sensor about a third axis",
-    stray: " (the readings stray from the best ellipsoid by more than max_residual_rel of the field)",
-    uncertain: "the predicted heading error exceeds max_heading_error_bound_deg: too few readings or too much noise for the part of the sphere covered; record a full tumble away from magnetic disturbances",
-};
+/// What the refusal of a stray ellipsoid says.
+const STRAY: &str =
+    " (the readings stray from the best ellipsoid by more than max_residual_rel of the field)";
 
 pub(crate) type Sums = ConicSums<3, MONOMIALS_3D>;
 pub(crate) type Slots = Retained<3, SPHERE_CELLS>;
@@ -61,17 +67,7 @@ type Base = RefreshBase<3, MONOMIALS_3D, SPHERE_CELLS, CompassCalibration3d>;
 #[inline]
 pub(crate) fn cell(h: &Vector3<f64>) -> Option<usize> {
     let n = h.norm();
-    if !(n > 0.0 && n.is_finite()) {
-        return None;
-    }
-    let band = (((h.z / n).clamp(-1.0, 1.0) + 1.0) * 0.5 * SPHERE_BANDS as f64) as usize;
-    let t = if h.x == 0.0 && h.y == 0.0 {
-        0.0
-    } else {
-        turns(h.y, h.x)
-    };
-    let sector = ((t * SPHERE_SECTORS as f64) as usize).min(SPHERE_SECTORS - 1);
-    Some(band.min(SPHERE_BANDS - 1) * SPHERE_SECTORS + sector)
+    (n > 0.0 && n.is_finite()).then(|| quality::sphere_cell(h.x, h.y, h.z, n) as usize)
 }
 
 /// Share of the cells holding a live retained reading, seen through calibration `m`.
@@ -202,6 +198,15 @@ pub(crate) struct Refresh {
     sigma: f64,
     l_inv: Option<SMatrix<f64, PARAMS, PARAMS>>,
     worst: f64,
+    /// The direct fit's bias bound, radians (see `crate::online_conic::direct_fit_bias_rad`).
+    bias_rad: f64,
+    /// The support's information matrix (upper triangle, row by row) while it is summed,
+    /// then its inverse factor, its cells, and the worst of `trace(G A⁻¹ Gᵀ)` over the
+    /// directions visited so far for it.
+    support_sums: [f64; UPPER],
+    support_l_inv: Option<SMatrix<f64, PARAMS, PARAMS>>,
+    support_cells: usize,
+    support_worst: f64,
 }
 
 impl Refresh {
@@ -209,10 +214,21 @@ impl Refresh {
         self.base.fail(e, STAGES);
     }
 
-    /// Stage 0: too few readings; as the batch fit, refuse before fitting when, seen from
-    /// the centre of their bounding box, the readings fill too few direction cells.
-    fn pre_check(&mut self, cfg: &OnlineEllipsoidConfig, lifetime: u64) {
-        if !self.base.require_samples(cfg.min_samples, STAGES) {
+    /// Stage 0: too few readings.
+    fn pre_check(&mut self, cfg: &OnlineEllipsoidConfig) {
+        self.base.require_samples(cfg.min_samples, STAGES);
+    }
+
+    /// After a stage of the fit: a fit that failed on readings that, seen from the centre
+    /// of their bounding box, fill less than [`OnlineEllipsoidConfig::min_coverage`] of the
+    /// direction cells is better explained by that (a turn about one axis, a small patch of
+    /// orientations) than by the symptom (a hyperboloid, a flat quadric). Explains; never
+    /// refuses a fit that succeeded, so more readings cannot turn into a refusal here.
+    fn explain_failure(&mut self, cfg: &OnlineEllipsoidConfig, lifetime: u64) {
+        if !matches!(
+            self.base.outcome,
+            Some(Err(Error::NotAnEllipse { .. } | Error::Degenerate { .. }))
+        ) {
             return;
         }
         let now = self.base.sums.count;
@@ -230,7 +246,7 @@ impl Refresh {
                 soft_iron: Matrix3::identity(),
             })
             .filter(|m| m.hard_iron.iter().all(|x| x.is_finite()));
-            self.fail(e);
+            self.base.outcome = Some(Err(e));
         }
     }
 
@@ -377,10 +393,78 @@ impl Refresh {
         let info = p * su * p.transpose();
         self.info = (info + info.transpose()) * 0.5;
         (self.sigma, self.l_inv) = noise_factor(&self.base.sums, ss, &self.info);
+        // The design vector's sums, (Σx², Σy², Σz², 2Σyz, 2Σxz, 2Σxy, 2Σx, 2Σy, 2Σz, Σ1) of
+        // the calibrated directions: their harmonics (h₂ the distance of their second
+        // moment from I/3, over √(2/3), its value for readings all in one direction), and
+        // the anisotropy of B².
+        let c = su.column(9);
+        let n = c[9];
+        let h1 = Vector3::new(c[6], c[7], c[8]).norm() / (2.0 * n);
+        let m = Matrix3::new(
+            c[0],
+            0.5 * c[5],
+            0.5 * c[4],
+            0.5 * c[5],
+            c[1],
+            0.5 * c[3],
+            0.5 * c[4],
+            0.5 * c[3],
+            c[2],
+        ) / n
+            - Matrix3::identity() / 3.0;
+        let h2 = m.norm() / (2.0f64 / 3.0).sqrt();
+        let kappa = sym_eigen3(&(e.unit_map * e.unit_map)).map_or(1.0, |(l, _)| {
+            let (hi, lo) = (l.max(), l.min());
+            ((hi - lo) / (hi + lo)).abs()
+        });
+        self.bias_rad = direct_fit_bias_rad(self.sigma, kappa, h1, h2);
     }
 
-    /// Stages 7–10: condition number of the information matrix, a few Jacobi sweeps per
-    /// stage (the last stage finishes the solver should it not have converged).
+    /// Stages 6–7: the information matrix of the support (see `crate::quality`'s `support`
+    /// module): the live retained readings, one per direction cell, each counted once, so
+    /// that its condition and dilution say what the orientations determine, whatever the
+    /// time spent in each; half of the cells per stage, the upper triangle only. The last
+    /// starts the Jacobi solver on it and keeps its inverse factor.
+    fn support(&mut self, half: usize, lifetime: u64) {
+        let now = self.base.sums.count;
+        let cells = SPHERE_CELLS / SUPPORT_STAGES as usize;
+        for j in half * cells..(half + 1) * cells {
+            if !self.base.slots.is_live(j, now, lifetime) {
+                continue;
+            }
+            let h = self.cal.correct(&self.base.slots.reading[j]);
+            let rho = h.norm();
+            if !(rho > 0.0 && rho.is_finite()) {
+                continue;
+            }
+            let phi = quality::regressor_3d(&(h / rho));
+            let mut k = 0;
+            for r in 0..PARAMS {
+                for c in r..PARAMS {
+                    self.support_sums[k] += phi[r] * phi[c];
+                    k += 1;
+                }
+            }
+            self.support_cells += 1;
+        }
+        if half + 1 == SUPPORT_STAGES as usize {
+            let mut a = SMatrix::<f64, PARAMS, PARAMS>::zeros();
+            let mut k = 0;
+            for r in 0..PARAMS {
+                for c in r..PARAMS {
+                    (a[(r, c)], a[(c, r)]) = (self.support_sums[k], self.support_sums[k]);
+                    k += 1;
+                }
+            }
+            self.jacobi = Jacobi9::new(&a);
+            self.support_l_inv = (self.support_cells >= PARAMS)
+                .then(|| inverse_factor(&a))
+                .flatten();
+        }
+    }
+
+    /// Stages 8–11: condition number of the support's information matrix, a few Jacobi
+    /// sweeps per stage (the last stage finishes the solver should it not have converged).
     fn condition(&mut self, last: bool) {
         let converged = if last {
             self.jacobi.finish()
@@ -396,9 +480,10 @@ impl Refresh {
         }
     }
 
-    /// Stages 11–18: the worst of `trace(G A⁻¹ Gᵀ)` over 32 of the lattice directions,
+    /// Stages 12–27: the worst of `trace(G A⁻¹ Gᵀ)` over 16 of the lattice directions,
     /// `G(u)` the Jacobian of the direction error `(I − uuᵀ)(E u − d)` (see
-    /// `crate::quality`).
+    /// `crate::quality`), for the bound (`A` of every reading) and for the support's
+    /// dilution.
     fn bound_chunk(&mut self, chunk: usize) {
         let Some(l) = self.l_inv else { return };
         let golden = core::f64::consts::PI * (3.0 - 5.0_f64.sqrt());
@@ -424,6 +509,25 @@ impl Refresh {
                 g.set_column(3 + j, &(proj * eu));
             }
             self.worst = self.worst.max((l * g.transpose()).norm_squared());
+            if let Some(ls) = self.support_l_inv {
+                self.support_worst = self.support_worst.max((ls * g.transpose()).norm_squared());
+            }
+        }
+    }
+
+    /// What the orientations determine: the support's dilution (see `crate::quality`).
+    fn uncertainty(&self) -> Uncertainty {
+        let dilution = match self.support_l_inv {
+            Some(_) => (self.support_cells as f64 * self.support_worst).sqrt(),
+            None => f64::INFINITY,
+        };
+        Uncertainty {
+            dilution: if dilution.is_finite() {
+                dilution
+            } else {
+                f64::INFINITY
+            },
+            ..Uncertainty::UNDETERMINED
         }
     }
 
@@ -436,18 +540,32 @@ impl Refresh {
             condition: self.condition,
         };
         let bound = bound_deg(self.sigma, self.l_inv.map(|_| self.worst));
-        let quality = report(fit, bound, self.sigma, self.field, cfg.expected_field);
-        let checked =
-            quality::require_sphere_coverage(self.coverage, cfg.min_coverage).and_then(|()| {
-                refuse_fit(
-                    &quality,
-                    cfg.max_condition,
-                    cfg.max_residual_rel,
-                    cfg.max_heading_error_bound_deg,
-                    self.base.t_factor(PARAMS),
-                    &REFUSALS,
-                )
-            });
+        let quality = report(
+            fit,
+            bound,
+            self.bias_rad,
+            self.sigma,
+            self.field,
+            cfg.expected_field,
+        );
+        let checked = quality::require_determined(
+            &self.uncertainty(),
+            3,
+            cfg.max_heading_error_bound_deg,
+            ORIENTATION_HINT,
+        )
+        .and_then(|()| {
+            quality::require_linear(&self.uncertainty(), self.sigma, cfg.max_noise_dilution)
+        })
+        .and_then(|()| {
+            refuse_fit(
+                &quality,
+                cfg.max_residual_rel,
+                cfg.max_heading_error_bound_deg,
+                self.base.residual_dof(PARAMS),
+                STRAY,
+            )
+        });
         self.base.outcome = Some(checked.map(|()| Solution {
             params: self.cal,
             quality,
@@ -510,19 +628,35 @@ impl ConicRefresh<3, MONOMIALS_3D, SPHERE_CELLS> for Refresh {
             condition: f64::INFINITY,
             sigma: f64::INFINITY,
             l_inv: None,
+            bias_rad: 0.0,
+            support_sums: [0.0; UPPER],
+            support_l_inv: None,
+            support_cells: 0,
+            support_worst: 0.0,
             worst: 0.0,
         }
     }
 
     fn run_stage(&mut self, stage: u8, cfg: &OnlineEllipsoidConfig, lifetime: u64) {
         match stage {
-            0 => self.pre_check(cfg, lifetime),
-            1 => self.reduce_stage(),
-            2 => self.constrained_stage(),
-            3 => self.fit(cfg),
+            0 => self.pre_check(cfg),
+            1 => {
+                self.reduce_stage();
+                self.explain_failure(cfg, lifetime);
+            }
+            2 => {
+                self.constrained_stage();
+                self.explain_failure(cfg, lifetime);
+            }
+            3 => {
+                self.fit(cfg);
+                self.explain_failure(cfg, lifetime);
+            }
             4 => self.cover(lifetime),
             5 => self.inform(),
-            6 => self.jacobi = Jacobi9::new(&self.info),
+            s if s < JACOBI_FIRST_STAGE => {
+                self.support(usize::from(s - SUPPORT_FIRST_STAGE), lifetime);
+            }
             s if s < BOUND_FIRST_STAGE => self.condition(s == BOUND_FIRST_STAGE - 1),
             s if s < STAGES - 1 => self.bound_chunk(usize::from(s - BOUND_FIRST_STAGE)),
             _ => self.finish(cfg),

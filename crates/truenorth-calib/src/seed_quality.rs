@@ -16,7 +16,7 @@
 use nalgebra::{Matrix3, Vector2, Vector3};
 use truenorth_compass::CompassCalibration2d;
 
-use crate::quality::{Assessment2d, Coverage, assess_2d};
+use crate::quality::{Assessment2d, Coverage, Support2d, SupportFigures, assess_2d};
 
 #[allow(unused_imports)]
 use truenorth_core::Float as _;
@@ -91,13 +91,14 @@ pub(crate) fn seed_assessment(
 
 /// What the one pass over the readings of [`assess_2d`] leaves for the report: the sums of
 /// the information matrix's twelve monomials, the sum of the squared residuals, the count of
-/// usable readings and their coverage.
+/// usable readings, their coverage and the support of their directions.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct ReportSums {
     pub sums: [f64; 12],
     pub ss: f64,
     pub n: usize,
     pub coverage: Coverage,
+    pub support: Support2d,
 }
 
 /// Most readings a [`SeedJob`] holds (the binned ellipse's most bins).
@@ -110,17 +111,17 @@ enum SeedStage {
     Sums,
     /// Next: the two-cycle fit.
     TwoCycle(ReportSums),
-    /// Next: the condition number of the information matrix.
+    /// Next: the condition number and the dilution of the support's information matrix.
     Condition(ReportSums, (f64, Option<f64>)),
     /// Next: the error bound and the report.
-    Report(ReportSums, (f64, Option<f64>), f64),
+    Report(ReportSums, (f64, Option<f64>), SupportFigures),
     /// Finished.
     Done(Assessment2d),
 }
 
 /// [`seed_assessment`] split into [`SeedJob::STEPS`] bounded steps that can run on
 /// consecutive pushes: the pass of the shared report over the readings, the two-cycle fit,
-/// the condition number, then the error bound and the report. The job holds a copy of its
+/// the support's condition number and dilution, then the error bound and the report. The job holds a copy of its
 /// readings, so the caller's may change meanwhile (double buffering); the steps do exactly
 /// the arithmetic of the call in one go, in the same order, so the result is the same bit
 /// for bit, and replaying a count of steps from [`SeedJob::start`] rebuilds a job exactly.
@@ -196,10 +197,10 @@ impl SeedJob {
                 SeedStage::Condition(s, two_cycle_fit(pts, &self.cal, self.field))
             }
             SeedStage::Condition(s, fit) => {
-                SeedStage::Report(s, fit, Assessment2d::condition_of(&s))
+                SeedStage::Report(s, fit, Assessment2d::support_figures(&s))
             }
-            SeedStage::Report(s, fit, condition) => SeedStage::Done(seed_report(
-                Assessment2d::from_sums(&s, condition, self.field),
+            SeedStage::Report(s, fit, support) => SeedStage::Done(seed_report(
+                Assessment2d::from_sums(&s, support, self.field),
                 fit,
                 self.samples_used,
             )),

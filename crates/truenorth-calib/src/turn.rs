@@ -35,8 +35,8 @@ use serde::{Deserialize, Serialize};
 use truenorth_compass::CompassCalibration2d;
 use truenorth_core::{
     Calibrator, CompassQuality, Error, Mag2Sample, Persistent, Progress, Pushed, Result, Snapshot,
-    Solution, TimeStep, Validate, angle_diff, check_finite, check_finite2, check_range,
-    check_snapshot_version,
+    Solution, TimeStep, Validate, angle_diff, check_finite, check_finite2, check_positive,
+    check_range, check_snapshot_version,
 };
 
 use crate::direction_slots::{DirectionSlots, SLOTS};
@@ -244,8 +244,19 @@ impl<T: Copy> TurnExtrema<T> {
 
     /// The signed angle turned (positive = right turn), measured about `centre` with the axes
     /// scaled by `radii`, by unwrapping the sequence first reading → extrema of both axes in
-    /// time order → last reading (consecutive ones are about a quarter turn apart, so the
-    /// unwrapping is unambiguous). Constant memory.
+    /// time order → last reading. Constant memory.
+    ///
+    /// Consecutive extrema are about a quarter turn apart, so the steps between them unwrap
+    /// without ambiguity, and one that goes backwards by more than [`REVERSAL_RAD`] means the
+    /// turn reversed. The two steps at the ends are not so bounded: an extremum is confirmed
+    /// only once the signal has retreated from it by the tracker's hysteresis, which on a
+    /// coarsely sampled turn (tens of degrees per reading) can lag it by more than half a
+    /// turn, so the last reading may lie more than 180° past the last confirmed extremum. An
+    /// end step is therefore read in the direction the extrema turned, unless it goes back
+    /// by more than [`REVERSAL_RAD`] and less than a quarter turn (a retreat that far could
+    /// not have passed the next extremum unconfirmed); a retreat of more than a quarter turn
+    /// past an extremum confirms a new extremum on the way back, which the steps between
+    /// extrema see.
     fn turned_rad(&self, centre: &Vector2<f64>, radii: &Vector2<f64>) -> Result<f64> {
         let (Some(first), Some(last)) = (self.first, self.last) else {
             return Ok(0.0);
@@ -260,16 +271,9 @@ impl<T: Copy> TurnExtrema<T> {
             |p: &Vector2<f64>| ((p.y - centre.y) / radii.y).atan2((p.x - centre.x) / radii.x);
         let mut xs = self.x.extrema().peekable();
         let mut ys = self.y.extrema().peekable();
-        let mut prev = phase(&first);
-        let (mut total, mut forward, mut backward) = (0.0f64, 0.0f64, 0.0f64);
-        let mut step_to = |p: &Vector2<f64>, total: &mut f64| {
-            let a = phase(p);
-            let s = angle_diff(a, prev);
-            prev = a;
-            *total += s;
-            forward = forward.max(s);
-            backward = backward.min(s);
-        };
+        // At most MAX_EXTREMA per axis (checked above).
+        let mut buf = [0.0; 2 * MAX_EXTREMA];
+        let mut len = 0;
         loop {
             let next = match (xs.peek(), ys.peek()) {
                 (Some(a), Some(b)) if a.index <= b.index => xs.next(),
@@ -279,14 +283,41 @@ impl<T: Copy> TurnExtrema<T> {
                 (None, None) => break,
             };
             if let Some(e) = next {
-                step_to(&e.tag.point, &mut total);
+                buf[len] = phase(&e.tag.point);
+                len += 1;
             }
         }
-        step_to(&last, &mut total);
-        if forward > REVERSAL_RAD && backward < -REVERSAL_RAD {
+        let points = &buf[..len];
+        let inner: f64 = points.windows(2).map(|w| angle_diff(w[1], w[0])).sum();
+        let reversed = |s: f64, dir: f64| s * dir < -REVERSAL_RAD;
+        let (start, end) = match (points.first(), points.last()) {
+            (Some(&a), Some(&b)) => (angle_diff(a, phase(&first)), angle_diff(phase(&last), b)),
+            _ => (angle_diff(phase(&last), phase(&first)), 0.0),
+        };
+        let dir = if points.len() >= 2 {
+            inner.signum()
+        } else {
+            (start + end).signum()
+        };
+        if points
+            .windows(2)
+            .any(|w| reversed(angle_diff(w[1], w[0]), dir))
+        {
             return Err(Error::Degenerate {
-                reason: "the turn changed direction; record one steady turn (at least 360° one way)",
+                reason: "the turn changed direction; calibrate on one steady turn (at least 360° one way): cut the record where the turn ends",
             });
+        }
+        let mut total = inner;
+        for s in [start, end] {
+            total += if !reversed(s, dir) {
+                s
+            } else if s * dir < -core::f64::consts::FRAC_PI_2 {
+                s + dir * TAU
+            } else {
+                return Err(Error::Degenerate {
+                    reason: "the turn changed direction; calibrate on one steady turn (at least 360° one way): cut the record where the turn ends",
+                });
+            };
         }
         Ok(-total)
     }
@@ -301,16 +332,23 @@ impl<T: Copy> TurnExtrema<T> {
                 need: MIN_TURN_SAMPLES,
             });
         }
-        let paired = self.averaged_pairs();
-        let (centre, radii, pairs) = paired.unwrap_or_else(|| {
-            let (x0, x1) = self.x.range();
-            let (y0, y1) = self.y.range();
-            (
-                self.provisional_centre(),
-                Vector2::new(0.5 * (x1 - x0), 0.5 * (y1 - y0)),
-                (0, 0),
-            )
-        });
+        let (x0, x1) = self.x.range();
+        let (y0, y1) = self.y.range();
+        let swing = Vector2::new(0.5 * (x1 - x0), 0.5 * (y1 - y0));
+        if !(swing.x > 0.0 && swing.y > 0.0 && swing.x.is_finite() && swing.y.is_finite()) {
+            return Err(Error::Degenerate {
+                reason: "the magnetometer readings do not change on one axis; the compass did not turn, or an axis is dead",
+            });
+        }
+        // Without a maximum and a minimum on both axes there is no centre to measure the
+        // turn about (the middle of the ranges of a short arc lies on its chord, from which
+        // a 1° arc reads as half a turn), and the turn is short of a revolution: a full one
+        // passes both extrema of both axes.
+        let Some((centre, radii, pairs)) = self.averaged_pairs() else {
+            return Err(Error::Degenerate {
+                reason: "the compass has not passed a maximum and a minimum on both axes, so the turn is short of a full revolution (need at least 360° one way); turn on",
+            });
+        };
         if !(radii.x > 0.0 && radii.y > 0.0 && radii.x.is_finite() && radii.y.is_finite()) {
             return Err(Error::Degenerate {
                 reason: "the magnetometer readings do not change on one axis; the compass did not turn, or an axis is dead",
@@ -326,7 +364,7 @@ impl<T: Copy> TurnExtrema<T> {
         }
         let complete =
             |t: &ExtremumTracker<TurnTag<T>>| t.has(ExtremumKind::Max) && t.has(ExtremumKind::Min);
-        if paired.is_none() || !complete(&self.x) || !complete(&self.y) {
+        if !complete(&self.x) || !complete(&self.y) {
             return Err(Error::Degenerate {
                 reason: "a magnetometer maximum or minimum lies at the start or end of the record, where the true extremum may be outside it; turn on for another quarter turn",
             });
@@ -359,12 +397,25 @@ pub struct TurnConfig {
     /// Shortest arc of calibrated headings accepted, degrees, 0..=360 ([`MIN_ARC_DEG`]; a
     /// full turn always passes).
     pub min_arc_deg: f64,
+    /// Longest step between two samples, seconds, > 0, that the gyro half
+    /// ([`crate::TurnCalibrator`]) integrates its rate across ([`DEFAULT_MAX_GAP_S`]); a
+    /// longer one is refused with [`Error::TimeGap`]. The compass half reads no time.
+    pub max_gap_s: f64,
 }
+
+/// The default [`TurnConfig::max_gap_s`]: 1 s. The trapezoid rule is exact across a step
+/// while the rate changes linearly, but a turn that starts or stops inside a step of `g`
+/// seconds can hide up to `Δr·g/2` of heading (Δr the change of rate): 10° for a 1-s step
+/// at the start of a 20°/s turn, a few per cent of the conversion constant from one
+/// revolution. A judgement: every logger sampling at 1 Hz or faster passes, a dropout of
+/// more than a second is refused rather than bridged.
+pub const DEFAULT_MAX_GAP_S: f64 = 1.0;
 
 impl Validate for TurnConfig {
     fn validate(&self) -> Result<()> {
         self.extrema.validate()?;
         check_range("turn min_arc_deg", self.min_arc_deg, 0.0, 360.0)?;
+        check_positive("turn max_gap_s", self.max_gap_s)?;
         Ok(())
     }
 }
@@ -374,6 +425,7 @@ impl Default for TurnConfig {
         Self {
             extrema: ExtremaConfig::default(),
             min_arc_deg: MIN_ARC_DEG,
+            max_gap_s: DEFAULT_MAX_GAP_S,
         }
     }
 }
@@ -446,6 +498,7 @@ impl TurnCompassCalibrator {
         let n = self.slots.collect(&mut buf);
         require_arc(
             &calibrated_coverage_2d(&buf[..n], &fit.calibration()),
+            0.0,
             self.config.min_arc_deg,
         )?;
         Ok((fit, buf, n))
@@ -630,14 +683,25 @@ mod tests {
 
     #[test]
     fn less_than_a_full_turn_is_refused() {
+        // 340° from just before the X maximum: both axes pass a maximum and a minimum, and
+        // the refusal gives the angle turned about the centre they place.
+        let c = run(sweep(-10.0, 340.0));
+        match c.solve() {
+            Err(Error::IncompleteTurn { turned_deg, .. }) => {
+                assert!((turned_deg - 340.0).abs() < 1.0, "{turned_deg}")
+            }
+            other => panic!("{other:?}"),
+        }
+        // 300° from 40° passes no X maximum, a third of a turn no extremum pair at all:
+        // there is no centre to measure the angle about, and the refusal says so without a
+        // figure.
         let c = run(sweep(40.0, 300.0));
-        assert!(
-            matches!(c.solve(), Err(Error::IncompleteTurn { .. })),
-            "{:?}",
-            c.solve()
-        );
+        assert!(matches!(c.solve(), Err(Error::Degenerate { .. })));
         let c = run(sweep(40.0, 120.0));
-        assert!(matches!(c.solve(), Err(Error::IncompleteTurn { .. })));
+        match c.solve() {
+            Err(Error::Degenerate { reason }) => assert!(reason.contains("360°"), "{reason}"),
+            other => panic!("{other:?}"),
+        }
     }
 
     #[test]

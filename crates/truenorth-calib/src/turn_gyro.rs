@@ -27,7 +27,9 @@
 //!
 //! Refusals: no standstill of at least [`MIN_REST_S`] at the start, a turn under 360°, an
 //! extremum at the edge of the record, a turn that reverses, fewer than two readings on
-//! either side of an extremum to place it.
+//! either side of an extremum to place it, and (at the sample after it) a step between
+//! samples longer than [`TurnConfig::max_gap_s`], across which the rate cannot be
+//! integrated: the calibrator never pairs extrema across a gap.
 
 use core::f64::consts::PI;
 
@@ -445,6 +447,7 @@ impl TurnCalibrator {
         let n = self.slots.collect(&mut buf);
         require_arc(
             &calibrated_coverage_2d(&buf[..n], &fit.calibration()),
+            0.0,
             self.config.min_arc_deg,
         )?;
         let (zero, zero_sigma, rest_s) = self.zero.or_else(|| self.find_zero()).ok_or(
@@ -512,13 +515,22 @@ impl Calibrator for TurnCalibrator {
     type Params = TurnCalibration;
     type Quality = TurnQuality;
 
-    /// Refuses a non-finite value or a timestamp that does not increase; a refused sample
-    /// changes nothing.
+    /// Refuses a non-finite value, a timestamp that does not increase, or one further than
+    /// [`TurnConfig::max_gap_s`] after the last ([`Error::TimeGap`]: the rate cannot be
+    /// integrated across it); a refused sample changes nothing.
     fn push(&mut self, sample: &TurnSample) -> Result<Pushed> {
         check_finite("gyr_z", sample.gyr_z_rps)?;
         check_finite2("magnetometer reading", &sample.mag)?;
         let mut clock = self.clock;
         let dt = clock.dt_s(sample.t_s)?;
+        if let Some(gap_s) = dt.filter(|&dt| dt > self.config.max_gap_s) {
+            return Err(Error::TimeGap {
+                what: "the gyro's integrated heading",
+                t_s: sample.t_s,
+                gap_s,
+                max_gap_s: self.config.max_gap_s,
+            });
+        }
         self.clock = clock;
         let t0 = *self.t0.get_or_insert(sample.t_s);
         if let Some(dt) = dt {

@@ -70,7 +70,8 @@ where
 {
     let every = samples.len().div_ceil(checkpoints).max(1);
     for (i, s) in samples.iter().enumerate() {
-        let _ = c.push(s);
+        c.push(s)
+            .map_err(|e| TestCaseError::fail(format!("sample {i} refused: {e}")))?;
         if (i + 1) % every == 0 || i + 1 == samples.len() {
             let ready = c.progress().ready;
             let first = c.solve();
@@ -232,7 +233,8 @@ where
 {
     let mut a = C::default();
     for s in &samples[..cut] {
-        let _ = a.push(s);
+        a.push(s)
+            .map_err(|e| TestCaseError::fail(format!("refused: {e}")))?;
     }
     let snap: Snapshot<C::State> = a.snapshot();
     let mut b = C::restore(snap.clone()).map_err(|e| TestCaseError::fail(format!("{e}")))?;

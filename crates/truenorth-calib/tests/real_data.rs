@@ -53,6 +53,9 @@ fn sunsided_full_sphere_field_constancy() {
     println!("  hard iron {:?}", sol.params.hard_iron.as_slice());
     println!("  soft iron {:?}", sol.params.soft_iron);
     println!("  quality {:?}", sol.quality);
+    // 1 %: the spread a consumer magnetometer keeps after calibration is under it (0.46 %
+    // here, 1.3 % for the unnamed tumbled sensor); the README's figure below is the binding
+    // check.
     assert!(after <= 0.01, "relative std {after}");
     // The raw spread depends on the data alone: equal to the README's to its rounding.
     assert!((100.0 * before - 13.62).abs() <= 0.005, "raw {before}");
@@ -136,6 +139,9 @@ fn sunsided_single_axis_turns_2d() {
         );
         assert_eq!(sol.quality.fit.coverage, 1.0);
         assert!(after < before);
+        // About a horizontal axis the in-plane field is the whole 0.48 G and a degree of
+        // wobble moves it by 1.7 % of itself, a degree of angle: the two calibrations agree
+        // within that (the README's figures below bind tighter).
         if horizontal_axis {
             assert!(rms.to_degrees() < 1.0, "{rec}: {}", rms.to_degrees());
         }
@@ -177,8 +183,13 @@ fn python_sample_fixture() {
         axes,
         sol.quality
     );
+    // The data's README: 37 % raw, 3.5 % after its general fit; ours models the same
+    // ellipsoid and may not do worse — it does better, and is held under 3 %.
     assert!(before > 0.3 && after < 0.03);
-    // The README's general fit puts the centre near (−65, 80, −130) counts.
+    // The README's general fit puts the centre near (−65, 80, −130) counts. With 347
+    // readings at 3.5 % of a 175-count field each centre component has about
+    // 0.035·175·√3/√347 = 0.6 counts of σ; 10 counts leaves room for the general fit's own
+    // (unreported) error and the rounding of its quoted centre.
     assert!((sol.params.hard_iron - Vector3::new(-64.8, 79.6, -130.1)).norm() < 10.0);
 }
 
@@ -203,6 +214,8 @@ fn ck_explorer_tumble() {
         100.0 * after,
         sol.quality
     );
+    // The data's README: 32 % raw, 1.3 % after an ellipsoid fit — a factor of 25; ten is the
+    // least a working fit gives, and the README's figure below binds.
     assert!(after < before / 10.0);
     assert!((100.0 * before - 32.0).abs() <= 0.05, "raw {before}");
     readme_figure(

@@ -278,7 +278,7 @@ fn field_norm_spread_of_ellipsoid_and_ellipsoid_accel() {
 /// and reported for where their forward axis points.
 #[test]
 fn sunsided_tilt_compensated_heading() {
-    let Some((ell, joint, _)) = full_sphere() else {
+    let Some((ell, joint, joint_quality, _)) = full_sphere_with_quality() else {
         return;
     };
     let mean = |v: &[Merged]| {
@@ -348,8 +348,19 @@ fn sunsided_tilt_compensated_heading() {
         .flat_map(|a| azimuths.iter().map(move |b| angle_diff(*a, *b).abs()))
         .fold(0.0, f64::max)
         .to_degrees();
-    println!("forward axes of the static poses within {spread:.1} deg of each other");
-    readme_figure("static poses' spread", spread, 19.0, 0.05, 4);
+    // The spread is the largest difference between two of the hand-placed poses: a
+    // property of how they were placed, which the calibration moves by at most its own
+    // heading bound at each of the two poses. The README's figure holds within that (an RMS
+    // rule over four values would allow twice it).
+    let bound = joint_quality.mag.heading_error_bound_deg();
+    println!(
+        "forward axes of the static poses within {spread:.1} deg of each other (calibration bound {bound:.2} deg)"
+    );
+    let limit = 19.0 + 0.05 + 2.0 * bound;
+    assert!(
+        spread <= limit,
+        "static poses' spread {spread} over {limit}"
+    );
     let methods: [(&str, Attitude); 2] = [
         (
             "ellipsoid + raw accelerometer",

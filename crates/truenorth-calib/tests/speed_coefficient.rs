@@ -25,7 +25,10 @@ fn drive(cal: &mut SpeedCoefficientCalibrator, seed: u64, a_true: f64) {
     // Timestamps continue from drive to drive, as a stored calibrator sees them.
     let t0 = 10_000.0 * seed as f64;
     for (w, t) in samples.windows(2).zip(drive.truth.iter().skip(1)) {
-        let (l, r) = (w[1].dist_l_m - w[0].dist_l_m, w[1].dist_r_m - w[0].dist_r_m);
+        let (Some(a), Some(b)) = (w[0].wheels, w[1].wheels) else {
+            continue;
+        };
+        let (l, r) = (b.dist_l_m - a.dist_l_m, b.dist_r_m - a.dist_r_m);
         let dt = w[1].t_s - w[0].t_s;
         let v = 0.5 * (l + r) / dt;
         let a = cal.coefficient();

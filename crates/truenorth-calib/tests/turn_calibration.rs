@@ -5,7 +5,7 @@
 
 use nalgebra::Vector2;
 use proptest::prelude::*;
-use truenorth_calib::{TurnCalibrator, TurnConfig, TurnSample};
+use truenorth_calib::{DEFAULT_MAX_GAP_S, TurnCalibrator, TurnConfig, TurnSample};
 use truenorth_core::{Calibrator, Error, angle_diff};
 use truenorth_sim::{DriveSpec, SimulatedDrive};
 
@@ -150,24 +150,90 @@ fn refuses_without_a_standstill_or_a_whole_turn() {
     assert!(cal.solve().is_err());
 }
 
+/// The next timestamp after `last_s`: anything at all, or a step that is valid, or a step
+/// longer than the calibrator integrates across (so that every branch is drawn often).
+fn next_time(last_s: f64) -> impl Strategy<Value = f64> {
+    prop_oneof![
+        proptest::num::f64::ANY,
+        (1e-6f64..DEFAULT_MAX_GAP_S).prop_map(move |dt| last_s + dt),
+        (DEFAULT_MAX_GAP_S * 1.000_001..1e6).prop_map(move |dt| last_s + dt),
+    ]
+}
+
 proptest! {
+    /// Any sample: accepted exactly when every value is finite and its time follows the last
+    /// by a positive step no longer than `max_gap_s`; a refused one is a typed error naming
+    /// the problem (a gap as [`Error::TimeGap`] with the true gap) and changes nothing; and
+    /// `ready` agrees with `solve` either way.
     #[test]
     fn no_panic_and_nothing_changes_on_bad_input(
-        t in proptest::num::f64::ANY, g in proptest::num::f64::ANY,
-        x in proptest::num::f64::ANY, y in proptest::num::f64::ANY,
+        t in next_time(opening_turn(1).0[199].t_s),
+        g in prop_oneof![Just(0.1), proptest::num::f64::ANY],
+        x in prop_oneof![Just(3.0), proptest::num::f64::ANY],
+        y in prop_oneof![Just(-2.0), proptest::num::f64::ANY],
     ) {
         let (samples, _) = opening_turn(1);
         let mut cal = TurnCalibrator::new(TurnConfig::default()).unwrap();
         for s in &samples[..200] {
             cal.push(s).unwrap();
         }
-        let before = format!("{:?}", cal.progress());
+        let before = (format!("{:?}", cal.progress()), cal.solve());
+        let last = samples[199].t_s;
         let bad = TurnSample { t_s: t, gyr_z_rps: g, mag: Vector2::new(x, y) };
-        let valid = [t, g, x, y].iter().all(|v| v.is_finite()) && t > samples[199].t_s;
-        prop_assert_eq!(cal.push(&bad).is_ok(), valid);
-        if !valid {
-            prop_assert_eq!(format!("{:?}", cal.progress()), before);
+        let finite = [t, g, x, y].iter().all(|v| v.is_finite());
+        let gap = t - last;
+        let valid = finite && gap > 0.0 && gap <= DEFAULT_MAX_GAP_S;
+        let pushed = cal.push(&bad);
+        prop_assert_eq!(pushed.is_ok(), valid, "{:?}", pushed);
+        if finite && gap > DEFAULT_MAX_GAP_S {
+            prop_assert_eq!(
+                pushed,
+                Err(Error::TimeGap { what: "the gyro's integrated heading", t_s: t, gap_s: gap, max_gap_s: DEFAULT_MAX_GAP_S })
+            );
         }
-        let _ = cal.solve();
+        if !valid {
+            prop_assert_eq!((format!("{:?}", cal.progress()), cal.solve()), before);
+        }
+        prop_assert_eq!(cal.progress().ready, cal.solve().is_ok());
     }
+}
+
+/// A record with an hour missing in the middle of its turn: the rate cannot be integrated
+/// across the gap, so the sample after it is refused with the gap it found, and what was
+/// learned before it is kept as it was (it once paired extrema across such a gap and gave
+/// a scale of 88.9 for a gyro of 1.02).
+#[test]
+fn a_gap_in_the_record_is_refused_not_bridged() {
+    let (samples, _) = opening_turn(2);
+    let mid = samples.len() / 2;
+    let mut cal = TurnCalibrator::new(TurnConfig::default()).unwrap();
+    for s in &samples[..mid] {
+        cal.push(s).unwrap();
+    }
+    let before = (format!("{:?}", cal.progress()), cal.solve());
+    let after_gap = TurnSample {
+        t_s: samples[mid].t_s + 3600.0,
+        ..samples[mid]
+    };
+    let gap = after_gap.t_s - samples[mid - 1].t_s;
+    match cal.push(&after_gap) {
+        Err(Error::TimeGap {
+            t_s,
+            gap_s,
+            max_gap_s,
+            ..
+        }) => {
+            assert_eq!(t_s, after_gap.t_s);
+            assert_eq!(gap_s, gap);
+            assert_eq!(max_gap_s, DEFAULT_MAX_GAP_S);
+        }
+        other => panic!("{other:?}"),
+    }
+    assert_eq!((format!("{:?}", cal.progress()), cal.solve()), before);
+    // The whole turn, without the gap, calibrates.
+    let mut whole = TurnCalibrator::new(TurnConfig::default()).unwrap();
+    for s in &samples {
+        whole.push(s).unwrap();
+    }
+    assert!(whole.solve().is_ok());
 }

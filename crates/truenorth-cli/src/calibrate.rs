@@ -9,7 +9,7 @@
 use std::path::PathBuf;
 
 use nalgebra::{SMatrix, SVector, Vector2, Vector3};
-use truenorth::calib::quality::{self, Grade, Uncertainty, Verdict};
+use truenorth::calib::quality::{self, Cause, Grade, Uncertainty, Verdict};
 use truenorth::calib::{
     BinnedEllipseCalibrator, EllipseCalibrator, EllipsoidCalibrator, MagAccelCalibrator,
     MagAccelConfig, MagAccelQuality, MagAccelSample, MeritCircleCalibrator,
@@ -116,15 +116,20 @@ later heading (3-D: the field direction error; ellipsoid-accel: the heading of t
 x axis): 3 standard deviations of the parameters' uncertainty plus what the method's
 model cannot remove; each reading's own noise (`heading_noise_rms_deg`) comes on top.
 `verdict`: `good` (bound ≤ 1°, noise ≤ 2°), `usable` (both ≤ 5°) or `poor`, with the
-number that decided it in `verdict_reason`.
+number that decided it in `verdict_reason` and `verdict_cause`: `calibration` (its own
+bound: record more readings, or a fuller turn or tumble) or `noise` (each reading
+scatters more than the grade allows while the calibration itself is within it: a noisy
+sensor, whose readings are worth averaging).
 
 A `poor` calibration is refused (exit 1) unless `--accept-poor`. With `--mag-unit`, a
 fitted field that is not a plausible Earth field in that unit (or, with --lat/--lon, more
 than 15 % from the World Magnetic Model's) is refused with the unit the data are
 probably in, unless `--accept-field-mismatch`. On success one summary line goes to
 stderr. Exit status 1 with one line on stderr when the file is bad or the data cannot
-support a calibration (too few points, orientations that do not determine it,
-degenerate, not an ellipse).
+support a calibration (too few points, too little of the circle, orientations that do
+not determine it whatever their count, too few readings for their noise, readings too
+noisy for their orientations, not an ellipse, or with `turn` and `gyr_z` a gap between
+rows longer than 1 s, across which the rate cannot be integrated).
 
 Example: a logger's file with columns `time;mx;my;mz;ax;ay;az`, sensor axes x forward,
 y left, z up, field in µT, recorded in London:
@@ -269,8 +274,12 @@ pub fn run(args: &Args) -> CliResult {
 fn summary(file: &CalibrationFile, verdict: &Verdict) -> String {
     let q = file.quality.as_ref();
     let num = |v: Option<f64>| v.map_or("unbounded".to_string(), |v| format!("{v:.2}"));
+    let cause = match verdict.cause {
+        Cause::None => String::new(),
+        c => format!(" (decided by the {c})"),
+    };
     let mut s = format!(
-        "calibrate: method {}, {} points, verdict {}, field {:.6} (input unit), heading error bound {} deg (3 sigma + systematic), per-reading noise {} deg RMS",
+        "calibrate: method {}, {} points, verdict {}{cause}, field {:.6} (input unit), heading error bound {} deg (3 sigma + systematic), per-reading noise {} deg RMS",
         file.method,
         q.map_or(0, |q| q.points),
         verdict.grade,

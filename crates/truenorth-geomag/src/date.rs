@@ -266,16 +266,57 @@ mod tests {
             prop_assert!(b > a);
         }
 
+        /// Any number: a Unix time is accepted exactly when finite and within the years
+        /// 1–9999 (giving a decimal year there), a decimal year exactly when finite and
+        /// inside the model's validity (refusing extrapolation) or within the extrapolation
+        /// limit of it (allowing it, with a warning outside the validity).
         #[test]
-        fn any_f64_never_panics(t: f64, y: f64) {
-            let _ = decimal_year_from_unix_seconds(t);
-            let _ = check_year(&WMM2025, y, Extrapolation::Allow);
-            let _ = check_year(&WMM2025, y, Extrapolation::Refuse);
+        fn any_f64_never_panics(
+            t in prop_oneof![any::<f64>(), -6.2e10f64..2.6e11],
+            y in prop_oneof![any::<f64>(), 1900.0f64..2150.0],
+        ) {
+            match decimal_year_from_unix_seconds(t) {
+                Ok(year) => prop_assert!((1.0..10_000.0).contains(&year), "{t} → {year}"),
+                Err(Error::NonFinite { .. }) => prop_assert!(!t.is_finite()),
+                Err(Error::OutOfRange { min, max, .. }) => {
+                    prop_assert!(t.is_finite() && !(min..max).contains(&t));
+                }
+                Err(e) => prop_assert!(false, "{e}"),
+            }
+            let inside = (2025.0..=2030.0).contains(&y);
+            let near = (2025.0 - EXTRAPOLATION_LIMIT_YEARS..=2030.0 + EXTRAPOLATION_LIMIT_YEARS).contains(&y);
+            prop_assert_eq!(check_year(&WMM2025, y, Extrapolation::Refuse).is_ok(), inside);
+            match check_year(&WMM2025, y, Extrapolation::Allow) {
+                Ok(warning) => prop_assert!(near && warning.is_some() != inside),
+                Err(_) => prop_assert!(!near),
+            }
         }
 
+        /// Any date: accepted exactly when it exists (year 1–9999, month 1–12, day within
+        /// the month by the Gregorian leap rule, recomputed here), giving a decimal year in
+        /// [year, year + 1).
         #[test]
-        fn any_date_never_panics(y: i32, m: u32, d: u32) {
-            let _ = decimal_year_from_date(y, m, d);
+        fn any_date_never_panics(
+            y in prop_oneof![any::<i32>(), 1i32..10_000],
+            m in prop_oneof![any::<u32>(), 0u32..14],
+            d in prop_oneof![any::<u32>(), 0u32..33],
+        ) {
+            let leap = y % 4 == 0 && (y % 100 != 0 || y % 400 == 0);
+            let days = match m {
+                1 | 3 | 5 | 7 | 8 | 10 | 12 => 31,
+                4 | 6 | 9 | 11 => 30,
+                2 if leap => 29,
+                2 => 28,
+                _ => 0,
+            };
+            let exists = (1..=9999).contains(&y) && (1..=days).contains(&d);
+            match decimal_year_from_date(y, m, d) {
+                Ok(year) => {
+                    prop_assert!(exists, "{y}-{m}-{d}");
+                    prop_assert!((f64::from(y)..f64::from(y) + 1.0).contains(&year));
+                }
+                Err(e) => prop_assert!(!exists, "{y}-{m}-{d}: {e}"),
+            }
         }
     }
 }

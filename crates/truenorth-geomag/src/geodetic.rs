@@ -336,16 +336,39 @@ mod tests {
             prop_assert_eq!(back.lon_rad(), g.lon_rad());
         }
 
+        /// Any numbers: a position is accepted exactly when finite and within the
+        /// latitudes and heights documented, goes to spherical and back to itself, and a
+        /// spherical point's geodetic position is one within those ranges or a typed
+        /// refusal.
         #[test]
-        fn any_f64_never_panics(lat: f64, lon: f64, h: f64) {
-            if let Ok(g) = Geodetic::new(lat, lon, h) {
-                let s = g.to_spherical();
-                prop_assert!(s.radius_m().is_finite() && s.radius_m() > 0.0);
-                let _ = s.to_geodetic();
+        fn any_f64_never_panics(
+            lat in prop_oneof![any::<f64>(), -1.6f64..1.6],
+            lon in prop_oneof![any::<f64>(), -10.0f64..10.0],
+            h in prop_oneof![any::<f64>(), -2.0e6f64..2.0e8],
+        ) {
+            let finite = lat.is_finite() && lon.is_finite() && h.is_finite();
+            let in_range = (-FRAC_PI_2..=FRAC_PI_2).contains(&lat) && (MIN_HEIGHT_M..=MAX_HEIGHT_M).contains(&h);
+            match Geodetic::new(lat, lon, h) {
+                Ok(g) => {
+                    prop_assert!(finite && in_range);
+                    let s = g.to_spherical();
+                    prop_assert!(s.radius_m().is_finite() && s.radius_m() > 0.0);
+                    let back = s.to_geodetic().unwrap();
+                    prop_assert!((back.lat_rad() - g.lat_rad()).abs() < 1e-9);
+                    prop_assert!((back.height_m() - g.height_m()).abs() < 1e-3 * (1.0 + g.height_m().abs() * 1e-9));
+                }
+                Err(_) => prop_assert!(!(finite && in_range)),
             }
-            let _ = Geodetic::from_degrees(lat, lon, h);
+            let deg_in_range = (-90.0..=90.0).contains(&lat) && (MIN_HEIGHT_M..=MAX_HEIGHT_M).contains(&h);
+            prop_assert_eq!(Geodetic::from_degrees(lat, lon, h).is_ok(), finite && deg_in_range);
             if let Ok(s) = GeocentricSpherical::new(lat, lon, h) {
-                let _ = s.to_geodetic();
+                match s.to_geodetic() {
+                    Ok(g) => prop_assert!(
+                        (-FRAC_PI_2..=FRAC_PI_2).contains(&g.lat_rad())
+                            && (MIN_HEIGHT_M..=MAX_HEIGHT_M).contains(&g.height_m())
+                    ),
+                    Err(e) => prop_assert!(matches!(e, Error::OutOfRange { .. }), "{e}"),
+                }
             }
         }
     }

@@ -57,8 +57,52 @@ pub(super) fn noise_rms_deg(sum_sq: f64, n: usize, p: usize) -> f64 {
     (sum_sq / dof as f64).sqrt().to_degrees()
 }
 
+/// `φ(u) = (−u_x, −u_y, u_x², 2u_xu_y, u_y²)` of the module documentation of `quality`: the
+/// radial residual's gradient in the 2-D error parameters at the unit direction `(x, y)`.
+#[inline]
+pub(crate) fn regressor_2d(x: f64, y: f64) -> SVector<f64, 5> {
+    SVector::<f64, 5>::new(-x, -y, x * x, 2.0 * x * y, y * y)
+}
+
+/// The 3-D `φ(u) = (−u, u_x², 2u_xu_y, 2u_xu_z, u_y², 2u_yu_z, u_z²)` (centre, then the
+/// symmetric soft-iron error row by row), as [`regressor_2d`].
+#[inline]
+pub(crate) fn regressor_3d(u: &Vector3<f64>) -> SVector<f64, 9> {
+    SVector::<f64, 9>::from([
+        -u.x,
+        -u.y,
+        -u.z,
+        u.x * u.x,
+        2.0 * u.x * u.y,
+        2.0 * u.x * u.z,
+        u.y * u.y,
+        2.0 * u.y * u.z,
+        u.z * u.z,
+    ])
+}
+
 /// Number of distinct monomials of degree 2 to 4 in `(u_x, u_y)`.
 pub(super) const MONOMIALS_2D: usize = 12;
+
+/// The monomials of `(x, y)` that [`information_2d`] takes the sums of, in its order, one
+/// product each: the reference the faster sums are tested against.
+#[cfg(test)]
+pub(super) fn monomials_2d(x: f64, y: f64) -> [f64; MONOMIALS_2D] {
+    [
+        x * x,
+        x * y,
+        y * y,
+        x * x * x,
+        x * x * y,
+        x * y * y,
+        y * y * y,
+        x.powi(4),
+        x.powi(3) * y,
+        x * x * y * y,
+        x * y.powi(3),
+        y.powi(4),
+    ]
+}
 
 /// The 2-D information matrix `A = Σ φ(u)φ(u)ᵀ`, `φ = (−u_x, −u_y, u_x², 2u_xu_y, u_y²)`,
 /// from the sums over the points of the monomials it is made of, in the order

@@ -12,6 +12,7 @@ use nalgebra::{Vector2, Vector3};
 use truenorth_compass::CompassCalibration2d;
 use truenorth_core::{Error, Result, angle_diff};
 
+use super::support::Support2d;
 use super::{COVERAGE_BINS, GAP_BINS, SPHERE_BANDS, SPHERE_CELLS, SPHERE_SECTORS};
 use crate::lm::{BLOCK, blocks};
 
@@ -214,6 +215,11 @@ impl AngleBins {
         self.fine[f as usize] = true;
     }
 
+    /// The directions marked, each 0.5° bin once (see the `support` module).
+    pub(super) fn support(&self) -> Support2d {
+        Support2d::of_bins(&self.fine)
+    }
+
     pub(super) fn coverage(&self) -> Coverage {
         let Some(start) = self.fine.iter().position(|&f| f) else {
             return Coverage {
@@ -256,6 +262,40 @@ pub fn coverage<'a>(
     bins.coverage()
 }
 
+/// The equal-area cell of the direction `(x, y, z)` of norm `n` (see [`mark_sphere_cells`]),
+/// in `0..SPHERE_CELLS`; an arbitrary cell for a zero or non-finite direction, which callers
+/// skip. Written without branches so that block loops vectorise it.
+#[inline(always)]
+pub(crate) fn sphere_cell(x: f64, y: f64, z: f64, n: f64) -> u32 {
+    let band = ((z / n).clamp(-1.0, 1.0) + 1.0) * 0.5 * SPHERE_BANDS as f64;
+    // Both in [0, 8] (or NaN, for a row that is skipped), where `as u32` truncates like
+    // `as usize`; u32 keeps the conversion in SIMD registers.
+    let b = (band as u32).min(SPHERE_BANDS as u32 - 1);
+    b * SPHERE_SECTORS as u32 + sector_16(y, x)
+}
+
+/// The sixteenth of a turn, counted counter-clockwise from +x, that `(x, y)` points into,
+/// in `0..16` (a direction on a boundary goes to either side).
+///
+/// By comparisons instead of an arctangent, which was the largest cost of the 3-D quality
+/// pass: within a quadrant, the angle `φ = atan(|y|/|x|)` has passed `k · 22.5°` when
+/// `|y| ≥ tan(k · 22.5°) |x|`, with `tan 22.5° = √2 − 1` and `tan 67.5° = √2 + 1`; the
+/// quadrant then mirrors or shifts that count.
+#[inline(always)]
+fn sector_16(y: f64, x: f64) -> u32 {
+    const TAN_22_5: f64 = core::f64::consts::SQRT_2 - 1.0;
+    const TAN_67_5: f64 = core::f64::consts::SQRT_2 + 1.0;
+    const _: () = assert!(SPHERE_SECTORS == 16);
+    let (ax, ay) = (x.abs(), y.abs());
+    let q = u32::from(ay >= TAN_22_5 * ax) + u32::from(ay >= ax) + u32::from(ay >= TAN_67_5 * ax);
+    match (x < 0.0, y < 0.0) {
+        (false, false) => q,
+        (true, false) => 7 - q,
+        (true, true) => 8 + q,
+        (false, true) => 15 - q,
+    }
+}
+
 /// Marks the equal-area cells of the directions `d` (a block of vectors, one array per
 /// coordinate, with their norms `n`) in `filled`, for the first `len` rows whose norm is
 /// positive and finite.
@@ -273,19 +313,7 @@ pub(super) fn mark_sphere_cells(
 ) -> usize {
     let mut cell = [0u32; BLOCK];
     for i in 0..BLOCK {
-        let band = ((d[2][i] / n[i]).clamp(-1.0, 1.0) + 1.0) * 0.5 * SPHERE_BANDS as f64;
-        // Computed either way and then chosen, so that the loop has no branch.
-        let ti = turns(d[1][i], d[0][i]);
-        let t = if d[0][i] == 0.0 && d[1][i] == 0.0 {
-            0.0
-        } else {
-            ti
-        };
-        // Both in [0, 8] and [0, 16] (or NaN, for a row that is skipped), where `as u32`
-        // truncates like `as usize`; u32 keeps the conversion in SIMD registers.
-        let b = (band as u32).min(SPHERE_BANDS as u32 - 1);
-        let sector = ((t * SPHERE_SECTORS as f64) as u32).min(SPHERE_SECTORS as u32 - 1);
-        cell[i] = b * SPHERE_SECTORS as u32 + sector;
+        cell[i] = sphere_cell(d[0][i], d[1][i], d[2][i], n[i]);
     }
     let mut marked = 0;
     for i in 0..len {
@@ -385,14 +413,30 @@ pub fn locus_turning_rad<'a>(
     turned.abs()
 }
 
+/// How far beyond each true end of an arc its outermost reading may lie, in standard
+/// deviations of the per-reading heading noise: 3. The ends of the arc a set of readings
+/// covers are its two outermost directions, and noise scatters a few dozen readings near an
+/// end by up to about 3σ (the largest of 30 normal deviates exceeds 3σ with probability
+/// 4 %); at 7 % noise that widens a 150° arc to nearly 200°.
+pub const ARC_END_NOISE_SIGMAS: f64 = 3.0;
+
 /// Refuses a 2-D calibration whose data span less than `need_deg` of heading (see
-/// [`super::MIN_ARC_DEG`]) with [`Error::InsufficientCoverage`].
-pub fn require_arc(coverage: &Coverage, need_deg: f64) -> Result<()> {
-    let covered_deg = coverage.span_rad().to_degrees();
-    if covered_deg < need_deg {
+/// [`super::MIN_ARC_DEG`]) with [`Error::InsufficientCoverage`]: the span of `coverage` less
+/// [`ARC_END_NOISE_SIGMAS`] of the per-reading heading noise `noise_rad` at each end (0 when
+/// unknown), so that noise cannot widen a short arc into an accepted one. The refusal
+/// gives both the span and the allowance.
+pub fn require_arc(coverage: &Coverage, noise_rad: f64, need_deg: f64) -> Result<()> {
+    let noise_deg = if noise_rad.is_finite() && noise_rad > 0.0 {
+        (2.0 * ARC_END_NOISE_SIGMAS * noise_rad).to_degrees()
+    } else {
+        0.0
+    };
+    let span_deg = coverage.span_rad().to_degrees();
+    if need_deg > 0.0 && span_deg - noise_deg < need_deg {
         Err(Error::InsufficientCoverage {
-            // Rounded down, so a refusal never prints a span equal to the one it needs.
-            covered_deg: covered_deg.floor(),
+            // Rounded so that a refusal never prints a net span equal to the one it needs.
+            covered_deg: span_deg.floor(),
+            noise_deg: noise_deg.ceil(),
             need_deg,
         })
     } else {
@@ -419,6 +463,21 @@ pub fn require_sphere_coverage(fraction: f64, need: f64) -> Result<()> {
 /// [`super::assess_2d`]'s coverage sees the same bins). Non-finite readings are skipped. Allocates
 /// nothing.
 pub fn calibrated_coverage_2d(points: &[Vector2<f64>], cal: &CompassCalibration2d) -> Coverage {
+    calibrated_bins_2d(points, cal).coverage()
+}
+
+/// The coverage of [`calibrated_coverage_2d`] and the support of the same directions (each
+/// 0.5° bin once; see the `support` module), from one pass.
+pub(crate) fn calibrated_directions_2d(
+    points: &[Vector2<f64>],
+    cal: &CompassCalibration2d,
+) -> (Coverage, Support2d) {
+    let bins = calibrated_bins_2d(points, cal);
+    (bins.coverage(), bins.support())
+}
+
+/// The direction bins of the calibrated readings of [`calibrated_coverage_2d`].
+fn calibrated_bins_2d(points: &[Vector2<f64>], cal: &CompassCalibration2d) -> AngleBins {
     let mut bins = AngleBins::new();
     let (s, c) = (&cal.soft_iron, &cal.hard_iron);
     let calibrated = |x: f64, y: f64| {
@@ -454,7 +513,7 @@ pub fn calibrated_coverage_2d(points: &[Vector2<f64>], cal: &CompassCalibration2
             }
         }
     }
-    bins.coverage()
+    bins
 }
 
 #[cfg(test)]
@@ -553,6 +612,18 @@ mod tests {
             let (exact, off) = atan2_bin(y, x);
             if off > 1e-7 {
                 prop_assert_eq!(bin, exact, "({}, {}) {} rad from a boundary", x, y, off);
+            }
+        }
+
+        /// The sector of a direction by comparisons is the sixteenth of a turn `atan2`
+        /// places it in, wherever the angle is not within rounding of a boundary.
+        #[test]
+        fn sector_matches_atan2((y, x) in direction()) {
+            let t = y.atan2(x).rem_euclid(core::f64::consts::TAU) / core::f64::consts::TAU * 16.0;
+            let s = sector_16(y, x);
+            prop_assert!(s < 16);
+            if (t - t.round()).abs() > 1e-9 {
+                prop_assert_eq!(s, (t as u32).min(15), "({}, {}) at {} sixteenths", x, y, t);
             }
         }
 

@@ -14,10 +14,12 @@ use super::bounds::{
     MONOMIALS_2D, MONOMIALS_3D, QUAD_3D, information_2d, information_3d, monomial_plan_3d,
     noise_rms_deg, worst_2d, worst_3d,
 };
-use super::coverage::{AngleBins, Coverage, turns};
+use super::coverage::{AngleBins, Coverage, sphere_cell, turns};
+use super::support::{Support2d, Support3d, support_dilution};
 use super::uncertainty::{Uncertainty, bound_and_uncertainty};
 use crate::linalg::{condition_from_eigenvalues, sym_eigen5, sym_eigen9};
 use crate::lm::{BLOCK, blocks, dot_block, sum_block};
+use crate::quality::SPHERE_CELLS;
 use crate::seed_quality::ReportSums;
 
 #[allow(unused_imports)]
@@ -52,13 +54,13 @@ pub struct Assessment3d {
 /// Non-finite readings are skipped. Allocates nothing.
 pub fn assess_2d(points: &[Vector2<f64>], cal: &CompassCalibration2d, field: f64) -> Assessment2d {
     let s = Assessment2d::sums(points, cal, field);
-    report_2d(&s.sums, s.ss, s.n, s.coverage, field)
+    report_2d(&s.sums, s.ss, s.n, s.coverage, &s.support, field)
 }
 
 impl Assessment2d {
     /// The one pass over the readings of [`assess_2d`], without the report built from it
     /// (so that a caller can spread the two over separate steps; see
-    /// [`Self::condition_of`] and [`Self::from_sums`]).
+    /// [`Self::support_figures`] and [`Self::from_sums`]).
     pub(crate) fn sums(
         points: &[Vector2<f64>],
         cal: &CompassCalibration2d,
@@ -67,16 +69,16 @@ impl Assessment2d {
         sums_2d(points, cal, field)
     }
 
-    /// The condition number of the information matrix of `s` (the costlier half of the
-    /// report built from the sums).
-    pub(crate) fn condition_of(s: &ReportSums) -> f64 {
-        condition_2d(&information_2d(&s.sums))
+    /// The condition number and the dilution of the support of `s` (the costlier half of
+    /// the report built from the sums).
+    pub(crate) fn support_figures(s: &ReportSums) -> SupportFigures {
+        support_figures_2d(&s.support)
     }
 
-    /// The report from the sums `s` and their [`Self::condition_of`]: exactly what
+    /// The report from the sums `s` and their [`Self::support_figures`]: exactly what
     /// [`assess_2d`] returns.
-    pub(crate) fn from_sums(s: &ReportSums, condition: f64, field: f64) -> Self {
-        report_2d_with(&s.sums, s.ss, s.n, s.coverage, field, condition)
+    pub(crate) fn from_sums(s: &ReportSums, support: SupportFigures, field: f64) -> Self {
+        report_2d_with(&s.sums, s.ss, s.n, s.coverage, field, support)
     }
 }
 
@@ -159,6 +161,7 @@ fn sums_2d(points: &[Vector2<f64>], cal: &CompassCalibration2d, field: f64) -> R
         ss,
         n,
         coverage: bins.coverage(),
+        support: bins.support(),
     }
 }
 
@@ -201,8 +204,10 @@ fn poly_sum(p: &Poly2, m: &Moments2) -> f64 {
 }
 
 /// The 2-D report of the ellipse `{ q : |B (q − c)| = 1 }` from the moments `m` of the `n`
-/// points `q` it was fitted to (in the same coordinates), with `coverage` measured
-/// separately and `field` the radius of the calibrated circle in the caller's unit.
+/// points `q` it was fitted to (in the same coordinates), with the coverage and support of
+/// the calibrated directions measured separately (`directions`, see
+/// `calibrated_directions_2d`) and `field` the radius of the calibrated circle in the
+/// caller's unit.
 ///
 /// The calibrated reading is `field · w` with `w = B (q − c)`, so every quantity of
 /// [`assess_2d`] is a sum over the points of a function of `w`, and `w` is affine in `q`:
@@ -218,7 +223,7 @@ pub(crate) fn assess_2d_from_moments(
     n: usize,
     centre: &Vector2<f64>,
     unit_map: &nalgebra::Matrix2<f64>,
-    coverage: Coverage,
+    directions: (Coverage, Support2d),
     field: f64,
 ) -> Assessment2d {
     let b = unit_map;
@@ -264,7 +269,7 @@ pub(crate) fn assess_2d_from_moments(
     } else {
         0.0
     };
-    report_2d(&sums, ss, n, coverage, field)
+    report_2d(&sums, ss, n, directions.0, &directions.1, field)
 }
 
 /// The first and second harmonics of the calibrated directions `w = B (q − c)` of the `n`
@@ -300,38 +305,53 @@ pub(crate) fn direction_harmonics(
 }
 
 /// The report from the sums of the information matrix's monomials and of the squared
-/// residuals of `n` readings (shared by [`assess_2d`] and [`assess_2d_from_moments`]).
+/// residuals of `n` readings, and the coverage and support of their directions (shared by
+/// [`assess_2d`] and [`assess_2d_from_moments`]).
 fn report_2d(
     sums: &[f64; MONOMIALS_2D],
     ss: f64,
     n: usize,
     coverage: Coverage,
+    support: &Support2d,
     field: f64,
 ) -> Assessment2d {
-    let condition = condition_2d(&information_2d(sums));
-    report_2d_with(sums, ss, n, coverage, field, condition)
+    report_2d_with(sums, ss, n, coverage, field, support_figures_2d(support))
 }
 
-/// The condition number of a 2-D information matrix (infinite when its eigenvalues cannot
-/// be found).
-fn condition_2d(info: &nalgebra::SMatrix<f64, 5, 5>) -> f64 {
-    sym_eigen5(info)
-        .map(|(l, _)| condition_from_eigenvalues(l.as_slice()))
-        .unwrap_or(f64::INFINITY)
+/// What the report takes from the support of the directions: the condition number and the
+/// dilution of its information matrix (see the `support` module).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct SupportFigures {
+    condition: f64,
+    dilution: f64,
 }
 
-/// [`report_2d`] given the condition number of its information matrix.
+/// The condition number (infinite when its eigenvalues cannot be found) and the dilution
+/// of a 2-D support.
+fn support_figures_2d(support: &Support2d) -> SupportFigures {
+    let info = support.information();
+    SupportFigures {
+        condition: sym_eigen5(&info)
+            .map(|(l, _)| condition_from_eigenvalues(l.as_slice()))
+            .unwrap_or(f64::INFINITY),
+        dilution: support_dilution(&info, support.cells, worst_2d),
+    }
+}
+
+/// [`report_2d`] given the figures of its support.
 fn report_2d_with(
     sums: &[f64; MONOMIALS_2D],
     ss: f64,
     n: usize,
     coverage: Coverage,
     field: f64,
-    condition: f64,
+    support: SupportFigures,
 ) -> Assessment2d {
     let info = information_2d(sums);
     let residual_rms_rel = if n > 0 { (ss / n as f64).sqrt() } else { 0.0 };
-    let (bound, uncertainty) = bound_and_uncertainty(&info, ss, n, field, 2, worst_2d);
+    let condition = support.condition;
+    let (bound, uncertainty) =
+        bound_and_uncertainty(&info, support.dilution, ss, n, field, 2, worst_2d);
     Assessment2d {
         quality: CompassQuality {
             fit: FitQuality {
@@ -369,61 +389,177 @@ pub fn quality_3d(
     assess_3d(points, cal, field).quality
 }
 
-/// The 3-D quality report of `cal` on `points` and what they determine: coverage as the
-/// information share of an evenly covered sphere ([`Uncertainty::efficiency`]), residual
-/// RMS relative to `field` (the radius of the calibrated sphere; see
-/// [`super::mean_corrected_norm_3d`] if the calibrator defines none), the condition number
-/// of the 9-parameter information matrix and the direction-error bound of the module
-/// documentation. Non-finite readings are skipped. Allocates nothing.
-pub fn assess_3d(points: &[Vector3<f64>], cal: &CompassCalibration3d, field: f64) -> Assessment3d {
-    // Sums of the squared residuals and of the monomials of `u` that make up the
-    // information matrix (see `information_3d`).
+/// One over the number of kept readings in each equal-area cell of the directions of
+/// `points` under `cal` (0 for an empty cell): the weights of the support.
+fn cell_weights(points: &[Vector3<f64>], cal: &CompassCalibration3d) -> [f64; SPHERE_CELLS] {
+    let mut in_cell = [0u32; SPHERE_CELLS];
+    for (p, len) in blocks(points) {
+        let b = CalibratedBlock::of(&p, len, cal);
+        for i in 0..len {
+            if b.kept[i] > 0.0 {
+                in_cell[b.cell[i] as usize] += 1;
+            }
+        }
+    }
+    core::array::from_fn(|k| {
+        if in_cell[k] > 0 {
+            1.0 / f64::from(in_cell[k])
+        } else {
+            0.0
+        }
+    })
+}
+
+/// The dilution of the support of the directions of `points` under `cal` alone (see the
+/// `support` module), as [`assess_3d`] reports it in [`Uncertainty::dilution`], without the
+/// sums of every reading, the residuals and the bound: what a check of the geometry before
+/// a fit needs. Allocates nothing.
+pub(crate) fn support_dilution_3d(points: &[Vector3<f64>], cal: &CompassCalibration3d) -> f64 {
+    let weight = cell_weights(points, cal);
     let mut sums = [0.0; MONOMIALS_3D];
+    let plan = monomial_plan_3d();
+    let mut cols = [[0.0; BLOCK]; 9];
+    let mut weighted = [[0.0; BLOCK]; 9];
+    for (p, len) in blocks(points) {
+        CalibratedBlock::of(&p, len, cal).monomials(&weight, &mut cols, &mut weighted);
+        for (wk, &(a, c)) in sums.iter_mut().zip(&plan) {
+            *wk += dot_block(&weighted[a], &cols[c]);
+        }
+    }
+    let cells = weight.iter().filter(|&&x| x > 0.0).count();
+    let support = Support3d { sums, cells };
+    support_dilution(&support.information(), cells, worst_3d)
+}
+
+/// A block of readings calibrated (see `crate::lm::BLOCK`): `h = soft_iron · (p − hard_iron)`
+/// as `CompassCalibration3d::correct`, its norm, its equal-area cell and whether the row is
+/// kept (1: finite, not at the centre, not past the end of the data; 0 otherwise). Every
+/// loop is written without branches so that it vectorises.
+struct CalibratedBlock {
+    h: [[f64; BLOCK]; 3],
+    rho: [f64; BLOCK],
+    cell: [u32; BLOCK],
+    kept: [f64; BLOCK],
+}
+
+impl CalibratedBlock {
+    #[inline(always)]
+    fn of(p: &[[f64; BLOCK]; 3], len: usize, cal: &CompassCalibration3d) -> Self {
+        let (s, c) = (&cal.soft_iron, &cal.hard_iron);
+        let mut b = Self {
+            h: [[0.0; BLOCK]; 3],
+            rho: [0.0; BLOCK],
+            cell: [0; BLOCK],
+            kept: [0.0; BLOCK],
+        };
+        // Row `i` of every column at once: indexed, so that the loop vectorises.
+        #[allow(clippy::needless_range_loop)]
+        for i in 0..BLOCK {
+            let d = [p[0][i] - c.x, p[1][i] - c.y, p[2][i] - c.z];
+            for a in 0..3 {
+                b.h[a][i] = s[(a, 0)] * d[0] + s[(a, 1)] * d[1] + s[(a, 2)] * d[2];
+            }
+            let rho =
+                (b.h[0][i] * b.h[0][i] + b.h[1][i] * b.h[1][i] + b.h[2][i] * b.h[2][i]).sqrt();
+            b.rho[i] = rho;
+            b.kept[i] = if rho > 0.0 && rho.is_finite() && i < len {
+                1.0
+            } else {
+                0.0
+            };
+        }
+        for i in 0..BLOCK {
+            b.cell[i] = sphere_cell(b.h[0][i], b.h[1][i], b.h[2][i], b.rho[i]);
+        }
+        b
+    }
+
+    /// The directions `u = h/|h|` in `cols` 0–2 and the products `u_a u_b` of `QUAD_3D` in
+    /// columns 3–8, zeros for the rows not kept (which then add nothing to a sum);
+    /// `weighted` the same times the reading's cell weight from `weight`. The weights are
+    /// looked up apart, so that the arithmetic loop has no indexed load and vectorises.
+    #[inline(always)]
+    fn monomials(
+        &self,
+        weight: &[f64; SPHERE_CELLS],
+        cols: &mut [[f64; BLOCK]; 9],
+        weighted: &mut [[f64; BLOCK]; 9],
+    ) {
+        let mut w = [0.0; BLOCK];
+        for i in 0..BLOCK {
+            w[i] = weight[self.cell[i] as usize] * self.kept[i];
+        }
+        for i in 0..BLOCK {
+            let k = self.kept[i] > 0.0;
+            let inv_rho = 1.0 / self.rho[i];
+            for (col, h) in cols.iter_mut().zip(&self.h) {
+                col[i] = if k { h[i] * inv_rho } else { 0.0 };
+            }
+            for (j, &(a, c)) in QUAD_3D.iter().enumerate() {
+                cols[3 + j][i] = cols[a][i] * cols[c][i];
+            }
+            for a in 0..9 {
+                weighted[a][i] = w[i] * cols[a][i];
+            }
+        }
+    }
+}
+
+/// The 3-D quality report of `cal` on `points` and what they determine: coverage as the
+/// information share of an evenly covered sphere ([`Uncertainty::efficiency`] of the
+/// support, see the `support` module), residual RMS relative to `field` (the radius of the
+/// calibrated sphere; see [`super::mean_corrected_norm_3d`] if the calibrator defines
+/// none), the condition number of the support's 9-parameter information matrix and the
+/// direction-error bound of the module documentation (from every reading). Non-finite
+/// readings are skipped. Allocates nothing.
+pub fn assess_3d(points: &[Vector3<f64>], cal: &CompassCalibration3d, field: f64) -> Assessment3d {
+    let weight = cell_weights(points, cal);
+    // Sums of the squared residuals and of the monomials of `u` that make up the
+    // information matrix (see `information_3d`), plain and weighted by the cells.
+    let mut sums = [0.0; MONOMIALS_3D];
+    let mut support_sums = [0.0; MONOMIALS_3D];
     let mut ss = 0.0;
     let mut n = 0usize;
     let inv_f = 1.0 / field;
-    let (s, c) = (&cal.soft_iron, &cal.hard_iron);
     let plan = monomial_plan_3d();
     // A block of points at a time (see `crate::lm::BLOCK`): first every point's direction,
-    // its products and its residual, then the sums. `cols` holds `u_a` in columns 0–2 and
-    // the products `u_a u_b` of `QUAD_3D` in columns 3–8.
+    // its products (`CalibratedBlock::monomials`) and its residual, then the sums.
     let mut cols = [[0.0; BLOCK]; 9];
+    let mut weighted = [[0.0; BLOCK]; 9];
     let mut r2 = [0.0; BLOCK];
-    let mut kept = [0.0; BLOCK];
     for (p, len) in blocks(points) {
-        for i in 0..BLOCK {
-            // h = soft_iron · (p − hard_iron), as `CompassCalibration3d::correct`.
-            let d = [p[0][i] - c.x, p[1][i] - c.y, p[2][i] - c.z];
-            let hi: [f64; 3] =
-                core::array::from_fn(|a| s[(a, 0)] * d[0] + s[(a, 1)] * d[1] + s[(a, 2)] * d[2]);
-            let rh = (hi[0] * hi[0] + hi[1] * hi[1] + hi[2] * hi[2]).sqrt();
-            // Non-finite readings are skipped, and the rows past the end of the data: a row
-            // of zeros adds nothing.
-            let k = rh > 0.0 && rh.is_finite() && i < len;
-            let inv_rho = 1.0 / rh;
-            let ui = hi.map(|x| if k { x * inv_rho } else { 0.0 });
-            for a in 0..3 {
-                cols[a][i] = ui[a];
-            }
-            for (j, &(a, b)) in QUAD_3D.iter().enumerate() {
-                cols[3 + j][i] = ui[a] * ui[b];
-            }
-            let r = rh * inv_f - 1.0;
-            r2[i] = if k { r * r } else { 0.0 };
-            kept[i] = if k { 1.0 } else { 0.0 };
+        let b = CalibratedBlock::of(&p, len, cal);
+        b.monomials(&weight, &mut cols, &mut weighted);
+        for ((sq, rho), kept) in r2.iter_mut().zip(&b.rho).zip(&b.kept) {
+            let r = rho * inv_f - 1.0;
+            *sq = if *kept > 0.0 { r * r } else { 0.0 };
         }
-        for (sk, &(a, b)) in sums.iter_mut().zip(&plan) {
-            *sk += dot_block(&cols[a], &cols[b]);
+        for ((sk, wk), &(a, c)) in sums.iter_mut().zip(support_sums.iter_mut()).zip(&plan) {
+            *sk += dot_block(&cols[a], &cols[c]);
+            *wk += dot_block(&weighted[a], &cols[c]);
         }
         ss += sum_block(&r2);
-        n += sum_block(&kept) as usize;
+        n += sum_block(&b.kept) as usize;
     }
+    let support = Support3d {
+        sums: support_sums,
+        cells: weight.iter().filter(|&&x| x > 0.0).count(),
+    };
     let info = information_3d(&sums);
+    let support_info = support.information();
     let residual_rms_rel = if n > 0 { (ss / n as f64).sqrt() } else { 0.0 };
-    let condition = sym_eigen9(&info)
+    let condition = sym_eigen9(&support_info)
         .map(|(l, _)| condition_from_eigenvalues(l.as_slice()))
         .unwrap_or(f64::INFINITY);
-    let (bound, uncertainty) = bound_and_uncertainty(&info, ss, n, field, 3, worst_3d);
+    let (bound, uncertainty) = bound_and_uncertainty(
+        &info,
+        support_dilution(&support_info, support.cells, worst_3d),
+        ss,
+        n,
+        field,
+        3,
+        worst_3d,
+    );
     Assessment3d {
         quality: CompassQuality {
             fit: FitQuality {

@@ -4,17 +4,16 @@
 //!
 //! # The dilution `G` (derivation)
 //!
-//! With `A = Σ φ(uᵢ)φ(uᵢ)ᵀ` the information matrix of the `N` calibrated directions and
-//! `g(u)` the gradient of the heading (3-D: field-direction) error at direction `u` (see
-//! the module documentation of `quality`), define
+//! With `A = Σ φ(uᵢ)φ(uᵢ)ᵀ` the information matrix of `N` calibrated directions and `g(u)`
+//! the gradient of the heading (3-D: field-direction) error at direction `u` (see the
+//! module documentation of `quality`), define
 //!
 //! `G = max_u √(N · g(u)ᵀ A⁻¹ g(u))`   (3-D: `√(N · trace(G(u) A⁻¹ G(u)ᵀ))`).
 //!
-//! It depends only on the directions seen, not on their number, units or noise, and says
-//! two things:
+//! It depends only on the directions, not on their units or noise, and says two things:
 //! * **Random errors.** Independent per-reading errors of standard deviation `σ` (relative to
 //!   the field) give a heading error of standard deviation `σ·G/√N` at the worst direction:
-//!   the 3σ bound of the report is `3σG/√N`.
+//!   the 3σ bound of the report is `3σG/√N`. It falls as `1/√N`: noise is averaged.
 //! * **Any errors.** Per-reading errors `eᵢ` of RMS `ε` — systematic ones too (an
 //!   unmodelled non-linearity, a field gradient across the site), which do not average
 //!   out — move the least-squares parameters by `δp = A⁻¹ Σ φᵢ eᵢ`, so the heading error
@@ -24,25 +23,31 @@
 //! Readings spread evenly round a circle have `G = 2` ([`DILUTION_EVEN_CIRCLE`]), an
 //! evenly covered sphere `G = √13.5 ≈ 3.67` ([`DILUTION_EVEN_SPHERE`]; both found by the
 //! tests from the moments of the uniform distribution); a few dozen well-chosen shots a
-//! few times more. Readings confined to a great circle make `A` singular (`G` infinite); a hand-held
-//! turn about one axis with a few degrees of wobble gives `G` in the thousands; a
+//! few times more. Readings confined to a great circle make `A` singular (`G` infinite); a
+//! hand-held turn about one axis with a few degrees of wobble gives `G` in the thousands; a
 //! hemisphere about 18.
+//!
+//! The dilution reported, and judged, is that of the *support* (the `support` module): each
+//! direction cell counted once, so that it is a property of the orientations seen and not
+//! of how many readings were taken in each — more readings in the same orientations never
+//! change it.
 //!
 //! # The test
 //!
-//! A calibration is determined when `G · max(ε̂, ε_model)`, the largest field-direction
-//! error that errors of the fit's own residual RMS `ε̂` — or, when that is smaller, of
-//! [`MODEL_ERROR_REL`], the per-reading error a consumer magnetometer keeps after
-//! calibration — could cause, stays within the largest bound the calibrator accepts.
-//! So the test is on what the data determine, not on how much of the sphere they fill:
-//! twenty-four shots in well-chosen orientations pass, a single-axis turn does not, however
-//! many readings it has.
+//! A calibration is determined by its orientations when `G · ε_model`, the largest
+//! field-direction error that a per-reading error of [`MODEL_ERROR_REL`] — what a consumer
+//! magnetometer keeps after calibration, and which more readings do not average away —
+//! could cause on the support, stays within the largest bound the calibrator accepts. The
+//! test reads neither the number of readings nor their noise: twenty-four shots in
+//! well-chosen orientations pass, a single-axis turn does not however many readings it has,
+//! and a noisy sensor tumbled in every direction passes (its noise is judged apart, by the
+//! 3σ bound, which falls as the readings grow, and by the verdict).
 
 use nalgebra::SMatrix;
 use serde::{Deserialize, Serialize};
-use truenorth_core::{Error, Result};
+use truenorth_core::{CompassQuality, Error, Result};
 
-use super::bounds::{bound_deg, whitened};
+use super::bounds::{bound_deg, t_factor_exact_small, whitened};
 
 #[allow(unused_imports)]
 use truenorth_core::Float as _;
@@ -54,19 +59,21 @@ pub const DILUTION_EVEN_CIRCLE: f64 = 2.0;
 pub const DILUTION_EVEN_SPHERE: f64 = 3.674_234_614_174_767;
 
 /// The per-reading error, relative to the field, that a consumer magnetometer keeps after
-/// a good calibration and that the determination test assumes at least: 0.5 %. The real
+/// a good calibration and that the determination test assumes: 0.5 %. The real
 /// full-sphere recording of an HMC5883L keeps 0.46 %, a tumbled unnamed sensor 1.3 %
-/// (`tests/real_data.rs`); a residual estimated from a few dozen shots can come out far
-/// smaller by chance, and must not let a weak geometry through.
+/// (`tests/real_data.rs`). The test does not use the fit's own residual: a residual made of
+/// noise is averaged away by more readings (it is judged by the 3σ bound), and one
+/// estimated from a few dozen shots can come out far smaller by chance.
 pub const MODEL_ERROR_REL: f64 = 0.005;
 
 /// What the readings determine (see the module documentation).
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 pub struct Uncertainty {
-    /// The dilution `G`: worst-direction heading (3-D: field-direction) error, radians, per
-    /// unit of per-reading error relative to the field, for `N` readings times `√N`. 2 for
-    /// an evenly covered circle, 3.67 for an evenly covered sphere; infinite when the
-    /// readings do not determine the calibration at all.
+    /// The dilution `G` of the orientations seen (each direction cell once; see the module
+    /// documentation): worst-direction heading (3-D: field-direction) error, radians, per
+    /// unit of per-reading error relative to the field, for `K` directions times `√K`. 2
+    /// for an evenly covered circle, 3.67 for an evenly covered sphere; infinite when the
+    /// orientations do not determine the calibration at all.
     pub dilution: f64,
     /// Predicted standard deviation (1σ) of each hard-iron component, input unit (3-D:
     /// three values; 2-D: two, the third 0).
@@ -85,15 +92,11 @@ impl Uncertainty {
         soft_iron_sigma_rel: f64::INFINITY,
     };
 
-    /// The largest heading (3-D: field-direction) error, degrees, that per-reading errors of
-    /// RMS `max(residual_rms_rel, MODEL_ERROR_REL)` could cause, random or not: `G·ε`.
-    pub fn worst_case_deg(&self, residual_rms_rel: f64) -> f64 {
-        let eps = if residual_rms_rel > MODEL_ERROR_REL {
-            residual_rms_rel
-        } else {
-            MODEL_ERROR_REL
-        };
-        let w = (self.dilution * eps).to_degrees();
+    /// The largest heading (3-D: field-direction) error, degrees, that a per-reading error
+    /// of [`MODEL_ERROR_REL`], random or not, could cause on the orientations seen: `G·ε`
+    /// (infinite when they do not determine the calibration).
+    pub fn geometry_error_deg(&self) -> f64 {
+        let w = (self.dilution * MODEL_ERROR_REL).to_degrees();
         if w.is_finite() { w } else { f64::INFINITY }
     }
 
@@ -114,11 +117,13 @@ impl Uncertainty {
 /// The 3σ bound of the module documentation of `quality` (degrees) and the uncertainty,
 /// from an information matrix of `P` parameters (the first `dimensions` the hard iron
 /// relative to the field, the rest the soft-iron perturbation), the residual sum of squares
-/// of `n` readings and the field; `worst` computes `max_u ‖L⁻¹g(u)‖²` over the test
-/// directions. Infinite bound and [`Uncertainty::UNDETERMINED`] when `n ≤ P` or `A` is not
-/// positive definite.
+/// of `n` readings and the field, with the support's `dilution` (see `support_dilution`,
+/// computed apart so that a staged caller can spread the two); `worst` computes
+/// `max_u ‖L⁻¹g(u)‖²` over the test directions. Infinite bound and
+/// [`Uncertainty::UNDETERMINED`] when `n ≤ P` or `A` is not positive definite.
 pub(super) fn bound_and_uncertainty<const P: usize>(
     info: &SMatrix<f64, P, P>,
+    dilution: f64,
     sum_sq: f64,
     n: usize,
     field: f64,
@@ -129,7 +134,6 @@ pub(super) fn bound_and_uncertainty<const P: usize>(
         return (f64::INFINITY, Uncertainty::UNDETERMINED);
     };
     let w = worst(&l_inv);
-    let dilution = (n as f64 * w).sqrt();
     // (A⁻¹)_kk = ‖column k of L⁻¹‖², since A⁻¹ = L⁻ᵀL⁻¹.
     let var = |k: usize| l_inv.column(k).norm_squared();
     let mut hard_iron_sigma = [0.0; 3];
@@ -143,28 +147,104 @@ pub(super) fn bound_and_uncertainty<const P: usize>(
     (
         bound_deg(sigma, w),
         Uncertainty {
-            dilution: finite(dilution),
+            dilution,
             hard_iron_sigma: hard_iron_sigma.map(finite),
             soft_iron_sigma_rel: finite(soft_iron_sigma_rel),
         },
     )
 }
 
-/// Refuses a calibration that its readings do not determine (see the module
-/// documentation): when `G · max(residual, MODEL_ERROR_REL)` exceeds `max_error_deg`.
+/// Refuses a calibration that its orientations do not determine (see the module
+/// documentation): when `G · MODEL_ERROR_REL` exceeds `max_error_deg`, with
+/// [`Error::Undetermined`] carrying the figures and `hint` (what to record instead).
+/// `dimensions` (2 or 3) names the even shape the dilution is compared with.
 pub fn require_determined(
     u: &Uncertainty,
-    residual_rms_rel: f64,
+    dimensions: usize,
     max_error_deg: f64,
+    hint: &'static str,
 ) -> Result<()> {
-    if u.worst_case_deg(residual_rms_rel) <= max_error_deg {
+    let error_deg = u.geometry_error_deg();
+    if error_deg <= max_error_deg {
         Ok(())
     } else {
-        Err(Error::Degenerate {
-            reason: "the orientations seen do not determine the calibration: an error of 0.5 % of the field per reading could turn the result by more than the largest accepted bound; add readings in other orientations (turns about a second and a third axis, or shots pointing and rolled in new directions)",
+        let (even_dilution, even_shape) = if dimensions == 2 {
+            (DILUTION_EVEN_CIRCLE, "circle")
+        } else {
+            (DILUTION_EVEN_SPHERE, "sphere")
+        };
+        Err(Error::Undetermined {
+            dilution: u.dilution,
+            even_dilution,
+            even_shape,
+            model_error_rel: MODEL_ERROR_REL,
+            error_deg,
+            max_deg: max_error_deg,
+            hint,
         })
     }
 }
+
+/// The largest product of the per-reading noise (relative to the field) and the dilution
+/// `G` at which a least-squares calibration's own figures are trusted: 0.5 rad.
+///
+/// The 3σ bound, the predicted σ's and the dilution itself come from the first-order
+/// (linearised) analysis of the fit about its solution; the terms it leaves out are of
+/// relative size `(σG)²/2` — 12 % at 0.5 — and, unlike the noise in the first-order ones,
+/// they do not average out with more readings. Beyond it the fit can drift along what the
+/// orientations leave loose and, through the calibration it drifted to, its readings can
+/// look well spread: a turn about one axis wobbling by 4° at 1.8 % noise fits a soft iron
+/// of 1.43 : 1 and a centre 20 % of the field away, through which its dilution reads 33
+/// where the truth's is 120 (`tests/families.rs`; σG = 0.59 there and 0.66 for a 3° wobble
+/// at 8 % noise). A sensor tumbled in every direction keeps σG below 0.3 at 8 % noise
+/// (G ≈ 3.7), so noise alone, with orientations that determine the calibration, never
+/// reaches it.
+pub const MAX_NOISE_DILUTION: f64 = 0.5;
+
+/// Refuses a calibration whose per-reading noise `noise_rel` times its dilution `u.dilution`
+/// exceeds `max_product` (by default [`MAX_NOISE_DILUTION`]), with
+/// [`Error::TooNoisyForOrientations`].
+pub fn require_linear(u: &Uncertainty, noise_rel: f64, max_product: f64) -> Result<()> {
+    let product = noise_rel * u.dilution;
+    if product <= max_product {
+        Ok(())
+    } else {
+        Err(Error::TooNoisyForOrientations {
+            noise_rel,
+            dilution: u.dilution,
+            product,
+            max_product,
+        })
+    }
+}
+
+/// Refuses a calibration whose own heading-error bound (3σ plus systematic), widened to the
+/// Student-t quantile of the `dof` degrees of freedom its σ was estimated from (readings
+/// less parameters), exceeds `max_bound_deg`, with [`Error::TooUncertain`]: too few readings
+/// for their noise and the orientations they cover. More readings lower it as `1/√N`.
+pub fn require_certain(q: &CompassQuality, dof: f64, max_bound_deg: f64) -> Result<()> {
+    let t = t_factor_exact_small(dof);
+    let bound_deg = q.heading_error_bound_deg() * t;
+    if bound_deg <= max_bound_deg {
+        return Ok(());
+    }
+    Err(Error::TooUncertain {
+        bound_deg,
+        max_deg: max_bound_deg,
+        points: q.fit.points,
+        noise_rel: q.heading_noise_rms_deg.to_radians(),
+        widened: if t > WIDENING_WORTH_SAYING {
+            ", widened for a noise estimated from few readings"
+        } else {
+            ""
+        },
+    })
+}
+
+/// The Student-t widening below which [`require_certain`] does not mention it: 1 %, the
+/// accuracy of the Cornish–Fisher series it comes from (reached at about 250 degrees of
+/// freedom).
+const WIDENING_WORTH_SAYING: f64 = 1.01;
 
 #[cfg(test)]
 mod tests {
@@ -219,13 +299,18 @@ mod tests {
                 Vector2::new(a.cos(), a.sin()) * (1.0 + rng.normal(0.01))
             })
             .collect();
+        // The 2-D support takes each reading at the centre of its 0.5° bin, at most 0.25°
+        // (4.4·10⁻³ rad) from it; these readings lie on bin boundaries, the worst case, and
+        // a direction error δ moves the dilution of an even set by about δ relative
+        // (measured 2.2·10⁻³): the limit is 2δ.
         let c = assess_2d(&ten, &CompassCalibration2d::identity(), 1.0).uncertainty;
+        let delta = 0.25f64.to_radians();
         assert!(
-            (c.dilution - DILUTION_EVEN_CIRCLE).abs() < 1e-9,
+            (c.dilution / DILUTION_EVEN_CIRCLE - 1.0).abs() < 2.0 * delta,
             "{}",
             c.dilution
         );
-        assert!((c.efficiency(2) - 1.0).abs() < 1e-9);
+        assert!((c.efficiency(2) - 1.0).abs() < 4.0 * delta);
     }
 
     /// σ·G/√N is the standard deviation of the heading error (the 3σ bound over three), and
@@ -276,24 +361,27 @@ mod tests {
                 .collect()
         };
         let flat = u3(&turn(0.0, &mut rng));
-        assert!(require_determined(&flat, 0.005, 10.0).is_err(), "{flat:?}");
+        assert!(require_determined(&flat, 3, 10.0, "").is_err(), "{flat:?}");
         for wobble in [1.0, 3.0, 10.0] {
             let u = u3(&turn(wobble, &mut rng));
             assert!(u.dilution > 200.0, "wobble {wobble}: {}", u.dilution);
-            assert!(require_determined(&u, 0.005, 10.0).is_err());
+            assert!(require_determined(&u, 3, 10.0, "").is_err());
         }
         let upper: Vec<_> = fibonacci(4000).into_iter().filter(|p| p.z > 0.0).collect();
         let h = u3(&noisy(&upper, &mut rng, 0.005));
         assert!((15.0..22.0).contains(&h.dilution), "{}", h.dilution);
-        assert!(require_determined(&h, 0.005, 10.0).is_ok());
+        assert!(require_determined(&h, 3, 10.0, "").is_ok());
     }
 
     proptest! {
         /// The dilution does not depend on how the readings are turned (it is a property of
         /// their directions relative to each other), to the resolution of the fixed lattice
         /// of test directions its maximum is taken over (256 directions, about 13° apart:
-        /// the worst direction falls between them differently), and the worst case grows
-        /// with the residual.
+        /// the worst direction falls between them differently), and the geometric error is
+        /// the dilution times the model error. The directions are drawn at least 45° apart,
+        /// more than the widest equal-area cell (41°, the polar ones), so that turning them
+        /// never puts two into one cell and the support weighs each alike: which readings
+        /// share a cell does depend on the turn.
         #[test]
         fn dilution_is_invariant_under_rotation(
             axis in proptest::array::uniform3(-1.0f64..1.0),
@@ -303,14 +391,20 @@ mod tests {
             prop_assume!(Vector3::from(axis).norm() > 0.1);
             let rot = Rotation3::from_axis_angle(&Unit::new_normalize(Vector3::from(axis)), angle);
             let mut rng = SplitMix64::new(seed);
-            let pts: Vec<_> = (0..40)
-                .map(|_| Vector3::new(rng.normal(1.0), rng.normal(1.0), rng.normal(1.0)).normalize() * (1.0 + rng.normal(0.01)))
-                .collect();
+            let mut pts: Vec<Vector3<f64>> = Vec::new();
+            // Eleven: well short of the ~14 at which random caps of 22.5° jam the sphere.
+            while pts.len() < 11 {
+                let d = Vector3::new(rng.normal(1.0), rng.normal(1.0), rng.normal(1.0)).normalize();
+                if pts.iter().all(|p| p.normalize().dot(&d) < 45f64.to_radians().cos()) {
+                    pts.push(d * (1.0 + rng.normal(0.01)));
+                }
+            }
             let turned: Vec<_> = pts.iter().map(|p| rot * p).collect();
             let (a, b) = (u3(&pts).dilution, u3(&turned).dilution);
             prop_assert!((a / b - 1.0).abs() < 0.05, "{a} vs {b}");
             let u = u3(&pts);
-            prop_assert!(u.worst_case_deg(0.01) >= u.worst_case_deg(0.001));
+            let expect = (u.dilution * MODEL_ERROR_REL).to_degrees();
+            prop_assert!(u.geometry_error_deg() == expect || (expect.is_infinite() && u.geometry_error_deg().is_infinite()));
         }
 
         /// Any finite or non-finite readings: a report without panic, and never a finite

@@ -6,8 +6,14 @@
 //!   ([`CompassQuality::heading_error_bound_deg`]: 3σ of the parameter uncertainty plus the
 //!   method's systematic error), which every later heading carries;
 //! * the per-reading heading noise ([`CompassQuality::heading_noise_rms_deg`]), which is the
-//!   residual of the fit in angle: large when the readings do not lie on the fitted circle or
-//!   ellipsoid (a disturbed site, a sensor that moved against its mount, the wrong model).
+//!   residual of the fit in angle: large for a noisy sensor, or when the readings do not lie
+//!   on the fitted circle or ellipsoid (a disturbed site, a sensor that moved against its
+//!   mount, the wrong model).
+//!
+//! The two are kept apart, and the verdict says which one decided it ([`Cause`]): a noisy
+//! sensor calibrated from many readings has a small bound (the noise averages out of the
+//! parameters) and a large per-reading scatter, and is `usable` or `poor` *because it is
+//! noisy* — a better recording would not help, averaging its readings would.
 //!
 //! `good`: both within [`GOOD_DEG`] (bound) and [`GOOD_NOISE_DEG`] (noise); `usable`: within
 //! [`USABLE_DEG`]; `poor`: beyond — a heading that can be off by more than that is not worth
@@ -52,11 +58,40 @@ impl fmt::Display for Grade {
     }
 }
 
-/// A grade and the numbers behind it.
+/// Which of the two numbers kept a calibration from a better grade.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Cause {
+    /// Nothing: the calibration is `good`.
+    None,
+    /// The calibration's own bound (3σ plus systematic): too few readings, too little of
+    /// the circle or sphere, or a method that cannot model the soft iron. A better
+    /// recording fixes it.
+    Calibration,
+    /// The per-reading noise only: the calibration itself is within the grade's bound, but
+    /// each reading scatters more than the grade allows. Recalibrating does not fix it;
+    /// averaging readings does (or, when the scatter is not random, removing what causes
+    /// it).
+    Noise,
+}
+
+impl fmt::Display for Cause {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Self::None => "none",
+            Self::Calibration => "calibration",
+            Self::Noise => "noise",
+        })
+    }
+}
+
+/// A grade, the numbers behind it and which of them decided it.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Verdict {
     /// The grade.
     pub grade: Grade,
+    /// What kept it from a better grade.
+    pub cause: Cause,
     /// The calibration bound, degrees (3σ plus systematic).
     pub bound_deg: f64,
     /// The per-reading heading noise, degrees.
@@ -76,46 +111,59 @@ impl Verdict {
         } else {
             Grade::Poor
         };
+        let (bound_limit, _) = Self::limits_missed(grade);
+        let cause = if grade == Grade::Good {
+            Cause::None
+        } else if !(bound_deg <= bound_limit) {
+            Cause::Calibration
+        } else {
+            Cause::Noise
+        };
         Self {
             grade,
+            cause,
             bound_deg,
             noise_deg,
+        }
+    }
+
+    /// The bound and noise limits of the grade above `grade`, which it missed.
+    fn limits_missed(grade: Grade) -> (f64, f64) {
+        match grade {
+            Grade::Good | Grade::Usable => (GOOD_DEG, GOOD_NOISE_DEG),
+            Grade::Poor => (USABLE_DEG, USABLE_DEG),
         }
     }
 }
 
 impl fmt::Display for Verdict {
-    /// The reason, one line: which number decided the grade.
+    /// The reason, one line: which number decided the grade, and what would help.
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let (b, n) = (self.bound_deg, self.noise_deg);
-        match self.grade {
-            Grade::Good => write!(
+        let (limit, noise_limit) = Self::limits_missed(self.grade);
+        match self.cause {
+            Cause::None => write!(
                 f,
                 "the calibration adds at most {b:.2} deg (3 sigma + systematic, limit {GOOD_DEG}) and each reading scatters {n:.2} deg RMS about it (limit {GOOD_NOISE_DEG})"
             ),
-            _ => {
-                let limit = if self.grade == Grade::Usable {
-                    GOOD_DEG
-                } else {
-                    USABLE_DEG
-                };
-                let noise_limit = if self.grade == Grade::Usable {
-                    GOOD_NOISE_DEG
-                } else {
-                    USABLE_DEG
-                };
-                if !(b <= limit) {
+            Cause::Calibration => {
+                write!(
+                    f,
+                    "the calibration itself may err by up to {b:.2} deg (3 sigma + systematic), more than {limit} deg: too few readings, too little of the circle or sphere, or a method that cannot model this soft iron"
+                )?;
+                if !(n <= noise_limit) {
                     write!(
                         f,
-                        "the calibration itself may err by up to {b:.2} deg (3 sigma + systematic), more than {limit} deg: too few readings, too little of the circle or sphere, or a method that cannot model this soft iron"
-                    )
-                } else {
-                    write!(
-                        f,
-                        "each reading scatters {n:.2} deg RMS about the fit, more than {noise_limit} deg: the readings do not lie on one circle or ellipsoid (a magnetically disturbed site, a sensor moving against its mount, or a tilted 2-axis compass)"
-                    )
+                        "; and each reading scatters {n:.2} deg RMS about the fit, more than {noise_limit} deg"
+                    )?;
                 }
+                Ok(())
             }
+            Cause::Noise => write!(
+                f,
+                "the sensor is noisy: each reading scatters {n:.2} deg RMS about the fit ({:.1} % of the field), more than {noise_limit} deg, while the calibration itself is determined to {b:.2} deg (3 sigma + systematic); average readings (their noise falls as 1/sqrt of their number) — a scatter that is not random means the readings do not lie on one circle or ellipsoid (a magnetically disturbed site, a sensor moving against its mount, or a tilted 2-axis compass)",
+                100.0 * n.to_radians()
+            ),
         }
     }
 }
@@ -142,8 +190,22 @@ mod tests {
         assert_eq!(v.grade, Grade::Poor);
         assert!(v.to_string().contains("42.90 deg"), "{v}");
         let v = Verdict::of(&report(0.5, 8.0));
-        assert_eq!(v.grade, Grade::Poor);
+        assert_eq!((v.grade, v.cause), (Grade::Poor, Cause::Noise));
         assert!(v.to_string().contains("scatters 8.00 deg"), "{v}");
+        assert!(v.to_string().contains("the sensor is noisy"), "{v}");
+        assert!(v.to_string().contains("determined to 0.50 deg"), "{v}");
+        // A sensor with 6 % noise, calibrated from thousands of readings: usable, for noise.
+        let v = Verdict::of(&report(0.3, 0.06f64.to_degrees()));
+        assert_eq!((v.grade, v.cause), (Grade::Usable, Cause::Noise));
+        assert!(v.to_string().contains("(6.0 % of the field)"), "{v}");
+        let v = Verdict::of(&report(2.0, 8.0));
+        assert_eq!((v.grade, v.cause), (Grade::Poor, Cause::Noise));
+        let v = Verdict::of(&report(7.0, 8.0));
+        assert_eq!((v.grade, v.cause), (Grade::Poor, Cause::Calibration));
+        assert!(
+            v.to_string().contains("and each reading scatters 8.00"),
+            "{v}"
+        );
         assert_eq!(Verdict::of(&report(0.04, 0.26)).grade, Grade::Good);
         assert_eq!(Verdict::of(&report(2.0, 0.3)).grade, Grade::Usable);
         assert_eq!(Verdict::of(&report(f64::NAN, 0.3)).grade, Grade::Poor);
@@ -151,13 +213,29 @@ mod tests {
     }
 
     proptest! {
-        /// The grade never improves as either number grows, and the reason is one line.
+        /// The grade never improves as either number grows, the reason is one line, and the
+        /// cause is the number that misses the better grade's limit: the noise only when the
+        /// bound meets it.
         #[test]
         fn grades_are_monotone(b in 0.0f64..20.0, n in 0.0f64..20.0, db in 0.0f64..5.0, dn in 0.0f64..5.0) {
             let a = Verdict::of(&report(b, n));
             let worse = Verdict::of(&report(b + db, n + dn));
             prop_assert!(worse.grade >= a.grade);
             prop_assert!(!a.to_string().contains('\n'));
+            let (bound_limit, noise_limit) = match a.grade {
+                Grade::Good => (f64::INFINITY, f64::INFINITY),
+                Grade::Usable => (GOOD_DEG, GOOD_NOISE_DEG),
+                Grade::Poor => (USABLE_DEG, USABLE_DEG),
+            };
+            let expect = match a.grade {
+                Grade::Good => Cause::None,
+                _ if b > bound_limit => Cause::Calibration,
+                _ => Cause::Noise,
+            };
+            prop_assert_eq!(a.cause, expect);
+            if a.cause == Cause::Noise {
+                prop_assert!(n > noise_limit && b <= bound_limit);
+            }
         }
     }
 }

@@ -38,6 +38,20 @@ impl Model2 {
         }
     }
 
+    /// A random compass of unit field: hard iron of any direction up to `max_hard` of the
+    /// field, soft iron up to 1.4 : 1 at any angle.
+    #[allow(dead_code)]
+    pub fn random(rng: &mut SplitMix64, max_hard: f64) -> Self {
+        let a = std::f64::consts::TAU * rng.uniform();
+        let hard = Vector2::new(a.cos(), a.sin()) * max_hard * rng.uniform();
+        Self::new(
+            hard,
+            1.0 + 0.4 * rng.uniform(),
+            std::f64::consts::PI * rng.uniform(),
+            1.0,
+        )
+    }
+
     /// The reading at heading `psi` with per-axis noise `sigma`.
     pub fn raw(&self, psi: f64, noise: &mut impl NoiseSource, sigma: f64) -> Vector2<f64> {
         let h = Vector2::new(self.field * psi.cos(), -self.field * psi.sin());
@@ -90,6 +104,18 @@ impl Model2 {
             .map(|(k, (psi, mag))| (psi, Mag2Sample { t_s: k as f64, mag }))
             .collect()
     }
+}
+
+/// Readings as samples 0.05 s apart, in their order.
+#[allow(dead_code)]
+pub fn stamped_2d(pts: &[Vector2<f64>]) -> Vec<Mag2Sample> {
+    pts.iter()
+        .enumerate()
+        .map(|(k, &mag)| Mag2Sample {
+            t_s: 0.05 * k as f64,
+            mag,
+        })
+        .collect()
 }
 
 /// `n` Fibonacci-sphere directions of a field `field` seen through `raw = hard + W·h`.
@@ -150,4 +176,130 @@ pub fn circular_std(a: &[f64]) -> f64 {
         .fold((0.0, 0.0), |(s, c), x| (s + x.sin(), c + x.cos()));
     let r = (s * s + c * c).sqrt() / a.len() as f64;
     (-2.0 * r.ln()).max(0.0).sqrt()
+}
+
+/// A direction drawn uniformly on the unit sphere.
+pub fn uniform_direction(rng: &mut SplitMix64) -> Vector3<f64> {
+    loop {
+        let v = Vector3::new(rng.normal(1.0), rng.normal(1.0), rng.normal(1.0));
+        let n = v.norm();
+        if n > 1e-9 {
+            return v / n;
+        }
+    }
+}
+
+/// A rotation drawn uniformly (Haar measure: a uniform unit quaternion).
+pub fn uniform_rotation(rng: &mut SplitMix64) -> Rotation3<f64> {
+    let q = nalgebra::Quaternion::new(
+        rng.normal(1.0),
+        rng.normal(1.0),
+        rng.normal(1.0),
+        rng.normal(1.0),
+    );
+    nalgebra::UnitQuaternion::from_quaternion(q).to_rotation_matrix()
+}
+
+/// A three-axis magnetometer with hard and soft iron and isotropic per-axis noise, in a
+/// field of magnitude `field` at dip `dip_rad` (NED: north and down components), carried
+/// through attitudes (body → NED); its accelerometer reads the specific force at rest with
+/// its own per-axis noise, in m/s².
+#[derive(Debug, Clone, Copy)]
+pub struct Model3 {
+    pub hard: Vector3<f64>,
+    pub w: Matrix3<f64>,
+    pub field: f64,
+    pub dip_rad: f64,
+    /// Per-axis noise, relative to the field.
+    pub noise_rel: f64,
+}
+
+impl Model3 {
+    /// A random installation: hard iron up to `hard_max` × the field, soft-iron semi-axes
+    /// within `1 ± soft` (unit determinant) at a random orientation, dip 30–75°.
+    pub fn random(
+        rng: &mut SplitMix64,
+        field: f64,
+        hard_max: f64,
+        soft: f64,
+        noise_rel: f64,
+    ) -> Self {
+        let hard = uniform_direction(rng) * field * hard_max * rng.uniform();
+        let a = 1.0 + soft * (2.0 * rng.uniform() - 1.0);
+        let b = 1.0 + soft * (2.0 * rng.uniform() - 1.0);
+        Self {
+            hard,
+            w: soft3(&uniform_rotation(rng), a, b),
+            field,
+            dip_rad: (30.0 + 45.0 * rng.uniform()).to_radians(),
+            noise_rel,
+        }
+    }
+
+    /// The field in body axes at `attitude`.
+    pub fn body_field(&self, attitude: &Rotation3<f64>) -> Vector3<f64> {
+        let (s, c) = self.dip_rad.sin_cos();
+        attitude.inverse() * Vector3::new(c, 0.0, s) * self.field
+    }
+
+    /// The raw reading at `attitude`.
+    pub fn raw(&self, attitude: &Rotation3<f64>, rng: &mut SplitMix64) -> Vector3<f64> {
+        let sigma = self.noise_rel * self.field;
+        self.hard
+            + self.w * self.body_field(attitude)
+            + Vector3::new(rng.normal(sigma), rng.normal(sigma), rng.normal(sigma))
+    }
+
+    /// The accelerometer at rest at `attitude`, m/s², with per-axis noise `sigma_mps2`.
+    pub fn acc(
+        &self,
+        attitude: &Rotation3<f64>,
+        rng: &mut SplitMix64,
+        sigma_mps2: f64,
+    ) -> Vector3<f64> {
+        attitude.inverse() * Vector3::new(0.0, 0.0, -9.80665)
+            + Vector3::new(
+                rng.normal(sigma_mps2),
+                rng.normal(sigma_mps2),
+                rng.normal(sigma_mps2),
+            )
+    }
+}
+
+/// `n` attitudes drawn uniformly: a tumble in every direction.
+pub fn tumble_attitudes(rng: &mut SplitMix64, n: usize) -> Vec<Rotation3<f64>> {
+    (0..n).map(|_| uniform_rotation(rng)).collect()
+}
+
+/// `n` attitudes of a turn through `span_deg` about one body axis (random), from a random
+/// start, each tilted by a random wobble of standard deviation `wobble_deg` (a hand-held
+/// turn).
+pub fn axis_turn_attitudes(
+    rng: &mut SplitMix64,
+    n: usize,
+    span_deg: f64,
+    wobble_deg: f64,
+) -> Vec<Rotation3<f64>> {
+    let start = uniform_rotation(rng);
+    let axis = nalgebra::Unit::new_normalize(uniform_direction(rng));
+    (0..n)
+        .map(|k| {
+            let turn = Rotation3::from_axis_angle(
+                &axis,
+                (span_deg * k as f64 / n.max(2).saturating_sub(1) as f64).to_radians(),
+            );
+            let tilt_axis = nalgebra::Unit::new_normalize(uniform_direction(rng));
+            let wobble =
+                Rotation3::from_axis_angle(&tilt_axis, rng.normal(wobble_deg.to_radians()));
+            start * turn * wobble
+        })
+        .collect()
+}
+
+/// Shuffles `v` in place (Fisher–Yates).
+pub fn shuffle<T>(v: &mut [T], rng: &mut SplitMix64) {
+    for i in (1..v.len()).rev() {
+        let j = ((rng.uniform() * (i + 1) as f64) as usize).min(i);
+        v.swap(i, j);
+    }
 }

@@ -131,6 +131,11 @@ pub struct QualityReport {
     /// Which number decided the verdict.
     #[serde(default)]
     pub verdict_reason: String,
+    /// What kept the calibration from a better verdict: `none` (it is `good`),
+    /// `calibration` (its own bound: a better recording helps) or `noise` (the per-reading
+    /// noise alone: the calibration is within the grade's bound; averaging readings helps).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub verdict_cause: Option<String>,
     /// Samples used in the solve.
     pub points: usize,
     /// 2-D: share of 10° heading bins that hold data; 3-D: information share of an evenly
@@ -140,7 +145,8 @@ pub struct QualityReport {
     pub residual_rms_rel: Option<f64>,
     /// Condition number of the calibration's information matrix.
     pub condition: Option<f64>,
-    /// Dilution of the readings' geometry: heading error per unit of per-reading error.
+    /// Dilution of the orientations seen, each direction once: heading error per unit of
+    /// per-reading error.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub geometry_dilution: Option<f64>,
     /// Bound on the heading (3-D: field direction) error the calibration itself adds,
@@ -208,6 +214,7 @@ impl QualityReport {
         Self {
             verdict: v.grade.to_string(),
             verdict_reason: v.to_string(),
+            verdict_cause: Some(v.cause.to_string()),
             points: q.fit.points,
             coverage: q.fit.coverage,
             residual_rms_rel: finite(q.fit.residual_rms_rel),
@@ -253,7 +260,7 @@ pub fn units_block(joint: bool) -> BTreeMap<String, String> {
         ),
         (
             "quality.geometry_dilution",
-            "radians of heading per unit of per-reading error relative to the field, times sqrt(points) (2 for an even circle, 3.67 for an even sphere)",
+            "radians of heading per unit of per-reading error relative to the field, times the square root of the directions seen, each 0.5-degree (2-D) or equal-area (3-D) direction cell counted once (2 for an even circle, 3.67 for an even sphere)",
         ),
         (
             "quality.heading_error_bound_deg",
