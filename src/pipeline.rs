@@ -254,7 +254,7 @@ mod tests {
 
     impl HeadingEstimator for Straight {
         fn update(&mut self, s: &VehicleSample) -> Result<NavEstimate> {
-            let d = 0.5 * (s.dist_l_m + s.dist_r_m);
+            let d = s.wheels.map_or(0.0, |w| 0.5 * (w.dist_l_m + w.dist_r_m));
             self.est = NavEstimate {
                 t_s: s.t_s,
                 north_m: d * self.heading.cos(),
@@ -302,7 +302,7 @@ mod tests {
             let decl = p.declination().unwrap().0;
             let mut nav = NavPipeline::new(Straight { heading, est: NavEstimate::at_start(0.0, MagneticHeading::new(0.0), 0.0) })
                 .with_true_north(&p).unwrap();
-            let r = nav.update(&VehicleSample { t_s: 1.0, dist_l_m: dist, dist_r_m: dist, gyr_z_rps: None, mag: None }).unwrap();
+            let r = nav.update(&VehicleSample::at(1.0).with_wheels(dist, dist)).unwrap();
             let th = r.true_heading.unwrap().rad();
             prop_assert!(angle_diff(th, heading + decl).abs() < 1e-9);
             // The true-north track points along the true heading and keeps its length.

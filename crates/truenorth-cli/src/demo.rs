@@ -11,9 +11,7 @@ use truenorth::core::{
     Calibrator, CompassQuality, Mag2Sample, VehicleSample, WheelSample, angle_diff,
 };
 use truenorth::gyro::{GyroCalibration, YawIntegrator, YawIntegratorConfig};
-use truenorth::odometer::{
-    DifferentialOdometer, DifferentialOdometerConfig, FixedTrack, OdometerWheels,
-};
+use truenorth::odometer::{DifferentialOdometer, DifferentialOdometerConfig, FixedTrack};
 use truenorth_sim::{
     Route, VehicleSensorParams, VehicleTruth, scenario, simulate, vehicle_streams,
 };
@@ -189,10 +187,7 @@ fn sensor_table(d: &DemoDrive) {
         p.gyro.noise_density_rps_per_sqrt_hz.to_degrees(),
         p.gyro.bias_walk_rps_per_sqrt_s.to_degrees()
     );
-    let track_m = match p.odometer.wheels {
-        OdometerWheels::Rear { track_m } => track_m,
-        OdometerWheels::Front(a) => a.track_m,
-    };
+    let track_m = p.odometer.wheels.track_m();
     println!(
         "  odometer   rear track {:.2} m, wheel scale errors {:+.1} % left / {:+.1} % right, {} cm pulses",
         track_m,
@@ -247,10 +242,13 @@ fn sensor_table(d: &DemoDrive) {
             .samples
             .iter()
             .map(|s| {
+                let Some(w) = s.wheels else {
+                    return f64::NAN;
+                };
                 let w = WheelSample {
                     t_s: s.t_s,
-                    dist_l_m: s.dist_l_m,
-                    dist_r_m: s.dist_r_m,
+                    dist_l_m: w.dist_l_m,
+                    dist_r_m: w.dist_r_m,
                 };
                 odo.push(&w).map_or(f64::NAN, |_| odo.heading_rad() + h0)
             })

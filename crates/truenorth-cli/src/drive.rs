@@ -14,7 +14,7 @@ use truenorth::fusion::vehicle::{
     NavFilter, SeedGyroCompass, SeedGyroCompassConfig, SeedOdometerCompass,
     SeedOdometerCompassConfig, TwoPassConfig, TwoPassStart, VehicleCalibration,
 };
-use truenorth::fusion::{VehicleConfig, VehicleEstimator};
+use truenorth::fusion::{SensorPriors, VehicleConfig, VehicleEstimator};
 use truenorth::odometer::{AckermannParams, OdometerWheels};
 
 use crate::field::Place;
@@ -26,25 +26,36 @@ use crate::io::{
 /// The long help of the command (after the options).
 const AFTER_HELP: &str = "VEHICLE.json: {\"track_m\": 1.55, \"odometer_wheels\": \"rear\"} or
 {\"track_m\": 1.55, \"wheelbase_m\": 2.7, \"odometer_wheels\": \"front\", \"pitman_ratio\": 0.13}
-— track_m the odometer wheels' track, m; wheelbase_m rear axle to front kingpins, m;
-pitman_ratio P = 2p/T_F (kingpin offset p over half the front track; front wheels only).
-Optional: \"wheel_resolution_m\" (distance per odometer pulse, default 0.02 with distance
-columns and 0.003 with speed columns, a CAN bus's 0.01 km/h over one second).
+or {\"track_m\": 0.6, \"odometer_wheels\": \"skid_steer\"} or \"differential\" — track_m the
+odometer wheels' track, m (a skid-steer's physical track: the effective one, 1.5-2.5 times it,
+is learned); wheelbase_m rear axle to front kingpins, m; pitman_ratio P = 2p/T_F (kingpin
+offset p over half the front track; front wheels only). Optional: \"wheel_resolution_m\"
+(distance per odometer pulse, default 0.02 with distance columns on a car and 0.003 with
+speed columns, a CAN bus's 0.01 km/h over one second; 0.001 on a robot). Unknown keys are
+refused.
 
-DRIVE.csv: `t_s` (strictly increasing) and either `dist_l_m,dist_r_m` (cumulative distance
-of the left and right odometer wheels as the odometer reports it) or
-`speed_l_mps,speed_r_mps` (wheel speeds, integrated by the trapezoid rule); optionally
-`gyr_z` (rad/s, raw, positive for a right turn) and `mag_x,mag_y` (any unit,
-uncalibrated; a level compass reads mag_x = H cos(heading), mag_y = -H sin(heading)).
-An empty gyr_z or mag cell means no reading on that row (sensors at different rates).
-Other columns are ignored. Frames: x forward, y right, z down.
+DRIVE.csv: `t_s` (strictly increasing, seconds) and any of: `dist_l_m,dist_r_m` (cumulative
+distance of the left and right odometer wheels as the odometer reports it) or
+`speed_l_mps,speed_r_mps` (wheel speeds, integrated by the trapezoid rule); `gyr_z` (rad/s,
+raw, positive for a right turn); `mag_x,mag_y` (any unit, uncalibrated; a level compass
+reads mag_x = H cos(heading), mag_y = -H sin(heading)). Each sensor may come at its own
+rate: an empty cell means no reading on that row, and each row is used for what it carries.
+Wheels or a gyro must be present. Other columns are ignored. Frames: x forward, y right,
+z down.
 
 Output: `t_s,north_m,east_m,heading_deg` — the rear-axle centre from the start point, and
 the heading clockwise from magnetic north (true north with --lat/--lon: the track is
-turned with it), in [0, 360). `--extra sigma` adds heading_sigma_deg, north_sigma_m,
-east_sigma_m; `--extra status` adds heading_absolute, compass_used, compass_disturbed,
-at_rest (0/1); `--extra calibration` adds the learned gyro_bias_dps, gyro_gain_right,
-gyro_gain_left, wheel_diff, track_scale, speed_coeff_s2_per_m2 (fused method only).
+turned with it), in [0, 360). Without wheels the position cells are empty (no position,
+not zero). `--extra sigma` adds heading_sigma_deg, north_sigma_m, east_sigma_m (the
+heading's σ is of the heading change since the start while heading_absolute is 0);
+`--extra status` adds heading_absolute, compass_used, compass_disturbed, at_rest (0/1);
+`--extra calibration` adds the learned gyro_bias_dps, gyro_gain_right, gyro_gain_left,
+wheel_diff, track_scale, speed_coeff_s2_per_m2 (fused method only); `--extra trust` adds
+gap (a sensor's readings resumed after more than 2 s: what it could not follow was
+widened) and unobserved_gyro_bias, unobserved_gyro_gain_right, unobserved_gyro_gain_left,
+unobserved_wheel_diff, unobserved_track_scale, unobserved_speed_coeff (1 while the data
+have not told that sensor error apart from the others: a steady circle cannot separate a
+gyro bias from a wheel-size difference).
 
 Nothing is assumed calibrated: a drive that begins with a full turn (or one that turns
 through a few corners soon) calibrates the compass from itself. Until then the heading is
@@ -52,7 +63,9 @@ relative to the start (status heading_absolute 0). By default the head of the dr
 held back (at most 2^17 rows) until the sensors are learned and then estimated again
 from the start, so that the first minutes are as good as the rest; --single-pass writes
 each row as it comes (a causal estimate, as a navigation unit would have it).
---calibration-in/--calibration-out carry what was learned from one drive to the next.";
+--calibration-in/--calibration-out carry what was learned from one drive to the next.
+A time base that contradicts the motion (t_s in milliseconds, a gyro in deg/s) is refused
+with the row where the evidence became clear.";
 
 /// Distance resolution assumed for integrated wheel speeds, m: a CAN bus's 0.01 km/h over
 /// the one second in which the estimator compares wheels with gyro. The pulse default
@@ -80,14 +93,17 @@ pub enum Extra {
     Status,
     /// The learned sensor errors (fused method only).
     Calibration,
+    /// gap and the unobserved_* flags: where the estimate leans on the prior rather than
+    /// on the data.
+    Trust,
 }
 
 /// Arguments of `truenorth drive` (the file layouts are in `AFTER_HELP`, shown by `--help`).
 #[derive(Debug, clap::Args)]
 #[command(after_long_help = AFTER_HELP)]
 pub struct Args {
-    /// Vehicle JSON: track_m, odometer_wheels ("rear" or "front"), wheelbase_m and
-    /// pitman_ratio for front wheels.
+    /// Vehicle JSON: track_m, odometer_wheels ("rear", "front", "skid_steer" or
+    /// "differential"), wheelbase_m and pitman_ratio for front wheels.
     #[arg(long)]
     pub vehicle: PathBuf,
     /// Drive CSV (`-`: standard input; `.gz` or gzip data read as such).
@@ -122,6 +138,7 @@ pub struct Args {
 
 /// The vehicle file.
 #[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
 struct VehicleFile {
     track_m: f64,
     odometer_wheels: String,
@@ -156,9 +173,17 @@ impl VehicleFile {
                     p,
                 )))
             }
+            "skid_steer" | "skid-steer" => Ok(OdometerWheels::SkidSteer {
+                track_m: self.track_m,
+            }),
+            "differential" => Ok(OdometerWheels::Differential {
+                track_m: self.track_m,
+            }),
             other => Err(CliError::file(
                 path,
-                format!("odometer_wheels is `{other}`; it must be \"rear\" or \"front\""),
+                format!(
+                    "odometer_wheels is `{other}`; it must be \"rear\", \"front\", \"skid_steer\" or \"differential\""
+                ),
             )),
         }
     }
@@ -176,16 +201,26 @@ enum Wheels {
 }
 
 impl Wheels {
-    /// Cumulative distances at time `t` from row `values`.
-    fn cumulative(&mut self, t: f64, values: &[f64]) -> [f64; 2] {
-        match self {
-            Self::Distances([l, r]) => [values[*l], values[*r]],
-            Self::Speeds {
-                columns: [l, r],
-                last,
-                dist,
-            } => {
-                let v = [values[*l], values[*r]];
+    /// Cumulative distances at time `t` from row `values`, if the row carries the wheels
+    /// (speeds are integrated from one row that carries them to the next); a row with one
+    /// wheel and not the other is an error.
+    fn cumulative(&mut self, t: f64, values: &[f64]) -> Result<Option<[f64; 2]>, &'static str> {
+        let [l, r] = match self {
+            Self::Distances(c) | Self::Speeds { columns: c, .. } => *c,
+        };
+        let v = [values[l], values[r]];
+        match (v[0].is_finite(), v[1].is_finite()) {
+            (false, false) => return Ok(None),
+            (true, true) => {}
+            _ => {
+                return Err(
+                    "has one wheel's value and not the other's; give both wheels on a row, or neither",
+                );
+            }
+        }
+        Ok(Some(match self {
+            Self::Distances(_) => v,
+            Self::Speeds { last, dist, .. } => {
                 if let Some((t0, v0)) = *last {
                     for k in 0..2 {
                         dist[k] += 0.5 * (v0[k] + v[k]) * (t - t0);
@@ -194,7 +229,7 @@ impl Wheels {
                 *last = Some((t, v));
                 *dist
             }
-        }
+        }))
     }
 }
 
@@ -211,6 +246,8 @@ struct Writer {
     extra: Vec<Extra>,
     declination: Option<Declination>,
     rows: usize,
+    /// Rows where a sensor resumed after a gap.
+    gaps: usize,
     error: Option<CliError>,
     last: Option<NavEstimate>,
 }
@@ -235,6 +272,15 @@ impl Writer {
                     "track_scale",
                     "speed_coeff_s2_per_m2",
                 ],
+                Extra::Trust => &[
+                    "gap",
+                    "unobserved_gyro_bias",
+                    "unobserved_gyro_gain_right",
+                    "unobserved_gyro_gain_left",
+                    "unobserved_wheel_diff",
+                    "unobserved_track_scale",
+                    "unobserved_speed_coeff",
+                ],
             });
         }
         h
@@ -251,15 +297,21 @@ impl Writer {
             let (s, c) = d.0.sin_cos();
             (n, east) = (c * n - s * east, s * n + c * east);
         }
+        if !e.status.position_known {
+            // No wheels: no position, written as empty cells.
+            (n, east) = (f64::NAN, f64::NAN);
+        }
         let mut row = vec![e.t_s, n, east, rad_to_deg(wrap_two_pi(heading))];
         for x in &self.extra {
             match x {
                 Extra::Sigma => {
                     let p = e.position_cov_m2;
+                    let known = e.status.position_known;
+                    let sigma = |v: f64| if known { v.max(0.0).sqrt() } else { f64::NAN };
                     row.extend([
                         rad_to_deg(e.heading_sigma_rad),
-                        p[(0, 0)].max(0.0).sqrt(),
-                        p[(1, 1)].max(0.0).sqrt(),
+                        sigma(p[(0, 0)]),
+                        sigma(p[(1, 1)]),
                     ]);
                 }
                 Extra::Status => {
@@ -289,12 +341,28 @@ impl Writer {
                     }
                     None => row.extend([f64::NAN; 6]),
                 },
+                Extra::Trust => {
+                    let u = e.status.unobserved;
+                    row.extend(
+                        [
+                            e.status.gap,
+                            u.gyro_bias,
+                            u.gyro_gain_right,
+                            u.gyro_gain_left,
+                            u.wheel_diff,
+                            u.track_scale,
+                            u.speed_coeff,
+                        ]
+                        .map(|b| f64::from(u8::from(b))),
+                    );
+                }
             }
         }
         if let Err(err) = self.out.row(&row) {
             self.error = Some(err);
         }
         self.rows += 1;
+        self.gaps += usize::from(e.status.gap);
         self.last = Some(*e);
     }
 }
@@ -339,20 +407,21 @@ pub fn run(args: &Args) -> CliResult {
         ix("speed_l_mps"),
         ix("speed_r_mps"),
     ) {
-        (Some(l), Some(r), _, _) => Wheels::Distances([l, r]),
-        (_, _, Some(l), Some(r)) => Wheels::Speeds {
+        (Some(l), Some(r), _, _) => Some(Wheels::Distances([l, r])),
+        (_, _, Some(l), Some(r)) => Some(Wheels::Speeds {
             columns: [l, r],
             last: None,
             dist: [0.0; 2],
-        },
-        _ => {
-            return Err(CliError::row(
-                rows.path(),
-                1,
-                "needs the wheels: `dist_l_m,dist_r_m` (cumulative distances) or `speed_l_mps,speed_r_mps` (wheel speeds)",
-            ));
-        }
+        }),
+        _ => None,
     };
+    if wheel_columns.is_none() && ix("gyr_z").is_none() {
+        return Err(CliError::row(
+            rows.path(),
+            1,
+            "needs a heading sensor: the wheels (`dist_l_m,dist_r_m` cumulative distances or `speed_l_mps,speed_r_mps` wheel speeds) or a gyro (`gyr_z`, rad/s)",
+        ));
+    }
     let vehicle = VehicleFile::read(&args.vehicle)?;
     let wheels = vehicle.wheels(&args.vehicle)?;
     let declination = if args.place.is_given() {
@@ -360,15 +429,17 @@ pub fn run(args: &Args) -> CliResult {
     } else {
         None
     };
-    let mut config = VehicleConfig {
+    let mut priors = SensorPriors::for_wheels(&wheels);
+    if let Some(r) = vehicle.wheel_resolution_m {
+        priors.wheel_resolution_m = r;
+    } else if matches!(wheel_columns, Some(Wheels::Speeds { .. })) && !wheels.can_pivot() {
+        priors.wheel_resolution_m = SPEED_RESOLUTION_M;
+    }
+    let config = VehicleConfig {
         wheels,
+        priors: Some(priors),
         ..VehicleConfig::default()
     };
-    if let Some(r) = vehicle.wheel_resolution_m {
-        config.priors.wheel_resolution_m = r;
-    } else if matches!(wheel_columns, Wheels::Speeds { .. }) {
-        config.priors.wheel_resolution_m = SPEED_RESOLUTION_M;
-    }
     let bad_config = |e: truenorth::core::Error| CliError::file(&args.vehicle, e.to_string());
     let fused = match &args.calibration_in {
         Some(path) => {
@@ -419,6 +490,7 @@ pub fn run(args: &Args) -> CliResult {
         extra: args.extra.clone(),
         declination,
         rows: 0,
+        gaps: 0,
         error: None,
         last: None,
     };
@@ -427,24 +499,20 @@ pub fn run(args: &Args) -> CliResult {
     while let Some(row) = rows.next_row()? {
         let v = &row.values;
         let number = row.number;
-        let [l, r] = wheel_columns.cumulative(v[t], v);
-        if !(l.is_finite() && r.is_finite()) {
-            return Err(CliError::row(
-                &path,
-                number,
-                "the wheel columns must have a value on every row (the estimator steps with the wheels)",
-            ));
+        let mut sample = VehicleSample::at(v[t]);
+        if let Some(w) = wheel_columns.as_mut()
+            && let Some([l, r]) = w
+                .cumulative(v[t], v)
+                .map_err(|m| CliError::row(&path, number, m))?
+        {
+            sample = sample.with_wheels(l, r);
         }
-        let present = |x: f64| x.is_finite().then_some(x);
-        let sample = VehicleSample {
-            t_s: v[t],
-            dist_l_m: l,
-            dist_r_m: r,
-            gyr_z_rps: gyr.and_then(|g| present(v[g])),
-            mag: mag.and_then(|[x, y]| {
-                (v[x].is_finite() && v[y].is_finite()).then(|| Vector2::new(v[x], v[y]))
-            }),
-        };
+        if let Some(g) = gyr.map(|g| v[g]).filter(|g| g.is_finite()) {
+            sample = sample.with_gyro(g);
+        }
+        if let Some([x, y]) = mag.filter(|[x, y]| v[*x].is_finite() && v[*y].is_finite()) {
+            sample = sample.with_mag(Vector2::new(v[x], v[y]));
+        }
         let bad = |e: truenorth::core::Error| CliError::row(&path, number, e.to_string());
         match &mut estimator {
             Estimator::Fused(two) => two
@@ -488,10 +556,18 @@ pub fn run(args: &Args) -> CliResult {
         out,
         last,
         rows: written,
+        gaps,
         ..
     } = writer;
     out.commit()?;
-    summary(args, samples, written, last.as_ref(), learned.as_ref());
+    summary(
+        args,
+        samples,
+        written,
+        gaps,
+        last.as_ref(),
+        learned.as_ref(),
+    );
     Ok(())
 }
 
@@ -500,6 +576,7 @@ fn summary(
     args: &Args,
     samples: usize,
     written: usize,
+    gaps: usize,
     last: Option<&NavEstimate>,
     learned: Option<&VehicleCalibration>,
 ) {
@@ -515,15 +592,38 @@ fn summary(
         "truenorth drive: {samples} rows → {written}, {:.0} m, heading {reference}",
         e.distance_m
     );
-    if e.status.heading_absolute {
-        line += &format!(", final heading σ {:.2}°", rad_to_deg(e.heading_sigma_rad));
+    if !e.status.position_known {
+        line += " (no wheels: no position)";
     }
+    line += &format!(", final heading σ {:.2}°", rad_to_deg(e.heading_sigma_rad));
     if let Some(c) = learned {
         line += &format!(
             ", gyro bias {:.3}°/s, wheel scale difference {:.3} %",
             rad_to_deg(c.gyro_bias_rps.value),
             100.0 * c.wheel_diff.value
         );
+    }
+    let u = e.status.unobserved;
+    let open: Vec<&str> = [
+        (u.gyro_bias, "gyro bias"),
+        (u.gyro_gain_right, "gyro gain right"),
+        (u.gyro_gain_left, "gyro gain left"),
+        (u.wheel_diff, "wheel scale difference"),
+        (u.track_scale, "effective track"),
+        (u.speed_coeff, "speed coefficient"),
+    ]
+    .iter()
+    .filter(|(o, _)| *o)
+    .map(|(_, n)| *n)
+    .collect();
+    if !open.is_empty() {
+        line += &format!(
+            "; not yet told apart by the motion (their priors stand): {}",
+            open.join(", ")
+        );
+    }
+    if gaps > 0 {
+        line += &format!("; {gaps} gaps in the log, widened rather than bridged");
     }
     eprintln!("{line}");
 }

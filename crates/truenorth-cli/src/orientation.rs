@@ -104,12 +104,19 @@ pub enum Frame {
 /// north. Yaw, pitch and roll are always the Z-Y-X angles of the sensor relative to NED
 /// (yaw clockwise from north, pitch nose up, roll right side down), whatever `--frame`.
 /// With `--status` the columns `bias_x_rps,bias_y_rps,bias_z_rps,at_rest,mag_used,
-/// mag_disturbed,mag_calibrating` follow (estimated gyro bias; 1/0 flags; mag_calibrating:
-/// a hard-iron offset learned online is being subtracted). `--plot FILE.svg` draws yaw,
-/// pitch and roll over time with the samples judged magnetically disturbed shaded.
+/// mag_disturbed,mag_calibrating,gap` follow (estimated gyro bias; 1/0 flags;
+/// mag_calibrating: a hard-iron offset learned online is being subtracted; gap: the time
+/// since the previous row was longer than the gyro can bridge, 0.5 s, and the attitude was
+/// taken anew from this row's accelerometer and magnetometer), and for the quaternion filter
+/// `sigma_x_deg,sigma_y_deg,sigma_z_deg`: one standard deviation of the attitude's error
+/// about the north, east and down axes (the last is heading's; with `--no-mag`, its drift
+/// since the start). `--plot FILE.svg` draws yaw, pitch and roll over time with the samples
+/// judged magnetically disturbed shaded.
 ///
-/// Exit status 1 with one line on stderr naming the file and row of the first unusable
-/// sample (non-finite value, time not increasing).
+/// After a gap a line on stderr says how many there were and at which rows. Exit status 1
+/// with one line on stderr naming the file and row of the first unusable sample
+/// (non-finite value, time not increasing, a time base whose steps are mostly such gaps:
+/// `t_s` in milliseconds).
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// Orientation method.
@@ -127,7 +134,8 @@ pub struct Args {
     /// Ignore the magnetometer (6-D: heading relative to the start, drifting).
     #[arg(long)]
     pub no_mag: bool,
-    /// Append the estimated gyro bias and the rest / magnetometer flags.
+    /// Append the estimated gyro bias, the rest / magnetometer / gap flags and (quaternion
+    /// filter) the attitude's σ.
     #[arg(long)]
     pub status: bool,
     /// What a gyro sample's rate stands for (quaternion filter).
@@ -148,7 +156,7 @@ const HEADER: [&str; 8] = [
     "pitch_deg",
     "roll_deg",
 ];
-const STATUS_HEADER: [&str; 7] = [
+const STATUS_HEADER: [&str; 8] = [
     "bias_x_rps",
     "bias_y_rps",
     "bias_z_rps",
@@ -156,7 +164,12 @@ const STATUS_HEADER: [&str; 7] = [
     "mag_used",
     "mag_disturbed",
     "mag_calibrating",
+    "gap",
 ];
+/// With `--status`, after [`STATUS_HEADER`], for an estimator that reports σ.
+const SIGMA_HEADER: [&str; 3] = ["sigma_x_deg", "sigma_y_deg", "sigma_z_deg"];
+/// Gaps listed by row in the summary line; more are counted.
+const GAPS_LISTED: usize = 5;
 
 /// Runs the subcommand.
 pub fn run(args: &Args) -> CliResult {
@@ -186,6 +199,9 @@ pub fn run(args: &Args) -> CliResult {
     };
     let mut rows = Vec::with_capacity(table.len());
     let mut disturbed = Vec::with_capacity(table.len());
+    // (row, t_s, gap length) of every gap.
+    let mut gaps: Vec<(usize, f64, f64)> = Vec::new();
+    let mut reports_sigma = false;
     for k in 0..table.len() {
         let m = match mag {
             Some((x, y, z)) if x[k].is_nan() && y[k].is_nan() && z[k].is_nan() => Axes::NONE,
@@ -201,6 +217,13 @@ pub fn run(args: &Args) -> CliResult {
         let est = estimator
             .update(&sample)
             .map_err(|e| CliError::row(&args.input, k + 2, e.to_string()))?;
+        if est.status.gap {
+            let since = k.checked_sub(1).map_or(0.0, |j| t[k] - t[j]);
+            gaps.push((k + 2, t[k], since));
+        }
+        if k == 0 {
+            reports_sigma = est.sigma_rad.is_some();
+        }
         let q = to_frame * est.attitude;
         let e = EulerZyx::from_quaternion(&est.attitude);
         let mut row = vec![
@@ -221,7 +244,11 @@ pub fn run(args: &Args) -> CliResult {
                 flag(est.status.mag_used),
                 flag(est.status.mag_disturbed),
                 flag(est.status.mag_calibrating),
+                flag(est.status.gap),
             ]);
+            if let Some(sigma) = est.sigma_rad.filter(|_| reports_sigma) {
+                row.extend(sigma.iter().map(|v| rad_to_deg(*v)));
+            }
         }
         disturbed.push(est.status.mag_disturbed);
         rows.push(row);
@@ -232,8 +259,35 @@ pub fn run(args: &Args) -> CliResult {
     let mut header: Vec<&str> = HEADER.to_vec();
     if args.status {
         header.extend(STATUS_HEADER);
+        if reports_sigma {
+            header.extend(SIGMA_HEADER);
+        }
     }
-    write_csv(&args.output, &header, rows)
+    write_csv(&args.output, &header, rows)?;
+    if !gaps.is_empty() {
+        eprintln!("{}", gap_summary(&args.input, &gaps));
+    }
+    Ok(())
+}
+
+/// One line: how many gaps, where, and what was done about them.
+fn gap_summary(input: &std::path::Path, gaps: &[(usize, f64, f64)]) -> String {
+    let listed: Vec<String> = gaps
+        .iter()
+        .take(GAPS_LISTED)
+        .map(|(row, t, gap)| format!("row {row} (t_s {t}, after {gap:.3} s)"))
+        .collect();
+    let more = match gaps.len().saturating_sub(GAPS_LISTED) {
+        0 => String::new(),
+        n => format!(" and {n} more"),
+    };
+    format!(
+        "truenorth orientation: {}: {} gap{} longer than the gyro can bridge at {}{more}; the attitude restarted there from the accelerometer and magnetometer (column gap with --status)",
+        input.display(),
+        gaps.len(),
+        if gaps.len() == 1 { "" } else { "s" },
+        listed.join(", "),
+    )
 }
 
 /// Yaw, pitch and roll (columns 5–7 of the output rows) over time, disturbed samples shaded.

@@ -21,21 +21,23 @@ fn write_drive(drive: &SimulatedDrive, path: &Path, speeds: bool, gyro: bool) {
     s += ",mag_x,mag_y\n";
     let mut last: Option<&truenorth::core::VehicleSample> = None;
     for x in &drive.samples {
+        let w = x.wheels.unwrap();
         if speeds {
             // The speed that, integrated by the trapezoid rule, gives the distances back.
             let (vl, vr) = match last {
                 Some(prev) => {
                     let dt = x.t_s - prev.t_s;
+                    let p = prev.wheels.unwrap();
                     (
-                        (x.dist_l_m - prev.dist_l_m) / dt,
-                        (x.dist_r_m - prev.dist_r_m) / dt,
+                        (w.dist_l_m - p.dist_l_m) / dt,
+                        (w.dist_r_m - p.dist_r_m) / dt,
                     )
                 }
                 None => (0.0, 0.0),
             };
             write!(s, "{},{vl},{vr}", x.t_s).unwrap();
         } else {
-            write!(s, "{},{},{}", x.t_s, x.dist_l_m, x.dist_r_m).unwrap();
+            write!(s, "{},{},{}", x.t_s, w.dist_l_m, w.dist_r_m).unwrap();
         }
         if gyro {
             write!(s, ",{}", x.gyr_z_rps.unwrap()).unwrap();
@@ -242,13 +244,13 @@ fn refusals_name_the_file_and_the_problem() {
     let input = dir.join("drive.csv");
     let out = dir.join("out.csv");
     let cases: [(&str, &str); 4] = [
-        ("t_s,mag_x,mag_y\n0,1,2\n", "needs the wheels"),
+        ("t_s,mag_x,mag_y\n0,1,2\n", "needs a heading sensor"),
         (
             "t_s,dist_l_m,dist_r_m\n0,0,0\n0,1,1\n",
             "does not come after",
         ),
         ("t_s,dist_l_m,dist_r_m,mag_x\n0,0,0,1\n", "mag_x, mag_y"),
-        ("t_s,dist_l_m,dist_r_m\n0,0,0\n1,,1\n", "every row"),
+        ("t_s,dist_l_m,dist_r_m\n0,0,0\n1,,1\n", "one wheel's value"),
     ];
     for (text, expect) in cases {
         std::fs::write(&input, text).unwrap();

@@ -18,6 +18,15 @@ fn dir(tag: &str) -> PathBuf {
 
 /// Two minutes of simulated hand-held motion with a typical consumer IMU, as the CLI's input.
 fn recording(dir: &Path) -> (PathBuf, Vec<MotionTruth>) {
+    recording_with_time(dir, "imu.csv", |t| t)
+}
+
+/// The recording with its time column mapped by `time` (a gap, another unit).
+fn recording_with_time(
+    dir: &Path,
+    name: &str,
+    time: impl Fn(f64) -> f64,
+) -> (PathBuf, Vec<MotionTruth>) {
     let truth = handheld_motion(&HandheldParams {
         duration_s: 120.0,
         ..HandheldParams::default()
@@ -31,18 +40,31 @@ fn recording(dir: &Path) -> (PathBuf, Vec<MotionTruth>) {
             s.acc_mps2.as_xyz().unwrap(),
             s.mag.as_xyz().unwrap(),
         );
-        csv += &format!(
-            "{},{},{},{},{},{},{},{},{},{}\n",
-            s.t_s, g.x, g.y, g.z, a.x, a.y, a.z, m.x, m.y, m.z
-        );
+        let cells = [time(s.t_s), g.x, g.y, g.z, a.x, a.y, a.z, m.x, m.y, m.z];
+        csv += &cells.map(|v| v.to_string()).join(",");
+        csv.push('\n');
     }
-    let path = dir.join("imu.csv");
+    let path = dir.join(name);
     std::fs::write(&path, csv).unwrap();
     (path, truth)
 }
 
 fn run(args: &[&str]) -> std::process::Output {
     bin().arg("orientation").args(args).output().unwrap()
+}
+
+/// Runs the default method on `input`, which must be refused without creating `output`;
+/// returns what it said on stderr.
+fn refused(input: &Path, output: &Path) -> String {
+    let o = run(&[
+        "--input",
+        input.to_str().unwrap(),
+        "--output",
+        output.to_str().unwrap(),
+    ]);
+    assert!(!o.status.success());
+    assert!(!output.exists());
+    String::from_utf8_lossy(&o.stderr).into_owned()
 }
 
 fn rows(path: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
@@ -58,6 +80,27 @@ fn rows(path: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
         .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
         .collect();
     (header, rows)
+}
+
+/// The quaternion filter's error on the recording (NED output rows) after 20 s stays within
+/// its bound. The motion never rests, so the 0.3°/s-per-axis gyro bias is learned only by
+/// the slow in-motion estimate; until then a complementary filter lags by bias × time
+/// constant, at most |b| · τ_mag = 0.52°/s · 15 s = 7.8° about the vertical, plus the tilt
+/// of the 0.07 m/s² accelerometer bias (0.4°) and the noise: 1° covers both.
+fn assert_within_bound(rows: &[Vec<f64>], truth: &[MotionTruth]) {
+    let bias_dps = 0.3f64 * 3f64.sqrt();
+    let bound_deg = bias_dps * truenorth::fusion::QuaternionFilterConfig::default().tau_mag_s + 1.0;
+    assert_eq!(rows.len(), truth.len());
+    let worst_deg = rows
+        .iter()
+        .zip(truth)
+        .filter(|(_, t)| t.t_s > 20.0)
+        .map(|(r, t)| quaternion(r).angle_to(&t.attitude).to_degrees())
+        .fold(0.0, f64::max);
+    assert!(
+        worst_deg < bound_deg,
+        "worst attitude error {worst_deg:.2}° (bound {bound_deg:.1}°)"
+    );
 }
 
 fn quaternion(r: &[f64]) -> UnitQuaternion<f64> {
@@ -102,7 +145,11 @@ fn attitude_follows_the_simulated_motion_in_both_frames() {
             "at_rest",
             "mag_used",
             "mag_disturbed",
-            "mag_calibrating"
+            "mag_calibrating",
+            "gap",
+            "sigma_x_deg",
+            "sigma_y_deg",
+            "sigma_z_deg"
         ]
     );
     let (_, enu_rows) = rows(&enu);
@@ -110,26 +157,13 @@ fn attitude_follows_the_simulated_motion_in_both_frames() {
     // ENU = (north, east, down) → (east, north, up): 180° about (1, 1, 0)/√2.
     let h = std::f64::consts::FRAC_1_SQRT_2;
     let ned_to_enu = UnitQuaternion::from_quaternion(Quaternion::new(0.0, h, h, 0.0));
-    let mut worst_deg: f64 = 0.0;
-    for ((n, e), t) in ned_rows.iter().zip(&enu_rows).zip(&truth) {
+    for (n, e) in ned_rows.iter().zip(&enu_rows) {
         let (qn, qe) = (quaternion(n), quaternion(e));
         assert!((ned_to_enu * qn).angle_to(&qe) < 1e-6);
         // Yaw, pitch and roll describe the NED attitude in both files.
         assert_eq!(n[5..8], e[5..8]);
-        if t.t_s > 20.0 {
-            worst_deg = worst_deg.max(qn.angle_to(&t.attitude).to_degrees());
-        }
     }
-    // The motion never rests, so the 0.3°/s-per-axis gyro bias is learned only by the slow
-    // in-motion estimate; until then a complementary filter lags by bias × time constant,
-    // at most |b| · τ_mag = 0.52°/s · 15 s = 7.8° about the vertical, plus the tilt of the
-    // 0.07 m/s² accelerometer bias (0.4°) and the noise: 1° covers both.
-    let bias_dps = 0.3f64 * 3f64.sqrt();
-    let bound_deg = bias_dps * truenorth::fusion::QuaternionFilterConfig::default().tau_mag_s + 1.0;
-    assert!(
-        worst_deg < bound_deg,
-        "worst attitude error {worst_deg:.2}° (bound {bound_deg:.1}°)"
-    );
+    assert_within_bound(&ned_rows, &truth);
 }
 
 #[test]
@@ -154,16 +188,8 @@ fn refusals_name_the_file_and_row() {
     let bad = d.join("bad.csv");
     std::fs::write(&bad, lines.join("\n")).unwrap();
     let out = d.join("out.csv");
-    let o = run(&[
-        "--input",
-        bad.to_str().unwrap(),
-        "--output",
-        out.to_str().unwrap(),
-    ]);
-    assert!(!o.status.success());
-    let err = String::from_utf8_lossy(&o.stderr);
+    let err = refused(&bad, &out);
     assert!(err.contains("row 6"), "{err}");
-    assert!(!out.exists());
     // A failed run leaves an existing output as it was.
     std::fs::write(&out, "kept\n").unwrap();
     let o = run(&[
@@ -220,4 +246,53 @@ fn euler_detector_and_plot() {
         input.to_str().unwrap(),
     ]);
     assert!(!o.status.success());
+}
+
+/// A recording with an hour missing in the middle: the attitude after the gap is taken anew
+/// from the sensors (not the gyro's last rate held for an hour), the rows say where, and a
+/// line on stderr says how many gaps there were and where.
+#[test]
+fn a_gap_restarts_the_attitude_and_is_reported() {
+    let d = dir("gap");
+    let (input, truth) =
+        recording_with_time(&d, "gap.csv", |t| if t >= 60.0 { t + 3600.0 } else { t });
+    let out = d.join("out.csv");
+    let o = run(&[
+        "--input",
+        input.to_str().unwrap(),
+        "--output",
+        out.to_str().unwrap(),
+        "--status",
+        "--gyro-timing",
+        "instantaneous",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let (header, rows) = rows(&out);
+    let gap = header.iter().position(|h| h == "gap").unwrap();
+    let gap_rows: Vec<usize> = rows
+        .iter()
+        .enumerate()
+        .filter(|(_, r)| r[gap] == 1.0)
+        .map(|(k, _)| k)
+        .collect();
+    // Sample 6000 (t = 60 s) follows the gap: file row 6002 with the header.
+    assert_eq!(gap_rows, [6000]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("1 gap") && err.contains("row 6002"), "{err}");
+    // Restarted from one reading in motion, then held within the bound of the gap-free run:
+    // the gyro's rate held over the hour instead turned the attitude 30–50° off.
+    assert_within_bound(&rows, &truth);
+}
+
+/// A time column in milliseconds: every step is a gap, which is no gyro record; refused
+/// with the row, and nothing written.
+#[test]
+fn a_millisecond_time_base_is_refused() {
+    let d = dir("ms");
+    let (input, _) = recording_with_time(&d, "ms.csv", |t| 1000.0 * t);
+    let err = refused(&input, &d.join("out.csv"));
+    assert!(
+        err.contains("row 4") && err.contains("milliseconds"),
+        "{err}"
+    );
 }

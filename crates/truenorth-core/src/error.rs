@@ -3,6 +3,39 @@
 
 use thiserror::Error;
 
+/// "by up to X°" for an angle that a first-order figure can give, "by any angle" beyond half
+/// a turn (where a first-order figure no longer means anything).
+struct UpTo(f64);
+
+impl core::fmt::Display for UpTo {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        if self.0 <= 180.0 {
+            write!(f, "by up to {:.1}°", self.0)
+        } else {
+            f.write_str("by any angle (the first-order figure exceeds 180°)")
+        }
+    }
+}
+
+/// ", X° net of the noise of the readings at its ends (Y°)" for a span `X + Y` of which the
+/// noise may account for `Y`; nothing when `Y` is 0.
+struct NetOfNoise(f64, f64);
+
+impl core::fmt::Display for NetOfNoise {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        if self.1 > 0.0 {
+            write!(
+                f,
+                ", {:.0}° once the noise of the readings at its two ends ({:.0}°) is allowed for",
+                (self.0 - self.1).max(0.0),
+                self.1
+            )
+        } else {
+            Ok(())
+        }
+    }
+}
+
 /// Everything that can go wrong in truenorth's library code.
 ///
 /// Library code never panics on bad input; it returns one of these.
@@ -45,6 +78,23 @@ pub enum Error {
         /// Largest valid value.
         max: f64,
     },
+    /// The data contradict the units they declare (a time base in milliseconds read as
+    /// seconds, a field in nT declared as µT, …): what they say cannot come from real motion.
+    #[error(
+        "the data contradict their declared units: {what} is {value:.4}, where real motion gives {min}–{max}; {hint}"
+    )]
+    Implausible {
+        /// Which quantity, with its declared unit.
+        what: &'static str,
+        /// The offending value, in the declared unit.
+        value: f64,
+        /// Smallest value real motion gives.
+        min: f64,
+        /// Largest value real motion gives.
+        max: f64,
+        /// What the data probably are and what to do.
+        hint: &'static str,
+    },
     /// Not enough samples to do what was asked.
     #[error("too few points: got {got}, need at least {need}; record more data before solving")]
     TooFewPoints {
@@ -55,11 +105,16 @@ pub enum Error {
     },
     /// The samples cover too little of a turn to determine a calibration.
     #[error(
-        "the samples cover only {covered_deg:.0}° of heading, need at least {need_deg:.0}°; turn further (a full circle is best) before solving"
+        "the samples cover only {covered_deg:.0}° of heading{}, need at least {need_deg:.0}°; turn further (a full circle is best) before solving",
+        NetOfNoise(*covered_deg, *noise_deg)
     )]
     InsufficientCoverage {
-        /// Heading span covered, degrees.
+        /// Heading span covered, degrees: between the outermost readings.
         covered_deg: f64,
+        /// What the readings' noise may add to that span at its two ends, degrees, and is
+        /// taken off it before it is compared with `need_deg` (0 where a calibrator does not
+        /// know the noise).
+        noise_deg: f64,
         /// Heading span required, degrees.
         need_deg: f64,
     },
@@ -91,6 +146,78 @@ pub enum Error {
     Degenerate {
         /// What was degenerate and what to do.
         reason: &'static str,
+    },
+    /// The orientations seen do not determine a calibration, however many readings were
+    /// taken in them: a geometric property of the directions, not of their number or noise.
+    #[error(
+        "the orientations seen do not determine the calibration: their dilution is {dilution:.1} (an evenly covered {even_shape} has {even_dilution:.1}), so an error of {:.1} % of the field per reading could turn the result {}, more than the {max_deg}° accepted; more readings in the same orientations will not help: {hint}",
+        100.0 * model_error_rel,
+        UpTo(*error_deg)
+    )]
+    Undetermined {
+        /// The dilution of the directions seen, each direction counted once (infinite when
+        /// they do not determine the calibration at all).
+        dilution: f64,
+        /// The dilution of an evenly covered circle (2-D) or sphere (3-D).
+        even_dilution: f64,
+        /// `"circle"` or `"sphere"`.
+        even_shape: &'static str,
+        /// The per-reading error, relative to the field, the test assumes.
+        model_error_rel: f64,
+        /// `dilution × model_error_rel`, degrees: the error that per-reading error could
+        /// cause.
+        error_deg: f64,
+        /// The largest error accepted, degrees.
+        max_deg: f64,
+        /// What to record instead.
+        hint: &'static str,
+    },
+    /// The readings are too noisy for the orientations they were taken in: the fit is
+    /// outside the range where its own error figures hold.
+    #[error(
+        "each reading scatters {:.1} % of the field about the fit and the orientations' dilution is {dilution:.1}: their product, {product:.2}, exceeds the {max_product} within which a least-squares calibration's error figures hold (beyond it the fit can drift along what the orientations leave loose, and more readings do not stop it); record orientations that determine the calibration better (a fuller tumble: an evenly covered sphere has a dilution of 3.7) or use a quieter sensor",
+        100.0 * noise_rel
+    )]
+    TooNoisyForOrientations {
+        /// Per-reading noise, relative to the field.
+        noise_rel: f64,
+        /// The orientations' dilution.
+        dilution: f64,
+        /// `noise_rel × dilution`.
+        product: f64,
+        /// The largest product accepted.
+        max_product: f64,
+    },
+    /// The calibration's own uncertainty is too large for the readings' noise and number.
+    #[error(
+        "the calibration itself could err by up to {bound_deg:.2}° (3 sigma{widened}), more than the {max_deg}° accepted: {points} readings with a noise of {:.2} % of the field each are too few for the orientations they cover; the error falls as 1/sqrt(readings), so record more readings, or turn (tumble) through more orientations",
+        100.0 * noise_rel
+    )]
+    TooUncertain {
+        /// The 3σ heading-error bound the refusal judged, degrees.
+        bound_deg: f64,
+        /// The largest bound accepted, degrees.
+        max_deg: f64,
+        /// Readings behind the fit.
+        points: usize,
+        /// Per-reading noise, relative to the field (the fit's residual standard deviation).
+        noise_rel: f64,
+        /// `""`, or how the bound was widened for a σ estimated from few residuals.
+        widened: &'static str,
+    },
+    /// Two consecutive samples are further apart in time than a method can bridge.
+    #[error(
+        "the record has a gap of {gap_s} s before t = {t_s} s, longer than the {max_gap_s} s that {what} can bridge; split the record at the gap and calibrate each part on its own (or start the calibrator again from this sample)"
+    )]
+    TimeGap {
+        /// What cannot bridge it (e.g. "the gyro's integrated heading").
+        what: &'static str,
+        /// Timestamp of the sample after the gap, seconds.
+        t_s: f64,
+        /// The gap, seconds.
+        gap_s: f64,
+        /// The longest gap accepted, seconds.
+        max_gap_s: f64,
     },
     /// A conic fit returned something that is not an ellipse (or ellipsoid).
     #[error(

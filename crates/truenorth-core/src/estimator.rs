@@ -24,6 +24,11 @@ pub struct AttitudeStatus {
     pub mag_disturbed: bool,
     /// The estimator is re-estimating the magnetometer's hard iron.
     pub mag_calibrating: bool,
+    /// The time since the previous sample was longer than the estimator can bridge with
+    /// the gyro (its `max_gap_s`): the attitude was taken anew from this sample's
+    /// accelerometer (and magnetometer) and its σ widened.
+    #[serde(default)]
+    pub gap: bool,
 }
 
 /// An orientation estimate.
@@ -40,7 +45,9 @@ pub struct AttitudeEstimate {
     /// Estimated gyro bias, rad/s, body axes (subtracted from the raw rates).
     pub gyro_bias_rps: Vector3<f64>,
     /// One standard deviation of the attitude error about the reference x, y, z axes
-    /// (roll, pitch, heading), radians; `None` when the estimator does not model it.
+    /// (north, east, down: the error rotation `attitude ⊗ truth⁻¹` as a rotation vector),
+    /// radians; `None` when the estimator does not model it. Without a magnetometer the
+    /// heading is relative to the start and its σ is the drift since the start.
     pub sigma_rad: Option<Vector3<f64>>,
     /// Rest and disturbance flags.
     pub status: AttitudeStatus,
@@ -90,6 +97,52 @@ pub struct NavStatus {
     /// The compass is judged disturbed (its readings disagree with the dead-reckoned
     /// heading or its field magnitude is off); heading runs on the gyro or wheels meanwhile.
     pub compass_disturbed: bool,
+    /// Wheel readings have been seen, so the position is dead-reckoned. While false (no
+    /// wheels fitted, or none read yet) `north_m` and `east_m` stay 0 and the position
+    /// covariance is infinite: the position is absent, not zero.
+    #[serde(default)]
+    pub position_known: bool,
+    /// A sensor's readings stopped for longer than the estimator can bridge, and resumed at
+    /// this sample: what could not be followed across the gap was widened (heading, the
+    /// track, the gyro bias) rather than guessed.
+    #[serde(default)]
+    pub gap: bool,
+    /// The learned sensor errors the data have not yet told apart.
+    #[serde(default)]
+    pub unobserved: Unobserved,
+}
+
+/// Which of a vehicle estimator's learned sensor errors the data have not yet determined:
+/// true where a state's uncertainty is still more than half its prior's, or where it is
+/// so strongly correlated with another that the data fix only their combination (a gyro
+/// bias and a wheel-size difference on a steady circle turn the heading alike).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct Unobserved {
+    /// Gyro bias.
+    pub gyro_bias: bool,
+    /// Gyro gain for right turns.
+    pub gyro_gain_right: bool,
+    /// Gyro gain for left turns.
+    pub gyro_gain_left: bool,
+    /// Difference of the two wheels' scales.
+    pub wheel_diff: bool,
+    /// The wheels' effective track.
+    pub track_scale: bool,
+    /// The speed coefficient of the wheels' difference.
+    pub speed_coeff: bool,
+}
+
+impl Unobserved {
+    /// Whether any state is not yet determined.
+    pub fn any(&self) -> bool {
+        self.gyro_bias
+            || self.gyro_gain_right
+            || self.gyro_gain_left
+            || self.wheel_diff
+            || self.track_scale
+            || self.speed_coeff
+    }
 }
 
 /// Position, heading and speed of a land vehicle relative to its start point, with their
@@ -104,9 +157,10 @@ pub struct NavEstimate {
     pub east_m: f64,
     /// Heading from magnetic north (add the declination for true north).
     pub heading: MagneticHeading,
-    /// One standard deviation of the heading, radians.
+    /// One standard deviation of the heading, radians: of the heading from north when
+    /// `status.heading_absolute`, otherwise of the heading change since the start.
     pub heading_sigma_rad: f64,
-    /// Covariance of (north, east), m².
+    /// Covariance of (north, east), m² (infinite while `status.position_known` is false).
     pub position_cov_m2: Matrix2<f64>,
     /// Speed along the track, m/s.
     pub speed_mps: f64,

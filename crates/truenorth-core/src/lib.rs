@@ -47,7 +47,7 @@ pub use calibrator::{
 pub use error::Error;
 pub use estimator::{
     AttitudeEstimate, AttitudeStatus, HeadingEstimator, NavEstimate, NavStatus,
-    OrientationEstimator,
+    OrientationEstimator, Unobserved,
 };
 pub use heading::{Declination, MagneticHeading, TrueHeading};
 pub use heading_source::{
@@ -57,7 +57,7 @@ pub use noise::{NoiseSource, SplitMix64, ZeroNoise};
 pub use persist::{Persistent, Snapshot, check_snapshot_version};
 pub use sample::{
     AccelSample, Axes, GyroSample, ImuSample, MAX_YAW_RATE_RPS, Mag2Sample, Mag3Sample,
-    VehicleSample, WheelSample,
+    VehicleSample, WheelReading, WheelSample,
 };
 pub use sensor_model::SensorModel;
 pub use units::{STANDARD_GRAVITY_MPS2, deg_to_rad, mph_to_mps, mps_to_mph, rad_to_deg};

@@ -186,19 +186,71 @@ pub struct WheelSample {
     pub dist_r_m: f64,
 }
 
-/// Everything a land vehicle's navigation sensors report at one instant (the `drive` CSV row).
+/// The cumulative distances of the left and right odometer wheels at one instant, as the
+/// odometer reports them (what `DRIVE.csv`'s `dist_l_m`, `dist_r_m` hold).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct VehicleSample {
-    /// Timestamp, seconds.
-    pub t_s: f64,
+pub struct WheelReading {
     /// Cumulative distance of the left odometer wheel, metres.
     pub dist_l_m: f64,
     /// Cumulative distance of the right odometer wheel, metres.
     pub dist_r_m: f64,
-    /// Raw yaw rate (with the gyro's own bias and scale error), rad/s, if a gyro is fitted.
+}
+
+/// What a land vehicle's navigation sensors report at one instant (the `drive` CSV row).
+///
+/// Every reading is optional: sensors arrive at their own rates, so a row may carry the
+/// wheels, the gyro, the compass or any subset of them.
+///
+/// ```
+/// use nalgebra::Vector2;
+/// use truenorth_core::VehicleSample;
+///
+/// let s = VehicleSample::at(1.5).with_wheels(10.2, 10.1).with_gyro(0.01);
+/// assert_eq!(s.wheels.unwrap().dist_l_m, 10.2);
+/// assert!(s.mag.is_none());
+/// let m = VehicleSample::at(1.6).with_mag(Vector2::new(20.0, -3.0));
+/// assert!(m.wheels.is_none() && m.gyr_z_rps.is_none());
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct VehicleSample {
+    /// Timestamp, seconds.
+    pub t_s: f64,
+    /// Cumulative wheel distances, if the row carries them.
+    pub wheels: Option<WheelReading>,
+    /// Raw yaw rate (with the gyro's own bias and scale error), rad/s, if the row carries one.
     pub gyr_z_rps: Option<f64>,
-    /// Raw, uncalibrated horizontal magnetometer reading, if a compass is fitted.
+    /// Raw, uncalibrated horizontal magnetometer reading, if the row carries one.
     pub mag: Option<Vector2<f64>>,
+}
+
+impl VehicleSample {
+    /// A row at `t_s` with no reading yet.
+    pub const fn at(t_s: f64) -> Self {
+        Self {
+            t_s,
+            wheels: None,
+            gyr_z_rps: None,
+            mag: None,
+        }
+    }
+
+    /// The row with cumulative wheel distances, metres.
+    pub const fn with_wheels(mut self, dist_l_m: f64, dist_r_m: f64) -> Self {
+        self.wheels = Some(WheelReading { dist_l_m, dist_r_m });
+        self
+    }
+
+    /// The row with a raw yaw rate, rad/s (positive turning right).
+    pub const fn with_gyro(mut self, gyr_z_rps: f64) -> Self {
+        self.gyr_z_rps = Some(gyr_z_rps);
+        self
+    }
+
+    /// The row with a raw horizontal magnetometer reading (any unit).
+    pub const fn with_mag(mut self, mag: Vector2<f64>) -> Self {
+        self.mag = Some(mag);
+        self
+    }
 }
 
 /// Largest yaw rate a vehicle sample may carry, rad/s (2000°/s, the widest range of MEMS
@@ -206,12 +258,14 @@ pub struct VehicleSample {
 pub const MAX_YAW_RATE_RPS: f64 = 2000.0 * core::f64::consts::PI / 180.0;
 
 impl Validate for VehicleSample {
-    /// Checks that the timestamp, the distances and every present reading are finite, and
-    /// the yaw rate within [`MAX_YAW_RATE_RPS`].
+    /// Checks that the timestamp and every present reading are finite, and the yaw rate
+    /// within [`MAX_YAW_RATE_RPS`].
     fn validate(&self) -> Result<()> {
         check_finite("timestamp t_s", self.t_s)?;
-        check_finite("dist_l_m", self.dist_l_m)?;
-        check_finite("dist_r_m", self.dist_r_m)?;
+        if let Some(w) = self.wheels {
+            check_finite("dist_l_m", w.dist_l_m)?;
+            check_finite("dist_r_m", w.dist_r_m)?;
+        }
         if let Some(g) = self.gyr_z_rps {
             check_range("gyr_z (rad/s)", g, -MAX_YAW_RATE_RPS, MAX_YAW_RATE_RPS)?;
         }

@@ -139,6 +139,11 @@ pub struct EulerDetectorConfig {
     /// Start-up field for a two-axis magnetometer (M_z reconstruction); without it a
     /// two-axis magnetometer is refused.
     pub startup_field: Option<StartupField>,
+    /// Longest time between samples the gyro is integrated across, s (default 0.5, as the
+    /// quaternion filter's `max_gap_s`): after a longer gap the angles are taken anew from
+    /// the static angles of the sample (status `gap`), and a time base of mostly such gaps
+    /// is refused.
+    pub max_gap_s: f64,
 }
 
 impl Default for EulerDetectorConfig {
@@ -152,6 +157,7 @@ impl Default for EulerDetectorConfig {
             coefficient_table: true,
             use_mag: true,
             startup_field: None,
+            max_gap_s: 0.5,
         }
     }
 }
@@ -175,6 +181,7 @@ impl Validate for EulerDetectorConfig {
             o.validate()?;
         }
         self.definer.validate()?;
+        crate::time_gap::check_max_gap(self.max_gap_s)?;
         if let Some(f) = self.startup_field {
             check_positive("startup_field.total", f.total)?;
             check_range(

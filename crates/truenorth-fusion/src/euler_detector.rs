@@ -18,6 +18,16 @@
 //!    `truenorth-gyro`.
 //! 10. The **yaw + pitch variant** ([`EulerVariant::YawPitch`]).
 //!
+//! A step longer than `max_gap_s` restarts the detector from the sample's static angles
+//! (status `gap`), as the quaternion filter does.
+//!
+//! The detector reports no σ (`sigma_rad` is `None`): its corrections switch on and off
+//! with the definer's tests and pull towards an unfiltered static angle, which errs by the
+//! body's acceleration over g at every corrected sample (32° of inclination on BROAD's
+//! fast-translation trial 16), and it has no estimate of the gyro's bias; an error model
+//! for that switching would have to be built and tested of its own, and a σ that has not
+//! been tested is no promise.
+//!
 //! Frames: body x forward, y right, z down; yaw clockwise from magnetic north, pitch nose
 //! up, roll right side down (the seed's pitch is positive nose down: see
 //! `truenorth_accel::static_tilt`). The output quaternion is `Rz(yaw)·Ry(pitch)·Rx(roll)`,
@@ -34,6 +44,7 @@ use truenorth_core::{
 use truenorth_gyro::{HighPassCorrection, HighPassFilter, IirHighPass, OscillationRemover};
 
 use crate::euler_config::MAX_DEFINER_WINDOW;
+use crate::time_gap::{GapMonitor, Step};
 use crate::{EulerDetectorConfig, EulerVariant, GyroConditioning, coefficient_table};
 
 #[allow(unused_imports)]
@@ -152,6 +163,7 @@ pub struct EulerDetector {
     removers: Option<[OscillationRemover; 3]>,
     mz: Option<MzReconstruction>,
     clock: TimeStep,
+    gaps: GapMonitor,
     state: State,
 }
 
@@ -178,6 +190,7 @@ impl EulerDetector {
             removers,
             mz,
             clock: TimeStep::new(),
+            gaps: GapMonitor::new(config.max_gap_s),
             state: State {
                 angles: EulerZyx::default(),
                 initialised: false,
@@ -421,13 +434,32 @@ fn through_vertical([roll, pitch, yaw]: [f64; 3]) -> EulerZyx {
 
 impl OrientationEstimator for EulerDetector {
     /// A non-finite value, a timestamp that does not increase, or missing sensors for the
-    /// chosen variant is an error and changes nothing.
+    /// chosen variant is an error and changes nothing. A step longer than `max_gap_s`
+    /// restarts the detector from the sample (status `gap`); a step that would make such
+    /// gaps the majority of the steps is an [`Error::Implausible`] time base.
     fn update(&mut self, sample: &ImuSample) -> Result<AttitudeEstimate> {
         sample.check_finite()?;
-        let saved = (self.clock, self.conditioners, self.removers, self.state);
+        let saved = (
+            self.clock,
+            self.gaps,
+            self.conditioners,
+            self.removers,
+            self.state,
+        );
         let result = (|| {
             let dt = self.clock.dt_s(sample.t_s)?;
-            let Some(dt_s) = dt else {
+            let step = dt.map(|d| self.gaps.classify(d)).transpose()?;
+            if let Some(step) = step {
+                self.gaps.count(step);
+            }
+            let gap = step == Some(Step::Gap);
+            if gap {
+                // The conditioners' and the definer's memories span the gap: start afresh.
+                let fresh = Self::new(self.config)?;
+                (self.conditioners, self.removers, self.state) =
+                    (fresh.conditioners, fresh.removers, fresh.state);
+            }
+            let Some(dt_s) = dt.filter(|_| !gap) else {
                 // The first sample: the static angles (and tentative yaw) are the attitude.
                 self.rates(sample, None)?;
                 if let Some((tilt, _)) = self.static_tilt(sample) {
@@ -442,6 +474,10 @@ impl OrientationEstimator for EulerDetector {
                 let q = self.state.angles.to_quaternion();
                 self.state.estimate = AttitudeEstimate {
                     t_s: sample.t_s,
+                    status: AttitudeStatus {
+                        gap,
+                        ..AttitudeStatus::default()
+                    },
                     ..AttitudeEstimate::initial(q)
                 };
                 return Ok(self.state.estimate);
@@ -459,7 +495,13 @@ impl OrientationEstimator for EulerDetector {
             Ok(e)
         })();
         if result.is_err() {
-            (self.clock, self.conditioners, self.removers, self.state) = saved;
+            (
+                self.clock,
+                self.gaps,
+                self.conditioners,
+                self.removers,
+                self.state,
+            ) = saved;
         }
         result
     }

@@ -15,8 +15,9 @@
 //! - [`EulerDetector`]: the orientation angle detector of WO 00/36376, every piece
 //!   selectable ([`EulerDetectorConfig`]).
 //! - [`QuaternionFilter`]: 6-D / 9-D quaternion filter with gyro-bias estimation at rest
-//!   ([`RestDetector`]) and in motion, magnetic-disturbance rejection ([`MagReference`]) and
-//!   online hard-iron re-estimation ([`HardIronEstimator`]).
+//!   ([`RestDetector`]) and in motion, magnetic-disturbance rejection ([`MagReference`]),
+//!   online hard-iron re-estimation ([`HardIronEstimator`]) and the σ of its attitude from
+//!   the sensors' error model ([`AttitudeUncertaintyConfig`]).
 //! - [`VehicleEstimator`]: vehicle heading and dead reckoning from wheels, an optional yaw
 //!   gyro and a raw compass, learning every sensor's errors while it drives (an 11-state
 //!   Kalman filter; [`vehicle`] also holds the two-pass start, the learned calibration
@@ -39,6 +40,7 @@
 #![cfg_attr(not(feature = "std"), no_std)]
 
 mod attitude_error;
+pub mod attitude_uncertainty;
 mod euler_config;
 mod euler_detector;
 mod hard_iron;
@@ -47,9 +49,11 @@ mod quaternion_config;
 mod quaternion_filter;
 mod rest_detector;
 pub(crate) mod rotation;
+mod time_gap;
 pub mod vehicle;
 
 pub use attitude_error::AttitudeError;
+pub use attitude_uncertainty::AttitudeUncertaintyConfig;
 pub use euler_config::{
     CorrectionDefinerConfig, EulerDetectorConfig, EulerVariant, GyroConditioning,
     MAX_DEFINER_WINDOW, StartupField, coefficient_table,

@@ -4,7 +4,7 @@
 use serde::{Deserialize, Serialize};
 use truenorth_core::{Result, Validate, check_positive, check_range};
 
-use crate::{HardIronConfig, MagReferenceConfig, RestConfig};
+use crate::{AttitudeUncertaintyConfig, HardIronConfig, MagReferenceConfig, RestConfig};
 
 #[allow(unused_imports)]
 use truenorth_core::Float as _;
@@ -70,6 +70,15 @@ pub struct QuaternionFilterConfig {
     /// Initial attitude, body → NED, scalar first; `None` (default) starts from the first
     /// accelerometer (and magnetometer) reading.
     pub initial_attitude: Option<[f64; 4]>,
+    /// Longest time between samples the gyro is integrated across, s (default 0.5). Strapdown
+    /// holds one rate sample over the step, and a hand-held sensor turning at 1 rad/s with
+    /// a 1 Hz bandwidth has changed its rate completely within half a second; after a longer
+    /// gap the attitude is taken anew from the accelerometer and magnetometer (status
+    /// `gap`). Half a second also makes a millisecond time column read as seconds a gap at
+    /// every step for every IMU up to 2 kHz, which the filter refuses as implausible.
+    pub max_gap_s: f64,
+    /// The sensors' error model behind `sigma_rad`.
+    pub uncertainty: AttitudeUncertaintyConfig,
 }
 
 impl Default for QuaternionFilterConfig {
@@ -91,6 +100,8 @@ impl Default for QuaternionFilterConfig {
             hard_iron: HardIronConfig::default(),
             use_mag: true,
             initial_attitude: None,
+            max_gap_s: 0.5,
+            uncertainty: AttitudeUncertaintyConfig::default(),
         }
     }
 }
@@ -120,6 +131,8 @@ impl Validate for QuaternionFilterConfig {
         self.rest.validate()?;
         self.mag.validate()?;
         self.hard_iron.validate()?;
+        crate::time_gap::check_max_gap(self.max_gap_s)?;
+        self.uncertainty.validate()?;
         if let Some(q) = self.initial_attitude {
             for v in q {
                 check_range("initial_attitude component", v, -1e3, 1e3)?;

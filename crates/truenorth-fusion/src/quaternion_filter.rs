@@ -45,7 +45,9 @@ use truenorth_core::{
     STANDARD_GRAVITY_MPS2, TimeStep, Validate,
 };
 
+use crate::attitude_uncertainty::AttitudeUncertainty;
 use crate::rotation::{rotation_from_vector, small_rotation};
+use crate::time_gap::{GapMonitor, Step};
 use crate::{GyroTiming, HardIronEstimator, MagReference, QuaternionFilterConfig, RestDetector};
 
 #[allow(unused_imports)]
@@ -68,13 +70,23 @@ struct Coefficients {
     bias_rest: f64,
 }
 
+/// Every time constant during the start-up, s at most.
+const STARTUP_TAU_S: f64 = 0.1;
+
+/// The time constant `tau_s` in effect: cut to [`STARTUP_TAU_S`] during the start-up.
+fn effective_tau(tau_s: f64, startup: bool) -> f64 {
+    if startup {
+        tau_s.min(STARTUP_TAU_S)
+    } else {
+        tau_s
+    }
+}
+
 impl Coefficients {
-    /// The gains for interval `dt_s`; with `startup`, every time constant is cut to 0.1 s.
+    /// The gains for interval `dt_s`; with `startup`, every time constant is cut to
+    /// [`STARTUP_TAU_S`].
     fn new(cfg: &QuaternionFilterConfig, dt_s: f64, startup: bool) -> Self {
-        let gain = |tau: f64| {
-            let tau = if startup { tau.min(0.1) } else { tau };
-            (dt_s / tau).min(1.0)
-        };
+        let gain = |tau: f64| (dt_s / effective_tau(tau, startup)).min(1.0);
         Self {
             dt_s,
             acc_lowpass: gain(cfg.acc_lowpass_s),
@@ -104,6 +116,8 @@ struct State {
     mag_dt_s: f64,
     since_start_s: f64,
     initialised: bool,
+    /// The σ of the attitude, propagated alongside it.
+    uncertainty: AttitudeUncertainty,
     estimate: AttitudeEstimate,
 }
 
@@ -140,6 +154,7 @@ pub struct QuaternionFilter {
     mag_ref: MagReference,
     hard_iron: HardIronEstimator,
     coefficients: Coefficients,
+    gaps: GapMonitor,
 }
 
 impl QuaternionFilter {
@@ -147,6 +162,7 @@ impl QuaternionFilter {
     pub fn new(config: QuaternionFilterConfig) -> Result<Self> {
         config.validate()?;
         let q0 = initial_attitude(&config);
+        let uncertainty = AttitudeUncertainty::new(config.uncertainty, !config.use_mag);
         Ok(Self {
             config,
             state: State {
@@ -160,13 +176,18 @@ impl QuaternionFilter {
                 mag_dt_s: 0.0,
                 since_start_s: 0.0,
                 initialised: config.initial_attitude.is_some(),
-                estimate: AttitudeEstimate::initial(q0),
+                uncertainty,
+                estimate: AttitudeEstimate {
+                    sigma_rad: Some(uncertainty.sigma_rad()),
+                    ..AttitudeEstimate::initial(q0)
+                },
             },
             clock: TimeStep::new(),
             rest: RestDetector::new(config.rest),
             mag_ref: MagReference::new(config.mag),
             hard_iron: HardIronEstimator::new(config.hard_iron),
             coefficients: Coefficients::new(&config, 0.0, false),
+            gaps: GapMonitor::new(config.max_gap_s),
         })
     }
 
@@ -225,6 +246,14 @@ impl QuaternionFilter {
         // step (at most 10⁻³ rad) are applied together at its end.
         let r = s.q.to_rotation_matrix();
         let r = r.matrix();
+        s.uncertainty.propagate(dt_s, &omega, rate_rps, r);
+        // The in-motion bias estimate's 1/τ, as the uncertainty credits it.
+        let inv_tau_bias = if startup || at_rest {
+            0.0
+        } else {
+            s.bias_inv_tau_motion
+        };
+        let tau_acc_s = effective_tau(cfg.tau_acc_s, startup);
         // The step's correction, a rotation vector in the reference frame.
         let mut correction = Vector3::zeros();
 
@@ -247,6 +276,13 @@ impl QuaternionFilter {
             correction.x = -lp.y * k;
             correction.y = lp.x * k;
             status.accel_used = true;
+            s.uncertainty.accel_corrected(
+                k * STANDARD_GRAVITY_MPS2,
+                (correction.x, correction.y),
+                tau_acc_s,
+                inv_tau_bias,
+                effective_tau(cfg.acc_lowpass_s, startup),
+            );
         }
 
         // 3. Heading.
@@ -289,6 +325,23 @@ impl QuaternionFilter {
                     };
                     let dz = -k * err;
                     correction.z = dz;
+                    // An offset learned from the attitude cannot also tell its error.
+                    if !status.mag_calibrating
+                        && let Some(reference) = self.mag_ref.reference_ned()
+                    {
+                        let tau = if at_rest {
+                            cfg.tau_mag_rest_s
+                        } else {
+                            cfg.tau_mag_s
+                        };
+                        s.uncertainty.mag_corrected(
+                            k,
+                            effective_tau(tau, startup),
+                            (horizontal, m_ned.z),
+                            (reference.x, reference.z),
+                            inv_tau_bias,
+                        );
+                    }
                     // Rz(−H/2) ← Rz(−dz/2) Rz(−H/2), first order and renormalised.
                     let (c, sn) = s.undo_heading;
                     let h = 0.5 * dz;
@@ -310,6 +363,8 @@ impl QuaternionFilter {
         if !startup {
             if at_rest {
                 s.bias_rps += (self.rest.gyro_mean() - s.bias_rps) * c.bias_rest;
+                s.uncertainty
+                    .at_rest(c.bias_rest, cfg.rest.mean_tau_s, cfg.bias_tau_rest_s);
                 if s.rest_s < cfg.bias_known_after_rest_s {
                     s.rest_s += dt_s;
                     let known = (s.rest_s / cfg.bias_known_after_rest_s).min(1.0);
@@ -336,9 +391,45 @@ impl QuaternionFilter {
             attitude: s.q,
             attitude_6d: undo * s.q,
             gyro_bias_rps: s.bias_rps,
-            sigma_rad: None,
+            sigma_rad: Some(s.uncertainty.sigma_rad()),
             status,
         };
+    }
+
+    /// Starts again after a gap of `gap_s` that the gyro cannot bridge: the attitude from
+    /// this sample's accelerometer (and magnetometer) when it has one, the start-up's fast
+    /// corrections again, the σ widened; the learned bias, field reference and hard iron
+    /// are properties of the sensor and carry over.
+    fn restart(
+        &mut self,
+        t_s: f64,
+        gap_s: f64,
+        gyr: Vector3<f64>,
+        acc: Option<Vector3<f64>>,
+        mag: Option<Vector3<f64>>,
+    ) -> AttitudeEstimate {
+        let s = &mut self.state;
+        if let Some(q) = acc.and_then(|a| attitude_from(&a, mag.as_ref())) {
+            s.q = q;
+        }
+        s.undo_heading = (1.0, 0.0);
+        s.acc_lp_ned = None;
+        s.last_gyr_rps = Some(gyr);
+        s.mag_dt_s = 0.0;
+        s.since_start_s = 0.0;
+        s.uncertainty.restart(false, gap_s);
+        self.rest = RestDetector::new(self.config.rest);
+        s.estimate = AttitudeEstimate {
+            t_s,
+            gyro_bias_rps: s.bias_rps,
+            sigma_rad: Some(s.uncertainty.sigma_rad()),
+            status: AttitudeStatus {
+                gap: true,
+                ..AttitudeStatus::default()
+            },
+            ..AttitudeEstimate::initial(s.q)
+        };
+        s.estimate
     }
 }
 
@@ -346,7 +437,9 @@ impl OrientationEstimator for QuaternionFilter {
     /// Needs a gyro triad; the accelerometer and magnetometer triads may be absent on any
     /// sample (a slower sensor). A non-finite value, a reading beyond any sensor's range
     /// (gyro 10⁴ rad/s, accelerometer 10⁶ m/s², field 10¹²), a timestamp that does not
-    /// increase or a gap over 10⁶ s is an error and changes nothing.
+    /// increase or a gap over 10⁶ s is an error and changes nothing. A step longer than
+    /// `max_gap_s` restarts the attitude from the sample (status `gap`); a step that would
+    /// make such gaps the majority of the steps is an [`Error::Implausible`] time base.
     fn update(&mut self, sample: &ImuSample) -> Result<AttitudeEstimate> {
         let gyr = sample.gyr_rps.as_xyz().ok_or(Error::Unsupported {
             reason: "the quaternion filter needs a three-axis gyro; use the Euler detector for two gyros",
@@ -374,7 +467,14 @@ impl OrientationEstimator for QuaternionFilter {
         let mut clock = self.clock;
         let dt = clock.dt_s(sample.t_s)?;
         check_bounds(&gyr, acc.as_ref(), mag.as_ref(), dt)?;
+        let step = dt.map(|d| self.gaps.classify(d)).transpose()?;
         self.clock = clock;
+        if let Some(step) = step {
+            self.gaps.count(step);
+        }
+        if let (Some(gap_s), Some(Step::Gap)) = (dt, step) {
+            return Ok(self.restart(sample.t_s, gap_s, gyr, acc, mag));
+        }
         let Some(dt_s) = dt else {
             if !self.state.initialised
                 && let Some(q) = acc.and_then(|a| attitude_from(&a, mag.as_ref()))
@@ -385,6 +485,7 @@ impl OrientationEstimator for QuaternionFilter {
             self.state.last_gyr_rps = Some(gyr);
             self.state.estimate = AttitudeEstimate {
                 t_s: sample.t_s,
+                sigma_rad: Some(self.state.uncertainty.sigma_rad()),
                 ..AttitudeEstimate::initial(self.state.q)
             };
             return Ok(self.state.estimate);
@@ -544,7 +645,11 @@ mod tests {
                 let s = ImuSample::new_9d(v[0], Vector3::new(v[1], v[2], v[3]), Vector3::new(v[4], v[5], v[6]), Vector3::new(v[7], v[8], v[9]));
                 let before = f.estimate();
                 match f.update(&s) {
-                    Ok(e) => prop_assert!((e.attitude.norm() - 1.0).abs() < 1e-9),
+                    Ok(e) => {
+                        prop_assert!((e.attitude.norm() - 1.0).abs() < 1e-9);
+                        let sigma = e.sigma_rad.unwrap();
+                        prop_assert!(sigma.iter().all(|v| v.is_finite() && *v >= 0.0), "{sigma:?}");
+                    }
                     Err(_) => prop_assert_eq!(format!("{:?}", f.estimate()), format!("{before:?}")),
                 }
             }
@@ -568,6 +673,17 @@ mod tests {
             },
             QuaternionFilterConfig {
                 initial_attitude: Some([0.0; 4]),
+                ..Default::default()
+            },
+            QuaternionFilterConfig {
+                max_gap_s: 0.0,
+                ..Default::default()
+            },
+            QuaternionFilterConfig {
+                uncertainty: crate::AttitudeUncertaintyConfig {
+                    gyro_scale_rel: -0.01,
+                    ..Default::default()
+                },
                 ..Default::default()
             },
         ] {

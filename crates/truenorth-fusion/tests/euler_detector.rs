@@ -1,10 +1,10 @@
 //! Properties of the Euler orientation detector (WO 00/36376): no panic on any input, the
 //! still sensor's attitude, continuity through the vertical, the two-axis magnetometer with
-//! the M_z reconstruction, and the yaw + pitch variant.
+//! the M_z reconstruction, the yaw + pitch variant, and gaps in time.
 
 use nalgebra::{UnitQuaternion, Vector2, Vector3};
 use proptest::prelude::*;
-use truenorth_core::{Axes, EulerZyx, ImuSample, OrientationEstimator};
+use truenorth_core::{Axes, Error, EulerZyx, ImuSample, OrientationEstimator};
 use truenorth_fusion::{
     EulerDetector, EulerDetectorConfig, EulerVariant, GyroConditioning, StartupField,
     coefficient_table,
@@ -37,6 +37,36 @@ fn any_conditioning() -> impl Strategy<Value = GyroConditioning> {
 }
 
 proptest! {
+    /// After a gap longer than `max_gap_s` (the body turned meanwhile) the detector starts
+    /// again from the sample's static angles, with any gyro conditioning, and says so; a
+    /// millisecond time base, every step a gap, is refused by its second step.
+    #[test]
+    fn a_gap_restarts_from_the_static_angles(
+        yaw in -3.1f64..3.1, pitch in -1.2f64..1.2, roll in -1.2f64..1.2,
+        gap_s in 0.6f64..1e5, gyro in any_conditioning(),
+    ) {
+        let cfg = EulerDetectorConfig { gyro, ..Default::default() };
+        let level = EulerZyx::default();
+        let turned = EulerZyx { yaw_rad: yaw, pitch_rad: pitch, roll_rad: roll };
+        let mut d = EulerDetector::new(cfg).unwrap();
+        let (a, m) = still(&level, 1.0);
+        for k in 0..300 {
+            prop_assert!(!d.update(&ImuSample::new_9d(0.01 * k as f64, Vector3::zeros(), a, m)).unwrap().status.gap);
+        }
+        let (a, m) = still(&turned, 1.0);
+        let e = d.update(&ImuSample::new_9d(2.99 + gap_s, Vector3::zeros(), a, m)).unwrap();
+        prop_assert!(e.status.gap);
+        prop_assert!(e.attitude.angle_to(&turned.to_quaternion()) < 1e-6);
+        prop_assert!(!d.update(&ImuSample::new_9d(3.0 + gap_s, Vector3::zeros(), a, m)).unwrap().status.gap);
+
+        let mut d = EulerDetector::new(cfg).unwrap();
+        let ms = |k: usize| ImuSample::new_9d(10.0 * k as f64, Vector3::zeros(), a, m);
+        d.update(&ms(0)).unwrap();
+        prop_assert!(d.update(&ms(1)).unwrap().status.gap);
+        let refused = matches!(d.update(&ms(2)), Err(Error::Implausible { .. }));
+        prop_assert!(refused);
+    }
+
     /// Held still in any upright attitude, the detector reads pitch, roll and magnetic
     /// heading from the accelerometer and magnetometer at once and keeps them.
     #[test]

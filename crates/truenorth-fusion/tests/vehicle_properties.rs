@@ -4,7 +4,7 @@
 
 use nalgebra::Vector2;
 use proptest::prelude::*;
-use truenorth_core::{HeadingEstimator, NavEstimate, VehicleSample};
+use truenorth_core::{HeadingEstimator, NavEstimate, VehicleSample, WheelReading};
 use truenorth_fusion::vehicle::{
     SeedGyroCompass, SeedGyroCompassConfig, SeedOdometerCompass, SeedOdometerCompassConfig,
     TwoPassConfig, TwoPassStart,
@@ -24,10 +24,12 @@ fn any_value() -> impl Strategy<Value = f64> {
     ]
 }
 
-/// A sample built from plausible increments or, now and then, arbitrary values.
+/// A sample built from plausible increments or, now and then, arbitrary values; each
+/// sensor present or not, as rows of a log with sensors at their own rates come.
 #[derive(Debug, Clone)]
 struct Step {
     dt_s: f64,
+    wheels: bool,
     dl_m: f64,
     dr_m: f64,
     gyro: Option<f64>,
@@ -37,6 +39,7 @@ struct Step {
 fn step() -> impl Strategy<Value = Step> {
     (
         prop_oneof![8 => 0.001f64..0.5, 1 => any_value()],
+        prop_oneof![3 => Just(true), 1 => Just(false)],
         prop_oneof![8 => -0.1f64..2.0, 1 => any_value()],
         prop_oneof![8 => -0.1f64..2.0, 1 => any_value()],
         proptest::option::of(prop_oneof![8 => -1.0f64..1.0, 1 => any_value()]),
@@ -45,8 +48,9 @@ fn step() -> impl Strategy<Value = Step> {
             prop_oneof![8 => -60.0f64..60.0, 1 => any_value()],
         )),
     )
-        .prop_map(|(dt_s, dl_m, dr_m, gyro, mag)| Step {
+        .prop_map(|(dt_s, wheels, dl_m, dr_m, gyro, mag)| Step {
             dt_s,
+            wheels,
             dl_m,
             dr_m,
             gyro,
@@ -64,8 +68,10 @@ fn samples(steps: &[Step]) -> Vec<VehicleSample> {
             r += s.dr_m;
             VehicleSample {
                 t_s: t,
-                dist_l_m: l,
-                dist_r_m: r,
+                wheels: s.wheels.then_some(WheelReading {
+                    dist_l_m: l,
+                    dist_r_m: r,
+                }),
                 gyr_z_rps: s.gyro,
                 mag: s.mag.map(|(x, y)| Vector2::new(x, y)),
             }
@@ -75,8 +81,8 @@ fn samples(steps: &[Step]) -> Vec<VehicleSample> {
 
 fn valid(s: &VehicleSample, last_t: Option<f64>) -> bool {
     let finite = s.t_s.is_finite()
-        && s.dist_l_m.is_finite()
-        && s.dist_r_m.is_finite()
+        && s.wheels
+            .is_none_or(|w| w.dist_l_m.is_finite() && w.dist_r_m.is_finite())
         && s.gyr_z_rps.is_none_or(f64::is_finite)
         && s.mag.is_none_or(|m| m.x.is_finite() && m.y.is_finite());
     finite && last_t.is_none_or(|t0| s.t_s > t0)
@@ -119,11 +125,13 @@ fn check(
     Ok(())
 }
 
-fn wheels(front: bool) -> OdometerWheels {
-    if front {
-        OdometerWheels::Front(AckermannParams::from_pitman_ratio(2.7, 1.5, 0.129))
-    } else {
-        OdometerWheels::Rear { track_m: 1.5 }
+/// Each kind of vehicle.
+fn wheels(kind: usize) -> OdometerWheels {
+    match kind % 4 {
+        0 => OdometerWheels::Rear { track_m: 1.5 },
+        1 => OdometerWheels::Front(AckermannParams::from_pitman_ratio(2.7, 1.5, 0.129)),
+        2 => OdometerWheels::SkidSteer { track_m: 0.6 },
+        _ => OdometerWheels::Differential { track_m: 0.4 },
     }
 }
 
@@ -131,22 +139,22 @@ proptest! {
     #[test]
     fn the_fused_estimator_refuses_bad_samples_and_never_panics(
         steps in proptest::collection::vec(step(), 1..300),
-        front in any::<bool>(),
+        kind in 0usize..4,
     ) {
         let input = samples(&steps);
-        let nav = VehicleEstimator::new(VehicleConfig { wheels: wheels(front), ..VehicleConfig::default() }).unwrap();
+        let nav = VehicleEstimator::new(VehicleConfig { wheels: wheels(kind), ..VehicleConfig::default() }).unwrap();
         check(Box::new(nav), &input)?;
     }
 
     #[test]
     fn the_seed_configurations_refuse_bad_samples_and_never_panic(
         steps in proptest::collection::vec(step(), 1..300),
-        front in any::<bool>(),
+        kind in 0usize..4,
     ) {
         let input = samples(&steps);
-        let a = SeedGyroCompass::new(SeedGyroCompassConfig { wheels: wheels(front), ..Default::default() }).unwrap();
+        let a = SeedGyroCompass::new(SeedGyroCompassConfig { wheels: wheels(kind), ..Default::default() }).unwrap();
         check(Box::new(a), &input)?;
-        let b = SeedOdometerCompass::new(SeedOdometerCompassConfig { wheels: wheels(front), ..Default::default() }).unwrap();
+        let b = SeedOdometerCompass::new(SeedOdometerCompassConfig { wheels: wheels(kind), ..Default::default() }).unwrap();
         check(Box::new(b), &input)?;
     }
 

@@ -232,6 +232,7 @@ mod tests {
                 ds_m: v * dt,
                 curvature_per_m: k,
                 speed_mps: v,
+                pivot_rad: 0.0,
             };
             truth += k * v * dt;
             let s = model.sample_cumulative(t, &m, dt).unwrap();

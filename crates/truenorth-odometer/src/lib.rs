@@ -61,7 +61,7 @@
 //! // 10 m on a right-hand curve of radius 8 m, in one step of 1 s.
 //! let start = odometer.sample_cumulative(0.0, &WheelMotion::default(), 1.0)?;
 //! assert_eq!(heading.step(&start)?, None); // the first sample only starts the clock
-//! let arc = WheelMotion { ds_m: 10.0, curvature_per_m: 1.0 / 8.0, speed_mps: 10.0 };
+//! let arc = WheelMotion { ds_m: 10.0, curvature_per_m: 1.0 / 8.0, speed_mps: 10.0, pivot_rad: 0.0 };
 //! let end = odometer.sample_cumulative(1.0, &arc, 1.0)?;
 //! assert!(end.dist_l_m > end.dist_r_m); // left longer: right turn
 //! let step = heading.step(&end)?.unwrap();

@@ -179,10 +179,15 @@ impl OdometerModel {
     /// Geometry, speed term and scale, no quantisation (see [`SensorModel::ideal`]).
     fn deterministic(&self, truth: &WheelMotion) -> Result<WheelDistances> {
         truth.check_finite()?;
-        let paths = self
+        let rolled = self
             .coeffs
             .geometry
             .wheel_paths_m(truth.ds_m, truth.curvature_per_m)?;
+        let pivot = self.coeffs.geometry.pivot_paths_m(truth.pivot_rad)?;
+        let paths = WheelDistances {
+            left_m: rolled.left_m + pivot.left_m,
+            right_m: rolled.right_m + pivot.right_m,
+        };
         let factor = speed_factor(
             self.params.speed_coeff_s2_per_m2,
             self.wheel_speed_mps(truth)?,
@@ -339,7 +344,7 @@ mod tests {
             p in params(), u in -0.999f64..0.999, ds in -5.0f64..5.0, v in 0.0f64..40.0,
         ) {
             let m = OdometerModel::new(p).unwrap();
-            let truth = WheelMotion { ds_m: ds, curvature_per_m: u * k_max(&m), speed_mps: v };
+            let truth = WheelMotion { ds_m: ds, curvature_per_m: u * k_max(&m), speed_mps: v, pivot_rad: 0.0 };
             let raw = m.ideal(&truth).unwrap();
             let raw = OdometerRaw {
                 dist_l_m: raw.left_m,
@@ -363,7 +368,7 @@ mod tests {
         ) {
             let with = OdometerModel::new(OdometerParams { speed_coeff_s2_per_m2: a, ..OdometerParams::perfect(w) }).unwrap();
             let without = OdometerModel::new(OdometerParams::perfect(w)).unwrap();
-            let truth = WheelMotion { ds_m: 1.0, curvature_per_m: u * k_max(&with), speed_mps: v };
+            let truth = WheelMotion { ds_m: 1.0, curvature_per_m: u * k_max(&with), speed_mps: v, pivot_rad: 0.0 };
             let (d1, d0) = (with.ideal(&truth).unwrap(), without.ideal(&truth).unwrap());
             let vw = with.wheel_speed_mps(&truth).unwrap();
             let ratio = (d1.left_m - d1.right_m) / (d0.left_m - d0.right_m);
@@ -385,7 +390,7 @@ mod tests {
             }).unwrap();
             let (mut sum_l, mut sum_r) = (0.0, 0.0);
             for (ds, k) in steps {
-                let d = m.sample(&WheelMotion { ds_m: ds, curvature_per_m: k, speed_mps: 10.0 }, 0.1, &mut ZeroNoise).unwrap();
+                let d = m.sample(&WheelMotion { ds_m: ds, curvature_per_m: k, speed_mps: 10.0, pivot_rad: 0.0 }, 0.1, &mut ZeroNoise).unwrap();
                 for x in [d.left_m, d.right_m] {
                     let n = x / dpp;
                     prop_assert!((n - n.round()).abs() < 1e-6, "{x} is not whole pulses of {dpp}");
@@ -415,7 +420,7 @@ mod tests {
                 dist_per_pulse_m: Some(0.02), speed_coeff_s2_per_m2: 1e-3, ..OdometerParams::perfect(w)
             }).unwrap();
             let before = m;
-            let truth = WheelMotion { ds_m: ds, curvature_per_m: k, speed_mps: v };
+            let truth = WheelMotion { ds_m: ds, curvature_per_m: k, speed_mps: v, pivot_rad: 0.0 };
             let finite = ds.is_finite() && k.is_finite() && v.is_finite();
             let r = m.sample(&truth, dt, &mut ZeroNoise);
             if !(finite && dt.is_finite() && dt > 0.0) {
@@ -473,6 +478,7 @@ mod tests {
             ds_m: 1.0,
             curvature_per_m: 0.1,
             speed_mps: 20.0,
+            pivot_rad: 0.0,
         };
         assert!(matches!(m.ideal(&fast), Err(Error::OutOfRange { .. })));
     }

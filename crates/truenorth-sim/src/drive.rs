@@ -29,6 +29,7 @@ use truenorth_core::{NoiseSource, Result, SplitMix64, VehicleSample, check_range
 use truenorth_gyro::GyroAxisParams;
 use truenorth_odometer::{AckermannParams, OdometerParams, OdometerWheels};
 
+use crate::draw::{between, either_sign};
 use crate::route::{Route, RouteBuilder};
 use crate::streams::{VehicleSensorParams, rotated_soft_iron, vehicle_streams_disturbed};
 use crate::vehicle::{VehicleTruth, simulate};
@@ -149,18 +150,15 @@ impl SimulatedDrive {
 
     /// Whether a disturbance is active at `t_s` (inside any window).
     pub fn disturbed_at(&self, t_s: f64) -> bool {
-        self.disturbances
-            .iter()
-            .any(|d| t_s >= d.start_s && t_s <= d.start_s + d.duration_s)
+        active_at(&self.disturbances, t_s)
     }
 }
 
-fn between(rng: &mut SplitMix64, lo: f64, hi: f64) -> f64 {
-    lo + (hi - lo) * rng.uniform()
-}
-
-fn either_sign(rng: &mut SplitMix64) -> f64 {
-    if rng.uniform() < 0.5 { -1.0 } else { 1.0 }
+/// Whether any of `disturbances` is active at `t_s`.
+pub(crate) fn active_at(disturbances: &[Disturbance], t_s: f64) -> bool {
+    disturbances
+        .iter()
+        .any(|d| t_s >= d.start_s && t_s <= d.start_s + d.duration_s)
 }
 
 /// A random mix of driving, `length_m` long or a segment more.
@@ -292,21 +290,26 @@ fn random_sensor_params(rng: &mut SplitMix64, wheels: DriveWheels) -> VehicleSen
             let (s, c) = (2.0 * PI * rng.uniform()).sin_cos();
             Vector2::new(c, s) * field * between(rng, 0.2, 0.6)
         },
-        compass_soft_iron: soft_iron(rng),
+        compass_soft_iron: soft_iron(rng, 1.1, 1.4),
         compass_noise: 0.01 * field,
         horizontal_field: field,
     }
 }
 
-fn soft_iron(rng: &mut SplitMix64) -> Matrix2<f64> {
-    let ratio = between(rng, 1.1, 1.4);
+/// A soft iron of ratio `lo`–`hi` : 1 with its major axis at any angle.
+pub(crate) fn soft_iron(rng: &mut SplitMix64, lo: f64, hi: f64) -> Matrix2<f64> {
+    let ratio = between(rng, lo, hi);
     rotated_soft_iron(ratio, 1.0, PI * rng.uniform())
 }
 
 /// Short strong disturbances about every two minutes and a slow field-turning one about
 /// every five, none in the first 60 s (which a calibration run may use) and none
 /// overlapping.
-fn random_disturbances(rng: &mut SplitMix64, duration_s: f64, field: f64) -> Vec<Disturbance> {
+pub(crate) fn random_disturbances(
+    rng: &mut SplitMix64,
+    duration_s: f64,
+    field: f64,
+) -> Vec<Disturbance> {
     let mut out = Vec::new();
     let mut t = 60.0 + between(rng, 0.0, 60.0);
     let mut since_slow = 0.0;

@@ -3,7 +3,7 @@
 
 use truenorth_core::{Error, NavEstimate, Result, angle_diff};
 
-use crate::SimulatedDrive;
+use crate::{RangeDrive, SimulatedDrive, VehicleTruth};
 
 /// The figures by which a drive's estimates are judged.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -26,8 +26,39 @@ pub struct DriveScore {
 impl SimulatedDrive {
     /// Scores `estimates`, one per sample of the drive, in order.
     pub fn score(&self, estimates: &[NavEstimate]) -> Result<DriveScore> {
-        let n_truth = self.truth.len() as f64;
-        if estimates.len() != self.truth.len() || estimates.is_empty() {
+        let o = self.params.odometer;
+        DriveScore::of(
+            &self.truth,
+            estimates,
+            |t| self.disturbed_at(t),
+            1.0 + 0.5 * (o.scale_error_l + o.scale_error_r),
+        )
+    }
+}
+
+impl RangeDrive {
+    /// Scores `estimates`, one per row of the drive, in order.
+    pub fn score(&self, estimates: &[NavEstimate]) -> Result<DriveScore> {
+        DriveScore::of(
+            &self.truth,
+            estimates,
+            |t| self.disturbed_at(t),
+            self.mean_wheel_scale(),
+        )
+    }
+}
+
+impl DriveScore {
+    /// Scores `estimates` against `truth`, one for one: `disturbed` says when a magnetic
+    /// disturbance is active, `wheel_scale` is the odometer's true mean scale.
+    pub fn of(
+        truth: &[VehicleTruth],
+        estimates: &[NavEstimate],
+        disturbed: impl Fn(f64) -> bool,
+        wheel_scale: f64,
+    ) -> Result<DriveScore> {
+        let n_truth = truth.len() as f64;
+        if estimates.len() != truth.len() || estimates.is_empty() {
             return Err(Error::OutOfRange {
                 what: "number of estimates (one per sample of the drive)",
                 value: estimates.len() as f64,
@@ -35,10 +66,10 @@ impl SimulatedDrive {
                 max: n_truth,
             });
         }
-        let t0 = self.truth[0].t_s;
+        let t0 = truth[0].t_s;
         let (mut sum, mut n, mut dsum, mut dn) = (0.0, 0usize, 0.0, 0usize);
         let mut absolute_from_s = f64::INFINITY;
-        for (e, t) in estimates.iter().zip(&self.truth) {
+        for (e, t) in estimates.iter().zip(truth) {
             if !e.status.heading_absolute {
                 continue;
             }
@@ -46,29 +77,35 @@ impl SimulatedDrive {
             let d = angle_diff(e.heading.rad(), t.heading_rad).to_degrees();
             sum += d * d;
             n += 1;
-            if self.disturbed_at(t.t_s) {
+            if disturbed(t.t_s) {
                 dsum += d * d;
                 dn += 1;
             }
         }
-        let (e, t) = (
-            &estimates[estimates.len() - 1],
-            &self.truth[self.truth.len() - 1],
-        );
-        let o = self.params.odometer;
-        let distance_m = self.distance_m().max(f64::MIN_POSITIVE);
-        let pct = |k: f64| {
-            100.0 * (e.north_m / k - t.north_m).hypot(e.east_m / k - t.east_m) / distance_m
-        };
+        let (e, t) = (&estimates[estimates.len() - 1], &truth[truth.len() - 1]);
+        let distance_m = t.distance_m.max(f64::MIN_POSITIVE);
+        // A track never referred to north is drawn as if the start heading were north.
+        let (north, east) = truth_in_frame(t, truth[0].heading_rad, e.status.heading_absolute);
+        let pct = |k: f64| 100.0 * (e.north_m / k - north).hypot(e.east_m / k - east) / distance_m;
         let rms = |s: f64, n: usize| if n == 0 { 0.0 } else { (s / n as f64).sqrt() };
         Ok(DriveScore {
             heading_rms_deg: if n == 0 { f64::INFINITY } else { rms(sum, n) },
             disturbed_rms_deg: rms(dsum, dn),
             final_error_pct: pct(1.0),
-            scale_removed_pct: pct(1.0 + 0.5 * (o.scale_error_l + o.scale_error_r)),
+            scale_removed_pct: pct(wheel_scale),
             absolute_from_s,
         })
     }
+}
+
+/// The true position `t` in the frame of an estimate: north-referred when `absolute`,
+/// otherwise turned so that the start heading `heading0_rad` points north.
+pub(crate) fn truth_in_frame(t: &VehicleTruth, heading0_rad: f64, absolute: bool) -> (f64, f64) {
+    if absolute {
+        return (t.north_m, t.east_m);
+    }
+    let (s, c) = heading0_rad.sin_cos();
+    (c * t.north_m + s * t.east_m, -s * t.north_m + c * t.east_m)
 }
 
 #[cfg(test)]

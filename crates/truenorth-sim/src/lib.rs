@@ -29,25 +29,35 @@
 //! # Ok::<(), truenorth_core::Error>(())
 //! ```
 
+mod baseline;
+pub mod consistency;
+mod draw;
 mod drive;
 mod drive_score;
 mod few_shot;
 mod handheld;
+mod range_drive;
+mod range_route;
 mod route;
 pub mod scenario;
 pub mod shared_data;
 mod streams;
 mod vehicle;
+mod vehicle_kind;
 
+pub use baseline::{gyro_wheels_final_error_pct, gyro_wheels_final_position};
+pub use consistency::{CHI2_2DOF_3SIGMA, Consistency, Normalised};
 pub use drive::{DriveSpec, DriveWheels, SimulatedDrive};
 pub use drive_score::DriveScore;
 pub use few_shot::{
     FewShotInstrument, Shot, pointing_ned, protocol_shots, random_attitude, rolled_run,
 };
 pub use handheld::{HandheldParams, MotionTruth, handheld_motion};
+pub use range_drive::{Fitted, RangeDrive, RangeSpec, SensorRates};
 pub use route::{Command, Route, RouteBuilder};
 pub use streams::{
     ImuSensorParams, VehicleSensorParams, imu_streams, rotated_soft_iron, vehicle_accel_stream,
     vehicle_streams, vehicle_streams_disturbed,
 };
 pub use vehicle::{MAX_SAMPLES, VehicleTruth, simulate};
+pub use vehicle_kind::{RangeVehicle, Slip, SlipProcess, VehicleKind};

@@ -19,6 +19,10 @@ pub struct Command {
     /// (a clothoid at constant speed). The curvature must not change sign within a command.
     #[serde(default)]
     pub curvature_rate_per_m_s: f64,
+    /// Turn rate in place, rad/s, positive right: a robot that drives its sides against
+    /// each other turns without moving (the speed must stay zero).
+    #[serde(default)]
+    pub pivot_rate_rps: f64,
 }
 
 impl Command {
@@ -49,7 +53,10 @@ impl Route {
             let k0 = c.curvature_per_m;
             let kr = c.curvature_rate_per_m_s;
             let a = c.accel_mps2;
-            let turn = k0 * v * t + (k0 * a + kr * v) * t * t / 2.0 + kr * a * t * t * t / 3.0;
+            let turn = k0 * v * t
+                + (k0 * a + kr * v) * t * t / 2.0
+                + kr * a * t * t * t / 3.0
+                + c.pivot_rate_rps * t;
             turned += turn.abs();
             v = (v + a * t).max(0.0);
         }
@@ -125,6 +132,7 @@ impl RouteBuilder {
             accel_mps2: 0.0,
             curvature_per_m: 0.0,
             curvature_rate_per_m_s: 0.0,
+            pivot_rate_rps: 0.0,
         });
         Ok(self)
     }
@@ -140,6 +148,7 @@ impl RouteBuilder {
             accel_mps2: 0.0,
             curvature_per_m: angle_rad.signum() / radius_m,
             curvature_rate_per_m_s: 0.0,
+            pivot_rate_rps: 0.0,
         });
         Ok(self)
     }
@@ -162,6 +171,7 @@ impl RouteBuilder {
             accel_mps2: 0.0,
             curvature_per_m: 0.0,
             curvature_rate_per_m_s: k / ease,
+            pivot_rate_rps: 0.0,
         });
         if held > 0.0 {
             self.route.commands.push(Command {
@@ -169,6 +179,7 @@ impl RouteBuilder {
                 accel_mps2: 0.0,
                 curvature_per_m: k,
                 curvature_rate_per_m_s: 0.0,
+                pivot_rate_rps: 0.0,
             });
         }
         self.route.commands.push(Command {
@@ -176,6 +187,7 @@ impl RouteBuilder {
             accel_mps2: 0.0,
             curvature_per_m: k,
             curvature_rate_per_m_s: -k / ease,
+            pivot_rate_rps: 0.0,
         });
         Ok(self)
     }
@@ -198,9 +210,31 @@ impl RouteBuilder {
                 accel_mps2: dv.signum() * accel_mps2.abs(),
                 curvature_per_m: 0.0,
                 curvature_rate_per_m_s: 0.0,
+                pivot_rate_rps: 0.0,
             });
             self.speed_mps = to_mps;
         }
+        Ok(self)
+    }
+
+    /// Turns in place through `angle_rad` (positive right) at `rate_rps` (the vehicle must
+    /// be at rest and able to pivot: a skid-steered or differential-drive robot).
+    pub fn pivot(mut self, angle_rad: f64, rate_rps: f64) -> Result<Self> {
+        check_positive("|angle_rad|", angle_rad.abs())?;
+        check_positive("rate_rps", rate_rps)?;
+        if self.speed_mps != 0.0 {
+            return Err(Error::NotReady {
+                what: "a vehicle at rest",
+                hint: "call change_speed(0.0, ..) before pivot",
+            });
+        }
+        self.route.commands.push(Command {
+            duration_s: angle_rad.abs() / rate_rps,
+            accel_mps2: 0.0,
+            curvature_per_m: 0.0,
+            curvature_rate_per_m_s: 0.0,
+            pivot_rate_rps: angle_rad.signum() * rate_rps,
+        });
         Ok(self)
     }
 
@@ -218,6 +252,7 @@ impl RouteBuilder {
             accel_mps2: 0.0,
             curvature_per_m: 0.0,
             curvature_rate_per_m_s: 0.0,
+            pivot_rate_rps: 0.0,
         });
         Ok(self)
     }

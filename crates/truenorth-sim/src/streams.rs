@@ -167,6 +167,7 @@ pub fn vehicle_streams_disturbed(
                     ds_m: ds,
                     curvature_per_m: if ds > 0.0 { dpsi / ds } else { 0.0 },
                     speed_mps: ds / dt,
+                    pivot_rad: if ds > 0.0 { 0.0 } else { dpsi },
                 };
                 odo.sample(&motion, dt, &mut rng)?;
                 let g = gyro.sample(&rate, dt, &mut rng)?;
@@ -174,13 +175,12 @@ pub fn vehicle_streams_disturbed(
                 (g, m, odo.cumulative_m())
             }
         };
-        out.push(VehicleSample {
-            t_s: s.t_s,
-            dist_l_m: dist.left_m,
-            dist_r_m: dist.right_m,
-            gyr_z_rps: Some(gyr),
-            mag: Some(mag),
-        });
+        out.push(
+            VehicleSample::at(s.t_s)
+                .with_wheels(dist.left_m, dist.right_m)
+                .with_gyro(gyr)
+                .with_mag(mag),
+        );
         prev = Some(s);
     }
     Ok(out)

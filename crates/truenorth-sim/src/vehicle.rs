@@ -69,7 +69,7 @@ pub fn simulate(route: &Route, heading0_rad: f64, rate_hz: f64) -> Result<Vec<Ve
     let mut planned_v = route.start_speed_mps;
     let mut cmd_idx = 0;
     let mut cmd_end = route.commands.first().map_or(0.0, |c| c.duration_s);
-    let mut rate = set_command(&mut s, route, cmd_idx);
+    let mut turning = set_command(&mut s, route, cmd_idx);
     out.push(s);
     let times = (1..=whole)
         .map(|k| k as f64 * dt)
@@ -90,46 +90,64 @@ pub fn simulate(route: &Route, heading0_rad: f64, rate_hz: f64) -> Result<Vec<Ve
                 }
                 cmd_idx += 1;
                 cmd_end += route.commands.get(cmd_idx).map_or(0.0, |c| c.duration_s);
-                rate = set_command(&mut s, route, cmd_idx);
+                turning = set_command(&mut s, route, cmd_idx);
             }
             let h = if cmd_idx < route.commands.len() {
                 (t1.min(cmd_end)) - t
             } else {
                 t1 - t
             };
-            advance(&mut s, h, rate);
+            advance(&mut s, h, turning);
             t += h;
         }
         s.t_s = t1;
-        s.yaw_rate_rps = s.speed_mps * s.curvature_per_m;
+        s.yaw_rate_rps = s.speed_mps * s.curvature_per_m + turning.pivot_rps;
         out.push(s);
     }
     Ok(out)
 }
 
-/// Takes the command's acceleration and curvature (and returns its curvature rate).
-fn set_command(s: &mut VehicleTruth, route: &Route, idx: usize) -> f64 {
-    let rate = match route.commands.get(idx) {
+/// How the curvature and the heading change within a command besides the path.
+#[derive(Debug, Clone, Copy, Default)]
+struct Turning {
+    /// Rate of change of the curvature, 1/(m·s).
+    curvature_rate: f64,
+    /// Turn rate in place, rad/s.
+    pivot_rps: f64,
+}
+
+/// Takes the command's acceleration and curvature (and returns how it turns).
+fn set_command(s: &mut VehicleTruth, route: &Route, idx: usize) -> Turning {
+    let turning = match route.commands.get(idx) {
         Some(c) => {
             s.accel_mps2 = c.accel_mps2;
             s.curvature_per_m = c.curvature_per_m;
-            c.curvature_rate_per_m_s
+            Turning {
+                curvature_rate: c.curvature_rate_per_m_s,
+                pivot_rps: c.pivot_rate_rps,
+            }
         }
         None => {
             s.accel_mps2 = 0.0;
             s.curvature_per_m = 0.0;
-            0.0
+            Turning::default()
         }
     };
-    s.yaw_rate_rps = s.speed_mps * s.curvature_per_m;
-    rate
+    s.yaw_rate_rps = s.speed_mps * s.curvature_per_m + turning.pivot_rps;
+    turning
 }
 
 /// Sub-steps of a step in which the curvature changes: the heading is exact, the position
 /// exact to third order in the sub-step's turn.
 const CLOTHOID_SUBSTEPS: usize = 8;
 
-fn advance(s: &mut VehicleTruth, h: f64, curvature_rate: f64) {
+fn advance(s: &mut VehicleTruth, h: f64, turning: Turning) {
+    if turning.pivot_rps != 0.0 {
+        s.heading_unwrapped_rad += turning.pivot_rps * h;
+        s.heading_rad = wrap_pi(s.heading_unwrapped_rad);
+        return;
+    }
+    let curvature_rate = turning.curvature_rate;
     if curvature_rate == 0.0 {
         advance_arc(s, h);
         return;

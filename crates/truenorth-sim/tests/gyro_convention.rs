@@ -39,6 +39,7 @@ fn route() -> Route {
         accel_mps2,
         curvature_per_m: CURVATURE_PER_M,
         curvature_rate_per_m_s: 0.0,
+        pivot_rate_rps: 0.0,
     };
     Route {
         start_speed_mps: 5.0,

@@ -35,8 +35,9 @@ fn perfect_vehicle_sensors_reproduce_the_truth() {
         let g = s[k].gyr_z_rps.unwrap();
         assert_eq!(g, b.speed_mps * b.curvature_per_m);
         // Odometer (rear wheels): (D_L − D_R)/T is the heading change; the mean is the distance.
-        let dl = s[k].dist_l_m - s[k - 1].dist_l_m;
-        let dr = s[k].dist_r_m - s[k - 1].dist_r_m;
+        let (wa, wb) = (s[k - 1].wheels.unwrap(), s[k].wheels.unwrap());
+        let dl = wb.dist_l_m - wa.dist_l_m;
+        let dr = wb.dist_r_m - wa.dist_r_m;
         assert!(((dl - dr) / 1.5 - dpsi).abs() < 1e-9);
         assert!((0.5 * (dl + dr) - (b.distance_m - a.distance_m)).abs() < 1e-9);
         // Compass: heading = atan2(−y, x).

@@ -197,7 +197,8 @@ impl CsvOutput {
         })
     }
 
-    /// Appends one row.
+    /// Appends one row; a NaN is written as an empty cell (no value, as an empty cell
+    /// reads on input).
     pub fn row(&mut self, values: &[f64]) -> CliResult {
         use std::fmt::Write as _;
         self.line.clear();
@@ -205,7 +206,9 @@ impl CsvOutput {
             if k > 0 {
                 self.line.push(',');
             }
-            let _ = write!(self.line, "{v}");
+            if !v.is_nan() {
+                let _ = write!(self.line, "{v}");
+            }
         }
         self.line.push('\n');
         self.out.write_all(self.line.as_bytes())

@@ -7,54 +7,121 @@ use truenorth_calib::OnlineEllipseConfig;
 use truenorth_core::{Result, Validate, check_positive, check_range};
 use truenorth_odometer::OdometerWheels;
 
-/// What the sensors are believed to do before anything is learned (the filter's prior and
-/// process noise). Defaults suit automotive MEMS gyros and ABS wheel sensors.
+/// What the sensors are believed to do before anything is learned: the filter's prior and
+/// process noise. Each learned state's prior is a physical range, not a tuning: it says what
+/// a sensor of its kind does out of the box, so that data which cannot separate two states
+/// leave each where physics puts it.
+///
+/// [`SensorPriors::for_wheels`] gives the defaults for a kind of vehicle; a
+/// [`VehicleConfig`] without `priors` uses them.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(default)]
+#[serde(default, deny_unknown_fields)]
 pub struct SensorPriors {
-    /// Gyro white noise (angle random walk), °/s/√Hz (0.03).
+    /// Gyro white noise (angle random walk), °/s/√Hz (0.05: the noisier consumer MEMS
+    /// yaw gyros; automotive parts are near 0.01).
     pub gyro_noise_dps_per_sqrt_hz: f64,
-    /// Gyro bias random walk, °/s/√s (0.005): how fast the bias may wander with temperature.
+    /// Gyro bias random walk, °/s/√s (0.01): how fast the bias may wander with temperature.
     pub gyro_bias_walk_dps_per_sqrt_s: f64,
-    /// Standard deviation of the gyro bias before it is measured, °/s (1).
+    /// Standard deviation of the gyro bias before it is measured, °/s (3: consumer MEMS
+    /// gyros specify a zero-rate offset of up to ±5 °/s, a uniform spread of σ 2.9).
     pub gyro_bias_sigma_dps: f64,
-    /// Standard deviation of each gyro gain error before it is learned (0.05).
+    /// Standard deviation of each gyro gain error before it is learned (0.03: MEMS
+    /// sensitivity tolerances of ±2–5 %).
     pub gyro_gain_sigma: f64,
-    /// Standard deviation of the differential wheel scale δ before it is learned (0.01).
+    /// Standard deviation of the differential wheel scale δ before it is learned (0.01:
+    /// tyres of one axle differ by tenths of a percent, ±2 % with a soft tyre).
     pub wheel_diff_sigma: f64,
     /// Standard deviation of the odometer's mean scale, which no sensor here observes; it
-    /// makes the reported along-track uncertainty (0.003).
+    /// makes the reported along-track uncertainty (0.003 for a car's ABS odometer, 0.012
+    /// for a robot's wheels).
     pub wheel_scale_sigma: f64,
-    /// Standard deviation of the relative error of the wheels' effective track before it is
-    /// learned (0.02): the contact patches' spacing differs from the nominal track, and the
-    /// mean scale error scales the wheels' heading too.
+    /// The wheels' effective track over the physical one before it is learned (1 for
+    /// rolling wheels; 1.9 for a skid-steer, whose sides slide in a turn).
+    pub track_factor: f64,
+    /// Standard deviation of the relative error ε of the wheels' effective track before it
+    /// is learned (0.02 for rolling wheels, whose contact patches sit within a few cm of
+    /// the nominal track; 0.3 for a skid-steer, whose factor lies between 1.5 and 2.5).
     pub wheel_track_sigma: f64,
-    /// Initial speed coefficient `a`, s²/m² (0).
+    /// Initial speed coefficient `a`, s²/m² (1e-4 for a car; 0 for a robot, which never
+    /// goes fast enough for it to show).
     pub speed_coeff_s2_per_m2: f64,
-    /// Standard deviation of `a` before it is learned, s²/m² (1e-4).
+    /// Standard deviation of `a` before it is learned, s²/m² (1e-4: the range 0–3·10⁻⁴
+    /// that lateral load transfer gives road cars; 0 where it is not learned). `a` is
+    /// never negative: a wheel pair's difference only grows with speed.
     pub speed_coeff_sigma: f64,
-    /// Heading noise of the wheels per square-root metre travelled, °/√m (0.01): slip,
-    /// bumps and tyre deflection.
+    /// Heading noise of the wheels per square-root metre travelled, °/√m (0.01): bumps and
+    /// the quantisation of short steps.
     pub wheel_heading_noise_deg_per_sqrt_m: f64,
+    /// Standard deviation of the relative error of the wheels' turn that slip leaves at
+    /// no lateral acceleration (0.003 for a car; 0.1 for a skid-steer, whose effective
+    /// track changes with the ground; 0.015 for a differential-drive robot).
+    pub wheel_slip: f64,
+    /// Its growth per g of lateral acceleration (0.02 for a car: what load transfer does to
+    /// the rolling radii beyond the `aV²` law, which varies with the road and the tyres;
+    /// 0 for a robot).
+    pub wheel_slip_per_g: f64,
+    /// Its growth with the square of the turn ratio c = ΔD/D of steered front wheels
+    /// (0.2: the effective track's sensitivity to the steering geometry grows as (Bκ)²,
+    /// about 3c², and a described Pitman ratio or wheelbase is rarely better than a few
+    /// percent; 0 for unsteered wheels).
+    pub wheel_slip_per_c2: f64,
     /// Resolution of the wheel distances, m (0.02: ABS pulses; a few mm for integrated CAN
-    /// wheel speeds). Sets the noise of the wheels' heading against the gyro's.
+    /// wheel speeds, a fraction of a mm for a robot's encoders). Sets the noise of the
+    /// wheels' heading against the gyro's.
     pub wheel_resolution_m: f64,
 }
 
 impl Default for SensorPriors {
+    /// A car on its rear wheels.
     fn default() -> Self {
-        Self {
-            gyro_noise_dps_per_sqrt_hz: 0.03,
-            gyro_bias_walk_dps_per_sqrt_s: 0.005,
-            gyro_bias_sigma_dps: 1.0,
-            gyro_gain_sigma: 0.05,
+        Self::for_wheels(&OdometerWheels::Rear { track_m: 1.55 })
+    }
+}
+
+impl SensorPriors {
+    /// The priors of the kind of vehicle `wheels` describes.
+    pub fn for_wheels(wheels: &OdometerWheels) -> Self {
+        let car = Self {
+            gyro_noise_dps_per_sqrt_hz: 0.05,
+            gyro_bias_walk_dps_per_sqrt_s: 0.01,
+            gyro_bias_sigma_dps: 3.0,
+            gyro_gain_sigma: 0.03,
             wheel_diff_sigma: 0.01,
             wheel_scale_sigma: 0.003,
+            track_factor: 1.0,
             wheel_track_sigma: 0.02,
-            speed_coeff_s2_per_m2: 0.0,
+            speed_coeff_s2_per_m2: 1e-4,
             speed_coeff_sigma: 1e-4,
             wheel_heading_noise_deg_per_sqrt_m: 0.01,
+            wheel_slip: 0.003,
+            wheel_slip_per_g: 0.02,
+            wheel_slip_per_c2: 0.0,
             wheel_resolution_m: 0.02,
+        };
+        let robot = Self {
+            wheel_scale_sigma: 0.012,
+            speed_coeff_s2_per_m2: 0.0,
+            speed_coeff_sigma: 0.0,
+            wheel_slip_per_g: 0.0,
+            wheel_resolution_m: 1e-3,
+            ..car
+        };
+        match wheels {
+            OdometerWheels::Rear { .. } => car,
+            OdometerWheels::Front(_) => Self {
+                wheel_slip_per_c2: 0.2,
+                ..car
+            },
+            OdometerWheels::SkidSteer { .. } => Self {
+                track_factor: 1.9,
+                wheel_track_sigma: 0.3,
+                wheel_slip: 0.1,
+                ..robot
+            },
+            OdometerWheels::Differential { .. } => Self {
+                wheel_slip: 0.015,
+                ..robot
+            },
         }
     }
 }
@@ -69,22 +136,26 @@ impl Validate for SensorPriors {
             "gyro_bias_walk_dps_per_sqrt_s",
             self.gyro_bias_walk_dps_per_sqrt_s,
         )?;
-        check_positive("gyro_bias_sigma_dps", self.gyro_bias_sigma_dps)?;
+        check_range("gyro_bias_sigma_dps", self.gyro_bias_sigma_dps, 1e-6, 100.0)?;
         check_range("gyro_gain_sigma", self.gyro_gain_sigma, 1e-9, 0.5)?;
         check_range("wheel_diff_sigma", self.wheel_diff_sigma, 1e-9, 0.2)?;
         check_range("wheel_scale_sigma", self.wheel_scale_sigma, 0.0, 0.5)?;
-        check_range("wheel_track_sigma", self.wheel_track_sigma, 1e-9, 0.3)?;
+        check_range("track_factor", self.track_factor, 0.5, 5.0)?;
+        check_range("wheel_track_sigma", self.wheel_track_sigma, 1e-9, 2.0)?;
         check_range(
             "speed_coeff_s2_per_m2",
             self.speed_coeff_s2_per_m2,
-            -1e-2,
+            0.0,
             1e-2,
         )?;
-        check_range("speed_coeff_sigma", self.speed_coeff_sigma, 1e-12, 1e-2)?;
+        check_range("speed_coeff_sigma", self.speed_coeff_sigma, 0.0, 1e-2)?;
         check_positive(
             "wheel_heading_noise_deg_per_sqrt_m",
             self.wheel_heading_noise_deg_per_sqrt_m,
         )?;
+        check_range("wheel_slip", self.wheel_slip, 0.0, 1.0)?;
+        check_range("wheel_slip_per_g", self.wheel_slip_per_g, 0.0, 1.0)?;
+        check_range("wheel_slip_per_c2", self.wheel_slip_per_c2, 0.0, 10.0)?;
         check_range("wheel_resolution_m", self.wheel_resolution_m, 1e-6, 1.0)?;
         Ok(())
     }
@@ -115,13 +186,19 @@ pub struct CompassGates {
     /// The compass counts as disturbed while the averaged innovation exceeds this many of
     /// its standard deviations (3).
     pub slow_gate_sigma: f64,
-    /// Standard deviation of the heading error that the calibration and the road (grade,
-    /// camber) leave in every reading alike for a while, degrees (0.3): the filter carries
-    /// it as a state, so that it is not averaged away as if it were noise.
+    /// Standard deviation of the heading error that the installation and the road (a
+    /// compass mounted a little askew, grade and camber tilting it) leave in every reading
+    /// alike, degrees (0.3): the filter carries it, with the calibration's own error, as a
+    /// state, so that it is not averaged away as if it were noise.
     pub systematic_deg: f64,
-    /// Correlation time of that error, s (20): it changes as the vehicle turns and the road
-    /// changes.
+    /// Correlation time of that error while driving straight, s (300): a road's grade and
+    /// camber last for hundreds of metres, and the calibration's error does not change at
+    /// all while the heading holds.
     pub systematic_tau_s: f64,
+    /// Turn over which the compass error changes, rad (0.7): what a calibration leaves is
+    /// a function of the heading, one and two cycles per turn (a residual hard iron, a
+    /// residual soft iron), which decorrelates over a radian or less of turning.
+    pub systematic_turn_rad: f64,
     /// Readings averaged into one heading correction (5): the covariance is carried
     /// forward once per correction rather than at every sample.
     pub readings_per_update: u32,
@@ -143,7 +220,8 @@ impl Default for CompassGates {
             slow_gate_tau_s: 1.5,
             slow_gate_sigma: 3.0,
             systematic_deg: 0.3,
-            systematic_tau_s: 20.0,
+            systematic_tau_s: 300.0,
+            systematic_turn_rad: 0.7,
             readings_per_update: 10,
             alignment_readings: 20,
         }
@@ -171,6 +249,7 @@ impl Validate for CompassGates {
         check_range("slow_gate_sigma", self.slow_gate_sigma, 1.0, 100.0)?;
         check_range("systematic_deg", self.systematic_deg, 1e-3, 45.0)?;
         check_positive("systematic_tau_s", self.systematic_tau_s)?;
+        check_range("systematic_turn_rad", self.systematic_turn_rad, 0.01, 100.0)?;
         check_range(
             "readings_per_update",
             f64::from(self.readings_per_update),
@@ -189,36 +268,52 @@ impl Validate for CompassGates {
 
 /// Configuration of the [`crate::VehicleEstimator`].
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(default)]
+#[serde(default, deny_unknown_fields)]
 pub struct VehicleConfig {
-    /// Which wheels carry the odometer and the vehicle's dimensions (default: rear wheels,
-    /// track 1.55 m).
+    /// Which wheels carry the odometer, on what kind of vehicle, and its dimensions
+    /// (default: a car's rear wheels, track 1.55 m).
     pub wheels: OdometerWheels,
-    /// Prior beliefs about the sensors.
-    pub priors: SensorPriors,
+    /// Prior beliefs about the sensors; `None` (the default) takes those of the kind of
+    /// vehicle `wheels` describes ([`SensorPriors::for_wheels`]).
+    pub priors: Option<SensorPriors>,
     /// Compass calibration and gates.
     pub compass: CompassGates,
     /// The wheels must stand still this long before the vehicle counts as at rest, s (0.5).
     pub standstill_s: f64,
+    /// Longest interval between two readings of one sensor that the estimator follows, s
+    /// (2): across a longer one it cannot integrate the gyro or draw the track, so it
+    /// widens what the gap left unknown (the heading without wheels, the track, the gyro
+    /// bias) and says so in the status.
+    pub max_gap_s: f64,
 }
 
 impl Default for VehicleConfig {
     fn default() -> Self {
         Self {
             wheels: OdometerWheels::Rear { track_m: 1.55 },
-            priors: SensorPriors::default(),
+            priors: None,
             compass: CompassGates::default(),
             standstill_s: 0.5,
+            max_gap_s: 2.0,
         }
+    }
+}
+
+impl VehicleConfig {
+    /// The priors in use: the given ones, or the kind of vehicle's.
+    pub fn priors(&self) -> SensorPriors {
+        self.priors
+            .unwrap_or_else(|| SensorPriors::for_wheels(&self.wheels))
     }
 }
 
 impl Validate for VehicleConfig {
     fn validate(&self) -> Result<()> {
         self.wheels.validate()?;
-        self.priors.validate()?;
+        self.priors().validate()?;
         self.compass.validate()?;
         check_range("standstill_s", self.standstill_s, 0.0, 60.0)?;
+        check_range("max_gap_s", self.max_gap_s, 0.01, 3600.0)?;
         Ok(())
     }
 }

@@ -4,14 +4,19 @@
 
 use serde::{Deserialize, Serialize};
 use truenorth_compass::CompassCalibration2d;
+#[allow(unused_imports)]
+use truenorth_core::Float as _;
 use truenorth_core::{
     CompassQuality, Error, Result, Validate, check_finite, check_positive, check_range,
 };
 
 use super::compass_monitor::CompassFix;
 use super::nav_filter::{
-    BIAS, GAIN_NEG, GAIN_POS, NavFilter, SPEED_COEFF, TRACK_SCALE, WHEEL_DIFF,
+    BIAS, DIM, GAIN_NEG, GAIN_POS, NavFilter, SPEED_COEFF, TRACK_SCALE, WHEEL_DIFF,
 };
+
+/// Share of a state's prior standard deviation that it may drift between two drives.
+const DRIFT_SHARE: f64 = 0.1;
 
 /// A learned value and its standard deviation (0: never learned, the prior stands).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -83,10 +88,13 @@ impl VehicleCalibration {
         }
     }
 
-    /// Writes the learned calibration states into `filter`, uncorrelated, each sigma
-    /// multiplied by `widen` (≥ 1: what was learned may have drifted since). States never
-    /// learned (sigma 0) keep the filter's prior.
-    pub fn to_filter(&self, filter: &mut NavFilter, widen: f64) {
+    /// Writes the learned calibration states into `filter`, uncorrelated. Each sigma is
+    /// widened by a tenth of its prior's, what a state may drift between drives (a MEMS
+    /// gyro's turn-on bias repeatability, a tyre's pressure), and kept within the prior's:
+    /// a state never learned comes back as it started, and a replay does not count the
+    /// same readings' information twice. `prior_sigma` holds each state's prior standard
+    /// deviation (0: not learned, left as the filter has it).
+    pub fn to_filter(&self, filter: &mut NavFilter, prior_sigma: &[f64; DIM]) {
         for (i, l) in [
             (BIAS, self.gyro_bias_rps),
             (GAIN_POS, self.gyro_gain_error_right),
@@ -95,9 +103,11 @@ impl VehicleCalibration {
             (TRACK_SCALE, self.track_scale),
             (SPEED_COEFF, self.speed_coeff_s2_per_m2),
         ] {
-            if l.sigma > 0.0 {
+            let prior = prior_sigma[i];
+            if l.sigma > 0.0 && prior > 0.0 {
                 filter.x[i] = l.value;
-                filter.reset_state(i, l.sigma * widen);
+                let drift = DRIFT_SHARE * prior;
+                filter.reset_state(i, (l.sigma * l.sigma + drift * drift).sqrt().min(prior));
             }
         }
     }
@@ -114,20 +124,38 @@ impl VehicleCalibration {
 }
 
 impl Validate for VehicleCalibration {
-    /// Every value finite, every sigma positive, gains and scales within ±50 %, and the
-    /// compass's soft iron invertible with a finite field.
+    /// Every value finite, every sigma non-negative; gains and the wheels' scale
+    /// difference within ±50 %, the effective track 0.5–3 times the physical one, the
+    /// speed coefficient in 0–0.01 s²/m²; the compass's soft iron invertible, not a
+    /// reflection, and the field positive.
     fn validate(&self) -> Result<()> {
         self.gyro_bias_rps.check("gyro_bias_rps")?;
-        for (what, l) in [
-            ("gyro_gain_error_right", self.gyro_gain_error_right),
-            ("gyro_gain_error_left", self.gyro_gain_error_left),
-            ("wheel_diff", self.wheel_diff),
-            ("track_scale", self.track_scale),
+        check_range(
+            "gyro_bias_rps (a bias beyond 100 °/s is no gyro's)",
+            self.gyro_bias_rps.value,
+            -1.75,
+            1.75,
+        )?;
+        for (what, l, lo, hi) in [
+            (
+                "gyro_gain_error_right",
+                self.gyro_gain_error_right,
+                -0.5,
+                0.5,
+            ),
+            ("gyro_gain_error_left", self.gyro_gain_error_left, -0.5, 0.5),
+            ("wheel_diff", self.wheel_diff, -0.5, 0.5),
+            ("track_scale", self.track_scale, -0.5, 2.0),
+            (
+                "speed_coeff_s2_per_m2",
+                self.speed_coeff_s2_per_m2,
+                0.0,
+                1e-2,
+            ),
         ] {
             l.check(what)?;
-            check_range(what, l.value, -0.5, 0.5)?;
+            check_range(what, l.value, lo, hi)?;
         }
-        self.speed_coeff_s2_per_m2.check("speed_coeff_s2_per_m2")?;
         if let Some(c) = &self.compass {
             for v in c
                 .calibration
@@ -138,9 +166,15 @@ impl Validate for VehicleCalibration {
                 check_finite("compass calibration", *v)?;
             }
             check_positive("compass field_magnitude", c.quality.field_magnitude)?;
-            if c.calibration.soft_iron.determinant().abs() < f64::EPSILON {
+            let det = c.calibration.soft_iron.determinant();
+            if det.abs() < f64::EPSILON {
                 return Err(Error::Degenerate {
                     reason: "the stored compass soft iron is singular; recalibrate the compass",
+                });
+            }
+            if det < 0.0 {
+                return Err(Error::Degenerate {
+                    reason: "the stored compass soft iron is a reflection (negative determinant), which no iron makes: the compass axes were swapped or one negated; recalibrate",
                 });
             }
         }

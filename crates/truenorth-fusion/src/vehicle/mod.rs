@@ -16,33 +16,35 @@
 //! // Ten seconds straight ahead at 10 m/s, a raw gyro with its own bias, a raw compass.
 //! for k in 0..=100 {
 //!     let t_s = 0.1 * k as f64;
-//!     let e = nav.update(&VehicleSample {
-//!         t_s,
-//!         dist_l_m: 10.0 * t_s,
-//!         dist_r_m: 10.0 * t_s,
-//!         gyr_z_rps: Some(0.005),
-//!         mag: Some(Vector2::new(25.0, -3.0)),
-//!     })?;
+//!     let row = VehicleSample::at(t_s)
+//!         .with_wheels(10.0 * t_s, 10.0 * t_s)
+//!         .with_gyro(0.005)
+//!         .with_mag(Vector2::new(25.0, -3.0));
+//!     let e = nav.update(&row)?;
 //!     // No turn yet, so no compass calibration: the heading is relative to the start.
 //!     assert!(!e.status.heading_absolute);
 //! }
 //! let e = nav.estimate();
 //! assert!((e.north_m.hypot(e.east_m) - 100.0).abs() < 1.0);
 //! // Time going backwards is refused, and changes nothing.
-//! let late = VehicleSample { t_s: 5.0, dist_l_m: 50.0, dist_r_m: 50.0, gyr_z_rps: None, mag: None };
+//! let late = VehicleSample::at(5.0).with_wheels(50.0, 50.0);
 //! assert!(nav.update(&late).is_err());
 //! assert_eq!(nav.estimate(), e);
 //! # Ok::<(), truenorth_core::Error>(())
 //! ```
 
+mod compass_fusion;
 mod compass_learning;
 mod compass_monitor;
 mod config;
+mod dead_reckoning;
 mod estimator;
 mod heading_trig;
 mod innovation_line;
 mod learned;
+mod learning_gates;
 pub mod nav_filter;
+mod observability;
 mod seed_blend;
 mod seed_gyro_compass;
 mod seed_odometer_compass;
@@ -55,9 +57,12 @@ pub use compass_monitor::{CompassFix, CompassMonitor, Verdict};
 pub use config::{CompassGates, SensorPriors, VehicleConfig};
 pub use estimator::VehicleEstimator;
 pub use learned::{Learned, LearnedCompass, VehicleCalibration};
+pub use learning_gates::SPEED_COEFF_MIN_SPEED_MPS;
 pub use nav_filter::NavFilter;
 pub use seed_blend::{SeedBlend, SeedBlendConfig};
 pub use seed_gyro_compass::{SeedGyroCompass, SeedGyroCompassConfig};
 pub use seed_odometer_compass::{SeedOdometerCompass, SeedOdometerCompassConfig};
 pub use two_pass::{TwoPassConfig, TwoPassStart};
-pub use wheel_odometry::{MAX_WHEEL_SPEED_MPS, WheelCalibration, WheelOdometry, WheelStep};
+pub use wheel_odometry::{
+    MAX_WHEEL_SPEED_MPS, TrackModel, WheelCalibration, WheelOdometry, WheelStep,
+};

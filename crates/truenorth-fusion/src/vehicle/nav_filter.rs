@@ -41,6 +41,17 @@ pub const COMPASS_BIAS: usize = 10;
 /// Number of states.
 pub const DIM: usize = 11;
 
+/// A set of states, one bit per index: the states a measurement may correct.
+pub type StateSet = u16;
+
+/// Every state.
+pub const ALL_STATES: StateSet = (1 << DIM) - 1;
+
+/// The set holding state `i` alone.
+pub const fn state(i: usize) -> StateSet {
+    1 << i
+}
+
 /// The nominal state and the error covariance.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct NavFilter {
@@ -102,6 +113,24 @@ impl NavFilter {
     /// innovation variance `h P hᵀ + r`, or `None` (and changes nothing) when it is not
     /// positive and finite.
     pub fn update(&mut self, h: &[(usize, f64)], nu: f64, r: f64) -> Option<f64> {
+        self.update_some(h, nu, r, ALL_STATES)
+    }
+
+    /// [`NavFilter::update`] that corrects only the states in `learn` (a Schmidt, or
+    /// "consider", update: Schmidt 1966; Brown & Hwang, *Introduction to Random Signals and
+    /// Applied Kalman Filtering*, 4th ed., §7.6). The others keep their value and their
+    /// variance, and the covariance stays that of the estimate's actual error: a state the
+    /// data cannot separate from another is not learned from them, and its uncertainty
+    /// still reaches every estimate it affects. With gain `K'` zero outside `learn`,
+    /// `P ← P − K'(Ph)ᵀ − (Ph)K'ᵀ + K's K'ᵀ`, which is `P_ij − (Ph)_i(Ph)_j/s` wherever `i` or
+    /// `j` is learned and `P_ij` where neither is.
+    pub fn update_some(
+        &mut self,
+        h: &[(usize, f64)],
+        nu: f64,
+        r: f64,
+        learn: StateSet,
+    ) -> Option<f64> {
         let mut ph = [0.0; DIM];
         for &(j, c) in h {
             for (phk, row) in ph.iter_mut().zip(&self.p) {
@@ -118,10 +147,15 @@ impl NavFilter {
         let root = inv.sqrt();
         let w = ph.map(|v| v * root);
         for (i, row) in self.p.iter_mut().enumerate() {
-            self.x[i] += ph[i] * inv * nu;
+            let learned_i = learn & state(i) != 0;
+            if learned_i {
+                self.x[i] += ph[i] * inv * nu;
+            }
             let wi = w[i];
-            for (pij, wj) in row.iter_mut().zip(&w) {
-                *pij -= wi * wj;
+            for (j, (pij, wj)) in row.iter_mut().zip(&w).enumerate() {
+                if learned_i || learn & state(j) != 0 {
+                    *pij -= wi * wj;
+                }
             }
             // Rounding may take a variance a hair below zero after a very precise update.
             if row[i] < 0.0 {
@@ -129,6 +163,23 @@ impl NavFilter {
             }
         }
         Some(s)
+    }
+
+    /// Keeps state `i` at or above `floor`: a value below it is moved to it, and every
+    /// state correlated with it by the regression on it (the estimate projected onto the
+    /// constraint, Simon & Chia, "Kalman filtering with state equality constraints", IEEE
+    /// Trans. AES 38(1), 2002). The covariance is left as it is.
+    pub fn project_at_least(&mut self, i: usize, floor: f64) {
+        let d = floor - self.x[i];
+        if d <= 0.0 || self.p[i][i] <= 0.0 {
+            self.x[i] = self.x[i].max(floor);
+            return;
+        }
+        let inv = 1.0 / self.p[i][i];
+        for k in 0..DIM {
+            self.x[k] += self.p[k][i] * inv * d;
+        }
+        self.x[i] = floor;
     }
 
     /// Adds `sigma² · g gᵀ`: an error common to several states in fixed proportion (the
@@ -223,6 +274,53 @@ mod tests {
             let before = f;
             prop_assert!(f.update(&[(PSI, 1.0)], nu, r).is_none());
             prop_assert_eq!(f, before);
+        }
+    }
+
+    proptest! {
+        #[test]
+        fn a_schmidt_update_leaves_what_it_does_not_learn_and_equals_the_full_one_otherwise(
+            sig in proptest::array::uniform11(1e-3f64..10.0),
+            corr in -0.9f64..0.9,
+            nu in -10.0f64..10.0,
+            r in 1e-6f64..10.0,
+            learn in 0u16..(1 << DIM),
+        ) {
+            let mut f = filter(sig);
+            let v = corr * sig[PSI] * sig[BIAS];
+            f.p[PSI][BIAS] = v;
+            f.p[BIAS][PSI] = v;
+            let mut full = f;
+            let mut some = f;
+            let h = [(PSI, 1.0), (BIAS, 2.0), (PSI_ODO, -1.0)];
+            full.update(&h, nu, r).unwrap();
+            some.update_some(&h, nu, r, learn).unwrap();
+            for i in 0..DIM {
+                let li = learn & state(i) != 0;
+                prop_assert_eq!(some.x[i], if li { full.x[i] } else { f.x[i] });
+                for j in 0..DIM {
+                    let lj = learn & state(j) != 0;
+                    let expect = if li || lj { full.p[i][j] } else { f.p[i][j] };
+                    prop_assert_eq!(some.p[i][j], expect);
+                    prop_assert_eq!(some.p[i][j], some.p[j][i]);
+                }
+            }
+        }
+
+        #[test]
+        fn a_projection_keeps_the_state_at_its_floor_and_moves_the_correlated_ones(
+            x in -1.0f64..1.0, corr in -0.9f64..0.9,
+        ) {
+            let mut f = filter([1.0; DIM]);
+            f.x[SPEED_COEFF] = x;
+            f.p[SPEED_COEFF][TRACK_SCALE] = corr;
+            f.p[TRACK_SCALE][SPEED_COEFF] = corr;
+            let before = f;
+            f.project_at_least(SPEED_COEFF, 0.0);
+            prop_assert_eq!(f.x[SPEED_COEFF], x.max(0.0));
+            let moved = (x.min(0.0)).abs() * corr;
+            prop_assert!((f.x[TRACK_SCALE] - moved).abs() < 1e-12);
+            prop_assert_eq!(f.p, before.p);
         }
     }
 

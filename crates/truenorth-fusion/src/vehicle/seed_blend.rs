@@ -80,6 +80,9 @@ pub struct SeedBlend {
     pub position: Vector2<f64>,
     /// Distance travelled, m.
     pub distance_m: f64,
+    /// The heading at the last travel, rad (the track follows the heading half-way
+    /// between two).
+    psi_at_travel: f64,
     aligned: bool,
     sin_sum: f64,
     cos_sum: f64,
@@ -101,6 +104,7 @@ impl SeedBlend {
             psi: 0.0,
             position: Vector2::zeros(),
             distance_m: 0.0,
+            psi_at_travel: 0.0,
             aligned: false,
             sin_sum: 0.0,
             cos_sum: 0.0,
@@ -117,16 +121,29 @@ impl SeedBlend {
         self.aligned
     }
 
-    /// Advances by heading change `dpsi` and rear-axle distance `ds_m` over `dt`; returns
-    /// whether the vehicle is at rest (`moved` false for the standstill time).
-    pub fn step(&mut self, dpsi: f64, ds_m: f64, dt: f64, moved: bool) -> bool {
-        let mid = self.psi + 0.5 * dpsi;
+    /// Turns the heading by `dpsi` (a relative heading sensor's step).
+    pub fn turn(&mut self, dpsi: f64) {
+        self.psi = wrap_pi(self.psi + dpsi);
+    }
+
+    /// Advances the rear axle by `ds_m` over `dt`, along the heading half-way between this
+    /// travel and the last; returns whether the vehicle is at rest (`moved` false for the
+    /// standstill time).
+    pub fn travel(&mut self, ds_m: f64, dt: f64, moved: bool) -> bool {
+        let mid = self.psi_at_travel + 0.5 * wrap_pi(self.psi - self.psi_at_travel);
+        self.psi_at_travel = self.psi;
         let (s, c) = mid.sin_cos();
         self.position += Vector2::new(c, s) * ds_m;
         self.distance_m += ds_m.abs();
-        self.psi = wrap_pi(self.psi + dpsi);
         self.still_s = if moved { 0.0 } else { self.still_s + dt };
         self.still_s >= self.config.standstill_s && self.still_s > 0.0
+    }
+
+    /// Corrects the heading by `d` (not a turn of the vehicle: the track's last heading is
+    /// corrected with it).
+    fn correct(&mut self, d: f64) {
+        self.psi = wrap_pi(self.psi + d);
+        self.psi_at_travel = wrap_pi(self.psi_at_travel + d);
     }
 
     /// Takes a calibrated horizontal reading `u` (body axes: x forward, y right) from a
@@ -174,7 +191,7 @@ impl SeedBlend {
                         s * self.position.x + c * self.position.y,
                     );
                 }
-                self.psi = wrap_pi(self.psi + offset);
+                self.correct(offset);
                 self.aligned = true;
             }
             return None;
@@ -190,7 +207,7 @@ impl SeedBlend {
             return None;
         }
         self.outliers_since = None;
-        self.psi = wrap_pi(self.psi + (dt / self.config.tau_s).min(1.0) * d);
+        self.correct((dt / self.config.tau_s).min(1.0) * d);
         Some(heading)
     }
 }
@@ -202,7 +219,7 @@ mod tests {
     #[test]
     fn aligns_then_follows_the_compass_slowly() {
         let mut b = SeedBlend::new(SeedBlendConfig::default()).unwrap();
-        b.step(0.0, 10.0, 1.0, true);
+        b.travel(10.0, 1.0, true);
         for k in 0..10 {
             b.compass(k as f64 * 0.1, 1.0, 1.0);
         }

@@ -14,7 +14,7 @@ use truenorth_core::{
 use truenorth_odometer::OdometerWheels;
 
 use super::seed_blend::{SeedBlend, SeedBlendConfig};
-use super::wheel_odometry::{WheelCalibration, WheelOdometry};
+use super::wheel_odometry::{TrackModel, WheelCalibration, WheelOdometry};
 
 #[allow(unused_imports)]
 use truenorth_core::Float as _;
@@ -67,7 +67,10 @@ pub struct SeedGyroCompass {
     zero_rps: f64,
     rest_sum: f64,
     rest_n: u32,
-    last_raw: Option<f64>,
+    /// The last gyro reading and its time.
+    last_gyro: Option<(f64, f64)>,
+    /// The wheels stand still.
+    at_rest: bool,
     since_solve: u32,
     clock: TimeStep,
     est: NavEstimate,
@@ -79,14 +82,15 @@ impl SeedGyroCompass {
         config.validate()?;
         Ok(Self {
             config,
-            wheels: WheelOdometry::new(config.wheels)?,
+            wheels: WheelOdometry::new(config.wheels, TrackModel::Patent)?,
             blend: SeedBlend::new(config.blend)?,
             turn: Some(TurnCalibrator::new(config.turn)?),
             calibration: None,
             zero_rps: 0.0,
             rest_sum: 0.0,
             rest_n: 0,
-            last_raw: None,
+            last_gyro: None,
+            at_rest: false,
             since_solve: 0,
             clock: TimeStep::new(),
             est: NavEstimate::at_start(f64::NAN, MagneticHeading::new(0.0), f64::INFINITY),
@@ -98,8 +102,9 @@ impl SeedGyroCompass {
         self.calibration.as_ref().map(|(c, _)| c)
     }
 
+    /// Offers a compass reading, with the latest gyro reading, to the turn calibration.
     fn learn_turn(&mut self, sample: &VehicleSample) {
-        let (Some(turn), Some(gyr), Some(mag)) = (&mut self.turn, sample.gyr_z_rps, sample.mag)
+        let (Some(turn), Some((_, gyr)), Some(mag)) = (&mut self.turn, self.last_gyro, sample.mag)
         else {
             return;
         };
@@ -127,34 +132,30 @@ impl SeedGyroCompass {
 }
 
 impl HeadingEstimator for SeedGyroCompass {
-    /// Takes one sample. A non-finite value or a timestamp that does not increase is a
-    /// typed error and changes nothing.
+    /// Takes one row, whatever readings it carries: the gyro turns the heading between its
+    /// readings, the wheels carry the track and say when the vehicle stands still. A
+    /// non-finite value or a timestamp that does not increase is a typed error and changes
+    /// nothing.
     fn update(&mut self, sample: &VehicleSample) -> Result<NavEstimate> {
         sample.validate()?;
-        self.wheels.check_speed(sample, self.clock.last_s())?;
-        let dt = self.clock.dt_s(sample.t_s)?;
-        let wheel = self.wheels.step(
-            sample.dist_l_m,
-            sample.dist_r_m,
-            dt.unwrap_or(1.0),
-            &WheelCalibration::default(),
-        );
-        let raw = sample.gyr_z_rps.or(self.last_raw);
-        let mut at_rest = false;
-        if let (Some(w), Some(dt)) = (wheel, dt) {
-            let (zero, gain) = self.calibration.map_or((self.zero_rps, 1.0), |(c, _)| {
-                (c.gyro.zero_rps, c.gyro.gain_pos)
-            });
-            let rest_now = !w.moved;
-            let dpsi = match (raw, self.last_raw) {
-                (Some(r), Some(p)) if !rest_now => (0.5 * (r + p) - zero) / gain * dt,
-                _ => 0.0,
-            };
-            at_rest = self.blend.step(dpsi, w.ds_m, dt, w.moved);
-            self.est.speed_mps = w.speed_mps;
+        if let Some(w) = &sample.wheels {
+            self.wheels.check_speed(sample.t_s, w)?;
+        }
+        self.clock.dt_s(sample.t_s)?;
+        let (zero, gain) = self.calibration.map_or((self.zero_rps, 1.0), |(c, _)| {
+            (c.gyro.zero_rps, c.gyro.gain_pos)
+        });
+        if let Some(r) = sample.gyr_z_rps {
+            if let Some((t0, p)) = self.last_gyro
+                && !self.at_rest
+            {
+                self.blend
+                    .turn((0.5 * (r + p) - zero) / gain * (sample.t_s - t0));
+            }
+            self.last_gyro = Some((sample.t_s, r));
             // The zero reading is taken again at every standstill (claims 8-9).
-            match (at_rest, raw, &mut self.calibration) {
-                (true, Some(r), Some((c, _))) => {
+            match (self.at_rest, &mut self.calibration) {
+                (true, Some((c, _))) => {
                     self.rest_sum += r;
                     self.rest_n += 1;
                     c.gyro.zero_rps = self.rest_sum / f64::from(self.rest_n);
@@ -165,7 +166,14 @@ impl HeadingEstimator for SeedGyroCompass {
                 }
             }
         }
-        self.last_raw = raw;
+        if let Some(w) = sample.wheels
+            && let Some(step) = self
+                .wheels
+                .step(sample.t_s, w, &WheelCalibration::default())
+        {
+            self.at_rest = self.blend.travel(step.ds_m, step.dt_s, step.moved);
+            self.est.speed_mps = step.speed_mps;
+        }
         self.learn_turn(sample);
         let mut used = false;
         if let (Some(mag), Some((c, field))) = (sample.mag, self.calibration) {
@@ -178,7 +186,8 @@ impl HeadingEstimator for SeedGyroCompass {
         let e = &mut self.est;
         e.status.compass_calibrated = self.calibration.is_some();
         e.status.compass_used = used;
-        e.status.at_rest = at_rest;
+        e.status.at_rest = self.at_rest;
+        e.status.position_known = self.wheels.last_s().is_some();
         Ok(*e)
     }
 

@@ -18,7 +18,7 @@ use truenorth_core::{
 use truenorth_odometer::OdometerWheels;
 
 use super::seed_blend::{SeedBlend, SeedBlendConfig};
-use super::wheel_odometry::{WheelCalibration, WheelOdometry};
+use super::wheel_odometry::{TrackModel, WheelCalibration, WheelOdometry};
 
 #[allow(unused_imports)]
 use truenorth_core::Float as _;
@@ -75,6 +75,8 @@ pub struct SeedOdometerCompass {
     compass: Option<(CompassCalibration2d, f64)>,
     refiner: SpeedCoefficientCalibrator,
     clock: TimeStep,
+    /// The wheels stand still.
+    at_rest: bool,
     est: NavEstimate,
 }
 
@@ -84,12 +86,13 @@ impl SeedOdometerCompass {
         config.validate()?;
         Ok(Self {
             config,
-            wheels: WheelOdometry::new(config.wheels)?,
+            wheels: WheelOdometry::new(config.wheels, TrackModel::Patent)?,
             blend: SeedBlend::new(config.blend)?,
             calibrator: BinnedEllipseCalibrator::new(config.compass)?,
             compass: None,
             refiner: SpeedCoefficientCalibrator::new(config.speed_coefficient)?,
             clock: TimeStep::new(),
+            at_rest: false,
             est: NavEstimate::at_start(f64::NAN, MagneticHeading::new(0.0), f64::INFINITY),
         })
     }
@@ -106,18 +109,20 @@ impl HeadingEstimator for SeedOdometerCompass {
     /// or a timestamp that does not increase is a typed error and changes nothing.
     fn update(&mut self, sample: &VehicleSample) -> Result<NavEstimate> {
         sample.validate()?;
-        self.wheels.check_speed(sample, self.clock.last_s())?;
-        let dt = self.clock.dt_s(sample.t_s)?;
+        if let Some(w) = &sample.wheels {
+            self.wheels.check_speed(sample.t_s, w)?;
+        }
+        self.clock.dt_s(sample.t_s)?;
         let cal = WheelCalibration {
             speed_coeff: self.refiner.coefficient(),
             ..WheelCalibration::default()
         };
-        let wheel = self
+        let wheel = sample
             .wheels
-            .step(sample.dist_l_m, sample.dist_r_m, dt.unwrap_or(1.0), &cal);
-        let mut at_rest = false;
-        if let (Some(w), Some(dt)) = (wheel, dt) {
-            at_rest = self.blend.step(w.heading_change_rad, w.ds_m, dt, w.moved);
+            .and_then(|w| self.wheels.step(sample.t_s, w, &cal));
+        if let Some(w) = wheel {
+            self.blend.turn(w.heading_change_rad);
+            self.at_rest = self.blend.travel(w.ds_m, w.dt_s, w.moved);
             self.est.speed_mps = w.speed_mps;
         }
         let mut used = None;
@@ -142,7 +147,7 @@ impl HeadingEstimator for SeedOdometerCompass {
                     .compass_vector(sample.t_s, c.correct(&raw), field);
             }
         }
-        if let (Some(w), Some(_)) = (wheel, dt) {
+        if let Some(w) = wheel {
             // Every sample here was accepted above, so the refiner accepts it too.
             self.refiner.push(&SpeedStep {
                 t_s: sample.t_s,
@@ -155,7 +160,8 @@ impl HeadingEstimator for SeedOdometerCompass {
         let e = &mut self.est;
         e.status.compass_calibrated = self.compass.is_some();
         e.status.compass_used = used.is_some();
-        e.status.at_rest = at_rest;
+        e.status.at_rest = self.at_rest;
+        e.status.position_known = self.wheels.last_s().is_some();
         Ok(*e)
     }
 

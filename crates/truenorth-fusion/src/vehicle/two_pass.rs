@@ -170,7 +170,11 @@ fn turned(e: &NavEstimate, offset: f64, heading_sigma_rad: f64) -> NavEstimate {
     t.heading = MagneticHeading::new(e.heading.rad() + offset);
     t.heading_sigma_rad = heading_sigma_rad;
     let r = nalgebra::Matrix2::new(c, -s, s, c);
-    t.position_cov_m2 = r * e.position_cov_m2 * r.transpose();
+    // The offset's own error turns the track about the start: across it, in proportion
+    // to the distance from the start.
+    let across = nalgebra::Vector2::new(-t.east_m, t.north_m);
+    t.position_cov_m2 = r * e.position_cov_m2 * r.transpose()
+        + heading_sigma_rad * heading_sigma_rad * across * across.transpose();
     t.status.heading_absolute = true;
     t
 }

@@ -3,14 +3,14 @@
 //!
 //! Per step (US 4,788,645 eqs. 2/8, 3/14): the raw wheel increments are divided by their
 //! gains `1 ± δ/2`, their difference by `1 + aV²`, and the result by the track — fixed for
-//! rear wheels, the effective track `T_E(ΔD/AD)` from the patent's look-up table for
+//! an unsteered axle, the effective track `T_E(ΔD/AD)` from a look-up table for
 //! Ackermann-steered front wheels. Front wheels also travel further than the rear axle in a
 //! turn: the front-axle midpoint runs on radius `√(R² + B²)` where the rear-axle centre runs
 //! on `R`, so the rear-axle distance is `√(AD² − (B·Δθ)²)`.
 
-use truenorth_core::{Error, Result, Validate, VehicleSample};
+use truenorth_core::{Error, Result, Validate, WheelReading};
 use truenorth_odometer::{
-    EffectiveTrack, EffectiveTrackTable, OdometerWheels, PatentAckermannTrack,
+    AckermannGeometry, EffectiveTrack, EffectiveTrackTable, OdometerWheels, PatentAckermannTrack,
 };
 
 #[allow(unused_imports)]
@@ -23,20 +23,49 @@ pub const MAX_WHEEL_SPEED_MPS: f64 = 100.0;
 /// Entries of the front-wheel effective-track table.
 const TABLE_ENTRIES: usize = 64;
 
+/// Share of the exact geometry's peak ratio that its table covers: the ratio turns back
+/// past the peak, and near it the track changes too fast for a table (the peak lies
+/// beyond any real car's lock, `truenorth-odometer`'s `ackermann_tests.rs`).
+const EXACT_TABLE_SHARE: f64 = 0.97;
+
+/// Which effective track of steered front wheels the odometry uses.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum TrackModel {
+    /// The exact rigid-body geometry ([`AckermannGeometry`]).
+    Exact,
+    /// US 4,788,645's closed form, eq. 3/14 ([`PatentAckermannTrack`]), as the seed
+    /// document has it.
+    Patent,
+}
+
 /// Ackermann-steered front wheels: the effective track's table and the wheelbase.
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct Steered {
     table: EffectiveTrackTable<TABLE_ENTRIES>,
     wheelbase_m: f64,
+    /// The path's curvature, averaged over the last few metres, 1/m: the front axle's
+    /// extra travel is second order in it, so the pulses' noise in one step's turn would
+    /// shorten every step on a straight (by 0.7 % with 4 cm pulses at 25 Hz); a car's
+    /// curvature cannot change faster than its steering turns.
+    curvature_per_m: f64,
 }
+
+/// Distance over which the curvature of steered wheels is averaged, m.
+const CURVATURE_SMOOTHING_M: f64 = 3.0;
 
 /// What one step of the wheels gives.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct WheelStep {
+    /// Time since the previous wheel reading, s.
+    pub dt_s: f64,
     /// Distance of the rear-axle centre, m (negative reversing).
     pub ds_m: f64,
     /// Heading change, rad, positive right.
     pub heading_change_rad: f64,
+    /// How tight the turn is, as the ratio c = ΔD/AD of a steady turn (about T/R, signed):
+    /// for steered wheels from the curvature averaged over the last metres (one step's
+    /// pulses can show any ratio while creeping), within the vehicle's lock.
+    pub ratio: f64,
     /// ∂(heading change)/∂δ, rad.
     pub d_heading_d_diff: f64,
     /// ∂(heading change)/∂a, rad·m²/s².
@@ -67,26 +96,37 @@ pub struct WheelOdometry {
     track_m: f64,
     /// Present when the odometer wheels steer.
     steered: Option<Steered>,
-    last: Option<(f64, f64)>,
+    /// The last reading and its time.
+    last: Option<(f64, WheelReading)>,
 }
 
 impl WheelOdometry {
-    /// Odometry on `wheels`; the front-wheel table covers the patent formula's whole range.
-    pub fn new(wheels: OdometerWheels) -> Result<Self> {
+    /// Odometry on `wheels`, with steered front wheels' track from `model` (over the whole
+    /// range of the patent's formula, or up to near the exact geometry's peak ratio).
+    pub fn new(wheels: OdometerWheels, model: TrackModel) -> Result<Self> {
         wheels.validate()?;
-        let (track_m, steered) = match wheels {
-            OdometerWheels::Rear { track_m } => (track_m, None),
+        let steered = match wheels {
             OdometerWheels::Front(p) => {
-                let formula = PatentAckermannTrack::from_params(&p)?;
-                let steered = Steered {
-                    table: EffectiveTrackTable::build(&formula, formula.max_ratio())?,
-                    wheelbase_m: p.wheelbase_m,
+                let table = match model {
+                    TrackModel::Patent => {
+                        let formula = PatentAckermannTrack::from_params(&p)?;
+                        EffectiveTrackTable::build(&formula, formula.max_ratio())?
+                    }
+                    TrackModel::Exact => {
+                        let exact = AckermannGeometry::new(p)?;
+                        EffectiveTrackTable::build(&exact, EXACT_TABLE_SHARE * exact.max_ratio())?
+                    }
                 };
-                (p.track_m, Some(steered))
+                Some(Steered {
+                    table,
+                    wheelbase_m: p.wheelbase_m,
+                    curvature_per_m: 0.0,
+                })
             }
+            _ => None,
         };
         Ok(Self {
-            track_m,
+            track_m: wheels.track_m(),
             steered,
             last: None,
         })
@@ -95,19 +135,27 @@ impl WheelOdometry {
     /// Forgets the last reading.
     pub fn reset(&mut self) {
         self.last = None;
+        if let Some(s) = &mut self.steered {
+            s.curvature_per_m = 0.0;
+        }
     }
 
-    /// Refuses `sample` if its distances, against the previous reading taken at `last_t_s`,
-    /// imply a wheel faster than [`MAX_WHEEL_SPEED_MPS`]. Changes nothing either way; a
-    /// timestamp that does not increase is left to the caller's clock.
-    pub fn check_speed(&self, sample: &VehicleSample, last_t_s: Option<f64>) -> Result<()> {
-        let (Some((l0, r0)), Some(t0)) = (self.last, last_t_s) else {
+    /// The time of the last reading taken, if any.
+    pub fn last_s(&self) -> Option<f64> {
+        self.last.map(|(t, _)| t)
+    }
+
+    /// Refuses `reading` at `t_s` if, against the previous reading, it implies a wheel
+    /// faster than [`MAX_WHEEL_SPEED_MPS`]. Changes nothing either way; a timestamp that
+    /// does not increase is left to the caller's clock.
+    pub fn check_speed(&self, t_s: f64, reading: &WheelReading) -> Result<()> {
+        let Some((t0, w0)) = self.last else {
             return Ok(());
         };
-        let dt = sample.t_s - t0;
-        let travel = (sample.dist_l_m - l0)
+        let dt = t_s - t0;
+        let travel = (reading.dist_l_m - w0.dist_l_m)
             .abs()
-            .max((sample.dist_r_m - r0).abs());
+            .max((reading.dist_r_m - w0.dist_r_m).abs());
         if dt > 0.0 && travel > MAX_WHEEL_SPEED_MPS * dt {
             return Err(Error::OutOfRange {
                 what: "wheel speed implied by the distances, m/s (a counter that wrapped or was reset: start a new drive there)",
@@ -119,15 +167,13 @@ impl WheelOdometry {
         Ok(())
     }
 
-    /// The step from the previous cumulative reading to this one (`None` for the first),
-    /// with differential scale `diff`, speed coefficient `speed_coeff` and the track's
-    /// relative error `track_scale`. Inputs are finite and `dt_s > 0` (checked by the
-    /// caller).
+    /// The step from the previous reading to `reading` at `t_s` (`None` for the first),
+    /// under calibration `cal`. Inputs are finite and `t_s` later than the previous
+    /// reading's (checked by the caller).
     pub fn step(
         &mut self,
-        dist_l_m: f64,
-        dist_r_m: f64,
-        dt_s: f64,
+        t_s: f64,
+        reading: WheelReading,
         cal: &WheelCalibration,
     ) -> Option<WheelStep> {
         let WheelCalibration {
@@ -135,8 +181,12 @@ impl WheelOdometry {
             speed_coeff,
             track_scale,
         } = *cal;
-        let (l0, r0) = self.last.replace((dist_l_m, dist_r_m))?;
-        let (raw_l, raw_r) = (dist_l_m - l0, dist_r_m - r0);
+        let (t0, w0) = self.last.replace((t_s, reading))?;
+        let dt_s = t_s - t0;
+        let (raw_l, raw_r) = (
+            reading.dist_l_m - w0.dist_l_m,
+            reading.dist_r_m - w0.dist_r_m,
+        );
         let moved = raw_l != 0.0 || raw_r != 0.0;
         let l = raw_l / (1.0 + 0.5 * diff);
         let r = raw_r / (1.0 + -0.5 * diff);
@@ -144,28 +194,38 @@ impl WheelOdometry {
         let speed_mps = mean.abs() / dt_s;
         let factor = (1.0 + speed_coeff * speed_mps * speed_mps).max(0.5);
         let delta = (l - r) / factor;
+        let ratio = if mean != 0.0 { delta / mean } else { 0.0 };
         let track_m = match &self.steered {
             None => self.track_m,
             Some(s) => {
                 // A step too short to resolve the turn (a pulse or two while creeping) can
                 // show a ratio past the vehicle's lock; the tightest turn stands in for it.
-                let ratio = if mean != 0.0 { delta / mean } else { 0.0 };
                 let c = ratio.abs().min(s.table.max_ratio());
                 s.table.effective_track_m(c).unwrap_or(self.track_m)
             }
         };
         let scale = (1.0 + track_scale).max(0.5);
         let heading = delta / (track_m * scale);
-        let ds_m = match &self.steered {
-            None => mean,
+        let (ds_m, ratio) = match &mut self.steered {
+            None => (mean, ratio),
             Some(s) => {
-                let lateral = s.wheelbase_m * heading;
-                mean.signum() * (mean * mean - lateral * lateral).max(0.0).sqrt()
+                if mean != 0.0 {
+                    let w = mean.abs() / (mean.abs() + CURVATURE_SMOOTHING_M);
+                    s.curvature_per_m += w * (heading / mean - s.curvature_per_m);
+                }
+                let lateral = s.wheelbase_m * s.curvature_per_m * mean;
+                let max = s.table.max_ratio();
+                (
+                    mean.signum() * (mean * mean - lateral * lateral).max(0.0).sqrt(),
+                    (s.curvature_per_m * self.track_m).clamp(-max, max),
+                )
             }
         };
         Some(WheelStep {
+            dt_s,
             ds_m,
             heading_change_rad: heading,
+            ratio,
             // u_l − u_r falls by the mean distance per unit δ (first order).
             d_heading_d_diff: -mean / (factor * track_m * scale),
             d_heading_d_speed_coeff: -heading * speed_mps * speed_mps / factor,
@@ -187,52 +247,50 @@ mod tests {
         track_scale: 0.0,
     };
 
+    fn at(l: f64, r: f64) -> WheelReading {
+        WheelReading {
+            dist_l_m: l,
+            dist_r_m: r,
+        }
+    }
+
+    fn rear() -> WheelOdometry {
+        let mut w =
+            WheelOdometry::new(OdometerWheels::Rear { track_m: 1.5 }, TrackModel::Exact).unwrap();
+        assert!(w.step(0.0, at(0.0, 0.0), &NONE).is_none());
+        w
+    }
+
     #[test]
     fn rear_wheels_give_the_plain_formula_and_its_derivatives() {
-        let mut w = WheelOdometry::new(OdometerWheels::Rear { track_m: 1.5 }).unwrap();
-        assert!(w.step(0.0, 0.0, 0.1, &NONE).is_none());
-        let s = w.step(1.03, 0.97, 0.1, &NONE).unwrap();
+        let s = rear().step(0.1, at(1.03, 0.97), &NONE).unwrap();
         assert!((s.heading_change_rad - 0.04).abs() < 1e-12);
         assert!((s.ds_m - 1.0).abs() < 1e-12);
         assert!((s.speed_mps - 10.0).abs() < 1e-12);
+        assert!((s.dt_s - 0.1).abs() < 1e-15);
+        assert!((s.ratio - 0.06).abs() < 1e-12);
         // Numerical derivatives agree with the analytic ones.
         let h = 1e-7;
-        let mut a = WheelOdometry::new(OdometerWheels::Rear { track_m: 1.5 }).unwrap();
-        let mut b = a;
-        a.step(0.0, 0.0, 0.1, &NONE);
-        b.step(0.0, 0.0, 0.1, &NONE);
-        let mut c = b;
-        let up = a
-            .step(1.03, 0.97, 0.1, &WheelCalibration { diff: h, ..NONE })
-            .unwrap()
-            .heading_change_rad;
-        assert!(((up - s.heading_change_rad) / h - s.d_heading_d_diff).abs() < 1e-5);
-        let up = b
-            .step(
-                1.03,
-                0.97,
-                0.1,
-                &WheelCalibration {
-                    speed_coeff: h,
-                    ..NONE
-                },
-            )
-            .unwrap()
-            .heading_change_rad;
-        assert!(((up - s.heading_change_rad) / h - s.d_heading_d_speed_coeff).abs() < 1e-4);
-        let up = c
-            .step(
-                1.03,
-                0.97,
-                0.1,
-                &WheelCalibration {
-                    track_scale: h,
-                    ..NONE
-                },
-            )
-            .unwrap()
-            .heading_change_rad;
-        assert!(((up - s.heading_change_rad) / h - s.d_heading_d_track_scale).abs() < 1e-5);
+        let turned = |cal: WheelCalibration| {
+            rear()
+                .step(0.1, at(1.03, 0.97), &cal)
+                .unwrap()
+                .heading_change_rad
+        };
+        let d = (turned(WheelCalibration { diff: h, ..NONE }) - s.heading_change_rad) / h;
+        assert!((d - s.d_heading_d_diff).abs() < 1e-5);
+        let d = (turned(WheelCalibration {
+            speed_coeff: h,
+            ..NONE
+        }) - s.heading_change_rad)
+            / h;
+        assert!((d - s.d_heading_d_speed_coeff).abs() < 1e-4);
+        let d = (turned(WheelCalibration {
+            track_scale: h,
+            ..NONE
+        }) - s.heading_change_rad)
+            / h;
+        assert!((d - s.d_heading_d_track_scale).abs() < 1e-5);
     }
 
     #[test]
@@ -242,23 +300,56 @@ mod tests {
             track_m: 1.55,
             kingpin_offset_m: 0.1,
         };
-        let geometry = truenorth_odometer::AckermannGeometry::new(car).unwrap();
-        let radius = 8.0;
-        let paths = geometry.wheel_paths_m(10.0, 1.0 / radius).unwrap();
-        let mut w = WheelOdometry::new(OdometerWheels::Front(car)).unwrap();
-        w.step(0.0, 0.0, 1.0, &NONE);
-        let s = w.step(paths.left_m, paths.right_m, 1.0, &NONE).unwrap();
-        // True heading change 10/8 rad; the patent's track is within 0.1 % at this radius.
-        assert!(
-            (s.heading_change_rad / 1.25 - 1.0).abs() < 1e-3,
-            "{}",
-            s.heading_change_rad
-        );
-        assert!((s.ds_m / 10.0 - 1.0).abs() < 2e-3, "{}", s.ds_m);
-        // A ratio past full lock is clamped, never NaN.
-        let s = w
-            .step(paths.left_m + 0.06, paths.right_m, 1.0, &NONE)
-            .unwrap();
-        assert!(s.heading_change_rad.is_finite() && s.ds_m.is_finite());
+        let geometry = AckermannGeometry::new(car).unwrap();
+        // The distance takes the front wheels' mean path for the front axle's midpoint,
+        // which runs on √(R² + B²); the contact points sit a kingpin offset off it, which
+        // the midpoint rule misses by 0.1 % at 8 m and 0.4 % at a lock of 4.5 m.
+        for (model, radius, tolerance, distance_tolerance) in [
+            // The exact table, to its interpolation, down to a tight lock.
+            (TrackModel::Exact, 8.0, 1e-4, 2e-3),
+            (TrackModel::Exact, 4.5, 1e-3, 5e-3),
+            // The patent's formula is within 0.1 % at 8 m (the crate's error table).
+            (TrackModel::Patent, 8.0, 1e-3, 2e-3),
+        ] {
+            // Ten 2 m steps round the circle: the averaged curvature settles on it.
+            let paths = geometry.wheel_paths_m(2.0, 1.0 / radius).unwrap();
+            let mut w = WheelOdometry::new(OdometerWheels::Front(car), model).unwrap();
+            w.step(0.0, at(0.0, 0.0), &NONE);
+            let mut s = WheelStep::default();
+            for k in 1..=10 {
+                let k = f64::from(k);
+                s = w
+                    .step(0.2 * k, at(k * paths.left_m, k * paths.right_m), &NONE)
+                    .unwrap();
+            }
+            let truth = 2.0 / radius;
+            assert!(
+                (s.heading_change_rad / truth - 1.0).abs() < tolerance,
+                "{model:?} {radius}: {}",
+                s.heading_change_rad
+            );
+            assert!(
+                (s.ds_m / 2.0 - 1.0).abs() < distance_tolerance,
+                "{}",
+                s.ds_m
+            );
+            // A ratio past full lock is clamped, never NaN.
+            let s = w
+                .step(
+                    3.0,
+                    at(12.0 * paths.left_m + 0.06, 11.0 * paths.right_m),
+                    &NONE,
+                )
+                .unwrap();
+            assert!(s.heading_change_rad.is_finite() && s.ds_m.is_finite());
+        }
+    }
+
+    #[test]
+    fn a_counter_that_jumps_is_refused_against_the_wheels_own_last_reading() {
+        let w = rear();
+        assert!(w.check_speed(0.1, &at(5.0, 5.0)).is_ok());
+        assert!(w.check_speed(0.1, &at(50.0, 50.0)).is_err());
+        assert_eq!(w.last_s(), Some(0.0));
     }
 }

@@ -5,6 +5,8 @@
 
 #![allow(dead_code)]
 
+pub mod consistency;
+
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
 

@@ -1,0 +1,466 @@
+//! The uncertainty of the [`crate::QuaternionFilter`]'s attitude: one standard deviation of
+//! the error about the reference (NED) x, y and z axes, propagated alongside the filter from
+//! the sensors' error model ([`AttitudeUncertaintyConfig`]) and the filter's own gains.
+//!
+//! The filter is a complementary filter: per axis the error obeys
+//! `e ← (1 − k) e − k v + w`, with `k = dt/τ` the correction's gain, `v` the error of what
+//! corrects it (accelerometer or magnetometer) and `w` what the gyro adds. A complementary
+//! filter with fixed gains is a steady-state Kalman filter for some noise model (Higgins,
+//! *A comparison of complementary and Kalman filtering*, IEEE TAES 11(3), 1975), so its
+//! error variance follows the same linear propagation with the gain held fixed instead of
+//! optimised. Inclination (about x and y, treated alike) and heading (about z) each carry:
+//!
+//! - **Gyro** (Groves, *Principles of GNSS, Inertial, and Multisensor Integrated Navigation
+//!   Systems*, 2nd ed., 2013, §4.4.6 and §14.2.7): white noise adds `N² dt` to the variance of
+//!   the angle error `e`; a bias error `β` (a random constant plus a random walk) adds to it
+//!   through the pair `(e, β)`, whose 2 × 2 covariance is propagated exactly. Each applied
+//!   correction multiplies `e` by `1 − k`; in motion the filter's bias estimate integrates
+//!   the corrections (`β ← β − (k/τ_b) e`), which is credited only with the in-phase part
+//!   of a first-order loop's response to a bias that turns with the body at `|ω|`,
+//!   `1/(1 + (|ω| τ)²)`: a fast-turning body shows its bias to the corrections only
+//!   briefly along any one reference axis (on a simulated hand-held run turning at up to
+//!   1.9 rad/s the bias was learned about three times slower than `τ_b`). At rest the bias variance
+//!   falls to that of the rest detector's mean of white noise, `N²/(2(τ_mean + τ_rest))`
+//!   (two first-order low-passes in cascade). As the body turns, the bias uncertainties of
+//!   the three reference axes mix (a body axis that was horizontal becomes vertical).
+//! - **Gyro scale and axis errors** `S` (relative, `s` per element): the error rate `R S ω`
+//!   accumulates coherently while the body keeps turning the same way and cancels when it
+//!   turns back, so it is `s |ψ|` with `ψ` the reference-frame rotation of the last
+//!   correction time constant, `ψ ← (1 − k) ψ + R ω dt` (exact for scale errors and a
+//!   rotation about one body axis).
+//! - **Latency**: a gyro's digital low-pass delays it by a few milliseconds (InvenSense
+//!   MPU-9250 register map, register 26: 2.9 ms at its widest bandwidth, 5.9 ms at 41 Hz),
+//!   so the attitude stands for a slightly earlier instant: an error `|R ω| δ` per axis.
+//! - **What the corrections trust**: the accelerometer's bias (`b/g` of tilt, a constant
+//!   passed fully) and white noise (through the two low-passes in cascade, variance
+//!   `N_a²/(2 g² (τ_lp + τ_acc))`); for heading, the magnetometer's residual calibration
+//!   error (a constant), its white noise (`σ_h² k/2`: a first-order low-pass of white
+//!   noise) and the inclination error about north, which the dip turns into a heading error
+//!   `e_x tan(dip)` (the east component of `e × m`). Of that, the parts that persist (the
+//!   biases' and the scale error's) pass the heading loop whole; the accelerations' varies
+//!   with the inclination loop's time constant and passes by `τ_acc/(τ_acc + τ_mag)`, the
+//!   variance a first-order low-pass leaves of a first-order Gauss–Markov process (Gelb,
+//!   *Applied Optimal Estimation*, 1974, §3.8). Such a variance `C` enters as
+//!   `P ← (1 − k)² P + (1 − (1 − k)²) C`, so it is reached with the correction's own time
+//!   constant and kept while corrections are suspended.
+//! - **What the sensors say the model cannot explain** (covariance matching on the
+//!   corrections, Mehra, *Approaches to adaptive filtering*, IEEE TAC 17(5), 1972):
+//!   - *accelerations*: the body's accelerations show in the inclination corrections; their
+//!     recent sum `ε ← (1 − k) ε + correction` is what the accelerometer has moved the
+//!     attitude by within the loop's time constant, and the envelope of its square is added
+//!     per axis (rising with it at once, decaying over the loop's natural period
+//!     `2π √(τ_lp τ_acc)`). A *sustained* horizontal acceleration (a vehicle's turn) looks exactly like a
+//!     tilt and is not seen: like the filter itself, σ assumes that the body's
+//!     accelerations average out over a few seconds.
+//!   - *magnetic disturbances*: the field's norm and dip departures from the learned
+//!     reference, `r_n` and `r_d` (relative), low-passed with the heading loop's time
+//!     constant over the readings that correct heading. A disturbance of random direction
+//!     moves the east component (which turns heading and cannot be seen) as much on average
+//!     as each of the two it shows, so it adds `(r_n² + r_d²)/(2 cos² dip)` to the heading
+//!     variance.
+//!   - *a hard-iron offset learned online* is estimated from the attitude itself, so
+//!     readings corrected by it cannot also tell the heading's error: while one is
+//!     subtracted, heading corrections shrink nothing (the gyro's terms grow as when the
+//!     field is rejected). A simulated hand-held run showed why: with a gyro bias of 1°/s
+//!     never measured at rest and slow turns, a heading error was adopted as an offset and
+//!     grew to 90°.
+//!
+//! Without a magnetometer the heading is relative to the start and its σ is the drift
+//! since the start. Everything is a few scalars per axis, cheap enough for every sample.
+
+use nalgebra::{Matrix3, Vector3};
+use serde::{Deserialize, Serialize};
+use truenorth_core::{Result, STANDARD_GRAVITY_MPS2, Validate, check_range};
+
+#[allow(unused_imports)]
+use truenorth_core::Float as _;
+
+/// The sensors' error model behind the filter's σ: what a typical consumer MEMS IMU with a
+/// calibrated magnetometer promises. Units in the names; every value is one standard
+/// deviation.
+///
+/// Outside the model, and so outside σ (see [the model](crate::attitude_uncertainty)): a
+/// horizontal acceleration that lasts longer than the inclination loop (a vehicle's turn,
+/// a hand carried along at more than about 0.5 m/s² below 0.1 Hz), which no accelerometer
+/// can tell from a tilt; a gyro whose scale differs between the two senses of rotation,
+/// which turns part of its scale error into a drift like a bias; a field disturbance
+/// present since the start, which becomes the reference.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct AttitudeUncertaintyConfig {
+    /// Gyro white-noise density (angle random walk), rad/s/√Hz (default 0.01°/s/√Hz:
+    /// InvenSense MPU-9250 0.01, Bosch BMI160 0.007, TDK ICM-20948 0.015).
+    pub gyro_noise_rps_per_sqrt_hz: f64,
+    /// Gyro bias before a rest has measured it, rad/s (default 0.5°/s: a consumer gyro's
+    /// zero-rate offset after a board-level calibration; datasheets give ±3–5°/s before).
+    pub gyro_bias_rps: f64,
+    /// Gyro bias random walk (its drift with time and temperature), rad/s/√s (default
+    /// 0.002°/s/√s: 0.03°/s over 4 minutes).
+    pub gyro_bias_walk_rps_per_sqrt_s: f64,
+    /// Gyro scale-factor and axis-misalignment error, relative (default 0.01: the ±3 %
+    /// sensitivity tolerance of consumer datasheets taken as 3σ).
+    pub gyro_scale_rel: f64,
+    /// Uncertainty of the gyro's latency against the other sensors and the timestamps, s
+    /// (default 0.003: the group delay of a consumer gyro's default digital low-pass).
+    pub gyro_latency_s: f64,
+    /// Accelerometer white-noise density, m/s²/√Hz (default 0.003: MPU-9250 300 µg/√Hz).
+    pub accel_noise_mps2_per_sqrt_hz: f64,
+    /// Accelerometer bias after calibration, m/s² (default 0.05, about 5 mg: 0.3° of tilt).
+    pub accel_bias_mps2: f64,
+    /// Magnetometer noise per component and reading, relative to the field's norm
+    /// (default 0.01).
+    pub mag_noise_rel: f64,
+    /// Heading error the magnetometer's calibration leaves, rad (default 1°).
+    pub mag_heading_rad: f64,
+}
+
+impl Default for AttitudeUncertaintyConfig {
+    fn default() -> Self {
+        Self {
+            gyro_noise_rps_per_sqrt_hz: 0.01f64.to_radians(),
+            gyro_bias_rps: 0.5f64.to_radians(),
+            gyro_bias_walk_rps_per_sqrt_s: 0.002f64.to_radians(),
+            gyro_scale_rel: 0.01,
+            gyro_latency_s: 0.003,
+            accel_noise_mps2_per_sqrt_hz: 0.003,
+            accel_bias_mps2: 0.05,
+            mag_noise_rel: 0.01,
+            mag_heading_rad: 1f64.to_radians(),
+        }
+    }
+}
+
+impl Validate for AttitudeUncertaintyConfig {
+    /// Every value finite and ≥ 0, and below a bound no real sensor reaches (rates 10 rad/s,
+    /// relative errors 1, latency 1 s, accelerometer terms 100 m/s², heading π).
+    fn validate(&self) -> Result<()> {
+        let bounds = [
+            (
+                "uncertainty.gyro_noise_rps_per_sqrt_hz",
+                self.gyro_noise_rps_per_sqrt_hz,
+                10.0,
+            ),
+            ("uncertainty.gyro_bias_rps", self.gyro_bias_rps, 10.0),
+            (
+                "uncertainty.gyro_bias_walk_rps_per_sqrt_s",
+                self.gyro_bias_walk_rps_per_sqrt_s,
+                10.0,
+            ),
+            ("uncertainty.gyro_scale_rel", self.gyro_scale_rel, 1.0),
+            ("uncertainty.gyro_latency_s", self.gyro_latency_s, 1.0),
+            (
+                "uncertainty.accel_noise_mps2_per_sqrt_hz",
+                self.accel_noise_mps2_per_sqrt_hz,
+                100.0,
+            ),
+            ("uncertainty.accel_bias_mps2", self.accel_bias_mps2, 100.0),
+            ("uncertainty.mag_noise_rel", self.mag_noise_rel, 1.0),
+            (
+                "uncertainty.mag_heading_rad",
+                self.mag_heading_rad,
+                core::f64::consts::PI,
+            ),
+        ];
+        for (what, value, max) in bounds {
+            check_range(what, value, 0.0, max)?;
+        }
+        Ok(())
+    }
+}
+
+/// The variance of the error about one kind of reference axis (inclination or heading).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+struct AxisVariance {
+    /// Angle error driven by the gyro, rad².
+    angle: f64,
+    /// Covariance of that angle error and the bias error, rad²/s.
+    angle_bias: f64,
+    /// Bias error, (rad/s)².
+    bias: f64,
+    /// Angle error left by what the corrections trust, rad².
+    measured: f64,
+}
+
+impl AxisVariance {
+    fn new(angle: f64, bias: f64) -> Self {
+        Self {
+            angle,
+            angle_bias: 0.0,
+            bias,
+            measured: 0.0,
+        }
+    }
+
+    /// `dt` of strapdown: `e ← e + β dt + w`, `β ← β + walk`.
+    #[inline]
+    fn propagate(&mut self, dt_s: f64, angle_noise: f64, bias_noise: f64) {
+        self.angle += dt_s * (2.0 * self.angle_bias + dt_s * self.bias) + angle_noise;
+        self.angle_bias += dt_s * self.bias;
+        self.bias += bias_noise;
+    }
+
+    /// One correction with gain `k` whose bias estimate takes `c` (1/s) of the error, and
+    /// whose measurement leaves the variance `target` (reached with the correction's own
+    /// time constant).
+    #[inline]
+    fn correct(&mut self, k: f64, c: f64, target: f64) {
+        let a = 1.0 - k;
+        let (pe, pb) = (self.angle, self.angle_bias);
+        self.angle = a * a * pe;
+        self.angle_bias = a * (pb - c * pe);
+        self.bias = (self.bias - c * (2.0 * pb - c * pe)).max(0.0);
+        self.measured += (1.0 - a * a) * (target - self.measured);
+    }
+}
+
+/// The propagated uncertainty (see the module documentation).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub(crate) struct AttitudeUncertainty {
+    config: AttitudeUncertaintyConfig,
+    inclination: AxisVariance,
+    heading: AxisVariance,
+    /// Reference-frame rotation within the inclination and heading loops' time constants.
+    turned_inclination: Vector3<f64>,
+    turned_heading: Vector3<f64>,
+    /// Recent sum of the inclination corrections about x and y, and the envelope of its
+    /// square per axis.
+    accel_moved: [f64; 2],
+    accel_moved_sq: [f64; 2],
+    /// Low-passed relative norm and dip departures of the field, and `1/(2 cos² dip)`.
+    norm_departure: f64,
+    dip_departure: f64,
+    half_inv_cos2_dip: f64,
+    /// Reference-frame rate and its norm at the last step.
+    rate_ned: Vector3<f64>,
+    rate_rps: f64,
+    /// The inclination correction's constants for the last (gain, time constant, low-pass):
+    /// variance target and the envelope's gain, recomputed only when those change.
+    accel_constants: ([f64; 3], f64, f64),
+}
+
+/// Inclination σ assumed before the first correction, rad: the tilt the first reading
+/// shows under a 2 m/s² horizontal acceleration (a brisk hand movement); the start-up's
+/// fast corrections shrink it within a second.
+const INITIAL_INCLINATION_RAD: f64 = 0.2;
+/// Heading σ of an unknown heading, rad: uniform over the circle, π/√3.
+const UNKNOWN_HEADING_RAD: f64 = core::f64::consts::PI / 1.732_050_807_568_877_2;
+
+impl AttitudeUncertainty {
+    /// Before any correction: inclination from one reading of unknown acceleration, heading
+    /// unknown (or, with `relative_heading`, zero: heading counted from the start).
+    pub(crate) fn new(config: AttitudeUncertaintyConfig, relative_heading: bool) -> Self {
+        let bias = config.gyro_bias_rps * config.gyro_bias_rps;
+        let heading = if relative_heading {
+            0.0
+        } else {
+            UNKNOWN_HEADING_RAD * UNKNOWN_HEADING_RAD
+        };
+        Self {
+            config,
+            inclination: AxisVariance::new(INITIAL_INCLINATION_RAD * INITIAL_INCLINATION_RAD, bias),
+            heading: AxisVariance::new(heading, bias),
+            turned_inclination: Vector3::zeros(),
+            turned_heading: Vector3::zeros(),
+            accel_moved: [0.0; 2],
+            accel_moved_sq: [0.0; 2],
+            norm_departure: 0.0,
+            dip_departure: 0.0,
+            half_inv_cos2_dip: 0.5,
+            rate_ned: Vector3::zeros(),
+            rate_rps: 0.0,
+            accel_constants: ([f64::NAN; 3], 0.0, 0.0),
+        }
+    }
+
+    /// Starts again after a gap the gyro could not bridge: the attitude is taken anew from
+    /// the sensors, while the bias uncertainty carries over, widened by its walk.
+    pub(crate) fn restart(&mut self, relative_heading: bool, gap_s: f64) {
+        let mut fresh = Self::new(self.config, relative_heading);
+        let walk = self.config.gyro_bias_walk_rps_per_sqrt_s;
+        let prior = fresh.inclination.bias;
+        let bias = |b: f64| (b + walk * walk * gap_s).min(prior);
+        fresh.inclination.bias = bias(self.inclination.bias);
+        fresh.heading.bias = bias(self.heading.bias);
+        *self = fresh;
+    }
+
+    /// One strapdown step of `dt_s` at the body rate `omega_rps` (bias removed) of norm
+    /// `rate_rps`, the body's attitude being `r` (body → NED).
+    #[inline]
+    pub(crate) fn propagate(
+        &mut self,
+        dt_s: f64,
+        omega_rps: &Vector3<f64>,
+        rate_rps: f64,
+        r: &Matrix3<f64>,
+    ) {
+        let cfg = &self.config;
+        let angle_noise = cfg.gyro_noise_rps_per_sqrt_hz * cfg.gyro_noise_rps_per_sqrt_hz * dt_s;
+        let walk = cfg.gyro_bias_walk_rps_per_sqrt_s;
+        let bias_noise = walk * walk * dt_s;
+        self.inclination.propagate(dt_s, angle_noise, bias_noise);
+        self.heading.propagate(dt_s, angle_noise, bias_noise);
+        self.rate_ned = r * omega_rps;
+        self.rate_rps = rate_rps;
+        let step = self.rate_ned * dt_s;
+        self.turned_inclination += step;
+        self.turned_heading += step;
+        // The body's turn mixes the reference axes' bias uncertainties (two inclination
+        // axes and one heading axis), by the fraction of a radian turned.
+        let mix = (rate_rps * dt_s).min(1.0);
+        let mean = (2.0 * self.inclination.bias + self.heading.bias) * (1.0 / 3.0);
+        self.inclination.bias += mix * (mean - self.inclination.bias);
+        self.heading.bias += mix * (mean - self.heading.bias);
+    }
+
+    /// The inclination correction of this step: gain `k`, the correction applied about
+    /// x and y (rad), and the bias estimate's `1/τ_b` (0 when it does not learn: at rest or
+    /// in the start-up).
+    #[inline]
+    pub(crate) fn accel_corrected(
+        &mut self,
+        k: f64,
+        correction: (f64, f64),
+        tau_s: f64,
+        inv_tau_bias: f64,
+        lowpass_s: f64,
+    ) {
+        if self.accel_constants.0 != [k, tau_s, lowpass_s] {
+            let cfg = &self.config;
+            let g = STANDARD_GRAVITY_MPS2;
+            let bias = cfg.accel_bias_mps2 / g;
+            let white = cfg.accel_noise_mps2_per_sqrt_hz / g;
+            let target = bias * bias + white * white / (2.0 * (lowpass_s + tau_s));
+            // The envelope of the square (below) follows a rise at once (the error an
+            // acceleration causes builds as fast as the corrections it causes) and decays
+            // over the loop's natural period 2π √(τ_lp τ_acc) (11 s by default), so that it
+            // holds through the swings of an acceleration slow enough to pass the loop
+            // (decaying with τ_acc, it fell between the swings of the simulated hand-held
+            // ensemble, `tests/orientation_consistency.rs`, and left errors at 4σ).
+            let period = core::f64::consts::TAU * (lowpass_s * tau_s).sqrt();
+            let k_env = (k * tau_s / period).min(1.0);
+            self.accel_constants = ([k, tau_s, lowpass_s], target, k_env);
+        }
+        let (_, target, k_env) = self.accel_constants;
+        let c = self.bias_credit(k, tau_s, inv_tau_bias);
+        self.inclination.correct(k, c, target);
+        self.turned_inclination *= 1.0 - k;
+        let a = 1.0 - k;
+        for (i, c) in [correction.0, correction.1].into_iter().enumerate() {
+            let moved = a * self.accel_moved[i] + c;
+            self.accel_moved[i] = moved;
+            let sq = moved * moved;
+            let env = self.accel_moved_sq[i];
+            self.accel_moved_sq[i] = if sq > env {
+                sq
+            } else {
+                env + k_env * (sq - env)
+            };
+        }
+    }
+
+    /// A heading correction that the field may be trusted for (not rejected, no offset
+    /// learned from the attitude subtracted): gain `k` (covering the time since the last
+    /// reading) with time constant `tau_s`, the reading's horizontal and vertical components
+    /// in the level frame and the reference's, and the bias estimate's `1/τ_b`.
+    #[inline]
+    pub(crate) fn mag_corrected(
+        &mut self,
+        k: f64,
+        tau_s: f64,
+        reading: (f64, f64),
+        reference: (f64, f64),
+        inv_tau_bias: f64,
+    ) {
+        let cfg = &self.config;
+        let (h, v) = reading;
+        let (h0, v0) = reference;
+        let n02 = h0 * h0 + v0 * v0;
+        // A reference with no field (never learned) says nothing about the heading.
+        if n02.is_nan() || n02 <= 0.0 {
+            return;
+        }
+        let inv_n02 = 1.0 / n02;
+        // Departures without a square root: (|m|² − |m₀|²)/(2|m₀|²) and the sine of the dip
+        // difference, both within a few per cent of exact for the fields that pass the test.
+        let rn = 0.5 * (h * h + v * v - n02) * inv_n02;
+        let rd = (v * h0 - h * v0) * inv_n02;
+        self.norm_departure += k * (rn - self.norm_departure);
+        self.dip_departure += k * (rd - self.dip_departure);
+        // 1/cos² dip = |m₀|²/h₀², the horizontal field kept above 10⁻³ of the whole.
+        let inv_cos2_dip = n02 / (h0 * h0).max(1e-6 * n02);
+        self.half_inv_cos2_dip = 0.5 * inv_cos2_dip;
+        let tan2_dip = inv_cos2_dip - 1.0;
+        // A reading's heading noise, σ/cos dip, through the loop: k/2 of its variance.
+        let white = cfg.mag_noise_rel * cfg.mag_noise_rel * inv_cos2_dip * 0.5 * k;
+        // The inclination error about north is the one the dip turns into heading. The parts
+        // of it that persist (the biases' and the scale error's) pass the heading loop
+        // whole; the accelerations' varies with the inclination loop's time constant and
+        // passes by τ_acc/(τ_acc + τ_mag).
+        let tau_acc_s = self.accel_constants.0[1];
+        let passed = if tau_acc_s > 0.0 {
+            tau_acc_s / (tau_acc_s + tau_s)
+        } else {
+            1.0
+        };
+        let acceleration = self.accel_moved_sq[0];
+        let tilt = tan2_dip * (self.inclination_variance(0) - (1.0 - passed) * acceleration);
+        let target = cfg.mag_heading_rad * cfg.mag_heading_rad + white + tilt;
+        let c = self.bias_credit(k, tau_s, inv_tau_bias);
+        self.heading.correct(k, c, target);
+        self.turned_heading *= 1.0 - k;
+    }
+
+    /// The share `c` (1/s) of a correction with gain `k` and time constant `tau_s` that the
+    /// bias estimate takes, credited by the in-phase response to a bias turning at |ω|.
+    #[inline]
+    fn bias_credit(&self, k: f64, tau_s: f64, inv_tau_bias: f64) -> f64 {
+        if inv_tau_bias == 0.0 {
+            return 0.0;
+        }
+        let wt = self.rate_rps * tau_s;
+        k * inv_tau_bias / (1.0 + wt * wt)
+    }
+
+    /// A step at rest: the bias follows the rest detector's mean with gain `k`.
+    #[inline]
+    pub(crate) fn at_rest(&mut self, k: f64, mean_tau_s: f64, rest_tau_s: f64) {
+        let n = self.config.gyro_noise_rps_per_sqrt_hz;
+        let floor = n * n / (2.0 * (mean_tau_s + rest_tau_s));
+        let a = (1.0 - k) * (1.0 - k);
+        for axis in [&mut self.inclination, &mut self.heading] {
+            axis.bias = a * axis.bias + (1.0 - a) * floor;
+            axis.angle_bias *= 1.0 - k;
+        }
+    }
+
+    /// The inclination error's variance about reference axis `i` (0: x, 1: y), without the
+    /// latency term.
+    #[inline]
+    fn inclination_variance(&self, i: usize) -> f64 {
+        let s = self.config.gyro_scale_rel;
+        self.inclination.angle
+            + self.inclination.measured
+            + self.accel_moved_sq[i]
+            + s * s * self.turned_inclination.norm_squared()
+    }
+
+    /// One σ of the error about the reference x, y and z axes, rad.
+    #[inline]
+    pub(crate) fn sigma_rad(&self) -> Vector3<f64> {
+        let lag = self.rate_ned * self.config.gyro_latency_s;
+        let s = self.config.gyro_scale_rel;
+        let disturbance = (self.norm_departure * self.norm_departure
+            + self.dip_departure * self.dip_departure)
+            * self.half_inv_cos2_dip;
+        let heading = self.heading.angle
+            + self.heading.measured
+            + s * s * self.turned_heading.norm_squared()
+            + disturbance;
+        Vector3::new(
+            (self.inclination_variance(0) + lag.x * lag.x).sqrt(),
+            (self.inclination_variance(1) + lag.y * lag.y).sqrt(),
+            (heading + lag.z * lag.z).sqrt(),
+        )
+    }
+}

@@ -1,0 +1,461 @@
+//! Dead reckoning between measurements: the gyro's and the wheels' readings moving the
+//! heading and the track, each at its own time, the error couplings and process noise
+//! they add, the gaps they cannot bridge, and the measurement epochs.
+
+use truenorth_core::{STANDARD_GRAVITY_MPS2, WheelReading, wrap_pi};
+
+use super::estimator::VehicleEstimator;
+use super::nav_filter::{
+    BIAS, COMPASS_BIAS, DIM, EAST, GAIN_NEG, GAIN_POS, NORTH, PSI, PSI_ODO, SPEED_COEFF,
+    TRACK_SCALE, WHEEL_DIFF,
+};
+use super::step_batch::Step;
+use super::wheel_odometry::{WheelCalibration, WheelStep};
+
+#[allow(unused_imports)]
+use truenorth_core::Float as _;
+
+/// Seconds of motion between two comparisons of the wheels' heading with the gyro's.
+const WHEEL_CHECK_S: f64 = 1.0;
+
+/// Seconds of rest averaged into one bias measurement.
+const REST_AVERAGE_S: f64 = 1.0;
+
+/// Weight of one interval in the gyro's running interval.
+const INTERVAL_WEIGHT: f64 = 0.1;
+
+/// Shortest silence of the gyro bridged by the wheels, s.
+const MIN_BRIDGE_S: f64 = 0.05;
+
+/// Slack on the freshness of the wheels' word that the vehicle stands still, s.
+const REST_FRESH_S: f64 = 0.05;
+
+/// Smallest bias-measurement noise at rest, rad/s (vibration of an idling engine).
+const REST_NOISE_FLOOR_RPS: f64 = 2e-5;
+
+/// Time constant of the low-passed turn rate that says which way the vehicle turns, s.
+const TURN_SMOOTHING_S: f64 = 0.3;
+
+/// Turn rate, above three standard deviations of the bias, from which a gyro reading is
+/// counted against the gain of its turning direction, rad/s (1°/s). Below it the
+/// direction is the sign of noise and vibration, which a per-direction gain would
+/// rectify into a drift the gyro does not have; the gains' uncertainty there is heading
+/// noise.
+const GAIN_COUPLING_MIN_RATE_RPS: f64 = 1.0 * core::f64::consts::PI / 180.0;
+
+/// Turn rate, above three standard deviations of the bias, from which a turn teaches the
+/// gain (2°/s): below it a gain error cannot be told from the bias (on the straight real
+/// drive of `truenorth-cli/tests/comma2k19.rs` vibration and an unlearned bias moved the
+/// gains by 13 %).
+const GAIN_LEARNING_MIN_RATE_RPS: f64 = 2.0 * core::f64::consts::PI / 180.0;
+
+/// Gyro gain error not captured by the two gains (non-linearity), per radian turned.
+const GYRO_GAIN_NOISE: f64 = 1e-3;
+
+/// Correlation time of the wheels' slip, s: its variance enters as white noise of density
+/// `2σ²τ` per unit of squared turn rate, which is the exact variance for turns longer than
+/// τ and more than it for shorter ones.
+const SLIP_TAU_S: f64 = 3.0;
+
+/// Random walk of the calibration states, per √s: they may drift a little (tyre pressure,
+/// temperature), so the filter never stops listening.
+const GAIN_WALK: f64 = 1e-5;
+const DIFF_WALK: f64 = 2e-7;
+const SPEED_COEFF_WALK: f64 = 1e-8;
+
+/// Position noise per metre travelled, m²/m (lateral creep, bumps).
+const POSITION_NOISE_M2_PER_M: f64 = 1e-6;
+
+/// Share of the turn made in a gap that the path through it leaves unknown: the chord's
+/// direction (for the track) and, for steered wheels, the effective track along it.
+const GAP_TURN_SHARE: f64 = 0.3;
+
+/// Share of a steered axle's turn across a gap that the unknown path leaves unknown: the
+/// effective track changes along the path by up to a tenth between straight and full lock
+/// (`truenorth-odometer`'s table of the exact track).
+const GAP_STEERED_SHARE: f64 = 0.05;
+
+impl VehicleEstimator {
+    /// Takes a gyro reading at `t_s`.
+    pub(super) fn gyro_reading(&mut self, t_s: f64, raw: f64) {
+        let Some((t0, raw0)) = self.gyro.last else {
+            self.start_gyro(t_s, raw);
+            return;
+        };
+        self.gyro.last = Some((t_s, raw));
+        let dt = t_s - t0;
+        let gap = dt > self.config.max_gap_s;
+        let at_rest = self.resting_at(t_s, raw, dt);
+        if !at_rest {
+            self.gates.count_step(gap);
+        }
+        if self.gyro.interval_s == 0.0 {
+            self.gyro.interval_s = dt.min(self.config.max_gap_s);
+        } else if dt <= 1.5 * self.gyro.interval_s {
+            self.gyro.interval_s += INTERVAL_WEIGHT * (dt - self.gyro.interval_s);
+        }
+        if gap || (self.wheels_fresh(t_s) && dt > self.gyro_bridge_s()) {
+            self.bridge_gyro_gap(gap);
+            return;
+        }
+        if at_rest {
+            self.rest.sum_raw += raw;
+            self.rest.n += 1;
+            self.rest.span_s += dt;
+            self.gyro.smoothed_rps = 0.0;
+            self.gyro.rate_rps = 0.0;
+            self.gyro.odo_at_last_rad = self.filter.x[PSI_ODO];
+            return;
+        }
+        self.rest = super::estimator::Rest::default();
+        let x = &self.filter.x;
+        let increment = 0.5 * (raw0 + raw) * dt - x[BIAS] * dt;
+        let alpha = dt / (dt + TURN_SMOOTHING_S);
+        self.gyro.smoothed_rps += alpha * (increment / dt - self.gyro.smoothed_rps);
+        let turning = if self.gyro.smoothed_rps != 0.0 {
+            self.gyro.smoothed_rps
+        } else {
+            increment
+        };
+        let gain_state = if turning >= 0.0 { GAIN_POS } else { GAIN_NEG };
+        let gain = 1.0 + x[gain_state];
+        let dpsi = increment / gain;
+        self.gyro.rate_rps = dpsi / dt;
+        let bias_sigma3 = 3.0 * self.filter.sigma(BIAS);
+        let rate = self.gyro.smoothed_rps.abs();
+        let mut step = Step::default();
+        step.psi_from[0] = (BIAS, -dt / gain);
+        // The trapezoid is exact for a rate that changes linearly between readings; a
+        // rate that changes faster (a robot starting to pivot) can change anywhere in the
+        // interval, leaving an error uniform within ±|Δω|·dt/2: variance (Δω·dt)²/12.
+        let integration = ((raw - raw0) * dt).powi(2) / 12.0;
+        step.q[PSI] =
+            self.coeffs.gyro_noise_rad2_per_s * dt + (GYRO_GAIN_NOISE * dpsi).powi(2) + integration;
+        if rate > GAIN_COUPLING_MIN_RATE_RPS + bias_sigma3 {
+            step.psi_from[1] = (gain_state, -dpsi / gain);
+        } else {
+            step.q[PSI] += (self.filter.sigma(gain_state) * dpsi).powi(2);
+        }
+        self.gates
+            .gyro_step(dpsi, rate > GAIN_LEARNING_MIN_RATE_RPS + bias_sigma3);
+        self.turn_heading(dpsi, &mut step);
+        self.batch.add(&step);
+        self.gyro.odo_at_last_rad = self.filter.x[PSI_ODO];
+    }
+
+    /// Whether the vehicle stands still at `t_s`, as far as a gyro reading `raw` taken
+    /// `dt` after the last can be held to it: the wheels said so at their last reading,
+    /// that reading is fresh (within two of their intervals), and the gyro does not
+    /// contradict it (a rate beyond five standard deviations of the bias and the reading's
+    /// noise is a turn the wheels missed: a skid-steer pivoting while its wheel readings
+    /// drop out).
+    fn resting_at(&self, t_s: f64, raw: f64, dt: f64) -> bool {
+        if !self.motion.at_rest {
+            return false;
+        }
+        let fresh = self
+            .wheels
+            .last_s()
+            .is_some_and(|t0| t_s - t0 <= 2.0 * self.motion.wheel_interval_s + REST_FRESH_S);
+        let spread = (self.filter.p[BIAS][BIAS] + self.coeffs.gyro_noise_rad2_per_s / dt)
+            .sqrt()
+            .max(REST_NOISE_FLOOR_RPS);
+        fresh && (raw - self.filter.x[BIAS]).abs() <= 5.0 * spread
+    }
+
+    /// Switches the heading to the gyro at its first reading: the wheels' heading starts
+    /// equal to it, fully correlated.
+    fn start_gyro(&mut self, t_s: f64, raw: f64) {
+        self.gyro.active = true;
+        self.gyro.last = Some((t_s, raw));
+        if !self.gyro.restored {
+            let s = &self.coeffs.prior_sigma;
+            self.filter.reset_state(BIAS, s[BIAS]);
+            self.filter.reset_state(GAIN_POS, s[GAIN_POS]);
+            self.filter.reset_state(GAIN_NEG, s[GAIN_NEG]);
+        }
+        self.restart_wheel_heading();
+    }
+
+    /// Starts the wheels' heading again from the gyro's: equal to it, fully correlated.
+    fn restart_wheel_heading(&mut self) {
+        self.flush();
+        let f = &mut self.filter;
+        f.x[PSI_ODO] = f.x[PSI];
+        for k in 0..DIM {
+            f.p[PSI_ODO][k] = f.p[PSI][k];
+            f.p[k][PSI_ODO] = f.p[k][PSI];
+        }
+        f.p[PSI_ODO][PSI_ODO] = f.p[PSI][PSI];
+        self.gyro.odo_at_last_rad = f.x[PSI_ODO];
+    }
+
+    /// Longest silence of the gyro its readings are integrated across while the wheels can
+    /// bridge it instead, s: three of its intervals (the trapezoid rule over a longer silence
+    /// misses a turn made inside it — a robot pivots through 90° in a second), within
+    /// [`super::VehicleConfig::max_gap_s`].
+    pub(super) fn gyro_bridge_s(&self) -> f64 {
+        (3.0 * self.gyro.interval_s).clamp(MIN_BRIDGE_S, self.config.max_gap_s)
+    }
+
+    /// Whether the wheels read recently enough to carry the heading at `t_s`.
+    fn wheels_fresh(&self, t_s: f64) -> bool {
+        self.est.status.position_known
+            && self
+                .wheels
+                .last_s()
+                .is_some_and(|t0| t_s - t0 <= 2.0 * self.motion.wheel_interval_s + REST_FRESH_S)
+    }
+
+    /// The gyro was silent for longer than it can be integrated across (`gap`: longer than
+    /// the estimator follows at all). The wheels, if any, carried the heading through most
+    /// of the silence; what they turned since the last gyro reading that nothing has yet
+    /// counted is added with a share of it as noise. Without wheels the heading is lost
+    /// until the compass refers it to north again.
+    fn bridge_gyro_gap(&mut self, gap: bool) {
+        self.est.status.gap |= gap;
+        self.gyro.smoothed_rps = 0.0;
+        self.gyro.rate_rps = 0.0;
+        if self.est.status.position_known {
+            let turned = wrap_pi(self.filter.x[PSI_ODO] - self.gyro.odo_at_last_rad);
+            let mut step = Step::default();
+            step.q[PSI] = (GAP_TURN_SHARE * turned).powi(2);
+            self.turn_heading(turned, &mut step);
+            self.batch.add(&step);
+            self.gyro.odo_at_last_rad = self.filter.x[PSI_ODO];
+        } else {
+            self.flush();
+            self.filter
+                .reset_state(PSI, super::estimator::UNKNOWN_HEADING_SIGMA_RAD);
+            self.alignment = super::estimator::Alignment::default();
+            self.window = super::estimator::CompassWindow::default();
+            self.restart_wheel_heading();
+        }
+    }
+
+    /// Moves the heading by `dpsi` in `step` (which carries its couplings), with the
+    /// compass error's growth as the heading turns, keeping it in (−π, π].
+    fn turn_heading(&mut self, dpsi: f64, step: &mut Step) {
+        // The compass error is a function of the heading: turning decorrelates it.
+        let decay = (-dpsi.abs() / self.config.compass.systematic_turn_rad).exp();
+        step.compass_decay *= decay;
+        step.q[COMPASS_BIAS] += self.compass_bias_var() * (1.0 - decay * decay);
+        let x = &mut self.filter.x;
+        x[COMPASS_BIAS] *= decay;
+        // Heading kept in (−π, π]: differences of headings stay in range, and the wheels'
+        // heading and the heading at the last wheel reading are wrapped with it so that
+        // their differences keep their meaning.
+        let wrapped = wrap_pi(x[PSI] + dpsi);
+        let shift = wrapped - (x[PSI] + dpsi);
+        x[PSI_ODO] += shift;
+        self.motion.psi_at_wheels_rad += shift;
+        self.gyro.odo_at_last_rad += shift;
+        x[PSI] = wrapped;
+    }
+
+    /// Takes a wheel reading at `t_s`.
+    pub(super) fn wheel_reading(&mut self, t_s: f64, reading: WheelReading) {
+        let x = self.filter.x;
+        let cal = WheelCalibration {
+            diff: x[WHEEL_DIFF],
+            speed_coeff: x[SPEED_COEFF],
+            track_scale: x[TRACK_SCALE],
+        };
+        let Some(wheel) = self.wheels.step(t_s, reading, &cal) else {
+            self.est.status.position_known = true;
+            self.motion.psi_at_wheels_rad = self.heading_at(t_s);
+            return;
+        };
+        let dt = wheel.dt_s;
+        let gap = dt > self.config.max_gap_s;
+        self.motion.still_s = if wheel.moved {
+            0.0
+        } else {
+            self.motion.still_s + dt
+        };
+        self.motion.at_rest =
+            self.motion.still_s >= self.config.standstill_s && self.motion.still_s > 0.0;
+        self.motion.wheel_interval_s = dt;
+        if wheel.moved {
+            self.gates.count_step(gap);
+            self.est.status.gap |= gap;
+        }
+        let wheel_q = self.wheel_noise(&wheel, gap);
+        let wheel_from = [
+            (WHEEL_DIFF, wheel.d_heading_d_diff),
+            (SPEED_COEFF, wheel.d_heading_d_speed_coeff),
+            (TRACK_SCALE, wheel.d_heading_d_track_scale),
+        ];
+        let turned = wheel.heading_change_rad;
+        let mut step = Step::default();
+        let gyro_silent = self
+            .gyro
+            .last
+            .is_some_and(|(t0, _)| t_s - t0 > self.gyro_bridge_s());
+        if self.gyro.active {
+            step.odo_from = wheel_from;
+            step.q[PSI_ODO] = wheel_q;
+            self.filter.x[PSI_ODO] += turned;
+            if gyro_silent {
+                // The gyro is in a gap: the wheels carry the heading across it.
+                step.psi_from = wheel_from;
+                step.q[PSI] = wheel_q;
+                self.turn_heading(turned, &mut step);
+                self.gyro.odo_at_last_rad = self.filter.x[PSI_ODO];
+            } else if !self.motion.at_rest && wheel.moved {
+                self.wheel_check_s += dt;
+            }
+        } else {
+            step.psi_from = wheel_from;
+            step.q[PSI] = wheel_q;
+            self.turn_heading(turned, &mut step);
+        }
+        if wheel.moved {
+            let compared = self.gyro.active && !gyro_silent;
+            self.gates.wheel_step(turned, wheel.speed_mps, compared);
+        }
+        self.advance_track(t_s, &wheel, gap, &mut step);
+        self.batch.add(&step);
+        self.est.speed_mps = wheel.speed_mps;
+        self.est.distance_m += wheel.ds_m.abs();
+        self.est.status.at_rest = self.motion.at_rest;
+    }
+
+    /// Variance of the wheels' heading change over `wheel`: bumps and pulses per metre,
+    /// and slip, which grows with lateral acceleration, with the turn ratio of steered
+    /// wheels, and with the wheels' observed disagreement.
+    fn wheel_noise(&self, wheel: &WheelStep, gap: bool) -> f64 {
+        let p = &self.coeffs.priors;
+        let turned = wheel.heading_change_rad;
+        let rate = turned / wheel.dt_s;
+        let lateral_g = (wheel.speed_mps * rate).abs() / STANDARD_GRAVITY_MPS2;
+        let slip = self.gates.slip_scale2.sqrt()
+            * (p.wheel_slip
+                + p.wheel_slip_per_g * lateral_g
+                + p.wheel_slip_per_c2 * wheel.ratio * wheel.ratio);
+        let mut q = self.coeffs.wheel_noise_rad2_per_m * wheel.ds_m.abs()
+            + 2.0 * slip * slip * SLIP_TAU_S * rate * turned;
+        if gap && p.wheel_slip_per_c2 > 0.0 {
+            q += (GAP_STEERED_SHARE * turned).powi(2);
+        }
+        q
+    }
+
+    /// Draws the track along the heading half-way between this wheel reading and the last.
+    fn advance_track(&mut self, t_s: f64, wheel: &WheelStep, gap: bool, step: &mut Step) {
+        let psi = self.heading_at(t_s);
+        let change = wrap_pi(psi - self.motion.psi_at_wheels_rad);
+        let (s, c) = self.trig.at(self.motion.psi_at_wheels_rad + 0.5 * change);
+        self.motion.psi_at_wheels_rad = psi;
+        let ds = wheel.ds_m;
+        step.north_from_psi = -ds * s;
+        step.east_from_psi = ds * c;
+        let mut q = POSITION_NOISE_M2_PER_M * ds.abs();
+        if gap {
+            // The path through a gap is unknown: the chord may lie anywhere between the
+            // turn made first and made last.
+            q += (GAP_TURN_SHARE * ds * change).powi(2);
+        }
+        step.q[NORTH] += q;
+        step.q[EAST] += q;
+        self.filter.x[NORTH] += ds * c;
+        self.filter.x[EAST] += ds * s;
+    }
+
+    /// The passage of the time since the last epoch: the compass error's decay and the
+    /// calibration states' random walk, composed into the batch as one step (they couple
+    /// to nothing within it).
+    fn time_passes(&mut self) {
+        let dt = core::mem::take(&mut self.pending_time_s);
+        if dt <= 0.0 {
+            return;
+        }
+        let decay = (-dt / self.config.compass.systematic_tau_s).exp();
+        let mut step = Step {
+            compass_decay: decay,
+            ..Step::default()
+        };
+        let q = &mut step.q;
+        q[COMPASS_BIAS] = self.compass_bias_var() * (1.0 - decay * decay);
+        if self.gyro.active {
+            q[BIAS] = self.coeffs.bias_walk_rad2_per_s3 * dt;
+            q[GAIN_POS] = GAIN_WALK * GAIN_WALK * dt;
+            q[GAIN_NEG] = q[GAIN_POS];
+        }
+        q[WHEEL_DIFF] = DIFF_WALK * DIFF_WALK * dt;
+        if self.coeffs.prior_sigma[SPEED_COEFF] > 0.0 {
+            q[SPEED_COEFF] = SPEED_COEFF_WALK * SPEED_COEFF_WALK * dt;
+        }
+        q[TRACK_SCALE] = GAIN_WALK * GAIN_WALK * dt;
+        self.filter.x[COMPASS_BIAS] *= decay;
+        self.batch.add(&step);
+    }
+
+    /// Carries the covariance forward through the steps composed so far: before any
+    /// measurement or change of the covariance.
+    pub(super) fn flush(&mut self) {
+        self.time_passes();
+        // The window's readings are tied to the heading through the couplings accumulated
+        // since the batch began; the next batch begins now, so refer them to now:
+        // A_k − A_now for each reading.
+        let n = f64::from(self.window.n);
+        let w = &mut self.window;
+        for (s, a) in w.sum_psi_from.iter_mut().zip(self.batch.psi_from()) {
+            *s -= n * a;
+        }
+        w.noise_after += n * self.batch.psi_noise() - w.sum_noise_at;
+        w.sum_noise_at = 0.0;
+        self.batch.apply(&mut self.filter);
+    }
+
+    /// A measurement epoch: the covariance is carried forward once, then every measurement
+    /// that is due corrects the state — the compass's averaged readings, the wheels'
+    /// heading against the gyro's once a second of driving, the bias once a second of rest.
+    pub(super) fn epoch(&mut self) {
+        self.rows_since_epoch = 0;
+        self.flush();
+        if self.rest.span_s >= REST_AVERAGE_S {
+            let mean = self.rest.sum_raw / f64::from(self.rest.n);
+            let r = self.coeffs.gyro_noise_rad2_per_s / self.rest.span_s
+                + REST_NOISE_FLOOR_RPS * REST_NOISE_FLOOR_RPS;
+            self.filter
+                .update(&[(BIAS, 1.0)], mean - self.filter.x[BIAS], r);
+            self.rest = super::estimator::Rest::default();
+        }
+        if self.wheel_check_s >= WHEEL_CHECK_S {
+            self.wheel_check_s = 0.0;
+            self.wheels_against_gyro();
+        }
+        if self.window.n >= self.config.compass.readings_per_update {
+            self.correct_with_compass();
+        }
+        // A wheel pair's difference only grows with speed: `a` is never negative.
+        self.filter.project_at_least(SPEED_COEFF, 0.0);
+    }
+
+    /// The wheels' heading minus the gyro's, measured against zero. A comparison far
+    /// outside what the model allows (a wheel that spun or slid) corrects nothing: the
+    /// wheels' heading starts again from the gyro's, and the disagreement lowers the
+    /// wheels' trust.
+    fn wheels_against_gyro(&mut self) {
+        self.gates.time_base_window();
+        let t_wheels = self.wheels.last_s().unwrap_or(f64::NAN);
+        let ahead = self.heading_at(t_wheels) - self.filter.x[PSI];
+        let nu = wrap_pi(self.filter.x[PSI_ODO] - self.filter.x[PSI] - ahead);
+        let h = [(PSI, 1.0), (PSI_ODO, -1.0)];
+        let r = self.coeffs.wheel_quantisation_rad2;
+        let f = &self.filter;
+        let s = f.p[PSI][PSI] - 2.0 * f.p[PSI][PSI_ODO] + f.p[PSI_ODO][PSI_ODO] + r;
+        let nis = nu * nu / s;
+        let learn = self.gates.wheel_check_learnable();
+        self.gates.wheel_check_done(nis);
+        if nis > OUTLIER_NIS || !nis.is_finite() {
+            self.restart_wheel_heading();
+            return;
+        }
+        self.filter.update_some(&h, nu, r, learn);
+    }
+}
+
+/// A comparison whose normalised innovation squared exceeds this (5σ) is an outlier.
+const OUTLIER_NIS: f64 = 25.0;
