@@ -11,9 +11,7 @@ use alloc::vec::Vec;
 use nalgebra::Vector2;
 use serde::{Deserialize, Serialize};
 use truenorth_compass::{CompassCalibration2d, EllipsePhasors};
-use truenorth_core::{
-    Error, Persistent, Result, Snapshot, Solution, Validate, check_snapshot_version,
-};
+use truenorth_core::{Error, Persistent, Result, Solution, Validate};
 
 use crate::binned_ellipse::{BinnedEllipseCalibrator, BinnedEllipseConfig, MAX_INIT_SAMPLES};
 use crate::binned_refresh::{Bin, BinState, Bins, EMPTY, MAX_BINS, RefreshJob};
@@ -91,40 +89,36 @@ impl Persistent for BinnedEllipseCalibrator {
     type State = BinnedEllipseSaved;
     const SNAPSHOT_VERSION: u32 = 3;
 
-    fn snapshot(&self) -> Snapshot<BinnedEllipseSaved> {
+    fn state(&self) -> BinnedEllipseSaved {
         let n = self.config.bins;
-        Snapshot {
-            version: Self::SNAPSHOT_VERSION,
-            state: BinnedEllipseSaved {
-                config: self.config,
-                bins: self.bins[..n].to_vec(),
-                origin: self.origin,
-                init: self.init[..self.init_count].to_vec(),
-                samples: self.samples,
-                since_update: self.since_update,
-                reference: self.reference[..n].to_vec(),
-                phasors: self.phasors,
-                restored: self.restored,
-                restarts: self.restarts,
-                estimate: self.estimate,
-                update: self.update.as_ref().map(|u| BinnedUpdateSaved {
-                    start_bins: u.start_bins[..n].to_vec(),
-                    start_origin: u.start_origin,
-                    budget: u.budget,
-                    stride: u.stride,
-                    advanced: u.advanced,
-                    phase: u.phase,
-                    assess_steps: u.assess_steps,
-                    pending: u.pending[..u.pending_len].to_vec(),
-                }),
-                backlog: self.backlog[..self.backlog_len].to_vec(),
-            },
+        BinnedEllipseSaved {
+            config: self.config,
+            bins: self.bins[..n].to_vec(),
+            origin: self.origin,
+            init: self.init[..self.init_count].to_vec(),
+            samples: self.samples,
+            since_update: self.since_update,
+            reference: self.reference[..n].to_vec(),
+            phasors: self.phasors,
+            restored: self.restored,
+            restarts: self.restarts,
+            estimate: self.estimate,
+            update: self.update.as_ref().map(|u| BinnedUpdateSaved {
+                start_bins: u.start_bins[..n].to_vec(),
+                start_origin: u.start_origin,
+                budget: u.budget,
+                stride: u.stride,
+                advanced: u.advanced,
+                phase: u.phase,
+                assess_steps: u.assess_steps,
+                pending: u.pending[..u.pending_len].to_vec(),
+            }),
+            backlog: self.backlog[..self.backlog_len].to_vec(),
         }
     }
 
-    fn restore(snapshot: Snapshot<BinnedEllipseSaved>) -> Result<Self> {
-        check_snapshot_version(snapshot.version, Self::SNAPSHOT_VERSION)?;
-        let s = snapshot.state;
+    fn from_state(state: BinnedEllipseSaved) -> Result<Self> {
+        let s = state;
         s.config.validate()?;
         let invalid = |reason| Err(Error::InvalidSnapshot { reason });
         let n = s.config.bins;

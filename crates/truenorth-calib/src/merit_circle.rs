@@ -61,8 +61,7 @@ use serde::{Deserialize, Serialize};
 use truenorth_compass::CompassCalibration2d;
 use truenorth_core::{
     Calibrator, CompassQuality, Error, Mag2Sample, OnlineCalibrator, Persistent, Progress, Pushed,
-    Result, Snapshot, Solution, Validate, angle_diff, check_finite, check_finite2, check_range,
-    check_snapshot_version,
+    Result, Solution, Validate, angle_diff, check_finite, check_finite2, check_range,
 };
 
 use crate::circumcentre::{BEST_AMPLIFICATION_SQ, Circumcircle, circumcircle};
@@ -582,37 +581,33 @@ impl Persistent for MeritCircleCalibrator {
     type State = MeritCircleSaved;
     const SNAPSHOT_VERSION: u32 = 2;
 
-    fn snapshot(&self) -> Snapshot<MeritCircleSaved> {
-        Snapshot {
-            version: Self::SNAPSHOT_VERSION,
-            state: MeritCircleSaved {
-                config: self.config,
-                samples: self.samples,
-                prev: self.prev,
-                step_sum: self.step_sum,
-                range: (self.samples > 0).then_some((self.lo, self.hi)),
-                ring: self.ring[..self.ring_len].to_vec(),
-                ring_next: self.ring_next,
-                last_point: self.last_point,
-                stats: self.state,
-                centre_m2: self.centre_m2,
-                slots: self.slots.to_vec(),
-                estimate: self.estimate,
-                refresh_due: self.refresh_due,
-                refresh: self.seed.as_ref().map(|j| MeritRefreshSaved {
-                    points: j.points().to_vec(),
-                    calibration: *j.calibration(),
-                    field: j.field(),
-                    samples_used: j.samples_used(),
-                    steps: j.steps(),
-                }),
-            },
+    fn state(&self) -> MeritCircleSaved {
+        MeritCircleSaved {
+            config: self.config,
+            samples: self.samples,
+            prev: self.prev,
+            step_sum: self.step_sum,
+            range: (self.samples > 0).then_some((self.lo, self.hi)),
+            ring: self.ring[..self.ring_len].to_vec(),
+            ring_next: self.ring_next,
+            last_point: self.last_point,
+            stats: self.state,
+            centre_m2: self.centre_m2,
+            slots: self.slots.to_vec(),
+            estimate: self.estimate,
+            refresh_due: self.refresh_due,
+            refresh: self.seed.as_ref().map(|j| MeritRefreshSaved {
+                points: j.points().to_vec(),
+                calibration: *j.calibration(),
+                field: j.field(),
+                samples_used: j.samples_used(),
+                steps: j.steps(),
+            }),
         }
     }
 
-    fn restore(snapshot: Snapshot<MeritCircleSaved>) -> Result<Self> {
-        check_snapshot_version(snapshot.version, Self::SNAPSHOT_VERSION)?;
-        let s = snapshot.state;
+    fn from_state(state: MeritCircleSaved) -> Result<Self> {
+        let s = state;
         s.config.validate()?;
         let invalid = |reason| Err(Error::InvalidSnapshot { reason });
         let st = &s.stats;

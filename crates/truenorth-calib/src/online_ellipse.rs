@@ -32,7 +32,7 @@
 use truenorth_compass::CompassCalibration2d;
 use truenorth_core::{
     Calibrator, CompassQuality, Mag2Sample, OnlineCalibrator, Persistent, Progress, Pushed, Result,
-    Snapshot, Solution, check_snapshot_version,
+    Solution,
 };
 
 use crate::conic_sums::MONOMIALS_2D;
@@ -138,16 +138,12 @@ impl Persistent for OnlineEllipseCalibrator {
     type State = OnlineEllipseState;
     const SNAPSHOT_VERSION: u32 = 1;
 
-    fn snapshot(&self) -> Snapshot<OnlineEllipseState> {
-        Snapshot {
-            version: Self::SNAPSHOT_VERSION,
-            state: self.core.state(),
-        }
+    fn state(&self) -> OnlineEllipseState {
+        self.core.state()
     }
 
-    fn restore(snapshot: Snapshot<OnlineEllipseState>) -> Result<Self> {
-        check_snapshot_version(snapshot.version, Self::SNAPSHOT_VERSION)?;
-        OnlineCore::restore(snapshot.state).map(|core| Self { core })
+    fn from_state(state: OnlineEllipseState) -> Result<Self> {
+        OnlineCore::restore(state).map(|core| Self { core })
     }
 }
 

@@ -13,7 +13,7 @@
 use truenorth_compass::CompassCalibration3d;
 use truenorth_core::{
     Calibrator, CompassQuality, Mag3Sample, OnlineCalibrator, Persistent, Progress, Pushed, Result,
-    Snapshot, Solution, check_snapshot_version,
+    Solution,
 };
 
 use crate::conic_sums::MONOMIALS_3D;
@@ -110,15 +110,11 @@ impl Persistent for OnlineEllipsoidCalibrator {
     type State = OnlineEllipsoidState;
     const SNAPSHOT_VERSION: u32 = 1;
 
-    fn snapshot(&self) -> Snapshot<OnlineEllipsoidState> {
-        Snapshot {
-            version: Self::SNAPSHOT_VERSION,
-            state: self.core.state(),
-        }
+    fn state(&self) -> OnlineEllipsoidState {
+        self.core.state()
     }
 
-    fn restore(snapshot: Snapshot<OnlineEllipsoidState>) -> Result<Self> {
-        check_snapshot_version(snapshot.version, Self::SNAPSHOT_VERSION)?;
-        OnlineCore::restore(snapshot.state).map(|core| Self { core })
+    fn from_state(state: OnlineEllipsoidState) -> Result<Self> {
+        OnlineCore::restore(state).map(|core| Self { core })
     }
 }

@@ -34,9 +34,8 @@ use nalgebra::{Matrix2, Vector2};
 use serde::{Deserialize, Serialize};
 use truenorth_compass::CompassCalibration2d;
 use truenorth_core::{
-    Calibrator, CompassQuality, Error, Mag2Sample, Persistent, Progress, Pushed, Result, Snapshot,
-    Solution, TimeStep, Validate, angle_diff, check_finite, check_finite2, check_positive,
-    check_range, check_snapshot_version,
+    Calibrator, CompassQuality, Error, Mag2Sample, Persistent, Progress, Pushed, Result, Solution,
+    TimeStep, Validate, angle_diff, check_finite, check_finite2, check_positive, check_range,
 };
 
 use crate::direction_slots::{DirectionSlots, SLOTS};
@@ -581,21 +580,17 @@ impl Persistent for TurnCompassCalibrator {
     type State = TurnSaved;
     const SNAPSHOT_VERSION: u32 = 1;
 
-    fn snapshot(&self) -> Snapshot<TurnSaved> {
-        Snapshot {
-            version: Self::SNAPSHOT_VERSION,
-            state: TurnSaved {
-                config: self.config,
-                extrema: self.extrema.saved(),
-                slots: self.slots.to_vec(),
-                last_t_s: self.clock.last_s(),
-            },
+    fn state(&self) -> TurnSaved {
+        TurnSaved {
+            config: self.config,
+            extrema: self.extrema.saved(),
+            slots: self.slots.to_vec(),
+            last_t_s: self.clock.last_s(),
         }
     }
 
-    fn restore(snapshot: Snapshot<TurnSaved>) -> Result<Self> {
-        check_snapshot_version(snapshot.version, Self::SNAPSHOT_VERSION)?;
-        let s = snapshot.state;
+    fn from_state(state: TurnSaved) -> Result<Self> {
+        let s = state;
         s.config.validate()?;
         let extrema = TurnExtrema::from_saved(s.extrema)?;
         if extrema.x.config() != &s.config.extrema || extrema.y.config() != &s.config.extrema {

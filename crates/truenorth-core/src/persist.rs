@@ -14,10 +14,11 @@ pub struct Snapshot<S> {
     pub state: S,
 }
 
-/// Saving and restoring a calibrator or estimator.
+/// Saving and restoring a calibrator or estimator: its state as plain data (as VQF's
+/// `getState` / `setState`), and a versioned snapshot of it built once, here.
 ///
-/// `restore(snapshot())` followed by the same pushes gives bit-identical results to never
-/// having stopped.
+/// `from_state(state())` (or `restore(snapshot())`) followed by the same pushes gives
+/// bit-identical results to never having stopped.
 pub trait Persistent: Sized {
     /// The serialisable state (configuration included).
     type State: Serialize + DeserializeOwned + Clone;
@@ -25,12 +26,26 @@ pub trait Persistent: Sized {
     /// Layout version written into every snapshot; bumped when `State` changes shape.
     const SNAPSHOT_VERSION: u32;
 
-    /// The current state.
-    fn snapshot(&self) -> Snapshot<Self::State>;
+    /// Everything needed to continue: configuration and learned state.
+    fn state(&self) -> Self::State;
 
-    /// Rebuilds from a snapshot, refusing one of another version or one whose contents are
-    /// invalid (it may have been edited or corrupted on disk).
-    fn restore(snapshot: Snapshot<Self::State>) -> Result<Self>;
+    /// Rebuilds from a state, refusing one whose contents are invalid (it may have been
+    /// edited or corrupted on disk).
+    fn from_state(state: Self::State) -> Result<Self>;
+
+    /// The current state, tagged with [`Self::SNAPSHOT_VERSION`].
+    fn snapshot(&self) -> Snapshot<Self::State> {
+        Snapshot {
+            version: Self::SNAPSHOT_VERSION,
+            state: self.state(),
+        }
+    }
+
+    /// Rebuilds from a snapshot, refusing one of another version or invalid contents.
+    fn restore(snapshot: Snapshot<Self::State>) -> Result<Self> {
+        check_snapshot_version(snapshot.version, Self::SNAPSHOT_VERSION)?;
+        Self::from_state(snapshot.state)
+    }
 }
 
 /// Checks a snapshot's version against the reader's.
