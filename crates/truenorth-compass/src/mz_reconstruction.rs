@@ -1,4 +1,4 @@
-//! Reconstructing the missing vertical magnetometer axis (METHODS.md §E.4, seed WO 00/36376).
+//! Reconstructing the missing vertical magnetometer axis (WO 00/36376).
 //!
 //! A body with only two magnetometers (body x and y) cannot be tilt-compensated directly: the
 //! body-z component is missing. The seed recovers it from the total field `Ht` measured at

@@ -1,4 +1,4 @@
-//! The binned-ellipse heading formulas (METHODS.md §D.5–6, seed EP 0634001 claims 7–11).
+//! The binned-ellipse heading formulas (EP 0634001, claims 7–11).
 //!
 //! About its origin, the sensed field of a compass with hard and soft iron traces an ellipse
 //! that the seed models as two counter-rotating phasors (claim 7):

@@ -4,8 +4,8 @@
 //! With `R = Rz(ψ) · Ry(θ) · Rx(φ)` (body → NED), the body reading is `m = Rᵀ f`, so
 //! `Ry(θ) · Rx(φ) · m = Rz(ψ)ᵀ f`: undoing pitch and roll leaves the field as a *level* body at
 //! the same heading would see it, `(H cos ψ, −H sin ψ, Z)`, and the heading follows as in 2-D.
-//! (METHODS.md §E.4 states it as `Hx = cos P·Mx + sin P·Mz`, with roll; the form here is that
-//! formula with both angles, derived from the rotation rather than read from the OCR'd text.)
+//! (WO 00/36376 writes it as `Hx = cos P·Mx + sin P·Mz`, with roll; the form here is that
+//! formula with both angles, derived from the rotation.)
 
 use nalgebra::Vector3;
 use truenorth_core::{Result, Tilt, check_finite, check_finite3};
