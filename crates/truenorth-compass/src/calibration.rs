@@ -9,7 +9,7 @@ use truenorth_core::{
 
 use crate::{level_field, tilt_compensated_heading};
 
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 
 /// Heading (radians, clockwise from magnetic north, (-π, π]) of a horizontal field vector in

@@ -6,7 +6,7 @@ use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 use truenorth_core::{Error, Result, check_finite, check_finite3};
 
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 
 /// Most disturbances one model holds (a fixed array keeps the model allocation-free): enough

@@ -8,7 +8,7 @@ use truenorth_core::{Error, NoiseSource, Result, SensorModel, check_finite, chec
 
 use crate::{CompassCalibration2d, Disturbance, Disturbances};
 
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 
 /// What a level compass should see: the vehicle's heading and the earth's horizontal field.

@@ -12,7 +12,7 @@ use crate::model2d::check_noise;
 use crate::{CompassCalibration3d, Disturbance, Disturbances};
 use truenorth_core::check_range;
 
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 
 /// The earth's field in the local-level frame of magnetic north (north, east, down) from its

@@ -29,7 +29,7 @@ use truenorth_core::{Error, Result, Tilt, check_finite, check_finite2, check_fin
 
 use crate::{level_field, tilt_compensated_heading};
 
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 
 /// Reconstructs `M_z` from two calibrated axes, the start-up field and the tilt.

@@ -30,7 +30,7 @@ use truenorth_core::{Error, Result, check_finite, check_finite2, wrap_pi};
 
 use crate::CompassCalibration2d;
 
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 
 /// Largest number of steps [`EllipsePhasors::earth_phase_iterative`] takes. The iteration is a

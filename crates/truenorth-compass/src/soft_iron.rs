@@ -7,7 +7,7 @@
 
 use nalgebra::Matrix2;
 
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 
 /// The axes of a symmetric 2×2 matrix: its eigenvalues and the direction of the larger one.

@@ -12,7 +12,7 @@ use truenorth_core::{Result, Tilt, check_finite, check_finite3};
 
 use crate::heading_from_horizontal;
 
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 
 /// The field as a level body at the same heading would see it: `Ry(pitch) · Rx(roll) · m`.

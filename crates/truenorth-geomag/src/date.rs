@@ -4,7 +4,7 @@
 use core::fmt;
 
 use serde::{Deserialize, Serialize};
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 use truenorth_core::{Error, Result, check_finite};
 

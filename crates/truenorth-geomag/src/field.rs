@@ -4,7 +4,7 @@
 
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 use truenorth_core::{Declination, rad_to_deg, wrap_pi};
 

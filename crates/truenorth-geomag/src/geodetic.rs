@@ -4,7 +4,7 @@
 
 use core::f64::consts::FRAC_PI_2;
 
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 use truenorth_core::{Error, Result, check_finite, deg_to_rad, wrap_pi};
 

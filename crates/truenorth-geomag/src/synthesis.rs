@@ -8,7 +8,7 @@
 //! many dates (or repeatedly, as a vehicle's position changes slowly) prepares the point
 //! once; each further evaluation is then only the weighted sums over 90 terms.
 
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 
 use crate::coefficients::{Coefficients, MAX_DEGREE, index};
