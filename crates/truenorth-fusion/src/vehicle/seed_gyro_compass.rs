@@ -11,6 +11,7 @@ use truenorth_core::{
     Calibrator, HeadingEstimator, MagneticHeading, NavEstimate, Result, TimeStep, Validate,
     VehicleSample,
 };
+use truenorth_gyro::YawIncrement;
 use truenorth_odometer::OdometerWheels;
 
 use super::seed_blend::{SeedBlend, SeedBlendConfig};
@@ -150,7 +151,7 @@ impl HeadingEstimator for SeedGyroCompass {
                 && !self.at_rest
             {
                 self.blend
-                    .turn((0.5 * (r + p) - zero) / gain * (sample.t_s - t0));
+                    .turn(YawIncrement::new(p, r, sample.t_s - t0).corrected_rad(zero, gain));
             }
             self.last_gyro = Some((sample.t_s, r));
             // The zero reading is taken again at every standstill (claims 8-9).
