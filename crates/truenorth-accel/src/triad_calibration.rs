@@ -1,6 +1,7 @@
 //! Accelerometer calibration with bias, per-axis scale and cross-axis sensitivity (the three
 //! axes not quite orthogonal, or coupled): `f = matrix · (raw − bias)`, raw reading in any
-//! unit, specific force in m/s².
+//! unit, specific force in m/s² — the [`InertialCalibration`] model with unit gains and the
+//! scale folded into the matrix, under the names the joint calibration files carry.
 //!
 //! A triad whose axes are not orthogonal reads `raw = K f + b` with `K` any invertible
 //! matrix; the calibration is its inverse. A tumble at rest determines `K⁻¹` only up to a
@@ -14,7 +15,7 @@
 
 use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
-use truenorth_core::{Calibration, Error, Result, Validate, check_finite3};
+use truenorth_core::{Calibration, Error, InertialCalibration, Result, Validate, check_finite3};
 
 #[allow(unused_imports)]
 use truenorth_core::Float as _;
@@ -56,7 +57,18 @@ impl AccelTriadCalibration {
     /// [`Calibration::apply`]).
     #[inline]
     pub fn correct(&self, raw: &Vector3<f64>) -> Vector3<f64> {
-        self.matrix * (raw - self.bias)
+        InertialCalibration::from(*self).correct(raw)
+    }
+}
+
+impl From<AccelTriadCalibration> for InertialCalibration {
+    /// Offset the bias, unit gains, the matrix as the misalignment.
+    fn from(c: AccelTriadCalibration) -> Self {
+        Self {
+            offset: c.bias,
+            gain: Vector3::repeat(1.0),
+            misalignment: Some(c.matrix),
+        }
     }
 }
 
