@@ -9,16 +9,9 @@
 //! the fits of this workspace take the symmetric matrix (the one closest to the sensor's
 //! own axes, by the polar decomposition) unless other information fixes the body axes.
 
-// `!(x > 0.0)` and `!(x <= limit)` are deliberate: they are true for NaN, so a NaN fails
-// every check instead of slipping through one.
-#![allow(clippy::neg_cmp_op_on_partial_ord)]
-
 use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 use truenorth_core::{Calibration, Error, InertialCalibration, Result, Validate, check_finite3};
-
-#[allow(unused_imports)]
-use truenorth_core::Float as _;
 
 /// The largest condition number (largest over smallest singular value) of an accepted
 /// matrix: 10, the largest axis ratio the ellipsoid fits accept. A real triad's scale
@@ -80,14 +73,16 @@ impl Validate for AccelTriadCalibration {
         for c in self.matrix.column_iter() {
             check_finite3("accelerometer matrix column", &c.into_owned())?;
         }
-        if !(self.matrix.determinant() > 0.0) {
+        // A NaN fails every check instead of slipping through one.
+        let determinant = self.matrix.determinant();
+        if determinant.is_nan() || determinant <= 0.0 {
             return Err(Error::Degenerate {
                 reason: "the accelerometer matrix is singular or mirrors the axes (determinant not positive); recalibrate",
             });
         }
         let sv = self.matrix.singular_values();
         let condition = sv.max() / sv.min();
-        if !(condition <= MAX_TRIAD_CONDITION) {
+        if condition.is_nan() || condition > MAX_TRIAD_CONDITION {
             return Err(Error::OutOfRange {
                 what: "condition number of the accelerometer matrix",
                 value: condition,

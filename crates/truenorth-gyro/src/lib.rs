@@ -4,7 +4,7 @@
 //! its calibration (zero and scale), and the integration of yaw rate into heading change.
 //!
 //! Conditioning of a gyro's output as the orientation detector of WO 00/36376 does it
-//! (METHODS §E.8–9): a [`HighPassFilter`] with a variable cutoff removes the offset, a
+//! (its high-pass filters, corrector and oscillation removers): a [`HighPassFilter`] with a variable cutoff removes the offset, a
 //! [`HighPassCorrection`] undoes the filter's distortion (with an offset-error compensator),
 //! an [`IirHighPass`] is the digital variant (buffer reset and input-offset correction), and
 //! an [`OscillationRemover`] zeroes hand tremor.

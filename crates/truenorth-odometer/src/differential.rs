@@ -1,4 +1,4 @@
-//! Heading change from the difference of two wheel distances (US 4,788,645; METHODS §B.1-2).
+//! Heading change from the difference of two wheel distances (US 4,788,645 eqs. 1/7 and 2/8).
 //!
 //! Sign: the left wheel rolling further means a right turn, i.e. a positive heading change
 //! (heading clockwise from north, body y to the right).

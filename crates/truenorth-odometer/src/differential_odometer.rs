@@ -1,6 +1,5 @@
 //! A differential odometer as a relative heading source: cumulative wheel distances in,
-//! heading change and distance per step out (US 4,788,645 eqs. 2/8 and 3/14; METHODS
-//! §B.1-5).
+//! heading change and distance per step out (US 4,788,645 eqs. 2/8 and 3/14).
 
 use serde::{Deserialize, Serialize};
 use truenorth_core::{
@@ -107,7 +106,7 @@ impl<T: EffectiveTrack> DifferentialOdometer<T> {
         &self.config.calibration
     }
 
-    /// Replaces the calibration (e.g. with a refined `a`, METHODS §B.3); from the next step.
+    /// Replaces the calibration (e.g. with a refined `a`, US 4,788,645 eq. 2/8); from the next step.
     /// An invalid calibration is refused and the old one kept.
     pub fn set_calibration(&mut self, calibration: OdometerCalibration) -> Result<()> {
         calibration.validate()?;

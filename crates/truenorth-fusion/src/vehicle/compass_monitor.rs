@@ -21,7 +21,7 @@ use truenorth_core::{CompassQuality, Solution};
 
 use super::config::CompassGates;
 
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 
 /// Smallest per-reading heading noise assumed, rad (0.1°): a calibration's own noise

@@ -13,7 +13,7 @@ use super::nav_filter::{
 use super::step_batch::Step;
 use super::wheel_odometry::{WheelCalibration, WheelStep};
 
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 
 /// Seconds of motion between two comparisons of the wheels' heading with the gyro's.

@@ -47,7 +47,7 @@ use super::observability::unobserved;
 use super::step_batch::StepBatch;
 use super::wheel_odometry::{TrackModel, WheelOdometry};
 
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 
 /// Most rows taken before the covariance is carried forward (it is carried forward at

@@ -1,4 +1,4 @@
-//! The configuration of EP 0640207 (METHODS.md §A): heading from the gyro, whose zero is
+//! The configuration of EP 0640207: heading from the gyro, whose zero is
 //! measured at rest and whose conversion constant comes from the compass extrema of the
 //! drive's first full turn ([`truenorth_calib::TurnCalibrator`]); the compass calibrated from
 //! the same extrema pulls the heading through a fixed-gain complementary filter
@@ -16,9 +16,6 @@ use truenorth_odometer::OdometerWheels;
 
 use super::seed_blend::{SeedBlend, SeedBlendConfig};
 use super::wheel_odometry::{TrackModel, WheelCalibration, WheelOdometry};
-
-#[allow(unused_imports)]
-use truenorth_core::Float as _;
 
 /// Samples between two checks of whether the turn calibration can be solved.
 const SOLVE_EVERY: u32 = 10;

@@ -21,7 +21,7 @@ use truenorth_core::{HeadingEstimator, MagneticHeading, NavEstimate, Result, Veh
 
 use super::estimator::VehicleEstimator;
 
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 
 /// When the head of the drive is run again.
