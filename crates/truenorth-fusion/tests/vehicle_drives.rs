@@ -43,7 +43,7 @@ fn run(drive: &SimulatedDrive, gyro: bool, method: Method) -> DriveScore {
     };
     let estimates: Vec<NavEstimate> = match method {
         Method::FusedTwoPass => {
-            let mut two = TwoPassStart::new(nav(), TwoPassConfig::default());
+            let mut two = TwoPassStart::new(nav(), TwoPassConfig::default()).unwrap();
             let mut out = Vec::new();
             for s in samples {
                 two.push(&s, |_, e, _| out.push(*e)).unwrap();

@@ -282,7 +282,7 @@ impl VehicleEstimator {
             initial: filter,
             filter,
             wheels: WheelOdometry::new(config.wheels, TrackModel::Exact)?,
-            compass: CompassMonitor::new(config.compass),
+            compass: CompassMonitor::new(config.compass)?,
             initial_fix: None,
             learner: CompassLearner::new(config.compass)?,
             clock: TimeStep::new(),
@@ -513,7 +513,7 @@ impl HeadingEstimator for VehicleEstimator {
     fn reset(&mut self) {
         self.filter = self.initial;
         self.wheels.reset();
-        self.compass = CompassMonitor::new(self.config.compass);
+        self.compass.reset();
         if let Some(fix) = self.initial_fix {
             self.compass.set_fix(fix);
         }
