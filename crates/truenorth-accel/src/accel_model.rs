@@ -8,7 +8,7 @@
 
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 use truenorth_core::{
     NoiseSource, Result, STANDARD_GRAVITY_MPS2, SensorModel, Validate, check_dt, check_finite3,

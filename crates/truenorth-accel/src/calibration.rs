@@ -1,8 +1,11 @@
-//! Accelerometer calibration: per-axis bias and gain, raw reading → specific force.
+//! Accelerometer calibration: per-axis bias and gain, raw reading → specific force: the
+//! [`InertialCalibration`] model without misalignment, under the accelerometer's names.
 
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
-use truenorth_core::{Calibration, Result, Validate, check_finite3, check_positive};
+use truenorth_core::{
+    Calibration, InertialCalibration, Result, Validate, check_finite3, check_positive,
+};
 
 /// `f = (raw − bias) ./ gain`, per axis.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -31,6 +34,17 @@ impl AccelCalibration {
     }
 }
 
+impl From<AccelCalibration> for InertialCalibration {
+    /// Offset the bias, the same gains, no misalignment.
+    fn from(c: AccelCalibration) -> Self {
+        Self {
+            offset: c.bias_mps2,
+            gain: c.gain,
+            misalignment: None,
+        }
+    }
+}
+
 impl Validate for AccelCalibration {
     /// The bias finite and every gain positive and finite. The fields are public (a
     /// calibration is loaded from disk), so [`Calibration::apply`] checks again.
@@ -52,7 +66,7 @@ impl Calibration for AccelCalibration {
     fn apply(&self, raw: &Vector3<f64>) -> Result<Vector3<f64>> {
         check_finite3("raw accelerometer reading", raw)?;
         self.validate()?;
-        let f = (raw - self.bias_mps2).component_div(&self.gain);
+        let f = InertialCalibration::from(*self).correct(raw);
         check_finite3("calibrated specific force (reading too large)", &f)?;
         Ok(f)
     }

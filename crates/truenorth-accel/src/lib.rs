@@ -4,7 +4,7 @@
 //! scale error and noise) for the simulator and round-trip tests, its calibration (per axis,
 //! or with cross-axis terms: [`AccelTriadCalibration`]), static
 //! tilt (pitch and roll from gravity) and the quasi-static test that says when static tilt
-//! can be trusted (the accelerometer parts of WO 00/36376, METHODS §E.3 and §E.5(7)).
+//! can be trusted (the accelerometer parts of WO 00/36376).
 //!
 //! Frames: body x forward, y right, z down; the truth's attitude rotates body → NED. The
 //! sensor reads specific force `f_b = Rᵀ(a_ned − g_ned)` with `g_ned = (0, 0, +g)`, so a level

@@ -1,5 +1,5 @@
 //! Quasi-static detection: is the accelerometer sensing gravity alone, so that its static tilt
-//! can be trusted? The seed's test with three accelerometers (WO 00/36376, METHODS §E.5(7)):
+//! can be trusted? The seed's test with three accelerometers (WO 00/36376):
 //! `| |a| − g |` below a threshold.
 //!
 //! The test is necessary, not sufficient: an acceleration that happens to keep |a − g| = g
@@ -8,8 +8,6 @@
 
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
-#[allow(unused_imports)]
-use truenorth_core::Float as _;
 use truenorth_core::{Result, STANDARD_GRAVITY_MPS2, Validate, check_finite3, check_positive};
 
 /// Settings of a [`QuasiStaticDetector`].

@@ -9,7 +9,7 @@
 //! Only ratios of the components enter, so the reading's unit and magnitude do not matter
 //! (g or m/s², a scale error common to all axes, or a |f| that is not quite g).
 //!
-//! # Against the seed (WO 00/36376, METHODS §E.3)
+//! # Against the seed (WO 00/36376)
 //!
 //! The seed takes readings in g of the gravity direction, `A = −f/g` (level: `A_z = +1`), and
 //! prints `P = asin(A_x)`, `R = asin(A_y / cos P)`, and with a third axis
@@ -25,7 +25,7 @@
 //! * With `A = −f/g` in these axes, `A_x = −sin θ`, so the seed's P is positive nose down;
 //!   here pitch is positive nose up, as in core's [`Tilt`].
 
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 use truenorth_core::{Error, Result, Tilt, check_finite, check_finite3, wrap_pi};
 
@@ -73,7 +73,7 @@ pub fn static_tilt(f_b: &Vector3<f64>) -> Result<Tilt> {
     })
 }
 
-/// Pitch from the forward axis alone (the seed's two-dimensional variant, METHODS §E.10):
+/// Pitch from the forward axis alone (the two-dimensional variant of WO 00/36376):
 /// `θ = asin(f_x / g)`. A typed error when `|f_x| > g` (the sensor is accelerating, so the
 /// reading is not gravity alone) or an input is not finite.
 pub fn pitch_from_forward_axis_rad(f_x_mps2: f64, gravity_mps2: f64) -> Result<f64> {

@@ -1,6 +1,7 @@
 //! Accelerometer calibration with bias, per-axis scale and cross-axis sensitivity (the three
 //! axes not quite orthogonal, or coupled): `f = matrix · (raw − bias)`, raw reading in any
-//! unit, specific force in m/s².
+//! unit, specific force in m/s² — the [`InertialCalibration`] model with unit gains and the
+//! scale folded into the matrix, under the names the joint calibration files carry.
 //!
 //! A triad whose axes are not orthogonal reads `raw = K f + b` with `K` any invertible
 //! matrix; the calibration is its inverse. A tumble at rest determines `K⁻¹` only up to a
@@ -8,16 +9,9 @@
 //! the fits of this workspace take the symmetric matrix (the one closest to the sensor's
 //! own axes, by the polar decomposition) unless other information fixes the body axes.
 
-// `!(x > 0.0)` and `!(x <= limit)` are deliberate: they are true for NaN, so a NaN fails
-// every check instead of slipping through one.
-#![allow(clippy::neg_cmp_op_on_partial_ord)]
-
 use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
-use truenorth_core::{Calibration, Error, Result, Validate, check_finite3};
-
-#[allow(unused_imports)]
-use truenorth_core::Float as _;
+use truenorth_core::{Calibration, Error, InertialCalibration, Result, Validate, check_finite3};
 
 /// The largest condition number (largest over smallest singular value) of an accepted
 /// matrix: 10, the largest axis ratio the ellipsoid fits accept. A real triad's scale
@@ -56,7 +50,18 @@ impl AccelTriadCalibration {
     /// [`Calibration::apply`]).
     #[inline]
     pub fn correct(&self, raw: &Vector3<f64>) -> Vector3<f64> {
-        self.matrix * (raw - self.bias)
+        InertialCalibration::from(*self).correct(raw)
+    }
+}
+
+impl From<AccelTriadCalibration> for InertialCalibration {
+    /// Offset the bias, unit gains, the matrix as the misalignment.
+    fn from(c: AccelTriadCalibration) -> Self {
+        Self {
+            offset: c.bias,
+            gain: Vector3::repeat(1.0),
+            misalignment: Some(c.matrix),
+        }
     }
 }
 
@@ -68,14 +73,16 @@ impl Validate for AccelTriadCalibration {
         for c in self.matrix.column_iter() {
             check_finite3("accelerometer matrix column", &c.into_owned())?;
         }
-        if !(self.matrix.determinant() > 0.0) {
+        // A NaN fails every check instead of slipping through one.
+        let determinant = self.matrix.determinant();
+        if determinant.is_nan() || determinant <= 0.0 {
             return Err(Error::Degenerate {
                 reason: "the accelerometer matrix is singular or mirrors the axes (determinant not positive); recalibrate",
             });
         }
         let sv = self.matrix.singular_values();
         let condition = sv.max() / sv.min();
-        if !(condition <= MAX_TRIAD_CONDITION) {
+        if condition.is_nan() || condition > MAX_TRIAD_CONDITION {
             return Err(Error::OutOfRange {
                 what: "condition number of the accelerometer matrix",
                 value: condition,

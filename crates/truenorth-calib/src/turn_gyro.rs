@@ -40,7 +40,7 @@ use truenorth_core::{
     Calibrator, CompassQuality, Error, Progress, Pushed, Result, Solution, TimeStep, Validate,
     check_finite, check_finite2,
 };
-use truenorth_gyro::GyroCalibration;
+use truenorth_gyro::{GyroCalibration, YawIncrement};
 
 use crate::direction_slots::DirectionSlots;
 use crate::extrema::ExtremumKind;
@@ -534,7 +534,7 @@ impl Calibrator for TurnCalibrator {
         self.clock = clock;
         let t0 = *self.t0.get_or_insert(sample.t_s);
         if let Some(dt) = dt {
-            self.at.integral += 0.5 * (self.last_rate + sample.gyr_z_rps) * dt;
+            self.at.integral += YawIncrement::new(self.last_rate, sample.gyr_z_rps, dt).angle_rad();
         }
         self.at.t_s = sample.t_s - t0;
         self.last_rate = sample.gyr_z_rps;

@@ -63,7 +63,7 @@ impl Configuration {
                     wheels,
                     ..VehicleConfig::default()
                 })?;
-                let mut two = TwoPassStart::new(nav, TwoPassConfig::default());
+                let mut two = TwoPassStart::new(nav, TwoPassConfig::default())?;
                 for s in samples {
                     two.push(&s, |_, e, _| out.push(*e))?;
                 }

@@ -454,9 +454,9 @@ pub fn run(args: &Args) -> CliResult {
     };
     let mut estimator = match args.method {
         Method::Fused if args.single_pass => Estimator::Causal(Box::new(fused)),
-        Method::Fused => {
-            Estimator::Fused(Box::new(TwoPassStart::new(fused, TwoPassConfig::default())))
-        }
+        Method::Fused => Estimator::Fused(Box::new(
+            TwoPassStart::new(fused, TwoPassConfig::default()).map_err(bad_config)?,
+        )),
         Method::SeedOdometerCompass => Estimator::Seed(Box::new(
             SeedOdometerCompass::new(SeedOdometerCompassConfig {
                 wheels,

@@ -31,6 +31,7 @@ mod error;
 mod estimator;
 mod heading;
 mod heading_source;
+mod inertial_calibration;
 mod noise;
 mod persist;
 mod sample;
@@ -53,6 +54,7 @@ pub use heading::{Declination, MagneticHeading, TrueHeading};
 pub use heading_source::{
     AbsoluteHeading, AbsoluteHeadingSource, RelativeHeadingSource, RelativeStep,
 };
+pub use inertial_calibration::{InertialCalibration, axis_calibrated};
 pub use noise::{NoiseSource, SplitMix64, ZeroNoise};
 pub use persist::{Persistent, Snapshot, check_snapshot_version};
 pub use sample::{

@@ -71,7 +71,7 @@ fn run(d: &RangeDrive, gyro: bool, two_pass: bool) -> Run {
         .map(|(s, _)| *s)
         .collect();
     let offset = if two_pass {
-        let mut two = TwoPassStart::new(nav, TwoPassConfig::default());
+        let mut two = TwoPassStart::new(nav, TwoPassConfig::default()).unwrap();
         for s in &rows {
             two.push(s, |_, e, _| estimates.push(*e)).unwrap();
         }
@@ -373,7 +373,7 @@ fn diagnose() {
     }
     if std::env::var("TWO").is_ok() {
         let nav = VehicleEstimator::new(config(&d)).unwrap();
-        let mut two = TwoPassStart::new(nav, TwoPassConfig::default());
+        let mut two = TwoPassStart::new(nav, TwoPassConfig::default()).unwrap();
         let mut out = Vec::new();
         // The compass calibration's own error at the true heading of a sample's time.
         let p = d.params;

@@ -166,7 +166,7 @@ proptest! {
     ) {
         let input = samples(&steps);
         let nav = VehicleEstimator::new(VehicleConfig::default()).unwrap();
-        let mut two = TwoPassStart::new(nav, TwoPassConfig::default());
+        let mut two = TwoPassStart::new(nav, TwoPassConfig::default()).unwrap();
         let mut times = Vec::new();
         let mut accepted = 0usize;
         for s in &input {

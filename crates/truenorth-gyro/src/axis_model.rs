@@ -6,7 +6,7 @@
 //! IMU orientation estimation with bias estimation and magnetic disturbance rejection").
 
 use serde::{Deserialize, Serialize};
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 use truenorth_core::{
     NoiseSource, Result, SensorModel, Validate, check_dt, check_finite, check_range,

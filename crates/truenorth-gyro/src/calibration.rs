@@ -1,4 +1,6 @@
-//! Gyro calibration: zero (bias) and scale, raw rate → physical rate.
+//! Gyro calibration: zero (bias) and scale, raw rate → physical rate: one axis of
+//! [`truenorth_core::InertialCalibration`] ([`axis_calibrated`]) with a gain for each
+//! direction of turn.
 //!
 //! The zero is what the calibrators estimate at rest (EP 0640207 claim 8/9: average the output
 //! while stationary) and the scale is the conversion constant of the full-turn method
@@ -7,7 +9,9 @@
 
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
-use truenorth_core::{Calibration, Result, Validate, check_finite, check_positive};
+use truenorth_core::{
+    Calibration, Result, Validate, axis_calibrated, check_finite, check_positive,
+};
 
 /// Zero and gain of one gyro axis: `rate = (raw − zero) / gain`, with `gain_pos` used when
 /// `raw − zero ≥ 0` and `gain_neg` otherwise. Gains are dimensionless (raw rad/s per true
@@ -55,13 +59,7 @@ impl GyroCalibration {
     /// `(raw − zero) / gain` for a valid calibration and a finite `raw_rps`.
     #[inline]
     fn apply_unchecked(&self, raw_rps: f64) -> f64 {
-        let centred = raw_rps - self.zero_rps;
-        let gain = if centred >= 0.0 {
-            self.gain_pos
-        } else {
-            self.gain_neg
-        };
-        centred / gain
+        axis_calibrated(raw_rps, self.zero_rps, self.gain_pos, self.gain_neg)
     }
 }
 

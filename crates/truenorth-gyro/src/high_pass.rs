@@ -1,5 +1,5 @@
-//! First-order high-pass filter with a variable cutoff, removing a gyro's offset (WO 00/36376,
-//! METHODS §E.8): the cutoff (≤ 0.1 Hz in operation) is raised just after power-on so the
+//! First-order high-pass filter with a variable cutoff, removing a gyro's offset
+//! (WO 00/36376): the cutoff (≤ 0.1 Hz in operation) is raised just after power-on so the
 //! filter settles fast, then lowered.
 //!
 //! Discrete form of the analogue RC filter `y' = x' − y/RC` (backward difference):

@@ -1,5 +1,5 @@
 //! Correction of an analogue high-pass filter's distortion, with the offset-error compensator
-//! (WO 00/36376, METHODS §E.8; the seed's HPF corrector 311 and circuit 31106-31108).
+//! (WO 00/36376; the seed's HPF corrector 311 and circuit 31106-31108).
 //!
 //! A first-order RC high-pass gives `F' = x' − F/RC`, so the input is recovered exactly by
 //! `x = F + (1/RC) ∫F dt`; sampled, `J(n) = F(n) + (dt/RC)·Σ F` (the seed's register,

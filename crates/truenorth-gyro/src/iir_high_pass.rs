@@ -1,4 +1,4 @@
-//! The digital variant of the gyro's offset removal (WO 00/36376, METHODS §E.8; the seed's
+//! The digital variant of the gyro's offset removal (WO 00/36376; the seed's
 //! IIR filter 315 with delay buffers P1, P2, the positive/negative definer 316, the buffer
 //! reset 317 and the input-offset correction 318-320).
 //!
@@ -12,7 +12,7 @@
 use serde::{Deserialize, Serialize};
 use truenorth_core::{Result, Validate, check_dt, check_finite, check_positive, check_range};
 
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 
 /// Settings of an [`IirHighPass`].

@@ -4,13 +4,14 @@
 //! its calibration (zero and scale), and the integration of yaw rate into heading change.
 //!
 //! Conditioning of a gyro's output as the orientation detector of WO 00/36376 does it
-//! (METHODS §E.8–9): a [`HighPassFilter`] with a variable cutoff removes the offset, a
+//! (its high-pass filters, corrector and oscillation removers): a [`HighPassFilter`] with a variable cutoff removes the offset, a
 //! [`HighPassCorrection`] undoes the filter's distortion (with an offset-error compensator),
 //! an [`IirHighPass`] is the digital variant (buffer reset and input-offset correction), and
 //! an [`OscillationRemover`] zeroes hand tremor.
 //!
 //! A vehicle usually has one gyro, about the vertical axis (`gyr_z`, positive for a right
-//! turn). That case is the plain [`GyroAxisModel`], [`GyroCalibration`] and [`YawIntegrator`];
+//! turn). That case is the plain [`GyroAxisModel`], [`GyroCalibration`] and [`YawIntegrator`]
+//! (whose trapezoid step, [`YawIncrement`], every estimator of the workspace integrates by);
 //! the three-axis [`Gyro3Model`] and [`Gyro3Calibration`] are three of those side by side.
 //!
 //! Error model of one axis (reading `r` for true rate `ω`, temperature `T`):
@@ -63,6 +64,7 @@ mod high_pass_correction;
 mod iir_high_pass;
 mod oscillation_remover;
 mod triad_model;
+mod yaw_increment;
 mod yaw_integrator;
 
 pub use axis_model::{
@@ -76,6 +78,7 @@ pub use oscillation_remover::{
     MAX_OSCILLATION_WINDOW, OscillationRemover, OscillationRemoverConfig,
 };
 pub use triad_model::{Gyro3Model, Gyro3Params, Rate3Truth};
+pub use yaw_increment::YawIncrement;
 pub use yaw_integrator::{YawIntegrator, YawIntegratorConfig};
 
 /// The model of a single-axis yaw gyro, the usual vehicle case (`gyr_z`, positive = right turn).

@@ -1,4 +1,4 @@
-//! The oscillation remover (WO 00/36376, METHODS §E.9; the seed's removers 321, 322): hand
+//! The oscillation remover (WO 00/36376; the seed's removers 321, 322): hand
 //! tremor makes a gyro swing about zero while the hand holds still; when the mean of the
 //! last `a + 1` outputs is below a threshold, `|J(n) + … + J(n−a)| / a < ε`, the output is
 //! taken as zero.

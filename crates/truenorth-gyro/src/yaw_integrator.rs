@@ -9,7 +9,7 @@ use truenorth_core::{
     check_finite, check_finite3,
 };
 
-use crate::GyroCalibration;
+use crate::{GyroCalibration, YawIncrement};
 
 /// Settings of a [`YawIntegrator`].
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
@@ -31,9 +31,10 @@ impl Validate for YawIntegratorConfig {
 ///
 /// Each sample is the instantaneous rate at its timestamp (the convention of
 /// [`GyroSample`], which the simulator follows too). Between two samples the rate is taken to
-/// vary linearly, so the step is the trapezoid `(ω_prev + ω_now)/2 · dt`: exact for a
-/// constant or linearly changing rate, with an error of `dt³/12 · |ω̈|` per step otherwise,
-/// where the rectangle rule on either end point would be off by `dt²/2 · |ω̇|` per step.
+/// vary linearly, so the step is the trapezoid `(ω_prev + ω_now)/2 · dt` ([`YawIncrement`]):
+/// exact for a constant or linearly changing rate, with an error of `dt³/12 · |ω̈|` per step
+/// otherwise, where the rectangle rule on either end point would be off by `dt²/2 · |ω̇|`
+/// per step.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct YawIntegrator {
     config: YawIntegratorConfig,
@@ -91,7 +92,7 @@ impl YawIntegrator {
                 dt_s,
                 heading_change_rad: check_finite(
                     "gyro heading change (rates too large)",
-                    0.5 * (prev + rate_rps) * dt_s,
+                    YawIncrement::new(prev, rate_rps, dt_s).angle_rad(),
                 )?,
                 distance_m: None,
             }),

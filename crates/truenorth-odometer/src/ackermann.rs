@@ -40,7 +40,7 @@
 //! Not modelled: kingpin inclination, caster, camber, tyre slip angles.
 
 use serde::{Deserialize, Serialize};
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 use truenorth_core::{Error, Result, Validate, check_finite, check_positive, check_range};
 

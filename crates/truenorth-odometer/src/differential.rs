@@ -1,4 +1,4 @@
-//! Heading change from the difference of two wheel distances (US 4,788,645; METHODS §B.1-2).
+//! Heading change from the difference of two wheel distances (US 4,788,645 eqs. 1/7 and 2/8).
 //!
 //! Sign: the left wheel rolling further means a right turn, i.e. a positive heading change
 //! (heading clockwise from north, body y to the right).
@@ -21,7 +21,11 @@ pub fn heading_change_plain_rad(dist_l_m: f64, dist_r_m: f64, track_m: f64) -> R
 pub fn speed_factor(speed_coeff_s2_per_m2: f64, speed_mps: f64) -> Result<f64> {
     let a = check_finite("speed coefficient a (s²/m²)", speed_coeff_s2_per_m2)?;
     let v = check_finite("speed_mps", speed_mps)?;
-    let f = 1.0 + a * v * v;
+    check_speed_factor(1.0 + a * v * v)
+}
+
+/// Refuses a speed factor `1 + aV²` that is not positive and finite.
+pub(crate) fn check_speed_factor(f: f64) -> Result<f64> {
     if !(f > 0.0 && f.is_finite()) {
         return Err(Error::OutOfRange {
             what: "speed factor 1 + aV² (lower |a| or the speed)",

@@ -1,14 +1,13 @@
 //! A differential odometer as a relative heading source: cumulative wheel distances in,
-//! heading change and distance per step out (US 4,788,645 eqs. 2/8 and 3/14; METHODS
-//! §B.1-5).
+//! heading change and distance per step out (US 4,788,645 eqs. 2/8 and 3/14).
 
 use serde::{Deserialize, Serialize};
 use truenorth_core::{
     RelativeHeadingSource, RelativeStep, Result, TimeStep, Validate, WheelSample, check_finite,
 };
 
-use crate::differential::{curvature_ratio, speed_factor};
-use crate::{EffectiveTrack, OdometerCalibration, WheelDistances};
+use crate::differential::{check_speed_factor, curvature_ratio};
+use crate::{EffectiveTrack, OdometerCalibration, OdometryStep, WheelDistances};
 
 /// Settings of a [`DifferentialOdometer`] (the effective-track source, a built object, is
 /// passed to [`DifferentialOdometer::new`] beside it).
@@ -107,7 +106,7 @@ impl<T: EffectiveTrack> DifferentialOdometer<T> {
         &self.config.calibration
     }
 
-    /// Replaces the calibration (e.g. with a refined `a`, METHODS §B.3); from the next step.
+    /// Replaces the calibration (e.g. with a refined `a`, US 4,788,645 eq. 2/8); from the next step.
     /// An invalid calibration is refused and the old one kept.
     pub fn set_calibration(&mut self, calibration: OdometerCalibration) -> Result<()> {
         calibration.validate()?;
@@ -151,21 +150,25 @@ impl<T: EffectiveTrack> DifferentialOdometer<T> {
     fn compute_step(&self, raw_l_m: f64, raw_r_m: f64, dt_s: f64) -> Result<OdometerStep> {
         let calibration = &self.config.calibration;
         let u = calibration.unscale(raw_l_m, raw_r_m)?;
+        // No floor on the speed factor: one that is not positive is refused below.
+        let step = OdometryStep::new(
+            &u,
+            dt_s,
+            calibration.speed_coeff_s2_per_m2,
+            f64::NEG_INFINITY,
+        );
         // The speed term leaves the mean alone, so the mean of the unscaled wheels is true.
-        let mean = check_finite(
-            "mean wheel distance (distances too large)",
-            0.5 * (u.left_m + u.right_m),
-        )?;
-        let wheel_speed_mps = check_finite("wheel speed", mean.abs() / dt_s)?;
-        let diff = (u.left_m - u.right_m)
-            / speed_factor(calibration.speed_coeff_s2_per_m2, wheel_speed_mps)?;
+        let mean = check_finite("mean wheel distance (distances too large)", step.mean_m)?;
+        let wheel_speed_mps = check_finite("wheel speed", step.speed_mps)?;
+        check_speed_factor(step.speed_factor)?;
+        let diff = step.diff_m;
         let ratio = curvature_ratio(mean + 0.5 * diff, mean - 0.5 * diff)?;
         let effective_track_m = self.track.effective_track_m(ratio)?;
         Ok(OdometerStep {
             dt_s,
             heading_change_rad: check_finite(
                 "heading change (distances too large)",
-                diff / effective_track_m,
+                step.turn(effective_track_m, 1.0).heading_change_rad,
             )?,
             mean_dist_m: mean,
             wheel_speed_mps,

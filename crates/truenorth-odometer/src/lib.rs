@@ -16,6 +16,9 @@
 //! * The effective front track ([`EffectiveTrack`]): exact ([`AckermannGeometry`]), the
 //!   patent's eq. 3/14 ([`PatentAckermannTrack`]) and its look-up table
 //!   ([`EffectiveTrackTable`], claims 15-16).
+//! * [`OdometryStep`]: one step of the two wheels → distance, speed-corrected difference and,
+//!   over the effective track, heading change with its derivatives with respect to the
+//!   calibration ([`OdometryTurn`]).
 //! * [`DifferentialOdometer`]: cumulative [`truenorth_core::WheelSample`]s → heading change
 //!   and distance per step, a [`truenorth_core::RelativeHeadingSource`].
 //!
@@ -82,6 +85,7 @@ mod differential;
 mod differential_odometer;
 mod effective_track;
 mod odometer_model;
+mod odometry_step;
 mod patent_track;
 mod track_table;
 mod wheels;
@@ -96,6 +100,7 @@ pub use effective_track::{EffectiveTrack, FixedTrack};
 pub use odometer_model::{
     MIN_SCALE_ERROR, OdometerCoefficients, OdometerModel, OdometerParams, OdometerState,
 };
+pub use odometry_step::{OdometryStep, OdometryTurn, differential_gains};
 pub use patent_track::PatentAckermannTrack;
 pub use track_table::EffectiveTrackTable;
 pub use wheels::{OdometerWheels, WheelDistances, WheelGeometry, WheelMotion};

@@ -12,7 +12,7 @@
 //! [`crate::WheelGeometry::motion_from_paths`] undoes 1.
 
 use serde::{Deserialize, Serialize};
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 use truenorth_core::{
     NoiseSource, Result, SensorModel, Validate, WheelSample, check_dt, check_finite,

@@ -20,7 +20,7 @@
 //! typical car; the patent says "approximately 0.27"): that is [`Error::OutOfRange`], never
 //! NaN.
 
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 use truenorth_core::{Error, Result, Validate, check_finite, check_positive, check_range};
 

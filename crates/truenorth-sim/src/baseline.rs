@@ -8,6 +8,7 @@
 //! say the vehicle does not turn.
 
 use truenorth_core::VehicleSample;
+use truenorth_gyro::YawIncrement;
 
 use crate::VehicleTruth;
 
@@ -38,7 +39,7 @@ pub fn gyro_wheels_final_position(
     for s in samples {
         if let Some(g) = s.gyr_z_rps {
             if let Some((t0, g0)) = last_gyro {
-                psi += (0.5 * (g + g0) - bias) * (s.t_s - t0);
+                psi += YawIncrement::new(g0, g, s.t_s - t0).corrected_rad(bias, 1.0);
             }
             last_gyro = Some((s.t_s, g));
         }

@@ -12,7 +12,7 @@ use super::heading_trig::small_atan2;
 use super::innovation_line::InnovationLine;
 use super::nav_filter::{BIAS, COMPASS_BIAS, DIM, EAST, NORTH, PSI, PSI_ODO, state};
 
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 
 /// Heading uncertainty beyond which a correction is no longer linear, rad (15°): the

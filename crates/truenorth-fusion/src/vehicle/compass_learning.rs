@@ -26,9 +26,6 @@ use truenorth_core::{Calibrator, Mag2Sample, OnlineCalibrator, Pushed, Result, S
 
 use super::config::CompassGates;
 
-#[allow(unused_imports)]
-use truenorth_core::Float as _;
-
 /// Dead-reckoned turning before the raw locus's extent is trusted for the consistency test,
 /// rad (half a turn: the bounding box then spans the locus in at least one direction).
 const EXTENT_TURN_RAD: f64 = core::f64::consts::PI;

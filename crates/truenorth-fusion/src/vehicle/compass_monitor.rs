@@ -17,11 +17,11 @@
 //! The calibration itself is learned by [`super::compass_learning`].
 
 use truenorth_compass::CompassCalibration2d;
-use truenorth_core::{CompassQuality, Solution};
+use truenorth_core::{CompassQuality, Result, Solution, Validate};
 
 use super::config::CompassGates;
 
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 
 /// Smallest per-reading heading noise assumed, rad (0.1°): a calibration's own noise
@@ -98,16 +98,29 @@ pub struct CompassMonitor {
 }
 
 impl CompassMonitor {
-    /// A monitor with no calibration yet.
-    pub fn new(gates: CompassGates) -> Self {
-        Self {
+    /// A monitor with no calibration yet, with validated `gates`.
+    pub fn new(gates: CompassGates) -> Result<Self> {
+        gates.validate()?;
+        Ok(Self {
             gates,
             fix: None,
             last_t_s: None,
             average_rad: 0.0,
             disturbed: false,
             steady: false,
-        }
+        })
+    }
+
+    /// Forgets the calibration and the readings judged; keeps the gates.
+    pub fn reset(&mut self) {
+        *self = Self {
+            gates: self.gates,
+            fix: None,
+            last_t_s: None,
+            average_rad: 0.0,
+            disturbed: false,
+            steady: false,
+        };
     }
 
     /// Uses `fix` from now on.
@@ -189,7 +202,7 @@ mod tests {
     fn calibrated() -> CompassMonitor {
         use super::super::compass_learning::{CompassLearner, Judged};
         let mut learner = CompassLearner::new(CompassGates::default()).unwrap();
-        let mut m = CompassMonitor::new(CompassGates::default());
+        let mut m = CompassMonitor::new(CompassGates::default()).unwrap();
         for k in 0..1440 {
             let psi = (k as f64 * 0.5).to_radians();
             let raw = Vector2::new(5.0 + 20.0 * psi.cos(), -3.0 - 20.0 * psi.sin());
@@ -243,7 +256,7 @@ mod tests {
     fn a_strong_field_change_is_unusable() {
         let mut m = calibrated();
         assert_eq!(m.judge(1.0, 0.0, 1.3, 1e-4), Verdict::Unusable);
-        let mut n = CompassMonitor::new(CompassGates::default());
+        let mut n = CompassMonitor::new(CompassGates::default()).unwrap();
         assert_eq!(n.judge(1.0, 0.0, 1.0, 1e-4), Verdict::Unusable);
     }
 }

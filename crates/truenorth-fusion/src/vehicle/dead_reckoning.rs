@@ -3,6 +3,7 @@
 //! they add, the gaps they cannot bridge, and the measurement epochs.
 
 use truenorth_core::{STANDARD_GRAVITY_MPS2, WheelReading, wrap_pi};
+use truenorth_gyro::YawIncrement;
 
 use super::estimator::VehicleEstimator;
 use super::nav_filter::{
@@ -12,7 +13,7 @@ use super::nav_filter::{
 use super::step_batch::Step;
 use super::wheel_odometry::{WheelCalibration, WheelStep};
 
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 
 /// Seconds of motion between two comparisons of the wheels' heading with the gyro's.
@@ -109,7 +110,8 @@ impl VehicleEstimator {
         }
         self.rest = super::estimator::Rest::default();
         let x = &self.filter.x;
-        let increment = 0.5 * (raw0 + raw) * dt - x[BIAS] * dt;
+        let trapezoid = YawIncrement::new(raw0, raw, dt);
+        let increment = trapezoid.angle_rad() - x[BIAS] * dt;
         let alpha = dt / (dt + TURN_SMOOTHING_S);
         self.gyro.smoothed_rps += alpha * (increment / dt - self.gyro.smoothed_rps);
         let turning = if self.gyro.smoothed_rps != 0.0 {
@@ -127,8 +129,8 @@ impl VehicleEstimator {
         step.psi_from[0] = (BIAS, -dt / gain);
         // The trapezoid is exact for a rate that changes linearly between readings; a
         // rate that changes faster (a robot starting to pivot) can change anywhere in the
-        // interval, leaving an error uniform within ±|Δω|·dt/2: variance (Δω·dt)²/12.
-        let integration = ((raw - raw0) * dt).powi(2) / 12.0;
+        // interval.
+        let integration = trapezoid.error_variance_rad2();
         step.q[PSI] =
             self.coeffs.gyro_noise_rad2_per_s * dt + (GYRO_GAIN_NOISE * dpsi).powi(2) + integration;
         if rate > GAIN_COUPLING_MIN_RATE_RPS + bias_sigma3 {

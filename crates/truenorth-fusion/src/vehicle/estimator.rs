@@ -47,7 +47,7 @@ use super::observability::unobserved;
 use super::step_batch::StepBatch;
 use super::wheel_odometry::{TrackModel, WheelOdometry};
 
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 
 /// Most rows taken before the covariance is carried forward (it is carried forward at
@@ -282,7 +282,7 @@ impl VehicleEstimator {
             initial: filter,
             filter,
             wheels: WheelOdometry::new(config.wheels, TrackModel::Exact)?,
-            compass: CompassMonitor::new(config.compass),
+            compass: CompassMonitor::new(config.compass)?,
             initial_fix: None,
             learner: CompassLearner::new(config.compass)?,
             clock: TimeStep::new(),
@@ -513,7 +513,7 @@ impl HeadingEstimator for VehicleEstimator {
     fn reset(&mut self) {
         self.filter = self.initial;
         self.wheels.reset();
-        self.compass = CompassMonitor::new(self.config.compass);
+        self.compass.reset();
         if let Some(fix) = self.initial_fix {
             self.compass.set_fix(fix);
         }

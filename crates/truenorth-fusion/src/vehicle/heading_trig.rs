@@ -2,7 +2,7 @@
 //! rotations instead of a `sin_cos` per sample, and the small-angle arctangent of an
 //! innovation.
 
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 
 /// Largest step taken by the series, rad: its truncation error is below

@@ -8,7 +8,7 @@
 
 use truenorth_core::wrap_pi;
 
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 
 /// What a completed run of readings says.

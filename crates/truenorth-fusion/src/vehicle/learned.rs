@@ -4,7 +4,7 @@
 
 use serde::{Deserialize, Serialize};
 use truenorth_compass::CompassCalibration2d;
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 use truenorth_core::{
     CompassQuality, Error, Result, Validate, check_finite, check_positive, check_range,

@@ -22,9 +22,6 @@ use super::nav_filter::{
     ALL_STATES, GAIN_NEG, GAIN_POS, SPEED_COEFF, StateSet, TRACK_SCALE, state,
 };
 
-#[allow(unused_imports)]
-use truenorth_core::Float as _;
-
 /// Turning (rad) an interval must hold, of the kind that separates a state, before a
 /// measurement at its end teaches that state (6°).
 const MIN_SEPARATING_TURN_RAD: f64 = 0.1;

@@ -10,7 +10,7 @@
 
 use serde::{Deserialize, Serialize};
 
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 
 /// Heading, rad, clockwise from north (or from the start heading before alignment).

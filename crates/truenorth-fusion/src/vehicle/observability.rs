@@ -12,9 +12,6 @@ use super::nav_filter::{
     BIAS, DIM, GAIN_NEG, GAIN_POS, NavFilter, SPEED_COEFF, TRACK_SCALE, WHEEL_DIFF,
 };
 
-#[allow(unused_imports)]
-use truenorth_core::Float as _;
-
 /// A state whose standard deviation is above this share of its prior's is not yet
 /// determined.
 const DETERMINED_SHARE: f64 = 0.5;

@@ -15,7 +15,7 @@ use truenorth_core::{
     MagneticHeading, NavEstimate, Result, Validate, check_positive, check_range, wrap_pi,
 };
 
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 
 /// Settings shared by the seed configurations.

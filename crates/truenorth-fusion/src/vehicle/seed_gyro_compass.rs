@@ -1,4 +1,4 @@
-//! The configuration of EP 0640207 (METHODS.md §A): heading from the gyro, whose zero is
+//! The configuration of EP 0640207: heading from the gyro, whose zero is
 //! measured at rest and whose conversion constant comes from the compass extrema of the
 //! drive's first full turn ([`truenorth_calib::TurnCalibrator`]); the compass calibrated from
 //! the same extrema pulls the heading through a fixed-gain complementary filter
@@ -11,13 +11,11 @@ use truenorth_core::{
     Calibrator, HeadingEstimator, MagneticHeading, NavEstimate, Result, TimeStep, Validate,
     VehicleSample,
 };
+use truenorth_gyro::YawIncrement;
 use truenorth_odometer::OdometerWheels;
 
 use super::seed_blend::{SeedBlend, SeedBlendConfig};
 use super::wheel_odometry::{TrackModel, WheelCalibration, WheelOdometry};
-
-#[allow(unused_imports)]
-use truenorth_core::Float as _;
 
 /// Samples between two checks of whether the turn calibration can be solved.
 const SOLVE_EVERY: u32 = 10;
@@ -150,7 +148,7 @@ impl HeadingEstimator for SeedGyroCompass {
                 && !self.at_rest
             {
                 self.blend
-                    .turn((0.5 * (r + p) - zero) / gain * (sample.t_s - t0));
+                    .turn(YawIncrement::new(p, r, sample.t_s - t0).corrected_rad(zero, gain));
             }
             self.last_gyro = Some((sample.t_s, r));
             // The zero reading is taken again at every standstill (claims 8-9).

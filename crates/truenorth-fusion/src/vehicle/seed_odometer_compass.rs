@@ -1,4 +1,4 @@
-//! The configuration of US 4,788,645 (METHODS.md §B): heading from two wheels with the
+//! The configuration of US 4,788,645: heading from two wheels with the
 //! speed correction `ΔD/(T(1 + aV²))` and, on steered front wheels, the Ackermann effective
 //! track from the patent's look-up table; `a` refined turn by turn against the compass
 //! (eqs. 9-13); a compass calibrated by the binned ellipse of EP 0634001 pulling the heading
@@ -19,9 +19,6 @@ use truenorth_odometer::OdometerWheels;
 
 use super::seed_blend::{SeedBlend, SeedBlendConfig};
 use super::wheel_odometry::{TrackModel, WheelCalibration, WheelOdometry};
-
-#[allow(unused_imports)]
-use truenorth_core::Float as _;
 
 /// Configuration of [`SeedOdometerCompass`].
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -134,8 +131,7 @@ impl HeadingEstimator for SeedOdometerCompass {
             // The last calibration stays in use while the calibrator has none (it starts
             // its bins over when it judges the ellipse changed, which a long disturbance
             // also triggers): without it the heading runs on the wheels alone, which drift
-            // a tenth of a degree per metre (on the simulated drives of
-            // `tests/vehicle_drives.rs`, seed 2 lost its compass for good after 90 s).
+            // a tenth of a degree per metre.
             if let Ok(truenorth_core::Pushed::NewEstimate) = self.calibrator.push(&reading)
                 && let Some(s) = self.calibrator.estimate()
             {

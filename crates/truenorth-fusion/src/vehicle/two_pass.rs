@@ -17,11 +17,13 @@ extern crate alloc;
 
 use alloc::vec::Vec;
 
-use truenorth_core::{HeadingEstimator, MagneticHeading, NavEstimate, Result, VehicleSample};
+use truenorth_core::{
+    Error, HeadingEstimator, MagneticHeading, NavEstimate, Result, Validate, VehicleSample,
+};
 
 use super::estimator::VehicleEstimator;
 
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 
 /// When the head of the drive is run again.
@@ -33,6 +35,22 @@ pub struct TwoPassConfig {
     /// Time the estimator must have had its heading referred to north, with a calibration
     /// learned from gated readings, before the head is run again, s.
     pub settle_s: f64,
+}
+
+impl Validate for TwoPassConfig {
+    /// A settling time that is a number and not negative (infinite: the head is run again
+    /// only when [`TwoPassConfig::capacity`] is reached; a capacity of 0 runs it at once).
+    fn validate(&self) -> Result<()> {
+        if self.settle_s.is_nan() || self.settle_s < 0.0 {
+            return Err(Error::OutOfRange {
+                what: "two-pass settle_s, s",
+                value: self.settle_s,
+                min: 0.0,
+                max: f64::INFINITY,
+            });
+        }
+        Ok(())
+    }
 }
 
 impl Default for TwoPassConfig {
@@ -59,16 +77,18 @@ pub struct TwoPassStart {
 }
 
 impl TwoPassStart {
-    /// Wraps `estimator` (usually fresh from [`VehicleEstimator::new`]).
-    pub fn new(estimator: VehicleEstimator, config: TwoPassConfig) -> Self {
-        Self {
+    /// Wraps `estimator` (usually fresh from [`VehicleEstimator::new`]) under a validated
+    /// `config`.
+    pub fn new(estimator: VehicleEstimator, config: TwoPassConfig) -> Result<Self> {
+        config.validate()?;
+        Ok(Self {
             config,
             estimator,
             head: Vec::new(),
             held: Vec::new(),
             replayed: false,
             settled_since_s: None,
-        }
+        })
     }
 
     /// The estimator (the second pass's once the head has been run again).

@@ -1,19 +1,22 @@
 //! One step of the odometer wheels under the current calibration estimate: heading change,
 //! the rear-axle distance, and how both depend on the calibration states.
 //!
-//! Per step (US 4,788,645 eqs. 2/8, 3/14): the raw wheel increments are divided by their
-//! gains `1 ± δ/2`, their difference by `1 + aV²`, and the result by the track — fixed for
-//! an unsteered axle, the effective track `T_E(ΔD/AD)` from a look-up table for
-//! Ackermann-steered front wheels. Front wheels also travel further than the rear axle in a
+//! Per step (US 4,788,645 eqs. 2/8, 3/14, computed by [`truenorth_odometer::OdometryStep`]):
+//! the raw wheel increments are divided by their gains `1 ± δ/2`, their difference by
+//! `1 + aV²`, and the result by the track — fixed for an unsteered axle, the effective track
+//! `T_E(ΔD/AD)` from a look-up table for Ackermann-steered front wheels. What is the
+//! estimator's own: the floors on the learned factors, the steered wheels' averaged
+//! curvature and the rear-axle distance. Front wheels also travel further than the rear axle in a
 //! turn: the front-axle midpoint runs on radius `√(R² + B²)` where the rear-axle centre runs
 //! on `R`, so the rear-axle distance is `√(AD² − (B·Δθ)²)`.
 
 use truenorth_core::{Error, Result, Validate, WheelReading};
 use truenorth_odometer::{
-    AckermannGeometry, EffectiveTrack, EffectiveTrackTable, OdometerWheels, PatentAckermannTrack,
+    AckermannGeometry, EffectiveTrack, EffectiveTrackTable, OdometerWheels, OdometryStep,
+    PatentAckermannTrack, WheelDistances, differential_gains,
 };
 
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 
 /// Fastest wheel speed a sample may imply, m/s (360 km/h, beyond any road vehicle):
@@ -49,6 +52,13 @@ struct Steered {
     /// curvature cannot change faster than its steering turns.
     curvature_per_m: f64,
 }
+
+/// Floor of the speed factor `1 + aV²`: a learned `a` that strays negative at speed must
+/// not shrink the difference to nothing.
+const MIN_SPEED_FACTOR: f64 = 0.5;
+
+/// Floor of the track factor `1 + ε`.
+const MIN_TRACK_SCALE: f64 = 0.5;
 
 /// Distance over which the curvature of steered wheels is averaged, m.
 const CURVATURE_SMOOTHING_M: f64 = 3.0;
@@ -188,13 +198,14 @@ impl WheelOdometry {
             reading.dist_r_m - w0.dist_r_m,
         );
         let moved = raw_l != 0.0 || raw_r != 0.0;
-        let l = raw_l / (1.0 + 0.5 * diff);
-        let r = raw_r / (1.0 + -0.5 * diff);
-        let mean = 0.5 * (l + r);
-        let speed_mps = mean.abs() / dt_s;
-        let factor = (1.0 + speed_coeff * speed_mps * speed_mps).max(0.5);
-        let delta = (l - r) / factor;
-        let ratio = if mean != 0.0 { delta / mean } else { 0.0 };
+        let (gain_l, gain_r) = differential_gains(diff);
+        let wheels = WheelDistances {
+            left_m: raw_l / gain_l,
+            right_m: raw_r / gain_r,
+        };
+        let step = OdometryStep::new(&wheels, dt_s, speed_coeff, MIN_SPEED_FACTOR);
+        let (mean, speed_mps) = (step.mean_m, step.speed_mps);
+        let ratio = step.ratio();
         let track_m = match &self.steered {
             None => self.track_m,
             Some(s) => {
@@ -204,8 +215,8 @@ impl WheelOdometry {
                 s.table.effective_track_m(c).unwrap_or(self.track_m)
             }
         };
-        let scale = (1.0 + track_scale).max(0.5);
-        let heading = delta / (track_m * scale);
+        let turn = step.turn(track_m, (1.0 + track_scale).max(MIN_TRACK_SCALE));
+        let heading = turn.heading_change_rad;
         let (ds_m, ratio) = match &mut self.steered {
             None => (mean, ratio),
             Some(s) => {
@@ -226,10 +237,9 @@ impl WheelOdometry {
             ds_m,
             heading_change_rad: heading,
             ratio,
-            // u_l − u_r falls by the mean distance per unit δ (first order).
-            d_heading_d_diff: -mean / (factor * track_m * scale),
-            d_heading_d_speed_coeff: -heading * speed_mps * speed_mps / factor,
-            d_heading_d_track_scale: -heading / scale,
+            d_heading_d_diff: turn.d_heading_d_diff,
+            d_heading_d_speed_coeff: turn.d_heading_d_speed_coeff,
+            d_heading_d_track_scale: turn.d_heading_d_track_scale,
             speed_mps,
             moved,
         })
