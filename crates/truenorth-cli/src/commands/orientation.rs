@@ -12,7 +12,7 @@ use truenorth::fusion::{
 };
 
 use crate::io::{CliError, CliResult, Table, check_distinct, write_csv};
-use crate::svg_timeseries::{Band, Line, write_timeseries};
+use crate::plot::{Band, Line, write_timeseries};
 
 /// Orientation methods.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]

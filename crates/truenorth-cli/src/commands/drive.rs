@@ -5,7 +5,6 @@
 use std::path::{Path, PathBuf};
 
 use nalgebra::Vector2;
-use serde::Deserialize;
 use truenorth::core::{
     Declination, HeadingEstimator, MagneticHeading, NavEstimate, VehicleSample, rad_to_deg,
     wrap_two_pi,
@@ -15,12 +14,11 @@ use truenorth::fusion::vehicle::{
     SeedOdometerCompassConfig, TwoPassConfig, TwoPassStart, VehicleCalibration,
 };
 use truenorth::fusion::{SensorPriors, VehicleConfig, VehicleEstimator};
-use truenorth::odometer::{AckermannParams, OdometerWheels};
 
-use crate::field::Place;
+use super::field::Place;
 use crate::io::{
-    CliError, CliResult, CsvOutput, InputOptions, InputPath, ReadSpec, RowReader, check_distinct,
-    write_atomically,
+    CliError, CliResult, CsvOutput, InputOptions, InputPath, ReadSpec, RowReader, VehicleFile,
+    WheelColumns, check_distinct, write_atomically,
 };
 
 /// The long help of the command (after the options).
@@ -134,103 +132,6 @@ pub struct Args {
     /// How to read the input.
     #[command(flatten)]
     pub input_options: InputOptions,
-}
-
-/// The vehicle file.
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct VehicleFile {
-    track_m: f64,
-    odometer_wheels: String,
-    wheelbase_m: Option<f64>,
-    pitman_ratio: Option<f64>,
-    wheel_resolution_m: Option<f64>,
-}
-
-impl VehicleFile {
-    fn read(path: &Path) -> CliResult<Self> {
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| CliError::file(path, format!("cannot read: {e}")))?;
-        serde_json::from_str(&text)
-            .map_err(|e| CliError::file(path, format!("not a vehicle file: {e}")))
-    }
-
-    fn wheels(&self, path: &Path) -> CliResult<OdometerWheels> {
-        match self.odometer_wheels.to_ascii_lowercase().as_str() {
-            "rear" => Ok(OdometerWheels::Rear {
-                track_m: self.track_m,
-            }),
-            "front" => {
-                let (Some(b), Some(p)) = (self.wheelbase_m, self.pitman_ratio) else {
-                    return Err(CliError::file(
-                        path,
-                        "front odometer wheels need wheelbase_m and pitman_ratio (Ackermann geometry)",
-                    ));
-                };
-                Ok(OdometerWheels::Front(AckermannParams::from_pitman_ratio(
-                    b,
-                    self.track_m,
-                    p,
-                )))
-            }
-            "skid_steer" | "skid-steer" => Ok(OdometerWheels::SkidSteer {
-                track_m: self.track_m,
-            }),
-            "differential" => Ok(OdometerWheels::Differential {
-                track_m: self.track_m,
-            }),
-            other => Err(CliError::file(
-                path,
-                format!(
-                    "odometer_wheels is `{other}`; it must be \"rear\", \"front\", \"skid_steer\" or \"differential\""
-                ),
-            )),
-        }
-    }
-}
-
-/// The wheel columns, as cumulative distances or as speeds to integrate.
-#[derive(Debug, Clone, Copy)]
-enum Wheels {
-    Distances([usize; 2]),
-    Speeds {
-        columns: [usize; 2],
-        last: Option<(f64, [f64; 2])>,
-        dist: [f64; 2],
-    },
-}
-
-impl Wheels {
-    /// Cumulative distances at time `t` from row `values`, if the row carries the wheels
-    /// (speeds are integrated from one row that carries them to the next); a row with one
-    /// wheel and not the other is an error.
-    fn cumulative(&mut self, t: f64, values: &[f64]) -> Result<Option<[f64; 2]>, &'static str> {
-        let [l, r] = match self {
-            Self::Distances(c) | Self::Speeds { columns: c, .. } => *c,
-        };
-        let v = [values[l], values[r]];
-        match (v[0].is_finite(), v[1].is_finite()) {
-            (false, false) => return Ok(None),
-            (true, true) => {}
-            _ => {
-                return Err(
-                    "has one wheel's value and not the other's; give both wheels on a row, or neither",
-                );
-            }
-        }
-        Ok(Some(match self {
-            Self::Distances(_) => v,
-            Self::Speeds { last, dist, .. } => {
-                if let Some((t0, v0)) = *last {
-                    for k in 0..2 {
-                        dist[k] += 0.5 * (v0[k] + v[k]) * (t - t0);
-                    }
-                }
-                *last = Some((t, v));
-                *dist
-            }
-        }))
-    }
 }
 
 /// The estimator the method asks for.
@@ -407,8 +308,8 @@ pub fn run(args: &Args) -> CliResult {
         ix("speed_l_mps"),
         ix("speed_r_mps"),
     ) {
-        (Some(l), Some(r), _, _) => Some(Wheels::Distances([l, r])),
-        (_, _, Some(l), Some(r)) => Some(Wheels::Speeds {
+        (Some(l), Some(r), _, _) => Some(WheelColumns::Distances([l, r])),
+        (_, _, Some(l), Some(r)) => Some(WheelColumns::Speeds {
             columns: [l, r],
             last: None,
             dist: [0.0; 2],
@@ -432,7 +333,7 @@ pub fn run(args: &Args) -> CliResult {
     let mut priors = SensorPriors::for_wheels(&wheels);
     if let Some(r) = vehicle.wheel_resolution_m {
         priors.wheel_resolution_m = r;
-    } else if matches!(wheel_columns, Some(Wheels::Speeds { .. })) && !wheels.can_pivot() {
+    } else if matches!(wheel_columns, Some(WheelColumns::Speeds { .. })) && !wheels.can_pivot() {
         priors.wheel_resolution_m = SPEED_RESOLUTION_M;
     }
     let config = VehicleConfig {

@@ -13,7 +13,7 @@ use truenorth::fusion::{
 use truenorth_sim::{HandheldParams, ImuSensorParams, handheld_motion, imu_streams};
 
 use crate::io::{CliError, CliResult};
-use crate::svg_timeseries::{Line, write_timeseries};
+use crate::plot::{Line, write_timeseries};
 
 /// One estimator's run: RMS heading and inclination error (degrees) after `settle_s`, and
 /// the total error angle over time (s, degrees).
@@ -61,7 +61,7 @@ fn run(
 }
 
 /// Prints the orientation table and writes `orientation_error.svg` into `out`.
-pub fn orientation_section(seed: u64, out: &Path) -> CliResult {
+pub(super) fn orientation_section(seed: u64, out: &Path) -> CliResult {
     println!(
         "\nOrientation on 300 s of simulated hand-held motion (consumer IMU: gyro bias 0.3 deg/s per axis, never at rest), errors after the first 30 s"
     );

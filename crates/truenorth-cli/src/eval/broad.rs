@@ -14,8 +14,8 @@ use serde::Serialize;
 use truenorth::core::ImuSample;
 use truenorth::fusion::AttitudeError;
 
+use crate::commands::orientation::{Estimator, Method, Timing, ned_to_enu};
 use crate::io::{CliError, CliResult};
-use crate::orientation::{Estimator, Method, Timing, ned_to_enu};
 
 /// Arguments of `truenorth eval broad`.
 ///

@@ -15,7 +15,7 @@ use truenorth::odometer::OdometerWheels;
 use truenorth_sim::{DriveScore, DriveSpec, DriveWheels, SimulatedDrive};
 
 use crate::io::{CliError, CliResult};
-use crate::svg::{Series, Style, write_plot};
+use crate::plot::{Series, Style, write_plot};
 
 /// Drives per row of the table.
 const DRIVES: u64 = 4;
@@ -135,7 +135,7 @@ fn table(seed: u64) -> Result<Vec<(DriveWheels, Configuration, Row)>> {
 }
 
 /// Prints the drive table and writes `drive_tracks.svg` into `out`.
-pub fn drive_section(seed: u64, out: &Path) -> CliResult {
+pub(super) fn drive_section(seed: u64, out: &Path) -> CliResult {
     let err = |e: truenorth::core::Error| CliError::msg(e.to_string());
     let km: Vec<f64> = drives(seed, DriveWheels::Rear)
         .map_err(err)?

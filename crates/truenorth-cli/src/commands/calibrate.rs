@@ -19,13 +19,13 @@ use truenorth::calib::{
 use truenorth::compass::{CompassCalibration2d, CompassCalibration3d};
 use truenorth::core::{Calibrator, CompassQuality, Mag2Sample, Mag3Sample, Solution};
 
-use crate::field::Place;
+use super::field::Place;
+use super::mag_unit::{MagUnit, check_field};
 use crate::io::{
     AccelPart, CALIBRATION_FORMAT, CALIBRATION_VERSION, CalibrationFile, CliError, CliResult,
     GyroPart, InputOptions, InputPath, QualityReport, ReadSpec, Table, check_distinct, finite,
     gyro_units, matrix_rows, units_block,
 };
-use crate::mag_unit::{MagUnit, check_field};
 
 /// Calibration methods.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]

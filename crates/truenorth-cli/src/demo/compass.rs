@@ -1,0 +1,181 @@
+//! The demo's compass section: every two-axis calibration method fitted on the opening
+//! circle and applied to the whole drive, the refusal of half a circle, and a plot of the
+//! least-squares fit.
+
+use truenorth::calib::{
+    BinnedEllipseCalibrator, EllipseCalibrator, MeritCircleCalibrator, OnlineEllipseCalibrator,
+    OnlineEllipseConfig, TurnCompassCalibrator,
+};
+use truenorth::compass::CompassCalibration2d;
+use truenorth::core::{Calibrator, CompassQuality, Mag2Sample};
+
+use super::sensors::{DemoDrive, heading_error};
+use crate::io::{CliError, CliResult};
+use crate::plot::{Series, Style, write_plot};
+
+type Compass2dCalibrator =
+    dyn Calibrator<Sample = Mag2Sample, Params = CompassCalibration2d, Quality = CompassQuality>;
+
+pub(super) fn compass_section(d: &DemoDrive, out: &std::path::Path) -> CliResult {
+    let cal_samples: Vec<Mag2Sample> = d
+        .samples
+        .iter()
+        .filter(|s| s.t_s <= d.circle_end_s)
+        .filter_map(|s| s.mag.map(|mag| Mag2Sample { t_s: s.t_s, mag }))
+        .collect();
+    let p = &d.params;
+    println!(
+        "Compass calibration: each method fitted on the opening circle ({} samples, hard iron {:.2} x field, soft iron 1.3 rotated 30 deg, noise {:.0} % of field), then applied to the whole drive",
+        cal_samples.len(),
+        p.compass_hard_iron.norm() / p.horizontal_field,
+        p.compass_noise / p.horizontal_field * 100.0
+    );
+    println!(
+        "{:<26} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>11}",
+        "method", "RMS deg", "max deg", "3sd deg", "sys deg", "noise deg", "coverage", "residual %"
+    );
+    let heading_rms = |cal: &CompassCalibration2d| {
+        let est: Vec<f64> = d
+            .samples
+            .iter()
+            .map(|s| s.mag.map_or(f64::NAN, |m| cal.heading_rad(&m)))
+            .collect();
+        heading_error(&d.truth, &est)
+    };
+    let truth_cal = CompassCalibration2d {
+        hard_iron: p.compass_hard_iron,
+        soft_iron: p.compass_soft_iron.try_inverse().unwrap_or_default(),
+    };
+    let floor = heading_rms(&truth_cal);
+    println!(
+        "{:<26} {:>9.2} {:>9.2} {:>9} {:>9} {:>9} {:>9} {:>11}",
+        "(noise floor: true cal.)", floor.rms_deg, floor.max_deg, "-", "-", "-", "-", "-"
+    );
+    let mut methods: Vec<(&str, Box<Compass2dCalibrator>)> = vec![
+        (
+            "least-squares ellipse",
+            Box::new(EllipseCalibrator::default()),
+        ),
+        (
+            "online least squares",
+            Box::new(
+                OnlineEllipseCalibrator::new(OnlineEllipseConfig::default())
+                    .map_err(|e| CliError::msg(e.to_string()))?,
+            ),
+        ),
+        (
+            "binned ellipse (EP0634001)",
+            Box::new(BinnedEllipseCalibrator::default()),
+        ),
+        (
+            "merit circle (US5297063)",
+            Box::new(MeritCircleCalibrator::default()),
+        ),
+        (
+            "turn extrema (EP0640207)",
+            Box::new(TurnCompassCalibrator::default()),
+        ),
+    ];
+    let mut ls_fit: Option<(CompassCalibration2d, f64)> = None;
+    for (name, cal) in methods.iter_mut() {
+        for s in &cal_samples {
+            // A rejected sample is skipped; the solve reports what the rest supports.
+            let _ = cal.push(s);
+        }
+        match cal.solve() {
+            Ok(sol) => {
+                let e = heading_rms(&sol.params);
+                println!(
+                    "{:<26} {:>9.2} {:>9.2} {:>9.2} {:>9.2} {:>9.2} {:>8.0}% {:>11.2}",
+                    name,
+                    e.rms_deg,
+                    e.max_deg,
+                    sol.quality.heading_error_3sigma_deg,
+                    sol.quality.heading_error_systematic_deg,
+                    sol.quality.heading_noise_rms_deg,
+                    sol.quality.fit.coverage * 100.0,
+                    sol.quality.fit.residual_rms_rel * 100.0
+                );
+                if ls_fit.is_none() {
+                    ls_fit = Some((sol.params, sol.quality.field_magnitude));
+                }
+            }
+            Err(e) => println!("{name:<26} refused: {e}"),
+        }
+    }
+    // A half circle is not enough for any method: each must refuse, not guess.
+    let half: Vec<&Mag2Sample> = cal_samples
+        .iter()
+        .zip(&d.truth)
+        .filter(|(_, t)| t.heading_unwrapped_rad < std::f64::consts::PI)
+        .map(|(s, _)| s)
+        .collect();
+    let mut refused = 0;
+    for (_, cal) in methods.iter_mut() {
+        cal.reset();
+        for s in &half {
+            let _ = cal.push(s);
+        }
+        refused += usize::from(cal.solve().is_err());
+    }
+    println!(
+        "RMS/max: heading error on the whole drive, noise included. 3sd: three standard deviations of the\n\
+         heading error from the fitted parameters' uncertainty; sys: the error the method's model leaves\n\
+         whatever the data; noise: RMS noise of one calibrated reading. residual: RMS distance from the\n\
+         fitted circle divided by the field."
+    );
+    println!(
+        "half circle (< 180 deg of turn): {refused} of {} methods refuse, as they must",
+        methods.len()
+    );
+
+    if let Some((cal, field)) = ls_fit {
+        let raw: Vec<(f64, f64)> = cal_samples.iter().map(|s| (s.mag.x, s.mag.y)).collect();
+        let inverse = cal.soft_iron.try_inverse().unwrap_or_default();
+        let ellipse: Vec<(f64, f64)> = (0..360)
+            .map(|k| {
+                let a = (k as f64).to_radians();
+                let r = inverse * nalgebra::Vector2::new(field * a.cos(), field * a.sin())
+                    + cal.hard_iron;
+                (r.x, r.y)
+            })
+            .collect();
+        let corrected: Vec<(f64, f64)> = cal_samples
+            .iter()
+            .map(|s| {
+                let c = cal.correct(&s.mag);
+                (c.x, c.y)
+            })
+            .collect();
+        let path = out.join("compass_calibration.svg");
+        write_plot(
+            &path,
+            "Compass: raw locus, least-squares ellipse, corrected circle",
+            "mag_x (uT)",
+            "mag_y (uT)",
+            &[
+                Series {
+                    label: "raw readings",
+                    colour: "#d62728",
+                    points: raw,
+                    style: Style::Dots,
+                },
+                Series {
+                    label: "fitted ellipse",
+                    colour: "#1f77b4",
+                    points: ellipse,
+                    style: Style::Closed,
+                },
+                Series {
+                    label: "corrected",
+                    colour: "#2ca02c",
+                    points: corrected,
+                    style: Style::Dots,
+                },
+            ],
+        )?;
+        println!("plot: {}", path.display());
+    }
+    println!();
+    Ok(())
+}
