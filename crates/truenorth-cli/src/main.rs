@@ -8,6 +8,7 @@ mod demo;
 mod eval;
 mod io;
 mod plot;
+mod registry;
 
 use std::process::ExitCode;
 

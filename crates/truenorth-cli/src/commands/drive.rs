@@ -6,20 +6,18 @@ use std::path::{Path, PathBuf};
 
 use nalgebra::Vector2;
 use truenorth::core::{
-    Declination, HeadingEstimator, MagneticHeading, NavEstimate, VehicleSample, rad_to_deg,
-    wrap_two_pi,
+    Declination, MagneticHeading, NavEstimate, VehicleSample, rad_to_deg, wrap_two_pi,
 };
-use truenorth::fusion::vehicle::{
-    NavFilter, SeedGyroCompass, SeedGyroCompassConfig, SeedOdometerCompass,
-    SeedOdometerCompassConfig, TwoPassConfig, TwoPassStart, VehicleCalibration,
-};
+use truenorth::fusion::vehicle::{NavFilter, VehicleCalibration};
 use truenorth::fusion::{SensorPriors, VehicleConfig, VehicleEstimator};
+use truenorth::odometer::OdometerWheels;
 
 use super::field::Place;
 use crate::io::{
-    CliError, CliResult, CsvOutput, InputOptions, InputPath, ReadSpec, RowReader, VehicleFile,
+    CliError, CliResult, CsvOutput, InputOptions, InputPath, ReadSpec, Row, RowReader, VehicleFile,
     WheelColumns, check_distinct, write_atomically,
 };
+use crate::registry::{VehicleMethod, VehicleRun};
 
 /// The long help of the command (after the options).
 const AFTER_HELP: &str = "VEHICLE.json: {\"track_m\": 1.55, \"odometer_wheels\": \"rear\"} or
@@ -71,17 +69,6 @@ with the row where the evidence became clear.";
 /// drive of `tests/comma2k19.rs` the heading then ended 4.7° off instead of 0.1°).
 const SPEED_RESOLUTION_M: f64 = 0.003;
 
-/// How the heading is estimated.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum Method {
-    /// Gyro (if present), wheels and compass fused, every sensor calibrated online.
-    Fused,
-    /// US 4,788,645: wheels with the speed correction, compass blended in; no gyro.
-    SeedOdometerCompass,
-    /// EP 0640207: gyro calibrated by the first full turn, compass blended in.
-    SeedGyroCompass,
-}
-
 /// Optional output column groups.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum Extra {
@@ -112,7 +99,7 @@ pub struct Args {
     pub output: PathBuf,
     /// Estimation method.
     #[arg(long, value_enum, default_value = "fused")]
-    pub method: Method,
+    pub method: VehicleMethod,
     /// Extra output columns, after the contract's (comma-separated).
     #[arg(long, value_enum, value_delimiter = ',')]
     pub extra: Vec<Extra>,
@@ -134,11 +121,238 @@ pub struct Args {
     pub input_options: InputOptions,
 }
 
-/// The estimator the method asks for.
-enum Estimator {
-    Fused(Box<TwoPassStart>),
-    Causal(Box<VehicleEstimator>),
-    Seed(Box<dyn HeadingEstimator>),
+/// The optional columns of a drive log.
+const OPTIONAL: [&str; 7] = [
+    "dist_l_m",
+    "dist_r_m",
+    "speed_l_mps",
+    "speed_r_mps",
+    "gyr_z",
+    "mag_x",
+    "mag_y",
+];
+
+/// Runs the subcommand: check the arguments, read the vehicle, build the method, run it
+/// over the log row by row, then save what it learned and summarise.
+pub fn run(args: &Args) -> CliResult {
+    check_arguments(args)?;
+    let spec = ReadSpec::new(&["t_s"])
+        .optional(&OPTIONAL)
+        .increasing("t_s");
+    let mut rows = RowReader::open(&InputPath::new(&args.input), &args.input_options, &spec)?;
+    let wheel_columns = wheel_columns(&rows)?;
+    let vehicle = VehicleFile::read(&args.vehicle)?;
+    let wheels = vehicle.wheels(&args.vehicle)?;
+    let declination = if args.place.is_given() {
+        Some(args.place.field()?.declination())
+    } else {
+        None
+    };
+    let speeds = matches!(wheel_columns, Some(WheelColumns::Speeds { .. }));
+    let mut method = build_method(args, &vehicle, wheels, speeds)?;
+    let mut columns = Columns {
+        t: rows.index("t_s").unwrap_or(0),
+        wheels: wheel_columns,
+        gyr: rows.index("gyr_z"),
+        mag: mag_columns(&rows)?,
+    };
+    let mut writer = Writer::create(args, declination)?;
+    let samples = estimate(&mut rows, &mut columns, method.as_mut(), &mut writer)?;
+    let learned = method.calibration();
+    if let (Some(out), Some(learned)) = (&args.calibration_out, &learned) {
+        save_calibration(out, learned)?;
+    }
+    let Writer {
+        out,
+        last,
+        rows: written,
+        gaps,
+        ..
+    } = writer;
+    out.commit()?;
+    summary(
+        args,
+        samples,
+        written,
+        gaps,
+        last.as_ref(),
+        learned.as_ref(),
+    );
+    Ok(())
+}
+
+/// Refuses outputs that are inputs and options that do not go together, before anything
+/// is read.
+fn check_arguments(args: &Args) -> CliResult {
+    let mut inputs: Vec<&Path> = vec![&args.input, &args.vehicle];
+    if let Some(c) = &args.calibration_in {
+        inputs.push(c);
+    }
+    check_distinct(&args.output, &inputs)?;
+    if let Some(c) = &args.calibration_out {
+        check_distinct(c, &inputs)?;
+        if c == &args.output {
+            return Err(CliError::msg(
+                "drive: --calibration-out and --output name the same file",
+            ));
+        }
+    }
+    if args.extra.contains(&Extra::Calibration) && args.method != VehicleMethod::Fused {
+        return Err(CliError::msg(
+            "drive: --extra calibration needs --method fused (the seed methods learn other things)",
+        ));
+    }
+    Ok(())
+}
+
+/// The wheel columns of the log (distances before speeds); an error if the log has neither
+/// wheels nor a gyro.
+fn wheel_columns(rows: &RowReader) -> CliResult<Option<WheelColumns>> {
+    let ix = |n: &str| rows.index(n);
+    let wheels = match (
+        ix("dist_l_m"),
+        ix("dist_r_m"),
+        ix("speed_l_mps"),
+        ix("speed_r_mps"),
+    ) {
+        (Some(l), Some(r), _, _) => Some(WheelColumns::Distances([l, r])),
+        (_, _, Some(l), Some(r)) => Some(WheelColumns::Speeds {
+            columns: [l, r],
+            last: None,
+            dist: [0.0; 2],
+        }),
+        _ => None,
+    };
+    if wheels.is_none() && ix("gyr_z").is_none() {
+        return Err(CliError::row(
+            rows.path(),
+            1,
+            "needs a heading sensor: the wheels (`dist_l_m,dist_r_m` cumulative distances or `speed_l_mps,speed_r_mps` wheel speeds) or a gyro (`gyr_z`, rad/s)",
+        ));
+    }
+    Ok(wheels)
+}
+
+/// The compass columns: both or neither.
+fn mag_columns(rows: &RowReader) -> CliResult<Option<[usize; 2]>> {
+    match (rows.index("mag_x"), rows.index("mag_y")) {
+        (Some(x), Some(y)) => Ok(Some([x, y])),
+        (None, None) => Ok(None),
+        _ => Err(CliError::row(
+            rows.path(),
+            1,
+            "has one of mag_x, mag_y but not both; give both (any unit, uncalibrated) or neither",
+        )),
+    }
+}
+
+/// The method the arguments ask for, through the registry. The fused estimator starts from
+/// the sensor priors of the vehicle (with the distance resolution of integrated speeds
+/// when the log has speeds and the file gives none), or from `--calibration-in`.
+fn build_method(
+    args: &Args,
+    vehicle: &VehicleFile,
+    wheels: OdometerWheels,
+    speeds: bool,
+) -> CliResult<Box<dyn VehicleRun>> {
+    let mut priors = SensorPriors::for_wheels(&wheels);
+    if let Some(r) = vehicle.wheel_resolution_m {
+        priors.wheel_resolution_m = r;
+    } else if speeds && !wheels.can_pivot() {
+        priors.wheel_resolution_m = SPEED_RESOLUTION_M;
+    }
+    let config = VehicleConfig {
+        wheels,
+        priors: Some(priors),
+        ..VehicleConfig::default()
+    };
+    let bad_config = |e: truenorth::core::Error| CliError::file(&args.vehicle, e.to_string());
+    let fused = match &args.calibration_in {
+        Some(path) => {
+            let text = std::fs::read_to_string(path)
+                .map_err(|e| CliError::file(path, format!("cannot read: {e}")))?;
+            let learned: VehicleCalibration = serde_json::from_str(&text)
+                .map_err(|e| CliError::file(path, format!("not a drive calibration: {e}")))?;
+            VehicleEstimator::with_calibration(config, &learned)
+                .map_err(|e| CliError::file(path, e.to_string()))?
+        }
+        None => VehicleEstimator::new(config).map_err(bad_config)?,
+    };
+    args.method
+        .runner(wheels, fused, args.single_pass)
+        .map_err(bad_config)
+}
+
+/// Where each sensor is in a row.
+struct Columns {
+    t: usize,
+    wheels: Option<WheelColumns>,
+    gyr: Option<usize>,
+    mag: Option<[usize; 2]>,
+}
+
+impl Columns {
+    /// The sample a row carries: each sensor whose cells are filled (wheel speeds
+    /// integrated into distances on the way).
+    fn sample(&mut self, row: &Row, path: &Path) -> CliResult<VehicleSample> {
+        let v = &row.values;
+        let mut sample = VehicleSample::at(v[self.t]);
+        if let Some(w) = self.wheels.as_mut()
+            && let Some([l, r]) = w
+                .cumulative(v[self.t], v)
+                .map_err(|m| CliError::row(path, row.number, m))?
+        {
+            sample = sample.with_wheels(l, r);
+        }
+        if let Some(g) = self.gyr.map(|g| v[g]).filter(|g| g.is_finite()) {
+            sample = sample.with_gyro(g);
+        }
+        if let Some([x, y]) = self
+            .mag
+            .filter(|[x, y]| v[*x].is_finite() && v[*y].is_finite())
+        {
+            sample = sample.with_mag(Vector2::new(v[x], v[y]));
+        }
+        Ok(sample)
+    }
+}
+
+/// Runs `method` over every row, each final estimate to `writer`; the number of rows.
+fn estimate(
+    rows: &mut RowReader,
+    columns: &mut Columns,
+    method: &mut dyn VehicleRun,
+    writer: &mut Writer,
+) -> CliResult<usize> {
+    let path = rows.path().to_path_buf();
+    let mut samples = 0usize;
+    while let Some(row) = rows.next_row()? {
+        let sample = columns.sample(row, &path)?;
+        method
+            .push(&sample, &mut |e, filter| writer.write(e, filter))
+            .map_err(|e| CliError::row(&path, row.number, e.to_string()))?;
+        if let Some(e) = writer.error.take() {
+            return Err(e);
+        }
+        samples += 1;
+    }
+    method
+        .finish(&mut |e, filter| writer.write(e, filter))
+        .map_err(|e| CliError::file(&path, e.to_string()))?;
+    if let Some(e) = writer.error.take() {
+        return Err(e);
+    }
+    if samples == 0 {
+        return Err(CliError::file(&path, "has no data rows"));
+    }
+    Ok(samples)
+}
+
+/// Writes what the drive learned, for `--calibration-in` of the next.
+fn save_calibration(path: &Path, learned: &VehicleCalibration) -> CliResult {
+    let json = serde_json::to_string_pretty(learned)
+        .map_err(|e| CliError::msg(format!("drive: cannot write the calibration: {e}")))?;
+    write_atomically(path, |w| Ok(w.write_all(json.as_bytes())?))
 }
 
 /// The output columns and how each row is written.
@@ -154,6 +368,18 @@ struct Writer {
 }
 
 impl Writer {
+    fn create(args: &Args, declination: Option<Declination>) -> CliResult<Self> {
+        Ok(Self {
+            out: CsvOutput::create(&args.output, &Self::header(&args.extra))?,
+            extra: args.extra.clone(),
+            declination,
+            rows: 0,
+            gaps: 0,
+            error: None,
+            last: None,
+        })
+    }
+
     fn header(extra: &[Extra]) -> Vec<&'static str> {
         let mut h = vec!["t_s", "north_m", "east_m", "heading_deg"];
         for e in extra {
@@ -187,10 +413,26 @@ impl Writer {
         h
     }
 
+    /// Writes one estimate (nothing after a write has failed: the error is kept for the
+    /// caller).
     fn write(&mut self, e: &NavEstimate, filter: Option<&NavFilter>) {
         if self.error.is_some() {
             return;
         }
+        let mut row = self.position_and_heading(e);
+        for x in &self.extra {
+            extra_cells(*x, e, filter, &mut row);
+        }
+        if let Err(err) = self.out.row(&row) {
+            self.error = Some(err);
+        }
+        self.rows += 1;
+        self.gaps += usize::from(e.status.gap);
+        self.last = Some(*e);
+    }
+
+    /// The contract's columns: `t_s,north_m,east_m,heading_deg`.
+    fn position_and_heading(&self, e: &NavEstimate) -> Vec<f64> {
         let (mut n, mut east, mut heading) = (e.north_m, e.east_m, e.heading.rad());
         if let Some(d) = self.declination {
             // True north: the heading and the whole track turn by the declination.
@@ -202,274 +444,65 @@ impl Writer {
             // No wheels: no position, written as empty cells.
             (n, east) = (f64::NAN, f64::NAN);
         }
-        let mut row = vec![e.t_s, n, east, rad_to_deg(wrap_two_pi(heading))];
-        for x in &self.extra {
-            match x {
-                Extra::Sigma => {
-                    let p = e.position_cov_m2;
-                    let known = e.status.position_known;
-                    let sigma = |v: f64| if known { v.max(0.0).sqrt() } else { f64::NAN };
-                    row.extend([
-                        rad_to_deg(e.heading_sigma_rad),
-                        sigma(p[(0, 0)]),
-                        sigma(p[(1, 1)]),
-                    ]);
-                }
-                Extra::Status => {
-                    let s = e.status;
-                    row.extend(
-                        [
-                            s.heading_absolute,
-                            s.compass_used,
-                            s.compass_disturbed,
-                            s.at_rest,
-                        ]
-                        .map(|b| f64::from(u8::from(b))),
-                    );
-                }
-                Extra::Calibration => match filter {
-                    Some(f) => {
-                        let x = &f.x;
-                        use truenorth::fusion::vehicle::nav_filter::*;
-                        row.extend([
-                            rad_to_deg(x[BIAS]),
-                            1.0 + x[GAIN_POS],
-                            1.0 + x[GAIN_NEG],
-                            x[WHEEL_DIFF],
-                            x[TRACK_SCALE],
-                            x[SPEED_COEFF],
-                        ]);
-                    }
-                    None => row.extend([f64::NAN; 6]),
-                },
-                Extra::Trust => {
-                    let u = e.status.unobserved;
-                    row.extend(
-                        [
-                            e.status.gap,
-                            u.gyro_bias,
-                            u.gyro_gain_right,
-                            u.gyro_gain_left,
-                            u.wheel_diff,
-                            u.track_scale,
-                            u.speed_coeff,
-                        ]
-                        .map(|b| f64::from(u8::from(b))),
-                    );
-                }
-            }
-        }
-        if let Err(err) = self.out.row(&row) {
-            self.error = Some(err);
-        }
-        self.rows += 1;
-        self.gaps += usize::from(e.status.gap);
-        self.last = Some(*e);
+        vec![e.t_s, n, east, rad_to_deg(wrap_two_pi(heading))]
     }
 }
 
-/// Runs the subcommand.
-pub fn run(args: &Args) -> CliResult {
-    let mut inputs: Vec<&Path> = vec![&args.input, &args.vehicle];
-    if let Some(c) = &args.calibration_in {
-        inputs.push(c);
-    }
-    check_distinct(&args.output, &inputs)?;
-    if let Some(c) = &args.calibration_out {
-        check_distinct(c, &inputs)?;
-        if c == &args.output {
-            return Err(CliError::msg(
-                "drive: --calibration-out and --output name the same file",
-            ));
-        }
-    }
-    if args.extra.contains(&Extra::Calibration) && args.method != Method::Fused {
-        return Err(CliError::msg(
-            "drive: --extra calibration needs --method fused (the seed methods learn other things)",
-        ));
-    }
-    const OPTIONAL: [&str; 7] = [
-        "dist_l_m",
-        "dist_r_m",
-        "speed_l_mps",
-        "speed_r_mps",
-        "gyr_z",
-        "mag_x",
-        "mag_y",
-    ];
-    let spec = ReadSpec::new(&["t_s"])
-        .optional(&OPTIONAL)
-        .increasing("t_s");
-    let mut rows = RowReader::open(&InputPath::new(&args.input), &args.input_options, &spec)?;
-    let ix = |n: &str| rows.index(n);
-    let mut wheel_columns = match (
-        ix("dist_l_m"),
-        ix("dist_r_m"),
-        ix("speed_l_mps"),
-        ix("speed_r_mps"),
-    ) {
-        (Some(l), Some(r), _, _) => Some(WheelColumns::Distances([l, r])),
-        (_, _, Some(l), Some(r)) => Some(WheelColumns::Speeds {
-            columns: [l, r],
-            last: None,
-            dist: [0.0; 2],
-        }),
-        _ => None,
+/// The cells of one `--extra` group, appended to `row`.
+fn extra_cells(x: Extra, e: &NavEstimate, filter: Option<&NavFilter>, row: &mut Vec<f64>) {
+    let flags = |b: &[bool]| {
+        b.iter()
+            .map(|&b| f64::from(u8::from(b)))
+            .collect::<Vec<_>>()
     };
-    if wheel_columns.is_none() && ix("gyr_z").is_none() {
-        return Err(CliError::row(
-            rows.path(),
-            1,
-            "needs a heading sensor: the wheels (`dist_l_m,dist_r_m` cumulative distances or `speed_l_mps,speed_r_mps` wheel speeds) or a gyro (`gyr_z`, rad/s)",
-        ));
-    }
-    let vehicle = VehicleFile::read(&args.vehicle)?;
-    let wheels = vehicle.wheels(&args.vehicle)?;
-    let declination = if args.place.is_given() {
-        Some(args.place.field()?.declination())
-    } else {
-        None
-    };
-    let mut priors = SensorPriors::for_wheels(&wheels);
-    if let Some(r) = vehicle.wheel_resolution_m {
-        priors.wheel_resolution_m = r;
-    } else if matches!(wheel_columns, Some(WheelColumns::Speeds { .. })) && !wheels.can_pivot() {
-        priors.wheel_resolution_m = SPEED_RESOLUTION_M;
-    }
-    let config = VehicleConfig {
-        wheels,
-        priors: Some(priors),
-        ..VehicleConfig::default()
-    };
-    let bad_config = |e: truenorth::core::Error| CliError::file(&args.vehicle, e.to_string());
-    let fused = match &args.calibration_in {
-        Some(path) => {
-            let text = std::fs::read_to_string(path)
-                .map_err(|e| CliError::file(path, format!("cannot read: {e}")))?;
-            let learned: VehicleCalibration = serde_json::from_str(&text)
-                .map_err(|e| CliError::file(path, format!("not a drive calibration: {e}")))?;
-            VehicleEstimator::with_calibration(config, &learned)
-                .map_err(|e| CliError::file(path, e.to_string()))?
+    match x {
+        Extra::Sigma => {
+            let p = e.position_cov_m2;
+            let known = e.status.position_known;
+            let sigma = |v: f64| if known { v.max(0.0).sqrt() } else { f64::NAN };
+            row.extend([
+                rad_to_deg(e.heading_sigma_rad),
+                sigma(p[(0, 0)]),
+                sigma(p[(1, 1)]),
+            ]);
         }
-        None => VehicleEstimator::new(config).map_err(bad_config)?,
-    };
-    let mut estimator = match args.method {
-        Method::Fused if args.single_pass => Estimator::Causal(Box::new(fused)),
-        Method::Fused => {
-            Estimator::Fused(Box::new(TwoPassStart::new(fused, TwoPassConfig::default())))
+        Extra::Status => {
+            let s = e.status;
+            row.extend(flags(&[
+                s.heading_absolute,
+                s.compass_used,
+                s.compass_disturbed,
+                s.at_rest,
+            ]));
         }
-        Method::SeedOdometerCompass => Estimator::Seed(Box::new(
-            SeedOdometerCompass::new(SeedOdometerCompassConfig {
-                wheels,
-                ..SeedOdometerCompassConfig::default()
-            })
-            .map_err(bad_config)?,
-        )),
-        Method::SeedGyroCompass => Estimator::Seed(Box::new(
-            SeedGyroCompass::new(SeedGyroCompassConfig {
-                wheels,
-                ..SeedGyroCompassConfig::default()
-            })
-            .map_err(bad_config)?,
-        )),
-    };
-
-    let (t, gyr) = (ix("t_s").unwrap_or(0), ix("gyr_z"));
-    let mag = match (ix("mag_x"), ix("mag_y")) {
-        (Some(x), Some(y)) => Some([x, y]),
-        (None, None) => None,
-        _ => {
-            return Err(CliError::row(
-                rows.path(),
-                1,
-                "has one of mag_x, mag_y but not both; give both (any unit, uncalibrated) or neither",
-            ));
-        }
-    };
-    let mut writer = Writer {
-        out: CsvOutput::create(&args.output, &Writer::header(&args.extra))?,
-        extra: args.extra.clone(),
-        declination,
-        rows: 0,
-        gaps: 0,
-        error: None,
-        last: None,
-    };
-    let path = rows.path().to_path_buf();
-    let mut samples = 0usize;
-    while let Some(row) = rows.next_row()? {
-        let v = &row.values;
-        let number = row.number;
-        let mut sample = VehicleSample::at(v[t]);
-        if let Some(w) = wheel_columns.as_mut()
-            && let Some([l, r]) = w
-                .cumulative(v[t], v)
-                .map_err(|m| CliError::row(&path, number, m))?
-        {
-            sample = sample.with_wheels(l, r);
-        }
-        if let Some(g) = gyr.map(|g| v[g]).filter(|g| g.is_finite()) {
-            sample = sample.with_gyro(g);
-        }
-        if let Some([x, y]) = mag.filter(|[x, y]| v[*x].is_finite() && v[*y].is_finite()) {
-            sample = sample.with_mag(Vector2::new(v[x], v[y]));
-        }
-        let bad = |e: truenorth::core::Error| CliError::row(&path, number, e.to_string());
-        match &mut estimator {
-            Estimator::Fused(two) => two
-                .push(&sample, |_, e, est| writer.write(e, Some(est.filter())))
-                .map_err(bad)?,
-            Estimator::Causal(est) => {
-                let e = est.update(&sample).map_err(bad)?;
-                writer.write(&e, Some(est.filter()));
+        Extra::Calibration => match filter {
+            Some(f) => {
+                let x = &f.x;
+                use truenorth::fusion::vehicle::nav_filter::*;
+                row.extend([
+                    rad_to_deg(x[BIAS]),
+                    1.0 + x[GAIN_POS],
+                    1.0 + x[GAIN_NEG],
+                    x[WHEEL_DIFF],
+                    x[TRACK_SCALE],
+                    x[SPEED_COEFF],
+                ]);
             }
-            Estimator::Seed(est) => {
-                let e = est.update(&sample).map_err(bad)?;
-                writer.write(&e, None);
-            }
+            None => row.extend([f64::NAN; 6]),
+        },
+        Extra::Trust => {
+            let u = e.status.unobserved;
+            row.extend(flags(&[
+                e.status.gap,
+                u.gyro_bias,
+                u.gyro_gain_right,
+                u.gyro_gain_left,
+                u.wheel_diff,
+                u.track_scale,
+                u.speed_coeff,
+            ]));
         }
-        if let Some(e) = writer.error.take() {
-            return Err(e);
-        }
-        samples += 1;
     }
-    if let Estimator::Fused(two) = &mut estimator {
-        two.finish(|_, e, est| writer.write(e, Some(est.filter())))
-            .map_err(|e| CliError::file(&path, e.to_string()))?;
-    }
-    if let Some(e) = writer.error.take() {
-        return Err(e);
-    }
-    if samples == 0 {
-        return Err(CliError::file(&path, "has no data rows"));
-    }
-    let learned = match &estimator {
-        Estimator::Fused(two) => Some(two.estimator().calibration()),
-        Estimator::Causal(est) => Some(est.calibration()),
-        Estimator::Seed(_) => None,
-    };
-    if let (Some(out), Some(learned)) = (&args.calibration_out, learned) {
-        let json = serde_json::to_string_pretty(&learned)
-            .map_err(|e| CliError::msg(format!("drive: cannot write the calibration: {e}")))?;
-        write_atomically(out, |w| Ok(w.write_all(json.as_bytes())?))?;
-    }
-    let Writer {
-        out,
-        last,
-        rows: written,
-        gaps,
-        ..
-    } = writer;
-    out.commit()?;
-    summary(
-        args,
-        samples,
-        written,
-        gaps,
-        last.as_ref(),
-        learned.as_ref(),
-    );
-    Ok(())
 }
 
 /// One line on stderr: what was done and what was learned.

@@ -2,19 +2,13 @@
 //! circle and applied to the whole drive, the refusal of half a circle, and a plot of the
 //! least-squares fit.
 
-use truenorth::calib::{
-    BinnedEllipseCalibrator, EllipseCalibrator, MeritCircleCalibrator, OnlineEllipseCalibrator,
-    OnlineEllipseConfig, TurnCompassCalibrator,
-};
 use truenorth::compass::CompassCalibration2d;
-use truenorth::core::{Calibrator, CompassQuality, Mag2Sample};
+use truenorth::core::Mag2Sample;
 
 use super::sensors::{DemoDrive, heading_error};
 use crate::io::{CliError, CliResult};
 use crate::plot::{Series, Style, write_plot};
-
-type Compass2dCalibrator =
-    dyn Calibrator<Sample = Mag2Sample, Params = CompassCalibration2d, Quality = CompassQuality>;
+use crate::registry::{CalibrationMethod, Planar};
 
 pub(super) fn compass_section(d: &DemoDrive, out: &std::path::Path) -> CliResult {
     let cal_samples: Vec<Mag2Sample> = d
@@ -51,31 +45,24 @@ pub(super) fn compass_section(d: &DemoDrive, out: &std::path::Path) -> CliResult
         "{:<26} {:>9.2} {:>9.2} {:>9} {:>9} {:>9} {:>9} {:>11}",
         "(noise floor: true cal.)", floor.rms_deg, floor.max_deg, "-", "-", "-", "-", "-"
     );
-    let mut methods: Vec<(&str, Box<Compass2dCalibrator>)> = vec![
-        (
-            "least-squares ellipse",
-            Box::new(EllipseCalibrator::default()),
-        ),
-        (
-            "online least squares",
-            Box::new(
-                OnlineEllipseCalibrator::new(OnlineEllipseConfig::default())
-                    .map_err(|e| CliError::msg(e.to_string()))?,
-            ),
-        ),
+    let mut methods: Vec<(&str, Box<Planar>)> = Vec::new();
+    for (name, method) in [
+        ("least-squares ellipse", CalibrationMethod::Ellipse),
+        ("online least squares", CalibrationMethod::OnlineEllipse),
         (
             "binned ellipse (EP0634001)",
-            Box::new(BinnedEllipseCalibrator::default()),
+            CalibrationMethod::BinnedEllipse,
         ),
-        (
-            "merit circle (US5297063)",
-            Box::new(MeritCircleCalibrator::default()),
-        ),
-        (
-            "turn extrema (EP0640207)",
-            Box::new(TurnCompassCalibrator::default()),
-        ),
-    ];
+        ("merit circle (US5297063)", CalibrationMethod::MeritCircle),
+        ("turn extrema (EP0640207)", CalibrationMethod::Turn),
+    ] {
+        let calibrator = method
+            .calibrator(None)
+            .map_err(|e| CliError::msg(e.to_string()))?
+            .into_planar()
+            .ok_or_else(|| CliError::msg(format!("{name}: not a two-axis method")))?;
+        methods.push((name, calibrator));
+    }
     let mut ls_fit: Option<(CompassCalibration2d, f64)> = None;
     for (name, cal) in methods.iter_mut() {
         for s in &cal_samples {

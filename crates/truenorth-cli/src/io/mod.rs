@@ -35,7 +35,7 @@ pub use calibration_file::{
 };
 pub use columns::InputOptions;
 pub use error::{CliError, CliResult};
-pub use reader::{ReadSpec, RowReader};
+pub use reader::{ReadSpec, Row, RowReader};
 pub use source::InputPath;
 pub use table::Table;
 pub use vehicle_file::VehicleFile;
