@@ -1,6 +1,6 @@
 //! `truenorth`: calibrate compasses, compute heading, and run the simulator demo from the
-//! command line. The CSV/JSON contract is in `ARCHITECTURE.md` and in each subcommand's
-//! `--help`. Errors exit non-zero with one line on stderr naming the file, the row and the
+//! command line. The CSV/JSON contract is in ARCHITECTURE.md, section "CLI contract", and in
+//! each subcommand's `--help`. Errors exit non-zero with one line on stderr naming the file, the row and the
 //! problem.
 
 mod commands;

@@ -65,8 +65,7 @@ with the row where the evidence became clear.";
 
 /// Distance resolution assumed for integrated wheel speeds, m: a CAN bus's 0.01 km/h over
 /// the one second in which the estimator compares wheels with gyro. The pulse default
-/// (2 cm) would make such wheels look a hundred times noisier than they are (on the real
-/// drive of `tests/comma2k19.rs` the heading then ended 4.7° off instead of 0.1°).
+/// (2 cm) would make such wheels look a hundred times noisier than they are.
 const SPEED_RESOLUTION_M: f64 = 0.003;
 
 /// Optional output column groups.
