@@ -202,18 +202,45 @@ pub struct OrientationReading {
 }
 
 /// An orientation estimator with true north.
+///
+/// The estimator may be chosen at run time: a boxed pipeline around a concrete estimator
+/// coerces to one around `dyn OrientationEstimator` (the estimator is the struct's last
+/// field), so every method runs through the same code.
+///
+/// ```
+/// use nalgebra::Vector3;
+/// use truenorth::core::{ImuSample, OrientationEstimator};
+/// use truenorth::fusion::{EulerDetector, QuaternionFilter};
+/// use truenorth::pipeline::OrientationPipeline;
+///
+/// type AnyMethod = OrientationPipeline<dyn OrientationEstimator>;
+/// let by_name = |name: &str| -> truenorth::core::Result<Box<AnyMethod>> {
+///     Ok(match name {
+///         "euler-detector" => {
+///             Box::new(OrientationPipeline::new(EulerDetector::new(Default::default())?))
+///         }
+///         _ => Box::new(OrientationPipeline::new(QuaternionFilter::new(Default::default())?)),
+///     })
+/// };
+/// let mut pipeline = by_name("euler-detector")?;
+/// let at_rest = ImuSample::new_6d(0.0, Vector3::zeros(), Vector3::new(0.0, 0.0, -9.81));
+/// let reading = pipeline.update(&at_rest)?;
+/// // Level at rest: the body's z axis points down.
+/// assert!((reading.attitude_true * Vector3::z()).z > 0.999);
+/// # Ok::<(), truenorth::core::Error>(())
+/// ```
 #[derive(Debug, Clone)]
-pub struct OrientationPipeline<E> {
-    estimator: E,
+pub struct OrientationPipeline<E: ?Sized> {
     to_true: UnitQuaternion<f64>,
+    estimator: E,
 }
 
 impl<E: OrientationEstimator> OrientationPipeline<E> {
     /// A pipeline around `estimator`, on magnetic north.
     pub fn new(estimator: E) -> Self {
         Self {
-            estimator,
             to_true: UnitQuaternion::identity(),
+            estimator,
         }
     }
 
@@ -224,7 +251,9 @@ impl<E: OrientationEstimator> OrientationPipeline<E> {
         self.to_true = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), d);
         Ok(self)
     }
+}
 
+impl<E: OrientationEstimator + ?Sized> OrientationPipeline<E> {
     /// Feeds one sample to the estimator.
     pub fn update(&mut self, sample: &ImuSample) -> Result<OrientationReading> {
         let estimate = self.estimator.update(sample)?;

@@ -1,25 +1,20 @@
 //! `truenorth`: calibrate compasses, compute heading, and run the simulator demo from the
-//! command line. The CSV/JSON contract is in `ARCHITECTURE.md` and in each subcommand's
-//! `--help`. Errors exit non-zero with one line on stderr naming the file, the row and the
+//! command line. The CSV/JSON contract is in ARCHITECTURE.md, section "CLI contract", and in
+//! each subcommand's `--help`. Errors exit non-zero with one line on stderr naming the file, the row and the
 //! problem.
 
-mod calibrate;
+mod commands;
 mod demo;
-mod demo_drive;
-mod demo_orientation;
-mod drive;
-mod eval_broad;
-mod field;
-mod heading;
+mod eval;
 mod io;
-mod mag_unit;
-mod orientation;
-mod svg;
-mod svg_timeseries;
+mod plot;
+mod registry;
 
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
+
+use commands::{calibrate, drive, field, heading, orientation};
 
 /// Calibrated heading, orientation and dead reckoning from low-cost navigation sensors.
 ///
@@ -59,7 +54,7 @@ enum Command {
 #[derive(Debug, Subcommand)]
 enum EvalCommand {
     /// The BROAD benchmark (its trial folder, BROAD's own error metric).
-    Broad(eval_broad::Args),
+    Broad(eval::broad::Args),
 }
 
 fn main() -> ExitCode {
@@ -71,7 +66,7 @@ fn main() -> ExitCode {
         Command::Field(a) => field::run(&a),
         Command::Orientation(a) => orientation::run(&a),
         Command::Drive(a) => drive::run(&a),
-        Command::Eval(EvalCommand::Broad(a)) => eval_broad::run(&a),
+        Command::Eval(EvalCommand::Broad(a)) => eval::broad::run(&a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -1,10 +1,6 @@
 //! The calibration file written by `truenorth calibrate` and read by `truenorth heading`:
 //! its JSON layout, and the checks a file must pass before it is used.
 
-// `!(x > 0.0)` and `!(x <= limit)` are deliberate: they are true for NaN, so a NaN fails
-// every check instead of slipping through one.
-#![allow(clippy::neg_cmp_op_on_partial_ord)]
-
 use std::collections::BTreeMap;
 use std::path::Path;
 
@@ -348,7 +344,8 @@ fn rows<const N: usize>(
 /// Refuses a soft iron that is singular, reflecting or too ill-conditioned to give
 /// trustworthy headings.
 fn check_soft_iron(det: f64, singular_values: &[f64]) -> Result<(), String> {
-    if !(det > 0.0) {
+    // A NaN fails every check instead of slipping through one.
+    if det.is_nan() || det <= 0.0 {
         return Err(format!(
             "`soft_iron` has determinant {det:.3e}: a singular matrix collapses every reading onto a line (constant headings) and a negative one mirrors them; recalibrate"
         ));
@@ -359,7 +356,7 @@ fn check_soft_iron(det: f64, singular_values: &[f64]) -> Result<(), String> {
         .copied()
         .fold(f64::INFINITY, f64::min);
     let condition = max / min;
-    if !(condition <= MAX_SOFT_IRON_CONDITION) {
+    if condition.is_nan() || condition > MAX_SOFT_IRON_CONDITION {
         return Err(format!(
             "`soft_iron` has condition number {condition:.1}, more than {MAX_SOFT_IRON_CONDITION}: it would squash the field nearly onto a line; recalibrate"
         ));

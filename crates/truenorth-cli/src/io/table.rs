@@ -110,3 +110,56 @@ impl Table {
         Ok(())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::io::write_csv;
+    use proptest::prelude::*;
+    use std::path::PathBuf;
+
+    fn temp_file(tag: &str, contents: &[u8]) -> PathBuf {
+        let path = std::env::temp_dir().join(format!(
+            "truenorth-io-{tag}-{}-{:?}",
+            std::process::id(),
+            std::thread::current().id()
+        ));
+        std::fs::write(&path, contents).expect("temp dir is writable");
+        path
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(64))]
+
+        /// What write_csv writes, Table::read reads back exactly (Rust prints the shortest
+        /// text that parses back to the same f64).
+        #[test]
+        fn write_then_read_round_trips(rows in proptest::collection::vec((-1e12f64..1e12, -1e6f64..1e6), 1..50)) {
+            let path = temp_file("rt", b"");
+            write_csv(&path, &["t_s", "mag_x"], rows.iter().map(|&(a, b)| vec![a, b])).unwrap();
+            let t = Table::read(&path, &["t_s", "mag_x"], &["mag_z"]).unwrap();
+            prop_assert_eq!(t.len(), rows.len());
+            prop_assert!(t.col("mag_z").is_none());
+            for (k, &(a, b)) in rows.iter().enumerate() {
+                prop_assert_eq!(t.req("t_s").unwrap()[k], a);
+                prop_assert_eq!(t.req("mag_x").unwrap()[k], b);
+            }
+            std::fs::remove_file(&path).ok();
+        }
+
+        /// Any bytes at all: a table or a one-line error naming the file, never a panic.
+        #[test]
+        fn any_file_reads_or_fails_with_one_line(bytes in proptest::collection::vec(any::<u8>(), 0..400)) {
+            let path = temp_file("any", &bytes);
+            match Table::read(&path, &["t_s"], &["mag_x"]) {
+                Ok(t) => prop_assert!(t.req("t_s").unwrap().iter().all(|v| v.is_finite())),
+                Err(e) => {
+                    let line = e.to_string();
+                    prop_assert!(!line.contains('\n'), "{}", line);
+                    prop_assert!(line.contains("truenorth-io-any"), "{}", line);
+                }
+            }
+            std::fs::remove_file(&path).ok();
+        }
+    }
+}

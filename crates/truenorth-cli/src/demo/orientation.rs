@@ -5,15 +5,13 @@
 
 use std::path::Path;
 
-use truenorth::core::{AttitudeEstimate, OrientationEstimator, Result};
-use truenorth::fusion::{
-    AttitudeError, EulerDetector, EulerDetectorConfig, GyroTiming, QuaternionFilter,
-    QuaternionFilterConfig,
-};
+use truenorth::core::{AttitudeEstimate, Result};
+use truenorth::fusion::AttitudeError;
 use truenorth_sim::{HandheldParams, ImuSensorParams, handheld_motion, imu_streams};
 
 use crate::io::{CliError, CliResult};
-use crate::svg_timeseries::{Line, write_timeseries};
+use crate::plot::{Line, write_timeseries};
+use crate::registry::{OrientationMethod, Timing};
 
 /// One estimator's run: RMS heading and inclination error (degrees) after `settle_s`, and
 /// the total error angle over time (s, degrees).
@@ -61,7 +59,7 @@ fn run(
 }
 
 /// Prints the orientation table and writes `orientation_error.svg` into `out`.
-pub fn orientation_section(seed: u64, out: &Path) -> CliResult {
+pub(super) fn orientation_section(seed: u64, out: &Path) -> CliResult {
     println!(
         "\nOrientation on 300 s of simulated hand-held motion (consumer IMU: gyro bias 0.3 deg/s per axis, never at rest), errors after the first 30 s"
     );
@@ -71,19 +69,13 @@ pub fn orientation_section(seed: u64, out: &Path) -> CliResult {
     );
     let err = |e: truenorth::core::Error| CliError::msg(e.to_string());
     // The simulator's gyro reads the instantaneous rate at each sample.
-    let quaternion = |use_mag: bool| {
-        QuaternionFilter::new(QuaternionFilterConfig {
-            use_mag,
-            gyro_timing: GyroTiming::Instantaneous,
-            ..QuaternionFilterConfig::default()
-        })
+    let run_method = |method: OrientationMethod, use_mag: bool| -> Result<Run> {
+        let mut m = method.pipeline(use_mag, Timing::Instantaneous)?;
+        run(|s| Ok(m.update(s)?.estimate), !use_mag, seed, 30.0)
     };
-    let mut f9 = quaternion(true).map_err(err)?;
-    let q9 = run(|s| f9.update(s), false, seed, 30.0).map_err(err)?;
-    let mut f6 = quaternion(false).map_err(err)?;
-    let q6 = run(|s| f6.update(s), true, seed, 30.0).map_err(err)?;
-    let mut d = EulerDetector::new(EulerDetectorConfig::default()).map_err(err)?;
-    let euler = run(|s| d.update(s), false, seed, 30.0).map_err(err)?;
+    let q9 = run_method(OrientationMethod::Quaternion, true).map_err(err)?;
+    let q6 = run_method(OrientationMethod::Quaternion, false).map_err(err)?;
+    let euler = run_method(OrientationMethod::EulerDetector, true).map_err(err)?;
     for (name, r, heading) in [
         ("quaternion filter, 9-D", &q9, true),
         ("quaternion filter, 6-D", &q6, false),
@@ -126,6 +118,10 @@ pub fn orientation_section(seed: u64, out: &Path) -> CliResult {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use truenorth::core::OrientationEstimator;
+    use truenorth::fusion::{
+        EulerDetector, EulerDetectorConfig, GyroTiming, QuaternionFilter, QuaternionFilterConfig,
+    };
 
     /// The demo's figures: the filter learns the 0.3°/s-per-axis bias in motion and stays
     /// within a few degrees; the detector, which has no bias estimate, lags by the bias

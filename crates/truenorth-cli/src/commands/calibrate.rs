@@ -2,80 +2,29 @@
 //! quality report and verdict, as JSON; the turn method with a yaw rate calibrates the
 //! gyro beside it.
 //!
-//! Every 2-D method is a `Calibrator<Sample = Mag2Sample, Params = CompassCalibration2d>`,
-//! so adding one is one arm in [`run`]; the 3-D methods are the same with `Mag3Sample` and
-//! `CompassCalibration3d`, and `ellipsoid-accel` fits both sensors together.
+//! Every method comes from the registry ([`CalibrationMethod::calibrator`]) boxed behind the
+//! `Calibrator` of its samples: every 2-D method is a `Calibrator<Sample = Mag2Sample,
+//! Params = CompassCalibration2d>`, so adding one is one arm in the registry; the 3-D
+//! methods are the same with `Mag3Sample` and `CompassCalibration3d`, and `ellipsoid-accel`
+//! fits both sensors together.
 
 use std::path::PathBuf;
 
 use nalgebra::{SMatrix, SVector, Vector2, Vector3};
 use truenorth::calib::quality::{self, Cause, Grade, Uncertainty, Verdict};
-use truenorth::calib::{
-    BinnedEllipseCalibrator, EllipseCalibrator, EllipsoidCalibrator, MagAccelCalibrator,
-    MagAccelConfig, MagAccelQuality, MagAccelSample, MeritCircleCalibrator,
-    OnlineEllipseCalibrator, OnlineEllipsoidCalibrator, TurnCalibrator, TurnCompassCalibrator,
-    TurnConfig, TurnQuality, TurnSample,
-};
-use truenorth::compass::{CompassCalibration2d, CompassCalibration3d};
+use truenorth::calib::{MagAccelQuality, MagAccelSample, TurnQuality, TurnSample};
 use truenorth::core::{Calibrator, CompassQuality, Mag2Sample, Mag3Sample, Solution};
 
-use crate::field::Place;
+use super::field::Place;
+use super::mag_unit::{MagUnit, check_field};
 use crate::io::{
     AccelPart, CALIBRATION_FORMAT, CALIBRATION_VERSION, CalibrationFile, CliError, CliResult,
     GyroPart, InputOptions, InputPath, QualityReport, ReadSpec, Table, check_distinct, finite,
     gyro_units, matrix_rows, units_block,
 };
-use crate::mag_unit::{MagUnit, check_field};
-
-/// Calibration methods.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum Method {
-    /// Least-squares ellipse (2-D): direct fit refined geometrically; hard + symmetric soft iron.
-    Ellipse,
-    /// Least-squares ellipsoid (3-D, needs mag_z): hard iron + full symmetric soft iron.
-    Ellipsoid,
-    /// Magnetometer and accelerometer together (needs mag_x,mag_y,mag_z,acc_x,acc_y,acc_z,
-    /// static or slow readings): accelerometer bias, scale and cross-axis, magnetometer hard
-    /// and soft iron, the rotation between the two (from the constant dip), and the pointing
-    /// axis from runs of shots aimed at one target while rolling (found automatically).
-    EllipsoidAccel,
-    /// Online least-squares ellipse (2-D): the same direct fit from running sums, in
-    /// constant memory, as a vehicle would run it while driving.
-    OnlineEllipse,
-    /// Online least-squares ellipsoid (3-D, needs mag_z), in constant memory.
-    OnlineEllipsoid,
-    /// Binned ellipse (EP 0634001): heading bins, origin iteration, ellipse phasors.
-    BinnedEllipse,
-    /// Merit circle (US 5,297,063): merit-weighted circumcentres; hard iron only.
-    MeritCircle,
-    /// One full turn (EP 0640207): compass centre and radii from the extrema; with `gyr_z`,
-    /// also the gyro's zero (from a standstill at the start) and scale.
-    Turn,
-}
-
-impl Method {
-    /// The name used on the command line and in the output file.
-    fn name(self) -> &'static str {
-        match self {
-            Method::Ellipse => "ellipse",
-            Method::Ellipsoid => "ellipsoid",
-            Method::EllipsoidAccel => "ellipsoid-accel",
-            Method::OnlineEllipse => "online-ellipse",
-            Method::OnlineEllipsoid => "online-ellipsoid",
-            Method::BinnedEllipse => "binned-ellipse",
-            Method::MeritCircle => "merit-circle",
-            Method::Turn => "turn",
-        }
-    }
-
-    /// 2 or 3.
-    fn dimensions(self) -> usize {
-        match self {
-            Method::Ellipsoid | Method::EllipsoidAccel | Method::OnlineEllipsoid => 3,
-            _ => 2,
-        }
-    }
-}
+use crate::registry::{
+    CalibrationMethod, CompassCalibrator, MagAccel, Planar, Spatial, TurnWithGyro,
+};
 
 /// The long help of the command (after the options).
 const AFTER_HELP: &str =
@@ -143,7 +92,7 @@ y left, z up, field in µT, recorded in London:
 pub struct Args {
     /// Calibration method.
     #[arg(long, value_enum)]
-    pub method: Method,
+    pub method: CalibrationMethod,
     /// Input CSV (`-`: standard input; `.gz` or gzip data read as such).
     #[arg(long)]
     pub input: PathBuf,
@@ -212,23 +161,13 @@ pub fn run(args: &Args) -> CliResult {
         )));
     }
     let expected = expected_field(args, args.method.dimensions())?;
-    let fitted = match args.method {
-        Method::Ellipse => calibrate_2d(args, EllipseCalibrator::default(), expected)?,
-        Method::Ellipsoid => calibrate_3d(args, EllipsoidCalibrator::default(), expected)?,
-        Method::EllipsoidAccel => calibrate_joint(args, expected)?,
-        Method::OnlineEllipse => calibrate_2d(
-            args,
-            OnlineEllipseCalibrator::new(Default::default()).map_err(library)?,
-            expected,
-        )?,
-        Method::OnlineEllipsoid => calibrate_3d(
-            args,
-            OnlineEllipsoidCalibrator::new(Default::default()).map_err(library)?,
-            expected,
-        )?,
-        Method::BinnedEllipse => calibrate_2d(args, BinnedEllipseCalibrator::default(), expected)?,
-        Method::MeritCircle => calibrate_2d(args, MeritCircleCalibrator::default(), expected)?,
-        Method::Turn => calibrate_turn(args, expected)?,
+    let fitted = match args.method.calibrator(expected).map_err(library)? {
+        CompassCalibrator::Planar(cal) => calibrate_2d(args, cal, expected)?,
+        CompassCalibrator::Spatial(cal) => calibrate_3d(args, cal, expected)?,
+        CompassCalibrator::MagAccel(cal) => calibrate_joint(args, cal)?,
+        CompassCalibrator::Turn { compass, with_gyro } => {
+            calibrate_turn(args, compass, with_gyro, expected)?
+        }
     };
     let input = InputPath::new(&args.input).display_path();
     let warn = |w: &str| eprintln!("truenorth: warning: {}: {w}", input.display());
@@ -346,10 +285,7 @@ fn vectors(table: &Table, names: [&str; 3]) -> CliResult<Vec<Vector3<f64>>> {
 }
 
 /// Feeds every row to a 2-D calibrator, solves, and builds the output file.
-fn calibrate_2d<C>(args: &Args, cal: C, expected: Option<f64>) -> CliResult<Fitted>
-where
-    C: Calibrator<Sample = Mag2Sample, Params = CompassCalibration2d, Quality = CompassQuality>,
-{
+fn calibrate_2d(args: &Args, cal: Box<Planar>, expected: Option<f64>) -> CliResult<Fitted> {
     let (table, t) = read_input(args, &["mag_x", "mag_y"])?;
     solve_2d(args, &table, &t, cal, expected)
 }
@@ -361,23 +297,20 @@ fn mag2(table: &Table) -> CliResult<Vec<Vector2<f64>>> {
 }
 
 /// [`calibrate_2d`] on a table already read, with its times `t`.
-fn solve_2d<C>(
+fn solve_2d(
     args: &Args,
     table: &Table,
     t: &[f64],
-    mut cal: C,
+    mut cal: Box<Planar>,
     expected: Option<f64>,
-) -> CliResult<Fitted>
-where
-    C: Calibrator<Sample = Mag2Sample, Params = CompassCalibration2d, Quality = CompassQuality>,
-{
+) -> CliResult<Fitted> {
     let points = mag2(table)?;
     let samples: Vec<Mag2Sample> = points
         .iter()
         .zip(t)
         .map(|(&mag, &t_s)| Mag2Sample { t_s, mag })
         .collect();
-    let sol = feed_and_solve(args, table, &mut cal, &samples, expected)?;
+    let sol = feed_and_solve(args, table, &mut *cal, &samples, expected)?;
     let u = quality::assess_2d(&points, &sol.params, sol.quality.field_magnitude).uncertainty;
     Ok(fitted(
         args,
@@ -388,14 +321,19 @@ where
     ))
 }
 
-/// The turn method (EP 0640207, METHODS.md §A). With `gyr_z`, the whole calibration of one
+/// The turn method (EP 0640207). With `gyr_z`, the whole calibration of one
 /// turn ([`TurnCalibrator`]): the gyro's zero and scale, and the compass from the same
 /// extrema (placed by the sinusoid fit the gyro's relative heading allows). Without it, the
 /// compass half alone ([`TurnCompassCalibrator`]).
-fn calibrate_turn(args: &Args, expected: Option<f64>) -> CliResult<Fitted> {
+fn calibrate_turn(
+    args: &Args,
+    compass: Box<Planar>,
+    mut with_gyro: Box<TurnWithGyro>,
+    expected: Option<f64>,
+) -> CliResult<Fitted> {
     let (table, t) = read_input_with(args, &["mag_x", "mag_y"], &["t_s", "gyr_z"])?;
     let Some(gyr) = table.col("gyr_z") else {
-        return solve_2d(args, &table, &t, TurnCompassCalibrator::default(), expected);
+        return solve_2d(args, &table, &t, compass, expected);
     };
     if table.col("t_s").is_none() {
         return Err(CliError::file(
@@ -411,8 +349,7 @@ fn calibrate_turn(args: &Args, expected: Option<f64>) -> CliResult<Fitted> {
             mag: points[k],
         })
         .collect();
-    let mut cal = TurnCalibrator::new(TurnConfig::default()).map_err(library)?;
-    let sol = feed_and_solve(args, &table, &mut cal, &samples, expected)?;
+    let sol = feed_and_solve(args, &table, &mut *with_gyro, &samples, expected)?;
     let (c, q) = (sol.params, sol.quality);
     let u = quality::assess_2d(&points, &c.compass, q.compass.field_magnitude).uncertainty;
     let mut f = fitted(
@@ -437,10 +374,7 @@ fn calibrate_turn(args: &Args, expected: Option<f64>) -> CliResult<Fitted> {
 }
 
 /// Feeds every row to a 3-D calibrator, solves, and builds the output file.
-fn calibrate_3d<C>(args: &Args, mut cal: C, expected: Option<f64>) -> CliResult<Fitted>
-where
-    C: Calibrator<Sample = Mag3Sample, Params = CompassCalibration3d, Quality = CompassQuality>,
-{
+fn calibrate_3d(args: &Args, mut cal: Box<Spatial>, expected: Option<f64>) -> CliResult<Fitted> {
     let (table, t) = read_input(args, &["mag_x", "mag_y", "mag_z"])?;
     let mags = vectors(&table, ["mag_x", "mag_y", "mag_z"])?;
     let samples: Vec<Mag3Sample> = mags
@@ -448,7 +382,7 @@ where
         .zip(&t)
         .map(|(m, &t_s)| Mag3Sample { t_s, mag: *m })
         .collect();
-    let sol = feed_and_solve(args, &table, &mut cal, &samples, expected)?;
+    let sol = feed_and_solve(args, &table, &mut *cal, &samples, expected)?;
     let u = quality::assess_3d(&mags, &sol.params, sol.quality.field_magnitude).uncertainty;
     Ok(fitted(
         args,
@@ -459,8 +393,9 @@ where
     ))
 }
 
-/// The joint magnetometer + accelerometer calibration.
-fn calibrate_joint(args: &Args, expected: Option<f64>) -> CliResult<Fitted> {
+/// The joint magnetometer + accelerometer calibration (the expected field is in its
+/// configuration).
+fn calibrate_joint(args: &Args, mut cal: Box<MagAccel>) -> CliResult<Fitted> {
     let (table, t) = read_input(
         args,
         &["mag_x", "mag_y", "mag_z", "acc_x", "acc_y", "acc_z"],
@@ -474,12 +409,7 @@ fn calibrate_joint(args: &Args, expected: Option<f64>) -> CliResult<Fitted> {
             acc: accs[k],
         })
         .collect();
-    let mut cal = MagAccelCalibrator::new(MagAccelConfig {
-        expected_field: expected,
-        ..MagAccelConfig::default()
-    })
-    .map_err(library)?;
-    let sol = feed_and_solve(args, &table, &mut cal, &samples, None)?;
+    let sol = feed_and_solve(args, &table, &mut *cal, &samples, None)?;
     let (c, q) = (sol.params, sol.quality);
     let mut f = fitted(
         args,
@@ -558,7 +488,7 @@ fn feed_and_solve<C>(
     expected: Option<f64>,
 ) -> CliResult<Solution<C::Params, C::Quality>>
 where
-    C: Calibrator,
+    C: Calibrator + ?Sized,
     C::Quality: HasCompassQuality,
 {
     for (k, s) in samples.iter().enumerate() {

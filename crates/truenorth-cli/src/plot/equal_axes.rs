@@ -31,7 +31,7 @@ pub enum Style {
 
 /// The smallest and largest finite x and y of `points`, as (x0, x1, y0, y1); an error
 /// naming `path` if there is no finite point.
-pub fn bounds<'a>(
+pub(super) fn bounds<'a>(
     path: &Path,
     points: impl Iterator<Item = &'a (f64, f64)>,
 ) -> CliResult<(f64, f64, f64, f64)> {

@@ -4,76 +4,11 @@
 use std::path::PathBuf;
 
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
-use truenorth::core::{
-    AttitudeEstimate, Axes, EulerZyx, ImuSample, OrientationEstimator, Result, rad_to_deg,
-};
-use truenorth::fusion::{
-    EulerDetector, EulerDetectorConfig, GyroTiming, QuaternionFilter, QuaternionFilterConfig,
-};
+use truenorth::core::{AttitudeEstimate, Axes, EulerZyx, ImuSample, rad_to_deg};
 
 use crate::io::{CliError, CliResult, Table, check_distinct, write_csv};
-use crate::svg_timeseries::{Band, Line, write_timeseries};
-
-/// Orientation methods.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum Method {
-    /// Quaternion filter: gyro strapdown, inclination from the low-passed specific force,
-    /// heading from the magnetometer with disturbance rejection and online hard-iron
-    /// re-estimation, gyro bias at rest and in motion.
-    Quaternion,
-    /// The Euler orientation angle detector of WO 00/36376 (Euler-rate integration,
-    /// static tilt and tilt-compensated yaw, correction definer, coefficient table).
-    EulerDetector,
-}
-
-/// What a gyro sample's rate stands for.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum Timing {
-    /// The mean rate over the interval ending at the sample (digital MEMS gyros).
-    IntervalMean,
-    /// The instantaneous rate at the sample (integrated by the trapezoid rule).
-    Instantaneous,
-}
-
-/// Either estimator, behind one `update`.
-pub enum Estimator {
-    /// The quaternion filter.
-    Quaternion(Box<QuaternionFilter>),
-    /// The Euler detector.
-    Euler(Box<EulerDetector>),
-}
-
-impl Estimator {
-    /// The estimator `method` with the magnetometer used or not and the gyro timing.
-    pub fn new(method: Method, use_mag: bool, timing: Timing) -> Result<Self> {
-        Ok(match method {
-            Method::Quaternion => {
-                Self::Quaternion(Box::new(QuaternionFilter::new(QuaternionFilterConfig {
-                    use_mag,
-                    gyro_timing: match timing {
-                        Timing::IntervalMean => GyroTiming::IntervalMean,
-                        Timing::Instantaneous => GyroTiming::Instantaneous,
-                    },
-                    ..Default::default()
-                })?))
-            }
-            Method::EulerDetector => {
-                Self::Euler(Box::new(EulerDetector::new(EulerDetectorConfig {
-                    use_mag,
-                    ..Default::default()
-                })?))
-            }
-        })
-    }
-
-    /// One sample.
-    pub fn update(&mut self, s: &ImuSample) -> Result<AttitudeEstimate> {
-        match self {
-            Self::Quaternion(f) => f.update(s),
-            Self::Euler(d) => d.update(s),
-        }
-    }
-}
+use crate::plot::{Band, Line, write_timeseries};
+use crate::registry::{Orientation, OrientationMethod, Timing};
 
 /// Body → NED into body → ENU: ENU = (NED y, NED x, −NED z), 180° about (1, 1, 0)/√2.
 pub fn ned_to_enu() -> UnitQuaternion<f64> {
@@ -121,7 +56,7 @@ pub enum Frame {
 pub struct Args {
     /// Orientation method.
     #[arg(long, value_enum, default_value = "quaternion")]
-    pub method: Method,
+    pub method: OrientationMethod,
     /// Input CSV.
     #[arg(long)]
     pub input: PathBuf,
@@ -171,12 +106,39 @@ const SIGMA_HEADER: [&str; 3] = ["sigma_x_deg", "sigma_y_deg", "sigma_z_deg"];
 /// Gaps listed by row in the summary line; more are counted.
 const GAPS_LISTED: usize = 5;
 
-/// Runs the subcommand.
+/// Runs the subcommand: read the recording, run the method over it, write the rows (and
+/// the plot), and say where the gyro could not bridge a gap.
 pub fn run(args: &Args) -> CliResult {
     check_distinct(&args.output, &[&args.input])?;
     if let Some(p) = &args.plot {
         check_distinct(p, &[&args.input, &args.output])?;
     }
+    let samples = read_samples(args)?;
+    let mut method = args
+        .method
+        .pipeline(!args.no_mag, args.gyro_timing)
+        .map_err(|e| CliError::msg(e.to_string()))?;
+    let out = estimate(args, &mut method, &samples)?;
+    if let Some(p) = &args.plot {
+        plot(p, &out.rows, &out.disturbed)?;
+    }
+    let mut header: Vec<&str> = HEADER.to_vec();
+    if args.status {
+        header.extend(STATUS_HEADER);
+        if out.reports_sigma {
+            header.extend(SIGMA_HEADER);
+        }
+    }
+    write_csv(&args.output, &header, out.rows)?;
+    if !out.gaps.is_empty() {
+        eprintln!("{}", gap_summary(&args.input, &out.gaps));
+    }
+    Ok(())
+}
+
+/// The recording as IMU samples; a row whose three magnetometer cells are empty has no
+/// magnetometer reading, and with `--no-mag` none has.
+fn read_samples(args: &Args) -> CliResult<Vec<ImuSample>> {
     let table = Table::read(
         &args.input,
         &["t_s", "gyr_x", "gyr_y", "gyr_z", "acc_x", "acc_y", "acc_z"],
@@ -191,83 +153,98 @@ pub fn run(args: &Args) -> CliResult {
         (Some(x), Some(y), Some(z)) if !args.no_mag => Some((x, y, z)),
         _ => None,
     };
-    let mut estimator = Estimator::new(args.method, !args.no_mag, args.gyro_timing)
-        .map_err(|e| CliError::msg(e.to_string()))?;
+    Ok((0..table.len())
+        .map(|k| ImuSample {
+            t_s: t[k],
+            gyr_rps: Axes::xyz(Vector3::new(gx[k], gy[k], gz[k])),
+            acc_mps2: Axes::xyz(Vector3::new(ax[k], ay[k], az[k])),
+            mag: match mag {
+                Some((x, y, z)) if x[k].is_nan() && y[k].is_nan() && z[k].is_nan() => Axes::NONE,
+                Some((x, y, z)) => Axes::xyz(Vector3::new(x[k], y[k], z[k])),
+                None => Axes::NONE,
+            },
+        })
+        .collect())
+}
+
+/// What the run gives: the output rows, which samples were magnetically disturbed, the
+/// gaps as (row, t_s, gap length), and whether the method reports σ.
+struct Estimated {
+    rows: Vec<Vec<f64>>,
+    disturbed: Vec<bool>,
+    gaps: Vec<(usize, f64, f64)>,
+    reports_sigma: bool,
+}
+
+/// Runs `method` over `samples`, one output row each.
+fn estimate(args: &Args, method: &mut Orientation, samples: &[ImuSample]) -> CliResult<Estimated> {
     let to_frame = match args.frame {
         Frame::Ned => UnitQuaternion::identity(),
         Frame::Enu => ned_to_enu(),
     };
-    let mut rows = Vec::with_capacity(table.len());
-    let mut disturbed = Vec::with_capacity(table.len());
-    // (row, t_s, gap length) of every gap.
-    let mut gaps: Vec<(usize, f64, f64)> = Vec::new();
-    let mut reports_sigma = false;
-    for k in 0..table.len() {
-        let m = match mag {
-            Some((x, y, z)) if x[k].is_nan() && y[k].is_nan() && z[k].is_nan() => Axes::NONE,
-            Some((x, y, z)) => Axes::xyz(Vector3::new(x[k], y[k], z[k])),
-            None => Axes::NONE,
-        };
-        let sample = ImuSample {
-            t_s: t[k],
-            gyr_rps: Axes::xyz(Vector3::new(gx[k], gy[k], gz[k])),
-            acc_mps2: Axes::xyz(Vector3::new(ax[k], ay[k], az[k])),
-            mag: m,
-        };
-        let est = estimator
-            .update(&sample)
-            .map_err(|e| CliError::row(&args.input, k + 2, e.to_string()))?;
+    let mut out = Estimated {
+        rows: Vec::with_capacity(samples.len()),
+        disturbed: Vec::with_capacity(samples.len()),
+        gaps: Vec::new(),
+        reports_sigma: false,
+    };
+    for (k, sample) in samples.iter().enumerate() {
+        let est = method
+            .update(sample)
+            .map_err(|e| CliError::row(&args.input, k + 2, e.to_string()))?
+            .estimate;
         if est.status.gap {
-            let since = k.checked_sub(1).map_or(0.0, |j| t[k] - t[j]);
-            gaps.push((k + 2, t[k], since));
+            let since = k
+                .checked_sub(1)
+                .map_or(0.0, |j| sample.t_s - samples[j].t_s);
+            out.gaps.push((k + 2, sample.t_s, since));
         }
         if k == 0 {
-            reports_sigma = est.sigma_rad.is_some();
+            out.reports_sigma = est.sigma_rad.is_some();
         }
-        let q = to_frame * est.attitude;
-        let e = EulerZyx::from_quaternion(&est.attitude);
-        let mut row = vec![
-            t[k],
-            q.w,
-            q.i,
-            q.j,
-            q.k,
-            rad_to_deg(e.yaw_rad),
-            rad_to_deg(e.pitch_rad),
-            rad_to_deg(e.roll_rad),
-        ];
-        if args.status {
-            let flag = |b: bool| f64::from(u8::from(b));
-            row.extend(est.gyro_bias_rps.iter());
-            row.extend([
-                flag(est.status.at_rest),
-                flag(est.status.mag_used),
-                flag(est.status.mag_disturbed),
-                flag(est.status.mag_calibrating),
-                flag(est.status.gap),
-            ]);
-            if let Some(sigma) = est.sigma_rad.filter(|_| reports_sigma) {
-                row.extend(sigma.iter().map(|v| rad_to_deg(*v)));
-            }
-        }
-        disturbed.push(est.status.mag_disturbed);
-        rows.push(row);
+        out.rows
+            .push(row(args, sample.t_s, &to_frame, &est, out.reports_sigma));
+        out.disturbed.push(est.status.mag_disturbed);
     }
-    if let Some(p) = &args.plot {
-        plot(p, &rows, &disturbed)?;
-    }
-    let mut header: Vec<&str> = HEADER.to_vec();
+    Ok(out)
+}
+
+/// One output row at `t_s`: the attitude in the chosen frame, the Z-Y-X angles from NED, and with
+/// `--status` the flags and σ.
+fn row(
+    args: &Args,
+    t_s: f64,
+    to_frame: &UnitQuaternion<f64>,
+    est: &AttitudeEstimate,
+    reports_sigma: bool,
+) -> Vec<f64> {
+    let q = to_frame * est.attitude;
+    let e = EulerZyx::from_quaternion(&est.attitude);
+    let mut row = vec![
+        t_s,
+        q.w,
+        q.i,
+        q.j,
+        q.k,
+        rad_to_deg(e.yaw_rad),
+        rad_to_deg(e.pitch_rad),
+        rad_to_deg(e.roll_rad),
+    ];
     if args.status {
-        header.extend(STATUS_HEADER);
-        if reports_sigma {
-            header.extend(SIGMA_HEADER);
+        let flag = |b: bool| f64::from(u8::from(b));
+        row.extend(est.gyro_bias_rps.iter());
+        row.extend([
+            flag(est.status.at_rest),
+            flag(est.status.mag_used),
+            flag(est.status.mag_disturbed),
+            flag(est.status.mag_calibrating),
+            flag(est.status.gap),
+        ]);
+        if let Some(sigma) = est.sigma_rad.filter(|_| reports_sigma) {
+            row.extend(sigma.iter().map(|v| rad_to_deg(*v)));
         }
     }
-    write_csv(&args.output, &header, rows)?;
-    if !gaps.is_empty() {
-        eprintln!("{}", gap_summary(&args.input, &gaps));
-    }
-    Ok(())
+    row
 }
 
 /// One line: how many gaps, where, and what was done about them.

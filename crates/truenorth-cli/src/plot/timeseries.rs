@@ -40,7 +40,8 @@ pub fn write_timeseries(
     const W: f64 = 900.0;
     const H: f64 = 420.0;
     const M: f64 = 60.0;
-    let (x0, x1, y0, y1) = crate::svg::bounds(path, lines.iter().flat_map(|l| l.points.iter()))?;
+    let (x0, x1, y0, y1) =
+        super::equal_axes::bounds(path, lines.iter().flat_map(|l| l.points.iter()))?;
     let (xs, ys) = ((x1 - x0).max(1e-12), (y1 - y0).max(1e-12) * 1.1);
     let yc = 0.5 * (y0 + y1);
     let sx = |x: f64| M + (x - x0) / xs * W;

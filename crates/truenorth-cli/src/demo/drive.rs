@@ -1,21 +1,18 @@
 //! The demo's drive section: the fused vehicle estimator (with and without the gyro) and the
-//! two seed configurations (METHODS.md §A gyro + compass, §B compass + wheels) on simulated
+//! two seed configurations (EP 0640207 gyro + compass, US 4,788,645 compass + wheels) on simulated
 //! mixed drives of about 10 km with rear and with front odometer wheels, scored against the truth,
 //! and a plot of the true and estimated tracks.
 
 use std::path::Path;
 
-use truenorth::core::{HeadingEstimator, NavEstimate, Result, VehicleSample};
-use truenorth::fusion::vehicle::{
-    SeedGyroCompass, SeedGyroCompassConfig, SeedOdometerCompass, SeedOdometerCompassConfig,
-    TwoPassConfig, TwoPassStart,
-};
+use truenorth::core::{NavEstimate, Result, VehicleSample};
 use truenorth::fusion::{VehicleConfig, VehicleEstimator};
 use truenorth::odometer::OdometerWheels;
 use truenorth_sim::{DriveScore, DriveSpec, DriveWheels, SimulatedDrive};
 
 use crate::io::{CliError, CliResult};
-use crate::svg::{Series, Style, write_plot};
+use crate::plot::{Series, Style, write_plot};
+use crate::registry::VehicleMethod;
 
 /// Drives per row of the table.
 const DRIVES: u64 = 4;
@@ -56,36 +53,21 @@ impl Configuration {
             gyr_z_rps: s.gyr_z_rps.filter(|_| gyro),
             ..*s
         });
+        let method = match self {
+            Self::Fused { .. } => VehicleMethod::Fused,
+            Self::SeedGyroCompass => VehicleMethod::SeedGyroCompass,
+            Self::SeedOdometerCompass => VehicleMethod::SeedOdometerCompass,
+        };
+        let fused = VehicleEstimator::new(VehicleConfig {
+            wheels,
+            ..VehicleConfig::default()
+        })?;
+        let mut runner = method.runner(wheels, fused, false)?;
         let mut out = Vec::with_capacity(drive.samples.len());
-        match self {
-            Self::Fused { .. } => {
-                let nav = VehicleEstimator::new(VehicleConfig {
-                    wheels,
-                    ..VehicleConfig::default()
-                })?;
-                let mut two = TwoPassStart::new(nav, TwoPassConfig::default())?;
-                for s in samples {
-                    two.push(&s, |_, e, _| out.push(*e))?;
-                }
-                two.finish(|_, e, _| out.push(*e))?;
-            }
-            Self::SeedGyroCompass | Self::SeedOdometerCompass => {
-                let mut e: Box<dyn HeadingEstimator> = if self == Self::SeedGyroCompass {
-                    Box::new(SeedGyroCompass::new(SeedGyroCompassConfig {
-                        wheels,
-                        ..SeedGyroCompassConfig::default()
-                    })?)
-                } else {
-                    Box::new(SeedOdometerCompass::new(SeedOdometerCompassConfig {
-                        wheels,
-                        ..SeedOdometerCompassConfig::default()
-                    })?)
-                };
-                for s in samples {
-                    out.push(e.update(&s)?);
-                }
-            }
+        for s in samples {
+            runner.push(&s, &mut |e, _| out.push(*e))?;
         }
+        runner.finish(&mut |e, _| out.push(*e))?;
         Ok(out)
     }
 }
@@ -135,7 +117,7 @@ fn table(seed: u64) -> Result<Vec<(DriveWheels, Configuration, Row)>> {
 }
 
 /// Prints the drive table and writes `drive_tracks.svg` into `out`.
-pub fn drive_section(seed: u64, out: &Path) -> CliResult {
+pub(super) fn drive_section(seed: u64, out: &Path) -> CliResult {
     let err = |e: truenorth::core::Error| CliError::msg(e.to_string());
     let km: Vec<f64> = drives(seed, DriveWheels::Rear)
         .map_err(err)?

@@ -7,7 +7,7 @@ use nalgebra::{Vector2, Vector3};
 use truenorth::accel::static_tilt;
 use truenorth::core::{Declination, MagneticHeading, Tilt, rad_to_deg};
 
-use crate::field::Place;
+use super::field::Place;
 use crate::io::{
     CalibrationFile, CliError, CliResult, CompassCalibration, CsvOutput, InputOptions, InputPath,
     ReadSpec, RowReader, check_distinct,

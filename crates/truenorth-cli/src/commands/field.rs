@@ -1,6 +1,6 @@
 //! `truenorth field`: the World Magnetic Model 2025 field at a place and date, as one CSV
-//! row `x_nt,y_nt,z_nt,h_nt,f_nt,incl_deg,decl_deg` on stdout (ARCHITECTURE.md, CLI
-//! contract).
+//! row `x_nt,y_nt,z_nt,h_nt,f_nt,incl_deg,decl_deg` on stdout (ARCHITECTURE.md, section
+//! "CLI contract").
 //!
 //! Every argument is read as text and parsed here, so that any bad input — a missing flag
 //! included — ends with exactly one line on stderr and a non-zero exit.

@@ -14,8 +14,9 @@ use serde::Serialize;
 use truenorth::core::ImuSample;
 use truenorth::fusion::AttitudeError;
 
+use crate::commands::orientation::ned_to_enu;
 use crate::io::{CliError, CliResult};
-use crate::orientation::{Estimator, Method, Timing, ned_to_enu};
+use crate::registry::{OrientationMethod, Timing};
 
 /// Arguments of `truenorth eval broad`.
 ///
@@ -32,7 +33,7 @@ pub struct Args {
     pub dir: PathBuf,
     /// Orientation method.
     #[arg(long, value_enum, default_value = "quaternion")]
-    pub method: Method,
+    pub method: OrientationMethod,
     /// Ignore the magnetometer (6-D: only inclination is meaningful).
     #[arg(long)]
     pub no_mag: bool,
@@ -86,12 +87,44 @@ struct Report {
     groups: Vec<GroupResult>,
 }
 
-/// Runs the subcommand.
+/// Runs the subcommand: each trial in name order, then the group means, printed as tables
+/// or as one JSON document.
 pub fn run(args: &Args) -> CliResult {
-    let dir = if args.dir.join("trials").is_dir() {
-        args.dir.join("trials")
+    let paths = trial_paths(&args.dir)?;
+    let mut progress = Progress::new(paths.len());
+    let mut results = Vec::with_capacity(paths.len());
+    for p in &paths {
+        let name = p
+            .file_name()
+            .map(|n| n.to_string_lossy().replace(".csv.gz", ""))
+            .unwrap_or_default();
+        progress.show(&name);
+        results.push(evaluate_trial(args, p, name)?);
+    }
+    progress.finish();
+    let groups = group_means(&results);
+    let report = Report {
+        method: format!("{:?}", args.method),
+        use_mag: !args.no_mag,
+        trials: results,
+        groups,
+    };
+    if args.json {
+        let text = serde_json::to_string_pretty(&report)
+            .map_err(|e| CliError::msg(format!("cannot write JSON: {e}")))?;
+        println!("{text}");
     } else {
-        args.dir.clone()
+        print_tables(&report, args.no_mag);
+    }
+    Ok(())
+}
+
+/// The trial files (`*.csv.gz`) of BROAD's folder or its `trials/` folder, sorted.
+fn trial_paths(dir: &Path) -> CliResult<Vec<PathBuf>> {
+    let dir = if dir.join("trials").is_dir() {
+        dir.join("trials")
+    } else {
+        dir.to_path_buf()
     };
     let mut paths: Vec<PathBuf> = std::fs::read_dir(&dir)
         .map_err(|e| CliError::file(&dir, format!("cannot read the folder: {e}")))?
@@ -105,40 +138,43 @@ pub fn run(args: &Args) -> CliResult {
             "no BROAD trial files (*.csv.gz) here; give BROAD's folder or its trials/ folder",
         ));
     }
-    let mut progress = Progress::new(paths.len());
-    let mut results = Vec::with_capacity(paths.len());
-    for p in &paths {
-        let name = p
-            .file_name()
-            .map(|n| n.to_string_lossy().replace(".csv.gz", ""))
-            .unwrap_or_default();
-        progress.show(&name);
-        let trial = read_trial(p)?;
-        let mut est = Estimator::new(args.method, !args.no_mag, args.gyro_timing)
-            .map_err(|e| CliError::msg(e.to_string()))?;
-        let to_enu = ned_to_enu();
-        let mut q = Vec::with_capacity(trial.samples.len());
-        for (k, s) in trial.samples.iter().enumerate() {
-            let e = est
-                .update(s)
-                .map_err(|e| CliError::row(p, k + 2, e.to_string()))?;
-            q.push(to_enu * e.attitude);
-        }
-        let rmse = broad_rmse(&q, &trial.reference, &trial.movement)
-            .ok_or_else(|| CliError::file(p, "no scored sample (movement phase empty)"))?;
-        let group = if name.contains("undisturbed") {
-            "undisturbed"
-        } else {
-            "disturbed"
-        };
-        results.push(TrialResult {
-            trial: name,
-            group,
-            rmse,
-        });
+    Ok(paths)
+}
+
+/// Runs the method over one trial (a fresh estimator, as BROAD scores each trial) and
+/// scores it.
+fn evaluate_trial(args: &Args, path: &Path, name: String) -> CliResult<TrialResult> {
+    let trial = read_trial(path)?;
+    let mut method = args
+        .method
+        .pipeline(!args.no_mag, args.gyro_timing)
+        .map_err(|e| CliError::msg(e.to_string()))?;
+    let to_enu = ned_to_enu();
+    let mut q = Vec::with_capacity(trial.samples.len());
+    for (k, s) in trial.samples.iter().enumerate() {
+        let r = method
+            .update(s)
+            .map_err(|e| CliError::row(path, k + 2, e.to_string()))?;
+        q.push(to_enu * r.estimate.attitude);
     }
-    progress.finish();
-    let groups = ["undisturbed", "disturbed", "all"]
+    let rmse = broad_rmse(&q, &trial.reference, &trial.movement)
+        .ok_or_else(|| CliError::file(path, "no scored sample (movement phase empty)"))?;
+    let group = if name.contains("undisturbed") {
+        "undisturbed"
+    } else {
+        "disturbed"
+    };
+    Ok(TrialResult {
+        trial: name,
+        group,
+        rmse,
+    })
+}
+
+/// The mean of the trial RMSEs per group (undisturbed, disturbed, all), groups without a
+/// trial left out.
+fn group_means(results: &[TrialResult]) -> Vec<GroupResult> {
+    ["undisturbed", "disturbed", "all"]
         .into_iter()
         .filter_map(|g| {
             let members: Vec<&Rmse> = results
@@ -161,24 +197,16 @@ pub fn run(args: &Args) -> CliResult {
                 }
             })
         })
-        .collect();
-    let report = Report {
-        method: format!("{:?}", args.method),
-        use_mag: !args.no_mag,
-        trials: results,
-        groups,
-    };
-    if args.json {
-        let text = serde_json::to_string_pretty(&report)
-            .map_err(|e| CliError::msg(format!("cannot write JSON: {e}")))?;
-        println!("{text}");
-        return Ok(());
-    }
+        .collect()
+}
+
+/// The per-trial table and the group means.
+fn print_tables(report: &Report, no_mag: bool) {
     println!(
         "BROAD, {} trials, method {}{} (RMSE in degrees, BROAD's metric)",
         report.trials.len(),
         report.method,
-        if args.no_mag { ", 6-D" } else { "" }
+        if no_mag { ", 6-D" } else { "" }
     );
     println!(
         "{:<46} {:>8} {:>8} {:>12}",
@@ -200,7 +228,6 @@ pub fn run(args: &Args) -> CliResult {
             g.mean.inclination_deg
         );
     }
-    Ok(())
 }
 
 /// BROAD's metric over the samples with `movement` and a valid reference (see the module

@@ -1,0 +1,562 @@
+//! `truenorth drive`: vehicle heading and dead reckoning from a drive log — wheels, an
+//! optional yaw gyro and an uncalibrated compass — calibrating every sensor from the drive
+//! itself.
+
+use std::path::{Path, PathBuf};
+
+use nalgebra::Vector2;
+use truenorth::core::{
+    Declination, MagneticHeading, NavEstimate, VehicleSample, rad_to_deg, wrap_two_pi,
+};
+use truenorth::fusion::vehicle::{NavFilter, VehicleCalibration};
+use truenorth::fusion::{SensorPriors, VehicleConfig, VehicleEstimator};
+use truenorth::odometer::OdometerWheels;
+
+use super::field::Place;
+use crate::io::{
+    CliError, CliResult, CsvOutput, InputOptions, InputPath, ReadSpec, Row, RowReader, VehicleFile,
+    WheelColumns, check_distinct, write_atomically,
+};
+use crate::registry::{VehicleMethod, VehicleRun};
+
+/// The long help of the command (after the options).
+const AFTER_HELP: &str = "VEHICLE.json: {\"track_m\": 1.55, \"odometer_wheels\": \"rear\"} or
+{\"track_m\": 1.55, \"wheelbase_m\": 2.7, \"odometer_wheels\": \"front\", \"pitman_ratio\": 0.13}
+or {\"track_m\": 0.6, \"odometer_wheels\": \"skid_steer\"} or \"differential\" — track_m the
+odometer wheels' track, m (a skid-steer's physical track: the effective one, 1.5-2.5 times it,
+is learned); wheelbase_m rear axle to front kingpins, m; pitman_ratio P = 2p/T_F (kingpin
+offset p over half the front track; front wheels only). Optional: \"wheel_resolution_m\"
+(distance per odometer pulse, default 0.02 with distance columns on a car and 0.003 with
+speed columns, a CAN bus's 0.01 km/h over one second; 0.001 on a robot). Unknown keys are
+refused.
+
+DRIVE.csv: `t_s` (strictly increasing, seconds) and any of: `dist_l_m,dist_r_m` (cumulative
+distance of the left and right odometer wheels as the odometer reports it) or
+`speed_l_mps,speed_r_mps` (wheel speeds, integrated by the trapezoid rule); `gyr_z` (rad/s,
+raw, positive for a right turn); `mag_x,mag_y` (any unit, uncalibrated; a level compass
+reads mag_x = H cos(heading), mag_y = -H sin(heading)). Each sensor may come at its own
+rate: an empty cell means no reading on that row, and each row is used for what it carries.
+Wheels or a gyro must be present. Other columns are ignored. Frames: x forward, y right,
+z down.
+
+Output: `t_s,north_m,east_m,heading_deg` — the rear-axle centre from the start point, and
+the heading clockwise from magnetic north (true north with --lat/--lon: the track is
+turned with it), in [0, 360). Without wheels the position cells are empty (no position,
+not zero). `--extra sigma` adds heading_sigma_deg, north_sigma_m, east_sigma_m (the
+heading's σ is of the heading change since the start while heading_absolute is 0);
+`--extra status` adds heading_absolute, compass_used, compass_disturbed, at_rest (0/1);
+`--extra calibration` adds the learned gyro_bias_dps, gyro_gain_right, gyro_gain_left,
+wheel_diff, track_scale, speed_coeff_s2_per_m2 (fused method only); `--extra trust` adds
+gap (a sensor's readings resumed after more than 2 s: what it could not follow was
+widened) and unobserved_gyro_bias, unobserved_gyro_gain_right, unobserved_gyro_gain_left,
+unobserved_wheel_diff, unobserved_track_scale, unobserved_speed_coeff (1 while the data
+have not told that sensor error apart from the others: a steady circle cannot separate a
+gyro bias from a wheel-size difference).
+
+Nothing is assumed calibrated: a drive that begins with a full turn (or one that turns
+through a few corners soon) calibrates the compass from itself. Until then the heading is
+relative to the start (status heading_absolute 0). By default the head of the drive is
+held back (at most 2^17 rows) until the sensors are learned and then estimated again
+from the start, so that the first minutes are as good as the rest; --single-pass writes
+each row as it comes (a causal estimate, as a navigation unit would have it).
+--calibration-in/--calibration-out carry what was learned from one drive to the next.
+A time base that contradicts the motion (t_s in milliseconds, a gyro in deg/s) is refused
+with the row where the evidence became clear.";
+
+/// Distance resolution assumed for integrated wheel speeds, m: a CAN bus's 0.01 km/h over
+/// the one second in which the estimator compares wheels with gyro. The pulse default
+/// (2 cm) would make such wheels look a hundred times noisier than they are.
+const SPEED_RESOLUTION_M: f64 = 0.003;
+
+/// Optional output column groups.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum Extra {
+    /// heading_sigma_deg, north_sigma_m, east_sigma_m.
+    Sigma,
+    /// heading_absolute, compass_used, compass_disturbed, at_rest.
+    Status,
+    /// The learned sensor errors (fused method only).
+    Calibration,
+    /// gap and the unobserved_* flags: where the estimate leans on the prior rather than
+    /// on the data.
+    Trust,
+}
+
+/// Arguments of `truenorth drive` (the file layouts are in `AFTER_HELP`, shown by `--help`).
+#[derive(Debug, clap::Args)]
+#[command(after_long_help = AFTER_HELP)]
+pub struct Args {
+    /// Vehicle JSON: track_m, odometer_wheels ("rear", "front", "skid_steer" or
+    /// "differential"), wheelbase_m and pitman_ratio for front wheels.
+    #[arg(long)]
+    pub vehicle: PathBuf,
+    /// Drive CSV (`-`: standard input; `.gz` or gzip data read as such).
+    #[arg(long)]
+    pub input: PathBuf,
+    /// Output CSV (`-`: standard output; `*.gz`: compressed).
+    #[arg(long)]
+    pub output: PathBuf,
+    /// Estimation method.
+    #[arg(long, value_enum, default_value = "fused")]
+    pub method: VehicleMethod,
+    /// Extra output columns, after the contract's (comma-separated).
+    #[arg(long, value_enum, value_delimiter = ',')]
+    pub extra: Vec<Extra>,
+    /// Write each row as it comes instead of estimating the drive's head again once the
+    /// sensors are learned.
+    #[arg(long)]
+    pub single_pass: bool,
+    /// Start from what an earlier drive learned (a file written by --calibration-out).
+    #[arg(long, value_name = "JSON")]
+    pub calibration_in: Option<PathBuf>,
+    /// Write what this drive learned about the sensors.
+    #[arg(long, value_name = "JSON")]
+    pub calibration_out: Option<PathBuf>,
+    /// Where and when the drive was made, for true heading.
+    #[command(flatten)]
+    pub place: Place,
+    /// How to read the input.
+    #[command(flatten)]
+    pub input_options: InputOptions,
+}
+
+/// The optional columns of a drive log.
+const OPTIONAL: [&str; 7] = [
+    "dist_l_m",
+    "dist_r_m",
+    "speed_l_mps",
+    "speed_r_mps",
+    "gyr_z",
+    "mag_x",
+    "mag_y",
+];
+
+/// Runs the subcommand: check the arguments, read the vehicle, build the method, run it
+/// over the log row by row, then save what it learned and summarise.
+pub fn run(args: &Args) -> CliResult {
+    check_arguments(args)?;
+    let spec = ReadSpec::new(&["t_s"])
+        .optional(&OPTIONAL)
+        .increasing("t_s");
+    let mut rows = RowReader::open(&InputPath::new(&args.input), &args.input_options, &spec)?;
+    let wheel_columns = wheel_columns(&rows)?;
+    let vehicle = VehicleFile::read(&args.vehicle)?;
+    let wheels = vehicle.wheels(&args.vehicle)?;
+    let declination = if args.place.is_given() {
+        Some(args.place.field()?.declination())
+    } else {
+        None
+    };
+    let speeds = matches!(wheel_columns, Some(WheelColumns::Speeds { .. }));
+    let mut method = build_method(args, &vehicle, wheels, speeds)?;
+    let mut columns = Columns {
+        t: rows.index("t_s").unwrap_or(0),
+        wheels: wheel_columns,
+        gyr: rows.index("gyr_z"),
+        mag: mag_columns(&rows)?,
+    };
+    let mut writer = Writer::create(args, declination)?;
+    let samples = estimate(&mut rows, &mut columns, method.as_mut(), &mut writer)?;
+    let learned = method.calibration();
+    if let (Some(out), Some(learned)) = (&args.calibration_out, &learned) {
+        save_calibration(out, learned)?;
+    }
+    let Writer {
+        out,
+        last,
+        rows: written,
+        gaps,
+        ..
+    } = writer;
+    out.commit()?;
+    summary(
+        args,
+        samples,
+        written,
+        gaps,
+        last.as_ref(),
+        learned.as_ref(),
+    );
+    Ok(())
+}
+
+/// Refuses outputs that are inputs and options that do not go together, before anything
+/// is read.
+fn check_arguments(args: &Args) -> CliResult {
+    let mut inputs: Vec<&Path> = vec![&args.input, &args.vehicle];
+    if let Some(c) = &args.calibration_in {
+        inputs.push(c);
+    }
+    check_distinct(&args.output, &inputs)?;
+    if let Some(c) = &args.calibration_out {
+        check_distinct(c, &inputs)?;
+        if c == &args.output {
+            return Err(CliError::msg(
+                "drive: --calibration-out and --output name the same file",
+            ));
+        }
+    }
+    if args.extra.contains(&Extra::Calibration) && args.method != VehicleMethod::Fused {
+        return Err(CliError::msg(
+            "drive: --extra calibration needs --method fused (the seed methods learn other things)",
+        ));
+    }
+    Ok(())
+}
+
+/// The wheel columns of the log (distances before speeds); an error if the log has neither
+/// wheels nor a gyro.
+fn wheel_columns(rows: &RowReader) -> CliResult<Option<WheelColumns>> {
+    let ix = |n: &str| rows.index(n);
+    let wheels = match (
+        ix("dist_l_m"),
+        ix("dist_r_m"),
+        ix("speed_l_mps"),
+        ix("speed_r_mps"),
+    ) {
+        (Some(l), Some(r), _, _) => Some(WheelColumns::Distances([l, r])),
+        (_, _, Some(l), Some(r)) => Some(WheelColumns::Speeds {
+            columns: [l, r],
+            last: None,
+            dist: [0.0; 2],
+        }),
+        _ => None,
+    };
+    if wheels.is_none() && ix("gyr_z").is_none() {
+        return Err(CliError::row(
+            rows.path(),
+            1,
+            "needs a heading sensor: the wheels (`dist_l_m,dist_r_m` cumulative distances or `speed_l_mps,speed_r_mps` wheel speeds) or a gyro (`gyr_z`, rad/s)",
+        ));
+    }
+    Ok(wheels)
+}
+
+/// The compass columns: both or neither.
+fn mag_columns(rows: &RowReader) -> CliResult<Option<[usize; 2]>> {
+    match (rows.index("mag_x"), rows.index("mag_y")) {
+        (Some(x), Some(y)) => Ok(Some([x, y])),
+        (None, None) => Ok(None),
+        _ => Err(CliError::row(
+            rows.path(),
+            1,
+            "has one of mag_x, mag_y but not both; give both (any unit, uncalibrated) or neither",
+        )),
+    }
+}
+
+/// The method the arguments ask for, through the registry. The fused estimator starts from
+/// the sensor priors of the vehicle (with the distance resolution of integrated speeds
+/// when the log has speeds and the file gives none), or from `--calibration-in`.
+fn build_method(
+    args: &Args,
+    vehicle: &VehicleFile,
+    wheels: OdometerWheels,
+    speeds: bool,
+) -> CliResult<Box<dyn VehicleRun>> {
+    let mut priors = SensorPriors::for_wheels(&wheels);
+    if let Some(r) = vehicle.wheel_resolution_m {
+        priors.wheel_resolution_m = r;
+    } else if speeds && !wheels.can_pivot() {
+        priors.wheel_resolution_m = SPEED_RESOLUTION_M;
+    }
+    let config = VehicleConfig {
+        wheels,
+        priors: Some(priors),
+        ..VehicleConfig::default()
+    };
+    let bad_config = |e: truenorth::core::Error| CliError::file(&args.vehicle, e.to_string());
+    let fused = match &args.calibration_in {
+        Some(path) => {
+            let text = std::fs::read_to_string(path)
+                .map_err(|e| CliError::file(path, format!("cannot read: {e}")))?;
+            let learned: VehicleCalibration = serde_json::from_str(&text)
+                .map_err(|e| CliError::file(path, format!("not a drive calibration: {e}")))?;
+            VehicleEstimator::with_calibration(config, &learned)
+                .map_err(|e| CliError::file(path, e.to_string()))?
+        }
+        None => VehicleEstimator::new(config).map_err(bad_config)?,
+    };
+    args.method
+        .runner(wheels, fused, args.single_pass)
+        .map_err(bad_config)
+}
+
+/// Where each sensor is in a row.
+struct Columns {
+    t: usize,
+    wheels: Option<WheelColumns>,
+    gyr: Option<usize>,
+    mag: Option<[usize; 2]>,
+}
+
+impl Columns {
+    /// The sample a row carries: each sensor whose cells are filled (wheel speeds
+    /// integrated into distances on the way).
+    fn sample(&mut self, row: &Row, path: &Path) -> CliResult<VehicleSample> {
+        let v = &row.values;
+        let mut sample = VehicleSample::at(v[self.t]);
+        if let Some(w) = self.wheels.as_mut()
+            && let Some([l, r]) = w
+                .cumulative(v[self.t], v)
+                .map_err(|m| CliError::row(path, row.number, m))?
+        {
+            sample = sample.with_wheels(l, r);
+        }
+        if let Some(g) = self.gyr.map(|g| v[g]).filter(|g| g.is_finite()) {
+            sample = sample.with_gyro(g);
+        }
+        if let Some([x, y]) = self
+            .mag
+            .filter(|[x, y]| v[*x].is_finite() && v[*y].is_finite())
+        {
+            sample = sample.with_mag(Vector2::new(v[x], v[y]));
+        }
+        Ok(sample)
+    }
+}
+
+/// Runs `method` over every row, each final estimate to `writer`; the number of rows.
+fn estimate(
+    rows: &mut RowReader,
+    columns: &mut Columns,
+    method: &mut dyn VehicleRun,
+    writer: &mut Writer,
+) -> CliResult<usize> {
+    let path = rows.path().to_path_buf();
+    let mut samples = 0usize;
+    while let Some(row) = rows.next_row()? {
+        let sample = columns.sample(row, &path)?;
+        method
+            .push(&sample, &mut |e, filter| writer.write(e, filter))
+            .map_err(|e| CliError::row(&path, row.number, e.to_string()))?;
+        if let Some(e) = writer.error.take() {
+            return Err(e);
+        }
+        samples += 1;
+    }
+    method
+        .finish(&mut |e, filter| writer.write(e, filter))
+        .map_err(|e| CliError::file(&path, e.to_string()))?;
+    if let Some(e) = writer.error.take() {
+        return Err(e);
+    }
+    if samples == 0 {
+        return Err(CliError::file(&path, "has no data rows"));
+    }
+    Ok(samples)
+}
+
+/// Writes what the drive learned, for `--calibration-in` of the next.
+fn save_calibration(path: &Path, learned: &VehicleCalibration) -> CliResult {
+    let json = serde_json::to_string_pretty(learned)
+        .map_err(|e| CliError::msg(format!("drive: cannot write the calibration: {e}")))?;
+    write_atomically(path, |w| Ok(w.write_all(json.as_bytes())?))
+}
+
+/// The output columns and how each row is written.
+struct Writer {
+    out: CsvOutput,
+    extra: Vec<Extra>,
+    declination: Option<Declination>,
+    rows: usize,
+    /// Rows where a sensor resumed after a gap.
+    gaps: usize,
+    error: Option<CliError>,
+    last: Option<NavEstimate>,
+}
+
+impl Writer {
+    fn create(args: &Args, declination: Option<Declination>) -> CliResult<Self> {
+        Ok(Self {
+            out: CsvOutput::create(&args.output, &Self::header(&args.extra))?,
+            extra: args.extra.clone(),
+            declination,
+            rows: 0,
+            gaps: 0,
+            error: None,
+            last: None,
+        })
+    }
+
+    fn header(extra: &[Extra]) -> Vec<&'static str> {
+        let mut h = vec!["t_s", "north_m", "east_m", "heading_deg"];
+        for e in extra {
+            h.extend_from_slice(match e {
+                Extra::Sigma => &["heading_sigma_deg", "north_sigma_m", "east_sigma_m"],
+                Extra::Status => &[
+                    "heading_absolute",
+                    "compass_used",
+                    "compass_disturbed",
+                    "at_rest",
+                ],
+                Extra::Calibration => &[
+                    "gyro_bias_dps",
+                    "gyro_gain_right",
+                    "gyro_gain_left",
+                    "wheel_diff",
+                    "track_scale",
+                    "speed_coeff_s2_per_m2",
+                ],
+                Extra::Trust => &[
+                    "gap",
+                    "unobserved_gyro_bias",
+                    "unobserved_gyro_gain_right",
+                    "unobserved_gyro_gain_left",
+                    "unobserved_wheel_diff",
+                    "unobserved_track_scale",
+                    "unobserved_speed_coeff",
+                ],
+            });
+        }
+        h
+    }
+
+    /// Writes one estimate (nothing after a write has failed: the error is kept for the
+    /// caller).
+    fn write(&mut self, e: &NavEstimate, filter: Option<&NavFilter>) {
+        if self.error.is_some() {
+            return;
+        }
+        let mut row = self.position_and_heading(e);
+        for x in &self.extra {
+            extra_cells(*x, e, filter, &mut row);
+        }
+        if let Err(err) = self.out.row(&row) {
+            self.error = Some(err);
+        }
+        self.rows += 1;
+        self.gaps += usize::from(e.status.gap);
+        self.last = Some(*e);
+    }
+
+    /// The contract's columns: `t_s,north_m,east_m,heading_deg`.
+    fn position_and_heading(&self, e: &NavEstimate) -> Vec<f64> {
+        let (mut n, mut east, mut heading) = (e.north_m, e.east_m, e.heading.rad());
+        if let Some(d) = self.declination {
+            // True north: the heading and the whole track turn by the declination.
+            heading = MagneticHeading::new(heading).to_true(d).rad();
+            let (s, c) = d.0.sin_cos();
+            (n, east) = (c * n - s * east, s * n + c * east);
+        }
+        if !e.status.position_known {
+            // No wheels: no position, written as empty cells.
+            (n, east) = (f64::NAN, f64::NAN);
+        }
+        vec![e.t_s, n, east, rad_to_deg(wrap_two_pi(heading))]
+    }
+}
+
+/// The cells of one `--extra` group, appended to `row`.
+fn extra_cells(x: Extra, e: &NavEstimate, filter: Option<&NavFilter>, row: &mut Vec<f64>) {
+    let flags = |b: &[bool]| {
+        b.iter()
+            .map(|&b| f64::from(u8::from(b)))
+            .collect::<Vec<_>>()
+    };
+    match x {
+        Extra::Sigma => {
+            let p = e.position_cov_m2;
+            let known = e.status.position_known;
+            let sigma = |v: f64| if known { v.max(0.0).sqrt() } else { f64::NAN };
+            row.extend([
+                rad_to_deg(e.heading_sigma_rad),
+                sigma(p[(0, 0)]),
+                sigma(p[(1, 1)]),
+            ]);
+        }
+        Extra::Status => {
+            let s = e.status;
+            row.extend(flags(&[
+                s.heading_absolute,
+                s.compass_used,
+                s.compass_disturbed,
+                s.at_rest,
+            ]));
+        }
+        Extra::Calibration => match filter {
+            Some(f) => {
+                let x = &f.x;
+                use truenorth::fusion::vehicle::nav_filter::*;
+                row.extend([
+                    rad_to_deg(x[BIAS]),
+                    1.0 + x[GAIN_POS],
+                    1.0 + x[GAIN_NEG],
+                    x[WHEEL_DIFF],
+                    x[TRACK_SCALE],
+                    x[SPEED_COEFF],
+                ]);
+            }
+            None => row.extend([f64::NAN; 6]),
+        },
+        Extra::Trust => {
+            let u = e.status.unobserved;
+            row.extend(flags(&[
+                e.status.gap,
+                u.gyro_bias,
+                u.gyro_gain_right,
+                u.gyro_gain_left,
+                u.wheel_diff,
+                u.track_scale,
+                u.speed_coeff,
+            ]));
+        }
+    }
+}
+
+/// One line on stderr: what was done and what was learned.
+fn summary(
+    args: &Args,
+    samples: usize,
+    written: usize,
+    gaps: usize,
+    last: Option<&NavEstimate>,
+    learned: Option<&VehicleCalibration>,
+) {
+    let Some(e) = last else { return };
+    let reference = if !e.status.heading_absolute {
+        "relative to the start heading (the compass never calibrated)"
+    } else if args.place.is_given() {
+        "true north"
+    } else {
+        "magnetic north"
+    };
+    let mut line = format!(
+        "truenorth drive: {samples} rows → {written}, {:.0} m, heading {reference}",
+        e.distance_m
+    );
+    if !e.status.position_known {
+        line += " (no wheels: no position)";
+    }
+    line += &format!(", final heading σ {:.2}°", rad_to_deg(e.heading_sigma_rad));
+    if let Some(c) = learned {
+        line += &format!(
+            ", gyro bias {:.3}°/s, wheel scale difference {:.3} %",
+            rad_to_deg(c.gyro_bias_rps.value),
+            100.0 * c.wheel_diff.value
+        );
+    }
+    let u = e.status.unobserved;
+    let open: Vec<&str> = [
+        (u.gyro_bias, "gyro bias"),
+        (u.gyro_gain_right, "gyro gain right"),
+        (u.gyro_gain_left, "gyro gain left"),
+        (u.wheel_diff, "wheel scale difference"),
+        (u.track_scale, "effective track"),
+        (u.speed_coeff, "speed coefficient"),
+    ]
+    .iter()
+    .filter(|(o, _)| *o)
+    .map(|(_, n)| *n)
+    .collect();
+    if !open.is_empty() {
+        line += &format!(
+            "; not yet told apart by the motion (their priors stand): {}",
+            open.join(", ")
+        );
+    }
+    if gaps > 0 {
+        line += &format!("; {gaps} gaps in the log, widened rather than bridged");
+    }
+    eprintln!("{line}");
+}

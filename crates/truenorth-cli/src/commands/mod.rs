@@ -1,0 +1,11 @@
+//! The product commands, one file each: `calibrate`, `heading`, `field`, `orientation` and
+//! `drive`; [`mag_unit`] is the magnetometer unit `calibrate` checks a fitted field
+//! against, and [`field::Place`] the place and date every command that turns magnetic into
+//! true north reads.
+
+pub mod calibrate;
+pub mod drive;
+pub mod field;
+pub mod heading;
+pub mod mag_unit;
+pub mod orientation;

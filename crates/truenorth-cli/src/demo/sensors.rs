@@ -1,0 +1,172 @@
+//! The demo drive with its sensor streams, and what each sensor gets wrong on its own.
+
+use truenorth::compass::CompassCalibration2d;
+use truenorth::core::{VehicleSample, WheelSample, angle_diff};
+use truenorth::gyro::{GyroCalibration, YawIntegrator, YawIntegratorConfig};
+use truenorth::odometer::{DifferentialOdometer, DifferentialOdometerConfig, FixedTrack};
+use truenorth_sim::{VehicleSensorParams, VehicleTruth, scenario, simulate, vehicle_streams};
+
+use super::scenarios::{RATE_HZ, opening_circle};
+use crate::io::{CliError, CliResult};
+
+/// The demo drive with its sensor streams.
+pub(super) struct DemoDrive {
+    /// End of the opening calibration circle, seconds.
+    pub circle_end_s: f64,
+    /// The sensor errors simulated.
+    pub params: VehicleSensorParams,
+    /// The true motion, one sample per sensor sample.
+    pub truth: Vec<VehicleTruth>,
+    /// The sensor readings.
+    pub samples: Vec<VehicleSample>,
+}
+
+impl DemoDrive {
+    pub(super) fn new(seed: u64) -> CliResult<Self> {
+        let err = |e: truenorth::core::Error| CliError::msg(format!("demo drive: {e}"));
+        let route = scenario::demo_drive().map_err(err)?;
+        let truth = simulate(&route, 0.0, RATE_HZ).map_err(err)?;
+        let params = VehicleSensorParams::typical();
+        let samples = vehicle_streams(&truth, &params, seed).map_err(err)?;
+        let circle_end_s = opening_circle().map_err(err)?.duration_s();
+        Ok(Self {
+            circle_end_s,
+            params,
+            truth,
+            samples,
+        })
+    }
+}
+
+/// Heading error statistics of one estimate against the truth, degrees.
+pub(super) struct HeadingError {
+    /// Root mean square.
+    pub rms_deg: f64,
+    /// Largest magnitude.
+    pub max_deg: f64,
+    /// At the last sample.
+    pub final_deg: f64,
+}
+
+pub(super) fn heading_error(truth: &[VehicleTruth], estimate: &[f64]) -> HeadingError {
+    let errs: Vec<f64> = truth
+        .iter()
+        .zip(estimate)
+        .map(|(t, e)| angle_diff(*e, t.heading_rad).to_degrees())
+        .collect();
+    let n = errs.len().max(1) as f64;
+    HeadingError {
+        rms_deg: (errs.iter().map(|e| e * e).sum::<f64>() / n).sqrt(),
+        max_deg: errs.iter().fold(0.0, |m, e| m.max(e.abs())),
+        final_deg: errs.last().copied().unwrap_or(0.0),
+    }
+}
+
+pub(super) fn sensor_table(d: &DemoDrive) {
+    let p = &d.params;
+    println!("Sensor errors in the simulation (VehicleSensorParams::typical)");
+    println!(
+        "  yaw gyro   bias {:.2} deg/s, scale error +{:.1} % right / +{:.1} % left, noise {:.3} deg/s/rtHz, bias walk {:.4} deg/s/rts",
+        p.gyro.bias_rps.to_degrees(),
+        p.gyro.scale_error_pos * 100.0,
+        p.gyro.scale_error_neg * 100.0,
+        p.gyro.noise_density_rps_per_sqrt_hz.to_degrees(),
+        p.gyro.bias_walk_rps_per_sqrt_s.to_degrees()
+    );
+    let track_m = p.odometer.wheels.track_m();
+    println!(
+        "  odometer   rear track {:.2} m, wheel scale errors {:+.1} % left / {:+.1} % right, {} cm pulses",
+        track_m,
+        p.odometer.scale_error_l * 100.0,
+        p.odometer.scale_error_r * 100.0,
+        p.odometer.dist_per_pulse_m.map_or(0.0, |d| d * 100.0)
+    );
+    let hard = p.compass_hard_iron.norm() / p.horizontal_field;
+    let eig = p.compass_soft_iron.symmetric_eigen();
+    let (major, minor) = (eig.eigenvalues.max(), eig.eigenvalues.min());
+    println!(
+        "  compass    hard iron {:.2} x field, soft iron axis ratio {:.2}, noise {:.1} % of the {:.0} uT horizontal field",
+        hard,
+        major / minor,
+        p.compass_noise / p.horizontal_field * 100.0,
+        p.horizontal_field
+    );
+    println!();
+
+    // What each sensor gets wrong on its own, before any method calibrates it.
+    let h0 = d.truth.first().map_or(0.0, |t| t.heading_rad);
+    let mut rows: Vec<(&str, HeadingError)> = Vec::new();
+    for (name, cal) in [
+        ("gyro, raw", GyroCalibration::default()),
+        (
+            "gyro, true zero+scale",
+            GyroCalibration::asymmetric(
+                p.gyro.bias_rps,
+                1.0 + p.gyro.scale_error_pos,
+                1.0 + p.gyro.scale_error_neg,
+            )
+            .unwrap_or_default(),
+        ),
+    ] {
+        let Ok(mut g) = YawIntegrator::new(YawIntegratorConfig { calibration: cal }) else {
+            continue;
+        };
+        let est: Vec<f64> = d
+            .samples
+            .iter()
+            .map(|s| {
+                g.push_yaw_rate(s.t_s, s.gyr_z_rps.unwrap_or(0.0))
+                    .map_or(f64::NAN, |_| g.heading_rad() + h0)
+            })
+            .collect();
+        rows.push((name, heading_error(&d.truth, &est)));
+    }
+    if let Ok(mut odo) = FixedTrack::new(track_m)
+        .and_then(|t| DifferentialOdometer::new(t, DifferentialOdometerConfig::default()))
+    {
+        let est: Vec<f64> = d
+            .samples
+            .iter()
+            .map(|s| {
+                let Some(w) = s.wheels else {
+                    return f64::NAN;
+                };
+                let w = WheelSample {
+                    t_s: s.t_s,
+                    dist_l_m: w.dist_l_m,
+                    dist_r_m: w.dist_r_m,
+                };
+                odo.push(&w).map_or(f64::NAN, |_| odo.heading_rad() + h0)
+            })
+            .collect();
+        rows.push(("odometer, nominal", heading_error(&d.truth, &est)));
+    }
+    let raw_compass = CompassCalibration2d::identity();
+    let true_compass = CompassCalibration2d {
+        hard_iron: p.compass_hard_iron,
+        soft_iron: p.compass_soft_iron.try_inverse().unwrap_or_default(),
+    };
+    for (name, cal) in [
+        ("compass, raw", raw_compass),
+        ("compass, true calibration", true_compass),
+    ] {
+        let est: Vec<f64> = d
+            .samples
+            .iter()
+            .map(|s| s.mag.map_or(f64::NAN, |m| cal.heading_rad(&m)))
+            .collect();
+        rows.push((name, heading_error(&d.truth, &est)));
+    }
+    println!("Each sensor alone on the whole demo drive (heading error vs truth)");
+    println!(
+        "{:<28} {:>9} {:>9} {:>10}",
+        "source", "RMS deg", "max deg", "final deg"
+    );
+    for (name, e) in rows {
+        println!(
+            "{:<28} {:>9.2} {:>9.2} {:>10.2}",
+            name, e.rms_deg, e.max_deg, e.final_deg
+        );
+    }
+    println!();
+}

@@ -1,0 +1,42 @@
+//! Input and output shared by the subcommands, with errors that name the file, the row and
+//! the problem.
+//!
+//! Reading (the same for every command, and for any that reads a CSV later):
+//! * [`InputPath`]: a file or `-` (standard input), gzip-compressed or not (found by the
+//!   magic bytes);
+//! * [`InputOptions`] (flatten into a command's arguments): the delimiter, a file without a
+//!   header, the column mapping `NAME=HEADER` (`-HEADER` negates) and the sensor's axis
+//!   convention (`--axes flu`); headers match without regard to case, and a requested
+//!   column named twice is an error;
+//! * [`RowReader`]: the streaming read, one row at a time, the requested columns by name as
+//!   `f64` with the row number for messages, time order checked on the way; memory does not
+//!   grow with the file;
+//! * [`Table`]: the whole-table read built on it.
+//!
+//! Writing: [`AtomicOutput`](atomic_write::AtomicOutput) / [`CsvOutput`] / [`write_csv`] / [`write_atomically`] write a
+//! temporary file beside the target, sync it and rename it over the target (`-`: standard
+//! output; `*.gz`: compressed); [`check_distinct`] refuses an output that is one of the
+//! inputs before anything is read.
+
+mod atomic_write;
+mod calibration_file;
+mod columns;
+mod error;
+mod reader;
+mod source;
+mod table;
+mod vehicle_file;
+mod wheel_columns;
+
+pub use atomic_write::{CsvOutput, check_distinct, write_atomically, write_csv};
+pub use calibration_file::{
+    AccelPart, CALIBRATION_FORMAT, CALIBRATION_VERSION, CalibrationFile, CompassCalibration,
+    GyroPart, QualityReport, finite, gyro_units, matrix_rows, units_block,
+};
+pub use columns::InputOptions;
+pub use error::{CliError, CliResult};
+pub use reader::{ReadSpec, Row, RowReader};
+pub use source::InputPath;
+pub use table::Table;
+pub use vehicle_file::VehicleFile;
+pub use wheel_columns::WheelColumns;

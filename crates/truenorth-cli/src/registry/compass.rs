@@ -1,0 +1,132 @@
+//! Compass calibration methods by name.
+
+use truenorth::calib::{
+    BinnedEllipseCalibrator, EllipseCalibrator, EllipsoidCalibrator, MagAccelCalibration,
+    MagAccelCalibrator, MagAccelConfig, MagAccelQuality, MagAccelSample, MeritCircleCalibrator,
+    OnlineEllipseCalibrator, OnlineEllipsoidCalibrator, TurnCalibration, TurnCalibrator,
+    TurnCompassCalibrator, TurnConfig, TurnQuality, TurnSample,
+};
+use truenorth::compass::{CompassCalibration2d, CompassCalibration3d};
+use truenorth::core::{Calibrator, CompassQuality, Mag2Sample, Mag3Sample, Result};
+
+/// A calibrator of two-axis magnetometer readings.
+pub type Planar =
+    dyn Calibrator<Sample = Mag2Sample, Params = CompassCalibration2d, Quality = CompassQuality>;
+
+/// A calibrator of three-axis magnetometer readings.
+pub type Spatial =
+    dyn Calibrator<Sample = Mag3Sample, Params = CompassCalibration3d, Quality = CompassQuality>;
+
+/// A calibrator of the magnetometer and the accelerometer together.
+pub type MagAccel = dyn Calibrator<Sample = MagAccelSample, Params = MagAccelCalibration, Quality = MagAccelQuality>;
+
+/// A calibrator of one turn's compass and yaw gyro together.
+pub type TurnWithGyro =
+    dyn Calibrator<Sample = TurnSample, Params = TurnCalibration, Quality = TurnQuality>;
+
+/// Calibration methods.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum CalibrationMethod {
+    /// Least-squares ellipse (2-D): direct fit refined geometrically; hard + symmetric soft iron.
+    Ellipse,
+    /// Least-squares ellipsoid (3-D, needs mag_z): hard iron + full symmetric soft iron.
+    Ellipsoid,
+    /// Magnetometer and accelerometer together (needs mag_x,mag_y,mag_z,acc_x,acc_y,acc_z,
+    /// static or slow readings): accelerometer bias, scale and cross-axis, magnetometer hard
+    /// and soft iron, the rotation between the two (from the constant dip), and the pointing
+    /// axis from runs of shots aimed at one target while rolling (found automatically).
+    EllipsoidAccel,
+    /// Online least-squares ellipse (2-D): the same direct fit from running sums, in
+    /// constant memory, as a vehicle would run it while driving.
+    OnlineEllipse,
+    /// Online least-squares ellipsoid (3-D, needs mag_z), in constant memory.
+    OnlineEllipsoid,
+    /// Binned ellipse (EP 0634001): heading bins, origin iteration, ellipse phasors.
+    BinnedEllipse,
+    /// Merit circle (US 5,297,063): merit-weighted circumcentres; hard iron only.
+    MeritCircle,
+    /// One full turn (EP 0640207): compass centre and radii from the extrema; with `gyr_z`,
+    /// also the gyro's zero (from a standstill at the start) and scale.
+    Turn,
+}
+
+/// A compass calibrator built by [`CalibrationMethod::calibrator`], by the samples it
+/// learns from.
+pub enum CompassCalibrator {
+    /// Two-axis readings.
+    Planar(Box<Planar>),
+    /// Three-axis readings.
+    Spatial(Box<Spatial>),
+    /// Magnetometer and accelerometer readings.
+    MagAccel(Box<MagAccel>),
+    /// One turn: the compass alone, or with a yaw rate the gyro beside it (which one runs
+    /// is known once the input's columns are).
+    Turn {
+        /// The compass from the turn's extrema.
+        compass: Box<Planar>,
+        /// The compass and the gyro's zero and scale.
+        with_gyro: Box<TurnWithGyro>,
+    },
+}
+
+impl CompassCalibrator {
+    /// The calibrator of two-axis readings, for a method that has one.
+    pub fn into_planar(self) -> Option<Box<Planar>> {
+        match self {
+            Self::Planar(c) | Self::Turn { compass: c, .. } => Some(c),
+            Self::Spatial(_) | Self::MagAccel(_) => None,
+        }
+    }
+}
+
+impl CalibrationMethod {
+    /// The name used on the command line and in the output file.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Ellipse => "ellipse",
+            Self::Ellipsoid => "ellipsoid",
+            Self::EllipsoidAccel => "ellipsoid-accel",
+            Self::OnlineEllipse => "online-ellipse",
+            Self::OnlineEllipsoid => "online-ellipsoid",
+            Self::BinnedEllipse => "binned-ellipse",
+            Self::MeritCircle => "merit-circle",
+            Self::Turn => "turn",
+        }
+    }
+
+    /// 2 or 3.
+    pub fn dimensions(self) -> usize {
+        match self {
+            Self::Ellipsoid | Self::EllipsoidAccel | Self::OnlineEllipsoid => 3,
+            _ => 2,
+        }
+    }
+
+    /// The method's calibrator in its default configuration; `expected_field` (input unit)
+    /// is given to the method that uses it in the fit (`ellipsoid-accel`).
+    pub fn calibrator(self, expected_field: Option<f64>) -> Result<CompassCalibrator> {
+        use CompassCalibrator as C;
+        Ok(match self {
+            Self::Ellipse => C::Planar(Box::new(EllipseCalibrator::default())),
+            Self::OnlineEllipse => {
+                C::Planar(Box::new(OnlineEllipseCalibrator::new(Default::default())?))
+            }
+            Self::BinnedEllipse => C::Planar(Box::new(BinnedEllipseCalibrator::default())),
+            Self::MeritCircle => C::Planar(Box::new(MeritCircleCalibrator::default())),
+            Self::Ellipsoid => C::Spatial(Box::new(EllipsoidCalibrator::default())),
+            Self::OnlineEllipsoid => C::Spatial(Box::new(OnlineEllipsoidCalibrator::new(
+                Default::default(),
+            )?)),
+            Self::EllipsoidAccel => {
+                C::MagAccel(Box::new(MagAccelCalibrator::new(MagAccelConfig {
+                    expected_field,
+                    ..MagAccelConfig::default()
+                })?))
+            }
+            Self::Turn => C::Turn {
+                compass: Box::new(TurnCompassCalibrator::default()),
+                with_gyro: Box::new(TurnCalibrator::new(TurnConfig::default())?),
+            },
+        })
+    }
+}
