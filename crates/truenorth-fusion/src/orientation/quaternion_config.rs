@@ -4,7 +4,10 @@
 use serde::{Deserialize, Serialize};
 use truenorth_core::{Result, Validate, check_positive, check_range};
 
-use crate::{AttitudeUncertaintyConfig, HardIronConfig, MagReferenceConfig, RestConfig};
+use super::attitude_uncertainty::AttitudeUncertaintyConfig;
+use super::hard_iron::HardIronConfig;
+use super::mag_reference::MagReferenceConfig;
+use super::rest_detector::RestConfig;
 
 #[allow(unused_imports)]
 use truenorth_core::Float as _;
@@ -131,7 +134,7 @@ impl Validate for QuaternionFilterConfig {
         self.rest.validate()?;
         self.mag.validate()?;
         self.hard_iron.validate()?;
-        crate::time_gap::check_max_gap(self.max_gap_s)?;
+        super::time_gap::check_max_gap(self.max_gap_s)?;
         self.uncertainty.validate()?;
         if let Some(q) = self.initial_attitude {
             for v in q {

@@ -35,7 +35,7 @@
 //!
 //! The per-sample path computes no trigonometric function: the strapdown step and the
 //! corrections use series that are exact to 10⁻¹⁰ rad at their step sizes
-//! ([`crate::rotation`]), the dip test compares sines, and the heading error is taken as
+//! ([`super::rotation`]), the dip test compares sines, and the heading error is taken as
 //! `sin ε = y/|h|` of the horizontal field `h = (x, y)` (±1 beyond ±90°).
 
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
@@ -45,10 +45,13 @@ use truenorth_core::{
     STANDARD_GRAVITY_MPS2, TimeStep, Validate,
 };
 
-use crate::attitude_uncertainty::AttitudeUncertainty;
-use crate::rotation::{rotation_from_vector, small_rotation};
-use crate::time_gap::{GapMonitor, Step};
-use crate::{GyroTiming, HardIronEstimator, MagReference, QuaternionFilterConfig, RestDetector};
+use super::attitude_uncertainty::AttitudeUncertainty;
+use super::hard_iron::HardIronEstimator;
+use super::mag_reference::MagReference;
+use super::quaternion_config::{GyroTiming, QuaternionFilterConfig};
+use super::rest_detector::RestDetector;
+use super::rotation::{rotation_from_vector, small_rotation};
+use super::time_gap::{GapMonitor, Step};
 
 #[allow(unused_imports)]
 use truenorth_core::Float as _;

@@ -43,9 +43,10 @@ use truenorth_core::{
 };
 use truenorth_gyro::{HighPassCorrection, HighPassFilter, IirHighPass, OscillationRemover};
 
-use crate::euler_config::MAX_DEFINER_WINDOW;
-use crate::time_gap::{GapMonitor, Step};
-use crate::{EulerDetectorConfig, EulerVariant, GyroConditioning, coefficient_table};
+use super::euler_config::{
+    EulerDetectorConfig, EulerVariant, GyroConditioning, MAX_DEFINER_WINDOW, coefficient_table,
+};
+use super::time_gap::{GapMonitor, Step};
 
 #[allow(unused_imports)]
 use truenorth_core::Float as _;

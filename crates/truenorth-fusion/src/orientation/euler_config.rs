@@ -181,7 +181,7 @@ impl Validate for EulerDetectorConfig {
             o.validate()?;
         }
         self.definer.validate()?;
-        crate::time_gap::check_max_gap(self.max_gap_s)?;
+        super::time_gap::check_max_gap(self.max_gap_s)?;
         if let Some(f) = self.startup_field {
             check_positive("startup_field.total", f.total)?;
             check_range(
