@@ -38,7 +38,7 @@
 //! ([`super::rotation`]), the dip test compares sines, and the heading error is taken as
 //! `sin ε = y/|h|` of the horizontal field `h = (x, y)` (±1 beyond ±90°).
 
-use nalgebra::{Quaternion, UnitQuaternion, Vector3};
+use nalgebra::{Matrix3, Quaternion, UnitQuaternion, Vector3};
 use serde::{Deserialize, Serialize};
 use truenorth_core::{
     AttitudeEstimate, AttitudeStatus, Error, ImuSample, OrientationEstimator, Result,
@@ -98,6 +98,32 @@ impl Coefficients {
             mag_rest: gain(cfg.tau_mag_rest_s),
             bias_rest: gain(cfg.bias_tau_rest_s),
         }
+    }
+}
+
+/// What the parts of one step share.
+struct StepContext {
+    dt_s: f64,
+    /// The step falls in the start-up (fast corrections, no bias learning).
+    startup: bool,
+    gains: Coefficients,
+    at_rest: bool,
+    /// Body → NED after the strapdown, before the step's corrections: one rotation matrix
+    /// serves every vector rotated in the step.
+    rotation: Matrix3<f64>,
+    /// |ω − b̂|, rad/s.
+    rate_rps: f64,
+}
+
+/// The heading error `sin ε` of the angle ε of the horizontal field `m_ned` (horizontal
+/// norm `horizontal`) east of north, and ±1 beyond ±90°: equal to ε to 0.13 % for
+/// |ε| < 5°, and bounded, so a disturbed reading that slips past the tests pulls no harder
+/// than a 57° error (the angle itself would pull with up to 180°).
+fn heading_error(m_ned: &Vector3<f64>, horizontal: f64) -> f64 {
+    if m_ned.x >= 0.0 {
+        m_ned.y / horizontal
+    } else {
+        1f64.copysign(m_ned.y)
     }
 }
 
@@ -205,6 +231,9 @@ impl QuaternionFilter {
         self.hard_iron.offset()
     }
 
+    /// One step of `dt_s` ending at `t_s`, in the order of the module documentation: the
+    /// strapdown, the σ carried through it, the corrections the sample's readings allow
+    /// (applied together at the end: at most 10⁻³ rad each), the gyro bias.
     fn step(
         &mut self,
         t_s: f64,
@@ -213,21 +242,65 @@ impl QuaternionFilter {
         acc: Option<Vector3<f64>>,
         mag: Option<Vector3<f64>>,
     ) {
-        let cfg = &self.config;
-        let s = &mut self.state;
-        s.since_start_s += dt_s;
-        let startup = s.since_start_s < cfg.startup_s;
-        let c = if startup {
-            Coefficients::new(cfg, dt_s, true)
-        } else {
-            if self.coefficients.dt_s != dt_s {
-                self.coefficients = Coefficients::new(cfg, dt_s, false);
-            }
-            self.coefficients
+        let startup = self.advance_time(dt_s);
+        let gains = self.gains(dt_s, startup);
+        let omega = self.strapdown(dt_s, gyr);
+        let at_rest = acc.is_some_and(|a| self.rest.update(&gyr, &a, mag.as_ref(), dt_s));
+        let step = StepContext {
+            dt_s,
+            startup,
+            gains,
+            at_rest,
+            rotation: *self.state.q.to_rotation_matrix().matrix(),
+            rate_rps: omega.norm(),
         };
+        self.propagate_uncertainty(&step, &omega);
+        let mut status = AttitudeStatus {
+            at_rest,
+            ..AttitudeStatus::default()
+        };
+        // The step's correction, a rotation vector in the reference frame.
+        let mut correction = Vector3::zeros();
+        if let Some(a) = acc
+            && a.norm_squared() > 1e-12
+        {
+            self.correct_inclination(&step, &a, &mut correction);
+            status.accel_used = true;
+        }
+        self.state.mag_dt_s += dt_s;
+        if let Some(m) = mag {
+            self.correct_heading(&step, &m, &mut correction, &mut status);
+        }
+        self.apply_correction(&correction);
+        if !startup {
+            self.estimate_bias(&step, &correction);
+        }
+        self.state.estimate = self.estimate_at(t_s, status);
+    }
 
-        // 1. Strapdown.
-        let rate = match cfg.gyro_timing {
+    /// Counts the step's time and says whether it falls in the start-up.
+    fn advance_time(&mut self, dt_s: f64) -> bool {
+        self.state.since_start_s += dt_s;
+        self.state.since_start_s < self.config.startup_s
+    }
+
+    /// The gains for a step of `dt_s`: the start-up's computed afresh, the others kept
+    /// until the interval changes.
+    fn gains(&mut self, dt_s: f64, startup: bool) -> Coefficients {
+        if startup {
+            return Coefficients::new(&self.config, dt_s, true);
+        }
+        if self.coefficients.dt_s != dt_s {
+            self.coefficients = Coefficients::new(&self.config, dt_s, false);
+        }
+        self.coefficients
+    }
+
+    /// Strapdown: `q ← q ⊗ exp((ω − b̂) dt / 2)` with the rate the gyro's timing calls for.
+    /// Returns the body rate less the bias, `ω − b̂`, rad/s.
+    fn strapdown(&mut self, dt_s: f64, gyr: Vector3<f64>) -> Vector3<f64> {
+        let s = &mut self.state;
+        let rate = match self.config.gyro_timing {
             GyroTiming::IntervalMean => gyr,
             GyroTiming::Instantaneous => 0.5 * (s.last_gyr_rps.unwrap_or(gyr) + gyr),
         };
@@ -235,168 +308,224 @@ impl QuaternionFilter {
         let omega = rate - s.bias_rps;
         s.q =
             UnitQuaternion::new_normalize(s.q.into_inner() * rotation_from_vector(&(omega * dt_s)));
-        let rate_rps = omega.norm();
+        omega
+    }
 
-        let at_rest = match acc {
-            Some(a) => self.rest.update(&gyr, &a, mag.as_ref(), dt_s),
-            None => false,
-        };
-        let mut status = AttitudeStatus {
-            at_rest,
-            ..AttitudeStatus::default()
-        };
-        // One rotation matrix serves every vector rotated this step; the corrections of the
-        // step (at most 10⁻³ rad) are applied together at its end.
-        let r = s.q.to_rotation_matrix();
-        let r = r.matrix();
-        s.uncertainty.propagate(dt_s, &omega, rate_rps, r);
-        // The in-motion bias estimate's 1/τ, as the uncertainty credits it.
-        let inv_tau_bias = if startup || at_rest {
+    /// Carries the σ through the strapdown step at body rate `omega` (bias removed).
+    fn propagate_uncertainty(&mut self, step: &StepContext, omega: &Vector3<f64>) {
+        self.state
+            .uncertainty
+            .propagate(step.dt_s, omega, step.rate_rps, &step.rotation);
+    }
+
+    /// The in-motion bias estimate's 1/τ as the σ credits it: none while the bias does not
+    /// learn from the corrections (start-up, rest).
+    fn bias_inv_tau_credited(&self, step: &StepContext) -> f64 {
+        if step.startup || step.at_rest {
             0.0
         } else {
-            s.bias_inv_tau_motion
-        };
-        let tau_acc_s = effective_tau(cfg.tau_acc_s, startup);
-        // The step's correction, a rotation vector in the reference frame.
-        let mut correction = Vector3::zeros();
-
-        // 2. Inclination.
-        if let Some(a) = acc
-            && a.norm_squared() > 1e-12
-        {
-            // Linear in the specific force: the body's own accelerations average out
-            // over a swing, where an angle (atan of horizontal over vertical) would not.
-            // A first low-pass in the reference frame before the proportional
-            // correction makes the response to acceleration second order.
-            let f = r * a;
-            let lp = match s.acc_lp_ned {
-                Some(lp) => lp + (f - lp) * c.acc_lowpass,
-                None => f,
-            };
-            s.acc_lp_ned = Some(lp);
-            let k = c.acc;
-            // down × ẑ with down = −lp/g.
-            correction.x = -lp.y * k;
-            correction.y = lp.x * k;
-            status.accel_used = true;
-            s.uncertainty.accel_corrected(
-                k * STANDARD_GRAVITY_MPS2,
-                (correction.x, correction.y),
-                tau_acc_s,
-                inv_tau_bias,
-                effective_tau(cfg.acc_lowpass_s, startup),
-            );
+            self.state.bias_inv_tau_motion
         }
+    }
 
-        // 3. Heading.
-        s.mag_dt_s += dt_s;
-        if let Some(m) = mag {
-            let mag_dt_s = core::mem::take(&mut s.mag_dt_s);
-            let offset = match self.mag_ref.reference_ned() {
-                Some(reference) => {
-                    let turning_rps = if at_rest { 0.0 } else { rate_rps };
-                    self.hard_iron
-                        .update(&m, r, &reference, turning_rps, mag_dt_s)
+    /// Inclination: the specific force `a` rotated into NED and low-passed there should
+    /// point up; adds the turn about the horizontal that moves it there by `dt/τ_acc` to
+    /// `correction`.
+    fn correct_inclination(
+        &mut self,
+        step: &StepContext,
+        a: &Vector3<f64>,
+        correction: &mut Vector3<f64>,
+    ) {
+        let inv_tau_bias = self.bias_inv_tau_credited(step);
+        let cfg = &self.config;
+        let s = &mut self.state;
+        // Linear in the specific force: the body's own accelerations average out over a
+        // swing, where an angle (atan of horizontal over vertical) would not. A first
+        // low-pass in the reference frame before the proportional correction makes the
+        // response to acceleration second order.
+        let f = step.rotation * a;
+        let lp = match s.acc_lp_ned {
+            Some(lp) => lp + (f - lp) * step.gains.acc_lowpass,
+            None => f,
+        };
+        s.acc_lp_ned = Some(lp);
+        let k = step.gains.acc;
+        // down × ẑ with down = −lp/g.
+        correction.x = -lp.y * k;
+        correction.y = lp.x * k;
+        s.uncertainty.accel_corrected(
+            k * STANDARD_GRAVITY_MPS2,
+            (correction.x, correction.y),
+            effective_tau(cfg.tau_acc_s, step.startup),
+            inv_tau_bias,
+            effective_tau(cfg.acc_lowpass_s, step.startup),
+        );
+    }
+
+    /// Heading: the field `m`, less any hard iron learned online, rotated into NED should
+    /// point north; adds the turn about the vertical that moves it there by `dt/τ_mag` to
+    /// `correction`, unless the reading is judged disturbed.
+    fn correct_heading(
+        &mut self,
+        step: &StepContext,
+        m: &Vector3<f64>,
+        correction: &mut Vector3<f64>,
+        status: &mut AttitudeStatus,
+    ) {
+        let mag_dt_s = core::mem::take(&mut self.state.mag_dt_s);
+        let offset = self.learn_hard_iron(step, m, mag_dt_s);
+        status.mag_calibrating = offset.is_some();
+        let m_ned = step.rotation * (m - offset.unwrap_or_default());
+        let horizontal = m_ned.xy().norm();
+        if horizontal > 0.0 {
+            let undisturbed = self
+                .mag_ref
+                .update(horizontal, m_ned.z, step.rate_rps, mag_dt_s);
+            status.mag_disturbed = !undisturbed;
+            if undisturbed && horizontal > 1e-9 * m_ned.z.abs() {
+                let k = self.heading_gain(step, mag_dt_s);
+                let dz = -k * heading_error(&m_ned, horizontal);
+                correction.z = dz;
+                // An offset learned from the attitude cannot also tell its error.
+                if !status.mag_calibrating {
+                    self.credit_heading_uncertainty(step, k, &m_ned, horizontal);
                 }
-                None => None,
-            };
-            status.mag_calibrating = offset.is_some();
-            let m = m - offset.unwrap_or_default();
-            let m_ned = r * m;
-            let horizontal = m_ned.xy().norm();
-            if horizontal > 0.0 {
-                let undisturbed = self.mag_ref.update(horizontal, m_ned.z, rate_rps, mag_dt_s);
-                status.mag_disturbed = !undisturbed;
-                if undisturbed && horizontal > 1e-9 * m_ned.z.abs() {
-                    // sin ε of the angle ε of the horizontal field east of north, and ±1
-                    // beyond ±90°: equal to ε to 0.13 % for |ε| < 5°, and bounded, so a
-                    // disturbed reading that slips past the tests pulls no harder than a
-                    // 57° error (the angle itself would pull with up to 180°).
-                    let err = if m_ned.x >= 0.0 {
-                        m_ned.y / horizontal
-                    } else {
-                        1f64.copysign(m_ned.y)
-                    };
-                    let k = match (at_rest, mag_dt_s == dt_s) {
-                        (true, true) => c.mag_rest,
-                        (false, true) => c.mag,
-                        // A reading after samples without one covers their time too.
-                        (rest, false) => {
-                            let g = Coefficients::new(cfg, mag_dt_s, startup);
-                            if rest { g.mag_rest } else { g.mag }
-                        }
-                    };
-                    let dz = -k * err;
-                    correction.z = dz;
-                    // An offset learned from the attitude cannot also tell its error.
-                    if !status.mag_calibrating
-                        && let Some(reference) = self.mag_ref.reference_ned()
-                    {
-                        let tau = if at_rest {
-                            cfg.tau_mag_rest_s
-                        } else {
-                            cfg.tau_mag_s
-                        };
-                        s.uncertainty.mag_corrected(
-                            k,
-                            effective_tau(tau, startup),
-                            (horizontal, m_ned.z),
-                            (reference.x, reference.z),
-                            inv_tau_bias,
-                        );
-                    }
-                    // Rz(−H/2) ← Rz(−dz/2) Rz(−H/2), first order and renormalised.
-                    let (c, sn) = s.undo_heading;
-                    let h = 0.5 * dz;
-                    let (c, sn) = (c + sn * h, sn - c * h);
-                    let n = (c * c + sn * sn).sqrt();
-                    s.undo_heading = (c / n, sn / n);
-                    status.mag_used = true;
-                }
+                self.undo_heading_correction(dz);
+                status.mag_used = true;
             }
         }
+    }
 
-        if correction != Vector3::zeros() {
-            s.q = small_rotation(&correction) * s.q;
-            // Turn the low-passed vector with the frame (first order, as the step is small).
+    /// The hard-iron offset to subtract from the reading `m`, learned while a field
+    /// reference is known; `mag_dt_s` is the time since the previous reading.
+    fn learn_hard_iron(
+        &mut self,
+        step: &StepContext,
+        m: &Vector3<f64>,
+        mag_dt_s: f64,
+    ) -> Option<Vector3<f64>> {
+        let reference = self.mag_ref.reference_ned()?;
+        // A gyro bias not yet learned must not count as turning.
+        let turning_rps = if step.at_rest { 0.0 } else { step.rate_rps };
+        self.hard_iron
+            .update(m, &step.rotation, &reference, turning_rps, mag_dt_s)
+    }
+
+    /// The heading correction's gain: at rest or in motion, and covering the samples
+    /// without a reading since the last one.
+    fn heading_gain(&self, step: &StepContext, mag_dt_s: f64) -> f64 {
+        let c = &step.gains;
+        match (step.at_rest, mag_dt_s == step.dt_s) {
+            (true, true) => c.mag_rest,
+            (false, true) => c.mag,
+            // A reading after samples without one covers their time too.
+            (rest, false) => {
+                let g = Coefficients::new(&self.config, mag_dt_s, step.startup);
+                if rest { g.mag_rest } else { g.mag }
+            }
+        }
+    }
+
+    /// The σ of heading after a correction with gain `k` by the field `m_ned` (horizontal
+    /// part `horizontal`), judged against the learned reference.
+    fn credit_heading_uncertainty(
+        &mut self,
+        step: &StepContext,
+        k: f64,
+        m_ned: &Vector3<f64>,
+        horizontal: f64,
+    ) {
+        let Some(reference) = self.mag_ref.reference_ned() else {
+            return;
+        };
+        let inv_tau_bias = self.bias_inv_tau_credited(step);
+        let cfg = &self.config;
+        let tau = if step.at_rest {
+            cfg.tau_mag_rest_s
+        } else {
+            cfg.tau_mag_s
+        };
+        self.state.uncertainty.mag_corrected(
+            k,
+            effective_tau(tau, step.startup),
+            (horizontal, m_ned.z),
+            (reference.x, reference.z),
+            inv_tau_bias,
+        );
+    }
+
+    /// Adds the heading correction `dz` to the turn the 6-D attitude undoes:
+    /// `Rz(−H/2) ← Rz(−dz/2) Rz(−H/2)`, first order and renormalised.
+    fn undo_heading_correction(&mut self, dz: f64) {
+        let (c, sn) = self.state.undo_heading;
+        let h = 0.5 * dz;
+        let (c, sn) = (c + sn * h, sn - c * h);
+        let n = (c * c + sn * sn).sqrt();
+        self.state.undo_heading = (c / n, sn / n);
+    }
+
+    /// Turns the attitude by the step's `correction` (in the reference frame), and the
+    /// low-passed specific force with it so that it stays in the frame of `q`.
+    fn apply_correction(&mut self, correction: &Vector3<f64>) {
+        if *correction != Vector3::zeros() {
+            let s = &mut self.state;
+            s.q = small_rotation(correction) * s.q;
+            // First order, as the step is small.
             s.acc_lp_ned = s.acc_lp_ned.map(|lp| lp + correction.cross(&lp));
         }
+    }
 
-        // 4. Gyro bias.
-        if !startup {
-            if at_rest {
-                s.bias_rps += (self.rest.gyro_mean() - s.bias_rps) * c.bias_rest;
-                s.uncertainty
-                    .at_rest(c.bias_rest, cfg.rest.mean_tau_s, cfg.bias_tau_rest_s);
-                if s.rest_s < cfg.bias_known_after_rest_s {
-                    s.rest_s += dt_s;
-                    let known = (s.rest_s / cfg.bias_known_after_rest_s).min(1.0);
-                    let tau = cfg.bias_tau_unknown_s
-                        + known * (cfg.bias_tau_motion_s - cfg.bias_tau_unknown_s);
-                    s.bias_inv_tau_motion = 1.0 / tau;
-                }
-            } else {
-                // A bias the estimate lacks makes the strapdown drift, and the corrections
-                // turn against the drift: integrating their rate removes it. Until a rest
-                // has measured the bias, it is learned faster, accepting more of the
-                // accelerations that leak into the corrections.
-                // Body-frame rate of the correction, Rᵀ·correction/dt, times dt/τ.
-                s.bias_rps -= r.tr_mul(&correction) * s.bias_inv_tau_motion;
-            }
-            let lim = cfg.max_bias_rps;
-            s.bias_rps = s.bias_rps.map(|b| b.clamp(-lim, lim));
+    /// Gyro bias: at rest it follows the rest detector's mean of the raw rate; in motion it
+    /// integrates the rate the step's `correction` implies. Clamped to `max_bias_rps`.
+    fn estimate_bias(&mut self, step: &StepContext, correction: &Vector3<f64>) {
+        if step.at_rest {
+            self.learn_bias_at_rest(step);
+        } else {
+            // A bias the estimate lacks makes the strapdown drift, and the corrections
+            // turn against the drift: integrating their rate removes it (the integral term
+            // of Mahony et al.). Until a rest has measured the bias, it is learned faster,
+            // accepting more of the accelerations that leak into the corrections.
+            // Body-frame rate of the correction, Rᵀ·correction/dt, times dt/τ.
+            let s = &mut self.state;
+            s.bias_rps -= step.rotation.tr_mul(correction) * s.bias_inv_tau_motion;
         }
+        let lim = self.config.max_bias_rps;
+        self.state.bias_rps = self.state.bias_rps.map(|b| b.clamp(-lim, lim));
+    }
 
+    /// The bias at rest, and how well it is known: the in-motion estimate's time constant
+    /// moves from `bias_tau_unknown_s` to `bias_tau_motion_s` as rest time accumulates.
+    fn learn_bias_at_rest(&mut self, step: &StepContext) {
+        let cfg = &self.config;
+        let s = &mut self.state;
+        let k = step.gains.bias_rest;
+        s.bias_rps += (self.rest.gyro_mean() - s.bias_rps) * k;
+        s.uncertainty
+            .at_rest(k, cfg.rest.mean_tau_s, cfg.bias_tau_rest_s);
+        if s.rest_s < cfg.bias_known_after_rest_s {
+            s.rest_s += step.dt_s;
+            let known = (s.rest_s / cfg.bias_known_after_rest_s).min(1.0);
+            let tau =
+                cfg.bias_tau_unknown_s + known * (cfg.bias_tau_motion_s - cfg.bias_tau_unknown_s);
+            s.bias_inv_tau_motion = 1.0 / tau;
+        }
+    }
+
+    /// The estimate after the step: the attitude, the 6-D attitude with every heading
+    /// correction undone, the bias and σ.
+    fn estimate_at(&self, t_s: f64, status: AttitudeStatus) -> AttitudeEstimate {
+        let s = &self.state;
         let (c, sn) = s.undo_heading;
         let undo = UnitQuaternion::new_unchecked(Quaternion::new(c, 0.0, 0.0, sn));
-        s.estimate = AttitudeEstimate {
+        AttitudeEstimate {
             t_s,
             attitude: s.q,
             attitude_6d: undo * s.q,
             gyro_bias_rps: s.bias_rps,
             sigma_rad: Some(s.uncertainty.sigma_rad()),
             status,
-        };
+        }
     }
 
     /// Starts again after a gap of `gap_s` that the gyro cannot bridge: the attitude from
