@@ -48,8 +48,9 @@ pub mod vehicle;
 pub use orientation::attitude_uncertainty;
 pub use orientation::{
     AttitudeError, AttitudeUncertaintyConfig, CorrectionDefinerConfig, EulerDetector,
-    EulerDetectorConfig, EulerVariant, GyroConditioning, GyroTiming, HardIronConfig,
-    HardIronEstimator, MAX_DEFINER_WINDOW, MagReference, MagReferenceConfig, QuaternionFilter,
-    QuaternionFilterConfig, RestConfig, RestDetector, StartupField, coefficient_table,
+    EulerDetectorConfig, EulerDetectorState, EulerVariant, GyroConditioning, GyroTiming,
+    HardIronConfig, HardIronEstimator, MAX_DEFINER_WINDOW, MagReference, MagReferenceConfig,
+    QuaternionFilter, QuaternionFilterConfig, QuaternionFilterState, RestConfig, RestDetector,
+    StartupField, coefficient_table,
 };
 pub use vehicle::{CompassGates, SensorPriors, VehicleConfig, VehicleEstimator};

@@ -20,7 +20,7 @@
 
 use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
-use truenorth_core::{Result, Validate, check_positive, check_range};
+use truenorth_core::{Error, Result, Validate, check_finite3, check_positive, check_range};
 
 #[allow(unused_imports)]
 use truenorth_core::Float as _;
@@ -173,6 +173,26 @@ impl HardIronEstimator {
     /// The adopted offset (body frame, sensor unit), if any.
     pub fn offset(&self) -> Option<Vector3<f64>> {
         self.offset
+    }
+
+    /// Checks a restored estimator against the thresholds `config` of its filter: the same
+    /// thresholds, finite statistics, spread, turn and time ≥ 0.
+    pub(crate) fn check(&self, config: &HardIronConfig) -> Result<()> {
+        if self.config != *config {
+            return Err(Error::InvalidSnapshot {
+                reason: "the hard-iron estimator's thresholds differ from the filter's",
+            });
+        }
+        check_finite3("hard_iron.mean", &self.mean)?;
+        if let Some(b) = &self.offset {
+            check_finite3("hard_iron.offset", b)?;
+        }
+        check_range("hard_iron.spread2", self.spread2, 0.0, f64::MAX)?;
+        check_range("hard_iron.turned_rad", self.turned_rad, 0.0, f64::MAX)?;
+        check_range("hard_iron.consistent_s", self.consistent_s, 0.0, f64::MAX)?;
+        check_range("hard_iron.gain", self.gain.1, 0.0, 1.0)?;
+        check_range("hard_iron.gain interval", self.gain.0, 0.0, f64::MAX)?;
+        Ok(())
     }
 }
 

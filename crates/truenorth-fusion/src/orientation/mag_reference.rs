@@ -9,7 +9,7 @@
 //! to the sensor) never becomes consistent and stays rejected.
 
 use serde::{Deserialize, Serialize};
-use truenorth_core::{Result, Validate, check_positive, check_range};
+use truenorth_core::{Error, Result, Validate, check_finite, check_positive, check_range};
 
 #[allow(unused_imports)]
 use truenorth_core::Float as _;
@@ -175,6 +175,34 @@ impl MagReference {
         let n = (h * h + v * v).sqrt();
         (n - n0).abs() <= self.config.norm_tol_rel * n0
             && (v * h0 - h * v0).abs() <= self.sin_dip_tol * n * n0
+    }
+
+    /// Checks a restored reference against the tolerances `config` of its filter: the same
+    /// tolerances, finite components, times ≥ 0.
+    pub(crate) fn check(&self, config: &MagReferenceConfig) -> Result<()> {
+        if self.config != *config || self.sin_dip_tol != Self::new(*config).sin_dip_tol {
+            return Err(Error::InvalidSnapshot {
+                reason: "the field reference's tolerances differ from the filter's",
+            });
+        }
+        for v in [
+            self.horizontal,
+            self.vertical,
+            self.candidate_horizontal,
+            self.candidate_vertical,
+        ] {
+            check_finite("mag reference component", v)?;
+        }
+        check_range("mag.candidate_s", self.candidate_s, 0.0, f64::MAX)?;
+        check_range(
+            "mag.candidate_moving_s",
+            self.candidate_moving_s,
+            0.0,
+            f64::MAX,
+        )?;
+        check_range("mag.gain", self.gain.1, 0.0, 1.0)?;
+        check_range("mag.gain interval", self.gain.0, 0.0, f64::MAX)?;
+        Ok(())
     }
 
     fn adopt(&mut self, horizontal: f64, vertical: f64) {

@@ -7,10 +7,14 @@ mod attitude_error;
 pub mod attitude_uncertainty;
 mod euler_config;
 mod euler_detector;
+mod euler_state;
+mod gyro_conditioner;
 mod hard_iron;
 mod mag_reference;
+mod moving_average;
 mod quaternion_config;
 mod quaternion_filter;
+mod quaternion_state;
 mod rest_detector;
 mod rotation;
 mod time_gap;
@@ -22,8 +26,13 @@ pub use euler_config::{
     MAX_DEFINER_WINDOW, StartupField, coefficient_table,
 };
 pub use euler_detector::EulerDetector;
+pub use euler_state::EulerDetectorState;
+pub use gyro_conditioner::GyroConditioner;
 pub use hard_iron::{HardIronConfig, HardIronEstimator};
 pub use mag_reference::{MagReference, MagReferenceConfig};
+pub use moving_average::MovingAverage;
 pub use quaternion_config::{GyroTiming, QuaternionFilterConfig};
 pub use quaternion_filter::QuaternionFilter;
+pub use quaternion_state::QuaternionFilterState;
 pub use rest_detector::{RestConfig, RestDetector};
+pub use time_gap::GapMonitor;

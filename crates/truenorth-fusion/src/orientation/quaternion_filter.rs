@@ -39,19 +39,16 @@
 //! `sin ε = y/|h|` of the horizontal field `h = (x, y)` (±1 beyond ±90°).
 
 use nalgebra::{Matrix3, Quaternion, UnitQuaternion, Vector3};
-use serde::{Deserialize, Serialize};
 use truenorth_core::{
-    AttitudeEstimate, AttitudeStatus, Error, ImuSample, OrientationEstimator, Result,
-    STANDARD_GRAVITY_MPS2, TimeStep, Validate,
+    AttitudeEstimate, AttitudeStatus, Error, ImuSample, OrientationEstimator, Persistent, Result,
+    STANDARD_GRAVITY_MPS2, Validate,
 };
 
-use super::attitude_uncertainty::AttitudeUncertainty;
-use super::hard_iron::HardIronEstimator;
-use super::mag_reference::MagReference;
 use super::quaternion_config::{GyroTiming, QuaternionFilterConfig};
+use super::quaternion_state::QuaternionFilterState;
 use super::rest_detector::RestDetector;
 use super::rotation::{rotation_from_vector, small_rotation};
-use super::time_gap::{GapMonitor, Step};
+use super::time_gap::Step;
 
 #[allow(unused_imports)]
 use truenorth_core::Float as _;
@@ -127,29 +124,6 @@ fn heading_error(m_ned: &Vector3<f64>, horizontal: f64) -> f64 {
     }
 }
 
-/// What the filter has learned.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-struct State {
-    q: UnitQuaternion<f64>,
-    /// `Rz(−H/2)` as (cos, sin) of `−H/2`, `H` the sum of the heading corrections (see the
-    /// module documentation).
-    undo_heading: (f64, f64),
-    bias_rps: Vector3<f64>,
-    acc_lp_ned: Option<Vector3<f64>>,
-    /// Time spent at rest since the start, s: how well the bias is known.
-    rest_s: f64,
-    /// `1/τ` of the in-motion bias estimate for the rest time so far.
-    bias_inv_tau_motion: f64,
-    last_gyr_rps: Option<Vector3<f64>>,
-    /// Time since the last magnetometer reading, s.
-    mag_dt_s: f64,
-    since_start_s: f64,
-    initialised: bool,
-    /// The σ of the attitude, propagated alongside it.
-    uncertainty: AttitudeUncertainty,
-    estimate: AttitudeEstimate,
-}
-
 /// The quaternion orientation filter (see the module documentation).
 ///
 /// ```
@@ -176,59 +150,35 @@ struct State {
 /// ```
 #[derive(Debug, Clone)]
 pub struct QuaternionFilter {
-    config: QuaternionFilterConfig,
-    state: State,
-    clock: TimeStep,
-    rest: RestDetector,
-    mag_ref: MagReference,
-    hard_iron: HardIronEstimator,
+    state: QuaternionFilterState,
+    /// Derived from the parameters and the sample interval.
     coefficients: Coefficients,
-    gaps: GapMonitor,
 }
 
 impl QuaternionFilter {
     /// A filter with the given parameters.
     pub fn new(config: QuaternionFilterConfig) -> Result<Self> {
         config.validate()?;
-        let q0 = initial_attitude(&config);
-        let uncertainty = AttitudeUncertainty::new(config.uncertainty, !config.use_mag);
-        Ok(Self {
-            config,
-            state: State {
-                q: q0,
-                undo_heading: (1.0, 0.0),
-                bias_rps: Vector3::zeros(),
-                acc_lp_ned: None,
-                rest_s: 0.0,
-                bias_inv_tau_motion: 1.0 / config.bias_tau_unknown_s,
-                last_gyr_rps: None,
-                mag_dt_s: 0.0,
-                since_start_s: 0.0,
-                initialised: config.initial_attitude.is_some(),
-                uncertainty,
-                estimate: AttitudeEstimate {
-                    sigma_rad: Some(uncertainty.sigma_rad()),
-                    ..AttitudeEstimate::initial(q0)
-                },
-            },
-            clock: TimeStep::new(),
-            rest: RestDetector::new(config.rest),
-            mag_ref: MagReference::new(config.mag),
-            hard_iron: HardIronEstimator::new(config.hard_iron),
-            coefficients: Coefficients::new(&config, 0.0, false),
-            gaps: GapMonitor::new(config.max_gap_s),
-        })
+        Ok(Self::with_state(QuaternionFilterState::initial(config)))
+    }
+
+    /// The filter continuing from a valid `state`.
+    fn with_state(state: QuaternionFilterState) -> Self {
+        Self {
+            coefficients: Coefficients::new(&state.config, 0.0, false),
+            state,
+        }
     }
 
     /// The parameters in use.
     pub fn config(&self) -> &QuaternionFilterConfig {
-        &self.config
+        &self.state.config
     }
 
     /// The hard-iron offset currently subtracted from the magnetometer (body frame, the
     /// magnetometer's unit), if one was learned.
     pub fn hard_iron_offset(&self) -> Option<Vector3<f64>> {
-        self.hard_iron.offset()
+        self.state.hard_iron.offset()
     }
 
     /// One step of `dt_s` ending at `t_s`, in the order of the module documentation: the
@@ -245,13 +195,13 @@ impl QuaternionFilter {
         let startup = self.advance_time(dt_s);
         let gains = self.gains(dt_s, startup);
         let omega = self.strapdown(dt_s, gyr);
-        let at_rest = acc.is_some_and(|a| self.rest.update(&gyr, &a, mag.as_ref(), dt_s));
+        let at_rest = acc.is_some_and(|a| self.state.rest.update(&gyr, &a, mag.as_ref(), dt_s));
         let step = StepContext {
             dt_s,
             startup,
             gains,
             at_rest,
-            rotation: *self.state.q.to_rotation_matrix().matrix(),
+            rotation: *self.state.attitude.to_rotation_matrix().matrix(),
             rate_rps: omega.norm(),
         };
         self.propagate_uncertainty(&step, &omega);
@@ -267,7 +217,7 @@ impl QuaternionFilter {
             self.correct_inclination(&step, &a, &mut correction);
             status.accel_used = true;
         }
-        self.state.mag_dt_s += dt_s;
+        self.state.since_mag_s += dt_s;
         if let Some(m) = mag {
             self.correct_heading(&step, &m, &mut correction, &mut status);
         }
@@ -275,23 +225,23 @@ impl QuaternionFilter {
         if !startup {
             self.estimate_bias(&step, &correction);
         }
-        self.state.estimate = self.estimate_at(t_s, status);
+        self.state.estimate = Some(self.estimate_at(t_s, status));
     }
 
     /// Counts the step's time and says whether it falls in the start-up.
     fn advance_time(&mut self, dt_s: f64) -> bool {
         self.state.since_start_s += dt_s;
-        self.state.since_start_s < self.config.startup_s
+        self.state.since_start_s < self.state.config.startup_s
     }
 
     /// The gains for a step of `dt_s`: the start-up's computed afresh, the others kept
     /// until the interval changes.
     fn gains(&mut self, dt_s: f64, startup: bool) -> Coefficients {
         if startup {
-            return Coefficients::new(&self.config, dt_s, true);
+            return Coefficients::new(&self.state.config, dt_s, true);
         }
         if self.coefficients.dt_s != dt_s {
-            self.coefficients = Coefficients::new(&self.config, dt_s, false);
+            self.coefficients = Coefficients::new(&self.state.config, dt_s, false);
         }
         self.coefficients
     }
@@ -300,14 +250,15 @@ impl QuaternionFilter {
     /// Returns the body rate less the bias, `ω − b̂`, rad/s.
     fn strapdown(&mut self, dt_s: f64, gyr: Vector3<f64>) -> Vector3<f64> {
         let s = &mut self.state;
-        let rate = match self.config.gyro_timing {
+        let rate = match s.config.gyro_timing {
             GyroTiming::IntervalMean => gyr,
             GyroTiming::Instantaneous => 0.5 * (s.last_gyr_rps.unwrap_or(gyr) + gyr),
         };
         s.last_gyr_rps = Some(gyr);
-        let omega = rate - s.bias_rps;
-        s.q =
-            UnitQuaternion::new_normalize(s.q.into_inner() * rotation_from_vector(&(omega * dt_s)));
+        let omega = rate - s.gyro_bias_rps;
+        s.attitude = UnitQuaternion::new_normalize(
+            s.attitude.into_inner() * rotation_from_vector(&(omega * dt_s)),
+        );
         omega
     }
 
@@ -324,7 +275,7 @@ impl QuaternionFilter {
         if step.startup || step.at_rest {
             0.0
         } else {
-            self.state.bias_inv_tau_motion
+            self.state.bias_inv_tau_motion_per_s
         }
     }
 
@@ -338,18 +289,18 @@ impl QuaternionFilter {
         correction: &mut Vector3<f64>,
     ) {
         let inv_tau_bias = self.bias_inv_tau_credited(step);
-        let cfg = &self.config;
         let s = &mut self.state;
+        let cfg = &s.config;
         // Linear in the specific force: the body's own accelerations average out over a
         // swing, where an angle (atan of horizontal over vertical) would not. A first
         // low-pass in the reference frame before the proportional correction makes the
         // response to acceleration second order.
         let f = step.rotation * a;
-        let lp = match s.acc_lp_ned {
+        let lp = match s.acc_lowpass_ned_mps2 {
             Some(lp) => lp + (f - lp) * step.gains.acc_lowpass,
             None => f,
         };
-        s.acc_lp_ned = Some(lp);
+        s.acc_lowpass_ned_mps2 = Some(lp);
         let k = step.gains.acc;
         // down × ẑ with down = −lp/g.
         correction.x = -lp.y * k;
@@ -373,15 +324,16 @@ impl QuaternionFilter {
         correction: &mut Vector3<f64>,
         status: &mut AttitudeStatus,
     ) {
-        let mag_dt_s = core::mem::take(&mut self.state.mag_dt_s);
+        let mag_dt_s = core::mem::take(&mut self.state.since_mag_s);
         let offset = self.learn_hard_iron(step, m, mag_dt_s);
         status.mag_calibrating = offset.is_some();
         let m_ned = step.rotation * (m - offset.unwrap_or_default());
         let horizontal = m_ned.xy().norm();
         if horizontal > 0.0 {
-            let undisturbed = self
-                .mag_ref
-                .update(horizontal, m_ned.z, step.rate_rps, mag_dt_s);
+            let undisturbed =
+                self.state
+                    .mag_reference
+                    .update(horizontal, m_ned.z, step.rate_rps, mag_dt_s);
             status.mag_disturbed = !undisturbed;
             if undisturbed && horizontal > 1e-9 * m_ned.z.abs() {
                 let k = self.heading_gain(step, mag_dt_s);
@@ -405,10 +357,11 @@ impl QuaternionFilter {
         m: &Vector3<f64>,
         mag_dt_s: f64,
     ) -> Option<Vector3<f64>> {
-        let reference = self.mag_ref.reference_ned()?;
+        let reference = self.state.mag_reference.reference_ned()?;
         // A gyro bias not yet learned must not count as turning.
         let turning_rps = if step.at_rest { 0.0 } else { step.rate_rps };
-        self.hard_iron
+        self.state
+            .hard_iron
             .update(m, &step.rotation, &reference, turning_rps, mag_dt_s)
     }
 
@@ -421,7 +374,7 @@ impl QuaternionFilter {
             (false, true) => c.mag,
             // A reading after samples without one covers their time too.
             (rest, false) => {
-                let g = Coefficients::new(&self.config, mag_dt_s, step.startup);
+                let g = Coefficients::new(&self.state.config, mag_dt_s, step.startup);
                 if rest { g.mag_rest } else { g.mag }
             }
         }
@@ -436,11 +389,11 @@ impl QuaternionFilter {
         m_ned: &Vector3<f64>,
         horizontal: f64,
     ) {
-        let Some(reference) = self.mag_ref.reference_ned() else {
+        let Some(reference) = self.state.mag_reference.reference_ned() else {
             return;
         };
         let inv_tau_bias = self.bias_inv_tau_credited(step);
-        let cfg = &self.config;
+        let cfg = &self.state.config;
         let tau = if step.at_rest {
             cfg.tau_mag_rest_s
         } else {
@@ -470,9 +423,9 @@ impl QuaternionFilter {
     fn apply_correction(&mut self, correction: &Vector3<f64>) {
         if *correction != Vector3::zeros() {
             let s = &mut self.state;
-            s.q = small_rotation(correction) * s.q;
+            s.attitude = small_rotation(correction) * s.attitude;
             // First order, as the step is small.
-            s.acc_lp_ned = s.acc_lp_ned.map(|lp| lp + correction.cross(&lp));
+            s.acc_lowpass_ned_mps2 = s.acc_lowpass_ned_mps2.map(|lp| lp + correction.cross(&lp));
         }
     }
 
@@ -488,19 +441,19 @@ impl QuaternionFilter {
             // accepting more of the accelerations that leak into the corrections.
             // Body-frame rate of the correction, Rᵀ·correction/dt, times dt/τ.
             let s = &mut self.state;
-            s.bias_rps -= step.rotation.tr_mul(correction) * s.bias_inv_tau_motion;
+            s.gyro_bias_rps -= step.rotation.tr_mul(correction) * s.bias_inv_tau_motion_per_s;
         }
-        let lim = self.config.max_bias_rps;
-        self.state.bias_rps = self.state.bias_rps.map(|b| b.clamp(-lim, lim));
+        let lim = self.state.config.max_bias_rps;
+        self.state.gyro_bias_rps = self.state.gyro_bias_rps.map(|b| b.clamp(-lim, lim));
     }
 
     /// The bias at rest, and how well it is known: the in-motion estimate's time constant
     /// moves from `bias_tau_unknown_s` to `bias_tau_motion_s` as rest time accumulates.
     fn learn_bias_at_rest(&mut self, step: &StepContext) {
-        let cfg = &self.config;
         let s = &mut self.state;
+        let cfg = &s.config;
         let k = step.gains.bias_rest;
-        s.bias_rps += (self.rest.gyro_mean() - s.bias_rps) * k;
+        s.gyro_bias_rps += (s.rest.gyro_mean() - s.gyro_bias_rps) * k;
         s.uncertainty
             .at_rest(k, cfg.rest.mean_tau_s, cfg.bias_tau_rest_s);
         if s.rest_s < cfg.bias_known_after_rest_s {
@@ -508,7 +461,7 @@ impl QuaternionFilter {
             let known = (s.rest_s / cfg.bias_known_after_rest_s).min(1.0);
             let tau =
                 cfg.bias_tau_unknown_s + known * (cfg.bias_tau_motion_s - cfg.bias_tau_unknown_s);
-            s.bias_inv_tau_motion = 1.0 / tau;
+            s.bias_inv_tau_motion_per_s = 1.0 / tau;
         }
     }
 
@@ -520,9 +473,9 @@ impl QuaternionFilter {
         let undo = UnitQuaternion::new_unchecked(Quaternion::new(c, 0.0, 0.0, sn));
         AttitudeEstimate {
             t_s,
-            attitude: s.q,
-            attitude_6d: undo * s.q,
-            gyro_bias_rps: s.bias_rps,
+            attitude: s.attitude,
+            attitude_6d: undo * s.attitude,
+            gyro_bias_rps: s.gyro_bias_rps,
             sigma_rad: Some(s.uncertainty.sigma_rad()),
             status,
         }
@@ -542,26 +495,27 @@ impl QuaternionFilter {
     ) -> AttitudeEstimate {
         let s = &mut self.state;
         if let Some(q) = acc.and_then(|a| attitude_from(&a, mag.as_ref())) {
-            s.q = q;
+            s.attitude = q;
         }
         s.undo_heading = (1.0, 0.0);
-        s.acc_lp_ned = None;
+        s.acc_lowpass_ned_mps2 = None;
         s.last_gyr_rps = Some(gyr);
-        s.mag_dt_s = 0.0;
+        s.since_mag_s = 0.0;
         s.since_start_s = 0.0;
         s.uncertainty.restart(false, gap_s);
-        self.rest = RestDetector::new(self.config.rest);
-        s.estimate = AttitudeEstimate {
+        s.rest = RestDetector::new(s.config.rest);
+        let estimate = AttitudeEstimate {
             t_s,
-            gyro_bias_rps: s.bias_rps,
+            gyro_bias_rps: s.gyro_bias_rps,
             sigma_rad: Some(s.uncertainty.sigma_rad()),
             status: AttitudeStatus {
                 gap: true,
                 ..AttitudeStatus::default()
             },
-            ..AttitudeEstimate::initial(s.q)
+            ..AttitudeEstimate::initial(s.attitude)
         };
-        s.estimate
+        s.estimate = Some(estimate);
+        estimate
     }
 }
 
@@ -577,7 +531,7 @@ impl OrientationEstimator for QuaternionFilter {
             reason: "the quaternion filter needs a three-axis gyro; use the Euler detector for two gyros",
         })?;
         let acc = sample.acc_mps2.as_xyz();
-        let mag = if self.config.use_mag {
+        let mag = if self.state.config.use_mag {
             sample.mag.as_xyz()
         } else {
             None
@@ -596,13 +550,13 @@ impl OrientationEstimator for QuaternionFilter {
         }
         // Readings beyond any sensor's range could overflow the update; they are refused
         // before anything changes, so the update needs no copy of the state to fall back to.
-        let mut clock = self.clock;
+        let mut clock = self.state.clock;
         let dt = clock.dt_s(sample.t_s)?;
         check_bounds(&gyr, acc.as_ref(), mag.as_ref(), dt)?;
-        let step = dt.map(|d| self.gaps.classify(d)).transpose()?;
-        self.clock = clock;
+        let step = dt.map(|d| self.state.gaps.classify(d)).transpose()?;
+        self.state.clock = clock;
         if let Some(step) = step {
-            self.gaps.count(step);
+            self.state.gaps.count(step);
         }
         if let (Some(gap_s), Some(Step::Gap)) = (dt, step) {
             return Ok(self.restart(sample.t_s, gap_s, gyr, acc, mag));
@@ -611,30 +565,51 @@ impl OrientationEstimator for QuaternionFilter {
             if !self.state.initialised
                 && let Some(q) = acc.and_then(|a| attitude_from(&a, mag.as_ref()))
             {
-                self.state.q = q;
+                self.state.attitude = q;
                 self.state.initialised = true;
             }
             self.state.last_gyr_rps = Some(gyr);
-            self.state.estimate = AttitudeEstimate {
+            let estimate = AttitudeEstimate {
                 t_s: sample.t_s,
                 sigma_rad: Some(self.state.uncertainty.sigma_rad()),
-                ..AttitudeEstimate::initial(self.state.q)
+                ..AttitudeEstimate::initial(self.state.attitude)
             };
-            return Ok(self.state.estimate);
+            self.state.estimate = Some(estimate);
+            return Ok(estimate);
         };
         self.step(sample.t_s, dt_s, gyr, acc, mag);
-        debug_assert!(self.state.q.coords.iter().all(|v| v.is_finite()));
-        Ok(self.state.estimate)
+        debug_assert!(self.state.attitude.coords.iter().all(|v| v.is_finite()));
+        Ok(self.estimate())
     }
 
+    /// The estimate after the last sample; before the first, the initial attitude with
+    /// its σ.
     fn estimate(&self) -> AttitudeEstimate {
-        self.state.estimate
+        let s = &self.state;
+        s.estimate.unwrap_or_else(|| AttitudeEstimate {
+            sigma_rad: Some(s.uncertainty.sigma_rad()),
+            ..AttitudeEstimate::initial(s.attitude)
+        })
     }
 
+    /// Back to the state before any sample, with the same parameters.
     fn reset(&mut self) {
-        if let Ok(f) = Self::new(self.config) {
-            *self = f;
-        }
+        *self = Self::with_state(QuaternionFilterState::initial(self.state.config));
+    }
+}
+
+impl Persistent for QuaternionFilter {
+    type State = QuaternionFilterState;
+    const SNAPSHOT_VERSION: u32 = 1;
+
+    fn state(&self) -> QuaternionFilterState {
+        self.state
+    }
+
+    /// Refuses a state that is not valid (see [`QuaternionFilterState`]'s `validate`).
+    fn from_state(state: QuaternionFilterState) -> Result<Self> {
+        state.validate()?;
+        Ok(Self::with_state(state))
     }
 }
 
@@ -686,13 +661,6 @@ fn check_bounds(
         check("time between samples, s", dt, MAX_DT_S)?;
     }
     Ok(())
-}
-
-fn initial_attitude(config: &QuaternionFilterConfig) -> UnitQuaternion<f64> {
-    match config.initial_attitude {
-        Some([w, x, y, z]) => UnitQuaternion::from_quaternion(Quaternion::new(w, x, y, z)),
-        None => UnitQuaternion::identity(),
-    }
 }
 
 /// The attitude whose NED up is the measured specific force and, with a magnetometer,

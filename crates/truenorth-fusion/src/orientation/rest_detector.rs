@@ -15,7 +15,7 @@
 
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
-use truenorth_core::{Result, Validate, check_positive, check_range};
+use truenorth_core::{Error, Result, Validate, check_finite3, check_positive, check_range};
 
 #[allow(unused_imports)]
 use truenorth_core::Float as _;
@@ -143,6 +143,25 @@ impl RestDetector {
     /// Running mean of the raw gyro, rad/s: the bias while at rest.
     pub fn gyro_mean(&self) -> Vector3<f64> {
         self.gyr_mean
+    }
+
+    /// Checks a restored detector against the thresholds `config` of its filter: the same
+    /// thresholds, finite means, a still time ≥ 0.
+    pub(crate) fn check(&self, config: &RestConfig) -> Result<()> {
+        if self.config != *config {
+            return Err(Error::InvalidSnapshot {
+                reason: "the rest detector's thresholds differ from the filter's",
+            });
+        }
+        check_finite3("rest.gyr_mean", &self.gyr_mean)?;
+        check_finite3("rest.acc_mean", &self.acc_mean)?;
+        for m in [self.mag_mean, self.mag_at_start].iter().flatten() {
+            check_finite3("rest.mag_mean", m)?;
+        }
+        check_range("rest.still_s", self.still_s, 0.0, f64::MAX)?;
+        check_range("rest.gain", self.gain.1, 0.0, 1.0)?;
+        check_range("rest.gain interval", self.gain.0, 0.0, f64::MAX)?;
+        Ok(())
     }
 }
 
