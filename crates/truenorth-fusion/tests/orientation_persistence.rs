@@ -52,7 +52,7 @@ fn bits(e: &AttitudeEstimate) -> (Vec<u64>, String) {
     let q = |q: &UnitQuaternion<f64>| q.coords.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
     let mut v = vec![e.t_s.to_bits()];
     v.extend(q(&e.attitude));
-    v.extend(q(&e.attitude_6d));
+    v.extend(e.attitude_6d.iter().flat_map(q));
     v.extend(e.gyro_bias_rps.iter().map(|x| x.to_bits()));
     v.extend(
         e.sigma_rad

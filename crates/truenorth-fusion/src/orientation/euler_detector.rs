@@ -282,7 +282,7 @@ impl EulerDetector {
         Ok(AttitudeEstimate {
             t_s: sample.t_s,
             attitude: q,
-            attitude_6d: q,
+            attitude_6d: None,
             gyro_bias_rps: Vector3::zeros(),
             sigma_rad: None,
             status,
@@ -380,6 +380,7 @@ impl OrientationEstimator for EulerDetector {
                         gap,
                         ..AttitudeStatus::default()
                     },
+                    attitude_6d: None,
                     ..AttitudeEstimate::initial(q)
                 };
                 self.state.estimate = Some(estimate);
@@ -405,9 +406,10 @@ impl OrientationEstimator for EulerDetector {
 
     /// The estimate after the last sample; before the first, level and facing north.
     fn estimate(&self) -> AttitudeEstimate {
-        self.state
-            .estimate
-            .unwrap_or_else(|| AttitudeEstimate::initial(UnitQuaternion::identity()))
+        self.state.estimate.unwrap_or_else(|| AttitudeEstimate {
+            attitude_6d: None,
+            ..AttitudeEstimate::initial(UnitQuaternion::identity())
+        })
     }
 
     /// Back to the state before any sample, with the same parameters.

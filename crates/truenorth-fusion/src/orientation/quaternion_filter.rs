@@ -474,7 +474,7 @@ impl QuaternionFilter {
         AttitudeEstimate {
             t_s,
             attitude: s.attitude,
-            attitude_6d: undo * s.attitude,
+            attitude_6d: Some(undo * s.attitude),
             gyro_bias_rps: s.gyro_bias_rps,
             sigma_rad: Some(s.uncertainty.sigma_rad()),
             status,

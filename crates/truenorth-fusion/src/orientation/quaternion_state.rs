@@ -156,7 +156,7 @@ impl Validate for QuaternionFilterState {
 /// A saved estimate's numbers: finite, σ ≥ 0.
 pub(crate) fn check_estimate(e: &AttitudeEstimate) -> Result<()> {
     check_finite("estimate t_s", e.t_s)?;
-    for q in [&e.attitude, &e.attitude_6d] {
+    for q in core::iter::once(&e.attitude).chain(&e.attitude_6d) {
         for v in q.coords.iter() {
             check_finite("estimate attitude component", *v)?;
         }
