@@ -96,8 +96,14 @@ pub struct HardIronEstimator {
 }
 
 impl HardIronEstimator {
-    /// No offset yet (validated by the filter's config).
-    pub fn new(config: HardIronConfig) -> Self {
+    /// No offset yet; invalid thresholds are refused.
+    pub fn new(config: HardIronConfig) -> Result<Self> {
+        config.validate()?;
+        Ok(Self::with_config(config))
+    }
+
+    /// No offset yet, for thresholds already validated (by the filter's config).
+    pub(crate) fn with_config(config: HardIronConfig) -> Self {
         Self {
             config,
             mean: Vector3::zeros(),
@@ -108,6 +114,11 @@ impl HardIronEstimator {
             offset: None,
             gain: (0.0, 0.0),
         }
+    }
+
+    /// Forgets the statistics and any adopted offset; the thresholds stay.
+    pub fn reset(&mut self) {
+        *self = Self::with_config(self.config);
     }
 
     /// Takes one raw field reading `m` (body frame), the attitude `r` (body → level frame of
@@ -225,7 +236,7 @@ mod tests {
             let d = Vector3::from(dir);
             prop_assume!(d.norm() > 0.1);
             let b = d.normalize() * size * reference().norm();
-            let mut h = HardIronEstimator::new(HardIronConfig::default());
+            let mut h = HardIronEstimator::new(HardIronConfig::default()).unwrap();
             let mut got = None;
             for k in 0..3000 {
                 let t = k as f64 * 0.01;
@@ -246,7 +257,7 @@ mod tests {
             let d = Vector3::from(dir);
             prop_assume!(d.norm() > 0.1);
             let disturbance = d.normalize() * size * reference().norm();
-            let mut h = HardIronEstimator::new(HardIronConfig::default());
+            let mut h = HardIronEstimator::new(HardIronConfig::default()).unwrap();
             for k in 0..3000 {
                 let t = k as f64 * 0.01;
                 let q = attitude(t);
@@ -260,7 +271,7 @@ mod tests {
     fn a_removed_magnet_is_dropped() {
         // Adopted within 10 s of turning at 1 rad/s, dropped once the magnet is gone.
         let b = Vector3::new(-3.0, 0.5, 27.0);
-        let mut h = HardIronEstimator::new(HardIronConfig::default());
+        let mut h = HardIronEstimator::new(HardIronConfig::default()).unwrap();
         for k in 0..6000 {
             let t = k as f64 * 0.01;
             let q = attitude(t);

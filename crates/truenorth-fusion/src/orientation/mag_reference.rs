@@ -82,8 +82,15 @@ pub struct MagReference {
 }
 
 impl MagReference {
-    /// No reference yet: the first field offered becomes it.
-    pub fn new(config: MagReferenceConfig) -> Self {
+    /// No reference yet: the first field offered becomes it. Invalid tolerances are
+    /// refused.
+    pub fn new(config: MagReferenceConfig) -> Result<Self> {
+        config.validate()?;
+        Ok(Self::with_config(config))
+    }
+
+    /// No reference yet, for tolerances already validated (by the filter's config).
+    pub(crate) fn with_config(config: MagReferenceConfig) -> Self {
         Self {
             config,
             sin_dip_tol: config.dip_tol_rad.min(core::f64::consts::FRAC_PI_2).sin(),
@@ -96,6 +103,11 @@ impl MagReference {
             valid: false,
             gain: (0.0, 0.0),
         }
+    }
+
+    /// Forgets the reference and any candidate; the tolerances stay.
+    pub fn reset(&mut self) {
+        *self = Self::with_config(self.config);
     }
 
     /// Judges one field reading, given as its horizontal magnitude and its vertical (down)
@@ -180,7 +192,7 @@ impl MagReference {
     /// Checks a restored reference against the tolerances `config` of its filter: the same
     /// tolerances, finite components, times ≥ 0.
     pub(crate) fn check(&self, config: &MagReferenceConfig) -> Result<()> {
-        if self.config != *config || self.sin_dip_tol != Self::new(*config).sin_dip_tol {
+        if self.config != *config || self.sin_dip_tol != Self::with_config(*config).sin_dip_tol {
             return Err(Error::InvalidSnapshot {
                 reason: "the field reference's tolerances differ from the filter's",
             });
@@ -222,7 +234,7 @@ mod tests {
     proptest! {
         #[test]
         fn the_learned_field_is_never_disturbed(norm in 1.0f64..100.0, dip in -1.4f64..1.4, n in 1usize..500) {
-            let mut r = MagReference::new(MagReferenceConfig::default());
+            let mut r = MagReference::new(MagReferenceConfig::default()).unwrap();
             for _ in 0..n {
                 prop_assert!(r.update(norm * dip.cos(), norm * dip.sin(), 1.0, 0.01));
             }
@@ -237,7 +249,7 @@ mod tests {
             // An attached magnet: the norm swings by ±swing of itself as the sensor turns,
             // never consistent for `new_reference_s`, so it stays rejected.
             let cfg = MagReferenceConfig::default();
-            let mut r = MagReference::new(cfg);
+            let mut r = MagReference::new(cfg).unwrap();
             r.update(norm * dip.cos(), norm * dip.sin(), 0.0, 0.01);
             let steps = (seconds / 0.01) as usize;
             for k in 0..steps {

@@ -46,7 +46,6 @@ use truenorth_core::{
 
 use super::quaternion_config::{GyroTiming, QuaternionFilterConfig};
 use super::quaternion_state::QuaternionFilterState;
-use super::rest_detector::RestDetector;
 use super::rotation::{rotation_from_vector, small_rotation};
 use super::time_gap::Step;
 
@@ -503,7 +502,7 @@ impl QuaternionFilter {
         s.since_mag_s = 0.0;
         s.since_start_s = 0.0;
         s.uncertainty.restart(false, gap_s);
-        s.rest = RestDetector::new(s.config.rest);
+        s.rest.reset();
         let estimate = AttitudeEstimate {
             t_s,
             gyro_bias_rps: s.gyro_bias_rps,

@@ -86,9 +86,9 @@ impl QuaternionFilterState {
             estimate: None,
             clock: TimeStep::new(),
             gaps: GapMonitor::new(config.max_gap_s),
-            rest: RestDetector::new(config.rest),
-            mag_reference: MagReference::new(config.mag),
-            hard_iron: HardIronEstimator::new(config.hard_iron),
+            rest: RestDetector::with_config(config.rest),
+            mag_reference: MagReference::with_config(config.mag),
+            hard_iron: HardIronEstimator::with_config(config.hard_iron),
         }
     }
 }
