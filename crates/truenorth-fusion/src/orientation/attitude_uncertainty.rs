@@ -74,7 +74,7 @@ use truenorth_core::{
     Error, Result, STANDARD_GRAVITY_MPS2, Validate, check_finite, check_finite3, check_range,
 };
 
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 
 /// The sensors' error model behind the filter's σ: what a typical consumer MEMS IMU with a

@@ -2,8 +2,6 @@
 //! seed's detector is a field here, so that each can be switched off and its effect measured.
 
 use serde::{Deserialize, Serialize};
-#[allow(unused_imports)]
-use truenorth_core::Float as _;
 use truenorth_core::{Result, Validate, check_positive, check_range};
 use truenorth_gyro::{
     HighPassConfig, HighPassCorrectionConfig, IirHighPassConfig, OscillationRemoverConfig,

@@ -46,7 +46,7 @@ use super::euler_config::{EulerDetectorConfig, EulerVariant, coefficient_table};
 use super::euler_state::EulerDetectorState;
 use super::time_gap::Step;
 
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 
 /// Smallest |cos β| the Euler kinematics divide by: at pitch ±90° yaw and roll are not

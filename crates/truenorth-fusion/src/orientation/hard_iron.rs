@@ -22,9 +22,6 @@ use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 use truenorth_core::{Error, Result, Validate, check_finite3, check_positive, check_range};
 
-#[allow(unused_imports)]
-use truenorth_core::Float as _;
-
 /// Thresholds of the [`HardIronEstimator`]. Field quantities are relative to the reference
 /// field's norm, so they hold for any magnetometer unit.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]

@@ -11,7 +11,7 @@
 use serde::{Deserialize, Serialize};
 use truenorth_core::{Error, Result, Validate, check_finite, check_positive, check_range};
 
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 
 /// Tolerances of the disturbance detector.

@@ -9,7 +9,7 @@ use super::hard_iron::HardIronConfig;
 use super::mag_reference::MagReferenceConfig;
 use super::rest_detector::RestConfig;
 
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 
 /// What a gyro sample's rate stands for, which decides how it is integrated.

@@ -49,7 +49,7 @@ use super::quaternion_state::QuaternionFilterState;
 use super::rotation::{rotation_from_vector, small_rotation};
 use super::time_gap::Step;
 
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 
 /// The per-sample gains, derived from the parameters and the sample interval; recomputed

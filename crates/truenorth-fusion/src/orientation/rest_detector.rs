@@ -17,7 +17,7 @@ use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 use truenorth_core::{Error, Result, Validate, check_finite3, check_positive, check_range};
 
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 
 /// Thresholds of the rest detector (derived values live in [`RestDetector`]).
