@@ -21,6 +21,8 @@
 //!   ([`RestDetector`]) and in motion, magnetic-disturbance rejection ([`MagReference`]),
 //!   online hard-iron re-estimation ([`HardIronEstimator`]) and the σ of its attitude from
 //!   the sensors' error model ([`AttitudeUncertaintyConfig`]).
+//! - Both orientation estimators save and restore what they carry between samples as plain
+//!   data ([`truenorth_core::Persistent`]: [`QuaternionFilterState`], [`EulerDetectorState`]).
 //! - [`VehicleEstimator`]: vehicle heading and dead reckoning from wheels, an optional yaw
 //!   gyro and a raw compass, learning every sensor's errors while it drives (an 11-state
 //!   Kalman filter; [`vehicle`] also holds the two-pass start, the learned calibration

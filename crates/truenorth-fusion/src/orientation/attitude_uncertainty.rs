@@ -18,8 +18,7 @@
 //!   the corrections (`β ← β − (k/τ_b) e`), which is credited only with the in-phase part
 //!   of a first-order loop's response to a bias that turns with the body at `|ω|`,
 //!   `1/(1 + (|ω| τ)²)`: a fast-turning body shows its bias to the corrections only
-//!   briefly along any one reference axis (on a simulated hand-held run turning at up to
-//!   1.9 rad/s the bias was learned about three times slower than `τ_b`). At rest the bias variance
+//!   briefly along any one reference axis. At rest the bias variance
 //!   falls to that of the rest detector's mean of white noise, `N²/(2(τ_mean + τ_rest))`
 //!   (two first-order low-passes in cascade). As the body turns, the bias uncertainties of
 //!   the three reference axes mix (a body axis that was horizontal becomes vertical).
@@ -61,9 +60,8 @@
 //!   - *a hard-iron offset learned online* is estimated from the attitude itself, so
 //!     readings corrected by it cannot also tell the heading's error: while one is
 //!     subtracted, heading corrections shrink nothing (the gyro's terms grow as when the
-//!     field is rejected). A simulated hand-held run showed why: with a gyro bias of 1°/s
-//!     never measured at rest and slow turns, a heading error was adopted as an offset and
-//!     grew to 90°.
+//!     field is rejected), or a heading error adopted as an offset would shrink the σ of
+//!     the heading it has spoilt.
 //!
 //! Without a magnetometer the heading is relative to the start and its σ is the drift
 //! since the start. Everything is a few scalars per axis, cheap enough for every sample.
@@ -338,9 +336,7 @@ impl AttitudeUncertainty {
             // The envelope of the square (below) follows a rise at once (the error an
             // acceleration causes builds as fast as the corrections it causes) and decays
             // over the loop's natural period 2π √(τ_lp τ_acc) (11 s by default), so that it
-            // holds through the swings of an acceleration slow enough to pass the loop
-            // (decaying with τ_acc, it fell between the swings of the simulated hand-held
-            // ensemble, `tests/orientation_consistency.rs`, and left errors at 4σ).
+            // holds through the swings of an acceleration slow enough to pass the loop.
             let period = core::f64::consts::TAU * (lowpass_s * tau_s).sqrt();
             let k_env = (k * tau_s / period).min(1.0);
             self.accel_constants = Some(([k, tau_s, lowpass_s], target, k_env));

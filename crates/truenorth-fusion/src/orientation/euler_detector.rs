@@ -1,4 +1,4 @@
-//! The orientation angle detector of WO 00/36376 (METHODS §E), every piece of it:
+//! The orientation angle detector of WO 00/36376, every piece of it:
 //!
 //! 1. **Motion angles** from the (conditioned) gyro rates by the Z-Y-X Euler kinematics,
 //!    `A_x = (J_x + tan β sin γ J_y + tan β cos γ J_z) dt`, `A_y = (cos γ J_y − sin γ J_z) dt`,

@@ -1,4 +1,4 @@
-//! One gyro axis's conditioning chain in the Euler detector (WO 00/36376, §E.8), as
+//! One gyro axis's conditioning chain in the Euler detector (WO 00/36376), as
 //! selected by [`GyroConditioning`]: the `truenorth-gyro` filters with their memories,
 //! kept as plain data in the detector's saved state.
 

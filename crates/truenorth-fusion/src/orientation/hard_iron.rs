@@ -34,9 +34,7 @@ pub struct HardIronConfig {
     /// Smallest offset taken as a hard-iron change, relative to the reference norm
     /// (default 0.15). An offset not much larger than the disturbance tolerance (0.1) is
     /// better rejected than estimated, since its estimate's own error (the residual's
-    /// spread, ≈ 5 % of the field) is a large part of it: on BROAD trial 36 (5.3 µT, 12 % of
-    /// the field) heading is 1.44° with the offset rejected and 2.32° with it estimated at a
-    /// threshold of 0.1 (`tests/broad.rs`).
+    /// spread, ≈ 5 % of the field) is a large part of it.
     pub min_offset_rel: f64,
     /// Largest RMS spread of the residual about its mean, relative to the reference norm,
     /// for the residual to count as one body-fixed offset (default 0.08). The budget of a
@@ -47,8 +45,7 @@ pub struct HardIronConfig {
     /// vertical one, 1.6 %) add to ≈ 4 % RSS; twice that leaves room for the spread
     /// estimate's own scatter. A field fixed in the room and turning with respect to the
     /// body spreads by a good part of its size, 20 % of the field or more for a disturbance
-    /// this estimator would take as an offset (`min_offset_rel`). (At 0.06 the 4 cm magnet of
-    /// BROAD trial 35, 8.6 µT, was not adopted: its residual spread is 2.6–3.3 µT.)
+    /// this estimator would take as an offset (`min_offset_rel`).
     pub max_spread_rel: f64,
     /// Rotation of the body, rad, through which the residual must stay consistent before
     /// the offset is adopted (default 90°).

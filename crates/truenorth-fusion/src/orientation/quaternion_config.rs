@@ -22,8 +22,7 @@ pub enum GyroTiming {
     IntervalMean,
     /// The instantaneous rate at the timestamp (the convention of `truenorth_core::GyroSample`
     /// and of the simulator): the step uses the mean of the previous and current rate, the
-    /// trapezoid rule. On BROAD's real recordings this lags half a sample: inclination
-    /// 0.83° → 1.00° (`tests/broad.rs`).
+    /// trapezoid rule. On a gyro that reports interval means it lags half a sample.
     Instantaneous,
 }
 
@@ -43,12 +42,11 @@ pub struct QuaternionFilterConfig {
     /// Time constant of the heading correction while the sensor rests, s (default 5): at
     /// rest the reading has no motion-induced error (no latency against the gyro, no
     /// acceleration in the tilt it is levelled with), so heading error collected during
-    /// motion is removed faster (BROAD: heading 1.97° → 1.92°, both groups better).
+    /// motion is removed faster.
     pub tau_mag_rest_s: f64,
     /// Time constant of the in-motion bias estimate, s (default 400): long against
     /// `tau_acc_s` so the bias loop cannot ring, and long enough that the body's own
-    /// accelerations, which leak into every correction, average out of it (at 60 s the
-    /// bias wandered by 2°/s on BROAD trial 16, `tests/broad.rs`).
+    /// accelerations, which leak into every correction, average out of it.
     pub bias_tau_motion_s: f64,
     /// Time constant of the in-motion bias estimate before any rest has measured the bias,
     /// s (default 60); it moves to `bias_tau_motion_s` as rest time accumulates.

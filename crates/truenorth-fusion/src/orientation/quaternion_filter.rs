@@ -15,8 +15,7 @@
 //!    the frame of `q`.
 //!    The correction is linear in the specific force (its horizontal part over g), so the
 //!    body's own accelerations, which average to zero over any swing, cancel; weighting
-//!    readings by how far |a| is from g, or using the angle, biases the average (on BROAD's
-//!    fast-translation trial 16 either one doubles the inclination error).
+//!    readings by how far |a| is from g, or using the angle, biases the average.
 //! 3. **Heading**: the magnetometer, less any hard-iron offset learned online
 //!    ([`crate::HardIronEstimator`]), rotated into NED should point north; `q` is turned
 //!    about the vertical only, by `dt/τ_mag` of the horizontal angle, so a disturbed field
