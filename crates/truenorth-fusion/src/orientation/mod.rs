@@ -14,10 +14,13 @@ mod mag_reference;
 mod moving_average;
 mod quaternion_config;
 mod quaternion_filter;
+mod quaternion_gains;
 mod quaternion_state;
 mod rest_detector;
 mod rotation;
+mod sample_bounds;
 mod time_gap;
+mod triad;
 
 pub use attitude_error::AttitudeError;
 pub use attitude_uncertainty::AttitudeUncertaintyConfig;
