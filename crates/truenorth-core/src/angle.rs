@@ -3,7 +3,7 @@
 
 use core::f64::consts::PI;
 
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use crate::Float as _;
 
 const TWO_PI: f64 = 2.0 * PI;

@@ -4,9 +4,6 @@
 use nalgebra::{UnitQuaternion, Vector3};
 use serde::{Deserialize, Serialize};
 
-#[allow(unused_imports)]
-use crate::Float as _;
-
 /// Pitch and roll of the body relative to the local level (Z-Y-X Euler convention).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
 pub struct Tilt {

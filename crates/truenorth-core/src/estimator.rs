@@ -40,8 +40,10 @@ pub struct AttitudeEstimate {
     /// and trusted (9-D).
     pub attitude: UnitQuaternion<f64>,
     /// Attitude from gyro and accelerometer only (6-D): inclination as good as `attitude`,
-    /// heading relative to the start and drifting with the uncorrected gyro bias.
-    pub attitude_6d: UnitQuaternion<f64>,
+    /// heading relative to the start and drifting with the uncorrected gyro bias. `None`
+    /// from an estimator that keeps no such attitude apart from `attitude` (the Euler
+    /// detector of WO 00/36376 corrects heading inside the same angles).
+    pub attitude_6d: Option<UnitQuaternion<f64>>,
     /// Estimated gyro bias, rad/s, body axes (subtracted from the raw rates).
     pub gyro_bias_rps: Vector3<f64>,
     /// One standard deviation of the attitude error about the reference x, y, z axes
@@ -54,12 +56,14 @@ pub struct AttitudeEstimate {
 }
 
 impl AttitudeEstimate {
-    /// The estimate before any sample: level, heading north, no bias.
+    /// The estimate before any sample: the given attitude (level, heading north unless the
+    /// estimator was given one), as its 6-D attitude too since no heading correction has
+    /// been made, no bias.
     pub fn initial(attitude: UnitQuaternion<f64>) -> Self {
         Self {
             t_s: f64::NAN,
             attitude,
-            attitude_6d: attitude,
+            attitude_6d: Some(attitude),
             gyro_bias_rps: Vector3::zeros(),
             sigma_rad: None,
             status: AttitudeStatus::default(),

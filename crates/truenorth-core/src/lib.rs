@@ -4,10 +4,11 @@
 //! that carry sensor readings, the traits that join sensor models, calibrators and
 //! estimators, input validation, and the one error type.
 //!
-//! Conventions (fixed across the workspace, see ARCHITECTURE.md, "Frames and signs"): body axes x forward,
-//! y right, z down; heading clockwise from north; radians and SI units inside, degrees only
-//! at the edges through [`deg_to_rad`] / [`rad_to_deg`]; quaternions are Hamilton,
-//! scalar first, rotating body vectors into the NED reference frame.
+//! Conventions (fixed across the workspace, see `ARCHITECTURE.md`, section "Frames and
+//! signs"): body axes x forward, y right, z down; heading clockwise from north; radians and
+//! SI units inside, degrees only at the edges through [`deg_to_rad`] / [`rad_to_deg`];
+//! quaternions are Hamilton, scalar first, rotating body vectors into the NED reference
+//! frame.
 //!
 //! ```
 //! use truenorth_core::{wrap_pi, deg_to_rad, rad_to_deg, TimeStep};

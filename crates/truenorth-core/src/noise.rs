@@ -1,7 +1,7 @@
 //! Random errors for sensor models. A small self-contained generator keeps simulations
 //! bit-for-bit reproducible for a given seed, whatever version of an RNG crate is around.
 
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use crate::Float as _;
 
 /// A source of random numbers for sensor models.

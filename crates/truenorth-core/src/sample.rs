@@ -51,7 +51,7 @@ pub struct AccelSample {
 
 /// The readings of up to three sensors on the body axes x, y, z, any of which may be absent:
 /// a two-axis magnetometer (x, y), the two accelerometers and two gyros of a reduced
-/// orientation detector (WO 00/36376 §E.10), or a full triad.
+/// orientation detector (the yaw + pitch variant of WO 00/36376), or a full triad.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
 pub struct Axes {
     /// Reading on the body x axis, if that sensor is fitted.

@@ -10,6 +10,9 @@
 //! [`truenorth_core::HeadingEstimator`] (vehicle samples → [`NavEstimate`]: position,
 //! heading, speed and their uncertainty).
 //!
+//! [`orientation`] holds the IMU estimators and their parts, [`vehicle`] the land-vehicle
+//! ones; their public types are also re-exported here.
+//!
 //! - [`AttitudeError`]: an estimate's error against a reference, split into heading and
 //!   inclination as the BROAD benchmark does.
 //! - [`EulerDetector`]: the orientation angle detector of WO 00/36376, every piece
@@ -18,6 +21,8 @@
 //!   ([`RestDetector`]) and in motion, magnetic-disturbance rejection ([`MagReference`]),
 //!   online hard-iron re-estimation ([`HardIronEstimator`]) and the σ of its attitude from
 //!   the sensors' error model ([`AttitudeUncertaintyConfig`]).
+//! - Both orientation estimators save and restore what they carry between samples as plain
+//!   data ([`truenorth_core::Persistent`]: [`QuaternionFilterState`], [`EulerDetectorState`]).
 //! - [`VehicleEstimator`]: vehicle heading and dead reckoning from wheels, an optional yaw
 //!   gyro and a raw compass, learning every sensor's errors while it drives (an 11-state
 //!   Kalman filter; [`vehicle`] also holds the two-pass start, the learned calibration
@@ -39,29 +44,15 @@
 //! [`NavEstimate`]: truenorth_core::NavEstimate
 #![cfg_attr(not(feature = "std"), no_std)]
 
-mod attitude_error;
-pub mod attitude_uncertainty;
-mod euler_config;
-mod euler_detector;
-mod hard_iron;
-mod mag_reference;
-mod quaternion_config;
-mod quaternion_filter;
-mod rest_detector;
-pub(crate) mod rotation;
-mod time_gap;
+pub mod orientation;
 pub mod vehicle;
 
-pub use attitude_error::AttitudeError;
-pub use attitude_uncertainty::AttitudeUncertaintyConfig;
-pub use euler_config::{
-    CorrectionDefinerConfig, EulerDetectorConfig, EulerVariant, GyroConditioning,
-    MAX_DEFINER_WINDOW, StartupField, coefficient_table,
+pub use orientation::attitude_uncertainty;
+pub use orientation::{
+    AttitudeError, AttitudeUncertaintyConfig, CorrectionDefinerConfig, EulerDetector,
+    EulerDetectorConfig, EulerDetectorState, EulerVariant, GyroConditioning, GyroTiming,
+    HardIronConfig, HardIronEstimator, MAX_DEFINER_WINDOW, MagReference, MagReferenceConfig,
+    QuaternionFilter, QuaternionFilterConfig, QuaternionFilterState, RestConfig, RestDetector,
+    StartupField, coefficient_table,
 };
-pub use euler_detector::EulerDetector;
-pub use hard_iron::{HardIronConfig, HardIronEstimator};
-pub use mag_reference::{MagReference, MagReferenceConfig};
-pub use quaternion_config::{GyroTiming, QuaternionFilterConfig};
-pub use quaternion_filter::QuaternionFilter;
-pub use rest_detector::{RestConfig, RestDetector};
 pub use vehicle::{CompassGates, SensorPriors, VehicleConfig, VehicleEstimator};

@@ -228,3 +228,24 @@ fn missing_sensors_are_refused() {
         .is_err()
     );
 }
+
+/// The detector corrects heading inside the same angles as tilt, so it has no gyro +
+/// accelerometer attitude to report apart from its 9-D one: `attitude_6d` is `None`
+/// before, at and after the first sample.
+#[test]
+fn no_6d_attitude_is_claimed() {
+    let mut d = EulerDetector::new(EulerDetectorConfig::default()).unwrap();
+    assert!(d.estimate().attitude_6d.is_none());
+    let (acc, mag) = still(&EulerZyx::default(), 1.0);
+    for k in 0..10 {
+        let e = d
+            .update(&ImuSample::new_9d(
+                0.01 * k as f64,
+                Vector3::zeros(),
+                acc,
+                mag,
+            ))
+            .unwrap();
+        assert!(e.attitude_6d.is_none());
+    }
+}

@@ -43,7 +43,7 @@ fn worst_norm_error(n: usize, seed: u64) -> f64 {
             .unwrap();
         worst = worst
             .max((e.attitude.as_ref().norm() - 1.0).abs())
-            .max((e.attitude_6d.as_ref().norm() - 1.0).abs());
+            .max((e.attitude_6d.unwrap().as_ref().norm() - 1.0).abs());
     }
     worst
 }

@@ -2,7 +2,8 @@
 //! magnetometer at ≈ 100 Hz with irregular timestamps, the magnetometer sampled and held at
 //! ≈ 20 Hz, no ground truth): the sensor lies still from ≈ 95 s, and between ≈ 100 and
 //! ≈ 115 s the field's norm drops from ≈ 44 to ≈ 38 µT with no motion (a magnetic
-//! disturbance; `../shared/data/xio_fusion/README.md`).
+//! disturbance). The recording is the one of the examples of x-io Technologies' Fusion
+//! (github.com/xioTechnologies/Fusion).
 //!
 //! Run with `cargo test --release -p truenorth-fusion --test xio_fusion -- --nocapture`.
 

@@ -38,7 +38,9 @@ fn run(
     for (s, t) in samples.iter().zip(&truth) {
         let est = update(s)?;
         let q = if use_6d {
-            est.attitude_6d
+            est.attitude_6d.ok_or(truenorth::core::Error::Unsupported {
+                reason: "the estimator keeps no 6-D attitude",
+            })?
         } else {
             est.attitude
         };

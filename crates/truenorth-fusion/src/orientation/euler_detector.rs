@@ -1,4 +1,4 @@
-//! The orientation angle detector of WO 00/36376 (METHODS §E), every piece of it:
+//! The orientation angle detector of WO 00/36376, every piece of it:
 //!
 //! 1. **Motion angles** from the (conditioned) gyro rates by the Z-Y-X Euler kinematics,
 //!    `A_x = (J_x + tan β sin γ J_y + tan β cos γ J_z) dt`, `A_y = (cos γ J_y − sin γ J_z) dt`,
@@ -34,106 +34,25 @@
 //! body → NED. Unlike the seed, which reports yaw relative to its value at start-up, yaw here
 //! is the magnetic heading, as every estimator's in this workspace.
 
-use nalgebra::Vector3;
+use nalgebra::{UnitQuaternion, Vector3};
 use truenorth_accel::static_tilt;
 use truenorth_compass::{MzReconstruction, tilt_compensated_heading};
 use truenorth_core::{
-    AttitudeEstimate, AttitudeStatus, Error, EulerZyx, ImuSample, OrientationEstimator, Result,
-    STANDARD_GRAVITY_MPS2, Tilt, TimeStep, Validate, wrap_pi,
+    AttitudeEstimate, AttitudeStatus, Error, EulerZyx, ImuSample, OrientationEstimator, Persistent,
+    Result, STANDARD_GRAVITY_MPS2, Tilt, Validate, wrap_pi,
 };
-use truenorth_gyro::{HighPassCorrection, HighPassFilter, IirHighPass, OscillationRemover};
 
-use crate::euler_config::MAX_DEFINER_WINDOW;
-use crate::time_gap::{GapMonitor, Step};
-use crate::{EulerDetectorConfig, EulerVariant, GyroConditioning, coefficient_table};
+use super::euler_config::{EulerDetectorConfig, EulerVariant, coefficient_table};
+use super::euler_state::EulerDetectorState;
+use super::time_gap::Step;
 
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 
 /// Smallest |cos β| the Euler kinematics divide by: at pitch ±90° yaw and roll are not
 /// separable and their rates are unbounded; the detector keeps integrating with this floor
 /// (a limit of every Euler-angle detector, which the quaternion filter does not share).
 const MIN_COS_PITCH: f64 = 1e-3;
-
-/// One gyro axis's conditioning chain.
-#[derive(Debug, Clone, Copy, PartialEq)]
-enum AxisConditioner {
-    None,
-    HighPass(HighPassFilter, Option<HighPassCorrection>),
-    Iir(IirHighPass),
-}
-
-impl AxisConditioner {
-    fn new(c: &GyroConditioning) -> Result<Self> {
-        Ok(match *c {
-            GyroConditioning::None => Self::None,
-            GyroConditioning::HighPass { filter, correction } => Self::HighPass(
-                HighPassFilter::new(filter)?,
-                correction.map(HighPassCorrection::new).transpose()?,
-            ),
-            GyroConditioning::Iir(c) => Self::Iir(IirHighPass::new(c)?),
-        })
-    }
-
-    fn push(&mut self, x: f64, dt_s: f64) -> Result<f64> {
-        match self {
-            Self::None => Ok(x),
-            Self::HighPass(f, c) => {
-                let y = f.push(x, dt_s)?;
-                match c {
-                    Some(c) => c.push(y, f.rc_s(), dt_s),
-                    None => Ok(y),
-                }
-            }
-            Self::Iir(f) => f.push(x, dt_s),
-        }
-    }
-}
-
-/// A moving average over the last `n` values (a fixed ring: `push` allocates nothing).
-#[derive(Debug, Clone, Copy, PartialEq)]
-struct MovingAverage {
-    ring: [f64; MAX_DEFINER_WINDOW],
-    n: usize,
-    next: usize,
-    filled: usize,
-    sum: f64,
-}
-
-impl MovingAverage {
-    fn new(n: usize) -> Self {
-        Self {
-            ring: [0.0; MAX_DEFINER_WINDOW],
-            n: n.clamp(1, MAX_DEFINER_WINDOW),
-            next: 0,
-            filled: 0,
-            sum: 0.0,
-        }
-    }
-
-    fn push(&mut self, x: f64) -> f64 {
-        if self.filled == self.n {
-            self.sum -= self.ring[self.next];
-        } else {
-            self.filled += 1;
-        }
-        self.ring[self.next] = x;
-        self.sum += x;
-        self.next = (self.next + 1) % self.n;
-        self.sum / self.filled as f64
-    }
-}
-
-/// The detector's state.
-#[derive(Debug, Clone, Copy, PartialEq)]
-struct State {
-    angles: EulerZyx,
-    initialised: bool,
-    /// Previous static (roll, pitch, yaw) or their moving averages, for the definer.
-    previous_static: Option<[f64; 3]>,
-    averages: [MovingAverage; 3],
-    estimate: AttitudeEstimate,
-}
 
 /// The orientation angle detector of WO 00/36376 (see the module documentation).
 ///
@@ -158,59 +77,45 @@ struct State {
 /// ```
 #[derive(Debug, Clone)]
 pub struct EulerDetector {
-    config: EulerDetectorConfig,
-    conditioners: [AxisConditioner; 3],
-    removers: Option<[OscillationRemover; 3]>,
+    state: EulerDetectorState,
+    /// The state before any sample (derived from the parameters): where a gap and
+    /// [`OrientationEstimator::reset`] start again.
+    fresh: EulerDetectorState,
+    /// The M_z reconstruction for a two-axis magnetometer (derived from the parameters).
     mz: Option<MzReconstruction>,
-    clock: TimeStep,
-    gaps: GapMonitor,
-    state: State,
 }
 
 impl EulerDetector {
     /// A detector with the given parameters.
     pub fn new(config: EulerDetectorConfig) -> Result<Self> {
         config.validate()?;
-        let c = AxisConditioner::new(&config.gyro)?;
-        let removers = match config.oscillation_remover {
-            Some(o) => {
-                let r = OscillationRemover::new(o)?;
-                Some([r; 3])
-            }
-            None => None,
-        };
+        Self::with_state(EulerDetectorState::initial(config)?)
+    }
+
+    /// The detector continuing from a valid `state`.
+    fn with_state(state: EulerDetectorState) -> Result<Self> {
+        let config = state.config;
         let mz = match config.startup_field {
             Some(f) => Some(MzReconstruction::new(f.total, f.inclination_rad)?),
             None => None,
         };
-        let window = config.definer.moving_average.unwrap_or(1);
         Ok(Self {
-            config,
-            conditioners: [c; 3],
-            removers,
+            state,
+            fresh: EulerDetectorState::initial(config)?,
             mz,
-            clock: TimeStep::new(),
-            gaps: GapMonitor::new(config.max_gap_s),
-            state: State {
-                angles: EulerZyx::default(),
-                initialised: false,
-                previous_static: None,
-                averages: [MovingAverage::new(window); 3],
-                estimate: AttitudeEstimate::initial(nalgebra::UnitQuaternion::identity()),
-            },
         })
     }
 
     /// The parameters in use.
     pub fn config(&self) -> &EulerDetectorConfig {
-        &self.config
+        &self.state.config
     }
 
     /// The gyro rates the variant needs, conditioned (rad/s; x is 0 for the yaw + pitch
     /// variant).
     fn rates(&mut self, sample: &ImuSample, dt_s: Option<f64>) -> Result<Vector3<f64>> {
         let g = &sample.gyr_rps;
-        let raw = match self.config.variant {
+        let raw = match self.state.config.variant {
             EulerVariant::Full => g.as_xyz().ok_or(Error::Unsupported {
                 reason: "the full Euler detector needs gyros on x, y and z; use variant yaw_pitch for two",
             })?,
@@ -228,8 +133,8 @@ impl EulerDetector {
         };
         let mut out = Vector3::zeros();
         for i in 0..3 {
-            let mut j = self.conditioners[i].push(raw[i], dt_s)?;
-            if let Some(r) = self.removers.as_mut() {
+            let mut j = self.state.conditioners[i].push(raw[i], dt_s)?;
+            if let Some(r) = self.state.oscillation_removers.as_mut() {
                 j = r[i].push(j)?;
             }
             out[i] = j;
@@ -242,12 +147,13 @@ impl EulerDetector {
         let a = &sample.acc_mps2;
         let g = STANDARD_GRAVITY_MPS2;
         let gravity_ok = |n: f64| {
-            self.config
+            self.state
+                .config
                 .definer
                 .gravity_tol_mps2
                 .is_none_or(|tol| (n - g).abs() <= tol)
         };
-        match self.config.variant {
+        match self.state.config.variant {
             EulerVariant::YawPitch => {
                 let fx = a.x?;
                 (fx.abs() <= g).then(|| {
@@ -286,7 +192,7 @@ impl EulerDetector {
 
     /// The tentative yaw from the magnetometer levelled with the static tilt.
     fn tentative_yaw(&self, sample: &ImuSample, tilt: &Tilt) -> Result<Option<f64>> {
-        if !self.config.use_mag {
+        if !self.state.config.use_mag {
             return Ok(None);
         }
         let m = &sample.mag;
@@ -305,7 +211,7 @@ impl EulerDetector {
 
     fn step(&mut self, sample: &ImuSample, dt_s: f64) -> Result<AttitudeEstimate> {
         let j = self.rates(sample, Some(dt_s))?;
-        let cfg = self.config;
+        let cfg = self.state.config;
         let prev = self.state.angles;
         // 1. Motion angles with the previous pitch and roll.
         let (sg, cg) = prev.roll_rad.sin_cos();
@@ -376,7 +282,7 @@ impl EulerDetector {
         Ok(AttitudeEstimate {
             t_s: sample.t_s,
             attitude: q,
-            attitude_6d: q,
+            attitude_6d: None,
             gyro_bias_rps: Vector3::zeros(),
             sigma_rad: None,
             status,
@@ -391,7 +297,7 @@ impl EulerDetector {
         gravity_ok: bool,
         has_yaw: bool,
     ) -> [bool; 3] {
-        let d = &self.config.definer;
+        let d = &self.state.config.definer;
         let Some(prev) = self.state.previous_static else {
             return [false; 3];
         };
@@ -439,25 +345,21 @@ impl OrientationEstimator for EulerDetector {
     /// gaps the majority of the steps is an [`Error::Implausible`] time base.
     fn update(&mut self, sample: &ImuSample) -> Result<AttitudeEstimate> {
         sample.check_finite()?;
-        let saved = (
-            self.clock,
-            self.gaps,
-            self.conditioners,
-            self.removers,
-            self.state,
-        );
+        let saved = self.state;
         let result = (|| {
-            let dt = self.clock.dt_s(sample.t_s)?;
-            let step = dt.map(|d| self.gaps.classify(d)).transpose()?;
+            let dt = self.state.clock.dt_s(sample.t_s)?;
+            let step = dt.map(|d| self.state.gaps.classify(d)).transpose()?;
             if let Some(step) = step {
-                self.gaps.count(step);
+                self.state.gaps.count(step);
             }
             let gap = step == Some(Step::Gap);
             if gap {
                 // The conditioners' and the definer's memories span the gap: start afresh.
-                let fresh = Self::new(self.config)?;
-                (self.conditioners, self.removers, self.state) =
-                    (fresh.conditioners, fresh.removers, fresh.state);
+                self.state = EulerDetectorState {
+                    clock: self.state.clock,
+                    gaps: self.state.gaps,
+                    ..self.fresh
+                };
             }
             let Some(dt_s) = dt.filter(|_| !gap) else {
                 // The first sample: the static angles (and tentative yaw) are the attitude.
@@ -472,15 +374,17 @@ impl OrientationEstimator for EulerDetector {
                     self.state.initialised = true;
                 }
                 let q = self.state.angles.to_quaternion();
-                self.state.estimate = AttitudeEstimate {
+                let estimate = AttitudeEstimate {
                     t_s: sample.t_s,
                     status: AttitudeStatus {
                         gap,
                         ..AttitudeStatus::default()
                     },
+                    attitude_6d: None,
                     ..AttitudeEstimate::initial(q)
                 };
-                return Ok(self.state.estimate);
+                self.state.estimate = Some(estimate);
+                return Ok(estimate);
             };
             let e = self.step(sample, dt_s)?;
             if !e.attitude.coords.iter().all(|v| v.is_finite()) {
@@ -491,28 +395,40 @@ impl OrientationEstimator for EulerDetector {
                     max: 1e6,
                 });
             }
-            self.state.estimate = e;
+            self.state.estimate = Some(e);
             Ok(e)
         })();
         if result.is_err() {
-            (
-                self.clock,
-                self.gaps,
-                self.conditioners,
-                self.removers,
-                self.state,
-            ) = saved;
+            self.state = saved;
         }
         result
     }
 
+    /// The estimate after the last sample; before the first, level and facing north.
     fn estimate(&self) -> AttitudeEstimate {
-        self.state.estimate
+        self.state.estimate.unwrap_or_else(|| AttitudeEstimate {
+            attitude_6d: None,
+            ..AttitudeEstimate::initial(UnitQuaternion::identity())
+        })
     }
 
+    /// Back to the state before any sample, with the same parameters.
     fn reset(&mut self) {
-        if let Ok(d) = Self::new(self.config) {
-            *self = d;
-        }
+        self.state = self.fresh;
+    }
+}
+
+impl Persistent for EulerDetector {
+    type State = EulerDetectorState;
+    const SNAPSHOT_VERSION: u32 = 1;
+
+    fn state(&self) -> EulerDetectorState {
+        self.state
+    }
+
+    /// Refuses a state that is not valid (see [`EulerDetectorState`]'s `validate`).
+    fn from_state(state: EulerDetectorState) -> Result<Self> {
+        state.validate()?;
+        Self::with_state(state)
     }
 }

@@ -4,7 +4,7 @@
 
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 
 /// Below this angle, rad, [`rotation_from_vector`] uses its series.

@@ -15,9 +15,9 @@
 
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
-use truenorth_core::{Result, Validate, check_positive, check_range};
+use truenorth_core::{Error, Result, Validate, check_finite3, check_positive, check_range};
 
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 
 /// Thresholds of the rest detector (derived values live in [`RestDetector`]).
@@ -77,8 +77,14 @@ pub struct RestDetector {
 }
 
 impl RestDetector {
-    /// A detector with the given thresholds (validated by the filter's config).
-    pub fn new(config: RestConfig) -> Self {
+    /// A detector with the given thresholds, refused when they are invalid.
+    pub fn new(config: RestConfig) -> Result<Self> {
+        config.validate()?;
+        Ok(Self::with_config(config))
+    }
+
+    /// A detector for thresholds already validated (by the filter's config).
+    pub(crate) fn with_config(config: RestConfig) -> Self {
         Self {
             config,
             gyr_mean: Vector3::zeros(),
@@ -89,6 +95,11 @@ impl RestDetector {
             primed: false,
             gain: (0.0, 0.0),
         }
+    }
+
+    /// Forgets everything seen; the thresholds stay.
+    pub fn reset(&mut self) {
+        *self = Self::with_config(self.config);
     }
 
     /// Takes one sample (raw gyro, accelerometer, optional magnetometer) `dt_s` after the
@@ -144,6 +155,25 @@ impl RestDetector {
     pub fn gyro_mean(&self) -> Vector3<f64> {
         self.gyr_mean
     }
+
+    /// Checks a restored detector against the thresholds `config` of its filter: the same
+    /// thresholds, finite means, a still time ≥ 0.
+    pub(crate) fn check(&self, config: &RestConfig) -> Result<()> {
+        if self.config != *config {
+            return Err(Error::InvalidSnapshot {
+                reason: "the rest detector's thresholds differ from the filter's",
+            });
+        }
+        check_finite3("rest.gyr_mean", &self.gyr_mean)?;
+        check_finite3("rest.acc_mean", &self.acc_mean)?;
+        for m in [self.mag_mean, self.mag_at_start].iter().flatten() {
+            check_finite3("rest.mag_mean", m)?;
+        }
+        check_range("rest.still_s", self.still_s, 0.0, f64::MAX)?;
+        check_range("rest.gain", self.gain.1, 0.0, 1.0)?;
+        check_range("rest.gain interval", self.gain.0, 0.0, f64::MAX)?;
+        Ok(())
+    }
 }
 
 #[cfg(test)]
@@ -159,7 +189,7 @@ mod tests {
             mag in proptest::array::uniform3(-50.0f64..50.0),
         ) {
             let cfg = RestConfig::default();
-            let mut r = RestDetector::new(cfg);
+            let mut r = RestDetector::new(cfg).unwrap();
             let (g, a, m) = (Vector3::from(bias), Vector3::from(acc), Vector3::from(mag));
             let mut rest = false;
             for _ in 0..((cfg.min_time_s / 0.01) as usize + 2) {
@@ -174,7 +204,7 @@ mod tests {
             // Constant gyro and specific force (a turn about the vertical), but the field's
             // direction turns: the magnetometer tells it from a bias.
             let cfg = RestConfig::default();
-            let mut r = RestDetector::new(cfg);
+            let mut r = RestDetector::new(cfg).unwrap();
             let g = Vector3::new(0.0, 0.0, rate_dps.to_radians());
             let a = Vector3::new(0.0, 0.0, -9.81);
             for k in 0..300 {

@@ -20,10 +20,7 @@
 
 use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
-use truenorth_core::{Result, Validate, check_positive, check_range};
-
-#[allow(unused_imports)]
-use truenorth_core::Float as _;
+use truenorth_core::{Error, Result, Validate, check_finite3, check_positive, check_range};
 
 /// Thresholds of the [`HardIronEstimator`]. Field quantities are relative to the reference
 /// field's norm, so they hold for any magnetometer unit.
@@ -37,9 +34,7 @@ pub struct HardIronConfig {
     /// Smallest offset taken as a hard-iron change, relative to the reference norm
     /// (default 0.15). An offset not much larger than the disturbance tolerance (0.1) is
     /// better rejected than estimated, since its estimate's own error (the residual's
-    /// spread, ≈ 5 % of the field) is a large part of it: on BROAD trial 36 (5.3 µT, 12 % of
-    /// the field) heading is 1.44° with the offset rejected and 2.32° with it estimated at a
-    /// threshold of 0.1 (`tests/broad.rs`).
+    /// spread, ≈ 5 % of the field) is a large part of it.
     pub min_offset_rel: f64,
     /// Largest RMS spread of the residual about its mean, relative to the reference norm,
     /// for the residual to count as one body-fixed offset (default 0.08). The budget of a
@@ -50,8 +45,7 @@ pub struct HardIronConfig {
     /// vertical one, 1.6 %) add to ≈ 4 % RSS; twice that leaves room for the spread
     /// estimate's own scatter. A field fixed in the room and turning with respect to the
     /// body spreads by a good part of its size, 20 % of the field or more for a disturbance
-    /// this estimator would take as an offset (`min_offset_rel`). (At 0.06 the 4 cm magnet of
-    /// BROAD trial 35, 8.6 µT, was not adopted: its residual spread is 2.6–3.3 µT.)
+    /// this estimator would take as an offset (`min_offset_rel`).
     pub max_spread_rel: f64,
     /// Rotation of the body, rad, through which the residual must stay consistent before
     /// the offset is adopted (default 90°).
@@ -96,8 +90,14 @@ pub struct HardIronEstimator {
 }
 
 impl HardIronEstimator {
-    /// No offset yet (validated by the filter's config).
-    pub fn new(config: HardIronConfig) -> Self {
+    /// No offset yet; invalid thresholds are refused.
+    pub fn new(config: HardIronConfig) -> Result<Self> {
+        config.validate()?;
+        Ok(Self::with_config(config))
+    }
+
+    /// No offset yet, for thresholds already validated (by the filter's config).
+    pub(crate) fn with_config(config: HardIronConfig) -> Self {
         Self {
             config,
             mean: Vector3::zeros(),
@@ -108,6 +108,11 @@ impl HardIronEstimator {
             offset: None,
             gain: (0.0, 0.0),
         }
+    }
+
+    /// Forgets the statistics and any adopted offset; the thresholds stay.
+    pub fn reset(&mut self) {
+        *self = Self::with_config(self.config);
     }
 
     /// Takes one raw field reading `m` (body frame), the attitude `r` (body → level frame of
@@ -174,6 +179,26 @@ impl HardIronEstimator {
     pub fn offset(&self) -> Option<Vector3<f64>> {
         self.offset
     }
+
+    /// Checks a restored estimator against the thresholds `config` of its filter: the same
+    /// thresholds, finite statistics, spread, turn and time ≥ 0.
+    pub(crate) fn check(&self, config: &HardIronConfig) -> Result<()> {
+        if self.config != *config {
+            return Err(Error::InvalidSnapshot {
+                reason: "the hard-iron estimator's thresholds differ from the filter's",
+            });
+        }
+        check_finite3("hard_iron.mean", &self.mean)?;
+        if let Some(b) = &self.offset {
+            check_finite3("hard_iron.offset", b)?;
+        }
+        check_range("hard_iron.spread2", self.spread2, 0.0, f64::MAX)?;
+        check_range("hard_iron.turned_rad", self.turned_rad, 0.0, f64::MAX)?;
+        check_range("hard_iron.consistent_s", self.consistent_s, 0.0, f64::MAX)?;
+        check_range("hard_iron.gain", self.gain.1, 0.0, 1.0)?;
+        check_range("hard_iron.gain interval", self.gain.0, 0.0, f64::MAX)?;
+        Ok(())
+    }
 }
 
 #[cfg(test)]
@@ -205,7 +230,7 @@ mod tests {
             let d = Vector3::from(dir);
             prop_assume!(d.norm() > 0.1);
             let b = d.normalize() * size * reference().norm();
-            let mut h = HardIronEstimator::new(HardIronConfig::default());
+            let mut h = HardIronEstimator::new(HardIronConfig::default()).unwrap();
             let mut got = None;
             for k in 0..3000 {
                 let t = k as f64 * 0.01;
@@ -226,7 +251,7 @@ mod tests {
             let d = Vector3::from(dir);
             prop_assume!(d.norm() > 0.1);
             let disturbance = d.normalize() * size * reference().norm();
-            let mut h = HardIronEstimator::new(HardIronConfig::default());
+            let mut h = HardIronEstimator::new(HardIronConfig::default()).unwrap();
             for k in 0..3000 {
                 let t = k as f64 * 0.01;
                 let q = attitude(t);
@@ -240,7 +265,7 @@ mod tests {
     fn a_removed_magnet_is_dropped() {
         // Adopted within 10 s of turning at 1 rad/s, dropped once the magnet is gone.
         let b = Vector3::new(-3.0, 0.5, 27.0);
-        let mut h = HardIronEstimator::new(HardIronConfig::default());
+        let mut h = HardIronEstimator::new(HardIronConfig::default()).unwrap();
         for k in 0..6000 {
             let t = k as f64 * 0.01;
             let q = attitude(t);

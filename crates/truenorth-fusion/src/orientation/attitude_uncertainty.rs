@@ -18,8 +18,7 @@
 //!   the corrections (`β ← β − (k/τ_b) e`), which is credited only with the in-phase part
 //!   of a first-order loop's response to a bias that turns with the body at `|ω|`,
 //!   `1/(1 + (|ω| τ)²)`: a fast-turning body shows its bias to the corrections only
-//!   briefly along any one reference axis (on a simulated hand-held run turning at up to
-//!   1.9 rad/s the bias was learned about three times slower than `τ_b`). At rest the bias variance
+//!   briefly along any one reference axis. At rest the bias variance
 //!   falls to that of the rest detector's mean of white noise, `N²/(2(τ_mean + τ_rest))`
 //!   (two first-order low-passes in cascade). As the body turns, the bias uncertainties of
 //!   the three reference axes mix (a body axis that was horizontal becomes vertical).
@@ -61,18 +60,19 @@
 //!   - *a hard-iron offset learned online* is estimated from the attitude itself, so
 //!     readings corrected by it cannot also tell the heading's error: while one is
 //!     subtracted, heading corrections shrink nothing (the gyro's terms grow as when the
-//!     field is rejected). A simulated hand-held run showed why: with a gyro bias of 1°/s
-//!     never measured at rest and slow turns, a heading error was adopted as an offset and
-//!     grew to 90°.
+//!     field is rejected), or a heading error adopted as an offset would shrink the σ of
+//!     the heading it has spoilt.
 //!
 //! Without a magnetometer the heading is relative to the start and its σ is the drift
 //! since the start. Everything is a few scalars per axis, cheap enough for every sample.
 
 use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
-use truenorth_core::{Result, STANDARD_GRAVITY_MPS2, Validate, check_range};
+use truenorth_core::{
+    Error, Result, STANDARD_GRAVITY_MPS2, Validate, check_finite, check_finite3, check_range,
+};
 
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 
 /// The sensors' error model behind the filter's σ: what a typical consumer MEMS IMU with a
@@ -213,9 +213,10 @@ impl AxisVariance {
     }
 }
 
-/// The propagated uncertainty (see the module documentation).
+/// The propagated uncertainty (see the module documentation): part of the
+/// [`crate::QuaternionFilterState`], opaque.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub(crate) struct AttitudeUncertainty {
+pub struct AttitudeUncertainty {
     config: AttitudeUncertaintyConfig,
     inclination: AxisVariance,
     heading: AxisVariance,
@@ -234,8 +235,9 @@ pub(crate) struct AttitudeUncertainty {
     rate_ned: Vector3<f64>,
     rate_rps: f64,
     /// The inclination correction's constants for the last (gain, time constant, low-pass):
-    /// variance target and the envelope's gain, recomputed only when those change.
-    accel_constants: ([f64; 3], f64, f64),
+    /// variance target and the envelope's gain, recomputed only when those change; `None`
+    /// before the first inclination correction.
+    accel_constants: Option<([f64; 3], f64, f64)>,
 }
 
 /// Inclination σ assumed before the first correction, rad: the tilt the first reading
@@ -268,7 +270,7 @@ impl AttitudeUncertainty {
             half_inv_cos2_dip: 0.5,
             rate_ned: Vector3::zeros(),
             rate_rps: 0.0,
-            accel_constants: ([f64::NAN; 3], 0.0, 0.0),
+            accel_constants: None,
         }
     }
 
@@ -325,7 +327,7 @@ impl AttitudeUncertainty {
         inv_tau_bias: f64,
         lowpass_s: f64,
     ) {
-        if self.accel_constants.0 != [k, tau_s, lowpass_s] {
+        if self.accel_constants.map(|c| c.0) != Some([k, tau_s, lowpass_s]) {
             let cfg = &self.config;
             let g = STANDARD_GRAVITY_MPS2;
             let bias = cfg.accel_bias_mps2 / g;
@@ -334,14 +336,14 @@ impl AttitudeUncertainty {
             // The envelope of the square (below) follows a rise at once (the error an
             // acceleration causes builds as fast as the corrections it causes) and decays
             // over the loop's natural period 2π √(τ_lp τ_acc) (11 s by default), so that it
-            // holds through the swings of an acceleration slow enough to pass the loop
-            // (decaying with τ_acc, it fell between the swings of the simulated hand-held
-            // ensemble, `tests/orientation_consistency.rs`, and left errors at 4σ).
+            // holds through the swings of an acceleration slow enough to pass the loop.
             let period = core::f64::consts::TAU * (lowpass_s * tau_s).sqrt();
             let k_env = (k * tau_s / period).min(1.0);
-            self.accel_constants = ([k, tau_s, lowpass_s], target, k_env);
+            self.accel_constants = Some(([k, tau_s, lowpass_s], target, k_env));
         }
-        let (_, target, k_env) = self.accel_constants;
+        let Some((_, target, k_env)) = self.accel_constants else {
+            return;
+        };
         let c = self.bias_credit(k, tau_s, inv_tau_bias);
         self.inclination.correct(k, c, target);
         self.turned_inclination *= 1.0 - k;
@@ -397,11 +399,9 @@ impl AttitudeUncertainty {
         // of it that persist (the biases' and the scale error's) pass the heading loop
         // whole; the accelerations' varies with the inclination loop's time constant and
         // passes by τ_acc/(τ_acc + τ_mag).
-        let tau_acc_s = self.accel_constants.0[1];
-        let passed = if tau_acc_s > 0.0 {
-            tau_acc_s / (tau_acc_s + tau_s)
-        } else {
-            1.0
+        let passed = match self.accel_constants {
+            Some(([_, tau_acc_s, _], ..)) if tau_acc_s > 0.0 => tau_acc_s / (tau_acc_s + tau_s),
+            _ => 1.0,
         };
         let acceleration = self.accel_moved_sq[0];
         let tilt = tan2_dip * (self.inclination_variance(0) - (1.0 - passed) * acceleration);
@@ -443,6 +443,51 @@ impl AttitudeUncertainty {
             + self.inclination.measured
             + self.accel_moved_sq[i]
             + s * s * self.turned_inclination.norm_squared()
+    }
+
+    /// Checks a restored uncertainty against the error model `config` of its filter: the
+    /// same model, finite numbers, variances ≥ 0.
+    pub(crate) fn check(&self, config: &AttitudeUncertaintyConfig) -> Result<()> {
+        if self.config != *config {
+            return Err(Error::InvalidSnapshot {
+                reason: "the σ's error model differs from the filter's",
+            });
+        }
+        for axis in [&self.inclination, &self.heading] {
+            check_range("uncertainty angle variance", axis.angle, 0.0, f64::MAX)?;
+            check_range("uncertainty bias variance", axis.bias, 0.0, f64::MAX)?;
+            check_range(
+                "uncertainty measured variance",
+                axis.measured,
+                0.0,
+                f64::MAX,
+            )?;
+            check_finite("uncertainty angle-bias covariance", axis.angle_bias)?;
+        }
+        for v in [
+            &self.turned_inclination,
+            &self.turned_heading,
+            &self.rate_ned,
+        ] {
+            check_finite3("uncertainty turn", v)?;
+        }
+        for v in self.accel_moved.iter().chain(&self.accel_moved_sq) {
+            check_finite("uncertainty acceleration term", *v)?;
+        }
+        for v in [
+            self.norm_departure,
+            self.dip_departure,
+            self.half_inv_cos2_dip,
+            self.rate_rps,
+        ] {
+            check_finite("uncertainty field term", v)?;
+        }
+        if let Some((key, target, k_env)) = self.accel_constants {
+            for v in key.iter().chain(&[target, k_env]) {
+                check_finite("uncertainty inclination constant", *v)?;
+            }
+        }
+        Ok(())
     }
 
     /// One σ of the error about the reference x, y and z axes, rad.

@@ -9,9 +9,9 @@
 //! to the sensor) never becomes consistent and stays rejected.
 
 use serde::{Deserialize, Serialize};
-use truenorth_core::{Result, Validate, check_positive, check_range};
+use truenorth_core::{Error, Result, Validate, check_finite, check_positive, check_range};
 
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 
 /// Tolerances of the disturbance detector.
@@ -82,8 +82,15 @@ pub struct MagReference {
 }
 
 impl MagReference {
-    /// No reference yet: the first field offered becomes it.
-    pub fn new(config: MagReferenceConfig) -> Self {
+    /// No reference yet: the first field offered becomes it. Invalid tolerances are
+    /// refused.
+    pub fn new(config: MagReferenceConfig) -> Result<Self> {
+        config.validate()?;
+        Ok(Self::with_config(config))
+    }
+
+    /// No reference yet, for tolerances already validated (by the filter's config).
+    pub(crate) fn with_config(config: MagReferenceConfig) -> Self {
         Self {
             config,
             sin_dip_tol: config.dip_tol_rad.min(core::f64::consts::FRAC_PI_2).sin(),
@@ -96,6 +103,11 @@ impl MagReference {
             valid: false,
             gain: (0.0, 0.0),
         }
+    }
+
+    /// Forgets the reference and any candidate; the tolerances stay.
+    pub fn reset(&mut self) {
+        *self = Self::with_config(self.config);
     }
 
     /// Judges one field reading, given as its horizontal magnitude and its vertical (down)
@@ -177,6 +189,34 @@ impl MagReference {
             && (v * h0 - h * v0).abs() <= self.sin_dip_tol * n * n0
     }
 
+    /// Checks a restored reference against the tolerances `config` of its filter: the same
+    /// tolerances, finite components, times ≥ 0.
+    pub(crate) fn check(&self, config: &MagReferenceConfig) -> Result<()> {
+        if self.config != *config || self.sin_dip_tol != Self::with_config(*config).sin_dip_tol {
+            return Err(Error::InvalidSnapshot {
+                reason: "the field reference's tolerances differ from the filter's",
+            });
+        }
+        for v in [
+            self.horizontal,
+            self.vertical,
+            self.candidate_horizontal,
+            self.candidate_vertical,
+        ] {
+            check_finite("mag reference component", v)?;
+        }
+        check_range("mag.candidate_s", self.candidate_s, 0.0, f64::MAX)?;
+        check_range(
+            "mag.candidate_moving_s",
+            self.candidate_moving_s,
+            0.0,
+            f64::MAX,
+        )?;
+        check_range("mag.gain", self.gain.1, 0.0, 1.0)?;
+        check_range("mag.gain interval", self.gain.0, 0.0, f64::MAX)?;
+        Ok(())
+    }
+
     fn adopt(&mut self, horizontal: f64, vertical: f64) {
         self.horizontal = horizontal;
         self.vertical = vertical;
@@ -194,7 +234,7 @@ mod tests {
     proptest! {
         #[test]
         fn the_learned_field_is_never_disturbed(norm in 1.0f64..100.0, dip in -1.4f64..1.4, n in 1usize..500) {
-            let mut r = MagReference::new(MagReferenceConfig::default());
+            let mut r = MagReference::new(MagReferenceConfig::default()).unwrap();
             for _ in 0..n {
                 prop_assert!(r.update(norm * dip.cos(), norm * dip.sin(), 1.0, 0.01));
             }
@@ -209,7 +249,7 @@ mod tests {
             // An attached magnet: the norm swings by ±swing of itself as the sensor turns,
             // never consistent for `new_reference_s`, so it stays rejected.
             let cfg = MagReferenceConfig::default();
-            let mut r = MagReference::new(cfg);
+            let mut r = MagReference::new(cfg).unwrap();
             r.update(norm * dip.cos(), norm * dip.sin(), 0.0, 0.01);
             let steps = (seconds / 0.01) as usize;
             for k in 0..steps {

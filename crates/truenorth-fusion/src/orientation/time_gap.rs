@@ -8,6 +8,7 @@
 //! read as seconds (every step at 100 Hz then lasts "10 s"), which is refused rather than
 //! answered with an attitude re-initialised at every sample.
 
+use serde::{Deserialize, Serialize};
 use truenorth_core::{Error, Result, check_positive};
 
 /// Shortest step a real IMU gives, s (a 10 kHz sample rate), for the error message.
@@ -22,9 +23,10 @@ pub(crate) enum Step {
     Gap,
 }
 
-/// Counts steps and gaps (validated `max_gap_s` from the estimator's config).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct GapMonitor {
+/// Counts steps and gaps (validated `max_gap_s` from the estimator's config): part of an
+/// orientation estimator's saved state.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct GapMonitor {
     max_gap_s: f64,
     steps: u64,
     gaps: u64,
@@ -57,6 +59,17 @@ impl GapMonitor {
             });
         }
         Ok(Step::Gap)
+    }
+
+    /// Checks a restored monitor against its estimator's `max_gap_s`: the same limit, and
+    /// no more gaps than steps.
+    pub(crate) fn check(&self, max_gap_s: f64) -> Result<()> {
+        if self.max_gap_s != max_gap_s || self.gaps > self.steps {
+            return Err(Error::InvalidSnapshot {
+                reason: "the gap count differs from the estimator's max_gap_s or exceeds the steps",
+            });
+        }
+        Ok(())
     }
 
     /// Counts a step that was classified and taken.

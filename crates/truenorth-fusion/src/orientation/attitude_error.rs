@@ -6,7 +6,7 @@
 
 use nalgebra::UnitQuaternion;
 
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 
 /// Total, heading and inclination error angles, radians.

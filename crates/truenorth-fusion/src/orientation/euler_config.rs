@@ -1,9 +1,7 @@
-//! Parameters of the [`crate::EulerDetector`] (WO 00/36376, METHODS §E): every piece of the
+//! Parameters of the [`crate::EulerDetector`] (WO 00/36376): every piece of the
 //! seed's detector is a field here, so that each can be switched off and its effect measured.
 
 use serde::{Deserialize, Serialize};
-#[allow(unused_imports)]
-use truenorth_core::Float as _;
 use truenorth_core::{Result, Validate, check_positive, check_range};
 use truenorth_gyro::{
     HighPassConfig, HighPassCorrectionConfig, IirHighPassConfig, OscillationRemoverConfig,
@@ -13,14 +11,15 @@ use truenorth_gyro::{
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum EulerVariant {
-    /// Yaw, pitch and roll from three gyros (§E.1–7).
+    /// Yaw, pitch and roll from three gyros (the seed's full detector).
     Full,
     /// Yaw and pitch only, from the gyros on the body y and z axes and one accelerometer on
-    /// x; roll is taken as zero (§E.10).
+    /// x; roll is taken as zero (the seed's yaw + pitch variant).
     YawPitch,
 }
 
-/// How each gyro's output is conditioned before it is integrated (§E.8).
+/// How each gyro's output is conditioned before it is integrated (the seed's gyro
+/// conditioning).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum GyroConditioning {
@@ -38,7 +37,8 @@ pub enum GyroConditioning {
     Iir(IirHighPassConfig),
 }
 
-/// When a static angle is trustworthy enough to correct with (§E.5). Every test that is
+/// When a static angle is trustworthy enough to correct with (the seed's correction
+/// definer, modes (1)–(7)). Every test that is
 /// `Some` must pass; `None` switches a test off.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
@@ -105,7 +105,7 @@ impl Validate for CorrectionDefinerConfig {
     }
 }
 
-/// The start-up field a two-axis magnetometer needs for the M_z reconstruction (§E.4).
+/// The start-up field a two-axis magnetometer needs for the seed's M_z reconstruction.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct StartupField {
     /// Total field `Ht`, the magnetometer's unit.
@@ -125,7 +125,7 @@ pub struct EulerDetectorConfig {
     pub gyro: GyroConditioning,
     /// The oscillation remover on each gyro (default `None`).
     pub oscillation_remover: Option<OscillationRemoverConfig>,
-    /// When a static angle may correct (§E.5).
+    /// When a static angle may correct (the correction definer).
     pub definer: CorrectionDefinerConfig,
     /// Time constants of the corrections of roll, pitch and yaw, s: the seed's gain is
     /// `k = dt/τ` per sample (0 < k < 1), so the behaviour does not depend on the sample
@@ -181,7 +181,7 @@ impl Validate for EulerDetectorConfig {
             o.validate()?;
         }
         self.definer.validate()?;
-        crate::time_gap::check_max_gap(self.max_gap_s)?;
+        super::time_gap::check_max_gap(self.max_gap_s)?;
         if let Some(f) = self.startup_field {
             check_positive("startup_field.total", f.total)?;
             check_range(

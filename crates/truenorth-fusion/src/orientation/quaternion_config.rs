@@ -4,9 +4,12 @@
 use serde::{Deserialize, Serialize};
 use truenorth_core::{Result, Validate, check_positive, check_range};
 
-use crate::{AttitudeUncertaintyConfig, HardIronConfig, MagReferenceConfig, RestConfig};
+use super::attitude_uncertainty::AttitudeUncertaintyConfig;
+use super::hard_iron::HardIronConfig;
+use super::mag_reference::MagReferenceConfig;
+use super::rest_detector::RestConfig;
 
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 
 /// What a gyro sample's rate stands for, which decides how it is integrated.
@@ -19,8 +22,7 @@ pub enum GyroTiming {
     IntervalMean,
     /// The instantaneous rate at the timestamp (the convention of `truenorth_core::GyroSample`
     /// and of the simulator): the step uses the mean of the previous and current rate, the
-    /// trapezoid rule. On BROAD's real recordings this lags half a sample: inclination
-    /// 0.83° → 1.00° (`tests/broad.rs`).
+    /// trapezoid rule. On a gyro that reports interval means it lags half a sample.
     Instantaneous,
 }
 
@@ -40,12 +42,11 @@ pub struct QuaternionFilterConfig {
     /// Time constant of the heading correction while the sensor rests, s (default 5): at
     /// rest the reading has no motion-induced error (no latency against the gyro, no
     /// acceleration in the tilt it is levelled with), so heading error collected during
-    /// motion is removed faster (BROAD: heading 1.97° → 1.92°, both groups better).
+    /// motion is removed faster.
     pub tau_mag_rest_s: f64,
     /// Time constant of the in-motion bias estimate, s (default 400): long against
     /// `tau_acc_s` so the bias loop cannot ring, and long enough that the body's own
-    /// accelerations, which leak into every correction, average out of it (at 60 s the
-    /// bias wandered by 2°/s on BROAD trial 16, `tests/broad.rs`).
+    /// accelerations, which leak into every correction, average out of it.
     pub bias_tau_motion_s: f64,
     /// Time constant of the in-motion bias estimate before any rest has measured the bias,
     /// s (default 60); it moves to `bias_tau_motion_s` as rest time accumulates.
@@ -131,7 +132,7 @@ impl Validate for QuaternionFilterConfig {
         self.rest.validate()?;
         self.mag.validate()?;
         self.hard_iron.validate()?;
-        crate::time_gap::check_max_gap(self.max_gap_s)?;
+        super::time_gap::check_max_gap(self.max_gap_s)?;
         self.uncertainty.validate()?;
         if let Some(q) = self.initial_attitude {
             for v in q {

@@ -1,0 +1,570 @@
+//! A quaternion orientation filter for 6-D (gyro + accelerometer) and 9-D (+ magnetometer)
+//! IMUs, with gyro-bias estimation at rest and in motion, magnetic-disturbance rejection and
+//! online hard-iron re-estimation.
+//!
+//! Per sample (body → NED quaternion `q`, Hamilton, scalar first):
+//! 1. **Strapdown**: `q ← q ⊗ exp((ω − b̂) dt / 2)`, with the rate the gyro's timing calls
+//!    for ([`GyroTiming`]).
+//! 2. **Inclination**: the specific force rotated into NED and low-passed there (its mean
+//!    over a swing is gravity alone) should point up, `(0, 0, −1)`; `q` is turned about the
+//!    horizontal axis by `dt/τ_acc` times the horizontal part of it over g — a
+//!    complementary filter (Mahony, Hamel & Pflimlin, IEEE TAC 53(5), 2008) with the error
+//!    formed in the reference frame so that heading is untouched, and the low-pass of the
+//!    reference-frame acceleration that VQF introduced (Laidig & Seel, Information Fusion
+//!    91, 2023). The low-passed vector is turned with every correction so that it stays in
+//!    the frame of `q`.
+//!    The correction is linear in the specific force (its horizontal part over g), so the
+//!    body's own accelerations, which average to zero over any swing, cancel; weighting
+//!    readings by how far |a| is from g, or using the angle, biases the average.
+//! 3. **Heading**: the magnetometer, less any hard-iron offset learned online
+//!    ([`crate::HardIronEstimator`]), rotated into NED should point north; `q` is turned
+//!    about the vertical only, by `dt/τ_mag` of the horizontal angle, so a disturbed field
+//!    can never tilt the inclination (the decoupling of Madgwick's and VQF's heading
+//!    updates). Readings judged disturbed by [`crate::MagReference`] (norm or dip off) are
+//!    skipped. Samples without a reading (a magnetometer slower than the gyro) are skipped
+//!    and the next reading's correction covers the time since the last one.
+//! 4. **Gyro bias**: at rest ([`crate::RestDetector`]) the bias follows the mean of the raw
+//!    rate; in motion, each correction's implied rate is integrated into the bias (the
+//!    integral term of Mahony et al.), along the axes the corrections observe.
+//!
+//! The 6-D attitude is the same rotation with every heading correction undone:
+//! `q₆ = Rz(−H) ⊗ q` with `H` the sum of the heading corrections, exact because each
+//! correction acts on the left (in the reference frame) and the inclination correction
+//! commutes with a rotation about the vertical.
+//!
+//! The per-sample path computes no trigonometric function: the strapdown step and the
+//! corrections use series that are exact to 10⁻¹⁰ rad at their step sizes
+//! ([`super::rotation`]), the dip test compares sines, and the heading error is taken as
+//! `sin ε = y/|h|` of the horizontal field `h = (x, y)` (±1 beyond ±90°).
+
+use nalgebra::{Matrix3, Quaternion, UnitQuaternion, Vector3};
+use truenorth_core::{
+    AttitudeEstimate, AttitudeStatus, Error, ImuSample, OrientationEstimator, Persistent, Result,
+    STANDARD_GRAVITY_MPS2, Validate,
+};
+
+use super::quaternion_config::{GyroTiming, QuaternionFilterConfig};
+use super::quaternion_gains::{Coefficients, effective_tau};
+use super::quaternion_state::QuaternionFilterState;
+use super::rotation::{rotation_from_vector, small_rotation};
+use super::sample_bounds::check_bounds;
+use super::time_gap::Step;
+use super::triad::attitude_from;
+
+#[cfg(not(feature = "std"))]
+use truenorth_core::Float as _;
+
+/// What the parts of one step share.
+struct StepContext {
+    dt_s: f64,
+    /// The step falls in the start-up (fast corrections, no bias learning).
+    startup: bool,
+    gains: Coefficients,
+    at_rest: bool,
+    /// Body → NED after the strapdown, before the step's corrections: one rotation matrix
+    /// serves every vector rotated in the step.
+    rotation: Matrix3<f64>,
+    /// |ω − b̂|, rad/s.
+    rate_rps: f64,
+}
+
+/// The heading error `sin ε` of the angle ε of the horizontal field `m_ned` (horizontal
+/// norm `horizontal`) east of north, and ±1 beyond ±90°: equal to ε to 0.13 % for
+/// |ε| < 5°, and bounded, so a disturbed reading that slips past the tests pulls no harder
+/// than a 57° error (the angle itself would pull with up to 180°).
+fn heading_error(m_ned: &Vector3<f64>, horizontal: f64) -> f64 {
+    if m_ned.x >= 0.0 {
+        m_ned.y / horizontal
+    } else {
+        1f64.copysign(m_ned.y)
+    }
+}
+
+/// The quaternion orientation filter (see the module documentation).
+///
+/// ```
+/// use nalgebra::Vector3;
+/// use truenorth_core::{ImuSample, OrientationEstimator};
+/// use truenorth_fusion::{QuaternionFilter, QuaternionFilterConfig};
+///
+/// let mut f = QuaternionFilter::new(QuaternionFilterConfig::default())?;
+/// // A minute level and still, facing magnetic north, with a 1°/s gyro bias on z.
+/// for k in 0..6000 {
+///     let s = ImuSample::new_9d(
+///         0.01 * k as f64,
+///         Vector3::new(0.0, 0.0, 1f64.to_radians()),
+///         Vector3::new(0.0, 0.0, -9.81),
+///         Vector3::new(20.0, 0.0, 45.0),
+///     );
+///     f.update(&s)?;
+/// }
+/// let est = f.estimate();
+/// assert!(est.status.at_rest);
+/// assert!((est.gyro_bias_rps.z - 1f64.to_radians()).abs() < 0.05f64.to_radians());
+/// assert!(est.attitude.angle() < 0.5f64.to_radians());
+/// # Ok::<(), truenorth_core::Error>(())
+/// ```
+#[derive(Debug, Clone)]
+pub struct QuaternionFilter {
+    state: QuaternionFilterState,
+    /// Derived from the parameters and the sample interval.
+    coefficients: Coefficients,
+}
+
+impl QuaternionFilter {
+    /// A filter with the given parameters.
+    pub fn new(config: QuaternionFilterConfig) -> Result<Self> {
+        config.validate()?;
+        Ok(Self::with_state(QuaternionFilterState::initial(config)))
+    }
+
+    /// The filter continuing from a valid `state`.
+    fn with_state(state: QuaternionFilterState) -> Self {
+        Self {
+            coefficients: Coefficients::new(&state.config, 0.0, false),
+            state,
+        }
+    }
+
+    /// The parameters in use.
+    pub fn config(&self) -> &QuaternionFilterConfig {
+        &self.state.config
+    }
+
+    /// The hard-iron offset currently subtracted from the magnetometer (body frame, the
+    /// magnetometer's unit), if one was learned.
+    pub fn hard_iron_offset(&self) -> Option<Vector3<f64>> {
+        self.state.hard_iron.offset()
+    }
+
+    /// One step of `dt_s` ending at `t_s`, in the order of the module documentation: the
+    /// strapdown, the σ carried through it, the corrections the sample's readings allow
+    /// (applied together at the end: at most 10⁻³ rad each), the gyro bias.
+    fn step(
+        &mut self,
+        t_s: f64,
+        dt_s: f64,
+        gyr: Vector3<f64>,
+        acc: Option<Vector3<f64>>,
+        mag: Option<Vector3<f64>>,
+    ) {
+        let startup = self.advance_time(dt_s);
+        let gains = self.gains(dt_s, startup);
+        let omega = self.strapdown(dt_s, gyr);
+        let at_rest = acc.is_some_and(|a| self.state.rest.update(&gyr, &a, mag.as_ref(), dt_s));
+        let step = StepContext {
+            dt_s,
+            startup,
+            gains,
+            at_rest,
+            rotation: *self.state.attitude.to_rotation_matrix().matrix(),
+            rate_rps: omega.norm(),
+        };
+        self.propagate_uncertainty(&step, &omega);
+        let mut status = AttitudeStatus {
+            at_rest,
+            ..AttitudeStatus::default()
+        };
+        // The step's correction, a rotation vector in the reference frame.
+        let mut correction = Vector3::zeros();
+        if let Some(a) = acc
+            && a.norm_squared() > 1e-12
+        {
+            self.correct_inclination(&step, &a, &mut correction);
+            status.accel_used = true;
+        }
+        self.state.since_mag_s += dt_s;
+        if let Some(m) = mag {
+            self.correct_heading(&step, &m, &mut correction, &mut status);
+        }
+        self.apply_correction(&correction);
+        if !startup {
+            self.estimate_bias(&step, &correction);
+        }
+        self.state.estimate = Some(self.estimate_at(t_s, status));
+    }
+
+    /// Counts the step's time and says whether it falls in the start-up.
+    fn advance_time(&mut self, dt_s: f64) -> bool {
+        self.state.since_start_s += dt_s;
+        self.state.since_start_s < self.state.config.startup_s
+    }
+
+    /// The gains for a step of `dt_s`: the start-up's computed afresh, the others kept
+    /// until the interval changes.
+    fn gains(&mut self, dt_s: f64, startup: bool) -> Coefficients {
+        if startup {
+            return Coefficients::new(&self.state.config, dt_s, true);
+        }
+        if self.coefficients.dt_s != dt_s {
+            self.coefficients = Coefficients::new(&self.state.config, dt_s, false);
+        }
+        self.coefficients
+    }
+
+    /// Strapdown: `q ← q ⊗ exp((ω − b̂) dt / 2)` with the rate the gyro's timing calls for.
+    /// Returns the body rate less the bias, `ω − b̂`, rad/s.
+    fn strapdown(&mut self, dt_s: f64, gyr: Vector3<f64>) -> Vector3<f64> {
+        let s = &mut self.state;
+        let rate = match s.config.gyro_timing {
+            GyroTiming::IntervalMean => gyr,
+            GyroTiming::Instantaneous => 0.5 * (s.last_gyr_rps.unwrap_or(gyr) + gyr),
+        };
+        s.last_gyr_rps = Some(gyr);
+        let omega = rate - s.gyro_bias_rps;
+        s.attitude = UnitQuaternion::new_normalize(
+            s.attitude.into_inner() * rotation_from_vector(&(omega * dt_s)),
+        );
+        omega
+    }
+
+    /// Carries the σ through the strapdown step at body rate `omega` (bias removed).
+    fn propagate_uncertainty(&mut self, step: &StepContext, omega: &Vector3<f64>) {
+        self.state
+            .uncertainty
+            .propagate(step.dt_s, omega, step.rate_rps, &step.rotation);
+    }
+
+    /// The in-motion bias estimate's 1/τ as the σ credits it: none while the bias does not
+    /// learn from the corrections (start-up, rest).
+    fn bias_inv_tau_credited(&self, step: &StepContext) -> f64 {
+        if step.startup || step.at_rest {
+            0.0
+        } else {
+            self.state.bias_inv_tau_motion_per_s
+        }
+    }
+
+    /// Inclination: the specific force `a` rotated into NED and low-passed there should
+    /// point up; adds the turn about the horizontal that moves it there by `dt/τ_acc` to
+    /// `correction`.
+    fn correct_inclination(
+        &mut self,
+        step: &StepContext,
+        a: &Vector3<f64>,
+        correction: &mut Vector3<f64>,
+    ) {
+        let inv_tau_bias = self.bias_inv_tau_credited(step);
+        let s = &mut self.state;
+        let cfg = &s.config;
+        // Linear in the specific force: the body's own accelerations average out over a
+        // swing, where an angle (atan of horizontal over vertical) would not. A first
+        // low-pass in the reference frame before the proportional correction makes the
+        // response to acceleration second order.
+        let f = step.rotation * a;
+        let lp = match s.acc_lowpass_ned_mps2 {
+            Some(lp) => lp + (f - lp) * step.gains.acc_lowpass,
+            None => f,
+        };
+        s.acc_lowpass_ned_mps2 = Some(lp);
+        let k = step.gains.acc;
+        // down × ẑ with down = −lp/g.
+        correction.x = -lp.y * k;
+        correction.y = lp.x * k;
+        s.uncertainty.accel_corrected(
+            k * STANDARD_GRAVITY_MPS2,
+            (correction.x, correction.y),
+            effective_tau(cfg.tau_acc_s, step.startup),
+            inv_tau_bias,
+            effective_tau(cfg.acc_lowpass_s, step.startup),
+        );
+    }
+
+    /// Heading: the field `m`, less any hard iron learned online, rotated into NED should
+    /// point north; adds the turn about the vertical that moves it there by `dt/τ_mag` to
+    /// `correction`, unless the reading is judged disturbed.
+    fn correct_heading(
+        &mut self,
+        step: &StepContext,
+        m: &Vector3<f64>,
+        correction: &mut Vector3<f64>,
+        status: &mut AttitudeStatus,
+    ) {
+        let mag_dt_s = core::mem::take(&mut self.state.since_mag_s);
+        let offset = self.learn_hard_iron(step, m, mag_dt_s);
+        status.mag_calibrating = offset.is_some();
+        let m_ned = step.rotation * (m - offset.unwrap_or_default());
+        let horizontal = m_ned.xy().norm();
+        if horizontal > 0.0 {
+            let undisturbed =
+                self.state
+                    .mag_reference
+                    .update(horizontal, m_ned.z, step.rate_rps, mag_dt_s);
+            status.mag_disturbed = !undisturbed;
+            if undisturbed && horizontal > 1e-9 * m_ned.z.abs() {
+                let k = self.heading_gain(step, mag_dt_s);
+                let dz = -k * heading_error(&m_ned, horizontal);
+                correction.z = dz;
+                // An offset learned from the attitude cannot also tell its error.
+                if !status.mag_calibrating {
+                    self.credit_heading_uncertainty(step, k, &m_ned, horizontal);
+                }
+                self.undo_heading_correction(dz);
+                status.mag_used = true;
+            }
+        }
+    }
+
+    /// The hard-iron offset to subtract from the reading `m`, learned while a field
+    /// reference is known; `mag_dt_s` is the time since the previous reading.
+    fn learn_hard_iron(
+        &mut self,
+        step: &StepContext,
+        m: &Vector3<f64>,
+        mag_dt_s: f64,
+    ) -> Option<Vector3<f64>> {
+        let reference = self.state.mag_reference.reference_ned()?;
+        // A gyro bias not yet learned must not count as turning.
+        let turning_rps = if step.at_rest { 0.0 } else { step.rate_rps };
+        self.state
+            .hard_iron
+            .update(m, &step.rotation, &reference, turning_rps, mag_dt_s)
+    }
+
+    /// The heading correction's gain: at rest or in motion, and covering the samples
+    /// without a reading since the last one.
+    fn heading_gain(&self, step: &StepContext, mag_dt_s: f64) -> f64 {
+        let c = &step.gains;
+        match (step.at_rest, mag_dt_s == step.dt_s) {
+            (true, true) => c.mag_rest,
+            (false, true) => c.mag,
+            // A reading after samples without one covers their time too.
+            (rest, false) => {
+                let g = Coefficients::new(&self.state.config, mag_dt_s, step.startup);
+                if rest { g.mag_rest } else { g.mag }
+            }
+        }
+    }
+
+    /// The σ of heading after a correction with gain `k` by the field `m_ned` (horizontal
+    /// part `horizontal`), judged against the learned reference.
+    fn credit_heading_uncertainty(
+        &mut self,
+        step: &StepContext,
+        k: f64,
+        m_ned: &Vector3<f64>,
+        horizontal: f64,
+    ) {
+        let Some(reference) = self.state.mag_reference.reference_ned() else {
+            return;
+        };
+        let inv_tau_bias = self.bias_inv_tau_credited(step);
+        let cfg = &self.state.config;
+        let tau = if step.at_rest {
+            cfg.tau_mag_rest_s
+        } else {
+            cfg.tau_mag_s
+        };
+        self.state.uncertainty.mag_corrected(
+            k,
+            effective_tau(tau, step.startup),
+            (horizontal, m_ned.z),
+            (reference.x, reference.z),
+            inv_tau_bias,
+        );
+    }
+
+    /// Adds the heading correction `dz` to the turn the 6-D attitude undoes:
+    /// `Rz(−H/2) ← Rz(−dz/2) Rz(−H/2)`, first order and renormalised.
+    fn undo_heading_correction(&mut self, dz: f64) {
+        let (c, sn) = self.state.undo_heading;
+        let h = 0.5 * dz;
+        let (c, sn) = (c + sn * h, sn - c * h);
+        let n = (c * c + sn * sn).sqrt();
+        self.state.undo_heading = (c / n, sn / n);
+    }
+
+    /// Turns the attitude by the step's `correction` (in the reference frame), and the
+    /// low-passed specific force with it so that it stays in the frame of `q`.
+    fn apply_correction(&mut self, correction: &Vector3<f64>) {
+        if *correction != Vector3::zeros() {
+            let s = &mut self.state;
+            s.attitude = small_rotation(correction) * s.attitude;
+            // First order, as the step is small.
+            s.acc_lowpass_ned_mps2 = s.acc_lowpass_ned_mps2.map(|lp| lp + correction.cross(&lp));
+        }
+    }
+
+    /// Gyro bias: at rest it follows the rest detector's mean of the raw rate; in motion it
+    /// integrates the rate the step's `correction` implies. Clamped to `max_bias_rps`.
+    fn estimate_bias(&mut self, step: &StepContext, correction: &Vector3<f64>) {
+        if step.at_rest {
+            self.learn_bias_at_rest(step);
+        } else {
+            // A bias the estimate lacks makes the strapdown drift, and the corrections
+            // turn against the drift: integrating their rate removes it (the integral term
+            // of Mahony et al.). Until a rest has measured the bias, it is learned faster,
+            // accepting more of the accelerations that leak into the corrections.
+            // Body-frame rate of the correction, Rᵀ·correction/dt, times dt/τ.
+            let s = &mut self.state;
+            s.gyro_bias_rps -= step.rotation.tr_mul(correction) * s.bias_inv_tau_motion_per_s;
+        }
+        let lim = self.state.config.max_bias_rps;
+        self.state.gyro_bias_rps = self.state.gyro_bias_rps.map(|b| b.clamp(-lim, lim));
+    }
+
+    /// The bias at rest, and how well it is known: the in-motion estimate's time constant
+    /// moves from `bias_tau_unknown_s` to `bias_tau_motion_s` as rest time accumulates.
+    fn learn_bias_at_rest(&mut self, step: &StepContext) {
+        let s = &mut self.state;
+        let cfg = &s.config;
+        let k = step.gains.bias_rest;
+        s.gyro_bias_rps += (s.rest.gyro_mean() - s.gyro_bias_rps) * k;
+        s.uncertainty
+            .at_rest(k, cfg.rest.mean_tau_s, cfg.bias_tau_rest_s);
+        if s.rest_s < cfg.bias_known_after_rest_s {
+            s.rest_s += step.dt_s;
+            let known = (s.rest_s / cfg.bias_known_after_rest_s).min(1.0);
+            let tau =
+                cfg.bias_tau_unknown_s + known * (cfg.bias_tau_motion_s - cfg.bias_tau_unknown_s);
+            s.bias_inv_tau_motion_per_s = 1.0 / tau;
+        }
+    }
+
+    /// The estimate after the step: the attitude, the 6-D attitude with every heading
+    /// correction undone, the bias and σ.
+    fn estimate_at(&self, t_s: f64, status: AttitudeStatus) -> AttitudeEstimate {
+        let s = &self.state;
+        let (c, sn) = s.undo_heading;
+        let undo = UnitQuaternion::new_unchecked(Quaternion::new(c, 0.0, 0.0, sn));
+        AttitudeEstimate {
+            t_s,
+            attitude: s.attitude,
+            attitude_6d: Some(undo * s.attitude),
+            gyro_bias_rps: s.gyro_bias_rps,
+            sigma_rad: Some(s.uncertainty.sigma_rad()),
+            status,
+        }
+    }
+
+    /// Starts again after a gap of `gap_s` that the gyro cannot bridge: the attitude from
+    /// this sample's accelerometer (and magnetometer) when it has one, the start-up's fast
+    /// corrections again, the σ widened; the learned bias, field reference and hard iron
+    /// are properties of the sensor and carry over.
+    fn restart(
+        &mut self,
+        t_s: f64,
+        gap_s: f64,
+        gyr: Vector3<f64>,
+        acc: Option<Vector3<f64>>,
+        mag: Option<Vector3<f64>>,
+    ) -> AttitudeEstimate {
+        let s = &mut self.state;
+        if let Some(q) = acc.and_then(|a| attitude_from(&a, mag.as_ref())) {
+            s.attitude = q;
+        }
+        s.undo_heading = (1.0, 0.0);
+        s.acc_lowpass_ned_mps2 = None;
+        s.last_gyr_rps = Some(gyr);
+        s.since_mag_s = 0.0;
+        s.since_start_s = 0.0;
+        s.uncertainty.restart(false, gap_s);
+        s.rest.reset();
+        let estimate = AttitudeEstimate {
+            t_s,
+            gyro_bias_rps: s.gyro_bias_rps,
+            sigma_rad: Some(s.uncertainty.sigma_rad()),
+            status: AttitudeStatus {
+                gap: true,
+                ..AttitudeStatus::default()
+            },
+            ..AttitudeEstimate::initial(s.attitude)
+        };
+        s.estimate = Some(estimate);
+        estimate
+    }
+}
+
+impl OrientationEstimator for QuaternionFilter {
+    /// Needs a gyro triad; the accelerometer and magnetometer triads may be absent on any
+    /// sample (a slower sensor). A non-finite value, a reading beyond any sensor's range
+    /// (gyro 10⁴ rad/s, accelerometer 10⁶ m/s², field 10¹²), a timestamp that does not
+    /// increase or a gap over 10⁶ s is an error and changes nothing. A step longer than
+    /// `max_gap_s` restarts the attitude from the sample (status `gap`); a step that would
+    /// make such gaps the majority of the steps is an [`Error::Implausible`] time base.
+    fn update(&mut self, sample: &ImuSample) -> Result<AttitudeEstimate> {
+        let gyr = sample.gyr_rps.as_xyz().ok_or(Error::Unsupported {
+            reason: "the quaternion filter needs a three-axis gyro; use the Euler detector for two gyros",
+        })?;
+        let acc = sample.acc_mps2.as_xyz();
+        let mag = if self.state.config.use_mag {
+            sample.mag.as_xyz()
+        } else {
+            None
+        };
+        // The usual sample is a finite 9-D one: test it in one pass, and let the sample's
+        // own check name the offending reading otherwise.
+        let finite = sample.t_s.is_finite()
+            && gyr.iter().all(|v| v.is_finite())
+            && acc.is_some_and(|a| a.iter().all(|v| v.is_finite()))
+            && sample
+                .mag
+                .as_xyz()
+                .is_some_and(|m| m.iter().all(|v| v.is_finite()));
+        if !finite {
+            sample.check_finite()?;
+        }
+        // Readings beyond any sensor's range could overflow the update; they are refused
+        // before anything changes, so the update needs no copy of the state to fall back to.
+        let mut clock = self.state.clock;
+        let dt = clock.dt_s(sample.t_s)?;
+        check_bounds(&gyr, acc.as_ref(), mag.as_ref(), dt)?;
+        let step = dt.map(|d| self.state.gaps.classify(d)).transpose()?;
+        self.state.clock = clock;
+        if let Some(step) = step {
+            self.state.gaps.count(step);
+        }
+        if let (Some(gap_s), Some(Step::Gap)) = (dt, step) {
+            return Ok(self.restart(sample.t_s, gap_s, gyr, acc, mag));
+        }
+        let Some(dt_s) = dt else {
+            if !self.state.initialised
+                && let Some(q) = acc.and_then(|a| attitude_from(&a, mag.as_ref()))
+            {
+                self.state.attitude = q;
+                self.state.initialised = true;
+            }
+            self.state.last_gyr_rps = Some(gyr);
+            let estimate = AttitudeEstimate {
+                t_s: sample.t_s,
+                sigma_rad: Some(self.state.uncertainty.sigma_rad()),
+                ..AttitudeEstimate::initial(self.state.attitude)
+            };
+            self.state.estimate = Some(estimate);
+            return Ok(estimate);
+        };
+        self.step(sample.t_s, dt_s, gyr, acc, mag);
+        debug_assert!(self.state.attitude.coords.iter().all(|v| v.is_finite()));
+        Ok(self.estimate())
+    }
+
+    /// The estimate after the last sample; before the first, the initial attitude with
+    /// its σ.
+    fn estimate(&self) -> AttitudeEstimate {
+        let s = &self.state;
+        s.estimate.unwrap_or_else(|| AttitudeEstimate {
+            sigma_rad: Some(s.uncertainty.sigma_rad()),
+            ..AttitudeEstimate::initial(s.attitude)
+        })
+    }
+
+    /// Back to the state before any sample, with the same parameters.
+    fn reset(&mut self) {
+        *self = Self::with_state(QuaternionFilterState::initial(self.state.config));
+    }
+}
+
+impl Persistent for QuaternionFilter {
+    type State = QuaternionFilterState;
+    const SNAPSHOT_VERSION: u32 = 1;
+
+    fn state(&self) -> QuaternionFilterState {
+        self.state
+    }
+
+    /// Refuses a state that is not valid (see [`QuaternionFilterState`]'s `validate`).
+    fn from_state(state: QuaternionFilterState) -> Result<Self> {
+        state.validate()?;
+        Ok(Self::with_state(state))
+    }
+}

@@ -1,0 +1,182 @@
+//! The [`QuaternionFilterState`]: everything the [`crate::QuaternionFilter`] carries from one
+//! sample to the next, its parameters included, as plain data (as VQF's `getState` /
+//! `setState`), so that a filter can be saved and later continue exactly where it stopped.
+
+use nalgebra::{UnitQuaternion, Vector3};
+use serde::{Deserialize, Serialize};
+use truenorth_core::{
+    AttitudeEstimate, Error, Result, TimeStep, Validate, check_finite, check_finite3, check_range,
+};
+
+use super::attitude_uncertainty::AttitudeUncertainty;
+use super::hard_iron::HardIronEstimator;
+use super::mag_reference::MagReference;
+use super::quaternion_config::QuaternionFilterConfig;
+use super::rest_detector::RestDetector;
+use super::time_gap::GapMonitor;
+
+#[cfg(not(feature = "std"))]
+use truenorth_core::Float as _;
+
+/// Largest departure of a restored attitude from a unit quaternion (serialisation keeps it
+/// within a few units of 10⁻¹⁶).
+const UNIT_NORM_TOL: f64 = 1e-9;
+
+/// What the [`crate::QuaternionFilter`] carries from one sample to the next (see the
+/// module documentation).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct QuaternionFilterState {
+    /// The parameters.
+    pub config: QuaternionFilterConfig,
+    /// The attitude `q`, body → NED.
+    pub attitude: UnitQuaternion<f64>,
+    /// `Rz(−H/2)` as (cos, sin) of `−H/2`, `H` the sum of the heading corrections: what
+    /// turns the attitude into the 6-D one.
+    pub undo_heading: (f64, f64),
+    /// The gyro bias estimate, rad/s, body axes.
+    pub gyro_bias_rps: Vector3<f64>,
+    /// The low-passed specific force in NED, m/s²; `None` before the first reading.
+    pub acc_lowpass_ned_mps2: Option<Vector3<f64>>,
+    /// Time spent at rest since the start, s (counted up to `bias_known_after_rest_s`):
+    /// how well the bias is known.
+    pub rest_s: f64,
+    /// `1/τ` of the in-motion bias estimate for the rest time so far, 1/s.
+    pub bias_inv_tau_motion_per_s: f64,
+    /// The previous gyro reading, rad/s (for [`crate::GyroTiming::Instantaneous`]).
+    pub last_gyr_rps: Option<Vector3<f64>>,
+    /// Time since the last magnetometer reading, s.
+    pub since_mag_s: f64,
+    /// Time since the start (or the last gap), s: the start-up runs while it is below
+    /// `startup_s`.
+    pub since_start_s: f64,
+    /// The attitude has been taken from a reading (or given in the parameters).
+    pub initialised: bool,
+    /// The σ of the attitude, propagated alongside it.
+    pub uncertainty: AttitudeUncertainty,
+    /// The estimate after the last sample; `None` before the first.
+    pub estimate: Option<AttitudeEstimate>,
+    /// The time of the last sample.
+    pub clock: TimeStep,
+    /// The steps taken and the gaps among them.
+    pub gaps: GapMonitor,
+    /// Rest detection.
+    pub rest: RestDetector,
+    /// The learned field reference (magnetic-disturbance detection).
+    pub mag_reference: MagReference,
+    /// The hard iron learned online.
+    pub hard_iron: HardIronEstimator,
+}
+
+impl QuaternionFilterState {
+    /// The state before any sample, for validated parameters.
+    pub(crate) fn initial(config: QuaternionFilterConfig) -> Self {
+        Self {
+            config,
+            attitude: initial_attitude(&config),
+            undo_heading: (1.0, 0.0),
+            gyro_bias_rps: Vector3::zeros(),
+            acc_lowpass_ned_mps2: None,
+            rest_s: 0.0,
+            bias_inv_tau_motion_per_s: 1.0 / config.bias_tau_unknown_s,
+            last_gyr_rps: None,
+            since_mag_s: 0.0,
+            since_start_s: 0.0,
+            initialised: config.initial_attitude.is_some(),
+            uncertainty: AttitudeUncertainty::new(config.uncertainty, !config.use_mag),
+            estimate: None,
+            clock: TimeStep::new(),
+            gaps: GapMonitor::new(config.max_gap_s),
+            rest: RestDetector::with_config(config.rest),
+            mag_reference: MagReference::with_config(config.mag),
+            hard_iron: HardIronEstimator::with_config(config.hard_iron),
+        }
+    }
+}
+
+impl Validate for QuaternionFilterState {
+    /// Valid parameters; a unit attitude and heading undo; finite vectors; a bias within
+    /// `max_bias_rps`; times ≥ 0; a finite estimate; parts built for these parameters.
+    fn validate(&self) -> Result<()> {
+        let cfg = &self.config;
+        cfg.validate()?;
+        let q = self.attitude.as_ref();
+        for v in q.coords.iter() {
+            check_finite("attitude component", *v)?;
+        }
+        check_range(
+            "attitude norm",
+            q.norm(),
+            1.0 - UNIT_NORM_TOL,
+            1.0 + UNIT_NORM_TOL,
+        )?;
+        let (c, s) = self.undo_heading;
+        check_finite("undo_heading cos", c)?;
+        check_finite("undo_heading sin", s)?;
+        let n = (c * c + s * s).sqrt();
+        check_range(
+            "undo_heading norm",
+            n,
+            1.0 - UNIT_NORM_TOL,
+            1.0 + UNIT_NORM_TOL,
+        )?;
+        check_finite3("gyro_bias_rps", &self.gyro_bias_rps)?;
+        if self.gyro_bias_rps.amax() > cfg.max_bias_rps {
+            return Err(Error::InvalidSnapshot {
+                reason: "the gyro bias exceeds max_bias_rps",
+            });
+        }
+        for v in [self.acc_lowpass_ned_mps2, self.last_gyr_rps]
+            .iter()
+            .flatten()
+        {
+            check_finite3("saved vector", v)?;
+        }
+        for (what, v) in [
+            ("rest_s", self.rest_s),
+            ("bias_inv_tau_motion_per_s", self.bias_inv_tau_motion_per_s),
+            ("since_mag_s", self.since_mag_s),
+            ("since_start_s", self.since_start_s),
+        ] {
+            check_range(what, v, 0.0, f64::MAX)?;
+        }
+        if let Some(e) = &self.estimate {
+            check_estimate(e)?;
+        }
+        if let Some(t) = self.clock.last_s() {
+            check_finite("time of the last sample", t)?;
+        }
+        self.uncertainty.check(&cfg.uncertainty)?;
+        self.gaps.check(cfg.max_gap_s)?;
+        self.rest.check(&cfg.rest)?;
+        self.mag_reference.check(&cfg.mag)?;
+        self.hard_iron.check(&cfg.hard_iron)
+    }
+}
+
+/// A saved estimate's numbers: finite, σ ≥ 0.
+pub(crate) fn check_estimate(e: &AttitudeEstimate) -> Result<()> {
+    check_finite("estimate t_s", e.t_s)?;
+    for q in core::iter::once(&e.attitude).chain(&e.attitude_6d) {
+        for v in q.coords.iter() {
+            check_finite("estimate attitude component", *v)?;
+        }
+    }
+    check_finite3("estimate gyro_bias_rps", &e.gyro_bias_rps)?;
+    if let Some(sigma) = &e.sigma_rad {
+        for v in sigma.iter() {
+            check_range("estimate sigma_rad", *v, 0.0, f64::MAX)?;
+        }
+    }
+    Ok(())
+}
+
+/// The attitude the parameters start from: the given one, or level and facing north until
+/// the first reading.
+fn initial_attitude(config: &QuaternionFilterConfig) -> UnitQuaternion<f64> {
+    match config.initial_attitude {
+        Some([w, x, y, z]) => {
+            UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(w, x, y, z))
+        }
+        None => UnitQuaternion::identity(),
+    }
+}
