@@ -5,6 +5,7 @@
 //!
 //! Run: `cargo run --release --example calibrate_compass`
 
+use truenorth::Error;
 use truenorth::calib::EllipseCalibrator;
 use truenorth::geomag::declination;
 use truenorth::prelude::*;

@@ -4,6 +4,7 @@
 //!
 //! Run: `cargo run --release --example orientation_filter [quaternion|euler]`
 
+use truenorth::Error;
 use truenorth::fusion::{
     AttitudeError, EulerDetector, EulerDetectorConfig, GyroTiming, QuaternionFilter,
     QuaternionFilterConfig,

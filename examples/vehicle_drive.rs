@@ -5,6 +5,7 @@
 //!
 //! Run: `cargo run --release --example vehicle_drive`
 
+use truenorth::Error;
 use truenorth::fusion::vehicle::{SeedOdometerCompass, SeedOdometerCompassConfig};
 use truenorth::fusion::{VehicleConfig, VehicleEstimator};
 use truenorth::prelude::*;

@@ -30,22 +30,39 @@
 
 pub mod pipeline;
 
+// Inlined so that `cargo doc -p truenorth` documents every crate's types under the facade.
+#[doc(inline)]
 pub use truenorth_accel as accel;
+#[doc(inline)]
 pub use truenorth_calib as calib;
+#[doc(inline)]
 pub use truenorth_compass as compass;
+#[doc(inline)]
 pub use truenorth_core as core;
+#[doc(inline)]
 pub use truenorth_fusion as fusion;
+#[doc(inline)]
 pub use truenorth_geomag as geomag;
+#[doc(inline)]
 pub use truenorth_gyro as gyro;
+#[doc(inline)]
 pub use truenorth_odometer as odometer;
 
-/// The types and functions most programs need, in one import.
+/// The linear-algebra crate of every vector, matrix and quaternion in the API, so that a user
+/// needs no version of their own to match it.
+pub use nalgebra;
+
+/// The one error type of every crate, and its `Result`.
+pub use truenorth_core::{Error, Result};
+
+/// The types and functions most programs need, in one import. The error type is not in it
+/// (it would hide `std::error::Error`): it is [`crate::Error`].
 pub mod prelude {
     pub use crate::pipeline::{CompassPipeline, NavPipeline, OrientationPipeline, Place};
     pub use truenorth_compass::{CompassCalibration2d, CompassCalibration3d};
     pub use truenorth_core::{
         AbsoluteHeadingSource, AttitudeEstimate, Axes, Calibration, Calibrator, CompassQuality,
-        Declination, Error, HeadingEstimator, ImuSample, Mag2Sample, Mag3Sample, MagneticHeading,
+        Declination, HeadingEstimator, ImuSample, Mag2Sample, Mag3Sample, MagneticHeading,
         NavEstimate, OnlineCalibrator, OrientationEstimator, Persistent, Pushed,
         RelativeHeadingSource, Solution, TrueHeading, VehicleSample, WheelSample, angle_diff,
         deg_to_rad, rad_to_deg, wrap_pi, wrap_two_pi,

@@ -1,6 +1,7 @@
 //! Cross-crate: the simulator's drive → every 2-D compass calibrator → heading on the whole
 //! drive, against the ground truth. The figures the demo prints are held to here.
 
+use truenorth::Error;
 use truenorth::calib::{
     BinnedEllipseCalibrator, EllipseCalibrator, MeritCircleCalibrator, TurnCompassCalibrator,
 };

@@ -2,7 +2,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::wrap_two_pi;
+use crate::{rad_to_deg, wrap_two_pi};
 
 /// Magnetic declination at a place and date: the angle from true north to magnetic north,
 /// positive east, radians.
@@ -28,6 +28,11 @@ impl MagneticHeading {
         self.0
     }
 
+    /// Degrees in [0, 360), for display and files (radians are the library's unit).
+    pub fn deg(self) -> f64 {
+        rad_to_deg(self.0)
+    }
+
     /// True heading = magnetic heading + declination (declination positive east).
     pub fn to_true(self, declination: Declination) -> TrueHeading {
         TrueHeading::new(self.0 + declination.0)
@@ -44,6 +49,11 @@ impl TrueHeading {
     pub fn rad(self) -> f64 {
         self.0
     }
+
+    /// Degrees in [0, 360), for display and files (radians are the library's unit).
+    pub fn deg(self) -> f64 {
+        rad_to_deg(self.0)
+    }
 }
 
 #[cfg(test)]
@@ -58,6 +68,8 @@ mod tests {
             let t = MagneticHeading::new(h).to_true(Declination(d));
             prop_assert!(angle_diff(t.rad(), h + d).abs() < 1e-9);
             prop_assert!((0.0..core::f64::consts::TAU).contains(&t.rad()));
+            prop_assert!((0.0..=360.0).contains(&t.deg()));
+            prop_assert!((t.deg() - t.rad().to_degrees()).abs() < 1e-9);
         }
     }
 }

@@ -24,6 +24,28 @@ pub struct Mag3Sample {
     pub mag: Vector3<f64>,
 }
 
+impl Mag2Sample {
+    /// A reading of `mag_x`, `mag_y` at `t_s` seconds. Nothing is checked here: a calibrator
+    /// checks each reading as it is pushed and refuses a non-finite one with a typed error.
+    pub fn new(t_s: f64, mag_x: f64, mag_y: f64) -> Self {
+        Self {
+            t_s,
+            mag: Vector2::new(mag_x, mag_y),
+        }
+    }
+}
+
+impl Mag3Sample {
+    /// A reading of `mag_x`, `mag_y`, `mag_z` at `t_s` seconds (checked when pushed, as
+    /// [`Mag2Sample::new`]).
+    pub fn new(t_s: f64, mag_x: f64, mag_y: f64, mag_z: f64) -> Self {
+        Self {
+            t_s,
+            mag: Vector3::new(mag_x, mag_y, mag_z),
+        }
+    }
+}
+
 /// A three-axis rate-gyro reading.
 ///
 /// **Sample convention**: the simulator writes the instantaneous angular rate at `t_s`, and
