@@ -4,7 +4,7 @@ use nalgebra::{Matrix2, Matrix3, Vector2, Vector3};
 use serde::{Deserialize, Serialize};
 use truenorth_core::{
     AbsoluteHeading, AbsoluteHeadingSource, Calibration, Error, Mag2Sample, Mag3Sample,
-    MagneticHeading, Result, Tilt, check_finite, check_finite2, check_finite3,
+    MagneticHeading, Result, Tilt, Validate, check_finite, check_finite2, check_finite3,
 };
 
 use crate::{level_field, tilt_compensated_heading};
@@ -24,12 +24,66 @@ pub fn heading_from_horizontal(h: &Vector2<f64>) -> f64 {
 /// `hard_iron` is the centre of the raw locus (the vehicle's permanent magnetisation plus
 /// sensor offsets); `soft_iron` maps the raw ellipse onto a circle whose radius is the
 /// horizontal field in the input unit.
+///
+/// Read from JSON (or any serde format), it is validated as [`Validate`] says, so a damaged
+/// file is an error on load rather than wrong headings later.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "Fields<Vector2<f64>, Matrix2<f64>>")]
 pub struct CompassCalibration2d {
     /// Offset to subtract from raw readings, input unit.
     pub hard_iron: Vector2<f64>,
     /// Matrix that turns the centred ellipse into a circle.
     pub soft_iron: Matrix2<f64>,
+}
+
+/// The serialised fields of a calibration, before validation.
+#[derive(Deserialize)]
+struct Fields<V, M> {
+    hard_iron: V,
+    soft_iron: M,
+}
+
+impl TryFrom<Fields<Vector2<f64>, Matrix2<f64>>> for CompassCalibration2d {
+    type Error = Error;
+
+    fn try_from(f: Fields<Vector2<f64>, Matrix2<f64>>) -> Result<Self> {
+        let c = Self {
+            hard_iron: f.hard_iron,
+            soft_iron: f.soft_iron,
+        };
+        c.validate()?;
+        Ok(c)
+    }
+}
+
+impl TryFrom<Fields<Vector3<f64>, Matrix3<f64>>> for CompassCalibration3d {
+    type Error = Error;
+
+    fn try_from(f: Fields<Vector3<f64>, Matrix3<f64>>) -> Result<Self> {
+        let c = Self {
+            hard_iron: f.hard_iron,
+            soft_iron: f.soft_iron,
+        };
+        c.validate()?;
+        Ok(c)
+    }
+}
+
+impl Validate for CompassCalibration2d {
+    /// A finite hard iron and a finite soft iron with a positive determinant (a singular one
+    /// gives constant headings, a negative one mirrored headings).
+    fn validate(&self) -> Result<()> {
+        check_finite2("hard iron", &self.hard_iron)?;
+        check_soft_iron_det(self.soft_iron.iter(), self.soft_iron.determinant())
+    }
+}
+
+impl Validate for CompassCalibration3d {
+    /// As for [`CompassCalibration2d`].
+    fn validate(&self) -> Result<()> {
+        check_finite3("hard iron", &self.hard_iron)?;
+        check_soft_iron_det(self.soft_iron.iter(), self.soft_iron.determinant())
+    }
 }
 
 impl Default for CompassCalibration2d {
@@ -75,8 +129,7 @@ impl Calibration for CompassCalibration2d {
     /// is singular or reflecting (it would give constant or mirrored headings).
     fn apply(&self, raw: &Vector2<f64>) -> Result<Vector2<f64>> {
         check_finite2("magnetometer reading", raw)?;
-        check_finite2("hard iron", &self.hard_iron)?;
-        check_soft_iron_det(self.soft_iron.iter(), self.soft_iron.determinant())?;
+        self.validate()?;
         Ok(self.correct(raw))
     }
 }
@@ -127,7 +180,10 @@ fn check_soft_iron_det<'a>(entries: impl Iterator<Item = &'a f64>, det: f64) -> 
 /// A three-axis magnetometer calibration: `corrected = soft_iron · (raw − hard_iron)`, with
 /// `soft_iron` symmetric positive definite, mapping the raw ellipsoid onto a sphere whose
 /// radius is the total field in the input unit.
+///
+/// Validated when read, as [`CompassCalibration2d`].
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "Fields<Vector3<f64>, Matrix3<f64>>")]
 pub struct CompassCalibration3d {
     /// Offset to subtract from raw readings, input unit.
     pub hard_iron: Vector3<f64>,
@@ -179,8 +235,7 @@ impl Calibration for CompassCalibration3d {
     /// is singular or reflecting.
     fn apply(&self, raw: &Vector3<f64>) -> Result<Vector3<f64>> {
         check_finite3("magnetometer reading", raw)?;
-        check_finite3("hard iron", &self.hard_iron)?;
-        check_soft_iron_det(self.soft_iron.iter(), self.soft_iron.determinant())?;
+        self.validate()?;
         Ok(self.correct(raw))
     }
 }
@@ -227,5 +282,47 @@ mod typed_heading_tests {
             let truth = mag.to_true(Declination(decl));
             prop_assert!(angle_diff(truth.rad(), heading + decl).abs() < 1e-9);
         }
+    }
+}
+
+#[cfg(test)]
+mod load_tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    proptest! {
+        /// A calibration read back from JSON is the one written, and it is refused on load
+        /// exactly when its soft iron does not keep the orientation (determinant ≤ 0) or a
+        /// number is not finite.
+        #[test]
+        fn json_load_validates(
+            h in prop::array::uniform2(-1e3f64..1e3),
+            m in prop::array::uniform4(-2.0f64..2.0),
+        ) {
+            let c = CompassCalibration2d {
+                hard_iron: Vector2::from(h),
+                soft_iron: Matrix2::new(m[0], m[1], m[2], m[3]),
+            };
+            let json = serde_json::to_string(&c).unwrap();
+            let back = serde_json::from_str::<CompassCalibration2d>(&json);
+            if c.soft_iron.determinant() > 0.0 {
+                prop_assert_eq!(back.unwrap(), c);
+            } else {
+                prop_assert!(back.is_err());
+            }
+        }
+    }
+
+    #[test]
+    fn an_all_zero_soft_iron_is_refused_on_load_with_the_reason() {
+        let json =
+            r#"{"hard_iron":[0.0,0.0,0.0],"soft_iron":[0.0,0.0,0.0,0.0,0.0,0.0,0.0,0.0,0.0]}"#;
+        let e = serde_json::from_str::<CompassCalibration3d>(json).unwrap_err();
+        assert!(e.to_string().contains("singular or reflecting"), "{e}");
+        let ok = serde_json::to_string(&CompassCalibration3d::identity()).unwrap();
+        assert_eq!(
+            serde_json::from_str::<CompassCalibration3d>(&ok).unwrap(),
+            CompassCalibration3d::identity()
+        );
     }
 }
