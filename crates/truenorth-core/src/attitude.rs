@@ -1,7 +1,7 @@
 //! Attitude types shared by the compass (tilt compensation), the accelerometer (static tilt)
 //! and the estimators.
 
-use nalgebra::{UnitQuaternion, Vector3};
+use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 use serde::{Deserialize, Serialize};
 
 /// Pitch and roll of the body relative to the local level (Z-Y-X Euler convention).
@@ -52,6 +52,14 @@ impl EulerZyx {
     }
 }
 
+/// The rotation that turns a body → NED attitude into a body → ENU one:
+/// `q_enu = ned_to_enu() * q_ned`. ENU is (NED y, NED x, −NED z), a half turn about
+/// (1, 1, 0)/√2; its inverse turns ENU attitudes (ROS REP-103, many benchmarks) into NED.
+pub fn ned_to_enu() -> UnitQuaternion<f64> {
+    let h = core::f64::consts::FRAC_1_SQRT_2;
+    UnitQuaternion::from_quaternion(Quaternion::new(0.0, h, h, 0.0))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -76,6 +84,18 @@ mod tests {
             let q = EulerZyx { yaw_rad: yaw, pitch_rad: 0.0, roll_rad: 0.0 }.to_quaternion();
             let fwd = q * Vector3::x();
             prop_assert!(fwd.y > 0.0);
+        }
+
+        #[test]
+        fn ned_to_enu_swaps_north_and_east_and_flips_down(
+            yaw in -3.1f64..3.1, pitch in -1.5f64..1.5, roll in -3.1f64..3.1,
+            v in prop::array::uniform3(-10.0f64..10.0),
+        ) {
+            let q_ned = EulerZyx { yaw_rad: yaw, pitch_rad: pitch, roll_rad: roll }.to_quaternion();
+            let v = Vector3::from(v);
+            let ned = q_ned * v;
+            let enu = (ned_to_enu() * q_ned) * v;
+            prop_assert!((enu - Vector3::new(ned.y, ned.x, -ned.z)).norm() < 1e-9);
         }
     }
 }

@@ -41,7 +41,7 @@ mod units;
 mod validate;
 
 pub use angle::{Unwrapper, angle_diff, unwrap_near, wrap_pi, wrap_two_pi};
-pub use attitude::{EulerZyx, Tilt};
+pub use attitude::{EulerZyx, Tilt, ned_to_enu};
 pub use calibrator::{
     Calibration, Calibrator, CompassQuality, FitQuality, OnlineCalibrator, Progress, Pushed,
     ScalarQuality, Solution,

@@ -3,18 +3,12 @@
 
 use std::path::PathBuf;
 
-use nalgebra::{Quaternion, UnitQuaternion, Vector3};
-use truenorth::core::{AttitudeEstimate, Axes, EulerZyx, ImuSample, rad_to_deg};
+use nalgebra::{UnitQuaternion, Vector3};
+use truenorth::core::{AttitudeEstimate, Axes, EulerZyx, ImuSample, ned_to_enu, rad_to_deg};
 
 use crate::io::{CliError, CliResult, Table, check_distinct, write_csv};
 use crate::plot::{Band, Line, write_timeseries};
 use crate::registry::{Orientation, OrientationMethod, Timing};
-
-/// Body → NED into body → ENU: ENU = (NED y, NED x, −NED z), 180° about (1, 1, 0)/√2.
-pub fn ned_to_enu() -> UnitQuaternion<f64> {
-    let h = std::f64::consts::FRAC_1_SQRT_2;
-    UnitQuaternion::from_quaternion(Quaternion::new(0.0, h, h, 0.0))
-}
 
 /// Reference frame of the output quaternion.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]

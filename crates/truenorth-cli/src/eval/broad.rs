@@ -14,9 +14,9 @@ use serde::Serialize;
 use truenorth::core::ImuSample;
 use truenorth::fusion::AttitudeError;
 
-use crate::commands::orientation::ned_to_enu;
 use crate::io::{CliError, CliResult};
 use crate::registry::{OrientationMethod, Timing};
+use truenorth::core::ned_to_enu;
 
 /// Arguments of `truenorth eval broad`.
 ///
