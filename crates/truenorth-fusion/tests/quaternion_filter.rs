@@ -3,7 +3,7 @@
 
 use nalgebra::Vector3;
 use proptest::prelude::*;
-use truenorth_core::{EulerZyx, ImuSample, OrientationEstimator};
+use truenorth_core::{EulerZyx, ImuSample, OrientationEstimator, Persistent};
 use truenorth_fusion::{QuaternionFilter, QuaternionFilterConfig};
 
 fn field_ned() -> Vector3<f64> {
@@ -89,4 +89,14 @@ fn invalid_configs_are_refused() {
     ] {
         assert!(QuaternionFilter::new(c).is_err());
     }
+}
+
+#[test]
+fn the_default_filter_is_the_default_configuration() {
+    let d = QuaternionFilter::default();
+    let n = QuaternionFilter::new(QuaternionFilterConfig::default()).unwrap();
+    assert_eq!(
+        serde_json::to_string(&d.state()).unwrap(),
+        serde_json::to_string(&n.state()).unwrap()
+    );
 }

@@ -475,6 +475,16 @@ impl QuaternionFilter {
     }
 }
 
+impl Default for QuaternionFilter {
+    /// The filter with [`QuaternionFilterConfig::default`], as the calibrators' `Default`.
+    fn default() -> Self {
+        // The default configuration passes validation (held by the test
+        // `the_default_filter_is_the_default_configuration`), so this cannot fail.
+        Self::new(QuaternionFilterConfig::default())
+            .expect("the default quaternion filter configuration is valid")
+    }
+}
+
 impl OrientationEstimator for QuaternionFilter {
     /// Needs a gyro triad; the accelerometer and magnetometer triads may be absent on any
     /// sample (a slower sensor). A non-finite value, a reading beyond any sensor's range
