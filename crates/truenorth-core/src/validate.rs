@@ -2,6 +2,7 @@
 
 use crate::{Error, Result};
 use nalgebra::{Vector2, Vector3};
+use serde::{Deserialize, Serialize};
 
 /// A configuration that can check itself: every `Config` in truenorth implements it, and
 /// every `new(config)` calls it first, so an invalid parameter is a typed error at
@@ -77,7 +78,8 @@ pub fn check_finite3(what: &'static str, v: &Vector3<f64>) -> Result<()> {
 /// Derives `dt` from successive timestamps and rejects any that do not increase.
 ///
 /// A rejected timestamp leaves the state unchanged, so the caller can skip that sample and go on.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
+/// It is plain data (serde), saved with the estimator that owns it.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
 pub struct TimeStep {
     last_t_s: Option<f64>,
 }
