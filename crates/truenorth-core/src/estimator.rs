@@ -154,6 +154,7 @@ impl Unobserved {
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct NavEstimate {
     /// Timestamp, seconds.
+    #[serde(with = "crate::extended_float::scalar")]
     pub t_s: f64,
     /// Northward displacement from the start, metres.
     pub north_m: f64,
@@ -165,6 +166,7 @@ pub struct NavEstimate {
     /// `status.heading_absolute`, otherwise of the heading change since the start.
     pub heading_sigma_rad: f64,
     /// Covariance of (north, east), m² (infinite while `status.position_known` is false).
+    #[serde(with = "crate::extended_float::matrix2")]
     pub position_cov_m2: Matrix2<f64>,
     /// Speed along the track, m/s.
     pub speed_mps: f64,

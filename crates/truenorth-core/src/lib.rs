@@ -30,6 +30,7 @@ mod attitude;
 mod calibrator;
 mod error;
 mod estimator;
+pub mod extended_float;
 mod heading;
 mod heading_source;
 mod inertial_calibration;

@@ -22,7 +22,9 @@
 use nalgebra::Vector2;
 use truenorth_calib::OnlineEllipseCalibrator;
 use truenorth_compass::CompassCalibration2d;
-use truenorth_core::{Calibrator, Mag2Sample, OnlineCalibrator, Pushed, Result, Solution, wrap_pi};
+use truenorth_core::{
+    Calibrator, Mag2Sample, OnlineCalibrator, Persistent, Pushed, Result, Solution, wrap_pi,
+};
 
 use super::config::CompassGates;
 
@@ -63,8 +65,8 @@ const RESTART_CHECK_PUSHES: u32 = 64;
 const RESTART_COVERAGE: f64 = 0.8;
 
 /// The consistency test of raw readings against the dead-reckoned heading.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
-struct RawConsistency {
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub(super) struct RawConsistency {
     anchor: Option<(Vector2<f64>, f64, f64)>,
     lo: Vector2<f64>,
     hi: Vector2<f64>,
@@ -107,6 +109,21 @@ impl RawConsistency {
     }
 }
 
+/// The state of an [`OnlineEllipseCalibrator`].
+type EllipseState = <OnlineEllipseCalibrator as Persistent>::State;
+
+/// A [`CompassLearner`]'s two calibrators and running values, as plain data
+/// ([`CompassLearner::state`]); opaque beyond serde.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct CompassLearnerState {
+    pub(super) bootstrap: EllipseState,
+    pub(super) clean: EllipseState,
+    pub(super) clean_in_use: bool,
+    pub(super) last_push: Option<(f64, f64)>,
+    pub(super) consistency: RawConsistency,
+    pub(super) bootstrap_pushes: u32,
+}
+
 /// The bootstrap and clean calibrators and the choice between them.
 #[derive(Debug, Clone)]
 pub struct CompassLearner {
@@ -143,6 +160,33 @@ impl CompassLearner {
         self.last_push = None;
         self.consistency = RawConsistency::default();
         self.bootstrap_pushes = 0;
+    }
+
+    /// Both calibrators' states and the decimation and consistency test's running values
+    /// (the gates come with the configuration).
+    pub fn state(&self) -> CompassLearnerState {
+        CompassLearnerState {
+            bootstrap: self.bootstrap.state(),
+            clean: self.clean.state(),
+            clean_in_use: self.clean_in_use,
+            last_push: self.last_push,
+            consistency: self.consistency,
+            bootstrap_pushes: self.bootstrap_pushes,
+        }
+    }
+
+    /// The learner with `gates`, continuing from `state`; a calibrator state that its
+    /// calibrator refuses is refused.
+    pub fn with_state(gates: CompassGates, state: CompassLearnerState) -> Result<Self> {
+        Ok(Self {
+            gates,
+            bootstrap: OnlineEllipseCalibrator::from_state(state.bootstrap)?,
+            clean: OnlineEllipseCalibrator::from_state(state.clean)?,
+            clean_in_use: state.clean_in_use,
+            last_push: state.last_push,
+            consistency: state.consistency,
+            bootstrap_pushes: state.bootstrap_pushes,
+        })
     }
 
     /// Starts learning afresh, for when the calibration in use has been found wanting: the

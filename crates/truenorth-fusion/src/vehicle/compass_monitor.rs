@@ -37,7 +37,7 @@ const MIN_NOISE_RAD: f64 = 0.1 * core::f64::consts::PI / 180.0;
 const RELEASE_SHARE: f64 = 1.0 / 3.0;
 
 /// A calibration in use and what it implies for one reading.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct CompassFix {
     /// Hard and soft iron.
     pub calibration: CompassCalibration2d,
@@ -86,6 +86,22 @@ pub enum Verdict {
     },
 }
 
+/// A [`CompassMonitor`]'s calibration and running gate values, as plain data
+/// ([`CompassMonitor::state`]).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct CompassMonitorState {
+    /// The calibration in use, if any.
+    pub fix: Option<CompassFix>,
+    /// The time of the last reading judged, s.
+    pub last_t_s: Option<f64>,
+    /// The exponential average of the innovations, rad.
+    pub average_rad: f64,
+    /// The averaged innovation marks the compass disturbed.
+    pub disturbed: bool,
+    /// The averaged innovation is within its spread.
+    pub steady: bool,
+}
+
 /// The calibration in use and the gates.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CompassMonitor {
@@ -121,6 +137,29 @@ impl CompassMonitor {
             disturbed: false,
             steady: false,
         };
+    }
+
+    /// The calibration in use and the gates' running values (the gates' settings come
+    /// with the configuration).
+    pub fn state(&self) -> CompassMonitorState {
+        CompassMonitorState {
+            fix: self.fix,
+            last_t_s: self.last_t_s,
+            average_rad: self.average_rad,
+            disturbed: self.disturbed,
+            steady: self.steady,
+        }
+    }
+
+    /// The monitor with `gates`, continuing from `state`.
+    pub fn with_state(gates: CompassGates, state: CompassMonitorState) -> Result<Self> {
+        let mut m = Self::new(gates)?;
+        m.fix = state.fix;
+        m.last_t_s = state.last_t_s;
+        m.average_rad = state.average_rad;
+        m.disturbed = state.disturbed;
+        m.steady = state.steady;
+        Ok(m)
     }
 
     /// Uses `fix` from now on.

@@ -82,7 +82,7 @@ pub(super) struct Coefficients {
 }
 
 impl Coefficients {
-    fn new(c: &VehicleConfig) -> Self {
+    pub(super) fn new(c: &VehicleConfig) -> Self {
         let p = c.priors();
         let q = p.wheel_resolution_m / c.wheels.track_m();
         let mut prior_sigma = [0.0; DIM];
@@ -107,7 +107,7 @@ impl Coefficients {
 }
 
 /// The gyro between readings.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub(super) struct GyroTrack {
     /// The gyro carries the heading (a reading has been seen and the method uses it).
     pub active: bool,
@@ -130,7 +130,7 @@ pub(super) struct GyroTrack {
 }
 
 /// How the vehicle moves, from the wheels.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub(super) struct Motion {
     /// Time the wheels have stood still, s.
     pub still_s: f64,
@@ -143,7 +143,7 @@ pub(super) struct Motion {
 }
 
 /// Rest and the bias average.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub(super) struct Rest {
     pub sum_raw: f64,
     pub n: u32,
@@ -151,7 +151,7 @@ pub(super) struct Rest {
 }
 
 /// How long the compass has been rejected, and how far the vehicle turned meanwhile.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub(super) struct Outage {
     pub rejected_s: f64,
     pub turned_rad: f64,
@@ -164,7 +164,7 @@ pub(super) struct Outage {
 }
 
 /// Compass readings taken since the last heading correction, averaged into one.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub(super) struct CompassWindow {
     pub n: u32,
     pub sum_nu: f64,
@@ -193,7 +193,7 @@ impl Default for CompassWindow {
 }
 
 /// Alignment: the first run of consistent compass readings.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub(super) struct Alignment {
     pub done: bool,
     /// The heading, though referred to north, is too uncertain for a linear correction:

@@ -14,7 +14,7 @@ const SERIES_STEP_RAD: f64 = 0.2;
 const RESYNC_EVERY: u32 = 64;
 
 /// `(sin, cos)` of an angle, carried along as the angle moves.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct HeadingTrig {
     angle: f64,
     sin: f64,

@@ -26,7 +26,7 @@ pub struct LineFit {
 
 /// Running sums of the fit, relative to the first reading so that they stay well
 /// conditioned and the innovations unwrapped.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct InnovationLine {
     first: Option<(f64, f64)>,
     n: u32,

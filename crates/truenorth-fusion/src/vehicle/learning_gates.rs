@@ -46,7 +46,7 @@ const NIS_DISTRUST: f64 = 3.0;
 const MAX_SLIP_SCALE2: f64 = 400.0;
 
 /// What a measurement interval held.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Interval {
     /// Gyro turning in clear turns, right and left, rad.
     pub clear_turn_rad: [f64; 2],
@@ -76,7 +76,7 @@ impl Interval {
 }
 
 /// The intervals of both kinds of measurement, and the wheels' adaptive trust.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct LearningGates {
     /// Since the last comparison of wheels and gyro.
     pub wheel_check: Interval,
@@ -188,7 +188,7 @@ const TIME_BASE_STEPS: u32 = 20;
 
 /// The evidence on the time base: how far the gyro turns against the wheels, and how many
 /// steps are gaps.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 struct TimeBase {
     gyro_rad: f64,
     wheels_rad: f64,

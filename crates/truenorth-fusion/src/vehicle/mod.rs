@@ -48,12 +48,13 @@ mod observability;
 mod seed_blend;
 mod seed_gyro_compass;
 mod seed_odometer_compass;
+mod state;
 mod step_batch;
 mod two_pass;
 mod wheel_odometry;
 
-pub use compass_learning::{CompassLearner, Judged};
-pub use compass_monitor::{CompassFix, CompassMonitor, Verdict};
+pub use compass_learning::{CompassLearner, CompassLearnerState, Judged};
+pub use compass_monitor::{CompassFix, CompassMonitor, CompassMonitorState, Verdict};
 pub use config::{CompassGates, SensorPriors, VehicleConfig};
 pub use estimator::VehicleEstimator;
 pub use learned::{Learned, LearnedCompass, VehicleCalibration};
@@ -62,7 +63,8 @@ pub use nav_filter::NavFilter;
 pub use seed_blend::{SeedBlend, SeedBlendConfig};
 pub use seed_gyro_compass::{SeedGyroCompass, SeedGyroCompassConfig};
 pub use seed_odometer_compass::{SeedOdometerCompass, SeedOdometerCompassConfig};
+pub use state::{VehicleEstimatorState, VehicleTracking};
 pub use two_pass::{TwoPassConfig, TwoPassStart};
 pub use wheel_odometry::{
-    MAX_WHEEL_SPEED_MPS, TrackModel, WheelCalibration, WheelOdometry, WheelStep,
+    MAX_WHEEL_SPEED_MPS, TrackModel, WheelCalibration, WheelOdometry, WheelOdometryState, WheelStep,
 };

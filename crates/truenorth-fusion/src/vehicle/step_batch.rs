@@ -66,7 +66,7 @@ impl Default for Step {
 }
 
 /// The composition of the steps since the last [`StepBatch::apply`].
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct StepBatch {
     steps: u32,
     /// `A`: the heading's accumulated couplings, by state.

@@ -99,6 +99,15 @@ pub struct WheelCalibration {
     pub track_scale: f64,
 }
 
+/// What a [`WheelOdometry`] has seen, as plain data ([`WheelOdometry::state`]).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct WheelOdometryState {
+    /// The last reading and its time, s.
+    pub last: Option<(f64, WheelReading)>,
+    /// The steered wheels' averaged curvature, 1/m (0 for wheels that are not steered).
+    pub curvature_per_m: f64,
+}
+
 /// Cumulative wheel distances → [`WheelStep`]s.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct WheelOdometry {
@@ -148,6 +157,36 @@ impl WheelOdometry {
         if let Some(s) = &mut self.steered {
             s.curvature_per_m = 0.0;
         }
+    }
+
+    /// What the odometry has seen: the last reading and the steered wheels' averaged
+    /// curvature (the track table is rebuilt from the wheels' description).
+    pub fn state(&self) -> WheelOdometryState {
+        WheelOdometryState {
+            last: self.last,
+            curvature_per_m: self.steered.map_or(0.0, |s| s.curvature_per_m),
+        }
+    }
+
+    /// The odometry for `wheels` under `model`, continuing from `state`. A curvature on
+    /// wheels that are not steered is refused: this odometry could not have written it.
+    pub fn with_state(
+        wheels: OdometerWheels,
+        model: TrackModel,
+        state: WheelOdometryState,
+    ) -> Result<Self> {
+        let mut w = Self::new(wheels, model)?;
+        match &mut w.steered {
+            Some(s) => s.curvature_per_m = state.curvature_per_m,
+            None if state.curvature_per_m != 0.0 => {
+                return Err(Error::InvalidSnapshot {
+                    reason: "a curvature saved for wheels that are not steered",
+                });
+            }
+            None => {}
+        }
+        w.last = state.last;
+        Ok(w)
     }
 
     /// The time of the last reading taken, if any.
