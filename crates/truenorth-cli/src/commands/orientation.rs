@@ -6,7 +6,10 @@ use std::path::PathBuf;
 use nalgebra::{UnitQuaternion, Vector3};
 use truenorth::core::{AttitudeEstimate, Axes, EulerZyx, ImuSample, ned_to_enu, rad_to_deg};
 
-use crate::io::{CliError, CliResult, Table, check_distinct, write_csv};
+use crate::io::{
+    AccUnit, CliError, CliResult, GyroUnit, InputOptions, InputPath, ReadSpec, Table,
+    check_distinct, write_csv,
+};
 use crate::plot::{Band, Line, write_timeseries};
 use crate::registry::{Orientation, OrientationMethod, Timing};
 
@@ -51,7 +54,7 @@ pub struct Args {
     /// Orientation method.
     #[arg(long, value_enum, default_value = "quaternion")]
     pub method: OrientationMethod,
-    /// Input CSV.
+    /// Input CSV (`-`: standard input; `.gz` or gzip data read as such).
     #[arg(long)]
     pub input: PathBuf,
     /// Output CSV.
@@ -73,6 +76,15 @@ pub struct Args {
     /// Also draw yaw, pitch and roll over time, disturbed samples shaded, to this SVG.
     #[arg(long)]
     pub plot: Option<PathBuf>,
+    /// Unit of the gyro columns, e.g. `--gyro-unit deg/s`.
+    #[arg(long, value_enum, value_name = "UNIT", default_value = "rad/s")]
+    pub gyro_unit: GyroUnit,
+    /// Unit of the accelerometer columns, e.g. `--acc-unit g`.
+    #[arg(long, value_enum, value_name = "UNIT", default_value = "m/s2")]
+    pub acc_unit: AccUnit,
+    /// How to read the file (delimiter, header, column names, axes).
+    #[command(flatten)]
+    pub input_options: InputOptions,
 }
 
 const HEADER: [&str; 8] = [
@@ -133,11 +145,10 @@ pub fn run(args: &Args) -> CliResult {
 /// The recording as IMU samples; a row whose three magnetometer cells are empty has no
 /// magnetometer reading, and with `--no-mag` none has.
 fn read_samples(args: &Args) -> CliResult<Vec<ImuSample>> {
-    let table = Table::read(
-        &args.input,
-        &["t_s", "gyr_x", "gyr_y", "gyr_z", "acc_x", "acc_y", "acc_z"],
-        &["mag_x", "mag_y", "mag_z"],
-    )?;
+    let spec = ReadSpec::new(&["t_s", "gyr_x", "gyr_y", "gyr_z", "acc_x", "acc_y", "acc_z"])
+        .optional(&["mag_x", "mag_y", "mag_z"]);
+    let table = Table::read_with(&InputPath::new(&args.input), &args.input_options, &spec)?;
+    let (to_rps, to_mps2) = (args.gyro_unit.to_rad_per_s(), args.acc_unit.to_mps2());
     table.require_rows()?;
     table.check_increasing_time()?;
     let col = |n: &str| table.req(n);
@@ -150,8 +161,8 @@ fn read_samples(args: &Args) -> CliResult<Vec<ImuSample>> {
     Ok((0..table.len())
         .map(|k| ImuSample {
             t_s: t[k],
-            gyr_rps: Axes::xyz(Vector3::new(gx[k], gy[k], gz[k])),
-            acc_mps2: Axes::xyz(Vector3::new(ax[k], ay[k], az[k])),
+            gyr_rps: Axes::xyz(Vector3::new(gx[k], gy[k], gz[k]) * to_rps),
+            acc_mps2: Axes::xyz(Vector3::new(ax[k], ay[k], az[k]) * to_mps2),
             mag: match mag {
                 Some((x, y, z)) if x[k].is_nan() && y[k].is_nan() && z[k].is_nan() => Axes::NONE,
                 Some((x, y, z)) => Axes::xyz(Vector3::new(x[k], y[k], z[k])),

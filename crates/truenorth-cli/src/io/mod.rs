@@ -22,6 +22,7 @@ mod atomic_write;
 mod calibration_file;
 mod columns;
 mod error;
+mod inertial_units;
 mod reader;
 mod source;
 mod table;
@@ -35,6 +36,7 @@ pub use calibration_file::{
 };
 pub use columns::InputOptions;
 pub use error::{CliError, CliResult};
+pub use inertial_units::{AccUnit, GyroUnit};
 pub use reader::{ReadSpec, Row, RowReader};
 pub use source::InputPath;
 pub use table::Table;

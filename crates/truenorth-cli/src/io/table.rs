@@ -2,7 +2,7 @@
 //! memory, for commands that need all the readings at once (a batch calibration).
 
 use std::collections::HashMap;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use super::columns::InputOptions;
 use super::reader::{ReadSpec, RowReader};
@@ -20,16 +20,10 @@ pub struct Table {
 }
 
 impl Table {
-    /// Reads `path` (`-` for standard input, gzip or not) with the default input options,
-    /// keeping the `required` columns (error if missing) and any `optional` ones present.
-    /// Every kept cell must parse as a number; an empty optional cell is NaN.
-    pub fn read(path: &Path, required: &[&str], optional: &[&str]) -> CliResult<Self> {
-        let spec = ReadSpec::new(required).optional(optional);
-        Self::read_with(&InputPath::new(path), &InputOptions::default(), &spec)
-    }
-
     /// Reads every row of `input` under `opts` (delimiter, column mapping, axis convention)
-    /// and `spec` (see [`RowReader::open`]).
+    /// and `spec` (see [`RowReader::open`]): the required columns (error if missing) and any
+    /// optional ones present. Every kept cell must parse as a number; an empty optional cell
+    /// is NaN.
     pub fn read_with(
         input: &InputPath,
         opts: &InputOptions,
@@ -116,7 +110,13 @@ mod tests {
     use super::*;
     use crate::io::write_csv;
     use proptest::prelude::*;
-    use std::path::PathBuf;
+    use std::path::Path;
+
+    /// The table under the default input options.
+    fn read(path: &Path, required: &[&str], optional: &[&str]) -> CliResult<Table> {
+        let spec = ReadSpec::new(required).optional(optional);
+        Table::read_with(&InputPath::new(path), &InputOptions::default(), &spec)
+    }
 
     fn temp_file(tag: &str, contents: &[u8]) -> PathBuf {
         let path = std::env::temp_dir().join(format!(
@@ -137,7 +137,7 @@ mod tests {
         fn write_then_read_round_trips(rows in proptest::collection::vec((-1e12f64..1e12, -1e6f64..1e6), 1..50)) {
             let path = temp_file("rt", b"");
             write_csv(&path, &["t_s", "mag_x"], rows.iter().map(|&(a, b)| vec![a, b])).unwrap();
-            let t = Table::read(&path, &["t_s", "mag_x"], &["mag_z"]).unwrap();
+            let t = read(&path, &["t_s", "mag_x"], &["mag_z"]).unwrap();
             prop_assert_eq!(t.len(), rows.len());
             prop_assert!(t.col("mag_z").is_none());
             for (k, &(a, b)) in rows.iter().enumerate() {
@@ -151,7 +151,7 @@ mod tests {
         #[test]
         fn any_file_reads_or_fails_with_one_line(bytes in proptest::collection::vec(any::<u8>(), 0..400)) {
             let path = temp_file("any", &bytes);
-            match Table::read(&path, &["t_s"], &["mag_x"]) {
+            match read(&path, &["t_s"], &["mag_x"]) {
                 Ok(t) => prop_assert!(t.req("t_s").unwrap().iter().all(|v| v.is_finite())),
                 Err(e) => {
                     let line = e.to_string();
