@@ -100,12 +100,79 @@ fn a_logged_recording_with_its_units_and_axes_declared_gives_the_contract_run() 
     // to far below the filter's own error (about a degree), not bit for bit.
     let same = largest_difference_deg(&attitudes(&out_plain), &attitudes(&out_logged));
     assert!(same < 1e-6, "declared units: attitudes differ by {same}°");
-    // Without the units the same file is read as rad/s and m/s² and the attitudes are
-    // wrong: the conversion is what makes them agree.
-    orientation(&logged, &out_unconverted, &mapping);
+    // Without the units the file is refused (the unit check), and forced through it is read
+    // as rad/s and m/s² with attitudes far off: the conversion is what makes them agree.
+    let (ok, err) = orientation_result(&logged, &mapping);
+    assert!(!ok && err.contains("--acc-unit g"), "{err}");
+    orientation(
+        &logged,
+        &out_unconverted,
+        &[&mapping[..], &["--accept-units"][..]].concat(),
+    );
     let wrong = largest_difference_deg(&attitudes(&out_plain), &attitudes(&out_unconverted));
     assert!(
         wrong > 10.0,
         "undeclared units moved the attitudes by only {wrong}°"
     );
+}
+
+/// Runs `orientation` and returns (success, stderr).
+fn orientation_result(input: &Path, extra: &[&str]) -> (bool, String) {
+    let o = Command::new(env!("CARGO_BIN_EXE_truenorth"))
+        .args(["orientation", "--input"])
+        .arg(input)
+        .arg("--output")
+        .arg(scratch("checked.out.csv"))
+        .args(extra)
+        .output()
+        .unwrap();
+    (
+        o.status.success(),
+        String::from_utf8_lossy(&o.stderr).into_owned(),
+    )
+}
+
+/// x-io's example recording as it is published (deg/s, g, µT; x forward, y left, z up; its
+/// own column names): read with its units declared it runs; with either unit left out it is
+/// refused, the message naming the unit the data are in.
+#[test]
+fn the_xio_recording_runs_as_published_and_its_units_are_checked() {
+    let Some(dir) = truenorth_sim::shared_data::folder("xio_fusion").unwrap() else {
+        return;
+    };
+    let input = dir.join("sensor_data.csv");
+    let columns = "t_s=Time (s),gyr_x=Gyroscope X (deg/s),gyr_y=Gyroscope Y (deg/s),gyr_z=Gyroscope Z (deg/s),acc_x=Accelerometer X (g),acc_y=Accelerometer Y (g),acc_z=Accelerometer Z (g),mag_x=Magnetometer X (uT),mag_y=Magnetometer Y (uT),mag_z=Magnetometer Z (uT)";
+    let base = ["--column", columns, "--axes", "flu"];
+    let units = ["--gyro-unit", "deg/s", "--acc-unit", "g"];
+    let (ok, err) = orientation_result(&input, &[&base[..], &units[..]].concat());
+    assert!(ok, "{err}");
+    let (ok, err) = orientation_result(&input, &[&base[..], &units[2..]].concat());
+    assert!(!ok && err.contains("--gyro-unit deg/s"), "{err}");
+    let (ok, err) = orientation_result(&input, &[&base[..], &units[..2]].concat());
+    assert!(!ok && err.contains("--acc-unit g"), "{err}");
+    let (ok, err) = orientation_result(
+        &input,
+        &[&base[..], &units[..2], &["--accept-units"][..]].concat(),
+    );
+    assert!(ok && err.contains("warning"), "{err}");
+}
+
+/// Every BROAD trial, in the contract's units, is accepted: the check refuses no good
+/// recording (slow and fast motion, vibration, tapping, magnets).
+#[test]
+fn no_broad_trial_is_refused_for_its_units() {
+    let Some(dir) = truenorth_sim::shared_data::folder("broad").unwrap() else {
+        return;
+    };
+    let mut trials: Vec<PathBuf> = std::fs::read_dir(dir.join("trials"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.to_string_lossy().ends_with(".csv.gz"))
+        .collect();
+    trials.sort();
+    assert_eq!(trials.len(), 20);
+    for t in &trials {
+        let (ok, err) = orientation_result(t, &[]);
+        assert!(ok, "{}: {err}", t.display());
+    }
 }

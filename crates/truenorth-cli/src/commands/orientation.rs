@@ -8,7 +8,7 @@ use truenorth::core::{AttitudeEstimate, Axes, EulerZyx, ImuSample, ned_to_enu, r
 
 use crate::io::{
     AccUnit, CliError, CliResult, GyroUnit, InputOptions, InputPath, ReadSpec, Table,
-    check_distinct, write_csv,
+    check_distinct, check_inertial_units, write_csv,
 };
 use crate::plot::{Band, Line, write_timeseries};
 use crate::registry::{Orientation, OrientationMethod, Timing};
@@ -82,6 +82,10 @@ pub struct Args {
     /// Unit of the accelerometer columns, e.g. `--acc-unit g`.
     #[arg(long, value_enum, value_name = "UNIT", default_value = "m/s2")]
     pub acc_unit: AccUnit,
+    /// Go on (with a warning on stderr) when the data contradict the declared units, instead
+    /// of refusing.
+    #[arg(long)]
+    pub accept_units: bool,
     /// How to read the file (delimiter, header, column names, axes).
     #[command(flatten)]
     pub input_options: InputOptions,
@@ -120,6 +124,7 @@ pub fn run(args: &Args) -> CliResult {
         check_distinct(p, &[&args.input, &args.output])?;
     }
     let samples = read_samples(args)?;
+    check_units(args, &samples)?;
     let mut method = args
         .method
         .pipeline(!args.no_mag, args.gyro_timing)
@@ -138,6 +143,22 @@ pub fn run(args: &Args) -> CliResult {
     write_csv(&args.output, &header, out.rows)?;
     if !out.gaps.is_empty() {
         eprintln!("{}", gap_summary(&args.input, &out.gaps));
+    }
+    Ok(())
+}
+
+/// Refuses a recording whose accelerometer or gyro contradicts its declared unit (or, with
+/// `--accept-units`, says so on stderr and goes on).
+fn check_units(args: &Args, samples: &[ImuSample]) -> CliResult {
+    for finding in check_inertial_units(samples, args.gyro_unit, args.acc_unit) {
+        if args.accept_units {
+            eprintln!("warning: {}: {finding}", args.input.display());
+        } else {
+            return Err(CliError::file(
+                &args.input,
+                format!("{finding} (or --accept-units to go on)"),
+            ));
+        }
     }
     Ok(())
 }

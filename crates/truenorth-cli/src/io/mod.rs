@@ -26,6 +26,7 @@ mod inertial_units;
 mod reader;
 mod source;
 mod table;
+mod unit_check;
 mod vehicle_file;
 mod wheel_columns;
 
@@ -40,5 +41,6 @@ pub use inertial_units::{AccUnit, GyroUnit};
 pub use reader::{ReadSpec, Row, RowReader};
 pub use source::InputPath;
 pub use table::Table;
+pub use unit_check::check_inertial_units;
 pub use vehicle_file::VehicleFile;
 pub use wheel_columns::WheelColumns;
