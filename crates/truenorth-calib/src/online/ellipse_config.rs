@@ -3,7 +3,7 @@
 use serde::{Deserialize, Serialize};
 use truenorth_core::{Result, Validate, check_positive, check_range};
 
-use crate::fits::ellipse::MIN_POINTS_2D;
+use crate::fits::ellipse::config::MIN_POINTS_2D;
 use crate::online::conic::OnlineConfig;
 use crate::quality::MIN_ARC_DEG;
 

@@ -13,10 +13,11 @@ use nalgebra::{Matrix2, Matrix3, SMatrix, SVector, Vector2, Vector3};
 use truenorth_compass::CompassCalibration2d;
 use truenorth_core::{Error, FitQuality, Mag2Sample, Result, Solution};
 
-use crate::fits::ellipse::{
-    Ellipse, conic_to_ellipse, denormalise, from_params, sampson_normal_equations, solve_direct,
-    to_params,
+use crate::fits::ellipse::direct::{
+    Ellipse, conic_to_ellipse, denormalise, from_params, solve_direct, to_params,
 };
+
+use crate::fits::ellipse::fit::sampson_normal_equations;
 use crate::fits::lm::LmSteps;
 use crate::fits::normalise::Normaliser;
 use crate::numerics::linalg::{condition_from_eigenvalues, sym_eigen2, sym_eigen5, sym_sqrt2};

@@ -3,7 +3,7 @@
 use serde::{Deserialize, Serialize};
 use truenorth_core::{Result, Validate, check_positive, check_range};
 
-use crate::fits::ellipsoid::MIN_POINTS_3D;
+use crate::fits::ellipsoid::config::MIN_POINTS_3D;
 use crate::online::conic::OnlineConfig;
 use crate::quality::{self, MIN_SPHERE_COVERAGE};
 

@@ -12,9 +12,11 @@ use nalgebra::{Matrix3, Matrix4, SMatrix, SVector, Vector3, Vector6};
 use truenorth_compass::CompassCalibration3d;
 use truenorth_core::{Error, FitQuality, Mag3Sample, Result, Solution};
 
-use crate::fits::ellipsoid::{
-    Ellipsoid, ORIENTATION_HINT, li_griffiths_constraint, quadratic_part, quadric_to_ellipsoid,
+use crate::fits::ellipsoid::direct::{
+    Ellipsoid, li_griffiths_constraint, quadratic_part, quadric_to_ellipsoid,
 };
+
+use crate::fits::ellipsoid::config::ORIENTATION_HINT;
 use crate::numerics::linalg::{
     condition_from_eigenvalues, constrained_min6, sym_eigen3, sym_eigen6,
 };

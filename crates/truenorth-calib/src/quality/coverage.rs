@@ -42,7 +42,7 @@ pub const MIN_ARC_DEG: f64 = 200.0;
 /// The share of the direction cells on the sphere ([`SPHERE_CELLS`]) below which the online
 /// ellipsoid calibrator explains a failed fit as too little of the sphere seen (no
 /// calibrator refuses a successful fit on it: whether the orientations determine a 3-D
-/// calibration is judged by their dilution, see [`require_determined`]).
+/// calibration is judged by their dilution, see [`require_determined`](super::require_determined)).
 ///
 /// One turn about a single axis traces a great circle, which passes through about 20–25 %
 /// of the cells and does not determine an ellipsoid; turns about two or more axes reach

@@ -1,6 +1,12 @@
 //! Tests of the least-squares ellipse fit.
 
-use super::*;
+use nalgebra::{Matrix2, SMatrix, SVector, Vector2};
+use truenorth_core::Error;
+
+use super::config::*;
+use super::direct::*;
+use super::fit::*;
+use crate::fits::normalise::Normaliser;
 
 fn ellipse_points(n: usize, span_deg: f64) -> Vec<Vector2<f64>> {
     let c = Vector2::new(3.0, -2.0);

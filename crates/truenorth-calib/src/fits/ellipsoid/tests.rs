@@ -1,6 +1,15 @@
 //! Tests of the least-squares ellipsoid fit.
 
-use super::*;
+use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
+use truenorth_core::Error;
+
+use super::config::*;
+use super::fit::*;
+use crate::fits::ellipsoid::direct::PAIRS;
+use crate::fits::ellipsoid::direct::from_params;
+use crate::fits::ellipsoid::direct::moments;
+use crate::fits::ellipsoid::fit::radial_normal_equations;
+use crate::fits::normalise::Normaliser;
 
 fn sphere_points(n: usize) -> Vec<Vector3<f64>> {
     let golden = core::f64::consts::PI * (3.0 - 5.0_f64.sqrt());

@@ -48,7 +48,9 @@ use truenorth_core::{
     Calibrator, Error, Progress, Pushed, Result, Solution, Validate, check_finite, check_finite3,
 };
 
-use crate::fits::ellipsoid::{EllipsoidConfig, fit_ellipsoid};
+use crate::fits::ellipsoid::config::EllipsoidConfig;
+
+use crate::fits::ellipsoid::fit::fit_ellipsoid;
 use crate::fits::lm;
 use crate::fits::mag_accel::calibration::{MagAccelCalibration, MagAccelSample};
 use crate::fits::mag_accel::config::{

@@ -1,6 +1,6 @@
 //! The configuration of the joint magnetometer + accelerometer calibration and its validation.
 
-use crate::fits::ellipsoid::EllipsoidConfig;
+use crate::fits::ellipsoid::config::EllipsoidConfig;
 use serde::{Deserialize, Serialize};
 use truenorth_core::{Result, Validate, check_positive, check_range};
 

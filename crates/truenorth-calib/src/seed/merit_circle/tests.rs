@@ -1,6 +1,13 @@
 //! Tests of [`super`]: the merit circle calibrator.
 
-use super::*;
+use nalgebra::Vector2;
+use truenorth_compass::CompassCalibration2d;
+use truenorth_core::{Calibrator, Error, Mag2Sample, OnlineCalibrator, Pushed, Result, Solution};
+
+use crate::seed::seed_quality::SeedJob;
+
+use super::calibrator::*;
+use super::config::*;
 use truenorth_core::{NoiseSource, SplitMix64};
 
 fn feed(c: &mut MeritCircleCalibrator, pts: impl Iterator<Item = Vector2<f64>>) {
