@@ -6,17 +6,10 @@
 //! `Σ rᵢ²` together with the normal equations `JᵀJ` and `Jᵀr` — one pass over the data per
 //! trial point, so an accepted step needs no second pass.
 
-// `!(x <= limit)` and `!(x > 0.0)` are deliberate: they are true for NaN, so a NaN fails
-// every check instead of slipping through one.
-#![allow(clippy::neg_cmp_op_on_partial_ord)]
-
 use nalgebra::{SMatrix, SVector};
 use truenorth_core::{Error, Result};
 
 use crate::numerics::blocks::{BLOCK, dot_block};
-
-#[allow(unused_imports)]
-use truenorth_core::Float as _;
 
 /// Cost and normal equations at one parameter vector.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -11,12 +11,12 @@
 
 // `!(x <= limit)` and `!(x > 0.0)` are deliberate: they are true for NaN, so a NaN fails
 // every check instead of slipping through one.
-#![allow(clippy::neg_cmp_op_on_partial_ord)]
+#![expect(clippy::neg_cmp_op_on_partial_ord)]
 
 use nalgebra::SVector;
 use truenorth_core::{Error, Result, check_finite};
 
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 
 /// `q = (p − centre) / scale`, with the centroid as centre and the RMS distance as scale.

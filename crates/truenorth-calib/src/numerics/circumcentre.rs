@@ -2,7 +2,7 @@
 
 use nalgebra::Vector2;
 
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 
 /// Squared amplification of an equilateral triangle inscribed in its circle (the best

@@ -8,7 +8,7 @@ use core::f64::consts::TAU;
 use nalgebra::Vector2;
 use truenorth_core::wrap_two_pi;
 
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 
 /// Number of direction slots (5° each).

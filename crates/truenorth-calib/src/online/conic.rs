@@ -8,7 +8,7 @@
 
 // `!(x <= limit)` and `!(x > 0.0)` are deliberate: they are true for NaN, so a NaN fails
 // every check instead of slipping through one.
-#![allow(clippy::neg_cmp_op_on_partial_ord)]
+#![expect(clippy::neg_cmp_op_on_partial_ord)]
 
 use core::fmt::Debug;
 
@@ -24,7 +24,7 @@ use crate::online::conic_sums::{
 };
 use crate::quality::{self, BOUND_SIGMAS};
 
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 
 /// The parameters of an online calibrator's configuration that its bookkeeping needs.

@@ -22,7 +22,7 @@
 
 // `!(x <= limit)` and `!(x > 0.0)` are deliberate: they are true for NaN, so a NaN fails
 // every check instead of slipping through one.
-#![allow(clippy::neg_cmp_op_on_partial_ord)]
+#![expect(clippy::neg_cmp_op_on_partial_ord)]
 
 extern crate alloc;
 
@@ -35,7 +35,7 @@ use truenorth_core::{Error, Result};
 pub(crate) use crate::online::retained::Retained;
 pub use crate::online::retained::RetainedSnapshot;
 
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 
 /// A term of a design vector: a constant factor times the monomial with these exponents.

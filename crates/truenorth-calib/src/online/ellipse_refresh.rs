@@ -5,7 +5,7 @@
 
 // `!(x <= limit)` and `!(x > 0.0)` are deliberate: they are true for NaN, so a NaN fails
 // every check instead of slipping through one.
-#![allow(clippy::neg_cmp_op_on_partial_ord)]
+#![expect(clippy::neg_cmp_op_on_partial_ord)]
 
 use core::f64::consts::TAU;
 
@@ -29,7 +29,7 @@ use crate::online::conic::{
 };
 use crate::online::ellipse_config::OnlineEllipseConfig;
 
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 
 /// Headings over which the heading-error bound takes its worst (5° apart, as the batch

@@ -4,10 +4,6 @@
 //! information matrix, its condition by a Jacobi solver a few sweeps at a time, the
 //! heading-error bound in chunks, and the refusals.
 
-// `!(x <= limit)` and `!(x > 0.0)` are deliberate: they are true for NaN, so a NaN fails
-// every check instead of slipping through one.
-#![allow(clippy::neg_cmp_op_on_partial_ord)]
-
 use nalgebra::{Matrix3, Matrix4, SMatrix, SVector, Vector3, Vector6};
 use truenorth_compass::CompassCalibration3d;
 use truenorth_core::{Error, FitQuality, Mag3Sample, Result, Solution};
@@ -30,7 +26,7 @@ use crate::online::conic::{
 };
 use crate::online::ellipsoid_config::OnlineEllipsoidConfig;
 
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 
 /// Parameters of the direction-error model (centre 3, symmetric soft iron 6).

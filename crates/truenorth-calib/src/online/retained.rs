@@ -1,18 +1,11 @@
 //! The readings an online least-squares calibrator retains for measuring coverage (at most
 //! one per direction slot), and their serialisable form.
 
-// `!(x <= limit)` and `!(x > 0.0)` are deliberate: they are true for NaN, so a NaN fails
-// every check instead of slipping through one.
-#![allow(clippy::neg_cmp_op_on_partial_ord)]
-
 use alloc::vec::Vec;
 
 use nalgebra::SVector;
 use serde::{Deserialize, Serialize};
 use truenorth_core::{Error, Result};
-
-#[allow(unused_imports)]
-use truenorth_core::Float as _;
 
 /// Readings kept for coverage: at most one per direction slot, so that how much of the
 /// circle (sphere) the data cover can be measured about any centre without storing every

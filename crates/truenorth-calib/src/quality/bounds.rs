@@ -49,7 +49,7 @@ use core::f64::consts::TAU;
 
 use nalgebra::{SMatrix, SVector, Vector3};
 
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 
 /// How many standard deviations the heading-error bound spans.

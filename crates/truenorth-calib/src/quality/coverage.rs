@@ -2,10 +2,6 @@
 //! the sphere (3-D: equal-area direction cells) the readings fill, seen from a centre, and
 //! the centre-free turning of the raw locus.
 
-// `!(x <= limit)` and `!(x > 0.0)` are deliberate: they are true for NaN, so a NaN fails
-// every check instead of slipping through one.
-#![allow(clippy::neg_cmp_op_on_partial_ord)]
-
 use core::f64::consts::TAU;
 
 use nalgebra::{Vector2, Vector3};
@@ -15,7 +11,7 @@ use truenorth_core::{Error, Result, angle_diff};
 use super::support::{GAP_BINS, Support2d};
 use crate::numerics::blocks::{BLOCK, blocks};
 
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 
 /// Number of heading bins used for coverage (10° each).

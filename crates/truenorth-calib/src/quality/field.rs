@@ -5,9 +5,6 @@ use nalgebra::{Vector2, Vector3};
 use truenorth_compass::{CompassCalibration2d, CompassCalibration3d};
 use truenorth_core::CompassQuality;
 
-#[allow(unused_imports)]
-use truenorth_core::Float as _;
-
 /// Sets [`CompassQuality::field_ratio_to_expected`]: the fitted field over `expected_field` (e.g.
 /// from the World Magnetic Model, in the input unit). Leaves it `None` when no positive
 /// finite expectation is given.

@@ -1,10 +1,6 @@
 //! Report assembly: the 2-D and 3-D [`CompassQuality`] of a calibration, from one pass
 //! over the readings or (2-D) from the monomial sums of the fit.
 
-// `!(x <= limit)` and `!(x > 0.0)` are deliberate: they are true for NaN, so a NaN fails
-// every check instead of slipping through one.
-#![allow(clippy::neg_cmp_op_on_partial_ord)]
-
 use nalgebra::Vector2;
 use nalgebra::Vector3;
 use truenorth_compass::{CompassCalibration2d, CompassCalibration3d};
@@ -21,7 +17,7 @@ use crate::numerics::blocks::{BLOCK, blocks, dot_block, sum_block};
 use crate::numerics::linalg::{condition_from_eigenvalues, sym_eigen5, sym_eigen9};
 use crate::quality::SPHERE_CELLS;
 
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 
 /// What the one pass over the readings of [`assess_2d`] leaves for the report: the sums of

@@ -30,7 +30,7 @@ use super::bounds::{MONOMIALS_2D, MONOMIALS_3D, information_2d, information_3d};
 /// Number of fine bins (0.5° each) used to measure the largest empty arc.
 pub(crate) const GAP_BINS: usize = 720;
 
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 
 /// Fine bins in a quarter turn.

@@ -23,7 +23,7 @@
 
 // `!(x <= limit)` and `!(x > 0.0)` are deliberate: they are true for NaN, so a NaN fails
 // every check instead of slipping through one.
-#![allow(clippy::neg_cmp_op_on_partial_ord)]
+#![expect(clippy::neg_cmp_op_on_partial_ord)]
 
 use core::fmt;
 

@@ -1,4 +1,4 @@
-//! Extremum tracking for the turn calibration (METHODS.md §A.2–5, seed EP 0640207).
+//! Extremum tracking for the turn calibration (EP 0640207).
 //!
 //! During a turn each magnetometer axis swings between a maximum and a minimum once per
 //! revolution. Both halves of the turn calibrator use those extrema: the compass half takes the
@@ -16,8 +16,8 @@
 //! stationary start from being taken for extrema (`mean |Δx|`, the mean sample-to-sample step,
 //! is about 1.1 σ for noise alone). A candidate with no swing of `h` before it lies at the
 //! start of the record and one with no swing after it at the end: neither is confirmed, since
-//! the true extremum may lie outside the record (METHODS.md §A: "an extremum at the edge of the
-//! record" is refused, not guessed). Allocation-free: the most recent [`MAX_EXTREMA`]
+//! the true extremum may lie outside the record (an extremum at the edge of the record is
+//! refused, not guessed). Allocation-free: the most recent [`MAX_EXTREMA`]
 //! extrema are kept.
 
 extern crate alloc;
@@ -26,9 +26,6 @@ use alloc::vec::Vec;
 
 use serde::{Deserialize, Serialize};
 use truenorth_core::{Error, Result, Validate, check_range};
-
-#[allow(unused_imports)]
-use truenorth_core::Float as _;
 
 /// Confirmed extrema kept per axis (the most recent ones): 32 revolutions.
 pub const MAX_EXTREMA: usize = 64;
@@ -56,7 +53,7 @@ pub struct Extremum<T> {
 }
 
 /// A maximum and the minimum next to it in time: half a revolution apart, never across
-/// revolutions (METHODS.md §A.3).
+/// revolutions (EP 0640207).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct HalfTurnPair<T> {
     /// The maximum.

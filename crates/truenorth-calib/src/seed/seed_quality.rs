@@ -18,7 +18,7 @@ use truenorth_compass::CompassCalibration2d;
 
 use crate::quality::{Assessment2d, ReportSums, SupportFigures, assess_2d};
 
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 
 /// Amplitude of the two-cycle component of `|cal(p)|/field − 1` over the heading of

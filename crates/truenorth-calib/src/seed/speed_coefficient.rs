@@ -1,5 +1,5 @@
-//! The adaptive speed coefficient of US 4,788,645 (eqs. 9-13, claims 10-11; METHODS.md
-//! §B.3): in a turn the wheels' difference grows with speed as `1 + aV²`, and `a` is refined
+//! The adaptive speed coefficient of US 4,788,645 (eqs. 9-13, claims
+//! 10-11): in a turn the wheels' difference grows with speed as `1 + aV²`, and `a` is refined
 //! turn by turn against the compass.
 //!
 //! Over a turn, `ERROR = Δθ_w − Δθ_c` when the wheels turned right (`Δθ_w ≥ 0`) and
@@ -26,7 +26,7 @@ use truenorth_core::{
     TimeStep, Validate, check_finite, check_positive, check_range, mph_to_mps, wrap_pi,
 };
 
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 
 /// Settings of the [`SpeedCoefficientCalibrator`].

@@ -1,4 +1,4 @@
-//! The compass half of the one-turn calibration (METHODS.md §A.4–5, seed EP 0640207
+//! The compass half of the one-turn calibration (EP 0640207
 //! claims 4, 5 and 10).
 //!
 //! The vehicle turns through at least one full revolution. Each magnetometer axis passes a
@@ -45,7 +45,7 @@ use crate::seed::extrema::{
 };
 use crate::seed::seed_quality::seed_assessment;
 
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 
 /// Fewest samples a turn calibration accepts.

@@ -1,4 +1,4 @@
-//! The whole one-turn calibration of EP 0640207 (METHODS.md §A): the gyro's zero reading
+//! The whole one-turn calibration of EP 0640207: the gyro's zero reading
 //! and conversion constant together with the compass's centre and radii, from a record that
 //! starts at rest and turns through at least one revolution.
 //!
@@ -48,7 +48,7 @@ use crate::seed::extrema::ExtremumKind;
 use crate::seed::seed_quality::seed_assessment;
 use crate::seed::turn::{TurnConfig, TurnEllipse, TurnExtrema};
 
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 
 /// Shortest standstill accepted before the turn, s.

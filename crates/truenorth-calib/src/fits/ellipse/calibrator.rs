@@ -1,10 +1,6 @@
 //! The batch least-squares ellipse calibrator: every reading kept, fitted with [`fit_ellipse`] on
 //! `solve`.
 
-// `!(x <= limit)` and `!(x > 0.0)` are deliberate: they are true for NaN, so a NaN fails
-// every check instead of slipping through one.
-#![allow(clippy::neg_cmp_op_on_partial_ord)]
-
 extern crate alloc;
 
 use alloc::vec::Vec;
@@ -20,9 +16,6 @@ use crate::quality::{self};
 
 use crate::fits::ellipse::config::EllipseConfig;
 use crate::fits::ellipse::fit::fit_ellipse;
-#[allow(unused_imports)]
-use truenorth_core::Float as _;
-
 /// Least-squares ellipse calibrator (batch): stores every reading pushed and fits them all
 /// with [`fit_ellipse`] on `solve`.
 ///

@@ -1,18 +1,11 @@
 //! The configuration of the least-squares ellipse fit and its validation.
 
-// `!(x <= limit)` and `!(x > 0.0)` are deliberate: they are true for NaN, so a NaN fails
-// every check instead of slipping through one.
-#![allow(clippy::neg_cmp_op_on_partial_ord)]
-
 extern crate alloc;
 
 use serde::{Deserialize, Serialize};
 use truenorth_core::{Result, Validate, check_positive, check_range};
 
 use crate::quality::MIN_ARC_DEG;
-
-#[allow(unused_imports)]
-use truenorth_core::Float as _;
 
 /// The fewest readings a 2-D least-squares fit accepts: five determine an ellipse, one
 /// more leaves a residual to judge it by.

@@ -2,10 +2,6 @@
 //! stable form of Halíř & Flusser 1998) and the conversions between the conic, the ellipse
 //! and the refinement's parameters.
 
-// `!(x <= limit)` and `!(x > 0.0)` are deliberate: they are true for NaN, so a NaN fails
-// every check instead of slipping through one.
-#![allow(clippy::neg_cmp_op_on_partial_ord)]
-
 extern crate alloc;
 
 use nalgebra::{Matrix2, Matrix3, SMatrix, SVector, Vector2, Vector3};
@@ -17,7 +13,7 @@ use crate::numerics::linalg::{constrained_min3, sym_eigen2, sym_eigen3, sym_sqrt
 use crate::quality::Moments2;
 
 use crate::fits::ellipse::config::MIN_POINTS_2D;
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 
 /// An ellipse `{ m : |B (m − c)| = 1 }`, `B` symmetric positive definite.

@@ -40,7 +40,7 @@
 
 // `!(x <= limit)` and `!(x > 0.0)` are deliberate: they are true for NaN, so a NaN fails
 // every check instead of slipping through one.
-#![allow(clippy::neg_cmp_op_on_partial_ord)]
+#![expect(clippy::neg_cmp_op_on_partial_ord)]
 
 extern crate alloc;
 
@@ -62,7 +62,7 @@ use crate::fits::ellipse::direct::denormalise;
 use crate::fits::ellipse::direct::direct_normalised;
 use crate::fits::ellipse::direct::from_params;
 use crate::fits::ellipse::direct::to_params;
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 
 /// Sampson residuals and their analytic Jacobian, accumulated as normal equations.

@@ -1,10 +1,6 @@
 //! The batch least-squares ellipsoid calibrator: every reading kept, fitted with
 //! [`fit_ellipsoid`] on `solve`.
 
-// `!(x <= limit)` and `!(x > 0.0)` are deliberate: they are true for NaN, so a NaN fails
-// every check instead of slipping through one.
-#![allow(clippy::neg_cmp_op_on_partial_ord)]
-
 extern crate alloc;
 
 use alloc::vec::Vec;
@@ -21,9 +17,6 @@ use crate::quality::{self};
 use crate::fits::ellipsoid::config::EllipsoidConfig;
 use crate::fits::ellipsoid::fit::bbox_centre;
 use crate::fits::ellipsoid::fit::fit_ellipsoid;
-#[allow(unused_imports)]
-use truenorth_core::Float as _;
-
 /// Least-squares ellipsoid calibrator (batch): stores every reading pushed and fits them
 /// all with [`fit_ellipsoid`] on `solve`.
 ///

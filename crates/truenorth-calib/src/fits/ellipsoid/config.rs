@@ -1,18 +1,11 @@
 //! The configuration of the least-squares ellipsoid fit and its validation.
 
-// `!(x <= limit)` and `!(x > 0.0)` are deliberate: they are true for NaN, so a NaN fails
-// every check instead of slipping through one.
-#![allow(clippy::neg_cmp_op_on_partial_ord)]
-
 extern crate alloc;
 
 use serde::{Deserialize, Serialize};
 use truenorth_core::{Result, Validate, check_positive, check_range};
 
 use crate::quality::{self};
-
-#[allow(unused_imports)]
-use truenorth_core::Float as _;
 
 /// How much looser the determination test is before the fit, about the bounding-box centre
 /// and without a soft iron, than after it (see `fit_unchecked`): a judgement, covering soft

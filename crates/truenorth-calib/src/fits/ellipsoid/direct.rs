@@ -1,10 +1,6 @@
 //! The direct least-squares ellipsoid fit (Li & Griffiths 2004) and the conversions between
 //! the quadric, the ellipsoid and the refinement's parameters.
 
-// `!(x <= limit)` and `!(x > 0.0)` are deliberate: they are true for NaN, so a NaN fails
-// every check instead of slipping through one.
-#![allow(clippy::neg_cmp_op_on_partial_ord)]
-
 extern crate alloc;
 
 use nalgebra::{Matrix3, Matrix4, SMatrix, SVector, Vector3, Vector6};
@@ -16,7 +12,7 @@ use crate::numerics::blocks::{BLOCK, blocks, dot_block};
 use crate::numerics::linalg::{constrained_min6, sym_eigen3, sym_eigen6, sym_sqrt3};
 
 use crate::fits::ellipsoid::config::MIN_POINTS_3D;
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 
 /// An ellipsoid `{ m : |B (m − c)| = 1 }`, `B` symmetric positive definite.

@@ -31,7 +31,7 @@
 
 // `!(x <= limit)` and `!(x > 0.0)` are deliberate: they are true for NaN, so a NaN fails
 // every check instead of slipping through one.
-#![allow(clippy::neg_cmp_op_on_partial_ord)]
+#![expect(clippy::neg_cmp_op_on_partial_ord)]
 
 extern crate alloc;
 
@@ -56,7 +56,7 @@ use crate::fits::ellipsoid::direct::denormalise;
 use crate::fits::ellipsoid::direct::direct_normalised;
 use crate::fits::ellipsoid::direct::from_params;
 use crate::fits::ellipsoid::direct::to_params;
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 
 /// Residuals `r = |B v| − 1` (`v = q − c`) and their Jacobian, accumulated as normal

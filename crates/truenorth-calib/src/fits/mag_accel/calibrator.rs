@@ -35,7 +35,7 @@
 
 // `!(x <= limit)` and `!(x > 0.0)` are deliberate: they are true for NaN, so a NaN fails
 // every check instead of slipping through one.
-#![allow(clippy::neg_cmp_op_on_partial_ord)]
+#![expect(clippy::neg_cmp_op_on_partial_ord)]
 
 extern crate alloc;
 
@@ -65,7 +65,7 @@ use crate::fits::mag_accel::solve::{
 use crate::fits::normalise::Normaliser;
 use crate::quality::{self};
 
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 
 /// Joint magnetometer + accelerometer calibrator (batch): stores every reading pushed and

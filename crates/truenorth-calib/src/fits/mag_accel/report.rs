@@ -2,10 +2,6 @@
 //! calibration in raw units and body axes, and the heading figures propagated from the
 //! parameters' covariance.
 
-// `!(x <= limit)` and `!(x > 0.0)` are deliberate: they are true for NaN, so a NaN fails
-// every check instead of slipping through one.
-#![allow(clippy::neg_cmp_op_on_partial_ord)]
-
 use core::ops::Range;
 use serde::{Deserialize, Serialize};
 
@@ -25,7 +21,7 @@ use crate::fits::normalise::Normaliser;
 use crate::numerics::linalg::sym_eigen3;
 use crate::quality::{self, Uncertainty};
 
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 
 /// The heading of the pointing axis (clockwise from magnetic north, radians) of a reading

@@ -9,7 +9,7 @@ use core::ops::Range;
 
 use nalgebra::{Matrix3, Vector3};
 
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 
 /// How runs are recognised.

@@ -26,7 +26,7 @@
 
 // `!(x <= limit)` and `!(x > 0.0)` are deliberate: they are true for NaN, so a NaN fails
 // every check instead of slipping through one.
-#![allow(clippy::neg_cmp_op_on_partial_ord)]
+#![expect(clippy::neg_cmp_op_on_partial_ord)]
 
 extern crate alloc;
 
@@ -37,7 +37,7 @@ use nalgebra::{Matrix3, Rotation3, SMatrix, SVector, Vector3};
 
 use crate::fits::lm::NormalEquations;
 
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 
 /// Number of parameters: `c_a` (3), `B_a` (6), `c_m` (3), `B_m` (6), `ω` (3), `s`, and the

@@ -15,7 +15,7 @@ use crate::seed::binned::config::BinnedEllipseConfig;
 use crate::seed::binned::refresh::RefreshJob;
 use crate::seed::seed_quality::{SeedJob, seed_assessment};
 
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 
 /// How many times the change that noise alone makes a restart needs (see

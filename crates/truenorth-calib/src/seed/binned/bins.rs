@@ -7,7 +7,7 @@ use nalgebra::Vector2;
 use serde::{Deserialize, Serialize};
 use truenorth_core::wrap_two_pi;
 
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 
 /// Most bins a calibrator can have (fixed arrays keep it allocation-free).

@@ -1,4 +1,4 @@
-//! Binned-ellipse auto-calibration (METHODS.md §D, seed EP 0634001).
+//! Binned-ellipse auto-calibration (EP 0634001).
 //!
 //! 1. **Initial origin** (claim 6): the mean of the first [`BinnedEllipseConfig::init_samples`]
 //!    readings.
@@ -87,9 +87,6 @@ use core::f64::consts::TAU;
 
 use crate::seed::binned::update::{DRAIN_PER_PUSH, REFRESH_PUSHES, REFRESH_STRIDE, Update};
 pub use crate::seed::binned::update::{MAX_UPDATE_PUSHES, UpdatePhase};
-
-#[allow(unused_imports)]
-use truenorth_core::Float as _;
 
 /// The binned-ellipse calibrator (EP 0634001). See the module documentation.
 ///

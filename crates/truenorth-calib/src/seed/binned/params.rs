@@ -2,10 +2,6 @@
 //! search for Ω_e minimising `S(θ)`, then the weighted sums that give the ratio and `|E_L|`,
 //! one evaluation of `S(θ)` at a time so that a refresh can run it in bounded slices.
 
-// `!(x <= limit)` and `!(x > 0.0)` are deliberate: they are true for NaN, so a NaN fails
-// every check instead of slipping through one.
-#![allow(clippy::neg_cmp_op_on_partial_ord)]
-
 use core::f64::consts::{PI, TAU};
 
 use nalgebra::Vector2;
@@ -14,7 +10,7 @@ use truenorth_core::{Error, Result, check_finite2};
 
 use crate::seed::binned::bins::MAX_BINS;
 
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 
 /// Number of `S(θ)` evaluations of the parameter search: a 1° scan of [0, π), the two

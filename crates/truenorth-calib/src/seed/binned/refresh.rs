@@ -10,10 +10,6 @@
 //! one interpolation partner tested, one bin re-binned, one bin's term of `S(θ)`), which
 //! makes the slicing deterministic: the same pushes give the same slices on every machine.
 
-// `!(x <= limit)` and `!(x > 0.0)` are deliberate: they are true for NaN, so a NaN fails
-// every check instead of slipping through one.
-#![allow(clippy::neg_cmp_op_on_partial_ord)]
-
 use core::f64::consts::TAU;
 
 use nalgebra::Vector2;
@@ -23,7 +19,7 @@ use truenorth_core::{Error, Result, angle_diff};
 use crate::seed::binned::bins::{BinState, Bins, EMPTY, MAX_BINS, filled, rebin_one};
 use crate::seed::binned::params::{EVALUATIONS, ParamSearch};
 
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 
 /// Cost, in bin operations, of one bin's share of a pass that needs a trigonometric

@@ -11,9 +11,6 @@ use crate::seed::binned::bins::Bins;
 use crate::seed::binned::refresh::RefreshJob;
 use crate::seed::seed_quality::SeedJob;
 
-#[allow(unused_imports)]
-use truenorth_core::Float as _;
-
 /// Most readings kept while a full-set update is in progress (they are binned when it
 /// completes).
 pub const MAX_UPDATE_PUSHES: usize = 128;

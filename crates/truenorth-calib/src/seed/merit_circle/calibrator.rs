@@ -1,4 +1,4 @@
-//! Auto-calibrating compass with a figure of merit (METHODS.md §C, seed US 5,297,063).
+//! Auto-calibrating compass with a figure of merit (US 5,297,063).
 //!
 //! The seed stores heading data points taken after the heading has changed (claim 1 step d),
 //! computes the centre of the circle through three of them (e), adds it to a running sum of
@@ -68,7 +68,7 @@ use crate::seed::seed_quality::{SeedJob, seed_assessment};
 
 use crate::seed::merit_circle::config::MeritCircleConfig;
 use crate::seed::merit_circle::config::RING;
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 
 /// Where the merit-circle estimate stands.

@@ -9,9 +9,6 @@ use truenorth_core::{Result, Validate, check_range};
 
 use crate::quality::MIN_ARC_DEG;
 
-#[allow(unused_imports)]
-use truenorth_core::Float as _;
-
 /// Data points kept to form triples.
 pub const RING: usize = 8;
 

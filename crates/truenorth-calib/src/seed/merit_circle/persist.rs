@@ -16,9 +16,6 @@ use crate::seed::merit_circle::calibrator::MeritCircleCalibrator;
 use crate::seed::merit_circle::calibrator::MeritCircleState;
 use crate::seed::merit_circle::config::MeritCircleConfig;
 use crate::seed::merit_circle::config::RING;
-#[allow(unused_imports)]
-use truenorth_core::Float as _;
-
 /// The saved state of a [`MeritCircleCalibrator`] ([`Persistent::State`]): its
 /// configuration and everything it has learned. Unset values are `None` (never an infinity),
 /// so the state is plain JSON-friendly data.
