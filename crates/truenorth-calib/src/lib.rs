@@ -74,82 +74,49 @@
 
 extern crate alloc;
 
-pub mod extrema;
 pub mod quality;
 
-mod ellipse_fit;
-mod ellipsoid_fit;
-mod linalg;
-mod lm;
-mod normalise;
+mod fits;
+mod numerics;
+mod online;
+mod seed;
 
-// Joint magnetometer + accelerometer calibration.
-mod mag_accel;
-mod mag_accel_report;
-mod mag_accel_runs;
-mod mag_accel_solve;
+pub use seed::extrema;
 
-// Online least-squares calibrators from running monomial sums.
-mod conic_sums;
-mod online_conic;
-mod online_ellipse;
-mod online_ellipse_config;
-mod online_ellipse_refresh;
-mod online_ellipsoid;
-mod online_ellipsoid_config;
-mod online_ellipsoid_refresh;
-mod retained;
-
-// Seed calibrators (turn, merit circle, binned ellipse) and their helpers.
-mod binned_assess;
-mod binned_config;
-mod binned_ellipse;
-mod binned_params;
-mod binned_persist;
-mod binned_refresh;
-mod binned_update;
-mod circumcentre;
-mod direction_slots;
-mod merit_circle;
-mod seed_quality;
-mod speed_coefficient;
-mod turn;
-mod turn_gyro;
-
-pub use binned_ellipse::{
-    BinnedEllipseCalibrator, BinnedEllipseConfig, MAX_INIT_SAMPLES, MAX_UPDATE_PUSHES, UpdatePhase,
-};
-pub use binned_persist::{BinnedEllipseSaved, BinnedUpdateSaved};
-pub use binned_refresh::{BinState, MAX_BINS, ellipse_parameters};
-pub use circumcentre::{Circumcircle, circumcircle};
-pub use conic_sums::{RetainedSnapshot, SumsSnapshot};
-pub use ellipse_fit::{
+pub use fits::ellipse::{
     Ellipse, EllipseCalibrator, EllipseConfig, MIN_POINTS_2D, fit_ellipse, fit_ellipse_direct,
 };
-pub use ellipsoid_fit::{
+pub use fits::ellipsoid::{
     Ellipsoid, EllipsoidCalibrator, EllipsoidConfig, MIN_POINTS_3D, fit_ellipsoid,
     fit_ellipsoid_direct,
 };
-pub use mag_accel::{
+pub use fits::mag_accel::{
     INITIAL_FIT_BOUND_DEG, MIN_MAG_ACCEL_READINGS, MagAccelCalibration, MagAccelCalibrator,
     MagAccelConfig, MagAccelQuality, MagAccelSample, fit_mag_accel,
 };
-pub use merit_circle::{
-    MERIT_CIRCLE_MIN_ARC_DEG, MeritCircleCalibrator, MeritCircleConfig, MeritCircleSaved,
-    MeritCircleState, RING,
-};
-pub use online_ellipse::{
+pub use numerics::circumcentre::{Circumcircle, circumcircle};
+pub use online::conic_sums::{RetainedSnapshot, SumsSnapshot};
+pub use online::ellipse::{
     ONLINE_SLOTS_2D, OnlineConicState, OnlineEllipseCalibrator, OnlineEllipseConfig,
     OnlineEllipseState, PendingRefresh,
 };
-pub use online_ellipsoid::{
+pub use online::ellipsoid::{
     OnlineEllipsoidCalibrator, OnlineEllipsoidConfig, OnlineEllipsoidState,
 };
-pub use speed_coefficient::{SpeedCoefficientCalibrator, SpeedCoefficientConfig, SpeedStep};
-pub use turn::{
+pub use seed::binned::{BinState, MAX_BINS, ellipse_parameters};
+pub use seed::binned::{
+    BinnedEllipseCalibrator, BinnedEllipseConfig, MAX_INIT_SAMPLES, MAX_UPDATE_PUSHES, UpdatePhase,
+};
+pub use seed::binned::{BinnedEllipseSaved, BinnedUpdateSaved};
+pub use seed::merit_circle::{
+    MERIT_CIRCLE_MIN_ARC_DEG, MeritCircleCalibrator, MeritCircleConfig, MeritCircleSaved,
+    MeritCircleState, RING,
+};
+pub use seed::speed_coefficient::{SpeedCoefficientCalibrator, SpeedCoefficientConfig, SpeedStep};
+pub use seed::turn::{
     DEFAULT_MAX_GAP_S, MIN_TURN_SAMPLES, TurnCompassCalibrator, TurnConfig, TurnEllipse,
     TurnExtrema, TurnExtremaSaved, TurnSaved, TurnTag,
 };
-pub use turn_gyro::{
+pub use seed::turn_gyro::{
     MIN_REST_S, RawHeading, TurnCalibration, TurnCalibrator, TurnQuality, TurnSample,
 };

@@ -1,14 +1,59 @@
 //! Heading-error bounds: the information matrices of the 2-D and 3-D calibration models,
-//! built from monomial sums, and the worst-direction bounds of the module documentation.
+//! built from monomial sums, and the worst-direction bounds derived below.
+//!
+//! # Derivation
+//!
+//! Write a calibrated reading as `h = F·u`, `u` a unit vector, `F` the field. Any 2-D
+//! calibration differs from the truth, to first order, by a small centre error `F·d` and a
+//! small symmetric matrix error `E` (the antisymmetric part of a soft-iron matrix is a pure
+//! rotation that no circle or ellipse fit can see; it is assumed zero, which is why the fits
+//! choose the symmetric square root). The estimate then maps a point on the true circle to
+//! `(I + E)(h − F·d)`, so
+//!
+//! * its radial residual, relative to `F`, is `uᵀE u − uᵀd` = `φ(u)ᵀ p` with
+//!   `p = (d_x, d_y, e₁₁, e₁₂, e₂₂)` and `φ(u) = (−u_x, −u_y, u_x², 2u_xu_y, u_y²)`;
+//! * its angle (heading) error is `u⊥ᵀ(E u − d)` = `g(u)ᵀ p`, `u⊥` the unit vector 90°
+//!   ahead of `u`.
+//!
+//! A least-squares calibration estimates `p` from the residuals of its `N` points; if those
+//! are independent with standard deviation `σ` (relative to `F`), the estimate's covariance
+//! is `σ²·A⁻¹` with the information matrix `A = Σᵢ φ(uᵢ)φ(uᵢ)ᵀ` (Gauss–Markov). The heading
+//! error at direction `u` then has variance `σ²·g(u)ᵀA⁻¹g(u)`, and the bound reported as
+//! `heading_error_3sigma_deg` is
+//!
+//! `bound = 3 · σ · max_u √(g(u)ᵀ A⁻¹ g(u))`   (3 σ at the worst heading, in degrees),
+//!
+//! with `σ² = Σ rᵢ² / (N − 5)` from the calibrated residuals `rᵢ = |hᵢ|/F − 1`. So it grows
+//! with the residuals, shrinks as `1/√N` with the point count, and grows steeply as the
+//! coverage shrinks (the directions `uᵢ` fill `A`). For `N` points spread evenly round the
+//! circle `g(u)ᵀA⁻¹g(u) = 4/N` at every heading, so the bound is `3·2σ/√N` radians. It is the
+//! error the calibration adds to every later heading; each reading's own noise adds about
+//! `σ` radians (RMS) on top, reported apart as `heading_noise_rms_deg`. It does not include
+//! model errors the residuals cannot reveal (a rotated soft iron, a tilted sensor, a field
+//! that changes during the turn); the seed methods report the part of those their model is
+//! known to leave as `heading_error_systematic_deg`.
+//!
+//! The `condition` reported is the condition number of `A` (largest over smallest
+//! eigenvalue): 2 for a full, evenly covered circle, growing without bound as the arc
+//! shortens. It is the condition of the linearised least-squares problem every 2-D
+//! calibration solves, in coordinates normalised by the field, so it does not depend on
+//! units or on where the hard iron is.
+//!
+//! The 3-D report is the same with `p = (d, e₁₁, e₁₂, e₁₃, e₂₂, e₂₃, e₃₃)` (9 parameters,
+//! condition 2.5 for an evenly covered sphere), the angle error being the component of
+//! `E u − d` perpendicular to `u` (the error of the field *direction*); the bound is the
+//! worst over the whole sphere of `3 σ √(trace of its covariance)`. The heading of a level
+//! compass errs by at most that divided by `cos(dip)`.
 
 use core::f64::consts::TAU;
 
 use nalgebra::{SMatrix, SVector, Vector3};
 
-use super::BOUND_SIGMAS;
-
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
+
+/// How many standard deviations the heading-error bound spans.
+pub const BOUND_SIGMAS: f64 = 3.0;
 
 /// For an information matrix `A = L Lᵀ` of `P` parameters fitted to `n` points with residual
 /// sum of squares `sum_sq`: `L⁻¹`, formed once so that every test direction costs one small
@@ -267,7 +312,7 @@ pub(super) fn worst_3d(l_inv: &SMatrix<f64, 9, 9>) -> f64 {
 }
 
 /// The Student-t widening of a 3σ bound whose σ comes from `dof` degrees of freedom (see
-/// `crate::conic_sums::t_factor`, the Cornish–Fisher series), with the exact quantile for
+/// [`t_factor`], the Cornish–Fisher series), with the exact quantile for
 /// one and two degrees of freedom, where the series falls far short (96 against 236 for
 /// one): the two-sided 99.73 % point is `tan(π(p − ½))` for one and
 /// `(2p − 1)/√(2p(1 − p))` for two, `p = Φ(3)` (Student 1908; e.g. Johnson, Kotz &
@@ -280,6 +325,35 @@ pub(crate) fn t_factor_exact_small(dof: f64) -> f64 {
     } else if dof == 2.0 {
         (2.0 * P - 1.0) / (2.0 * P * (1.0 - P)).sqrt() / BOUND_SIGMAS
     } else {
-        crate::conic_sums::t_factor(dof)
+        t_factor(dof)
     }
+}
+
+/// The factor by which a bound of `k = 3` standard deviations must grow when the standard
+/// deviation is estimated from `dof` degrees of freedom, to keep its confidence: the
+/// Student-t quantile of the normal 3σ level over 3, by the Cornish–Fisher expansion of
+/// Abramowitz & Stegun (1964) 26.7.5 (within 1 % for `dof ≥ 5`, and short of the exact
+/// quantile below, e.g. 96 against 236 for one degree of freedom). A fit of six readings
+/// for five parameters estimates σ from one residual; without this factor such a fit can
+/// look certain by chance.
+fn t_factor(dof: f64) -> f64 {
+    if dof.is_nan() || dof <= 0.0 {
+        return f64::INFINITY;
+    }
+    let x = 3.0_f64;
+    let (x2, x3) = (x * x, x * x * x);
+    let (x5, x7, x9) = (x3 * x2, x3 * x2 * x2, x3 * x3 * x3);
+    let g = [
+        (x3 + x) / 4.0,
+        (5.0 * x5 + 16.0 * x3 + 3.0 * x) / 96.0,
+        (3.0 * x7 + 19.0 * x5 + 17.0 * x3 - 15.0 * x) / 384.0,
+        (79.0 * x9 + 776.0 * x7 + 1482.0 * x5 - 1920.0 * x3 - 945.0 * x) / 92160.0,
+    ];
+    let mut t = x;
+    let mut p = 1.0;
+    for gk in g {
+        p /= dof;
+        t += gk * p;
+    }
+    t / x
 }

@@ -2,22 +2,48 @@
 //! the sphere (3-D: equal-area direction cells) the readings fill, seen from a centre, and
 //! the centre-free turning of the raw locus.
 
-// `!(x <= limit)` and `!(x > 0.0)` are deliberate: they are true for NaN, so a NaN fails
-// every check instead of slipping through one.
-#![allow(clippy::neg_cmp_op_on_partial_ord)]
-
 use core::f64::consts::TAU;
 
 use nalgebra::{Vector2, Vector3};
 use truenorth_compass::CompassCalibration2d;
 use truenorth_core::{Error, Result, angle_diff};
 
-use super::support::Support2d;
-use super::{COVERAGE_BINS, GAP_BINS, SPHERE_BANDS, SPHERE_CELLS, SPHERE_SECTORS};
-use crate::lm::{BLOCK, blocks};
+use super::support::{GAP_BINS, Support2d};
+use crate::numerics::blocks::{BLOCK, blocks};
 
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
+
+/// Number of heading bins used for coverage (10° each).
+pub const COVERAGE_BINS: usize = 36;
+
+/// Equal-area latitude bands of the direction cells on the sphere (uniform in `sin(lat)`,
+/// so every band has the same area).
+pub const SPHERE_BANDS: usize = 8;
+
+/// Longitude sectors per band of the direction cells on the sphere.
+pub const SPHERE_SECTORS: usize = 16;
+
+/// Number of equal-area direction cells on the sphere (`SPHERE_BANDS × SPHERE_SECTORS`,
+/// each about 320 square degrees, roughly 18° × 18° at the equator).
+pub const SPHERE_CELLS: usize = SPHERE_BANDS * SPHERE_SECTORS;
+
+/// The shortest arc of a turn, degrees, from which a 2-D calibration is accepted.
+///
+/// A half circle does not determine an ellipse (the missing half is extrapolated, and a
+/// small noise at its ends moves the centre a lot), so every 2-D calibrator refuses spans up
+/// to a little beyond 180°; the margin keeps a noisy half circle from slipping through.
+pub const MIN_ARC_DEG: f64 = 200.0;
+
+/// The share of the direction cells on the sphere ([`SPHERE_CELLS`]) below which the online
+/// ellipsoid calibrator explains a failed fit as too little of the sphere seen (no
+/// calibrator refuses a successful fit on it: whether the orientations determine a 3-D
+/// calibration is judged by their dilution, see [`require_determined`](super::require_determined)).
+///
+/// One turn about a single axis traces a great circle, which passes through about 20–25 %
+/// of the cells and does not determine an ellipsoid; turns about two or more axes reach
+/// well beyond this.
+pub const MIN_SPHERE_COVERAGE: f64 = 0.3;
 
 /// How much of the circle a set of points covers, seen from a centre.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -333,7 +359,7 @@ pub fn sphere_coverage<'a>(
 ) -> f64 {
     let mut filled = [false; SPHERE_CELLS];
     let mut points = points.into_iter();
-    // A block of points at a time (see `crate::lm::BLOCK`).
+    // A block of points at a time (see `crate::numerics::blocks::BLOCK`).
     loop {
         let mut d = [[0.0; BLOCK]; 3];
         let mut len = 0;
@@ -421,7 +447,7 @@ pub fn locus_turning_rad<'a>(
 pub const ARC_END_NOISE_SIGMAS: f64 = 3.0;
 
 /// Refuses a 2-D calibration whose data span less than `need_deg` of heading (see
-/// [`super::MIN_ARC_DEG`]) with [`Error::InsufficientCoverage`]: the span of `coverage` less
+/// [`MIN_ARC_DEG`]) with [`Error::InsufficientCoverage`]: the span of `coverage` less
 /// [`ARC_END_NOISE_SIGMAS`] of the per-reading heading noise `noise_rad` at each end (0 when
 /// unknown), so that noise cannot widen a short arc into an accepted one. The refusal
 /// gives both the span and the allowance.
@@ -445,7 +471,7 @@ pub fn require_arc(coverage: &Coverage, noise_rad: f64, need_deg: f64) -> Result
 }
 
 /// Refuses a 3-D calibration whose data fill less than `need` of the direction cells (see
-/// [`super::MIN_SPHERE_COVERAGE`]) with [`Error::InsufficientCoverage`]; the degrees reported are
+/// [`MIN_SPHERE_COVERAGE`]) with [`Error::InsufficientCoverage`]; the degrees reported are
 /// the solid angle covered, as an equivalent share of 360°.
 pub fn require_sphere_coverage(fraction: f64, need: f64) -> Result<()> {
     if fraction < need {
@@ -487,7 +513,7 @@ fn calibrated_bins_2d(points: &[Vector2<f64>], cal: &CompassCalibration2d) -> An
             s[(1, 0)] * dx + s[(1, 1)] * dy,
         )
     };
-    // A block of points at a time (see `crate::lm::BLOCK`): every direction first, in a loop
+    // A block of points at a time (see `crate::numerics::blocks::BLOCK`): every direction first, in a loop
     // without branches that the compiler vectorises, then the marking, where the few
     // directions next to a bin boundary are computed again and binned by `turns`.
     let mut coarse = [0u32; BLOCK];

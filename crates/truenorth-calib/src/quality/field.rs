@@ -5,9 +5,6 @@ use nalgebra::{Vector2, Vector3};
 use truenorth_compass::{CompassCalibration2d, CompassCalibration3d};
 use truenorth_core::CompassQuality;
 
-#[allow(unused_imports)]
-use truenorth_core::Float as _;
-
 /// Sets [`CompassQuality::field_ratio_to_expected`]: the fitted field over `expected_field` (e.g.
 /// from the World Magnetic Model, in the input unit). Leaves it `None` when no positive
 /// finite expectation is given.
@@ -92,4 +89,38 @@ fn mean_norm(norms: impl Iterator<Item = f64>) -> f64 {
         n += 1;
     }
     if n > 0 { s / n as f64 } else { 0.0 }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    proptest! {
+        #[test]
+        fn warns_exactly_outside_the_tolerance(fitted in 0.0f64..100.0, expected in 1e-3f64..100.0) {
+            let q = CompassQuality { field_magnitude: fitted, ..CompassQuality::default() };
+            let ratio = fitted / expected;
+            let warned = field_mismatch(&q, expected);
+            prop_assert_eq!(warned.is_some(), (ratio - 1.0).abs() > FIELD_RATIO_TOLERANCE);
+            if let Some(w) = warned {
+                prop_assert!((w.ratio() - ratio).abs() < 1e-12);
+            }
+        }
+
+        #[test]
+        fn no_expectation_no_warning(
+            fitted in proptest::num::f64::ANY,
+            expected in prop_oneof![
+                Just(f64::NAN),
+                Just(f64::INFINITY),
+                Just(f64::NEG_INFINITY),
+                Just(0.0),
+                -1e9f64..0.0,
+            ],
+        ) {
+            let q = CompassQuality { field_magnitude: fitted, ..CompassQuality::default() };
+            prop_assert!(field_mismatch(&q, expected).is_none());
+        }
+    }
 }

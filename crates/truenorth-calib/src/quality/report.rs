@@ -1,10 +1,6 @@
 //! Report assembly: the 2-D and 3-D [`CompassQuality`] of a calibration, from one pass
 //! over the readings or (2-D) from the monomial sums of the fit.
 
-// `!(x <= limit)` and `!(x > 0.0)` are deliberate: they are true for NaN, so a NaN fails
-// every check instead of slipping through one.
-#![allow(clippy::neg_cmp_op_on_partial_ord)]
-
 use nalgebra::Vector2;
 use nalgebra::Vector3;
 use truenorth_compass::{CompassCalibration2d, CompassCalibration3d};
@@ -17,13 +13,24 @@ use super::bounds::{
 use super::coverage::{AngleBins, Coverage, sphere_cell, turns};
 use super::support::{Support2d, Support3d, support_dilution};
 use super::uncertainty::{Uncertainty, bound_and_uncertainty};
-use crate::linalg::{condition_from_eigenvalues, sym_eigen5, sym_eigen9};
-use crate::lm::{BLOCK, blocks, dot_block, sum_block};
+use crate::numerics::blocks::{BLOCK, blocks, dot_block, sum_block};
+use crate::numerics::linalg::{condition_from_eigenvalues, sym_eigen5, sym_eigen9};
 use crate::quality::SPHERE_CELLS;
-use crate::seed_quality::ReportSums;
 
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
+
+/// What the one pass over the readings of [`assess_2d`] leaves for the report: the sums of
+/// the information matrix's twelve monomials, the sum of the squared residuals, the count of
+/// usable readings, their coverage and the support of their directions.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct ReportSums {
+    pub sums: [f64; 12],
+    pub ss: f64,
+    pub n: usize,
+    pub coverage: Coverage,
+    pub support: Support2d,
+}
 
 /// A 2-D quality report and the coverage behind it.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -92,7 +99,7 @@ fn sums_2d(points: &[Vector2<f64>], cal: &CompassCalibration2d, field: f64) -> R
     let mut n = 0usize;
     let inv_f = 1.0 / field;
     let (s, c) = (&cal.soft_iron, &cal.hard_iron);
-    // A block of points at a time (see `crate::lm::BLOCK`): first every point's direction,
+    // A block of points at a time (see `crate::numerics::blocks::BLOCK`): first every point's direction,
     // its products, its residual and its heading, then the sums and the bins.
     let mut ux = [0.0; BLOCK];
     let mut uy = [0.0; BLOCK];
@@ -431,7 +438,7 @@ pub(crate) fn support_dilution_3d(points: &[Vector3<f64>], cal: &CompassCalibrat
     support_dilution(&support.information(), cells, worst_3d)
 }
 
-/// A block of readings calibrated (see `crate::lm::BLOCK`): `h = soft_iron · (p − hard_iron)`
+/// A block of readings calibrated (see `crate::numerics::blocks::BLOCK`): `h = soft_iron · (p − hard_iron)`
 /// as `CompassCalibration3d::correct`, its norm, its equal-area cell and whether the row is
 /// kept (1: finite, not at the centre, not past the end of the data; 0 otherwise). Every
 /// loop is written without branches so that it vectorises.
@@ -522,7 +529,7 @@ pub fn assess_3d(points: &[Vector3<f64>], cal: &CompassCalibration3d, field: f64
     let mut n = 0usize;
     let inv_f = 1.0 / field;
     let plan = monomial_plan_3d();
-    // A block of points at a time (see `crate::lm::BLOCK`): first every point's direction,
+    // A block of points at a time (see `crate::numerics::blocks::BLOCK`): first every point's direction,
     // its products (`CalibratedBlock::monomials`) and its residual, then the sums.
     let mut cols = [[0.0; BLOCK]; 9];
     let mut weighted = [[0.0; BLOCK]; 9];

@@ -49,7 +49,7 @@ use truenorth_core::{CompassQuality, Error, Result};
 
 use super::bounds::{bound_deg, t_factor_exact_small, whitened};
 
-#[allow(unused_imports)]
+#[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 
 /// The dilution `G` of readings spread evenly round a circle (2-D).

@@ -21,6 +21,10 @@
 //! is what a good hand bearing compass reads to, 5° the accuracy class of the vehicle
 //! compasses in the seed patents.
 
+// `!(x <= limit)` and `!(x > 0.0)` are deliberate: they are true for NaN, so a NaN fails
+// every check instead of slipping through one.
+#![expect(clippy::neg_cmp_op_on_partial_ord)]
+
 use core::fmt;
 
 use serde::{Deserialize, Serialize};

@@ -1,0 +1,120 @@
+//! The batch least-squares ellipse calibrator: every reading kept, fitted with [`fit_ellipse`] on
+//! `solve`.
+
+extern crate alloc;
+
+use alloc::vec::Vec;
+
+use nalgebra::Vector2;
+use truenorth_compass::CompassCalibration2d;
+use truenorth_core::{
+    Calibrator, CompassQuality, Mag2Sample, Progress, Pushed, Result, Solution, Validate,
+    check_finite, check_finite2,
+};
+
+use crate::quality::{self};
+
+use crate::fits::ellipse::config::EllipseConfig;
+use crate::fits::ellipse::fit::fit_ellipse;
+/// Least-squares ellipse calibrator (batch): stores every reading pushed and fits them all
+/// with [`fit_ellipse`] on `solve`.
+///
+/// Its memory grows with every push; for calibrating while driving use the online
+/// least-squares calibrator, which keeps only the fit's sums.
+///
+/// [`Calibrator::progress`] runs the whole fit to decide `ready` (so that it agrees with
+/// `solve` exactly): it costs as much as `solve`, O(n). Call it now and then, not per sample.
+///
+/// ```
+/// use truenorth_calib::{EllipseCalibrator, EllipseConfig};
+/// use truenorth_core::{Calibrator, Mag2Sample};
+/// use nalgebra::Vector2;
+///
+/// let mut cal = EllipseCalibrator::new(EllipseConfig::default())?;
+/// for k in 0..72 {
+///     let psi = (k as f64 * 5.0).to_radians();
+///     // A level compass in a 30-unit field with a (10, −4) hard iron.
+///     let mag = Vector2::new(10.0 + 30.0 * psi.cos(), -4.0 - 30.0 * psi.sin());
+///     cal.push(&Mag2Sample { t_s: k as f64, mag })?;
+/// }
+/// assert!(cal.progress().ready);
+/// let sol = cal.solve()?;
+/// assert!((sol.params.hard_iron - Vector2::new(10.0, -4.0)).norm() < 1e-6);
+/// assert!((sol.quality.field_magnitude - 30.0).abs() < 1e-6);
+/// # Ok::<(), truenorth_core::Error>(())
+/// ```
+#[derive(Debug, Clone, Default)]
+pub struct EllipseCalibrator {
+    points: Vec<Vector2<f64>>,
+    config: EllipseConfig,
+}
+
+impl EllipseCalibrator {
+    /// A calibrator with the given configuration (validated).
+    pub fn new(config: EllipseConfig) -> Result<Self> {
+        config.validate()?;
+        Ok(Self {
+            points: Vec::new(),
+            config,
+        })
+    }
+
+    /// The readings stored so far.
+    pub fn points(&self) -> &[Vector2<f64>] {
+        &self.points
+    }
+
+    /// The configuration in use.
+    pub fn config(&self) -> &EllipseConfig {
+        &self.config
+    }
+}
+
+impl Calibrator for EllipseCalibrator {
+    type Sample = Mag2Sample;
+    type Params = CompassCalibration2d;
+    type Quality = CompassQuality;
+
+    fn push(&mut self, sample: &Mag2Sample) -> Result<Pushed> {
+        check_finite("timestamp t_s", sample.t_s)?;
+        check_finite2("magnetometer reading", &sample.mag)?;
+        self.points.push(sample.mag);
+        Ok(Pushed::Accepted)
+    }
+
+    /// `ready` runs the fit (see the type's documentation); `coverage` is seen from the
+    /// centre of the readings' bounding box (the centre of any full ellipse; an estimate
+    /// before the fit).
+    fn progress(&self) -> Progress {
+        let c = bbox_centre(&self.points);
+        let cov = quality::coverage(&self.points, &c);
+        Progress {
+            samples: self.points.len(),
+            coverage: cov.fraction,
+            ready: self.solve().is_ok(),
+        }
+    }
+
+    fn solve(&self) -> Result<Solution<CompassCalibration2d>> {
+        fit_ellipse(&self.points, &self.config)
+    }
+
+    fn reset(&mut self) {
+        self.points.clear();
+    }
+}
+
+/// Centre of the axis-aligned bounding box (zero for no points).
+fn bbox_centre(points: &[Vector2<f64>]) -> Vector2<f64> {
+    let mut lo = Vector2::repeat(f64::INFINITY);
+    let mut hi = Vector2::repeat(f64::NEG_INFINITY);
+    for p in points {
+        lo = lo.inf(p);
+        hi = hi.sup(p);
+    }
+    if points.is_empty() {
+        Vector2::zeros()
+    } else {
+        (lo + hi) * 0.5
+    }
+}

@@ -1,0 +1,15 @@
+//! Joint calibration of a magnetometer and an accelerometer mounted together: its
+//! configuration, the calibration it produces, the calibrator and its fit, the
+//! least-squares problem, the runs of shots aimed at one target, and the report.
+
+pub(crate) mod calibration;
+pub(crate) mod calibrator;
+pub(crate) mod config;
+pub(crate) mod report;
+pub(crate) mod runs;
+pub(crate) mod solve;
+
+pub use calibration::{MagAccelCalibration, MagAccelSample};
+pub use calibrator::{MagAccelCalibrator, fit_mag_accel};
+pub use config::{INITIAL_FIT_BOUND_DEG, MIN_MAG_ACCEL_READINGS, MagAccelConfig};
+pub use report::MagAccelQuality;

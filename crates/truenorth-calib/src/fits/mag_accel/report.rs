@@ -1,0 +1,283 @@
+//! The report of the joint magnetometer + accelerometer calibration (see `mag_accel`): the
+//! calibration in raw units and body axes, and the heading figures propagated from the
+//! parameters' covariance.
+
+use core::ops::Range;
+use serde::{Deserialize, Serialize};
+
+use nalgebra::{Rotation3, SMatrix, SVector, Vector3};
+use truenorth_accel::AccelTriadCalibration;
+use truenorth_compass::CompassCalibration3d;
+use truenorth_core::{
+    CompassQuality, Error, FitQuality, Result, STANDARD_GRAVITY_MPS2, Solution, Validate,
+};
+
+use crate::fits::mag_accel::calibration::{MagAccelCalibration, MagAccelSample};
+use crate::fits::mag_accel::config::MagAccelConfig;
+use crate::fits::mag_accel::solve::{
+    BM, CA, CM, Data, GroupSums, Model, OMEGA, P, Weights, aim_rms, level_direction,
+};
+use crate::fits::normalise::Normaliser;
+use crate::numerics::linalg::sym_eigen3;
+use crate::quality::{self, Uncertainty};
+
+#[cfg(not(feature = "std"))]
+use truenorth_core::Float as _;
+
+/// The heading of the pointing axis (clockwise from magnetic north, radians) of a reading
+/// `(a, m)` (normalised coordinates) under `theta`, for an accelerometer reading specific
+/// force: the level frame is then (north, west, up).
+pub(crate) fn heading_of(
+    theta: &SVector<f64, P>,
+    r0: &Rotation3<f64>,
+    a: &Vector3<f64>,
+    m: &Vector3<f64>,
+) -> Option<f64> {
+    let md = Model::of(theta, r0);
+    let u = (md.b_a * (a - md.c_a)).try_normalize(1e-12)?;
+    let v = (md.b_m * (m - md.c_m)).try_normalize(1e-12)?;
+    let w = level_direction(&u, &(md.rot * v), &md.p)?;
+    Some((-w.y).atan2(w.x))
+}
+
+/// The worst 3σ heading error over the test attitudes (pitch of the pointing axis within
+/// ±60°, any roll and heading) from the covariance `cov`, and the RMS per-reading heading
+/// noise for direction noise `sigma_a`, `sigma_m` (radians) on the two sensors, degrees.
+pub(crate) fn heading_figures(
+    theta: &SVector<f64, P>,
+    r0: &Rotation3<f64>,
+    cov: &SMatrix<f64, P, P>,
+    sigma_a: f64,
+    sigma_m: f64,
+) -> (f64, f64) {
+    let md = Model::of(theta, r0);
+    let (Some(ba_inv), Some(bm_inv)) = (md.b_a.try_inverse(), md.b_m.try_inverse()) else {
+        return (f64::INFINITY, f64::INFINITY);
+    };
+    // The body frame with x along p: level vectors in it map to the accelerometer's frame
+    // by the rotation taking x onto p.
+    let to_acc =
+        Rotation3::rotation_between(&Vector3::x(), &md.p).unwrap_or_else(Rotation3::identity);
+    let dip = (-md.s).clamp(-1.0, 1.0).asin();
+    let mut worst: f64 = 0.0;
+    let (mut noise_ss, mut count) = (0.0, 0usize);
+    const H: f64 = 1.5e-8;
+    for pitch_deg in [-60.0f64, -30.0, 0.0, 30.0, 60.0] {
+        for k in 0..12 {
+            for j in 0..8 {
+                let att = truenorth_core::EulerZyx {
+                    yaw_rad: core::f64::consts::TAU * j as f64 / 8.0,
+                    pitch_rad: pitch_deg.to_radians(),
+                    roll_rad: core::f64::consts::TAU * k as f64 / 12.0,
+                }
+                .to_quaternion();
+                let f_body = att.inverse_transform_vector(&Vector3::new(0.0, 0.0, -1.0));
+                let h_body = att.inverse_transform_vector(&Vector3::new(dip.cos(), 0.0, dip.sin()));
+                let u = to_acc * f_body;
+                let v = md.rot.transpose() * (to_acc * h_body);
+                let a = ba_inv * u + md.c_a;
+                let m = bm_inv * v + md.c_m;
+                let Some(h0) = heading_of(theta, r0, &a, &m) else {
+                    continue;
+                };
+                let mut g = SVector::<f64, P>::zeros();
+                for p in 0..P {
+                    let mut t = *theta;
+                    t[p] += H;
+                    if let Some(hp) = heading_of(&t, r0, &a, &m) {
+                        g[p] = truenorth_core::angle_diff(hp, h0) / H;
+                    }
+                }
+                worst = worst.max(g.dot(&(cov * g)));
+                // Per-reading noise: the heading's sensitivity to each unit vector, across it.
+                let sens = |perturb: &dyn Fn(Vector3<f64>) -> Option<f64>,
+                            x: &Vector3<f64>|
+                 -> f64 {
+                    let e1 = x.cross(&Vector3::new(0.3, -0.5, 0.8)).normalize();
+                    let e2 = x.cross(&e1);
+                    [e1, e2]
+                        .iter()
+                        .map(|e| {
+                            perturb(x + e * H)
+                                .map_or(0.0, |hp| (truenorth_core::angle_diff(hp, h0) / H).powi(2))
+                        })
+                        .sum()
+                };
+                let ga = sens(
+                    &|uu: Vector3<f64>| heading_of(theta, r0, &(ba_inv * uu + md.c_a), &m),
+                    &u,
+                );
+                let gm = sens(
+                    &|vv: Vector3<f64>| heading_of(theta, r0, &a, &(bm_inv * vv + md.c_m)),
+                    &v,
+                );
+                noise_ss += sigma_a * sigma_a * ga + sigma_m * sigma_m * gm;
+                count += 1;
+            }
+        }
+    }
+    let bound = (quality::BOUND_SIGMAS * worst.sqrt()).to_degrees();
+    let noise = (noise_ss / count.max(1) as f64).sqrt().to_degrees();
+    (
+        if bound.is_finite() {
+            bound
+        } else {
+            f64::INFINITY
+        },
+        noise,
+    )
+}
+
+/// The calibration in raw units and body axes, and its report.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn assemble(
+    samples: &[MagAccelSample],
+    data: &Data,
+    na: &Normaliser<3>,
+    nm: &Normaliser<3>,
+    r0: &Rotation3<f64>,
+    theta: &SVector<f64, P>,
+    runs: &[Range<usize>],
+    sums: &GroupSums,
+    cov: &SMatrix<f64, P, P>,
+    w: &Weights,
+    mag_raw: &[Vector3<f64>],
+    config: &MagAccelConfig,
+) -> Result<Solution<MagAccelCalibration, MagAccelQuality>> {
+    let md = Model::of(theta, r0);
+    let not_finite = Error::Degenerate {
+        reason: "the joint fit is not finite; check the input scale",
+    };
+    // u = B_n((x − μ)/s − c_n) = (B_n/s)(x − (μ + s·c_n)).
+    let acc_bias = na.centre + md.c_a * na.scale;
+    let acc_unit = md.b_a / na.scale;
+    let hard_iron = nm.centre + md.c_m * nm.scale;
+    let mag_unit = md.b_m / nm.scale;
+    let gravity = acc_unit.determinant().powf(-1.0 / 3.0);
+    let field = mag_unit.determinant().powf(-1.0 / 3.0);
+    if !(gravity.is_finite() && gravity > 0.0 && field.is_finite() && field > 0.0) {
+        return Err(not_finite);
+    }
+    // Body frame: x along the pointing axis (the accelerometer's x without runs).
+    let to_body =
+        Rotation3::rotation_between(&md.p, &Vector3::x()).unwrap_or_else(Rotation3::identity);
+    let accel = AccelTriadCalibration {
+        bias: acc_bias,
+        matrix: (to_body.into_inner() * acc_unit) * STANDARD_GRAVITY_MPS2,
+    };
+    let mag = CompassCalibration3d {
+        hard_iron,
+        soft_iron: mag_unit * field,
+    };
+    let cal = MagAccelCalibration {
+        mag,
+        mag_to_body: to_body.into_inner() * md.rot,
+        accel,
+        field,
+        gravity,
+        dip_rad: (-md.s).clamp(-1.0, 1.0).asin(),
+    };
+    cal.validate().map_err(|_| not_finite.clone())?;
+    let rms = |(ss, n): (f64, usize)| (ss / n.max(1) as f64).sqrt();
+    let (sigma_a, sigma_m) = (rms(sums.acc), rms(sums.mag));
+    let (bound, noise) = heading_figures(theta, r0, cov, 1.0 / w.acc, 1.0 / w.mag);
+    // The magnetometer's own geometry, for its coverage, condition and dilution.
+    let own = quality::assess_3d(mag_raw, &mag, field);
+    let sd = |k: usize| cov[(k, k)].max(0.0).sqrt();
+    let mut hard_sigma = [0.0; 3];
+    let mut bias_sigma = [0.0; 3];
+    for k in 0..3 {
+        hard_sigma[k] = sd(CM + k) * nm.scale;
+        bias_sigma[k] = sd(CA + k) * na.scale;
+    }
+    // The soft iron relative: σ of B's entries over B's size.
+    let b_size = sym_eigen3(&md.b_m).map_or(1.0, |(l, _)| l.mean());
+    let soft_sigma = (BM..BM + 6).map(sd).fold(0.0, f64::max) / b_size;
+    let omega_sd = (0..3)
+        .map(|k| cov[(OMEGA + k, OMEGA + k)].max(0.0))
+        .sum::<f64>()
+        .sqrt();
+    let dip_spread =
+        (rms(sums.dip) / md.s.clamp(-1.0, 1.0).acos().sin().abs().max(1e-9)).to_degrees();
+    let run_shots: usize = runs.iter().map(|r| r.len()).sum();
+    let quality = MagAccelQuality {
+        mag: quality::with_expected_field(
+            CompassQuality {
+                fit: FitQuality {
+                    points: samples.len(),
+                    coverage: own.quality.fit.coverage,
+                    residual_rms_rel: sigma_m,
+                    condition: own.quality.fit.condition,
+                },
+                heading_error_3sigma_deg: bound,
+                heading_error_systematic_deg: 0.0,
+                heading_noise_rms_deg: noise,
+                field_magnitude: field,
+                field_ratio_to_expected: None,
+            },
+            config.expected_field,
+        ),
+        mag_uncertainty: Uncertainty {
+            dilution: own.uncertainty.dilution,
+            hard_iron_sigma: hard_sigma,
+            soft_iron_sigma_rel: soft_sigma,
+        },
+        accel_residual_rms_rel: sigma_a,
+        accel_bias_sigma: bias_sigma,
+        dip_deg: cal.dip_rad.to_degrees(),
+        dip_spread_deg: dip_spread,
+        alignment_deg: Rotation3::from_matrix_unchecked(md.rot)
+            .angle()
+            .to_degrees(),
+        alignment_sigma_deg: omega_sd.to_degrees(),
+        runs: runs.len(),
+        run_shots,
+        pointing_offset_deg: md.p.angle(&Vector3::x()).to_degrees(),
+        aim_rms_deg: if runs.is_empty() {
+            0.0
+        } else {
+            aim_rms(data, runs, r0, theta).to_degrees() * 3f64.sqrt()
+        },
+    };
+    Ok(Solution {
+        params: cal,
+        quality,
+    })
+}
+
+/// How far to trust a joint calibration.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub struct MagAccelQuality {
+    /// The magnetometer's report: its points, coverage and condition (its own geometry),
+    /// its field-norm residual, and the heading figures of the joint calibration (the 3σ
+    /// bound is that of the heading of the pointing axis, propagated from every
+    /// parameter's uncertainty, the accelerometer's and the alignment's included).
+    pub mag: CompassQuality,
+    /// What the readings determine of the magnetometer (σ from the joint fit; dilution
+    /// from its own geometry).
+    pub mag_uncertainty: Uncertainty,
+    /// RMS of `|f|/g − 1` of the calibrated accelerometer.
+    pub accel_residual_rms_rel: f64,
+    /// Predicted 1σ of each accelerometer bias component, its raw unit.
+    pub accel_bias_sigma: [f64; 3],
+    /// Mean dip, degrees.
+    pub dip_deg: f64,
+    /// RMS spread of the dip over the readings, degrees: how well gravity and the field
+    /// keep their angle after calibration.
+    pub dip_spread_deg: f64,
+    /// Angle of the rotation between the magnetometer's and the accelerometer's calibrated
+    /// frames, degrees.
+    pub alignment_deg: f64,
+    /// Predicted 1σ of that rotation (the norm of its three components), degrees.
+    pub alignment_sigma_deg: f64,
+    /// Runs of shots aimed at one target that were found.
+    pub runs: usize,
+    /// Shots in those runs.
+    pub run_shots: usize,
+    /// Angle between the pointing axis the runs found and the accelerometer's x axis,
+    /// degrees (0 without runs).
+    pub pointing_offset_deg: f64,
+    /// RMS of the runs' pointing directions about their means, degrees (how steadily the
+    /// target was held, plus what the model leaves).
+    pub aim_rms_deg: f64,
+}

@@ -1,0 +1,372 @@
+//! The joint least-squares problem of the magnetometer + accelerometer calibration (see
+//! `mag_accel`): parameters, residuals, their Jacobian and the normal equations.
+//!
+//! In the coordinates of each sensor's normaliser, with `uᵢ = B_a(aᵢ − c_a)` and
+//! `vᵢ = B_m(mᵢ − c_m)` (`B` symmetric), `R = R₀·exp([ω]×)` the rotation from the
+//! magnetometer's calibrated frame into the accelerometer's, `s` the cosine of the angle
+//! between gravity and the field, and `p` the pointing axis in the accelerometer's frame,
+//! every reading contributes
+//! * `|uᵢ| − 1` and `|vᵢ| − 1`: each sensor's readings lie on its ellipsoid (Li & Griffiths
+//!   2004; Vasconcelos et al. 2011, "Geometric approach to strapdown magnetometer
+//!   calibration in sensor frame", IEEE Trans. Aerospace and Electronic Systems 47(2));
+//! * `ûᵢᵀ R v̂ᵢ − s`: the angle between gravity and the field is the same in every static
+//!   reading (the dip-angle constraint; e.g. Kok & Schön 2016, "Magnetometer calibration
+//!   using inertial sensors", IEEE Sensors Journal 16(14)).
+//!
+//! Every shot of a run aimed at one target also contributes `wᵢ − w̄`: the direction of `p`
+//! in the level frame of the shot (built from `ûᵢ` and `R v̂ᵢ` by TRIAD: Black 1964, "A
+//! passive system for determining the attitude of a satellite", AIAA Journal 2(7)) less
+//! its mean over the run, since the pointing axis keeps its direction while the instrument
+//! rolls about it.
+//!
+//! Each group is weighted by the inverse of its own standard deviation, estimated from its
+//! residuals (Helmert's variance components; e.g. Koch 1999, *Parameter Estimation and
+//! Hypothesis Testing in Linear Models*), so that neither sensor's unit nor noise decides
+//! how much it counts.
+
+// `!(x <= limit)` and `!(x > 0.0)` are deliberate: they are true for NaN, so a NaN fails
+// every check instead of slipping through one.
+#![expect(clippy::neg_cmp_op_on_partial_ord)]
+
+extern crate alloc;
+
+use alloc::vec::Vec;
+use core::ops::Range;
+
+use nalgebra::{Matrix3, Rotation3, SMatrix, SVector, Vector3};
+
+use crate::fits::lm::NormalEquations;
+
+#[cfg(not(feature = "std"))]
+use truenorth_core::Float as _;
+
+/// Number of parameters: `c_a` (3), `B_a` (6), `c_m` (3), `B_m` (6), `ω` (3), `s`, and the
+/// pointing axis's two offsets from x.
+pub(crate) const P: usize = 24;
+pub(crate) const CA: usize = 0;
+pub(crate) const BA: usize = 3;
+pub(crate) const CM: usize = 9;
+pub(crate) const BM: usize = 12;
+pub(crate) const OMEGA: usize = 18;
+pub(crate) const S: usize = 21;
+pub(crate) const PT: usize = 22;
+
+/// Index pairs of the six free entries of a symmetric matrix, in parameter order.
+pub(crate) const PAIRS: [(usize, usize); 6] = [(0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)];
+
+/// The symmetric matrix of six parameters.
+pub(crate) fn sym(b: &[f64]) -> Matrix3<f64> {
+    let mut m = Matrix3::zeros();
+    for (k, &(r, c)) in PAIRS.iter().enumerate() {
+        m[(r, c)] = b[k];
+        m[(c, r)] = b[k];
+    }
+    m
+}
+
+/// The six parameters of a symmetric matrix.
+pub(crate) fn unsym(m: &Matrix3<f64>) -> [f64; 6] {
+    PAIRS.map(|(r, c)| 0.5 * (m[(r, c)] + m[(c, r)]))
+}
+
+/// The pointing axis with offsets `(α, β)` from x: `(1, α, β)/|·|`.
+pub(crate) fn pointing(alpha: f64, beta: f64) -> Vector3<f64> {
+    Vector3::new(1.0, alpha, beta).normalize()
+}
+
+/// The parameters, unpacked.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Model {
+    pub c_a: Vector3<f64>,
+    pub b_a: Matrix3<f64>,
+    pub c_m: Vector3<f64>,
+    pub b_m: Matrix3<f64>,
+    pub rot: Matrix3<f64>,
+    pub s: f64,
+    pub p: Vector3<f64>,
+}
+
+impl Model {
+    pub fn of(theta: &SVector<f64, P>, r0: &Rotation3<f64>) -> Self {
+        let t = theta.as_slice();
+        Self {
+            c_a: Vector3::new(t[CA], t[CA + 1], t[CA + 2]),
+            b_a: sym(&t[BA..BA + 6]),
+            c_m: Vector3::new(t[CM], t[CM + 1], t[CM + 2]),
+            b_m: sym(&t[BM..BM + 6]),
+            rot: (r0 * Rotation3::new(Vector3::new(t[OMEGA], t[OMEGA + 1], t[OMEGA + 2])))
+                .into_inner(),
+            s: t[S],
+            p: pointing(t[PT], t[PT + 1]),
+        }
+    }
+}
+
+/// The direction of `p` in the level frame of a reading whose unit specific force is `u`
+/// and unit field (in the same frame) `g`: `(e₁·p, e₂·p, e₃·p)` with `e₃ = u`,
+/// `e₂ = u × g/|u × g|`, `e₁ = e₂ × e₃`. For a specific force (pointing up) the frame is
+/// (north, west, up). `None` when gravity and the field are parallel.
+pub(crate) fn level_direction(
+    u: &Vector3<f64>,
+    g: &Vector3<f64>,
+    p: &Vector3<f64>,
+) -> Option<Vector3<f64>> {
+    let n = u.cross(g);
+    let nn = n.norm();
+    if !(nn > 1e-9) {
+        return None;
+    }
+    let e2 = n / nn;
+    let e1 = e2.cross(u);
+    Some(Vector3::new(e1.dot(p), e2.dot(p), u.dot(p)))
+}
+
+/// The readings, each sensor in its normaliser's coordinates.
+#[derive(Debug, Clone)]
+pub(crate) struct Data {
+    pub acc: Vec<Vector3<f64>>,
+    pub mag: Vec<Vector3<f64>>,
+}
+
+/// Inverse standard deviations of the residual groups.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Weights {
+    pub acc: f64,
+    pub mag: f64,
+    pub dip: f64,
+    pub aim: f64,
+}
+
+/// Sums of squared (unweighted) residuals and counts per group.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub(crate) struct GroupSums {
+    pub acc: (f64, usize),
+    pub mag: (f64, usize),
+    pub dip: (f64, usize),
+    pub aim: (f64, usize),
+}
+
+/// A rank-one update of the normal equations by the row `j` with residual `r`, both
+/// already weighted.
+fn add_row(
+    jtj: &mut SMatrix<f64, P, P>,
+    jtr: &mut SVector<f64, P>,
+    cost: &mut f64,
+    j: &SVector<f64, P>,
+    r: f64,
+) {
+    for a in 0..P {
+        if j[a] == 0.0 {
+            continue;
+        }
+        for b in a..P {
+            jtj[(a, b)] += j[a] * j[b];
+        }
+        jtr[a] += j[a] * r;
+    }
+    *cost += r * r;
+}
+
+/// `∂x̂/∂x = (I − x̂x̂ᵀ)/|x|` applied to the row vector `g` (gives `(g − (g·x̂)x̂)/|x|`).
+fn unit_gradient(g: &Vector3<f64>, x_hat: &Vector3<f64>, norm: f64) -> Vector3<f64> {
+    (g - x_hat * g.dot(x_hat)) / norm
+}
+
+/// Adds to `row` the gradient with respect to `(c, B)` of a function of `u = B(x − c)`
+/// whose gradient in `u` is `gu`: `∂/∂c = −B gu`, `∂/∂B_rs = gu_r d_s + gu_s d_r`
+/// (`gu_r d_r` on the diagonal), `d = x − c`. For `|u| − 1`, `gu = û`.
+fn chain_to_ellipsoid(
+    row: &mut SVector<f64, P>,
+    c0: usize,
+    b0: usize,
+    b: &Matrix3<f64>,
+    d: &Vector3<f64>,
+    gu: &Vector3<f64>,
+) {
+    let bc = -(b * gu);
+    for k in 0..3 {
+        row[c0 + k] += bc[k];
+    }
+    for (k, &(r, s)) in PAIRS.iter().enumerate() {
+        row[b0 + k] += if r == s {
+            gu[r] * d[r]
+        } else {
+            gu[r] * d[s] + gu[s] * d[r]
+        };
+    }
+}
+
+/// The normal equations of the weighted residuals at `theta`, and the group sums of the
+/// unweighted ones; `None` where the model is undefined (a reading at a centre, a
+/// non-finite value). `runs` are index ranges of shots aimed at one target; without any,
+/// the pointing axis is held at x by a stiff prior.
+pub(crate) fn normal_equations(
+    data: &Data,
+    runs: &[Range<usize>],
+    w: &Weights,
+    r0: &Rotation3<f64>,
+    theta: &SVector<f64, P>,
+) -> Option<(NormalEquations<P>, GroupSums)> {
+    let m = Model::of(theta, r0);
+    let mut jtj = SMatrix::<f64, P, P>::zeros();
+    let mut jtr = SVector::<f64, P>::zeros();
+    let mut cost = 0.0;
+    let mut sums = GroupSums::default();
+    for (a, mg) in data.acc.iter().zip(&data.mag) {
+        let da = a - m.c_a;
+        let u = m.b_a * da;
+        let nu = u.norm();
+        let dm = mg - m.c_m;
+        let v = m.b_m * dm;
+        let nv = v.norm();
+        if !(nu > 1e-12 && nv > 1e-12) {
+            return None;
+        }
+        let (u_hat, v_hat) = (u / nu, v / nv);
+        // |u| − 1.
+        let mut row = SVector::<f64, P>::zeros();
+        chain_to_ellipsoid(&mut row, CA, BA, &m.b_a, &da, &u_hat);
+        let r = nu - 1.0;
+        add_row(&mut jtj, &mut jtr, &mut cost, &(row * w.acc), r * w.acc);
+        sums.acc.0 += r * r;
+        sums.acc.1 += 1;
+        // |v| − 1.
+        let mut row = SVector::<f64, P>::zeros();
+        chain_to_ellipsoid(&mut row, CM, BM, &m.b_m, &dm, &v_hat);
+        let r = nv - 1.0;
+        add_row(&mut jtj, &mut jtr, &mut cost, &(row * w.mag), r * w.mag);
+        sums.mag.0 += r * r;
+        sums.mag.1 += 1;
+        // ûᵀ R v̂ − s.
+        let g = m.rot * v_hat;
+        let r = u_hat.dot(&g) - m.s;
+        let mut row = SVector::<f64, P>::zeros();
+        chain_to_ellipsoid(
+            &mut row,
+            CA,
+            BA,
+            &m.b_a,
+            &da,
+            &unit_gradient(&g, &u_hat, nu),
+        );
+        let rtu = m.rot.transpose() * u_hat;
+        chain_to_ellipsoid(
+            &mut row,
+            CM,
+            BM,
+            &m.b_m,
+            &dm,
+            &unit_gradient(&rtu, &v_hat, nv),
+        );
+        // d/dδ ûᵀR exp([δ]×) v̂ at δ = 0 is v̂ × Rᵀû. At ω ≠ 0 this is the derivative in
+        // the right-perturbation of R, which differs from ∂/∂ω by an invertible 3×3 factor:
+        // the stationary points, and so the solution, are the same.
+        let dw = v_hat.cross(&rtu);
+        for k in 0..3 {
+            row[OMEGA + k] = dw[k];
+        }
+        row[S] = -1.0;
+        add_row(&mut jtj, &mut jtr, &mut cost, &(row * w.dip), r * w.dip);
+        sums.dip.0 += r * r;
+        sums.dip.1 += 1;
+    }
+    if runs.is_empty() {
+        // No run: the pointing axis is x. A stiff prior keeps the normal equations regular.
+        for k in [PT, PT + 1] {
+            let mut row = SVector::<f64, P>::zeros();
+            row[k] = 1e4;
+            add_row(&mut jtj, &mut jtr, &mut cost, &row, 1e4 * theta[k]);
+        }
+    }
+    for run in runs {
+        run_rows(
+            data, run, w, r0, theta, &mut jtj, &mut jtr, &mut cost, &mut sums,
+        )?;
+    }
+    for a in 0..P {
+        for b in 0..a {
+            jtj[(a, b)] = jtj[(b, a)];
+        }
+    }
+    let ne = NormalEquations { cost, jtj, jtr };
+    (ne.cost.is_finite() && ne.jtj.iter().all(|x| x.is_finite())).then_some((ne, sums))
+}
+
+/// The level-frame direction of the pointing axis for shot `i` under `theta`.
+fn shot_direction(
+    data: &Data,
+    i: usize,
+    r0: &Rotation3<f64>,
+    theta: &SVector<f64, P>,
+) -> Option<Vector3<f64>> {
+    let m = Model::of(theta, r0);
+    let u = (m.b_a * (data.acc[i] - m.c_a)).try_normalize(1e-12)?;
+    let v = (m.b_m * (data.mag[i] - m.c_m)).try_normalize(1e-12)?;
+    level_direction(&u, &(m.rot * v), &m.p)
+}
+
+/// The rows `wᵢ − w̄` of one run, with Jacobians by forward differences (the TRIAD frame's
+/// derivatives are long to write out and a run is a few shots), centred like the residuals.
+#[allow(clippy::too_many_arguments)]
+fn run_rows(
+    data: &Data,
+    run: &Range<usize>,
+    w: &Weights,
+    r0: &Rotation3<f64>,
+    theta: &SVector<f64, P>,
+    jtj: &mut SMatrix<f64, P, P>,
+    jtr: &mut SVector<f64, P>,
+    cost: &mut f64,
+    sums: &mut GroupSums,
+) -> Option<()> {
+    let n = run.len();
+    let mut dirs: Vec<Vector3<f64>> = Vec::with_capacity(n);
+    let mut jac: Vec<SMatrix<f64, 3, P>> = Vec::with_capacity(n);
+    // Step: the parameters are of order one in normalised coordinates; √ε balances
+    // truncation and rounding of a forward difference.
+    const H: f64 = 1.5e-8;
+    for i in run.clone() {
+        let d0 = shot_direction(data, i, r0, theta)?;
+        let mut j = SMatrix::<f64, 3, P>::zeros();
+        for k in 0..P {
+            let mut t = *theta;
+            t[k] += H;
+            let dk = shot_direction(data, i, r0, &t)?;
+            j.set_column(k, &((dk - d0) / H));
+        }
+        dirs.push(d0);
+        jac.push(j);
+    }
+    let inv = 1.0 / n as f64;
+    let mean: Vector3<f64> = dirs.iter().sum::<Vector3<f64>>() * inv;
+    let mean_j: SMatrix<f64, 3, P> = jac.iter().sum::<SMatrix<f64, 3, P>>() * inv;
+    for (d, j) in dirs.iter().zip(&jac) {
+        let r = d - mean;
+        let jc = j - mean_j;
+        for c in 0..3 {
+            let row: SVector<f64, P> = jc.row(c).transpose();
+            add_row(jtj, jtr, cost, &(row * w.aim), r[c] * w.aim);
+            sums.aim.0 += r[c] * r[c];
+        }
+        sums.aim.1 += 3;
+    }
+    Some(())
+}
+
+/// RMS of the run residuals.
+pub(crate) fn aim_rms(
+    data: &Data,
+    runs: &[Range<usize>],
+    r0: &Rotation3<f64>,
+    theta: &SVector<f64, P>,
+) -> f64 {
+    let w = Weights {
+        acc: 0.0,
+        mag: 0.0,
+        dip: 0.0,
+        aim: 1.0,
+    };
+    normal_equations(data, runs, &w, r0, theta)
+        .map(|(_, s)| (s.aim.0 / s.aim.1.max(1) as f64).sqrt())
+        .unwrap_or(1.0)
+}

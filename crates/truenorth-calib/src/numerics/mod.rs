@@ -1,0 +1,8 @@
+//! Shared mathematics of the calibrators: small dense linear algebra, blocked sums over
+//! the readings, the circle through three points, and a bounded sample of readings spread
+//! by direction.
+
+pub(crate) mod blocks;
+pub mod circumcentre;
+pub(crate) mod direction_slots;
+pub(crate) mod linalg;

@@ -1,0 +1,448 @@
+//! What the online least-squares ellipse and ellipsoid calibrators share: the bookkeeping
+//! around their running sums, retained readings and staged refresh (push, progress, solve,
+//! reset, snapshot and restore), generic over the dimension, as [`crate::fits::normalise`]'s
+//! `Normaliser<D>` is. The 2-D and 3-D specifics — the direct fit and its stages, the
+//! direction slots, the coverage measure — come from the refresh type through
+//! [`ConicRefresh`], so the per-sample path is monomorphised: no dynamic dispatch, no
+//! allocation.
+
+// `!(x <= limit)` and `!(x > 0.0)` are deliberate: they are true for NaN, so a NaN fails
+// every check instead of slipping through one.
+#![expect(clippy::neg_cmp_op_on_partial_ord)]
+
+use core::fmt::Debug;
+
+use nalgebra::SMatrix;
+use nalgebra::SVector;
+use serde::{Deserialize, Serialize};
+use truenorth_core::{
+    CompassQuality, Error, FitQuality, Progress, Pushed, Result, Solution, Validate, check_finite,
+};
+
+use crate::online::conic_sums::{
+    ConicSums, Retained, RetainedSnapshot, SumsSnapshot, forgetting, inverse_factor, sigma_kappa,
+};
+use crate::quality::{self, BOUND_SIGMAS};
+
+#[cfg(not(feature = "std"))]
+use truenorth_core::Float as _;
+
+/// The parameters of an online calibrator's configuration that its bookkeeping needs.
+pub(crate) trait OnlineConfig: Copy + Debug + PartialEq + Validate {
+    /// Fewest readings a solution is accepted from (and when the first refresh starts).
+    fn min_samples(&self) -> u32;
+    /// Readings between the starts of two refreshes.
+    fn refresh_interval_samples(&self) -> u32;
+    /// Half-life of a reading's weight, in readings (`None`: never forget).
+    fn forgetting_half_life_samples(&self) -> Option<f64>;
+}
+
+/// A staged refresh of a `D`-axis online conic calibrator with `M` running monomial sums and
+/// `N` retained-reading slots: the dimension's specifics the shared bookkeeping calls.
+pub(crate) trait ConicRefresh<const D: usize, const M: usize, const N: usize>:
+    Clone + Debug
+{
+    /// The calibrator's configuration.
+    type Config: OnlineConfig;
+    /// The calibration it fits.
+    type Cal: Copy + Debug + PartialEq;
+    /// The sample it is fed.
+    type Sample;
+    /// Number of stages of a refresh.
+    const STAGES: u8;
+    /// The refusal of a solve whose refresh ended without an outcome.
+    const NOT_READY: Error;
+    /// The sample's timestamp and magnetometer reading.
+    fn reading(sample: &Self::Sample) -> (f64, &SVector<f64, D>);
+    /// Adds reading `p` to `sums` (see [`ConicSums::add`]).
+    fn add(sums: &mut ConicSums<D, M>, p: &SVector<f64, D>, decay: f64) -> Result<()>;
+    /// The retained-reading slot of `p` under calibration `cal`.
+    fn slot(cal: &Self::Cal, p: &SVector<f64, D>) -> Option<usize>;
+    /// Coverage of the live retained readings about calibration `cal`, as a fraction.
+    fn coverage(slots: &Retained<D, N>, now: u64, lifetime: u64, cal: &Self::Cal) -> f64;
+    /// Whether every coefficient of `cal` is finite.
+    fn is_finite(cal: &Self::Cal) -> bool;
+    /// A refresh of copies of `sums` and `slots`, no stage run yet.
+    fn start(sums: &ConicSums<D, M>, slots: &Retained<D, N>) -> Self;
+    /// Runs stage `stage` (see [`ConicRefresh::step`]).
+    fn run_stage(&mut self, stage: u8, cfg: &Self::Config, lifetime: u64);
+    /// What every refresh keeps: its copies, its stage, its sorting map and its outcome.
+    fn base(&self) -> &RefreshBase<D, M, N, Self::Cal>;
+    /// As [`ConicRefresh::base`], mutable.
+    fn base_mut(&mut self) -> &mut RefreshBase<D, M, N, Self::Cal>;
+    /// As [`ConicRefresh::base`], by value, once the refresh is done.
+    fn into_base(self) -> RefreshBase<D, M, N, Self::Cal>;
+
+    /// Runs the next stage; `true` once the outcome is known.
+    #[inline]
+    fn step(&mut self, cfg: &Self::Config, lifetime: u64) -> bool {
+        if self.base().outcome.is_some() {
+            return true;
+        }
+        let stage = self.base().stage;
+        self.run_stage(stage, cfg, lifetime);
+        self.base_mut().stage += 1;
+        self.base().outcome.is_some()
+    }
+}
+
+/// What every staged refresh keeps: a copy of the sums and retained readings taken when it
+/// started, the stages run, the calibration to sort retained readings by from now on, and
+/// the outcome once known.
+#[derive(Debug, Clone)]
+pub(crate) struct RefreshBase<const D: usize, const M: usize, const N: usize, C> {
+    pub sums: ConicSums<D, M>,
+    pub slots: Retained<D, N>,
+    pub stage: u8,
+    pub map: Option<C>,
+    pub outcome: Option<Result<Solution<C>>>,
+}
+
+impl<const D: usize, const M: usize, const N: usize, C> RefreshBase<D, M, N, C> {
+    /// Copies of `sums` and `slots`, no stage run yet.
+    pub fn new(sums: &ConicSums<D, M>, slots: &Retained<D, N>) -> Self {
+        Self {
+            sums: *sums,
+            slots: *slots,
+            stage: 0,
+            map: None,
+            outcome: None,
+        }
+    }
+
+    /// Ends the refresh with refusal `e`, past its last stage (`stages`).
+    pub fn fail(&mut self, e: Error, stages: u8) {
+        self.outcome = Some(Err(e));
+        self.stage = stages;
+    }
+
+    /// Refuses fewer readings than `min_samples`; whether there are enough.
+    pub fn require_samples(&mut self, min_samples: u32, stages: u8) -> bool {
+        let count = self.sums.count;
+        if count < u64::from(min_samples) {
+            self.fail(
+                Error::TooFewPoints {
+                    got: count as usize,
+                    need: min_samples as usize,
+                },
+                stages,
+            );
+            return false;
+        }
+        true
+    }
+
+    /// The degrees of freedom of σ with `params` parameters: the effective count of
+    /// readings (the count, without forgetting) less the parameters. The refusal on the
+    /// heading-error bound widens it by their Student-t factor, the report keeps the plain
+    /// 3σ one, as the batch fits'.
+    pub fn residual_dof(&self, params: usize) -> f64 {
+        self.sums.effective_count() - params as f64
+    }
+}
+
+/// The residual standard deviation σ of a fit of `P` parameters from the weighted residual
+/// sum of squares `weighted_ss` (see [`sigma_kappa`]), and `L⁻¹` of its information matrix
+/// scaled by `√κ`, so that `‖L⁻¹g‖²` is the variance factor of a gradient `g` directly.
+/// `(∞, None)` when the readings do not outnumber the parameters.
+pub(crate) fn noise_factor<const D: usize, const M: usize, const P: usize>(
+    sums: &ConicSums<D, M>,
+    weighted_ss: f64,
+    info: &SMatrix<f64, P, P>,
+) -> (f64, Option<SMatrix<f64, P, P>>) {
+    match sigma_kappa(weighted_ss, sums.weight(), sums.effective_count(), P) {
+        Some((sigma, kappa)) => (sigma, inverse_factor(info).map(|l| l * kappa.sqrt())),
+        None => (f64::INFINITY, None),
+    }
+}
+
+/// The heading-error bound, degrees: [`BOUND_SIGMAS`]·σ times the square root of the worst
+/// variance factor over the test directions (`None` without an information factor: ∞).
+pub(crate) fn bound_deg(sigma: f64, worst: Option<f64>) -> f64 {
+    match worst {
+        Some(w) => {
+            let b = (BOUND_SIGMAS * sigma * w.sqrt()).to_degrees();
+            if b.is_finite() { b } else { f64::INFINITY }
+        }
+        None => f64::INFINITY,
+    }
+}
+
+/// A bound on the heading (3-D: field-direction) error, radians, that the second-order bias
+/// of the direct (algebraic) fit leaves, which no number of readings removes:
+/// `4σ²(κ + h₁ + h₂)`, with `σ` the per-reading noise (relative), `κ = (λ₁ − λ₂)/(λ₁ + λ₂)`
+/// the anisotropy of `B²` (largest and smallest eigenvalues), and `h₁`, `h₂` the first and
+/// second harmonics of the calibrated directions (1 each for readings all in one direction,
+/// 0 for an even spread). The derivation is that of the batch ellipse's
+/// `refinement_could_matter`: isotropic sensor noise is anisotropic in the calibrated frame,
+/// the algebraic fit of such points is an ellipse of axis ratio `1 + 4(σ₁² − σ₂²)`, a
+/// two-cycle heading error of amplitude `4σ²κ`, and an uneven spread adds its harmonics
+/// with the same factor. In 3-D each plane section is such an ellipse; the bound is held
+/// against the error actually left by `tests/noisy_tumble.rs` (0.53° at 6 % noise, where the
+/// 3σ part alone is 0.31°).
+pub(crate) fn direct_fit_bias_rad(sigma: f64, kappa: f64, h1: f64, h2: f64) -> f64 {
+    let b = 4.0 * sigma * sigma * (kappa + h1 + h2);
+    if b.is_finite() { b } else { f64::INFINITY }
+}
+
+/// The quality report of a refresh, the direct fit's bias bound (radians) as its
+/// systematic part.
+pub(crate) fn report(
+    fit: FitQuality,
+    bound_deg: f64,
+    bias_rad: f64,
+    sigma: f64,
+    field: f64,
+    expected_field: Option<f64>,
+) -> CompassQuality {
+    quality::with_expected_field(
+        CompassQuality {
+            fit,
+            heading_error_3sigma_deg: bound_deg,
+            heading_error_systematic_deg: bias_rad.to_degrees(),
+            heading_noise_rms_deg: sigma.to_degrees(),
+            field_magnitude: field,
+            field_ratio_to_expected: None,
+        },
+        expected_field,
+    )
+}
+
+/// The refusals that follow the coverage checks, in the order of the batch fits: the
+/// residual (beyond `max_residual_rel`, an [`Error::NotAnEllipse`] with detail `stray`),
+/// then the heading-error bound widened by the Student-t factor of σ's `dof` degrees of
+/// freedom ([`quality::require_certain`]).
+pub(crate) fn refuse_fit(
+    q: &CompassQuality,
+    max_residual_rel: f64,
+    max_bound_deg: f64,
+    dof: f64,
+    stray: &'static str,
+) -> Result<()> {
+    if !(q.fit.residual_rms_rel <= max_residual_rel) {
+        Err(Error::NotAnEllipse { detail: stray })
+    } else {
+        quality::require_certain(q, dof, max_bound_deg)
+    }
+}
+
+/// The state and per-sample logic of an online conic calibrator (see the
+/// `online_ellipse` module for the scheme).
+#[derive(Debug, Clone)]
+pub(crate) struct OnlineCore<const D: usize, const M: usize, const N: usize, R>
+where
+    R: ConicRefresh<D, M, N>,
+{
+    pub config: R::Config,
+    /// Per-reading weight factor and retained-reading lifetime, from the config.
+    decay: f64,
+    lifetime: u64,
+    sums: ConicSums<D, M>,
+    slots: Retained<D, N>,
+    /// The calibration retained readings are sorted by (`None` before the first refresh).
+    map: Option<R::Cal>,
+    estimate: Option<Solution<R::Cal>>,
+    /// Sample count at which the next refresh starts.
+    next_refresh: u64,
+    pending: Option<R>,
+}
+
+impl<const D: usize, const M: usize, const N: usize, R> OnlineCore<D, M, N, R>
+where
+    R: ConicRefresh<D, M, N>,
+{
+    /// A calibrator with the given configuration, or the first invalid parameter, named.
+    pub fn new(config: R::Config) -> Result<Self> {
+        config.validate()?;
+        let (decay, lifetime) = forgetting(config.forgetting_half_life_samples());
+        Ok(Self {
+            config,
+            decay,
+            lifetime,
+            sums: ConicSums::new(),
+            slots: Retained::new(),
+            map: None,
+            estimate: None,
+            next_refresh: u64::from(config.min_samples()),
+            pending: None,
+        })
+    }
+
+    /// The stage a refresh in progress will run at the next push.
+    pub fn refresh_stage(&self) -> Option<u8> {
+        self.pending.as_ref().map(|r| r.base().stage)
+    }
+
+    /// Completes a finished refresh: adopts its sorting map (re-sorting the retained
+    /// readings) and, if it succeeded, its estimate. Returns whether the estimate changed.
+    fn publish(&mut self, r: R) -> bool {
+        let RefreshBase { map, outcome, .. } = r.into_base();
+        if let Some(m) = map {
+            self.map = Some(m);
+            self.slots
+                .rekey(|p| R::slot(&m, p), self.sums.count, self.lifetime);
+        }
+        match outcome {
+            Some(Ok(sol)) if self.estimate != Some(sol) => {
+                self.estimate = Some(sol);
+                true
+            }
+            _ => false,
+        }
+    }
+
+    /// See [`truenorth_core::Calibrator::push`] on the calibrators.
+    pub fn push(&mut self, sample: &R::Sample) -> Result<Pushed> {
+        let (t_s, mag) = R::reading(sample);
+        check_finite("timestamp t_s", t_s)?;
+        for &x in mag.iter() {
+            check_finite("magnetometer reading", x)?;
+        }
+        R::add(&mut self.sums, mag, self.decay)?;
+        let now = self.sums.count;
+        // Before the first refresh there is no calibration to sort by: the first readings
+        // take the slots in order, and the first refresh sorts them.
+        let slot = match &self.map {
+            Some(m) => R::slot(m, mag),
+            None => Some((now - 1) as usize),
+        };
+        if let Some(k) = slot {
+            self.slots.offer(k, mag, now, self.lifetime);
+        }
+        if self.pending.is_none() && now >= self.next_refresh {
+            self.pending = Some(R::start(&self.sums, &self.slots));
+            self.next_refresh = now + u64::from(self.config.refresh_interval_samples());
+        }
+        let done = match &mut self.pending {
+            Some(r) => r.step(&self.config, self.lifetime),
+            None => false,
+        };
+        if done
+            && let Some(r) = self.pending.take()
+            && self.publish(r)
+        {
+            return Ok(Pushed::NewEstimate);
+        }
+        Ok(Pushed::Accepted)
+    }
+
+    /// See [`truenorth_core::Calibrator::progress`] on the calibrators.
+    pub fn progress(&self) -> Progress {
+        let coverage = self
+            .map
+            .map(|m| R::coverage(&self.slots, self.sums.count, self.lifetime, &m))
+            .unwrap_or(0.0);
+        Progress {
+            samples: self.sums.count as usize,
+            coverage,
+            ready: self.solve().is_ok(),
+        }
+    }
+
+    /// See [`truenorth_core::Calibrator::solve`] on the calibrators.
+    pub fn solve(&self) -> Result<Solution<R::Cal>> {
+        let mut r = R::start(&self.sums, &self.slots);
+        while !r.step(&self.config, self.lifetime) {}
+        r.into_base().outcome.unwrap_or(Err(R::NOT_READY))
+    }
+
+    /// Forgets every reading, keeping the configuration.
+    pub fn reset(&mut self) {
+        self.sums = ConicSums::new();
+        self.slots = Retained::new();
+        self.map = None;
+        self.estimate = None;
+        self.next_refresh = u64::from(self.config.min_samples());
+        self.pending = None;
+    }
+
+    /// The latest refresh's successful solution.
+    pub fn estimate(&self) -> Option<Solution<R::Cal>> {
+        self.estimate
+    }
+
+    /// The saved state.
+    pub fn state(&self) -> OnlineConicState<R::Config, R::Cal> {
+        OnlineConicState {
+            config: self.config,
+            sums: self.sums.snapshot(),
+            retained: self.slots.snapshot(),
+            sorting: self.map,
+            estimate: self.estimate,
+            next_refresh: self.next_refresh,
+            pending: self.pending.as_ref().map(|r| PendingRefresh {
+                sums: r.base().sums.snapshot(),
+                retained: r.base().slots.snapshot(),
+                stage: r.base().stage,
+            }),
+        }
+    }
+
+    /// Back from a saved state, refusing one that this calibrator could not have written.
+    pub fn restore(s: OnlineConicState<R::Config, R::Cal>) -> Result<Self> {
+        let mut cal = Self::new(s.config)?;
+        cal.sums = ConicSums::restore(&s.sums)?;
+        cal.slots = Retained::restore(&s.retained, cal.sums.count)?;
+        if !s.sorting.as_ref().is_none_or(R::is_finite)
+            || !s.estimate.as_ref().is_none_or(|e| R::is_finite(&e.params))
+        {
+            return Err(Error::InvalidSnapshot {
+                reason: "a saved calibration is not finite",
+            });
+        }
+        cal.map = s.sorting;
+        cal.estimate = s.estimate;
+        cal.next_refresh = s.next_refresh;
+        if let Some(p) = s.pending {
+            let sums = ConicSums::restore(&p.sums)?;
+            if sums.count > cal.sums.count || p.stage >= R::STAGES {
+                return Err(Error::InvalidSnapshot {
+                    reason: "the saved refresh does not fit the saved sums",
+                });
+            }
+            let slots = Retained::restore(&p.retained, sums.count)?;
+            let mut r = R::start(&sums, &slots);
+            while r.base().stage < p.stage && !r.step(&cal.config, cal.lifetime) {}
+            if r.base().outcome.is_some() || r.base().stage != p.stage {
+                return Err(Error::InvalidSnapshot {
+                    reason: "the saved refresh had already finished",
+                });
+            }
+            cal.pending = Some(r);
+        }
+        Ok(cal)
+    }
+}
+
+/// The saved state of an online least-squares calibrator with configuration `C` fitting
+/// calibration `P`: everything it learned and the refresh in progress, so a restored
+/// calibrator continues bit for bit.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct OnlineConicState<C, P> {
+    /// The configuration.
+    pub config: C,
+    /// The running sums.
+    pub sums: SumsSnapshot,
+    /// The retained readings for coverage.
+    pub retained: RetainedSnapshot,
+    /// The calibration retained readings are sorted by.
+    pub sorting: Option<P>,
+    /// The current estimate.
+    pub estimate: Option<Solution<P>>,
+    /// Sample count at which the next refresh starts.
+    pub next_refresh: u64,
+    /// A refresh in progress: its copy of the sums and retained readings, and how many of
+    /// its stages have run (they are run again on restore, with the same result).
+    pub pending: Option<PendingRefresh>,
+}
+
+/// A refresh in progress, as saved.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PendingRefresh {
+    /// The sums it works on.
+    pub sums: SumsSnapshot,
+    /// The retained readings it works on.
+    pub retained: RetainedSnapshot,
+    /// Stages run.
+    pub stage: u8,
+}

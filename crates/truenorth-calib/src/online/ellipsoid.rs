@@ -1,0 +1,120 @@
+//! Online least-squares ellipsoid calibration of a three-axis magnetometer, in bounded
+//! memory: the direct ellipsoid fit of [`crate::EllipsoidCalibrator`] (Li & Griffiths 2004)
+//! solved from the 35 running monomial sums of degree ≤ 4 (see the `conic_sums` module),
+//! optionally forgetting old readings.
+//!
+//! It works as the two-axis [`crate::OnlineEllipseCalibrator`] does (see that module for
+//! the approximations the sums imply): O(1) per push, and a refresh every
+//! [`OnlineEllipsoidConfig::refresh_interval_samples`] readings split into short stages, one
+//! per push — here more of them, since the 3-D algebra is larger (the heading-error bound
+//! alone visits 256 directions, 32 per stage). Coverage is the share of the equal-area
+//! direction cells of [`crate::quality`] holding a retained reading, at most one per cell.
+
+use truenorth_compass::CompassCalibration3d;
+use truenorth_core::{
+    Calibrator, CompassQuality, Mag3Sample, OnlineCalibrator, Persistent, Progress, Pushed, Result,
+    Solution,
+};
+
+use crate::online::conic::{OnlineConicState, OnlineCore};
+use crate::online::conic_sums::MONOMIALS_3D;
+pub use crate::online::ellipsoid_config::OnlineEllipsoidConfig;
+use crate::online::ellipsoid_refresh::Refresh;
+use crate::quality::SPHERE_CELLS;
+
+/// Online least-squares ellipsoid calibrator: the direct fit of
+/// [`crate::EllipsoidCalibrator`] from running sums, O(1) memory and O(1) per push.
+///
+/// ```
+/// use nalgebra::Vector3;
+/// use truenorth_calib::{OnlineEllipsoidCalibrator, OnlineEllipsoidConfig};
+/// use truenorth_core::{Calibrator, Mag3Sample};
+///
+/// let mut cal = OnlineEllipsoidCalibrator::new(OnlineEllipsoidConfig::default())?;
+/// let golden = std::f64::consts::PI * (3.0 - 5.0_f64.sqrt());
+/// for k in 0..500 {
+///     // Directions spread over the sphere, a 50-unit field, a (5, −2, 8) hard iron.
+///     let z = 1.0 - (2.0 * k as f64 + 1.0) / 500.0;
+///     let r = (1.0 - z * z).sqrt();
+///     let (s, c) = (golden * k as f64).sin_cos();
+///     let mag = Vector3::new(5.0, -2.0, 8.0) + 50.0 * Vector3::new(r * c, r * s, z);
+///     cal.push(&Mag3Sample { t_s: k as f64, mag })?;
+/// }
+/// let sol = cal.solve()?;
+/// assert!((sol.params.hard_iron - Vector3::new(5.0, -2.0, 8.0)).norm() < 1e-6);
+/// assert!((sol.quality.field_magnitude - 50.0).abs() < 1e-6);
+/// # Ok::<(), truenorth_core::Error>(())
+/// ```
+#[derive(Debug, Clone)]
+pub struct OnlineEllipsoidCalibrator {
+    core: OnlineCore<3, MONOMIALS_3D, SPHERE_CELLS, Refresh>,
+}
+
+impl OnlineEllipsoidCalibrator {
+    /// A calibrator with the given configuration, or the first invalid parameter, named.
+    pub fn new(config: OnlineEllipsoidConfig) -> Result<Self> {
+        OnlineCore::new(config).map(|core| Self { core })
+    }
+
+    /// The stage a refresh in progress will run at the next push, if one is in progress
+    /// (for profiling the per-push cost).
+    pub fn refresh_stage(&self) -> Option<u8> {
+        self.core.refresh_stage()
+    }
+
+    /// The configuration in use.
+    pub fn config(&self) -> &OnlineEllipsoidConfig {
+        &self.core.config
+    }
+}
+
+impl Calibrator for OnlineEllipsoidCalibrator {
+    type Sample = Mag3Sample;
+    type Params = CompassCalibration3d;
+    type Quality = CompassQuality;
+
+    /// Adds a reading to the sums (and, when its direction cell is free, to the retained
+    /// readings), and runs one stage of a refresh when one is due. O(1), no allocation; a
+    /// non-finite sample is refused and changes nothing.
+    fn push(&mut self, sample: &Mag3Sample) -> Result<Pushed> {
+        self.core.push(sample)
+    }
+
+    /// Samples accepted, direction-cell coverage of the retained readings about the current
+    /// calibration, and `ready` exactly when [`Calibrator::solve`] succeeds (it runs the
+    /// solve: tens of microseconds, independent of the number of readings).
+    fn progress(&self) -> Progress {
+        self.core.progress()
+    }
+
+    fn solve(&self) -> Result<Solution<CompassCalibration3d>> {
+        self.core.solve()
+    }
+
+    fn reset(&mut self) {
+        self.core.reset();
+    }
+}
+
+impl OnlineCalibrator for OnlineEllipsoidCalibrator {
+    /// The latest refresh's successful solution (a refused refresh keeps the previous one).
+    fn estimate(&self) -> Option<Solution<CompassCalibration3d>> {
+        self.core.estimate()
+    }
+}
+
+/// The saved state of an [`OnlineEllipsoidCalibrator`].
+pub type OnlineEllipsoidState = OnlineConicState<OnlineEllipsoidConfig, CompassCalibration3d>;
+
+impl Persistent for OnlineEllipsoidCalibrator {
+    type State = OnlineEllipsoidState;
+    const SNAPSHOT_VERSION: u32 = 1;
+
+    fn state(&self) -> OnlineEllipsoidState {
+        self.core.state()
+    }
+
+    fn from_state(state: OnlineEllipsoidState) -> Result<Self> {
+        OnlineCore::restore(state).map(|core| Self { core })
+    }
+}

@@ -1,0 +1,119 @@
+//! The configuration of the [`crate::OnlineEllipsoidCalibrator`] and its validation.
+
+use serde::{Deserialize, Serialize};
+use truenorth_core::{Result, Validate, check_positive, check_range};
+
+use crate::fits::ellipsoid::config::MIN_POINTS_3D;
+use crate::online::conic::OnlineConfig;
+use crate::quality::{self, MIN_SPHERE_COVERAGE};
+
+/// Configuration of [`crate::OnlineEllipsoidCalibrator`]. The refusal limits are those of
+/// [`crate::EllipsoidConfig`], with the same defaults.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct OnlineEllipsoidConfig {
+    /// Share of the sphere's direction cells, 0..=1 ([`MIN_SPHERE_COVERAGE`]), below which
+    /// a fit that fails (a hyperboloid, a flat or collapsed quadric) is explained as too
+    /// little of the sphere seen. It refuses nothing on its own: whether the orientations
+    /// determine the calibration is judged by their dilution, as the batch fit's.
+    pub min_coverage: f64,
+    /// Fewest readings a solution is accepted from, MIN_POINTS_3D..=10⁶ (50). More than the
+    /// fit's minimum ([`MIN_POINTS_3D`]): a refresh runs unattended, and with few residuals
+    /// beyond the parameters the noise, and so the heading-error bound, is estimated from
+    /// so few residuals that a chance fit of a short arc can pass every other check.
+    pub min_samples: u32,
+    /// Readings between the starts of two refreshes of the estimate, 1..=10⁶ (64). A
+    /// refresh runs over the next 20 pushes, one stage each.
+    pub refresh_interval_samples: u32,
+    /// Half-life of a reading's weight, in readings, 50..=10⁹ (`None`: never forget).
+    /// Readings older than four half-lives no longer count towards coverage.
+    pub forgetting_half_life_samples: Option<f64>,
+    /// Largest ratio of longest to shortest semi-axis accepted, ≥ 1 (10).
+    pub max_axis_ratio: f64,
+    /// Largest residual RMS, relative to the fitted field, accepted, > 0 (0.2).
+    pub max_residual_rel: f64,
+    /// Largest direction-error bound of the calibration accepted, degrees, > 0 (10).
+    pub max_heading_error_bound_deg: f64,
+    /// Largest per-reading noise (relative to the field) times the orientations' dilution
+    /// accepted, > 0 ([`quality::MAX_NOISE_DILUTION`]: beyond it the fit's own error figures
+    /// no longer hold; see [`quality::require_linear`]).
+    pub max_noise_dilution: f64,
+    /// The expected total field, input unit, > 0, reported as
+    /// [`truenorth_core::CompassQuality::field_ratio_to_expected`] (`None`).
+    pub expected_field: Option<f64>,
+}
+
+impl Default for OnlineEllipsoidConfig {
+    fn default() -> Self {
+        Self {
+            min_coverage: MIN_SPHERE_COVERAGE,
+            min_samples: 50,
+            refresh_interval_samples: 64,
+            forgetting_half_life_samples: None,
+            max_axis_ratio: 10.0,
+            max_residual_rel: 0.2,
+            max_heading_error_bound_deg: 10.0,
+            max_noise_dilution: quality::MAX_NOISE_DILUTION,
+            expected_field: None,
+        }
+    }
+}
+
+impl Validate for OnlineEllipsoidConfig {
+    fn validate(&self) -> Result<()> {
+        check_range("online ellipsoid min_coverage", self.min_coverage, 0.0, 1.0)?;
+        check_range(
+            "online ellipsoid min_samples",
+            self.min_samples as f64,
+            MIN_POINTS_3D as f64,
+            1e6,
+        )?;
+        check_range(
+            "online ellipsoid refresh_interval_samples",
+            self.refresh_interval_samples as f64,
+            1.0,
+            1e6,
+        )?;
+        if let Some(h) = self.forgetting_half_life_samples {
+            check_range(
+                "online ellipsoid forgetting_half_life_samples",
+                h,
+                50.0,
+                1e9,
+            )?;
+        }
+        check_range(
+            "online ellipsoid max_axis_ratio",
+            self.max_axis_ratio,
+            1.0,
+            f64::MAX,
+        )?;
+        check_positive("online ellipsoid max_residual_rel", self.max_residual_rel)?;
+        check_positive(
+            "online ellipsoid max_heading_error_bound_deg",
+            self.max_heading_error_bound_deg,
+        )?;
+        check_positive(
+            "online ellipsoid max_noise_dilution",
+            self.max_noise_dilution,
+        )?;
+        if let Some(f) = self.expected_field {
+            check_positive("online ellipsoid expected_field", f)?;
+        }
+        Ok(())
+    }
+}
+
+impl OnlineConfig for OnlineEllipsoidConfig {
+    fn min_samples(&self) -> u32 {
+        self.min_samples
+    }
+
+    fn refresh_interval_samples(&self) -> u32 {
+        self.refresh_interval_samples
+    }
+
+    fn forgetting_half_life_samples(&self) -> Option<f64> {
+        self.forgetting_half_life_samples
+    }
+}

@@ -1,0 +1,14 @@
+//! The online least-squares calibrators: the direct ellipse (2-D) and ellipsoid (3-D) fits
+//! from running monomial sums, in bounded memory, refreshed in bounded steps as readings
+//! arrive; their configurations, their staged refreshes, and the readings they retain for
+//! judging coverage.
+
+pub(crate) mod conic;
+pub mod conic_sums;
+pub mod ellipse;
+pub(crate) mod ellipse_config;
+pub(crate) mod ellipse_refresh;
+pub mod ellipsoid;
+pub(crate) mod ellipsoid_config;
+pub(crate) mod ellipsoid_refresh;
+pub(crate) mod retained;

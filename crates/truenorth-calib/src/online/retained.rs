@@ -1,0 +1,124 @@
+//! The readings an online least-squares calibrator retains for measuring coverage (at most
+//! one per direction slot), and their serialisable form.
+
+use alloc::vec::Vec;
+
+use nalgebra::SVector;
+use serde::{Deserialize, Serialize};
+use truenorth_core::{Error, Result};
+
+/// Readings kept for coverage: at most one per direction slot, so that how much of the
+/// circle (sphere) the data cover can be measured about any centre without storing every
+/// reading.
+///
+/// A reading's slot is its direction under the current calibration (the caller's key);
+/// a slot keeps the first reading that reached it until that reading expires (forgetting),
+/// so the ends of an arc are never replaced by readings from its middle. A coverage measured
+/// on these readings is that of a subset of the data, so it never exceeds the batch fit's
+/// coverage about the same centre.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Retained<const D: usize, const N: usize> {
+    /// The reading in each slot.
+    pub reading: [SVector<f64, D>; N],
+    /// Its sample number (1 for the first reading accepted); 0 for an empty slot.
+    pub stamp: [u64; N],
+}
+
+impl<const D: usize, const N: usize> Retained<D, N> {
+    /// No readings.
+    pub fn new() -> Self {
+        Self {
+            reading: [SVector::zeros(); N],
+            stamp: [0; N],
+        }
+    }
+
+    /// Whether slot `j` holds a reading younger than `lifetime` samples at sample `now`.
+    #[inline]
+    pub fn is_live(&self, j: usize, now: u64, lifetime: u64) -> bool {
+        let s = self.stamp[j];
+        s != 0 && now.saturating_sub(s) < lifetime
+    }
+
+    /// Keeps reading `p` (sample number `stamp`) in `slot` unless a live reading is there.
+    #[inline]
+    pub fn offer(&mut self, slot: usize, p: &SVector<f64, D>, stamp: u64, lifetime: u64) {
+        if slot < N && !self.is_live(slot, stamp, lifetime) {
+            self.reading[slot] = *p;
+            self.stamp[slot] = stamp;
+        }
+    }
+
+    /// Re-sorts the live readings into the slots of a new `key`; of two readings that meet
+    /// in a slot the older stays. O(N), no allocation.
+    pub fn rekey(
+        &mut self,
+        key: impl Fn(&SVector<f64, D>) -> Option<usize>,
+        now: u64,
+        lifetime: u64,
+    ) {
+        let mut out = Self::new();
+        for j in 0..N {
+            if !self.is_live(j, now, lifetime) {
+                continue;
+            }
+            if let Some(k) = key(&self.reading[j]).filter(|&k| k < N)
+                && (out.stamp[k] == 0 || out.stamp[k] > self.stamp[j])
+            {
+                out.reading[k] = self.reading[j];
+                out.stamp[k] = self.stamp[j];
+            }
+        }
+        *self = out;
+    }
+
+    /// The live readings at sample `now`.
+    pub fn live(&self, now: u64, lifetime: u64) -> impl Iterator<Item = &SVector<f64, D>> {
+        (0..N)
+            .filter(move |&j| self.is_live(j, now, lifetime))
+            .map(move |j| &self.reading[j])
+    }
+
+    /// The serialisable form.
+    pub fn snapshot(&self) -> RetainedSnapshot {
+        RetainedSnapshot {
+            readings: self
+                .reading
+                .iter()
+                .flat_map(|p| p.iter().copied())
+                .collect(),
+            stamps: self.stamp.to_vec(),
+        }
+    }
+
+    /// Back from the serialisable form, refusing wrong lengths, non-finite readings and
+    /// stamps from the future.
+    pub fn restore(s: &RetainedSnapshot, count: u64) -> Result<Self> {
+        if s.readings.len() != N * D || s.stamps.len() != N {
+            return Err(Error::InvalidSnapshot {
+                reason: "the retained readings do not have the layout of this calibrator",
+            });
+        }
+        if !s.readings.iter().all(|x| x.is_finite()) || s.stamps.iter().any(|&t| t > count) {
+            return Err(Error::InvalidSnapshot {
+                reason: "a retained reading is not finite or is newer than the sample count",
+            });
+        }
+        let mut out = Self::new();
+        for j in 0..N {
+            out.reading[j] = SVector::from_fn(|i, _| s.readings[j * D + i]);
+            out.stamp[j] = s.stamps[j];
+        }
+        Ok(out)
+    }
+}
+
+/// Serialisable retained readings: `readings` holds the slots' coordinates one slot
+/// after another, `stamps` their sample numbers (0 for an empty slot).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RetainedSnapshot {
+    /// Coordinates of the slots' readings, flattened, input unit.
+    pub readings: Vec<f64>,
+    /// Sample number of each slot's reading, 0 for an empty slot.
+    pub stamps: Vec<u64>,
+}

@@ -1,0 +1,74 @@
+//! Quality measures shared by every compass calibrator: how much of the circle (or sphere)
+//! the data cover, how far the calibrated readings stray from a circle (sphere), how well
+//! the geometry determines the calibration, and how large a heading error that allows.
+//!
+//! Every calibrator in this crate fills its [`CompassQuality`](truenorth_core::CompassQuality) through [`assess_2d`] /
+//! [`quality_2d`] (or [`quality_3d`]), so the numbers mean the same thing whichever method
+//! produced them. The least-squares ellipse fit computes the same 2-D report from the
+//! monomial sums of its direct fit instead of a second pass over the readings.
+//!
+//! The parts live in submodules: coverage (heading bins, sphere cells, the locus's turning),
+//! bounds (information matrices and heading-error bounds), uncertainty (what the readings
+//! determine: the dilution of the information matrix, the predicted parameter σ, and the
+//! determination test that replaces a share of direction cells), verdict (good / usable /
+//! poor), report (assembly of the [`CompassQuality`](truenorth_core::CompassQuality)) and
+//! field (the fitted field against an expected one).
+//!
+//! # The three parts of the heading error
+//!
+//! * `heading_error_3sigma_deg` — three standard deviations of the heading error caused by
+//!   the uncertainty of the fitted parameters, at the worst heading (derived below). It is
+//!   the error the calibration adds to every later heading; it shrinks as `1/√N` with more
+//!   readings. Per-reading noise is **not** in it.
+//! * `heading_error_systematic_deg` — the deterministic heading error the method's model
+//!   leaves even with perfect data: 0 for the least-squares ellipse and ellipsoid (their
+//!   model represents any symmetric soft iron); for the seed methods that fit a circle or an
+//!   axis-aligned ellipse, the peak of the two-cycle error of an unremoved rotated soft iron
+//!   (see the `seed_quality` module).
+//! * `heading_noise_rms_deg` — the RMS heading noise of one calibrated reading, estimated
+//!   from the residuals that remain once the model (and, for the seed methods, the
+//!   systematic two-cycle part) is taken out: for isotropic sensor noise of standard
+//!   deviation `σ·F` per axis the radial residual and the heading error of one reading both
+//!   have standard deviation `σ` (radians). Averaging readings reduces it; recalibrating
+//!   does not.
+//!
+//! [`CompassQuality::heading_error_bound_deg`](truenorth_core::CompassQuality::heading_error_bound_deg) is the first two added: a bound on the error
+//! of the calibration itself. A single reading's heading errs by that plus its own noise.
+//!
+//!
+//! The bound's derivation is in the `bounds` module.
+
+mod bounds;
+mod coverage;
+mod field;
+mod report;
+mod support;
+mod uncertainty;
+mod verdict;
+
+#[cfg(test)]
+mod tests;
+
+pub use bounds::BOUND_SIGMAS;
+pub(crate) use bounds::{regressor_2d, regressor_3d};
+pub use coverage::{
+    ARC_END_NOISE_SIGMAS, COVERAGE_BINS, Coverage, MIN_ARC_DEG, MIN_SPHERE_COVERAGE, SPHERE_BANDS,
+    SPHERE_CELLS, SPHERE_SECTORS, calibrated_coverage_2d, coverage, locus_turning_rad, require_arc,
+    require_sphere_coverage, sphere_coverage,
+};
+pub(crate) use coverage::{calibrated_directions_2d, sphere_cell, turns};
+pub use field::{
+    FIELD_RATIO_TOLERANCE, FieldMismatch, field_mismatch, mean_corrected_norm_2d,
+    mean_corrected_norm_3d, with_expected_field,
+};
+pub use report::{Assessment2d, Assessment3d, assess_2d, assess_3d, quality_2d, quality_3d};
+pub(crate) use report::{
+    Moments2, ReportSums, SupportFigures, assess_2d_from_moments, direction_harmonics,
+    support_dilution_3d,
+};
+pub(crate) use support::GAP_BINS;
+pub use uncertainty::{
+    DILUTION_EVEN_CIRCLE, DILUTION_EVEN_SPHERE, MAX_NOISE_DILUTION, MODEL_ERROR_REL, Uncertainty,
+    require_certain, require_determined, require_linear,
+};
+pub use verdict::{Cause, GOOD_DEG, GOOD_NOISE_DEG, Grade, USABLE_DEG, Verdict};

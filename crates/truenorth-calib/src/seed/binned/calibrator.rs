@@ -1,0 +1,583 @@
+//! Binned-ellipse auto-calibration (EP 0634001).
+//!
+//! 1. **Initial origin** (claim 6): the mean of the first [`BinnedEllipseConfig::init_samples`]
+//!    readings.
+//! 2. **Bins by direction** (claim 4): the direction of a reading about the current origin
+//!    picks one of `N` bins, which stores the reading (claim 1). With
+//!    [`BinnedEllipseConfig::bin_memory`] = 1 (the default, as in the seed) a new reading
+//!    replaces the stored one; a larger memory keeps a running mean of the last few.
+//! 3. **Interpolation** (claims 1–2): once more than
+//!    [`BinnedEllipseConfig::min_filled_bins`] bins hold readings, every empty bin gets a value
+//!    by linear interpolation between its nearest filled neighbours. What is interpolated is
+//!    the *magnitude* of the sensed field (the seed's "values of the magnitude"), placed at the
+//!    empty bin's own direction, so a long gap is bridged by an arc rather than a chord.
+//!    Interpolated values are recomputed at every update, so a new measurement always replaces
+//!    one (claim 3). Filled bins are treated the same way — their reading, which may lie
+//!    anywhere within the bin, is one end of the interpolation at the bin's centre direction —
+//!    so the full set is exactly uniform in direction. Without this refinement the mean of the
+//!    set is biased by where readings fall within their bins (about 1° of heading error on
+//!    the reference turn; with it, under 0.2°).
+//! 4. **Origin iteration** (claims 1, 5, 12): the new origin is the mean of the full set; the
+//!    stored readings are re-binned about it (two landing in one bin are merged); this is
+//!    repeated [`BinnedEllipseConfig::origin_iterations`] times.
+//! 5. **Ellipse parameters** (claims 7–9):
+//!    - Ω_e minimises `S(θ) = Σ R_i² |cos(θ_i − θ)|` (a 1° scan of [0, π) refined by golden
+//!      section). **It finds the minor axis**: to first order in `r`,
+//!      `S(θ) ∝ 1 + (2/3) r cos 2(θ − α)` with α the major axis, so the minimum lies across the
+//!      major axis. Consequently the ratio below comes out negative (`E_R/E_L < 0` about the
+//!      minor axis), which the phasor formulas take as it is
+//!      ([`EllipsePhasors::normalised`] gives the `r ≥ 0` form).
+//!    - Ratio: with `X'`, `Y'` the readings rotated by Ω_e (claim 9),
+//!      `k = Σ R_i²|X'_i| / Σ R_i²|Y'_i|` and `E_R/E_L = (k − 1)/(k + 1)`; and
+//!      `|E_L| = (π/4) Σ R_i²(|X'_i| + |Y'_i|) / Σ R_i²`. The weights `R_i²` are the seed's own
+//!      (from S(θ)) and are what makes these means right: the bins are uniform in the
+//!      *direction* of the reading, and `R² dθ = |E_L|²(1 − r²) du` turns a sum over directions
+//!      into an integral over the earth-field phase `u`, over which `mean|cos u| = 2/π`. The
+//!      seed equalises the two means by increments instead; the ratio is the same quantity.
+//! 6. **Heading** (claims 10–11): [`EllipsePhasors`] in `truenorth-compass`; the solve returns
+//!    its closed form as a [`CompassCalibration2d`].
+//! 7. **Stored parameters** (claims 13–14): [`BinnedEllipseCalibrator::parameters_to_store`]
+//!    gives the parameters once [`BinnedEllipseConfig::min_samples_to_store`] readings were
+//!    binned; [`BinnedEllipseCalibrator::from_stored_parameters`] regenerates every bin from
+//!    them. (The whole learned state is saved and restored exactly through
+//!    [`truenorth_core::Persistent`].)
+//! 8. **Restart** (claim 15): every [`BinnedEllipseConfig::update_interval`] readings the full
+//!    set is rebuilt; once enough bins hold readings, it is compared with the previous full set
+//!    and, if the RMS change of the bins measured in both exceeds
+//!    [`BinnedEllipseConfig::restart_threshold`] of `|E_L|`, calibration restarts from scratch.
+//!    A transient disturbance touches a few bins and stays below it; a magnet added near the
+//!    sensor moves every bin visited and trips it.
+//!
+//! ## Cost per push, estimate, solve
+//! A full-set update (steps 3–5) is about 20,000 bin operations for 64 bins, far more than a
+//! push may cost. So push starts it on a copy of the bins (the `binned_update` module) and
+//! advances it by one bounded slice on every second push only, over at most
+//! `min(update_interval, 96)` pushes (the `binned_refresh` module); the pushes between do
+//! no update work at all. The finished refresh is then assessed over a few pushes (the
+//! restart check and the locus's turning; the quality report in bounded steps, one per push,
+//! and the other acceptance tests) and applied at the next, which swaps in its bins, origin and estimate together
+//! (so the published estimate is always one update's) and bins the readings that arrived
+//! meanwhile about the new origin, exactly as if the update had been done at once when it
+//! started; at most 16 of them in that push and as many in each of the next (readings
+//! pushed meanwhile queue behind them), which bins them exactly as binning them at once
+//! would. The estimate ([`truenorth_core::OnlineCalibrator::estimate`], O(1)) changes
+//! only at the application, and that push returns [`Pushed::NewEstimate`].
+//!
+//! `solve` leaves the calibrator unchanged: it completes any update in progress and runs a
+//! full update on a copy, then applies the acceptance tests (origin, filled bins, arc about
+//! the origin, the locus's own turning, residual). `progress().ready` runs that same path, so
+//! the two always agree; both cost a full update (about half a millisecond for 64 bins):
+//! call them now and then, not per sample.
+//!
+//! Push, solve and progress allocate nothing.
+
+use nalgebra::Vector2;
+use truenorth_compass::{CompassCalibration2d, EllipsePhasors};
+use truenorth_core::{
+    Calibrator, CompassQuality, Error, Mag2Sample, OnlineCalibrator, Progress, Pushed, Result,
+    Solution, Validate, check_finite, check_finite2,
+};
+
+use crate::seed::binned::assess::{Assessor, Verdict};
+use crate::seed::binned::bins::{Bin, BinState, Bins, EMPTY, MAX_BINS, bin_reading, filled};
+pub use crate::seed::binned::config::{BinnedEllipseConfig, MAX_INIT_SAMPLES};
+use crate::seed::binned::refresh::RefreshJob;
+
+use core::f64::consts::TAU;
+
+use crate::seed::binned::update::{DRAIN_PER_PUSH, REFRESH_PUSHES, REFRESH_STRIDE, Update};
+pub use crate::seed::binned::update::{MAX_UPDATE_PUSHES, UpdatePhase};
+
+/// The binned-ellipse calibrator (EP 0634001). See the module documentation.
+///
+/// ```
+/// use nalgebra::Vector2;
+/// use truenorth_calib::{BinnedEllipseCalibrator, BinnedEllipseConfig};
+/// use truenorth_compass::{HeadingTruth, MagnetometerModel2d, soft_iron_from_axes};
+/// use truenorth_core::{Calibrator, Mag2Sample, OnlineCalibrator, SensorModel, angle_diff};
+///
+/// let model = MagnetometerModel2d::new(
+///     Vector2::new(10.0, -5.0), soft_iron_from_axes(1.3, 1.0, 30f64.to_radians()), 0.0)?;
+/// let mut cal = BinnedEllipseCalibrator::new(BinnedEllipseConfig::default())?;
+/// for i in 0..720 {
+///     let truth = HeadingTruth { heading_rad: (i as f64 * 0.5).to_radians(), horizontal_field: 20.0 };
+///     cal.push(&Mag2Sample { t_s: i as f64 * 0.1, mag: model.ideal(&truth)? })?;
+/// }
+/// assert!(cal.progress().ready);
+/// let sol = cal.solve()?;
+/// let raw = model.ideal(&HeadingTruth { heading_rad: 1.0, horizontal_field: 20.0 })?;
+/// assert!(angle_diff(sol.params.heading_rad(&raw), 1.0).abs().to_degrees() < 0.5);
+/// // The running estimate of the last completed update, O(1).
+/// assert!(cal.estimate().is_some());
+/// # Ok::<(), truenorth_core::Error>(())
+/// ```
+#[derive(Debug, Clone, PartialEq)]
+pub struct BinnedEllipseCalibrator {
+    pub(crate) config: BinnedEllipseConfig,
+    pub(crate) bins: Bins,
+    pub(crate) origin: Option<Vector2<f64>>,
+    pub(crate) init: [Vector2<f64>; MAX_INIT_SAMPLES],
+    pub(crate) init_count: usize,
+    pub(crate) samples: usize,
+    pub(crate) since_update: usize,
+    pub(crate) reference: [Option<Vector2<f64>>; MAX_BINS],
+    pub(crate) phasors: Option<EllipsePhasors>,
+    pub(crate) restored: bool,
+    pub(crate) restarts: usize,
+    pub(crate) estimate: Option<Solution<CompassCalibration2d>>,
+    pub(crate) update: Option<Update>,
+    /// Readings that waited for an applied update and are not binned yet (the front
+    /// `backlog_len`; never while an update is in progress).
+    pub(crate) backlog: [Vector2<f64>; MAX_UPDATE_PUSHES],
+    pub(crate) backlog_len: usize,
+}
+
+impl Default for BinnedEllipseCalibrator {
+    fn default() -> Self {
+        Self::build(BinnedEllipseConfig::default())
+    }
+}
+
+impl BinnedEllipseCalibrator {
+    /// A calibrator with the given configuration (validated).
+    pub fn new(config: BinnedEllipseConfig) -> Result<Self> {
+        config.validate()?;
+        Ok(Self::build(config))
+    }
+
+    pub(crate) fn build(config: BinnedEllipseConfig) -> Self {
+        Self {
+            config,
+            bins: [EMPTY; MAX_BINS],
+            origin: None,
+            init: [Vector2::zeros(); MAX_INIT_SAMPLES],
+            init_count: 0,
+            samples: 0,
+            since_update: 0,
+            reference: [None; MAX_BINS],
+            phasors: None,
+            restored: false,
+            restarts: 0,
+            estimate: None,
+            update: None,
+            backlog: [Vector2::zeros(); MAX_UPDATE_PUSHES],
+            backlog_len: 0,
+        }
+    }
+
+    /// Switch-on with stored parameters (claim 13): takes the stored origin and regenerates
+    /// every bin from the ellipse. New readings replace regenerated values bin by bin; if
+    /// they show that the locus has moved (a magnet was added while the compass was off),
+    /// the restart rule of claim 15 applies.
+    pub fn from_stored_parameters(
+        config: BinnedEllipseConfig,
+        stored: &EllipsePhasors,
+    ) -> Result<Self> {
+        config.validate()?;
+        stored.validate()?;
+        let mut c = Self::build(config);
+        c.origin = Some(stored.origin);
+        let n = config.bins;
+        for (i, bin) in c.bins[..n].iter_mut().enumerate() {
+            let dir = (i as f64 + 0.5) * TAU / n as f64;
+            *bin = Bin {
+                value: stored.point_at_direction(dir),
+                count: 0,
+                state: BinState::Regenerated,
+            };
+        }
+        c.phasors = Some(*stored);
+        c.restored = true;
+        c.capture_reference();
+        Ok(c)
+    }
+
+    /// The configuration in use.
+    pub fn config(&self) -> &BinnedEllipseConfig {
+        &self.config
+    }
+
+    /// The origin of the bins (of the last completed update).
+    pub fn origin(&self) -> Option<Vector2<f64>> {
+        self.origin
+    }
+
+    /// The ellipse parameters of the last completed full-set update, if any.
+    pub fn phasors(&self) -> Option<EllipsePhasors> {
+        self.phasors
+    }
+
+    /// How often a change of the locus restarted calibration (claim 15).
+    pub fn restarts(&self) -> usize {
+        self.restarts
+    }
+
+    /// Bins holding real or regenerated readings (the readings of an update in progress not
+    /// yet binned).
+    pub fn filled_bins(&self) -> usize {
+        filled(&self.bins, self.config.bins)
+    }
+
+    /// The state of each of the N bins.
+    pub fn bin_states(&self) -> impl Iterator<Item = BinState> + '_ {
+        self.bins[..self.config.bins].iter().map(|b| b.state)
+    }
+
+    /// Whether a full-set update is in progress.
+    pub fn updating(&self) -> bool {
+        self.update.is_some()
+    }
+
+    /// Readings that waited for the last applied update and are still to be binned (a
+    /// bounded number are binned per push; see the module documentation).
+    pub fn waiting_readings(&self) -> usize {
+        self.backlog_len
+    }
+
+    /// How many pushes the assessment of the update in progress has had (0 outside phase
+    /// [`UpdatePhase::Assess`] and at its start).
+    pub fn assessment_steps(&self) -> usize {
+        self.update
+            .as_ref()
+            .filter(|u| u.phase == UpdatePhase::Assess)
+            .map_or(0, |u| u.assess_steps)
+    }
+
+    /// The phase of the full-set update in progress, if any, and how many pushes it has
+    /// seen.
+    pub fn update_phase(&self) -> Option<(UpdatePhase, usize)> {
+        self.update.as_ref().map(|u| (u.phase, u.advanced))
+    }
+
+    /// The ellipse parameters a solve now would use, before its acceptance tests: completes
+    /// any update in progress and runs a full one, on a copy (the calibrator is unchanged;
+    /// the cost of a solve).
+    pub fn solve_phasors(&self) -> Result<EllipsePhasors> {
+        let mut scratch = self.clone();
+        scratch.finish_update();
+        scratch.refresh()
+    }
+
+    /// The parameters to store when the compass is switched off (claims 13–14), those of
+    /// [`Self::solve_phasors`]: `Some` only once
+    /// [`BinnedEllipseConfig::min_samples_to_store`] readings were binned since the last
+    /// (re)start, or when the current parameters were themselves restored.
+    pub fn parameters_to_store(&self) -> Option<EllipsePhasors> {
+        let mut scratch = self.clone();
+        scratch.finish_update();
+        let enough = scratch.samples >= self.config.min_samples_to_store || scratch.restored;
+        if !enough {
+            return None;
+        }
+        scratch.refresh().ok()
+    }
+
+    /// The push logic proper, for a finite reading (no update in progress).
+    fn ingest(&mut self, p: &Vector2<f64>) {
+        self.samples += 1;
+        if self.origin.is_none() {
+            // Claim 6: average the first readings for the initial origin, then bin them.
+            self.init[self.init_count] = *p;
+            self.init_count += 1;
+            if self.init_count >= self.config.init_samples {
+                let k = self.init_count;
+                let init = self.init;
+                let o = init[..k].iter().sum::<Vector2<f64>>() / k as f64;
+                self.origin = Some(o);
+                for q in &init[..k] {
+                    self.bin(q);
+                }
+            }
+            return;
+        }
+        self.bin(p);
+        self.since_update += 1;
+        if self.since_update >= self.config.update_interval
+            && self.filled_bins() >= self.config.min_filled_bins
+        {
+            self.since_update = 0;
+            self.start_update();
+        }
+    }
+
+    fn bin(&mut self, p: &Vector2<f64>) {
+        if let Some(origin) = self.origin {
+            bin_reading(
+                &mut self.bins,
+                self.config.bins,
+                &origin,
+                p,
+                self.config.bin_memory,
+            );
+        }
+    }
+
+    /// Starts a full-set update on a copy of the bins, with the refresh spread evenly over
+    /// the working pushes (every `stride`-th) among the first
+    /// `min(update_interval, REFRESH_PUSHES)`.
+    fn start_update(&mut self) {
+        let Some(origin) = self.origin else { return };
+        let n = self.config.bins;
+        let span = self.config.update_interval.clamp(1, REFRESH_PUSHES);
+        let stride = REFRESH_STRIDE.min(span);
+        let working = span / stride;
+        let bound = RefreshJob::work_bound(n, self.config.origin_iterations);
+        self.update = Some(Update {
+            job: RefreshJob::start(
+                &self.bins,
+                n,
+                &origin,
+                self.config.origin_iterations,
+                self.config.min_filled_bins,
+            ),
+            start_bins: self.bins,
+            start_origin: origin,
+            budget: bound.div_ceil(working),
+            stride,
+            advanced: 0,
+            phase: UpdatePhase::Refresh,
+            precheck: None,
+            verdict: None,
+            seed: None,
+            assess_steps: 0,
+            pending: [Vector2::zeros(); MAX_UPDATE_PUSHES],
+            pending_len: 0,
+        });
+    }
+
+    /// Applies a finished, assessed update: its bins and origin, then the verdict (restart,
+    /// or new parameters, reference and estimate), all in this one push so that what is
+    /// published is always one update's; then bins the readings that arrived meanwhile
+    /// (with `spread`, a bounded number of them now and the rest on the next pushes, see
+    /// [`Self::drain`]). Returns whether the estimate changed.
+    fn complete_update(&mut self, mut u: Update, spread: bool) -> bool {
+        u.job.finish();
+        let verdict = match u.verdict {
+            Some(v) => v,
+            None => self.assessor().assess(&u.job),
+        };
+        let before = self.estimate;
+        self.bins = u.job.bins;
+        self.origin = Some(u.job.origin);
+        match verdict {
+            Verdict::Failed => {}
+            Verdict::Restart(params) => {
+                self.phasors = Some(params);
+                self.restart();
+            }
+            Verdict::Accept(params, estimate) => {
+                self.phasors = Some(params);
+                self.capture_reference();
+                self.estimate = estimate;
+            }
+        }
+        // No backlog while an update is in progress, and a restart above cleared it anyway.
+        self.backlog[..u.pending_len].copy_from_slice(&u.pending[..u.pending_len]);
+        self.backlog_len = u.pending_len;
+        self.drain(spread);
+        self.estimate != before
+    }
+
+    /// Bins waiting readings in the order they arrived: with `spread`, at most
+    /// `DRAIN_PER_PUSH` of them, else all. Binning them over several pushes gives exactly
+    /// the bins of binning them at once as long as none of them starts the next update
+    /// (the readings pushed meanwhile queue behind them, so the order is the same): each
+    /// reading raises the count towards `update_interval` by at most one, so while the
+    /// count plus the backlog is below it none can, and once it reaches it only the latest
+    /// reading can, and all are binned in that push — exactly when the update would start
+    /// if nothing had waited.
+    fn drain(&mut self, spread: bool) {
+        let len = self.backlog_len;
+        if len == 0 {
+            return;
+        }
+        let all = !spread || self.since_update + len >= self.config.update_interval;
+        let k = if all { len } else { len.min(DRAIN_PER_PUSH) };
+        for i in 0..k {
+            let p = self.backlog[i];
+            self.ingest(&p);
+        }
+        self.backlog.copy_within(k..len, 0);
+        // Unused entries stay zero, so equal states compare equal.
+        self.backlog[len - k..len].fill(Vector2::zeros());
+        self.backlog_len = len - k;
+    }
+
+    /// Runs any update in progress to its end and applies it.
+    fn finish_update(&mut self) {
+        self.drain(false);
+        if let Some(u) = self.update.take() {
+            self.complete_update(u, false);
+        }
+    }
+
+    /// A full update now (claims 1, 5, 12 then 7–9): iterate the origin, then compute the
+    /// ellipse parameters; the re-binned bins are kept.
+    fn refresh(&mut self) -> Result<EllipsePhasors> {
+        let Some(origin) = self.origin else {
+            return Err(Error::NotReady {
+                what: "the binned-ellipse origin",
+                hint: "push more readings",
+            });
+        };
+        let mut job = RefreshJob::start(
+            &self.bins,
+            self.config.bins,
+            &origin,
+            self.config.origin_iterations,
+            self.config.min_filled_bins,
+        );
+        job.finish();
+        self.bins = job.bins;
+        self.origin = Some(job.origin);
+        let p = job.result.unwrap_or(Err(Error::NotReady {
+            what: "the binned-ellipse update",
+            hint: "push more readings",
+        }))?;
+        self.phasors = Some(p);
+        Ok(p)
+    }
+
+    /// Solve on this (scratch) calibrator: complete any update, run a full one, accept.
+    fn solve_in_place(&mut self) -> Result<Solution<CompassCalibration2d>> {
+        self.finish_update();
+        if self.origin.is_none() {
+            return Err(Error::TooFewPoints {
+                got: self.samples,
+                need: self.config.init_samples,
+            });
+        }
+        let filled = self.filled_bins();
+        if filled < self.config.min_filled_bins {
+            return Err(Error::TooFewPoints {
+                got: filled,
+                need: self.config.min_filled_bins,
+            });
+        }
+        let params = self.refresh()?;
+        self.assessor().accept(&self.bins, &params)
+    }
+
+    /// What the assessment of an update reads of this calibrator.
+    pub(crate) fn assessor(&self) -> Assessor<'_> {
+        Assessor {
+            config: &self.config,
+            reference: &self.reference,
+            phasors: self.phasors.as_ref(),
+            samples: self.samples,
+        }
+    }
+
+    /// The filled bins' values become the reference for the next restart check.
+    fn capture_reference(&mut self) {
+        let n = self.config.bins;
+        for i in 0..n {
+            self.reference[i] =
+                (self.bins[i].state != BinState::Empty).then_some(self.bins[i].value);
+        }
+    }
+
+    /// Forgets the readings and the origin (claim 15); keeps the configuration and the count
+    /// of restarts.
+    fn restart(&mut self) {
+        let restarts = self.restarts + 1;
+        *self = Self::build(self.config);
+        self.restarts = restarts;
+    }
+}
+
+impl Calibrator for BinnedEllipseCalibrator {
+    type Sample = Mag2Sample;
+    type Params = CompassCalibration2d;
+    type Quality = CompassQuality;
+
+    /// Refuses a non-finite reading or timestamp (and changes nothing). Bounded work: at
+    /// most one slice, the assessment or the application of a full-set update (see the
+    /// module documentation).
+    fn push(&mut self, sample: &Mag2Sample) -> Result<Pushed> {
+        let p = sample.mag;
+        check_finite("timestamp t_s", sample.t_s)?;
+        check_finite2("magnetometer reading", &p)?;
+        if let Some(u) = self.update.as_mut() {
+            u.pending[u.pending_len] = p;
+            u.pending_len += 1;
+        } else if self.backlog_len > 0 {
+            // Behind the readings still waiting from the last update (never full: it only
+            // shrinks by more than one a push).
+            self.backlog[self.backlog_len] = p;
+            self.backlog_len += 1;
+            self.drain(true);
+        } else {
+            self.ingest(&p);
+        }
+        let Some(u) = self.update.as_mut() else {
+            return Ok(Pushed::Accepted);
+        };
+        // The phase at the start of this push decides its work: one slice of the refresh
+        // (on working pushes), or the assessment, or the application — never two of them.
+        let phase = u.phase;
+        u.step_refresh();
+        let full = u.pending_len >= MAX_UPDATE_PUSHES;
+        match phase {
+            _ if full => {}
+            UpdatePhase::Refresh => return Ok(Pushed::Accepted),
+            UpdatePhase::Precheck | UpdatePhase::Assess => {
+                let assessor = Assessor {
+                    config: &self.config,
+                    reference: &self.reference,
+                    phasors: self.phasors.as_ref(),
+                    samples: self.samples,
+                };
+                if let Some(u) = self.update.as_mut() {
+                    u.advance_assessment(&assessor);
+                }
+                return Ok(Pushed::Accepted);
+            }
+            UpdatePhase::Apply => {}
+        }
+        let Some(u) = self.update.take() else {
+            return Ok(Pushed::Accepted);
+        };
+        // The refresh ends within `REFRESH_PUSHES` and a few more pushes complete it, well
+        // within the pending buffer; completing at once when it is full is a safeguard that
+        // does not change the result.
+        if self.complete_update(u, !full) {
+            Ok(Pushed::NewEstimate)
+        } else {
+            Ok(Pushed::Accepted)
+        }
+    }
+
+    /// Runs the same path as [`Calibrator::solve`] on a copy (so `ready` agrees with it
+    /// exactly, at the cost of a full-set update); `coverage` is the share of bins filled.
+    fn progress(&self) -> Progress {
+        let mut scratch = self.clone();
+        let ready = scratch.solve_in_place().is_ok();
+        Progress {
+            samples: scratch.samples,
+            coverage: scratch.filled_bins() as f64 / self.config.bins as f64,
+            ready,
+        }
+    }
+
+    /// Completes any update in progress and runs a full one, on a copy: the calibrator is
+    /// unchanged.
+    fn solve(&self) -> Result<Solution<CompassCalibration2d>> {
+        self.clone().solve_in_place()
+    }
+
+    fn reset(&mut self) {
+        *self = Self::build(self.config);
+    }
+}
+
+impl OnlineCalibrator for BinnedEllipseCalibrator {
+    /// The solution of the last completed full-set update that passed the acceptance tests.
+    fn estimate(&self) -> Option<Solution<CompassCalibration2d>> {
+        self.estimate
+    }
+}
+
+#[cfg(test)]
+#[path = "tests.rs"]
+mod tests;
