@@ -4,18 +4,16 @@
 //! information matrix, its condition by a Jacobi solver a few sweeps at a time, the
 //! heading-error bound in chunks, and the refusals.
 
-use nalgebra::{Matrix3, Matrix4, SMatrix, SVector, Vector3, Vector6};
+use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
 use truenorth_compass::CompassCalibration3d;
 use truenorth_core::{Error, FitQuality, Mag3Sample, Result, Solution};
 
 use crate::fits::ellipsoid::direct::{
-    Ellipsoid, li_griffiths_constraint, quadratic_part, quadric_to_ellipsoid,
+    Ellipsoid, Reduced, constrained_quadric, quadric_to_ellipsoid, reduce,
 };
 
 use crate::fits::ellipsoid::config::ORIENTATION_HINT;
-use crate::numerics::linalg::{
-    condition_from_eigenvalues, constrained_min6, sym_eigen3, sym_eigen6,
-};
+use crate::numerics::linalg::{condition_from_eigenvalues, sym_eigen3};
 use crate::online::conic_sums::inverse_factor;
 use crate::online::conic_sums::{ConicSums, LAYOUT_3D, MONOMIALS_3D, Retained};
 use crate::quality::Uncertainty;
@@ -188,10 +186,9 @@ pub(crate) struct Refresh {
     coverage: f64,
     residual_rms_rel: f64,
     info: SMatrix<f64, PARAMS, PARAMS>,
-    /// The direct fit between its stages: the reduced 6×6 scatter and the map back to the
+    /// The direct fit between its stages: the reduced scatter with the map back to the
     /// linear terms, then the quadric.
-    reduced: SMatrix<f64, 6, 6>,
-    back: SMatrix<f64, 4, 6>,
+    reduced: Reduced,
     quadric: SVector<f64, 10>,
     jacobi: Jacobi9,
     condition: f64,
@@ -283,55 +280,25 @@ impl Refresh {
         }
     }
 
-    /// Stage 1: normalise, then the first step of the direct fit
-    /// ([`crate::fits::ellipsoid`]'s `solve_direct`, whose arithmetic the stages 1–3 repeat in
-    /// the same order): eliminate the linear terms and refuse a hyperboloid.
+    /// Stage 1: normalise, then the first step of the direct fit ([`reduce`]): eliminate the
+    /// linear terms and refuse a hyperboloid.
     fn reduce_stage(&mut self) {
         self.normalise();
         if self.base.outcome.is_some() {
             return;
         }
-        let s = &self.scatter;
-        let s1: SMatrix<f64, 6, 6> = s.fixed_view::<6, 6>(0, 0).into_owned();
-        let s2: SMatrix<f64, 6, 4> = s.fixed_view::<6, 4>(0, 6).into_owned();
-        let s3: Matrix4<f64> = s.fixed_view::<4, 4>(6, 6).into_owned();
-        let Some(s3_inv) = s3.try_inverse() else {
-            return self.fail(Error::Degenerate {
-                reason: "the readings lie in a plane (or on a line); tumble the sensor about more than one axis",
-            });
-        };
-        let t: SMatrix<f64, 4, 6> = -s3_inv * s2.transpose();
-        let m = s1 + s2 * t;
-        let m = (m + m.transpose()) * 0.5;
-        // The best quadric without the ellipsoid constraint, normalised by the Frobenius
-        // norm of its quadratic part: a hyperboloid means the data are not a rotation in a
-        // constant field.
-        let h = core::f64::consts::FRAC_1_SQRT_2;
-        let d_inv = SMatrix::<f64, 6, 6>::from_diagonal(&Vector6::new(1.0, 1.0, 1.0, h, h, h));
-        if let Some((_, v)) = sym_eigen6(&(d_inv * m * d_inv)) {
-            let u = d_inv * v.column(0);
-            if let Some((l, _)) = sym_eigen3(&quadratic_part(&u)) {
-                let tol = 1e-9 * l.amax();
-                if !(l[0] > tol || l[2] < -tol) {
-                    return self.fail(Error::NotAnEllipse {
-                        detail: " (it is a hyperboloid or a cylinder)",
-                    });
-                }
-            }
+        match reduce(&self.scatter) {
+            Ok(r) => self.reduced = r,
+            Err(e) => self.fail(e),
         }
-        (self.reduced, self.back) = (m, t);
     }
 
-    /// Stage 2: the constrained minimum of the direct fit (Li & Griffiths 2004, eq. 7).
+    /// Stage 2: the constrained minimum of the direct fit ([`constrained_quadric`]).
     fn constrained_stage(&mut self) {
-        let Some(a1) = constrained_min6(&self.reduced, &li_griffiths_constraint()) else {
-            return self.fail(Error::Degenerate {
-                reason: "too few distinct readings off a plane; tumble the sensor through more orientations",
-            });
-        };
-        let a2 = self.back * a1;
-        self.quadric.fixed_rows_mut::<6>(0).copy_from(&a1);
-        self.quadric.fixed_rows_mut::<4>(6).copy_from(&a2);
+        match constrained_quadric(&self.reduced) {
+            Ok(k) => self.quadric = k,
+            Err(e) => self.fail(e),
+        }
     }
 
     /// Stage 3: the ellipsoid of the quadric and its calibration.
@@ -621,8 +588,10 @@ impl ConicRefresh<3, MONOMIALS_3D, SPHERE_CELLS> for Refresh {
             coverage: 0.0,
             residual_rms_rel: 0.0,
             info: SMatrix::zeros(),
-            reduced: SMatrix::zeros(),
-            back: SMatrix::zeros(),
+            reduced: Reduced {
+                m: SMatrix::zeros(),
+                t: SMatrix::zeros(),
+            },
             quadric: SVector::zeros(),
             jacobi: Jacobi9::new(&SMatrix::zeros()),
             condition: f64::INFINITY,

@@ -208,6 +208,23 @@ pub(crate) fn li_griffiths_constraint() -> SMatrix<f64, 6, 6> {
 /// Reduced direct fit (see the module documentation). Returns the ten quadric coefficients
 /// `(a, b, c, f, g, h, p, q, r, d)`.
 pub(crate) fn solve_direct(s: &SMatrix<f64, 10, 10>) -> Result<SVector<f64, 10>> {
+    let reduced = reduce(s)?;
+    constrained_quadric(&reduced)
+}
+
+/// The scatter with the linear terms eliminated (`m`) and the map back to them (`t`): the
+/// first step of the direct fit, which the online calibrator runs as a stage of its own.
+#[derive(Debug, Clone)]
+pub(crate) struct Reduced {
+    /// The 6 × 6 reduced scatter of the quadratic coefficients.
+    pub(crate) m: SMatrix<f64, 6, 6>,
+    /// Linear coefficients from quadratic ones: `a₂ = t a₁`.
+    pub(crate) t: SMatrix<f64, 4, 6>,
+}
+
+/// Eliminates the linear terms of the scatter `s` and refuses data that no ellipsoid fits
+/// (a plane, a hyperboloid).
+pub(crate) fn reduce(s: &SMatrix<f64, 10, 10>) -> Result<Reduced> {
     let s1: SMatrix<f64, 6, 6> = s.fixed_view::<6, 6>(0, 0).into_owned();
     let s2: SMatrix<f64, 6, 4> = s.fixed_view::<6, 4>(0, 6).into_owned();
     let s3: Matrix4<f64> = s.fixed_view::<4, 4>(6, 6).into_owned();
@@ -233,10 +250,16 @@ pub(crate) fn solve_direct(s: &SMatrix<f64, 10, 10>) -> Result<SVector<f64, 10>>
             }
         }
     }
-    let a1 = constrained_min6(&m, &li_griffiths_constraint()).ok_or(Error::Degenerate {
+    Ok(Reduced { m, t })
+}
+
+/// The constrained minimum (Li & Griffiths 2004, eq. 7) of the reduced scatter, with the
+/// linear terms restored: the ten quadric coefficients.
+pub(crate) fn constrained_quadric(r: &Reduced) -> Result<SVector<f64, 10>> {
+    let a1 = constrained_min6(&r.m, &li_griffiths_constraint()).ok_or(Error::Degenerate {
         reason: "too few distinct readings off a plane; tumble the sensor through more orientations",
     })?;
-    let a2 = t * a1;
+    let a2 = r.t * a1;
     let mut k = SVector::<f64, 10>::zeros();
     k.fixed_rows_mut::<6>(0).copy_from(&a1);
     k.fixed_rows_mut::<4>(6).copy_from(&a2);
