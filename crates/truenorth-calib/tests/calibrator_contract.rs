@@ -237,7 +237,11 @@ where
             .map_err(|e| TestCaseError::fail(format!("refused: {e}")))?;
     }
     let snap: Snapshot<C::State> = a.snapshot();
-    let mut b = C::restore(snap.clone()).map_err(|e| TestCaseError::fail(format!("{e}")))?;
+    // Through JSON, as a user stores it: the state read back must be the state written.
+    let json = serde_json::to_string(&snap).map_err(|e| TestCaseError::fail(format!("{e}")))?;
+    let read: Snapshot<C::State> =
+        serde_json::from_str(&json).map_err(|e| TestCaseError::fail(format!("{e}")))?;
+    let mut b = C::restore(read).map_err(|e| TestCaseError::fail(format!("{e}")))?;
     prop_assert_eq!(estimate(&a), estimate(&b));
     for s in &samples[cut..] {
         prop_assert_eq!(a.push(s), b.push(s));
