@@ -92,3 +92,21 @@ proptest! {
         }
     }
 }
+
+/// `reset` forgets everything: the same drive after a reset gives the coefficient a new
+/// calibrator gives.
+#[test]
+fn reset_is_a_new_calibrator() {
+    let mut fresh = SpeedCoefficientCalibrator::new(SpeedCoefficientConfig::default()).unwrap();
+    let mut used = SpeedCoefficientCalibrator::new(SpeedCoefficientConfig::default()).unwrap();
+    drive(&mut used, 4, 5e-5);
+    used.reset();
+    assert_eq!(used.progress(), fresh.progress());
+    drive(&mut used, 4, 5e-5);
+    drive(&mut fresh, 4, 5e-5);
+    assert_eq!(used.coefficient().to_bits(), fresh.coefficient().to_bits());
+    assert_eq!(
+        format!("{:?}", used.solve()),
+        format!("{:?}", fresh.solve())
+    );
+}

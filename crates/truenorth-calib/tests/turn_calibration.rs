@@ -237,3 +237,24 @@ fn a_gap_in_the_record_is_refused_not_bridged() {
     }
     assert!(whole.solve().is_ok());
 }
+
+/// `reset` forgets everything: the same turn pushed again after a reset gives the solution a
+/// new calibrator gives, and the progress starts from nothing.
+#[test]
+fn reset_is_a_new_calibrator() {
+    let (samples, _) = opening_turn(3);
+    let mut fresh = TurnCalibrator::new(TurnConfig::default()).unwrap();
+    let mut used = TurnCalibrator::new(TurnConfig::default()).unwrap();
+    for s in &samples {
+        used.push(s).unwrap();
+    }
+    used.reset();
+    assert_eq!(used.progress(), fresh.progress());
+    for s in &samples {
+        assert_eq!(used.push(s).unwrap(), fresh.push(s).unwrap());
+    }
+    assert_eq!(
+        format!("{:?}", used.solve()),
+        format!("{:?}", fresh.solve())
+    );
+}

@@ -232,7 +232,13 @@ impl SpeedCoefficientCalibrator {
     /// A refiner starting from the configured `a`.
     pub fn new(config: SpeedCoefficientConfig) -> Result<Self> {
         config.validate()?;
-        Ok(Self {
+        Ok(Self::fresh(config))
+    }
+
+    /// A calibrator that has seen nothing, from a validated `config` (so that `reset` cannot
+    /// fail).
+    fn fresh(config: SpeedCoefficientConfig) -> Self {
+        Self {
             config,
             a: config.initial_s2_per_m2,
             clock: TimeStep::new(),
@@ -247,7 +253,7 @@ impl SpeedCoefficientCalibrator {
             updates: 0,
             steps: 0,
             error_sq_sum: 0.0,
-        })
+        }
     }
 
     /// The current `a`, s²/m².
@@ -427,9 +433,7 @@ impl Calibrator for SpeedCoefficientCalibrator {
     }
 
     fn reset(&mut self) {
-        if let Ok(fresh) = Self::new(self.config) {
-            *self = fresh;
-        }
+        *self = Self::fresh(self.config);
     }
 }
 

@@ -223,9 +223,15 @@ impl TurnCalibrator {
     /// A calibrator with the given configuration (validated).
     pub fn new(config: TurnConfig) -> Result<Self> {
         config.validate()?;
-        Ok(Self {
+        Ok(Self::fresh(config, TurnExtrema::new(config.extrema)?))
+    }
+
+    /// A calibrator that has seen nothing, from a validated `config` and its empty extremum
+    /// trackers (so that `reset` cannot fail).
+    fn fresh(config: TurnConfig, extrema: TurnExtrema<RawHeading>) -> Self {
+        Self {
             config,
-            extrema: TurnExtrema::new(config.extrema)?,
+            extrema,
             slots: DirectionSlots::new(),
             clock: TimeStep::new(),
             t0: None,
@@ -242,7 +248,7 @@ impl TurnCalibrator {
             pending_len: [0; 2],
             confirmed: [0; 2],
             zero: None,
-        })
+        }
     }
 
     /// The gyro's zero reading (rad/s), its standard deviation and the standstill's length
@@ -584,8 +590,8 @@ impl Calibrator for TurnCalibrator {
     }
 
     fn reset(&mut self) {
-        if let Ok(fresh) = Self::new(self.config) {
-            *self = fresh;
-        }
+        let mut extrema = self.extrema.clone();
+        extrema.reset();
+        *self = Self::fresh(self.config, extrema);
     }
 }
