@@ -123,42 +123,11 @@ impl Persistent for BinnedEllipseCalibrator {
     fn from_state(state: BinnedEllipseSaved) -> Result<Self> {
         let s = state;
         s.config.validate()?;
-        let invalid = |reason| Err(Error::InvalidSnapshot { reason });
         let n = s.config.bins;
         let mut c = Self::build(s.config);
         c.bins = bins_from(&s.bins, n)?;
-        if !(s.origin.iter().all(finite2)
-            && s.init.iter().all(finite2)
-            && s.reference.iter().flatten().all(finite2))
-        {
-            return invalid("a saved binned-ellipse reading is not finite");
-        }
-        if s.reference.len() != n || s.init.len() > MAX_INIT_SAMPLES {
-            return invalid("the saved binned-ellipse arrays have the wrong length");
-        }
-        // Before the origin exists the initial readings are being collected; after, they
-        // were averaged and binned.
-        let init_ok = match s.origin {
-            None => s.init.len() < s.config.init_samples && s.init.len() == s.samples,
-            // (Regenerated from stored parameters, it never collected any.)
-            Some(_) => true,
-        };
-        if !init_ok
-            || (s.origin.is_none()
-                && (s.update.is_some() || c.bins[..n].iter().any(|b| b.state != BinState::Empty)))
-        {
-            return invalid(
-                "the saved binned-ellipse origin, initial readings and bins do not fit together",
-            );
-        }
-        if let Some(p) = &s.phasors {
-            p.validate()?;
-        }
-        if let Some(e) = &s.estimate
-            && !(e.params.hard_iron.iter().chain(e.params.soft_iron.iter())).all(|x| x.is_finite())
-        {
-            return invalid("the saved binned-ellipse estimate is not finite");
-        }
+        check_readings(&s, n)?;
+        check_stage(&s, &c.bins[..n])?;
         c.origin = s.origin;
         c.init[..s.init.len()].copy_from_slice(&s.init);
         c.init_count = s.init.len();
@@ -169,84 +138,149 @@ impl Persistent for BinnedEllipseCalibrator {
         c.restored = s.restored;
         c.restarts = s.restarts;
         c.estimate = s.estimate;
-        // Readings wait only after an update was applied, never during one.
-        if s.backlog.len() >= MAX_UPDATE_PUSHES
-            || (!s.backlog.is_empty() && s.update.is_some())
-            || !s.backlog.iter().all(finite2)
-        {
-            return invalid("the saved binned-ellipse waiting readings are inconsistent");
-        }
+        check_backlog(&s)?;
         c.backlog[..s.backlog.len()].copy_from_slice(&s.backlog);
         c.backlog_len = s.backlog.len();
         if let Some(u) = s.update {
-            let start_bins = bins_from(&u.start_bins, n)?;
-            if !(finite2(&u.start_origin) && u.pending.iter().all(finite2)) {
-                return invalid("a saved reading of the update in progress is not finite");
-            }
-            let bound = RefreshJob::work_bound(n, s.config.origin_iterations);
-            if u.pending.len() >= MAX_UPDATE_PUSHES
-                || u.advanced == 0
-                || u.advanced > MAX_UPDATE_PUSHES
-                || u.budget == 0
-                || u.budget > bound
-                || u.stride == 0
-                || u.stride > REFRESH_STRIDE
-            {
-                return invalid("the saved update in progress is inconsistent");
-            }
-            let job = RefreshJob::start(
-                &start_bins,
-                n,
-                &u.start_origin,
-                s.config.origin_iterations,
-                s.config.min_filled_bins,
-            );
-            let mut pending = [Vector2::zeros(); MAX_UPDATE_PUSHES];
-            pending[..u.pending.len()].copy_from_slice(&u.pending);
-            let mut update = Update {
-                job,
-                start_bins,
-                start_origin: u.start_origin,
-                budget: u.budget,
-                stride: u.stride,
-                advanced: 0,
-                phase: UpdatePhase::Refresh,
-                precheck: None,
-                verdict: None,
-                seed: None,
-                assess_steps: 0,
-                pending,
-                pending_len: u.pending.len(),
-            };
-            // Replaying the pushes rebuilds the job exactly; an assessed update is assessed
-            // again (the assessment is pure and what it reads has not changed since).
-            for _ in 0..u.advanced {
-                update.step_refresh();
-            }
-            let replayed = match u.phase {
-                UpdatePhase::Refresh => UpdatePhase::Refresh,
-                _ => UpdatePhase::Precheck,
-            };
-            if update.phase != replayed {
-                return invalid("the saved update in progress does not match its phase");
-            }
-            // Precheck, the steps of the assessment, then the application: a saved update is
-            // at most that many assessment pushes past its refresh.
-            let mut left = 2 + SeedJob::STEPS;
-            while update.phase != u.phase
-                || (u.phase == UpdatePhase::Assess && update.assess_steps < u.assess_steps)
-            {
-                if left == 0 {
-                    return invalid("the saved update in progress does not match its phase");
-                }
-                left -= 1;
-                update.advance_assessment(&c.assessor());
-            }
-            if update.assess_steps != u.assess_steps {
-                return invalid("the saved update in progress does not match its phase");
-            }
+            let update = replay_update(u, &s.config, &c)?;
             c.update = Some(update);
         }
         Ok(c)
     }
+}
+
+/// A refusal of a damaged binned-ellipse state.
+fn invalid<T>(reason: &'static str) -> Result<T> {
+    Err(Error::InvalidSnapshot { reason })
+}
+
+/// Every saved reading finite and every array of its configured length.
+fn check_readings(s: &BinnedEllipseSaved, n: usize) -> Result<()> {
+    if !(s.origin.iter().all(finite2)
+        && s.init.iter().all(finite2)
+        && s.reference.iter().flatten().all(finite2))
+    {
+        return invalid("a saved binned-ellipse reading is not finite");
+    }
+    if s.reference.len() != n || s.init.len() > MAX_INIT_SAMPLES {
+        return invalid("the saved binned-ellipse arrays have the wrong length");
+    }
+    Ok(())
+}
+
+/// The origin, initial readings, bins, phasors and estimate of one stage of the method.
+fn check_stage(s: &BinnedEllipseSaved, bins: &[Bin]) -> Result<()> {
+    // Before the origin exists the initial readings are being collected; after, they
+    // were averaged and binned.
+    let init_ok = match s.origin {
+        None => s.init.len() < s.config.init_samples && s.init.len() == s.samples,
+        // (Regenerated from stored parameters, it never collected any.)
+        Some(_) => true,
+    };
+    if !init_ok
+        || (s.origin.is_none()
+            && (s.update.is_some() || bins.iter().any(|b| b.state != BinState::Empty)))
+    {
+        return invalid(
+            "the saved binned-ellipse origin, initial readings and bins do not fit together",
+        );
+    }
+    if let Some(p) = &s.phasors {
+        p.validate()?;
+    }
+    if let Some(e) = &s.estimate
+        && !(e.params.hard_iron.iter().chain(e.params.soft_iron.iter())).all(|x| x.is_finite())
+    {
+        return invalid("the saved binned-ellipse estimate is not finite");
+    }
+    Ok(())
+}
+
+/// Readings wait only after an update was applied, never during one.
+fn check_backlog(s: &BinnedEllipseSaved) -> Result<()> {
+    if s.backlog.len() >= MAX_UPDATE_PUSHES
+        || (!s.backlog.is_empty() && s.update.is_some())
+        || !s.backlog.iter().all(finite2)
+    {
+        return invalid("the saved binned-ellipse waiting readings are inconsistent");
+    }
+    Ok(())
+}
+
+/// The update in progress rebuilt by replaying its pushes from the bins it started from
+/// (the refresh job is not saved: replaying rebuilds it exactly), refused where the saved
+/// counts cannot come from a real run.
+fn replay_update(
+    u: BinnedUpdateSaved,
+    config: &BinnedEllipseConfig,
+    c: &BinnedEllipseCalibrator,
+) -> Result<Update> {
+    let n = config.bins;
+    let start_bins = bins_from(&u.start_bins, n)?;
+    if !(finite2(&u.start_origin) && u.pending.iter().all(finite2)) {
+        return invalid("a saved reading of the update in progress is not finite");
+    }
+    let bound = RefreshJob::work_bound(n, config.origin_iterations);
+    if u.pending.len() >= MAX_UPDATE_PUSHES
+        || u.advanced == 0
+        || u.advanced > MAX_UPDATE_PUSHES
+        || u.budget == 0
+        || u.budget > bound
+        || u.stride == 0
+        || u.stride > REFRESH_STRIDE
+    {
+        return invalid("the saved update in progress is inconsistent");
+    }
+    let job = RefreshJob::start(
+        &start_bins,
+        n,
+        &u.start_origin,
+        config.origin_iterations,
+        config.min_filled_bins,
+    );
+    let mut pending = [Vector2::zeros(); MAX_UPDATE_PUSHES];
+    pending[..u.pending.len()].copy_from_slice(&u.pending);
+    let mut update = Update {
+        job,
+        start_bins,
+        start_origin: u.start_origin,
+        budget: u.budget,
+        stride: u.stride,
+        advanced: 0,
+        phase: UpdatePhase::Refresh,
+        precheck: None,
+        verdict: None,
+        seed: None,
+        assess_steps: 0,
+        pending,
+        pending_len: u.pending.len(),
+    };
+    // Replaying the pushes rebuilds the job exactly; an assessed update is assessed
+    // again (the assessment is pure and what it reads has not changed since).
+    for _ in 0..u.advanced {
+        update.step_refresh();
+    }
+    let replayed = match u.phase {
+        UpdatePhase::Refresh => UpdatePhase::Refresh,
+        _ => UpdatePhase::Precheck,
+    };
+    if update.phase != replayed {
+        return invalid("the saved update in progress does not match its phase");
+    }
+    // Precheck, the steps of the assessment, then the application: a saved update is
+    // at most that many assessment pushes past its refresh.
+    let mut left = 2 + SeedJob::STEPS;
+    while update.phase != u.phase
+        || (u.phase == UpdatePhase::Assess && update.assess_steps < u.assess_steps)
+    {
+        if left == 0 {
+            return invalid("the saved update in progress does not match its phase");
+        }
+        left -= 1;
+        update.advance_assessment(&c.assessor());
+    }
+    if update.assess_steps != u.assess_steps {
+        return invalid("the saved update in progress does not match its phase");
+    }
+    Ok(update)
 }
