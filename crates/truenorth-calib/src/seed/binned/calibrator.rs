@@ -322,27 +322,14 @@ impl BinnedEllipseCalibrator {
         let stride = REFRESH_STRIDE.min(span);
         let working = span / stride;
         let bound = RefreshJob::work_bound(n, self.config.origin_iterations);
-        self.update = Some(Update {
-            job: RefreshJob::start(
-                &self.bins,
-                n,
-                &origin,
-                self.config.origin_iterations,
-                self.config.min_filled_bins,
-            ),
-            start_bins: self.bins,
-            start_origin: origin,
-            budget: bound.div_ceil(working),
+        self.update = Some(Update::start(
+            self.bins,
+            n,
+            origin,
+            &self.config,
+            bound.div_ceil(working),
             stride,
-            advanced: 0,
-            phase: UpdatePhase::Refresh,
-            precheck: None,
-            verdict: None,
-            seed: None,
-            assess_steps: 0,
-            pending: [Vector2::zeros(); MAX_UPDATE_PUSHES],
-            pending_len: 0,
-        });
+        ));
     }
 
     /// Applies a finished, assessed update: its bins and origin, then the verdict (restart,

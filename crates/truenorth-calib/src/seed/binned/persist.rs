@@ -231,30 +231,9 @@ fn replay_update(
     {
         return invalid("the saved update in progress is inconsistent");
     }
-    let job = RefreshJob::start(
-        &start_bins,
-        n,
-        &u.start_origin,
-        config.origin_iterations,
-        config.min_filled_bins,
-    );
-    let mut pending = [Vector2::zeros(); MAX_UPDATE_PUSHES];
-    pending[..u.pending.len()].copy_from_slice(&u.pending);
-    let mut update = Update {
-        job,
-        start_bins,
-        start_origin: u.start_origin,
-        budget: u.budget,
-        stride: u.stride,
-        advanced: 0,
-        phase: UpdatePhase::Refresh,
-        precheck: None,
-        verdict: None,
-        seed: None,
-        assess_steps: 0,
-        pending,
-        pending_len: u.pending.len(),
-    };
+    let mut update = Update::start(start_bins, n, u.start_origin, config, u.budget, u.stride);
+    update.pending[..u.pending.len()].copy_from_slice(&u.pending);
+    update.pending_len = u.pending.len();
     // Replaying the pushes rebuilds the job exactly; an assessed update is assessed
     // again (the assessment is pure and what it reads has not changed since).
     for _ in 0..u.advanced {

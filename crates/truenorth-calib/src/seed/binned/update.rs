@@ -8,6 +8,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::seed::binned::assess::{Assessor, Precheck, Verdict};
 use crate::seed::binned::bins::Bins;
+use crate::seed::binned::config::BinnedEllipseConfig;
 use crate::seed::binned::refresh::RefreshJob;
 use crate::seed::seed_quality::SeedJob;
 
@@ -67,6 +68,39 @@ pub(crate) struct Update {
 }
 
 impl Update {
+    /// An update that has seen no push yet: its refresh job started on `bins` (the first
+    /// `n` used) about `origin`, doing `budget` work per working push every `stride` pushes.
+    pub(crate) fn start(
+        bins: Bins,
+        n: usize,
+        origin: Vector2<f64>,
+        config: &BinnedEllipseConfig,
+        budget: usize,
+        stride: usize,
+    ) -> Self {
+        Self {
+            job: RefreshJob::start(
+                &bins,
+                n,
+                &origin,
+                config.origin_iterations,
+                config.min_filled_bins,
+            ),
+            start_bins: bins,
+            start_origin: origin,
+            budget,
+            stride,
+            advanced: 0,
+            phase: UpdatePhase::Refresh,
+            precheck: None,
+            verdict: None,
+            seed: None,
+            assess_steps: 0,
+            pending: [Vector2::zeros(); MAX_UPDATE_PUSHES],
+            pending_len: 0,
+        }
+    }
+
     /// The assessment's share of a push: its first half in phase `Precheck`, its second in
     /// phase `Assess`.
     pub(crate) fn advance_assessment(&mut self, assessor: &Assessor<'_>) {
