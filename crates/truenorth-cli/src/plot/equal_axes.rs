@@ -56,16 +56,53 @@ pub fn write_plot(
     y_label: &str,
     series: &[Series],
 ) -> CliResult {
-    const SIZE: f64 = 560.0;
-    const MARGIN: f64 = 60.0;
     let (x0, x1, y0, y1) = bounds(path, series.iter().flat_map(|s| s.points.iter()))?;
     // Equal scales on both axes so that a circle looks like a circle.
-    let span = (x1 - x0).max(y1 - y0).max(1e-12) * 1.1;
-    let (cx, cy) = (0.5 * (x0 + x1), 0.5 * (y0 + y1));
-    let sx = |x: f64| MARGIN + (x - cx + span / 2.0) / span * SIZE;
-    let sy = |y: f64| MARGIN + (cy + span / 2.0 - y) / span * SIZE;
-    let w = SIZE + 2.0 * MARGIN;
+    let view = View {
+        span: (x1 - x0).max(y1 - y0).max(1e-12) * 1.1,
+        cx: 0.5 * (x0 + x1),
+        cy: 0.5 * (y0 + y1),
+    };
     let mut svg = String::new();
+    frame(&mut svg, title, x_label, y_label);
+    ticks(&mut svg, &view);
+    zero_axes(&mut svg, &view);
+    for (k, s) in series.iter().enumerate() {
+        draw_series(&mut svg, &view, k, s);
+    }
+    svg.push_str("</svg>\n");
+    std::fs::write(path, svg).map_err(|e| CliError::file(path, format!("cannot write: {e}")))
+}
+
+/// Side of the square plot area, px.
+const SIZE: f64 = 560.0;
+/// Margin around it for labels, px.
+const MARGIN: f64 = 60.0;
+/// Width (and height) of the whole figure, px.
+const WIDTH: f64 = SIZE + 2.0 * MARGIN;
+
+/// The square of data shown: its centre and side, in data units.
+struct View {
+    span: f64,
+    cx: f64,
+    cy: f64,
+}
+
+impl View {
+    /// Pixel column of data `x`.
+    fn sx(&self, x: f64) -> f64 {
+        MARGIN + (x - self.cx + self.span / 2.0) / self.span * SIZE
+    }
+
+    /// Pixel row of data `y` (up is up).
+    fn sy(&self, y: f64) -> f64 {
+        MARGIN + (self.cy + self.span / 2.0 - y) / self.span * SIZE
+    }
+}
+
+/// The SVG header, background, title, axis labels and plot border.
+fn frame(svg: &mut String, title: &str, x_label: &str, y_label: &str) {
+    let w = WIDTH;
     let _ = writeln!(
         svg,
         r#"<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{w}" viewBox="0 0 {w} {w}" font-family="sans-serif" font-size="13">"#
@@ -92,17 +129,21 @@ pub fn write_plot(
         svg,
         r##"<rect x="{MARGIN}" y="{MARGIN}" width="{SIZE}" height="{SIZE}" fill="none" stroke="#888"/>"##
     );
-    // Tick labels at round values (1, 2 or 5 times a power of ten), about six per axis.
-    let step = nice_step(span / 6.0);
-    for (lo, to_px, vertical) in [
-        (cx - span / 2.0, &sx as &dyn Fn(f64) -> f64, true),
-        (cy - span / 2.0, &sy, false),
+}
+
+/// Tick marks and labels at round values (1, 2 or 5 times a power of ten), about six per
+/// axis.
+fn ticks(svg: &mut String, view: &View) {
+    let step = nice_step(view.span / 6.0);
+    for (lo, vertical) in [
+        (view.cx - view.span / 2.0, true),
+        (view.cy - view.span / 2.0, false),
     ] {
         let mut v = (lo / step).ceil() * step;
-        while v <= lo + span {
-            let px = to_px(v);
+        while v <= lo + view.span {
             let label = format!("{}", (v / step).round() * step);
             if vertical {
+                let px = view.sx(v);
                 let _ = writeln!(
                     svg,
                     r##"<line x1="{px:.1}" y1="{0}" x2="{px:.1}" y2="{1}" stroke="#888"/>"##,
@@ -115,6 +156,7 @@ pub fn write_plot(
                     MARGIN + SIZE + 18.0
                 );
             } else {
+                let px = view.sy(v);
                 let _ = writeln!(
                     svg,
                     r##"<line x1="{0}" y1="{px:.1}" x2="{MARGIN}" y2="{px:.1}" stroke="#888"/>"##,
@@ -130,69 +172,73 @@ pub fn write_plot(
             v += step;
         }
     }
-    // Axes through zero when zero is in view.
-    if (cx - span / 2.0..cx + span / 2.0).contains(&0.0) {
+}
+
+/// Axes through zero when zero is in view.
+fn zero_axes(svg: &mut String, view: &View) {
+    let half = view.span / 2.0;
+    if (view.cx - half..view.cx + half).contains(&0.0) {
         let _ = writeln!(
             svg,
             r##"<line x1="{0}" y1="{MARGIN}" x2="{0}" y2="{1}" stroke="#ccc"/>"##,
-            sx(0.0),
+            view.sx(0.0),
             MARGIN + SIZE
         );
     }
-    if (cy - span / 2.0..cy + span / 2.0).contains(&0.0) {
+    if (view.cy - half..view.cy + half).contains(&0.0) {
         let _ = writeln!(
             svg,
             r##"<line x1="{MARGIN}" y1="{0}" x2="{1}" y2="{0}" stroke="#ccc"/>"##,
-            sy(0.0),
+            view.sy(0.0),
             MARGIN + SIZE
         );
     }
-    for (k, s) in series.iter().enumerate() {
-        if s.style != Style::Dots {
-            let pts: Vec<String> = s
-                .points
-                .iter()
-                .map(|&(x, y)| format!("{:.1},{:.1}", sx(x), sy(y)))
-                .collect();
-            let _ = writeln!(
-                svg,
-                r#"<{} points="{}" fill="none" stroke="{}" stroke-width="2"/>"#,
-                if s.style == Style::Closed {
-                    "polygon"
-                } else {
-                    "polyline"
-                },
-                pts.join(" "),
-                s.colour
-            );
-        } else {
-            for &(x, y) in &s.points {
-                let _ = writeln!(
-                    svg,
-                    r#"<circle cx="{:.1}" cy="{:.1}" r="1.6" fill="{}"/>"#,
-                    sx(x),
-                    sy(y),
-                    s.colour
-                );
-            }
-        }
-        let ly = MARGIN + 18.0 + 18.0 * k as f64;
+}
+
+/// Series `k`: its points (dots, or a line open or closed) and its legend entry.
+fn draw_series(svg: &mut String, view: &View, k: usize, s: &Series) {
+    if s.style != Style::Dots {
+        let pts: Vec<String> = s
+            .points
+            .iter()
+            .map(|&(x, y)| format!("{:.1},{:.1}", view.sx(x), view.sy(y)))
+            .collect();
         let _ = writeln!(
             svg,
-            r#"<rect x="{}" y="{}" width="12" height="12" fill="{}"/>"#,
-            MARGIN + 10.0,
-            ly - 10.0,
+            r#"<{} points="{}" fill="none" stroke="{}" stroke-width="2"/>"#,
+            if s.style == Style::Closed {
+                "polygon"
+            } else {
+                "polyline"
+            },
+            pts.join(" "),
             s.colour
         );
-        let _ = writeln!(
-            svg,
-            r#"<text x="{}" y="{ly}">{}</text>"#,
-            MARGIN + 28.0,
-            s.label
-        );
+    } else {
+        for &(x, y) in &s.points {
+            let _ = writeln!(
+                svg,
+                r#"<circle cx="{:.1}" cy="{:.1}" r="1.6" fill="{}"/>"#,
+                view.sx(x),
+                view.sy(y),
+                s.colour
+            );
+        }
     }
-    svg.push_str("</svg>\n");
-    std::fs::write(path, svg).map_err(|e| CliError::file(path, format!("cannot write: {e}")))
+    let ly = MARGIN + 18.0 + 18.0 * k as f64;
+    let _ = writeln!(
+        svg,
+        r#"<rect x="{}" y="{}" width="12" height="12" fill="{}"/>"#,
+        MARGIN + 10.0,
+        ly - 10.0,
+        s.colour
+    );
+    let _ = writeln!(
+        svg,
+        r#"<text x="{}" y="{ly}">{}</text>"#,
+        MARGIN + 28.0,
+        s.label
+    );
 }
 
 /// The round step (1, 2 or 5 × 10ⁿ) nearest above `raw`.
