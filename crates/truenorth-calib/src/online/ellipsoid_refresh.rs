@@ -9,7 +9,7 @@ use truenorth_compass::CompassCalibration3d;
 use truenorth_core::{Error, FitQuality, Mag3Sample, Result, Solution};
 
 use crate::fits::ellipsoid::direct::{
-    Ellipsoid, Reduced, constrained_quadric, quadric_to_ellipsoid, reduce,
+    Ellipsoid, Reduced, constrained_quadric, quadric_to_ellipsoid, reduce, second_moments,
 };
 
 use crate::fits::ellipsoid::config::ORIENTATION_HINT;
@@ -255,20 +255,7 @@ impl Refresh {
             });
         };
         (self.scatter, self.centre, self.scale) = (s, centre, scale);
-        // Σ qqᵀ from the quadratic terms' entries in the constant term's column (the
-        // off-diagonal terms carry a factor 2).
-        let w = self.base.sums.weight();
-        let cov = Matrix3::new(
-            s[(0, 9)],
-            0.5 * s[(5, 9)],
-            0.5 * s[(4, 9)],
-            0.5 * s[(5, 9)],
-            s[(1, 9)],
-            0.5 * s[(3, 9)],
-            0.5 * s[(4, 9)],
-            0.5 * s[(3, 9)],
-            s[(2, 9)],
-        ) / w;
+        let cov = second_moments(&s, self.base.sums.weight());
         match sym_eigen3(&cov) {
             None => self.fail(Error::Degenerate {
                 reason: "the readings could not be analysed",

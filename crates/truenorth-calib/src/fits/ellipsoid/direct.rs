@@ -176,9 +176,14 @@ pub(crate) fn moments(
             s[(b, a)] = v;
         }
     }
-    let n = points.len() as f64;
-    // Σ qqᵀ from the quadratic moments: s[(0,9)] = Σx², s[(5,9)] = 2Σxy, ...
-    let cov = Matrix3::new(
+    let cov = second_moments(&s, points.len() as f64);
+    (s, cov)
+}
+
+/// `Σ qqᵀ / weight` from the scatter's quadratic moments in the constant term's column:
+/// `s[(0,9)] = Σx²`, `s[(5,9)] = 2Σxy`, … (the off-diagonal terms carry a factor 2).
+pub(crate) fn second_moments(s: &SMatrix<f64, 10, 10>, weight: f64) -> Matrix3<f64> {
+    Matrix3::new(
         s[(0, 9)],
         0.5 * s[(5, 9)],
         0.5 * s[(4, 9)],
@@ -188,8 +193,7 @@ pub(crate) fn moments(
         0.5 * s[(4, 9)],
         0.5 * s[(3, 9)],
         s[(2, 9)],
-    ) / n;
-    (s, cov)
+    ) / weight
 }
 
 /// The constraint `4J − I² = a₁ᵀ C₁ a₁` on `a₁ = (a, b, c, f, g, h)` (Li & Griffiths 2004,
