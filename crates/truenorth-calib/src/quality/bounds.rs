@@ -285,30 +285,38 @@ pub(super) fn bound_3d(info: &SMatrix<f64, 9, 9>, sum_sq: f64, n: usize) -> f64 
 /// `max_u trace(G(u) A⁻¹ G(u)ᵀ) = max_u ‖L⁻¹ G(u)ᵀ‖²_F` over [`BOUND_DIRECTIONS_3D`]
 /// directions: each costs one small matrix product.
 pub(super) fn worst_3d(l_inv: &SMatrix<f64, 9, 9>) -> f64 {
-    let golden = core::f64::consts::PI * (3.0 - 5.0_f64.sqrt());
     let mut worst: f64 = 0.0;
     for k in 0..BOUND_DIRECTIONS_3D {
-        let z = 1.0 - (2.0 * k as f64 + 1.0) / BOUND_DIRECTIONS_3D as f64;
-        let r = (1.0 - z * z).max(0.0).sqrt();
-        let (s, c) = (golden * k as f64).sin_cos();
-        let u = Vector3::new(r * c, r * s, z);
-        let proj = nalgebra::Matrix3::identity() - u * u.transpose();
-        let mut g = SMatrix::<f64, 3, 9>::zeros();
-        for kk in 0..3 {
-            g.set_column(kk, &(-proj.column(kk)));
-        }
-        // E_kl u for (11, 12, 13, 22, 23, 33): the symmetric basis matrices applied to u.
-        for (j, &(a, b)) in QUAD_3D.iter().enumerate() {
-            let mut eu = Vector3::zeros();
-            eu[a] += u[b];
-            if a != b {
-                eu[b] += u[a];
-            }
-            g.set_column(3 + j, &(proj * eu));
-        }
+        let g = direction_jacobian_3d(k);
         worst = worst.max((l_inv * g.transpose()).norm_squared());
     }
     worst
+}
+
+/// `G(u)` for the `k`-th of [`BOUND_DIRECTIONS_3D`] directions `u`, spread evenly over the
+/// sphere (a Fibonacci lattice): how the calibrated direction of a reading along `u` moves
+/// with the hard iron (first three columns) and the soft iron's six entries.
+pub(super) fn direction_jacobian_3d(k: usize) -> SMatrix<f64, 3, 9> {
+    let golden = core::f64::consts::PI * (3.0 - 5.0_f64.sqrt());
+    let z = 1.0 - (2.0 * k as f64 + 1.0) / BOUND_DIRECTIONS_3D as f64;
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    let (s, c) = (golden * k as f64).sin_cos();
+    let u = Vector3::new(r * c, r * s, z);
+    let proj = nalgebra::Matrix3::identity() - u * u.transpose();
+    let mut g = SMatrix::<f64, 3, 9>::zeros();
+    for kk in 0..3 {
+        g.set_column(kk, &(-proj.column(kk)));
+    }
+    // E_kl u for (11, 12, 13, 22, 23, 33): the symmetric basis matrices applied to u.
+    for (j, &(a, b)) in QUAD_3D.iter().enumerate() {
+        let mut eu = Vector3::zeros();
+        eu[a] += u[b];
+        if a != b {
+            eu[b] += u[a];
+        }
+        g.set_column(3 + j, &(proj * eu));
+    }
+    g
 }
 
 /// The Student-t widening of a 3σ bound whose σ comes from `dof` degrees of freedom (see

@@ -1,8 +1,8 @@
 //! Tests of the shared quality report: coverage, bounds and the turning of the locus.
 
 use super::bounds::{
-    BOUND_DIRECTIONS_3D, MONOMIALS_2D, MONOMIALS_3D, QUAD_3D, bound_3d, information_2d,
-    information_3d, monomial_tuples_3d, monomials_2d,
+    BOUND_DIRECTIONS_3D, MONOMIALS_2D, MONOMIALS_3D, bound_3d, direction_jacobian_3d,
+    information_2d, information_3d, monomial_tuples_3d, monomials_2d,
 };
 use super::coverage::turns;
 use super::*;
@@ -109,26 +109,9 @@ fn bound_3d_matches_solving_with_the_information_matrix() {
     let m = SMatrix::<f64, 9, 9>::from_fn(|_, _| rng.normal(1.0));
     let info = m * m.transpose() + SMatrix::<f64, 9, 9>::identity();
     let chol = info.cholesky().unwrap();
-    let golden = core::f64::consts::PI * (3.0 - 5.0_f64.sqrt());
     let mut worst: f64 = 0.0;
     for k in 0..BOUND_DIRECTIONS_3D {
-        let z = 1.0 - (2.0 * k as f64 + 1.0) / BOUND_DIRECTIONS_3D as f64;
-        let r = (1.0 - z * z).max(0.0).sqrt();
-        let (s, c) = (golden * k as f64).sin_cos();
-        let u = Vector3::new(r * c, r * s, z);
-        let proj = nalgebra::Matrix3::identity() - u * u.transpose();
-        let mut g = SMatrix::<f64, 3, 9>::zeros();
-        for kk in 0..3 {
-            g.set_column(kk, &(-proj.column(kk)));
-        }
-        for (j, &(a, b)) in QUAD_3D.iter().enumerate() {
-            let mut eu = Vector3::zeros();
-            eu[a] += u[b];
-            if a != b {
-                eu[b] += u[a];
-            }
-            g.set_column(3 + j, &(proj * eu));
-        }
+        let g = direction_jacobian_3d(k);
         worst = worst.max((g * chol.solve(&g.transpose())).trace());
     }
     let (sum_sq, n) = (0.5, 100);
