@@ -10,7 +10,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::Result;
+use crate::{CompassQuality, Result};
 
 /// A calibration: turns a raw reading into a physical quantity using stored parameters.
 ///
@@ -68,41 +68,6 @@ pub struct FitQuality {
     pub condition: f64,
 }
 
-/// How good a compass calibration is.
-///
-/// Heading error has three parts, reported apart so none is mistaken for another:
-/// the uncertainty of the fitted parameters (`heading_error_3sigma_deg`), the error the
-/// method's model cannot remove whatever the data (`heading_error_systematic_deg`, e.g. a
-/// rotated soft iron under a circle-only method), and the noise of each reading, which no
-/// calibration removes (`heading_noise_rms_deg`).
-#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
-pub struct CompassQuality {
-    /// What every calibrator reports.
-    pub fit: FitQuality,
-    /// Three standard deviations of the heading error caused by the uncertainty of the
-    /// fitted parameters, worst over heading, degrees. Excludes per-reading noise.
-    pub heading_error_3sigma_deg: f64,
-    /// Largest heading error the method's model leaves in place even with perfect data,
-    /// degrees (0 when the model can represent the distortion it was given).
-    pub heading_error_systematic_deg: f64,
-    /// RMS heading noise of a single calibrated reading, estimated from the residuals,
-    /// degrees. Averaging readings reduces it; recalibrating does not.
-    pub heading_noise_rms_deg: f64,
-    /// Fitted field magnitude (horizontal for 2-D, total for 3-D), in the input unit.
-    pub field_magnitude: f64,
-    /// Fitted field magnitude divided by the expected one (from a geomagnetic model), if
-    /// one was supplied. Far from 1 means a disturbed site or wrong units.
-    pub field_ratio_to_expected: Option<f64>,
-}
-
-impl CompassQuality {
-    /// Bound on the heading error of the calibration itself, degrees: the 3σ parameter
-    /// uncertainty plus the systematic part. Per-reading noise comes on top.
-    pub fn heading_error_bound_deg(&self) -> f64 {
-        self.heading_error_3sigma_deg + self.heading_error_systematic_deg
-    }
-}
-
 /// How good the calibration of one scalar coefficient is (a gyro bias or scale, an odometer
 /// wheel scale, the speed coefficient `a`).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
@@ -156,24 +121,4 @@ pub trait OnlineCalibrator: Calibrator {
     /// result of the latest refresh, which [`Calibrator::push`] announces with
     /// [`Pushed::NewEstimate`].
     fn estimate(&self) -> Option<Solution<Self::Params, Self::Quality>>;
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use proptest::prelude::*;
-
-    proptest! {
-        #[test]
-        fn heading_bound_is_uncertainty_plus_systematic(a in 0.0f64..90.0, b in 0.0f64..90.0, n in 0.0f64..10.0) {
-            let q = CompassQuality {
-                heading_error_3sigma_deg: a,
-                heading_error_systematic_deg: b,
-                heading_noise_rms_deg: n,
-                ..Default::default()
-            };
-            // Per-reading noise is reported apart and never enters the calibration's bound.
-            prop_assert_eq!(q.heading_error_bound_deg(), a + b);
-        }
-    }
 }

@@ -132,6 +132,23 @@ pub mod matrix2 {
     }
 }
 
+/// `#[serde(with = "truenorth_core::extended_float::array3")]` on a `[f64; 3]` field: the three
+/// entries, each as [`scalar`].
+pub mod array3 {
+    use super::Extended;
+    use serde::{Deserialize, Deserializer, Serialize, Serializer};
+
+    /// Writes the three entries.
+    pub fn serialize<S: Serializer>(v: &[f64; 3], serializer: S) -> Result<S::Ok, S::Error> {
+        v.map(Extended).serialize(serializer)
+    }
+
+    /// Reads three entries.
+    pub fn deserialize<'de, D: Deserializer<'de>>(deserializer: D) -> Result<[f64; 3], D::Error> {
+        <[Extended; 3]>::deserialize(deserializer).map(|v| v.map(|e| e.0))
+    }
+}
+
 /// Checks that every number `value` serialises as a plain number is finite: the fields
 /// marked with this module's `with` helpers may hold anything (they serialise non-finite
 /// values as text), every other number of a saved state must be finite. Refuses with

@@ -28,6 +28,7 @@
 mod angle;
 mod attitude;
 mod calibrator;
+pub mod compass_quality;
 mod error;
 mod estimator;
 pub mod extended_float;
@@ -40,13 +41,15 @@ mod sample;
 mod sensor_model;
 mod units;
 mod validate;
+pub mod verdict;
 
 pub use angle::{Unwrapper, angle_diff, unwrap_near, wrap_pi, wrap_two_pi};
 pub use attitude::{EulerZyx, Tilt, ned_to_enu};
 pub use calibrator::{
-    Calibration, Calibrator, CompassQuality, FitQuality, OnlineCalibrator, Progress, Pushed,
-    ScalarQuality, Solution,
+    Calibration, Calibrator, FitQuality, OnlineCalibrator, Progress, Pushed, ScalarQuality,
+    Solution,
 };
+pub use compass_quality::{CompassQuality, CompassUncertainty};
 pub use error::Error;
 pub use estimator::{
     AttitudeEstimate, AttitudeStatus, HeadingEstimator, NavEstimate, NavStatus,
@@ -69,6 +72,7 @@ pub use validate::{
     TimeStep, Validate, check_dt, check_finite, check_finite2, check_finite3, check_positive,
     check_range,
 };
+pub use verdict::{Cause, Grade, Verdict};
 
 /// Float methods (`sin`, `sqrt`, `atan2`, …) for `f64` that work with and without `std`.
 ///

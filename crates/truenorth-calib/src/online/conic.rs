@@ -16,7 +16,8 @@ use nalgebra::SMatrix;
 use nalgebra::SVector;
 use serde::{Deserialize, Serialize};
 use truenorth_core::{
-    CompassQuality, Error, FitQuality, Progress, Pushed, Result, Solution, Validate, check_finite,
+    CompassQuality, CompassUncertainty, Error, FitQuality, Progress, Pushed, Result, Solution,
+    Validate, check_finite,
 };
 
 use crate::online::conic_sums::{
@@ -194,6 +195,7 @@ pub(crate) fn report(
     sigma: f64,
     field: f64,
     expected_field: Option<f64>,
+    uncertainty: CompassUncertainty,
 ) -> CompassQuality {
     quality::with_expected_field(
         CompassQuality {
@@ -203,6 +205,7 @@ pub(crate) fn report(
             heading_noise_rms_deg: sigma.to_degrees(),
             field_magnitude: field,
             field_ratio_to_expected: None,
+            uncertainty,
         },
         expected_field,
     )

@@ -11,7 +11,7 @@ use core::f64::consts::TAU;
 
 use nalgebra::{Matrix2, Matrix3, SMatrix, SVector, Vector2, Vector3};
 use truenorth_compass::CompassCalibration2d;
-use truenorth_core::{Error, FitQuality, Mag2Sample, Result, Solution};
+use truenorth_core::{CompassUncertainty, Error, FitQuality, Mag2Sample, Result, Solution};
 
 use crate::fits::ellipse::direct::{
     Ellipse, conic_to_ellipse, denormalise, from_params, solve_direct, to_params,
@@ -21,7 +21,7 @@ use crate::fits::ellipse::fit::sampson_normal_equations;
 use crate::fits::lm::LmSteps;
 use crate::fits::normalise::Normaliser;
 use crate::numerics::linalg::{condition_from_eigenvalues, sym_eigen2, sym_eigen5, sym_sqrt2};
-use crate::online::conic_sums::{ConicSums, LAYOUT_2D, MONOMIALS_2D, Retained};
+use crate::online::conic_sums::{ConicSums, LAYOUT_2D, MONOMIALS_2D, Retained, inverse_factor};
 use crate::quality::{self, COVERAGE_BINS, Coverage, GAP_BINS, turns};
 
 use crate::online::conic::{
@@ -135,6 +135,10 @@ pub(crate) struct Refresh {
     condition: f64,
     sigma: f64,
     l_inv: Option<SMatrix<f64, PARAMS, PARAMS>>,
+    /// The inverse factor of the support's information matrix (each live direction slot
+    /// once) and its slots, for the dilution.
+    support_l_inv: Option<SMatrix<f64, PARAMS, PARAMS>>,
+    support_cells: usize,
     /// The direct fit's bias bound, radians (see `crate::online::conic::direct_fit_bias_rad`).
     bias_rad: f64,
     /// The geometric refinement of the retained readings (normalised coordinates), its
@@ -143,6 +147,21 @@ pub(crate) struct Refresh {
     support: [Vector2<f64>; ONLINE_SLOTS_2D],
     support_len: usize,
     arc: Coverage,
+}
+
+/// `max_u ‖L⁻¹g(u)‖²` over [`BOUND_HEADINGS`] headings, `g(u)` the heading error's gradient
+/// (see `crate::quality`); the headings by rotation, without trigonometry per step.
+fn worst_over_headings(l: &SMatrix<f64, PARAMS, PARAMS>) -> f64 {
+    let (sd, cd) = (TAU / BOUND_HEADINGS as f64).sin_cos();
+    let (mut c, mut s) = (1.0, 0.0);
+    let mut worst: f64 = 0.0;
+    for _ in 0..BOUND_HEADINGS {
+        let (px, py) = (-s, c);
+        let g = SVector::<f64, PARAMS>::new(-px, -py, px * c, px * s + py * c, py * s);
+        worst = worst.max((l * g).norm_squared());
+        (c, s) = (c * cd - s * sd, s * cd + c * sd);
+    }
+    worst
 }
 
 /// What the refusal of a stray ellipse says.
@@ -330,6 +349,7 @@ impl Refresh {
         let info = p * su * p.transpose();
         let info = (info + info.transpose()) * 0.5;
         let mut support = SMatrix::<f64, PARAMS, PARAMS>::zeros();
+        let mut cells = 0;
         for q in self.base.slots.live(self.base.sums.count, lifetime) {
             let h = self.cal.correct(q);
             let rho = h.norm();
@@ -339,10 +359,15 @@ impl Refresh {
             let (x, y) = (h.x / rho, h.y / rho);
             let phi = quality::regressor_2d(x, y);
             support += phi * phi.transpose();
+            cells += 1;
         }
         self.condition = sym_eigen5(&support)
             .map(|(l, _)| condition_from_eigenvalues(l.as_slice()))
             .unwrap_or(f64::INFINITY);
+        self.support_cells = cells;
+        self.support_l_inv = (cells >= PARAMS)
+            .then(|| inverse_factor(&support))
+            .flatten();
         (self.sigma, self.l_inv) = noise_factor(&self.base.sums, ss, &info);
         // The design vector's sums, (Σu_x², Σu_xu_y, Σu_y², Σu_x, Σu_y, Σ1): the harmonics
         // of the directions, and the anisotropy of B².
@@ -357,20 +382,19 @@ impl Refresh {
     /// Stage 4: the heading-error bound, the report and the refusals, in the order of the
     /// batch fit.
     fn finish(&mut self, cfg: &OnlineEllipseConfig, lifetime: u64) {
-        // 3σ max_u √(gᵀA⁻¹g) over 72 headings, g(u) the heading error's gradient (see
-        // `crate::quality`); the headings by rotation, without trigonometry per step.
-        let worst = self.l_inv.map(|l| {
-            let (sd, cd) = (TAU / BOUND_HEADINGS as f64).sin_cos();
-            let (mut c, mut s) = (1.0, 0.0);
-            let mut worst: f64 = 0.0;
-            for _ in 0..BOUND_HEADINGS {
-                let (px, py) = (-s, c);
-                let g = SVector::<f64, PARAMS>::new(-px, -py, px * c, px * s + py * c, py * s);
-                worst = worst.max((l * g).norm_squared());
-                (c, s) = (c * cd - s * sd, s * cd + c * sd);
-            }
-            worst
+        // 3σ max_u √(gᵀA⁻¹g) over the headings.
+        let worst = self.l_inv.map(|l| worst_over_headings(&l));
+        // The support's dilution √(K · max_u gᵀS⁻¹g), as the batch report's.
+        let dilution = self.support_l_inv.map_or(f64::INFINITY, |l| {
+            (self.support_cells as f64 * worst_over_headings(&l)).sqrt()
         });
+        let uncertainty = match self.l_inv {
+            Some(l) => quality::uncertainty_from_factor(&l, self.sigma, self.field, 2, dilution),
+            None => CompassUncertainty {
+                dilution,
+                ..CompassUncertainty::UNDETERMINED
+            },
+        };
         let fit = FitQuality {
             points: self.base.sums.count as usize,
             coverage: self.coverage.fraction,
@@ -385,6 +409,7 @@ impl Refresh {
             self.sigma,
             self.field,
             cfg.expected_field,
+            uncertainty,
         );
         let checked = quality::require_arc(&self.arc, self.sigma, cfg.min_arc_deg).and_then(|()| {
             refuse_fit(
@@ -498,6 +523,8 @@ impl ConicRefresh<2, MONOMIALS_2D, ONLINE_SLOTS_2D> for Refresh {
             condition: f64::INFINITY,
             sigma: 0.0,
             l_inv: None,
+            support_l_inv: None,
+            support_cells: 0,
             bias_rad: 0.0,
             refine: None,
             support: [Vector2::zeros(); ONLINE_SLOTS_2D],

@@ -16,7 +16,7 @@ use crate::fits::ellipsoid::config::ORIENTATION_HINT;
 use crate::numerics::linalg::{condition_from_eigenvalues, sym_eigen3};
 use crate::online::conic_sums::inverse_factor;
 use crate::online::conic_sums::{ConicSums, LAYOUT_3D, MONOMIALS_3D, Retained};
-use crate::quality::Uncertainty;
+use crate::quality::CompassUncertainty;
 use crate::quality::{self, SPHERE_CELLS};
 
 use crate::online::conic::{
@@ -469,19 +469,23 @@ impl Refresh {
         }
     }
 
-    /// What the orientations determine: the support's dilution (see `crate::quality`).
-    fn uncertainty(&self) -> Uncertainty {
+    /// What the readings determine: the support's dilution (see `crate::quality`) and the
+    /// parameters' σ from the information factor.
+    fn uncertainty(&self) -> CompassUncertainty {
         let dilution = match self.support_l_inv {
             Some(_) => (self.support_cells as f64 * self.support_worst).sqrt(),
             None => f64::INFINITY,
         };
-        Uncertainty {
-            dilution: if dilution.is_finite() {
-                dilution
-            } else {
-                f64::INFINITY
+        match self.l_inv {
+            Some(l) => quality::uncertainty_from_factor(&l, self.sigma, self.field, 3, dilution),
+            None => CompassUncertainty {
+                dilution: if dilution.is_finite() {
+                    dilution
+                } else {
+                    f64::INFINITY
+                },
+                ..CompassUncertainty::UNDETERMINED
             },
-            ..Uncertainty::UNDETERMINED
         }
     }
 
@@ -494,6 +498,7 @@ impl Refresh {
             condition: self.condition,
         };
         let bound = bound_deg(self.sigma, self.l_inv.map(|_| self.worst));
+        let uncertainty = self.uncertainty();
         let quality = report(
             fit,
             bound,
@@ -501,16 +506,15 @@ impl Refresh {
             self.sigma,
             self.field,
             cfg.expected_field,
+            uncertainty,
         );
         let checked = quality::require_determined(
-            &self.uncertainty(),
+            &uncertainty,
             3,
             cfg.max_heading_error_bound_deg,
             ORIENTATION_HINT,
         )
-        .and_then(|()| {
-            quality::require_linear(&self.uncertainty(), self.sigma, cfg.max_noise_dilution)
-        })
+        .and_then(|()| quality::require_linear(&uncertainty, self.sigma, cfg.max_noise_dilution))
         .and_then(|()| {
             refuse_fit(
                 &quality,

@@ -3,16 +3,19 @@
 //! the geometry determines the calibration, and how large a heading error that allows.
 //!
 //! Every calibrator in this crate fills its [`CompassQuality`](truenorth_core::CompassQuality) through [`assess_2d`] /
-//! [`quality_2d`] (or [`quality_3d`]), so the numbers mean the same thing whichever method
+//! [`quality_2d`] (or [`assess_3d`]), so the numbers mean the same thing whichever method
 //! produced them. The least-squares ellipse fit computes the same 2-D report from the
 //! monomial sums of its direct fit instead of a second pass over the readings.
 //!
 //! The parts live in submodules: coverage (heading bins, sphere cells, the locus's turning),
 //! bounds (information matrices and heading-error bounds), uncertainty (what the readings
 //! determine: the dilution of the information matrix, the predicted parameter σ, and the
-//! determination test that replaces a share of direction cells), verdict (good / usable /
-//! poor), report (assembly of the [`CompassQuality`](truenorth_core::CompassQuality)) and
-//! field (the fitted field against an expected one).
+//! determination test that replaces a share of direction cells), report (assembly of the
+//! [`CompassQuality`](truenorth_core::CompassQuality), its
+//! [`CompassUncertainty`](truenorth_core::CompassUncertainty) included) and field (the
+//! fitted field against an expected one). The report's data types and its verdict (good /
+//! usable / poor, [`Verdict`]) live in `truenorth-core`, beside the calibrator trait, and are
+//! re-exported here.
 //!
 //! # The three parts of the heading error
 //!
@@ -44,7 +47,6 @@ mod field;
 mod report;
 mod support;
 mod uncertainty;
-mod verdict;
 
 #[cfg(test)]
 mod tests;
@@ -61,14 +63,16 @@ pub use field::{
     FIELD_RATIO_TOLERANCE, FieldMismatch, field_mismatch, mean_corrected_norm_2d,
     mean_corrected_norm_3d, with_expected_field,
 };
-pub use report::{Assessment2d, Assessment3d, assess_2d, assess_3d, quality_2d, quality_3d};
+pub use report::{Assessment2d, assess_2d, assess_3d, quality_2d};
 pub(crate) use report::{
     Moments2, ReportSums, SupportFigures, assess_2d_from_moments, direction_harmonics,
     support_dilution_3d,
 };
 pub(crate) use support::GAP_BINS;
-pub use uncertainty::{
-    DILUTION_EVEN_CIRCLE, DILUTION_EVEN_SPHERE, MAX_NOISE_DILUTION, MODEL_ERROR_REL, Uncertainty,
-    require_certain, require_determined, require_linear,
+pub use truenorth_core::compass_quality::{
+    DILUTION_EVEN_CIRCLE, DILUTION_EVEN_SPHERE, MODEL_ERROR_REL,
 };
-pub use verdict::{Cause, GOOD_DEG, GOOD_NOISE_DEG, Grade, USABLE_DEG, Verdict};
+pub use truenorth_core::verdict::{GOOD_DEG, GOOD_NOISE_DEG, USABLE_DEG};
+pub use truenorth_core::{Cause, CompassUncertainty, Grade, Verdict};
+pub(crate) use uncertainty::uncertainty_from_factor;
+pub use uncertainty::{MAX_NOISE_DILUTION, require_certain, require_determined, require_linear};

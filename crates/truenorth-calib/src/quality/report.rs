@@ -12,7 +12,7 @@ use super::bounds::{
 };
 use super::coverage::{AngleBins, Coverage, sphere_cell, turns};
 use super::support::{Support2d, Support3d, support_dilution};
-use super::uncertainty::{Uncertainty, bound_and_uncertainty};
+use super::uncertainty::bound_and_uncertainty;
 use crate::numerics::blocks::{BLOCK, blocks, dot_block, sum_block};
 use crate::numerics::linalg::{condition_from_eigenvalues, sym_eigen5, sym_eigen9};
 use crate::quality::SPHERE_CELLS;
@@ -39,18 +39,6 @@ pub struct Assessment2d {
     pub quality: CompassQuality,
     /// Coverage of the calibrated headings (seen from the origin of the calibrated circle).
     pub coverage: Coverage,
-    /// What the readings determine.
-    pub uncertainty: Uncertainty,
-}
-
-/// A 3-D quality report and what the readings determine.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Assessment3d {
-    /// The report to return with the solution; its coverage is
-    /// [`Uncertainty::efficiency`].
-    pub quality: CompassQuality,
-    /// What the readings determine.
-    pub uncertainty: Uncertainty,
 }
 
 /// Everything the 2-D report needs, in one pass over the raw readings: the calibrated
@@ -372,9 +360,9 @@ fn report_2d_with(
             heading_noise_rms_deg: noise_rms_deg(ss, n, 5),
             field_magnitude: field,
             field_ratio_to_expected: None,
+            uncertainty,
         },
         coverage,
-        uncertainty,
     }
 }
 
@@ -385,15 +373,6 @@ pub fn quality_2d(
     field: f64,
 ) -> CompassQuality {
     assess_2d(points, cal, field).quality
-}
-
-/// The 3-D quality report of `cal` on `points` (see [`assess_3d`]).
-pub fn quality_3d(
-    points: &[Vector3<f64>],
-    cal: &CompassCalibration3d,
-    field: f64,
-) -> CompassQuality {
-    assess_3d(points, cal, field).quality
 }
 
 /// One over the number of kept readings in each equal-area cell of the directions of
@@ -418,7 +397,7 @@ fn cell_weights(points: &[Vector3<f64>], cal: &CompassCalibration3d) -> [f64; SP
 }
 
 /// The dilution of the support of the directions of `points` under `cal` alone (see the
-/// `support` module), as [`assess_3d`] reports it in [`Uncertainty::dilution`], without the
+/// `support` module), as [`assess_3d`] reports it in [`CompassUncertainty::dilution`], without the
 /// sums of every reading, the residuals and the bound: what a check of the geometry before
 /// a fit needs. Allocates nothing.
 pub(crate) fn support_dilution_3d(points: &[Vector3<f64>], cal: &CompassCalibration3d) -> f64 {
@@ -513,13 +492,17 @@ impl CalibratedBlock {
 }
 
 /// The 3-D quality report of `cal` on `points` and what they determine: coverage as the
-/// information share of an evenly covered sphere ([`Uncertainty::efficiency`] of the
+/// information share of an evenly covered sphere ([`CompassUncertainty::efficiency`] of the
 /// support, see the `support` module), residual RMS relative to `field` (the radius of the
 /// calibrated sphere; see [`super::mean_corrected_norm_3d`] if the calibrator defines
 /// none), the condition number of the support's 9-parameter information matrix and the
 /// direction-error bound of the module documentation (from every reading). Non-finite
 /// readings are skipped. Allocates nothing.
-pub fn assess_3d(points: &[Vector3<f64>], cal: &CompassCalibration3d, field: f64) -> Assessment3d {
+pub fn assess_3d(
+    points: &[Vector3<f64>],
+    cal: &CompassCalibration3d,
+    field: f64,
+) -> CompassQuality {
     let weight = cell_weights(points, cal);
     // Sums of the squared residuals and of the monomials of `u` that make up the
     // information matrix (see `information_3d`), plain and weighted by the cells.
@@ -567,20 +550,18 @@ pub fn assess_3d(points: &[Vector3<f64>], cal: &CompassCalibration3d, field: f64
         3,
         worst_3d,
     );
-    Assessment3d {
-        quality: CompassQuality {
-            fit: FitQuality {
-                points: n,
-                coverage: uncertainty.efficiency(3),
-                residual_rms_rel,
-                condition,
-            },
-            heading_error_3sigma_deg: bound,
-            heading_error_systematic_deg: 0.0,
-            heading_noise_rms_deg: noise_rms_deg(ss, n, 9),
-            field_magnitude: field,
-            field_ratio_to_expected: None,
+    CompassQuality {
+        fit: FitQuality {
+            points: n,
+            coverage: uncertainty.efficiency(3),
+            residual_rms_rel,
+            condition,
         },
+        heading_error_3sigma_deg: bound,
+        heading_error_systematic_deg: 0.0,
+        heading_noise_rms_deg: noise_rms_deg(ss, n, 9),
+        field_magnitude: field,
+        field_ratio_to_expected: None,
         uncertainty,
     }
 }

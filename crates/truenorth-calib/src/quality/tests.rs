@@ -168,7 +168,7 @@ fn sphere_report() {
             Vector3::new(r * c, r * s, z) * 3.0
         })
         .collect();
-    let q = quality_3d(&pts, &CompassCalibration3d::identity(), 3.0);
+    let q = assess_3d(&pts, &CompassCalibration3d::identity(), 3.0);
     // The coverage is the efficiency of the support (each equal-area cell's readings
     // weighed as one), whose mass sits at the cells' mean directions instead of spread
     // evenly over them: 0.9990 measured here, so a judgement of 0.995.

@@ -44,75 +44,16 @@
 //! 3σ bound, which falls as the readings grow, and by the verdict).
 
 use nalgebra::SMatrix;
-use serde::{Deserialize, Serialize};
-use truenorth_core::{CompassQuality, Error, Result};
+
+use truenorth_core::compass_quality::{
+    DILUTION_EVEN_CIRCLE, DILUTION_EVEN_SPHERE, MODEL_ERROR_REL,
+};
+use truenorth_core::{CompassQuality, CompassUncertainty, Error, Result};
 
 use super::bounds::{bound_deg, t_factor_exact_small, whitened};
 
 #[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
-
-/// The dilution `G` of readings spread evenly round a circle (2-D).
-pub const DILUTION_EVEN_CIRCLE: f64 = 2.0;
-
-/// The dilution `G` of readings spread evenly over the sphere (3-D): `√13.5`.
-pub const DILUTION_EVEN_SPHERE: f64 = 3.674_234_614_174_767;
-
-/// The per-reading error, relative to the field, that a consumer magnetometer keeps after
-/// a good calibration and that the determination test assumes: 0.5 %. The real
-/// full-sphere recording of an HMC5883L keeps 0.46 %, a tumbled unnamed sensor 1.3 %
-/// (`tests/real_data.rs`). The test does not use the fit's own residual: a residual made of
-/// noise is averaged away by more readings (it is judged by the 3σ bound), and one
-/// estimated from a few dozen shots can come out far smaller by chance.
-pub const MODEL_ERROR_REL: f64 = 0.005;
-
-/// What the readings determine (see the module documentation).
-#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
-pub struct Uncertainty {
-    /// The dilution `G` of the orientations seen (each direction cell once; see the module
-    /// documentation): worst-direction heading (3-D: field-direction) error, radians, per
-    /// unit of per-reading error relative to the field, for `K` directions times `√K`. 2
-    /// for an evenly covered circle, 3.67 for an evenly covered sphere; infinite when the
-    /// orientations do not determine the calibration at all.
-    pub dilution: f64,
-    /// Predicted standard deviation (1σ) of each hard-iron component, input unit (3-D:
-    /// three values; 2-D: two, the third 0).
-    pub hard_iron_sigma: [f64; 3],
-    /// Predicted standard deviation (1σ) of the least determined soft-iron entry, relative
-    /// (the soft iron is known to `(I + E)·soft_iron`, this is the largest σ of an entry of
-    /// `E`).
-    pub soft_iron_sigma_rel: f64,
-}
-
-impl Uncertainty {
-    /// Nothing determined.
-    pub const UNDETERMINED: Self = Self {
-        dilution: f64::INFINITY,
-        hard_iron_sigma: [f64::INFINITY; 3],
-        soft_iron_sigma_rel: f64::INFINITY,
-    };
-
-    /// The largest heading (3-D: field-direction) error, degrees, that a per-reading error
-    /// of [`MODEL_ERROR_REL`], random or not, could cause on the orientations seen: `G·ε`
-    /// (infinite when they do not determine the calibration).
-    pub fn geometry_error_deg(&self) -> f64 {
-        let w = (self.dilution * MODEL_ERROR_REL).to_degrees();
-        if w.is_finite() { w } else { f64::INFINITY }
-    }
-
-    /// How much of an even coverage's information per reading the readings give, in
-    /// [0, 1]: `(G_even / G)²` (an even circle or sphere: 1; half as many evenly spread
-    /// readings would determine the calibration as well as these: 0.5).
-    pub fn efficiency(&self, dimensions: usize) -> f64 {
-        let even = if dimensions == 2 {
-            DILUTION_EVEN_CIRCLE
-        } else {
-            DILUTION_EVEN_SPHERE
-        };
-        let e = (even / self.dilution).powi(2);
-        if e.is_finite() { e.min(1.0) } else { 0.0 }
-    }
-}
 
 /// The 3σ bound of the module documentation of `quality` (degrees) and the uncertainty,
 /// from an information matrix of `P` parameters (the first `dimensions` the hard iron
@@ -120,7 +61,7 @@ impl Uncertainty {
 /// of `n` readings and the field, with the support's `dilution` (see `support_dilution`,
 /// computed apart so that a staged caller can spread the two); `worst` computes
 /// `max_u ‖L⁻¹g(u)‖²` over the test directions. Infinite bound and
-/// [`Uncertainty::UNDETERMINED`] when `n ≤ P` or `A` is not positive definite.
+/// [`CompassUncertainty::UNDETERMINED`] when `n ≤ P` or `A` is not positive definite.
 pub(super) fn bound_and_uncertainty<const P: usize>(
     info: &SMatrix<f64, P, P>,
     dilution: f64,
@@ -129,11 +70,28 @@ pub(super) fn bound_and_uncertainty<const P: usize>(
     field: f64,
     dimensions: usize,
     worst: impl Fn(&SMatrix<f64, P, P>) -> f64,
-) -> (f64, Uncertainty) {
+) -> (f64, CompassUncertainty) {
     let Some((l_inv, sigma)) = whitened(info, sum_sq.max(0.0), n) else {
-        return (f64::INFINITY, Uncertainty::UNDETERMINED);
+        return (f64::INFINITY, CompassUncertainty::UNDETERMINED);
     };
     let w = worst(&l_inv);
+    (
+        bound_deg(sigma, w),
+        uncertainty_from_factor(&l_inv, sigma, field, dimensions, dilution),
+    )
+}
+
+/// What the readings determine, from the inverse Cholesky factor `L⁻¹` of the information
+/// matrix (`A⁻¹ = L⁻ᵀL⁻¹`, in the parameters of [`bound_and_uncertainty`], scaled so that
+/// `σ²A⁻¹` is the parameters' covariance), the per-reading noise `sigma` (relative to the
+/// field), the field, and the support's `dilution`. Non-finite figures are reported as +∞.
+pub(crate) fn uncertainty_from_factor<const P: usize>(
+    l_inv: &SMatrix<f64, P, P>,
+    sigma: f64,
+    field: f64,
+    dimensions: usize,
+    dilution: f64,
+) -> CompassUncertainty {
     // (A⁻¹)_kk = ‖column k of L⁻¹‖², since A⁻¹ = L⁻ᵀL⁻¹.
     let var = |k: usize| l_inv.column(k).norm_squared();
     let mut hard_iron_sigma = [0.0; 3];
@@ -144,14 +102,11 @@ pub(super) fn bound_and_uncertainty<const P: usize>(
         .map(|k| sigma * var(k).sqrt())
         .fold(0.0, f64::max);
     let finite = |v: f64| if v.is_finite() { v } else { f64::INFINITY };
-    (
-        bound_deg(sigma, w),
-        Uncertainty {
-            dilution,
-            hard_iron_sigma: hard_iron_sigma.map(finite),
-            soft_iron_sigma_rel: finite(soft_iron_sigma_rel),
-        },
-    )
+    CompassUncertainty {
+        dilution: finite(dilution),
+        hard_iron_sigma: hard_iron_sigma.map(finite),
+        soft_iron_sigma_rel: finite(soft_iron_sigma_rel),
+    }
 }
 
 /// Refuses a calibration that its orientations do not determine (see the module
@@ -159,7 +114,7 @@ pub(super) fn bound_and_uncertainty<const P: usize>(
 /// [`Error::Undetermined`] carrying the figures and `hint` (what to record instead).
 /// `dimensions` (2 or 3) names the even shape the dilution is compared with.
 pub fn require_determined(
-    u: &Uncertainty,
+    u: &CompassUncertainty,
     dimensions: usize,
     max_error_deg: f64,
     hint: &'static str,
@@ -204,7 +159,7 @@ pub const MAX_NOISE_DILUTION: f64 = 0.5;
 /// Refuses a calibration whose per-reading noise `noise_rel` times its dilution `u.dilution`
 /// exceeds `max_product` (by default [`MAX_NOISE_DILUTION`]), with
 /// [`Error::TooNoisyForOrientations`].
-pub fn require_linear(u: &Uncertainty, noise_rel: f64, max_product: f64) -> Result<()> {
+pub fn require_linear(u: &CompassUncertainty, noise_rel: f64, max_product: f64) -> Result<()> {
     let product = noise_rel * u.dilution;
     if product <= max_product {
         Ok(())
@@ -276,7 +231,7 @@ mod tests {
             .collect()
     }
 
-    fn u3(points: &[Vector3<f64>]) -> Uncertainty {
+    fn u3(points: &[Vector3<f64>]) -> CompassUncertainty {
         assess_3d(points, &CompassCalibration3d::identity(), 1.0).uncertainty
     }
 
@@ -303,7 +258,9 @@ mod tests {
         // (4.4·10⁻³ rad) from it; these readings lie on bin boundaries, the worst case, and
         // a direction error δ moves the dilution of an even set by about δ relative
         // (measured 2.2·10⁻³): the limit is 2δ.
-        let c = assess_2d(&ten, &CompassCalibration2d::identity(), 1.0).uncertainty;
+        let c = assess_2d(&ten, &CompassCalibration2d::identity(), 1.0)
+            .quality
+            .uncertainty;
         let delta = 0.25f64.to_radians();
         assert!(
             (c.dilution / DILUTION_EVEN_CIRCLE - 1.0).abs() < 2.0 * delta,
@@ -329,8 +286,8 @@ mod tests {
         for h in a.uncertainty.hard_iron_sigma {
             assert!((h / expect_h - 1.0).abs() < 0.1, "{h} vs {expect_h}");
         }
-        let g = a.quality.heading_error_3sigma_deg.to_radians() / 3.0;
-        let expect_g = a.quality.fit.residual_rms_rel * a.uncertainty.dilution / (n as f64).sqrt();
+        let g = a.heading_error_3sigma_deg.to_radians() / 3.0;
+        let expect_g = a.fit.residual_rms_rel * a.uncertainty.dilution / (n as f64).sqrt();
         assert!((g / expect_g - 1.0).abs() < 0.01, "{g} vs {expect_g}");
     }
 

@@ -11,7 +11,7 @@
 use std::path::PathBuf;
 
 use nalgebra::{SMatrix, SVector, Vector2, Vector3};
-use truenorth::calib::quality::{self, Cause, Grade, Uncertainty, Verdict};
+use truenorth::calib::quality::{self, Cause, Grade, Verdict};
 use truenorth::calib::{MagAccelQuality, MagAccelSample, TurnQuality, TurnSample};
 use truenorth::core::{Calibrator, CompassQuality, Mag2Sample, Mag3Sample, Solution};
 
@@ -189,7 +189,7 @@ pub fn run(args: &Args) -> CliResult {
         // An expected field given directly: a warning, as the numbers are the user's.
         warn(&w.to_string());
     }
-    let verdict = Verdict::of(&fitted.quality);
+    let verdict = fitted.quality.verdict();
     if verdict.grade == Grade::Poor {
         let what = format!(
             "the calibration with method `{}` is poor: {verdict}",
@@ -311,13 +311,11 @@ fn solve_2d(
         .map(|(&mag, &t_s)| Mag2Sample { t_s, mag })
         .collect();
     let sol = feed_and_solve(args, table, &mut *cal, &samples, expected)?;
-    let u = quality::assess_2d(&points, &sol.params, sol.quality.field_magnitude).uncertainty;
     Ok(fitted(
         args,
         &sol.params.hard_iron,
         &sol.params.soft_iron,
         sol.quality,
-        &u,
     ))
 }
 
@@ -351,14 +349,7 @@ fn calibrate_turn(
         .collect();
     let sol = feed_and_solve(args, &table, &mut *with_gyro, &samples, expected)?;
     let (c, q) = (sol.params, sol.quality);
-    let u = quality::assess_2d(&points, &c.compass, q.compass.field_magnitude).uncertainty;
-    let mut f = fitted(
-        args,
-        &c.compass.hard_iron,
-        &c.compass.soft_iron,
-        q.compass,
-        &u,
-    );
+    let mut f = fitted(args, &c.compass.hard_iron, &c.compass.soft_iron, q.compass);
     f.file.units.extend(gyro_units());
     // One turn measures the gain of the direction turned; it stands for both.
     f.file.gyro = Some(GyroPart {
@@ -383,13 +374,11 @@ fn calibrate_3d(args: &Args, mut cal: Box<Spatial>, expected: Option<f64>) -> Cl
         .map(|(m, &t_s)| Mag3Sample { t_s, mag: *m })
         .collect();
     let sol = feed_and_solve(args, &table, &mut *cal, &samples, expected)?;
-    let u = quality::assess_3d(&mags, &sol.params, sol.quality.field_magnitude).uncertainty;
     Ok(fitted(
         args,
         &sol.params.hard_iron,
         &sol.params.soft_iron,
         sol.quality,
-        &u,
     ))
 }
 
@@ -411,13 +400,7 @@ fn calibrate_joint(args: &Args, mut cal: Box<MagAccel>) -> CliResult<Fitted> {
         .collect();
     let sol = feed_and_solve(args, &table, &mut *cal, &samples, None)?;
     let (c, q) = (sol.params, sol.quality);
-    let mut f = fitted(
-        args,
-        &c.mag.hard_iron,
-        &c.mag.soft_iron,
-        q.mag,
-        &q.mag_uncertainty,
-    );
+    let mut f = fitted(args, &c.mag.hard_iron, &c.mag.soft_iron, q.mag);
     f.file.units = units_block(true);
     f.file.mag_to_body = Some(matrix_rows(&c.mag_to_body));
     f.file.accelerometer = Some(AccelPart {
@@ -505,7 +488,7 @@ where
             ),
         )
     })?;
-    if expected.is_some() {
+    if expected.is_some() && !args.method.reports_expected_field() {
         let q = *sol.quality.compass();
         *sol.quality.compass_mut() = quality::with_expected_field(q, expected);
     }
@@ -518,7 +501,6 @@ fn fitted<const D: usize>(
     hard_iron: &SVector<f64, D>,
     soft_iron: &SMatrix<f64, D, D>,
     q: CompassQuality,
-    u: &Uncertainty,
 ) -> Fitted {
     let file = CalibrationFile {
         format: CALIBRATION_FORMAT.into(),
@@ -534,7 +516,7 @@ fn fitted<const D: usize>(
         accelerometer: None,
         dip_deg: None,
         gyro: None,
-        quality: Some(QualityReport::new(&q, Some(u), D)),
+        quality: Some(QualityReport::new(&q, D)),
         input: InputPath::new(&args.input)
             .display_path()
             .display()

@@ -7,7 +7,6 @@ use std::path::Path;
 use nalgebra::{Matrix3, Vector2, Vector3};
 use truenorth::accel::AccelTriadCalibration;
 use truenorth::calib::MagAccelCalibration;
-use truenorth::calib::quality::{Uncertainty, Verdict};
 use truenorth::compass::{CompassCalibration2d, CompassCalibration3d};
 use truenorth::core::{CompassQuality, Validate};
 
@@ -204,9 +203,10 @@ pub fn finite(v: f64) -> Option<f64> {
 }
 
 impl QualityReport {
-    /// The report of a 2-D or 3-D calibration with what its readings determine.
-    pub fn new(q: &CompassQuality, u: Option<&Uncertainty>, dimensions: usize) -> Self {
-        let v = Verdict::of(q);
+    /// The report of a 2-D or 3-D calibration, what its readings determine and its
+    /// verdict, all as the calibrator computed them.
+    pub fn new(q: &CompassQuality, dimensions: usize) -> Self {
+        let (v, u) = (q.verdict(), &q.uncertainty);
         Self {
             verdict: v.grade.to_string(),
             verdict_reason: v.to_string(),
@@ -215,18 +215,18 @@ impl QualityReport {
             coverage: q.fit.coverage,
             residual_rms_rel: finite(q.fit.residual_rms_rel),
             condition: finite(q.fit.condition),
-            geometry_dilution: u.and_then(|u| finite(u.dilution)),
+            geometry_dilution: finite(u.dilution),
             heading_error_bound_deg: finite(q.heading_error_bound_deg()),
             heading_error_3sigma_deg: finite(q.heading_error_3sigma_deg),
             heading_error_systematic_deg: finite(q.heading_error_systematic_deg),
             heading_noise_rms_deg: finite(q.heading_noise_rms_deg),
-            hard_iron_sigma: u.map(|u| {
+            hard_iron_sigma: Some(
                 u.hard_iron_sigma[..dimensions]
                     .iter()
                     .map(|&s| finite(s))
-                    .collect()
-            }),
-            soft_iron_sigma_rel: u.and_then(|u| finite(u.soft_iron_sigma_rel)),
+                    .collect(),
+            ),
+            soft_iron_sigma_rel: finite(u.soft_iron_sigma_rel),
             field_ratio_to_expected: q.field_ratio_to_expected.and_then(finite),
             ..Self::default()
         }

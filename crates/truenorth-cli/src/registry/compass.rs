@@ -1,9 +1,10 @@
 //! Compass calibration methods by name.
 
 use truenorth::calib::{
-    BinnedEllipseCalibrator, EllipseCalibrator, EllipsoidCalibrator, MagAccelCalibration,
-    MagAccelCalibrator, MagAccelConfig, MagAccelQuality, MagAccelSample, MeritCircleCalibrator,
-    OnlineEllipseCalibrator, OnlineEllipsoidCalibrator, TurnCalibration, TurnCalibrator,
+    BinnedEllipseCalibrator, EllipseCalibrator, EllipseConfig, EllipsoidCalibrator,
+    EllipsoidConfig, MagAccelCalibration, MagAccelCalibrator, MagAccelConfig, MagAccelQuality,
+    MagAccelSample, MeritCircleCalibrator, OnlineEllipseCalibrator, OnlineEllipseConfig,
+    OnlineEllipsoidCalibrator, OnlineEllipsoidConfig, TurnCalibration, TurnCalibrator,
     TurnCompassCalibrator, TurnConfig, TurnQuality, TurnSample,
 };
 use truenorth::compass::{CompassCalibration2d, CompassCalibration3d};
@@ -102,20 +103,40 @@ impl CalibrationMethod {
         }
     }
 
-    /// The method's calibrator in its default configuration; `expected_field` (input unit)
-    /// is given to the method that uses it in the fit (`ellipsoid-accel`).
+    /// Whether the method's calibrator reports the fitted field against an expected one
+    /// itself (its configuration takes `expected_field`); the seed methods' do not.
+    pub fn reports_expected_field(self) -> bool {
+        !matches!(self, Self::BinnedEllipse | Self::MeritCircle | Self::Turn)
+    }
+
+    /// The method's calibrator in its default configuration, with `expected_field` (input
+    /// unit) for the methods whose configuration takes one (the least-squares and online
+    /// fits report the fitted field against it; `ellipsoid-accel` also uses it in the fit).
+    /// The seed methods take none: see [`Self::reports_expected_field`].
     pub fn calibrator(self, expected_field: Option<f64>) -> Result<CompassCalibrator> {
         use CompassCalibrator as C;
         Ok(match self {
-            Self::Ellipse => C::Planar(Box::new(EllipseCalibrator::default())),
-            Self::OnlineEllipse => {
-                C::Planar(Box::new(OnlineEllipseCalibrator::new(Default::default())?))
-            }
+            Self::Ellipse => C::Planar(Box::new(EllipseCalibrator::new(EllipseConfig {
+                expected_field,
+                ..EllipseConfig::default()
+            })?)),
+            Self::OnlineEllipse => C::Planar(Box::new(OnlineEllipseCalibrator::new(
+                OnlineEllipseConfig {
+                    expected_field,
+                    ..OnlineEllipseConfig::default()
+                },
+            )?)),
             Self::BinnedEllipse => C::Planar(Box::new(BinnedEllipseCalibrator::default())),
             Self::MeritCircle => C::Planar(Box::new(MeritCircleCalibrator::default())),
-            Self::Ellipsoid => C::Spatial(Box::new(EllipsoidCalibrator::default())),
+            Self::Ellipsoid => C::Spatial(Box::new(EllipsoidCalibrator::new(EllipsoidConfig {
+                expected_field,
+                ..EllipsoidConfig::default()
+            })?)),
             Self::OnlineEllipsoid => C::Spatial(Box::new(OnlineEllipsoidCalibrator::new(
-                Default::default(),
+                OnlineEllipsoidConfig {
+                    expected_field,
+                    ..OnlineEllipsoidConfig::default()
+                },
             )?)),
             Self::EllipsoidAccel => {
                 C::MagAccel(Box::new(MagAccelCalibrator::new(MagAccelConfig {

@@ -62,7 +62,7 @@ impl Calibrator for EllipsoidCalibrator {
     }
 
     /// `ready` runs the fit (see the type's documentation); `coverage` is the information
-    /// share of an evenly covered sphere ([`quality::Uncertainty::efficiency`]) of the
+    /// share of an evenly covered sphere ([`quality::CompassUncertainty::efficiency`]) of the
     /// directions seen from the centre of the readings' bounding box (an estimate before
     /// the fit).
     fn progress(&self) -> Progress {

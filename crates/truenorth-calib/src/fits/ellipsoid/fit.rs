@@ -43,7 +43,7 @@ use crate::fits::lm::{self, NormalAccumulator, NormalEquations};
 use crate::fits::normalise::Normaliser;
 use crate::numerics::blocks::{BLOCK, blocks};
 use crate::numerics::linalg::sym_sqrt3;
-use crate::quality::{self, Uncertainty};
+use crate::quality::{self, CompassUncertainty};
 
 use crate::fits::ellipsoid::config::EllipsoidConfig;
 use crate::fits::ellipsoid::config::MIN_POINTS_3D;
@@ -162,9 +162,9 @@ fn fit_unchecked(
             soft_iron: Matrix3::identity(),
         };
         // Only the dilution is judged here; the fit's own figures come after it.
-        let pre = Uncertainty {
+        let pre = CompassUncertainty {
             dilution: quality::support_dilution_3d(points, &raw),
-            ..Uncertainty::UNDETERMINED
+            ..CompassUncertainty::UNDETERMINED
         };
         quality::require_determined(
             &pre,
@@ -190,16 +190,15 @@ fn fit_unchecked(
             reason: "the fitted ellipsoid is not finite; check the input scale",
         });
     }
-    let a = quality::assess_3d(points, &cal, field);
-    let q = a.quality;
+    let q = quality::assess_3d(points, &cal, field);
     quality::require_determined(
-        &a.uncertainty,
+        &q.uncertainty,
         3,
         config.max_heading_error_bound_deg,
         ORIENTATION_HINT,
     )?;
     quality::require_linear(
-        &a.uncertainty,
+        &q.uncertainty,
         q.heading_noise_rms_deg.to_radians(),
         config.max_noise_dilution,
     )?;

@@ -19,7 +19,7 @@ use crate::fits::mag_accel::solve::{
 };
 use crate::fits::normalise::Normaliser;
 use crate::numerics::linalg::sym_eigen3;
-use crate::quality::{self, Uncertainty};
+use crate::quality::{self, CompassUncertainty};
 
 #[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
@@ -205,23 +205,23 @@ pub(crate) fn assemble(
             CompassQuality {
                 fit: FitQuality {
                     points: samples.len(),
-                    coverage: own.quality.fit.coverage,
+                    coverage: own.fit.coverage,
                     residual_rms_rel: sigma_m,
-                    condition: own.quality.fit.condition,
+                    condition: own.fit.condition,
                 },
                 heading_error_3sigma_deg: bound,
                 heading_error_systematic_deg: 0.0,
                 heading_noise_rms_deg: noise,
                 field_magnitude: field,
                 field_ratio_to_expected: None,
+                uncertainty: CompassUncertainty {
+                    dilution: own.uncertainty.dilution,
+                    hard_iron_sigma: hard_sigma,
+                    soft_iron_sigma_rel: soft_sigma,
+                },
             },
             config.expected_field,
         ),
-        mag_uncertainty: Uncertainty {
-            dilution: own.uncertainty.dilution,
-            hard_iron_sigma: hard_sigma,
-            soft_iron_sigma_rel: soft_sigma,
-        },
         accel_residual_rms_rel: sigma_a,
         accel_bias_sigma: bias_sigma,
         dip_deg: cal.dip_rad.to_degrees(),
@@ -251,11 +251,9 @@ pub struct MagAccelQuality {
     /// The magnetometer's report: its points, coverage and condition (its own geometry),
     /// its field-norm residual, and the heading figures of the joint calibration (the 3σ
     /// bound is that of the heading of the pointing axis, propagated from every
-    /// parameter's uncertainty, the accelerometer's and the alignment's included).
+    /// parameter's uncertainty, the accelerometer's and the alignment's included); its
+    /// uncertainty has the σ of the joint fit and the dilution of its own geometry.
     pub mag: CompassQuality,
-    /// What the readings determine of the magnetometer (σ from the joint fit; dilution
-    /// from its own geometry).
-    pub mag_uncertainty: Uncertainty,
     /// RMS of `|f|/g − 1` of the calibrated accelerometer.
     pub accel_residual_rms_rel: f64,
     /// Predicted 1σ of each accelerometer bias component, its raw unit.

@@ -27,8 +27,8 @@
 
 use core::fmt;
 
+use crate::CompassQuality;
 use serde::{Deserialize, Serialize};
-use truenorth_core::CompassQuality;
 
 /// Largest calibration bound of a `good` calibration, degrees.
 pub const GOOD_DEG: f64 = 1.0;
@@ -90,20 +90,22 @@ impl fmt::Display for Cause {
 }
 
 /// A grade, the numbers behind it and which of them decided it.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Verdict {
     /// The grade.
     pub grade: Grade,
     /// What kept it from a better grade.
     pub cause: Cause,
     /// The calibration bound, degrees (3σ plus systematic).
+    #[serde(with = "crate::extended_float::scalar")]
     pub bound_deg: f64,
     /// The per-reading heading noise, degrees.
+    #[serde(with = "crate::extended_float::scalar")]
     pub noise_deg: f64,
 }
 
 impl Verdict {
-    /// The verdict on a report.
+    /// The verdict on a report (also [`CompassQuality::verdict`]).
     pub fn of(q: &CompassQuality) -> Self {
         let bound_deg = q.heading_error_bound_deg();
         let noise_deg = q.heading_noise_rms_deg;
