@@ -1,0 +1,149 @@
+//! truenorth on a Cortex-M4F: the quaternion filter over a real BROAD slice and a calibrated
+//! compass heading ([`shared_run`], the same file the host twin runs), printed over
+//! semihosting, then the instructions one filter update takes, counted with the SysTick
+//! timer under QEMU's `-icount shift=0` (virtual time advances one step per instruction).
+//!
+//! Run (QEMU's `mps2-an386`, see `.cargo/config.toml`): `cargo run --release`.
+#![no_std]
+#![no_main]
+
+mod shared_run;
+
+use core::alloc::{GlobalAlloc, Layout};
+use core::fmt::Write as _;
+
+use cortex_m::peripheral::SYST;
+use cortex_m::peripheral::syst::SystClkSource;
+use cortex_m_rt::entry;
+use cortex_m_semihosting::{debug, hio};
+use panic_semihosting as _;
+
+use shared_run::UpdateMeter;
+
+/// The library links `alloc` (truenorth-calib's saved states hold `Vec`s) but the filter and
+/// the compass never allocate. This allocator refuses every request, so the run proves it:
+/// an allocation would end it with an allocation-error panic and a failing exit status.
+struct NoHeap;
+
+// SAFETY: returning null is how `GlobalAlloc::alloc` reports failure; `dealloc` is never
+// given a pointer, since no allocation ever succeeds.
+unsafe impl GlobalAlloc for NoHeap {
+    unsafe fn alloc(&self, _: Layout) -> *mut u8 {
+        core::ptr::null_mut()
+    }
+    unsafe fn dealloc(&self, _: *mut u8, _: Layout) {}
+}
+
+#[global_allocator]
+static HEAP: NoHeap = NoHeap;
+
+/// The SysTick reload: the full 24 bits, 16.7 M ticks between wraps.
+const SYST_RELOAD: u32 = 0x00FF_FFFF;
+
+/// Ticks elapsed between two readings of the down-counting SysTick (at most one wrap).
+fn ticks_between(start: u32, end: u32) -> u32 {
+    start.wrapping_sub(end) & SYST_RELOAD
+}
+
+/// Instructions in [`known_block`]: 400 passes of 250 `nop`s, `subs` and `bne`.
+const KNOWN_BLOCK_INSTRUCTIONS: u32 = 400 * 252;
+
+/// A block of exactly [`KNOWN_BLOCK_INSTRUCTIONS`] instructions, to learn how many
+/// instructions one SysTick tick stands for (25 MHz clock, 1 ns per instruction: 40).
+#[inline(never)]
+fn known_block() {
+    // SAFETY: only `nop`s and a loop counter in a scratch register; no memory, no stack.
+    unsafe {
+        core::arch::asm!(
+            "2:",
+            ".rept 250",
+            "nop",
+            ".endr",
+            "subs {n}, {n}, #1",
+            "bne 2b",
+            n = inout(reg) 400u32 => _,
+            options(nomem, nostack),
+        );
+    }
+}
+
+/// Sums the SysTick ticks of each measured update.
+struct SysTickMeter {
+    ticks: u64,
+    updates: u32,
+}
+
+impl UpdateMeter for SysTickMeter {
+    fn measure<T>(&mut self, update: impl FnOnce() -> T) -> T {
+        let start = SYST::get_current();
+        let result = update();
+        let end = SYST::get_current();
+        self.ticks += u64::from(ticks_between(start, end));
+        self.updates += 1;
+        result
+    }
+}
+
+/// Ticks an empty measurement costs, averaged over many (a tick is tens of instructions).
+fn meter_overhead_ticks() -> f64 {
+    const N: u32 = 1000;
+    let mut meter = SysTickMeter {
+        ticks: 0,
+        updates: 0,
+    };
+    for _ in 0..N {
+        meter.measure(|| core::hint::black_box(0));
+    }
+    meter.ticks as f64 / f64::from(N)
+}
+
+#[entry]
+fn main() -> ! {
+    let code = match run() {
+        Ok(()) => debug::EXIT_SUCCESS,
+        Err(e) => {
+            if let Ok(mut err) = hio::hstderr() {
+                let _ = writeln!(err, "error: {e}");
+            }
+            debug::EXIT_FAILURE
+        }
+    };
+    debug::exit(code);
+    #[allow(clippy::empty_loop)] // semihosting's exit does not return under QEMU
+    loop {}
+}
+
+/// The shared run, then the measured cost of an update.
+fn run() -> Result<(), shared_run::RunError> {
+    let mut out = hio::hstdout().map_err(|()| shared_run::RunError::Output(core::fmt::Error))?;
+    let mut syst = cortex_m::Peripherals::take()
+        .ok_or(shared_run::RunError::Output(core::fmt::Error))?
+        .SYST;
+    syst.set_clock_source(SystClkSource::Core);
+    syst.set_reload(SYST_RELOAD);
+    syst.clear_current();
+    syst.enable_counter();
+
+    let start = SYST::get_current();
+    known_block();
+    let known_ticks = ticks_between(start, SYST::get_current());
+    let instructions_per_tick = f64::from(KNOWN_BLOCK_INSTRUCTIONS) / f64::from(known_ticks);
+    let overhead = meter_overhead_ticks();
+
+    let mut meter = SysTickMeter {
+        ticks: 0,
+        updates: 0,
+    };
+    shared_run::run(&mut out, &mut meter)?;
+
+    let per_update =
+        (meter.ticks as f64 / f64::from(meter.updates) - overhead) * instructions_per_tick;
+    writeln!(
+        out,
+        "measured instructions_per_update={per_update:.0} updates={} float={} \
+         instructions_per_tick={instructions_per_tick:.3} meter_overhead_ticks={overhead:.3}",
+        meter.updates,
+        core::any::type_name::<shared_run::Real>()
+    )?;
+    Ok(())
+}

@@ -1,0 +1,190 @@
+//! The computation that the Cortex-M4F binary and its host twin (`tests/embedded_twin.rs` in
+//! the main workspace) both run, from this one file: the quaternion filter over a slice of a
+//! real BROAD recording compiled into the binary, then a tilt-compensated compass heading
+//! with a stored calibration. Every result goes out as text through [`core::fmt::Write`], so
+//! the two outputs can be compared line by line.
+//!
+//! Nothing here allocates, reads a clock or knows where it runs; the only hook is
+//! [`UpdateMeter`], which the target uses to count the instructions of each filter update.
+
+use core::fmt::{self, Write};
+
+use nalgebra::{Matrix3, Quaternion, UnitQuaternion, Vector3};
+use truenorth_compass::CompassCalibration3d;
+use truenorth_core::{EulerZyx, ImuSample, OrientationEstimator, ned_to_enu};
+use truenorth_fusion::QuaternionFilter;
+
+/// The float type the filter runs in. Switching precision is this line and [`Filter`].
+pub type Real = f64;
+
+/// The filter at [`Real`] precision.
+pub type Filter = QuaternionFilter;
+
+/// The recording, as written by `tests/embedded_twin.rs` (`embedded_data_is_the_broad_slice`):
+/// little-endian `f32`s, first [`HEADER_VALUES`] of header, then [`SAMPLE_VALUES`] per
+/// sample. Header: the first sample's index in the trial, the compass calibration's hard iron
+/// (µT, 3) and soft iron (9, row-major), and the motion-capture reference attitude at the
+/// last sample (sensor → ENU with magnetic north, `w, x, y, z`). Sample: gyro (rad/s, 3),
+/// accelerometer (m/s², 3), magnetometer (µT, 3), in the sensor's axes.
+static RECORDING: &[u8] = include_bytes!("../data/broad_01_slice.bin");
+
+/// Values in the recording's header.
+pub const HEADER_VALUES: usize = 17;
+/// Values per sample in the recording.
+pub const SAMPLE_VALUES: usize = 9;
+/// BROAD's sample interval, seconds (285.714 Hz = 2000/7 Hz).
+pub const SAMPLE_INTERVAL_S: f64 = 0.0035;
+/// Every how many samples the attitude is printed.
+const PRINT_EVERY: usize = 100;
+
+/// Counts what one filter update costs; the host twin's meter does nothing.
+pub trait UpdateMeter {
+    /// Runs `update` and accounts for it.
+    fn measure<T>(&mut self, update: impl FnOnce() -> T) -> T;
+}
+
+/// Why the run stopped early.
+#[derive(Debug)]
+pub enum RunError {
+    /// The recording's length is not a header plus whole samples.
+    Recording,
+    /// The filter refused a sample.
+    Filter(truenorth_core::Error),
+    /// The output could not be written.
+    Output(fmt::Error),
+}
+
+impl fmt::Display for RunError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::Recording => f.write_str("the recording is not a header plus whole samples"),
+            Self::Filter(e) => write!(f, "the filter refused a sample: {e}"),
+            Self::Output(_) => f.write_str("the output could not be written"),
+        }
+    }
+}
+
+impl From<fmt::Error> for RunError {
+    fn from(e: fmt::Error) -> Self {
+        Self::Output(e)
+    }
+}
+
+impl From<truenorth_core::Error> for RunError {
+    fn from(e: truenorth_core::Error) -> Self {
+        Self::Filter(e)
+    }
+}
+
+/// Value `i` of the recording (header and samples counted together).
+fn value(i: usize) -> Option<f32> {
+    let b = RECORDING.get(4 * i..4 * i + 4)?;
+    Some(f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+}
+
+/// `n` consecutive values from `first`, as [`Real`].
+fn values<const N: usize>(first: usize) -> Option<[Real; N]> {
+    let mut out = [0.0; N];
+    for (k, v) in out.iter_mut().enumerate() {
+        *v = Real::from(value(first + k)?);
+    }
+    Some(out)
+}
+
+/// The recording's compass calibration (stored in the header).
+fn calibration() -> Option<CompassCalibration3d> {
+    let h: [f64; 3] = values::<3>(1)?.map(f64::from);
+    let s: [f64; 9] = values::<9>(4)?.map(f64::from);
+    Some(CompassCalibration3d {
+        hard_iron: Vector3::from(h),
+        soft_iron: Matrix3::from_row_slice(&s),
+    })
+}
+
+/// The reference attitude at the last sample, body → NED.
+fn reference_ned() -> Option<UnitQuaternion<f64>> {
+    let [w, x, y, z]: [f64; 4] = values::<4>(13)?.map(f64::from);
+    let enu = UnitQuaternion::from_quaternion(Quaternion::new(w, x, y, z));
+    Some(ned_to_enu().inverse() * enu)
+}
+
+/// Sample `k` of the slice, timed from the trial's start.
+fn sample(first_index: f64, k: usize) -> Option<ImuSample> {
+    let v: [Real; SAMPLE_VALUES] = values(HEADER_VALUES + SAMPLE_VALUES * k)?;
+    let t_s = (first_index + k as f64) * SAMPLE_INTERVAL_S;
+    Some(ImuSample::new_9d(
+        t_s,
+        Vector3::new(v[0], v[1], v[2]),
+        Vector3::new(v[3], v[4], v[5]),
+        Vector3::new(v[6], v[7], v[8]),
+    ))
+}
+
+/// Degrees of an angle in radians (of either float type), in `f64`.
+fn deg(rad: impl Into<f64>) -> f64 {
+    rad.into().to_degrees()
+}
+
+/// Runs the filter over the recording and the compass on its last reading, writing one
+/// `name value...` line per result (numbers in Rust's shortest round-trip form, so equal
+/// text means equal bits).
+pub fn run(out: &mut impl Write, meter: &mut impl UpdateMeter) -> Result<(), RunError> {
+    let body = RECORDING
+        .len()
+        .checked_sub(4 * HEADER_VALUES)
+        .ok_or(RunError::Recording)?;
+    if !body.is_multiple_of(4 * SAMPLE_VALUES) || !RECORDING.len().is_multiple_of(4) {
+        return Err(RunError::Recording);
+    }
+    let n = body / (4 * SAMPLE_VALUES);
+    let first_index = f64::from(value(0).ok_or(RunError::Recording)?);
+    let cal = calibration().ok_or(RunError::Recording)?;
+    let reference = reference_ned().ok_or(RunError::Recording)?;
+    writeln!(
+        out,
+        "recording BROAD trial 01 samples {first_index}..{} ({n} at 2000/7 Hz), filter float {}",
+        first_index + n as f64,
+        core::any::type_name::<Real>()
+    )?;
+
+    let mut filter = Filter::default();
+    let mut last_mag = Vector3::zeros();
+    for k in 0..n {
+        let s = sample(first_index, k).ok_or(RunError::Recording)?;
+        let estimate = meter.measure(|| filter.update(&s))?;
+        if let Some(m) = s.mag.as_xyz() {
+            last_mag = m;
+        }
+        if (k + 1).is_multiple_of(PRINT_EVERY) {
+            let q = estimate.attitude;
+            writeln!(out, "q[{}] {} {} {} {}", k + 1, q.w, q.i, q.j, q.k)?;
+        }
+    }
+
+    let e = filter.estimate();
+    let q = e.attitude;
+    writeln!(out, "final_q {} {} {} {}", q.w, q.i, q.j, q.k)?;
+    let b = e.gyro_bias_rps;
+    writeln!(
+        out,
+        "gyro_bias_deg_s {} {} {}",
+        deg(b.x),
+        deg(b.y),
+        deg(b.z)
+    )?;
+    // Angles and the compass in f64 whatever the filter's precision (`cast` is the identity
+    // when `Real` is f64).
+    let euler = EulerZyx::from_quaternion(&q.cast::<f64>());
+    writeln!(
+        out,
+        "filter_yaw_pitch_roll_deg {} {} {}",
+        deg(euler.yaw_rad),
+        deg(euler.pitch_rad),
+        deg(euler.roll_rad)
+    )?;
+    let compass = cal.heading_rad(&last_mag.cast::<f64>(), &euler.tilt());
+    writeln!(out, "compass_heading_deg {}", deg(compass))?;
+    let reference_yaw = EulerZyx::from_quaternion(&reference).yaw_rad;
+    writeln!(out, "reference_yaw_deg {}", deg(reference_yaw))?;
+    Ok(())
+}
