@@ -9,6 +9,7 @@ mod common;
 use common::circular_std;
 use nalgebra::Vector3;
 use truenorth_accel::static_tilt;
+use truenorth_calib::quality::FitLimits;
 use truenorth_calib::{
     EllipsoidConfig, MagAccelConfig, MagAccelSample, fit_ellipsoid, fit_mag_accel,
 };
@@ -49,7 +50,10 @@ impl Methods {
         // The separate fits as the joint fit starts from them: a few dozen shots may not
         // determine the accelerometer's ellipsoid to the default bound on its own.
         let cfg = EllipsoidConfig {
-            max_heading_error_bound_deg: truenorth_calib::INITIAL_FIT_BOUND_DEG,
+            limits: FitLimits {
+                max_heading_error_bound_deg: truenorth_calib::INITIAL_FIT_BOUND_DEG,
+                ..FitLimits::default()
+            },
             ..EllipsoidConfig::default()
         };
         Self {

@@ -20,6 +20,7 @@ use common::*;
 use nalgebra::{Matrix3, SMatrix, SVector, Vector2, Vector3};
 use proptest::prelude::*;
 use proptest::test_runner::RngSeed;
+use truenorth_calib::quality::FitLimits;
 use truenorth_calib::quality::{ARC_END_NOISE_SIGMAS, MODEL_ERROR_REL};
 use truenorth_calib::{
     EllipseConfig, EllipsoidConfig, MIN_POINTS_3D, TurnCompassCalibrator, fit_ellipse,
@@ -176,13 +177,21 @@ fn widening_is_plausible(w: f64, dof: f64) -> bool {
     w >= 1.0 - 1e-12 && w <= most
 }
 
+/// No limit on the residual or the bound (the axis ratio keeps its default).
+fn unlimited() -> FitLimits {
+    FitLimits {
+        max_residual_rel: f64::MAX,
+        max_heading_error_bound_deg: f64::MAX,
+        ..FitLimits::default()
+    }
+}
+
 /// Checks a refusal of the 2-D fit of `pts`, whose true headings span `true_span` degrees
 /// with per-axis noise `noise` (relative to the field).
 fn check_2d(pts: &[Vector2<f64>], e: &Error, true_span: f64) -> Result<(), TestCaseError> {
     let relaxed = EllipseConfig {
         min_arc_deg: 0.0,
-        max_residual_rel: f64::MAX,
-        max_heading_error_bound_deg: f64::MAX,
+        limits: unlimited(),
         ..EllipseConfig::default()
     };
     match *e {
@@ -288,8 +297,7 @@ proptest! {
 /// Checks a refusal of the 3-D fit of `pts`.
 fn check_3d(pts: &[Vector3<f64>], e: &Error) -> Result<(), TestCaseError> {
     let relaxed = EllipsoidConfig {
-        max_residual_rel: f64::MAX,
-        max_heading_error_bound_deg: f64::MAX,
+        limits: unlimited(),
         max_noise_dilution: f64::MAX,
         ..EllipsoidConfig::default()
     };

@@ -1,6 +1,8 @@
 //! The configuration of the [`crate::OnlineEllipseCalibrator`] and its validation.
 
 use serde::{Deserialize, Serialize};
+
+use crate::quality::FitLimits;
 use truenorth_core::{Result, Validate, check_positive, check_range};
 
 use crate::fits::ellipse::config::MIN_POINTS_2D;
@@ -26,12 +28,9 @@ pub struct OnlineEllipseConfig {
     /// forgetting the calibration follows a slowly changing hard or soft iron; readings
     /// older than four half-lives no longer count towards coverage.
     pub forgetting_half_life_samples: Option<f64>,
-    /// Largest ratio of the semi-axes accepted, ≥ 1 (10).
-    pub max_axis_ratio: f64,
-    /// Largest residual RMS, relative to the fitted field, accepted, > 0 (0.2).
-    pub max_residual_rel: f64,
-    /// Largest heading-error bound of the calibration accepted, degrees, > 0 (10).
-    pub max_heading_error_bound_deg: f64,
+    /// The refusal limits shared by the least-squares fits (flat in JSON).
+    #[serde(flatten)]
+    pub limits: FitLimits,
     /// The expected horizontal field, input unit (e.g. from the World Magnetic Model), > 0,
     /// reported as [`truenorth_core::CompassQuality::field_ratio_to_expected`] (`None`).
     pub expected_field: Option<f64>,
@@ -44,9 +43,7 @@ impl Default for OnlineEllipseConfig {
             min_samples: 30,
             refresh_interval_samples: 32,
             forgetting_half_life_samples: None,
-            max_axis_ratio: 10.0,
-            max_residual_rel: 0.2,
-            max_heading_error_bound_deg: 10.0,
+            limits: FitLimits::default(),
             expected_field: None,
         }
     }
@@ -70,17 +67,7 @@ impl Validate for OnlineEllipseConfig {
         if let Some(h) = self.forgetting_half_life_samples {
             check_range("online ellipse forgetting_half_life_samples", h, 20.0, 1e9)?;
         }
-        check_range(
-            "online ellipse max_axis_ratio",
-            self.max_axis_ratio,
-            1.0,
-            f64::MAX,
-        )?;
-        check_positive("online ellipse max_residual_rel", self.max_residual_rel)?;
-        check_positive(
-            "online ellipse max_heading_error_bound_deg",
-            self.max_heading_error_bound_deg,
-        )?;
+        self.limits.validate()?;
         if let Some(f) = self.expected_field {
             check_positive("online ellipse expected_field", f)?;
         }

@@ -218,7 +218,8 @@ impl Refresh {
 
     /// Stage 1: the direct fit, its calibration, and the sorting map for retained readings.
     fn fit(&mut self, cfg: &OnlineEllipseConfig, lifetime: u64) {
-        let e = solve_direct(&self.scatter).and_then(|k| conic_to_ellipse(&k, cfg.max_axis_ratio));
+        let e = solve_direct(&self.scatter)
+            .and_then(|k| conic_to_ellipse(&k, cfg.limits.max_axis_ratio));
         let e = match e {
             Ok(e) => e,
             Err(err) => {
@@ -298,7 +299,7 @@ impl Refresh {
             unit_map,
         };
         if e.semi_axes()
-            .is_none_or(|(a, b)| !(a / b <= cfg.max_axis_ratio))
+            .is_none_or(|(a, b)| !(a / b <= cfg.limits.max_axis_ratio))
         {
             return;
         }
@@ -414,8 +415,8 @@ impl Refresh {
         let checked = quality::require_arc(&self.arc, self.sigma, cfg.min_arc_deg).and_then(|()| {
             refuse_fit(
                 &quality,
-                cfg.max_residual_rel,
-                cfg.max_heading_error_bound_deg,
+                cfg.limits.max_residual_rel,
+                cfg.limits.max_heading_error_bound_deg,
                 self.base.residual_dof(PARAMS),
                 STRAY,
             )

@@ -1,6 +1,8 @@
 //! The configuration of the [`crate::OnlineEllipsoidCalibrator`] and its validation.
 
 use serde::{Deserialize, Serialize};
+
+use crate::quality::FitLimits;
 use truenorth_core::{Result, Validate, check_positive, check_range};
 
 use crate::fits::ellipsoid::config::MIN_POINTS_3D;
@@ -28,12 +30,9 @@ pub struct OnlineEllipsoidConfig {
     /// Half-life of a reading's weight, in readings, 50..=10⁹ (`None`: never forget).
     /// Readings older than four half-lives no longer count towards coverage.
     pub forgetting_half_life_samples: Option<f64>,
-    /// Largest ratio of longest to shortest semi-axis accepted, ≥ 1 (10).
-    pub max_axis_ratio: f64,
-    /// Largest residual RMS, relative to the fitted field, accepted, > 0 (0.2).
-    pub max_residual_rel: f64,
-    /// Largest direction-error bound of the calibration accepted, degrees, > 0 (10).
-    pub max_heading_error_bound_deg: f64,
+    /// The refusal limits shared by the least-squares fits (flat in JSON).
+    #[serde(flatten)]
+    pub limits: FitLimits,
     /// Largest per-reading noise (relative to the field) times the orientations' dilution
     /// accepted, > 0 ([`quality::MAX_NOISE_DILUTION`]: beyond it the fit's own error figures
     /// no longer hold; see [`quality::require_linear`]).
@@ -50,9 +49,7 @@ impl Default for OnlineEllipsoidConfig {
             min_samples: 50,
             refresh_interval_samples: 64,
             forgetting_half_life_samples: None,
-            max_axis_ratio: 10.0,
-            max_residual_rel: 0.2,
-            max_heading_error_bound_deg: 10.0,
+            limits: FitLimits::default(),
             max_noise_dilution: quality::MAX_NOISE_DILUTION,
             expected_field: None,
         }
@@ -82,17 +79,7 @@ impl Validate for OnlineEllipsoidConfig {
                 1e9,
             )?;
         }
-        check_range(
-            "online ellipsoid max_axis_ratio",
-            self.max_axis_ratio,
-            1.0,
-            f64::MAX,
-        )?;
-        check_positive("online ellipsoid max_residual_rel", self.max_residual_rel)?;
-        check_positive(
-            "online ellipsoid max_heading_error_bound_deg",
-            self.max_heading_error_bound_deg,
-        )?;
+        self.limits.validate()?;
         check_positive(
             "online ellipsoid max_noise_dilution",
             self.max_noise_dilution,

@@ -290,7 +290,7 @@ impl Refresh {
 
     /// Stage 3: the ellipsoid of the quadric and its calibration.
     fn fit(&mut self, cfg: &OnlineEllipsoidConfig) {
-        let e = match quadric_to_ellipsoid(&self.quadric, cfg.max_axis_ratio) {
+        let e = match quadric_to_ellipsoid(&self.quadric, cfg.limits.max_axis_ratio) {
             Ok(e) => e,
             Err(err) => return self.fail(err),
         };
@@ -511,15 +511,15 @@ impl Refresh {
         let checked = quality::require_determined(
             &uncertainty,
             3,
-            cfg.max_heading_error_bound_deg,
+            cfg.limits.max_heading_error_bound_deg,
             ORIENTATION_HINT,
         )
         .and_then(|()| quality::require_linear(&uncertainty, self.sigma, cfg.max_noise_dilution))
         .and_then(|()| {
             refuse_fit(
                 &quality,
-                cfg.max_residual_rel,
-                cfg.max_heading_error_bound_deg,
+                cfg.limits.max_residual_rel,
+                cfg.limits.max_heading_error_bound_deg,
                 self.base.residual_dof(PARAMS),
                 STRAY,
             )

@@ -44,6 +44,7 @@
 mod bounds;
 mod coverage;
 mod field;
+mod limits;
 mod report;
 mod support;
 mod uncertainty;
@@ -63,6 +64,7 @@ pub use field::{
     FIELD_RATIO_TOLERANCE, FieldMismatch, field_mismatch, mean_corrected_norm_2d,
     mean_corrected_norm_3d, with_expected_field,
 };
+pub use limits::FitLimits;
 pub use report::{Assessment2d, assess_2d, assess_3d, quality_2d};
 pub(crate) use report::{
     Moments2, ReportSums, SupportFigures, assess_2d_from_moments, direction_harmonics,

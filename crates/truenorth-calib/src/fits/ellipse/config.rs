@@ -3,6 +3,8 @@
 extern crate alloc;
 
 use serde::{Deserialize, Serialize};
+
+use crate::quality::FitLimits;
 use truenorth_core::{Result, Validate, check_positive, check_range};
 
 use crate::quality::MIN_ARC_DEG;
@@ -29,17 +31,9 @@ pub struct EllipseConfig {
     pub max_iterations: usize,
     /// Shortest arc of heading accepted, degrees, 0..=360 ([`MIN_ARC_DEG`]).
     pub min_arc_deg: f64,
-    /// Largest ratio of the semi-axes accepted, ≥ 1 (10): flatter ellipses are refused as
-    /// not an ellipse — no plausible soft iron squashes the field that much.
-    pub max_axis_ratio: f64,
-    /// Largest residual RMS, relative to the fitted field, accepted, > 0 (0.2): readings
-    /// that stray further from the best ellipse are not a rotation in a constant field
-    /// (a static sensor, a disturbed site, a badly tilting mount).
-    pub max_residual_rel: f64,
-    /// Largest heading-error bound of the calibration accepted
-    /// ([`CompassQuality::heading_error_bound_deg`](truenorth_core::CompassQuality::heading_error_bound_deg)), degrees, > 0 (10; see
-    /// [`crate::quality`]): a calibration that uncertain is refused rather than returned.
-    pub max_heading_error_bound_deg: f64,
+    /// The refusal limits shared by the least-squares fits (flat in JSON).
+    #[serde(flatten)]
+    pub limits: FitLimits,
     /// The expected horizontal field, input unit (e.g. from the World Magnetic Model), > 0,
     /// reported as [`CompassQuality::field_ratio_to_expected`](truenorth_core::CompassQuality::field_ratio_to_expected) (`None`).
     pub expected_field: Option<f64>,
@@ -51,9 +45,7 @@ impl Default for EllipseConfig {
             refine: true,
             max_iterations: 100,
             min_arc_deg: MIN_ARC_DEG,
-            max_axis_ratio: 10.0,
-            max_residual_rel: 0.2,
-            max_heading_error_bound_deg: 10.0,
+            limits: FitLimits::default(),
             expected_field: None,
         }
     }
@@ -68,12 +60,7 @@ impl Validate for EllipseConfig {
             1e6,
         )?;
         check_range("ellipse min_arc_deg", self.min_arc_deg, 0.0, 360.0)?;
-        check_range("ellipse max_axis_ratio", self.max_axis_ratio, 1.0, f64::MAX)?;
-        check_positive("ellipse max_residual_rel", self.max_residual_rel)?;
-        check_positive(
-            "ellipse max_heading_error_bound_deg",
-            self.max_heading_error_bound_deg,
-        )?;
+        self.limits.validate()?;
         if let Some(f) = self.expected_field {
             check_positive("ellipse expected_field", f)?;
         }

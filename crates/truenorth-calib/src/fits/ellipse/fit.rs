@@ -11,7 +11,7 @@
 //!    `Σ (a x² + b xy + c y² + d x + e y + f)²` subject to `4ac − b² = 1`.
 //! 4. Refuse when the data are not an ellipse: the best conic without the ellipse
 //!    constraint is a hyperbola or parabola, or the ellipse is flatter than
-//!    [`EllipseConfig::max_axis_ratio`].
+//!    [`FitLimits::max_axis_ratio`](crate::quality::FitLimits::max_axis_ratio).
 //! 5. Geometric refinement: Levenberg–Marquardt on the Sampson distance
 //!    `g(m) / |∇g(m)|` with `g(m) = |B (m − c)|² − 1` (Sampson 1982; a first-order
 //!    approximation of the orthogonal distance, the maximum-likelihood residual for
@@ -199,7 +199,7 @@ fn fit_unchecked(
     points: &[Vector2<f64>],
     config: &EllipseConfig,
 ) -> Result<Solution<CompassCalibration2d>> {
-    let (norm, direct, moments) = direct_normalised(points, config.max_axis_ratio)?;
+    let (norm, direct, moments) = direct_normalised(points, config.limits.max_axis_ratio)?;
     // Fewer than five residuals cannot judge a fit: the chance that noise alone makes the
     // residual standard deviation look ten times too small is P(χ²_ν < ν/100), 8 % for one
     // residual degree of freedom, 0.5 % for two, 3·10⁻⁸ for five. A short noisy arc fitted
@@ -249,7 +249,7 @@ fn fit_unchecked(
             centre: e.centre,
             unit_map,
         };
-        check_axis_ratio(&e, config.max_axis_ratio)?;
+        check_axis_ratio(&e, config.limits.max_axis_ratio)?;
         (cal, a) = assess(&e)?;
     }
     quality::require_arc(
@@ -257,7 +257,7 @@ fn fit_unchecked(
         a.quality.heading_noise_rms_deg.to_radians(),
         config.min_arc_deg,
     )?;
-    if !(a.quality.fit.residual_rms_rel <= config.max_residual_rel) {
+    if !(a.quality.fit.residual_rms_rel <= config.limits.max_residual_rel) {
         return Err(Error::NotAnEllipse {
             detail: " (the readings stray from the best ellipse by more than max_residual_rel of the field)",
         });
@@ -268,7 +268,7 @@ fn fit_unchecked(
     quality::require_certain(
         &a.quality,
         a.quality.fit.points as f64 - 5.0,
-        config.max_heading_error_bound_deg,
+        config.limits.max_heading_error_bound_deg,
     )?;
     Ok(Solution {
         params: cal,

@@ -3,6 +3,8 @@
 extern crate alloc;
 
 use serde::{Deserialize, Serialize};
+
+use crate::quality::FitLimits;
 use truenorth_core::{Result, Validate, check_positive, check_range};
 
 use crate::quality::{self};
@@ -29,18 +31,9 @@ pub struct EllipsoidConfig {
     /// Most Levenberg–Marquardt steps before refusing with [`Error::NoConvergence`](truenorth_core::Error::NoConvergence), 1..=10⁶
     /// (100).
     pub max_iterations: usize,
-    /// Largest ratio of longest to shortest semi-axis accepted, ≥ 1 (10).
-    pub max_axis_ratio: f64,
-    /// Largest residual RMS, relative to the fitted field, accepted, > 0 (0.2): readings
-    /// that stray further from the best ellipsoid are not a rotation in a constant field
-    /// (a static sensor, a disturbed site, a badly tilting mount).
-    pub max_residual_rel: f64,
-    /// Largest direction-error bound of the calibration accepted
-    /// ([`CompassQuality::heading_error_bound_deg`](truenorth_core::CompassQuality::heading_error_bound_deg)), degrees, > 0 (10; see
-    /// [`crate::quality`]): a calibration that uncertain is refused rather than returned.
-    /// It also bounds the error that the geometry of the readings would let a per-reading
-    /// error of [`quality::MODEL_ERROR_REL`] cause ([`quality::require_determined`]).
-    pub max_heading_error_bound_deg: f64,
+    /// The refusal limits shared by the least-squares fits (flat in JSON).
+    #[serde(flatten)]
+    pub limits: FitLimits,
     /// Largest per-reading noise (relative to the field) times the orientations' dilution
     /// accepted, > 0 ([`quality::MAX_NOISE_DILUTION`]: beyond it the fit's own error figures
     /// no longer hold; see [`quality::require_linear`]).
@@ -55,9 +48,7 @@ impl Default for EllipsoidConfig {
         Self {
             refine: true,
             max_iterations: 100,
-            max_axis_ratio: 10.0,
-            max_residual_rel: 0.2,
-            max_heading_error_bound_deg: 10.0,
+            limits: FitLimits::default(),
             max_noise_dilution: quality::MAX_NOISE_DILUTION,
             expected_field: None,
         }
@@ -72,17 +63,7 @@ impl Validate for EllipsoidConfig {
             1.0,
             1e6,
         )?;
-        check_range(
-            "ellipsoid max_axis_ratio",
-            self.max_axis_ratio,
-            1.0,
-            f64::MAX,
-        )?;
-        check_positive("ellipsoid max_residual_rel", self.max_residual_rel)?;
-        check_positive(
-            "ellipsoid max_heading_error_bound_deg",
-            self.max_heading_error_bound_deg,
-        )?;
+        self.limits.validate()?;
         check_positive("ellipsoid max_noise_dilution", self.max_noise_dilution)?;
         if let Some(f) = self.expected_field {
             check_positive("ellipsoid expected_field", f)?;

@@ -17,7 +17,7 @@
 //!    The linear terms are eliminated as in Halíř & Flusser (1998) and the 6×6 problem is
 //!    solved as a symmetric eigenproblem (see the `linalg` module).
 //! 4. Refuse when the best quadric without the constraint is not an ellipsoid (hyperboloid)
-//!    or the ellipsoid is flatter than [`EllipsoidConfig::max_axis_ratio`].
+//!    or the ellipsoid is flatter than [`FitLimits::max_axis_ratio`](crate::quality::FitLimits::max_axis_ratio).
 //! 5. Refinement: Levenberg–Marquardt over the centre `c` and a symmetric matrix `B` on
 //!    `rᵢ = |B (mᵢ − c)| − 1`. With `S = F·B` this is `(|S (mᵢ − c)| − F)/F`, the geometric
 //!    residual `|S(m − b)| − F` scaled by `1/F`. `F` grows with the ellipsoid, so this
@@ -169,11 +169,11 @@ fn fit_unchecked(
         quality::require_determined(
             &pre,
             3,
-            PRE_FIT_SLACK * config.max_heading_error_bound_deg,
+            PRE_FIT_SLACK * config.limits.max_heading_error_bound_deg,
             ORIENTATION_HINT,
         )?;
     }
-    let (norm, direct) = direct_normalised(points, config.max_axis_ratio)?;
+    let (norm, direct) = direct_normalised(points, config.limits.max_axis_ratio)?;
     // The refinement only improves the direct fit. Where it does not converge, or ends
     // flatter than any plausible soft iron, the direct fit stands and is judged like any
     // other: noisy readings crowded into a few directions can make the relative residual
@@ -194,7 +194,7 @@ fn fit_unchecked(
     quality::require_determined(
         &q.uncertainty,
         3,
-        config.max_heading_error_bound_deg,
+        config.limits.max_heading_error_bound_deg,
         ORIENTATION_HINT,
     )?;
     quality::require_linear(
@@ -205,7 +205,7 @@ fn fit_unchecked(
     // The condition number of the orientations seen is reported, not judged: a reading in a
     // new direction adds information, yet can raise the largest eigenvalue more than the
     // smallest; the dilution above is what says whether they determine the calibration.
-    if !(q.fit.residual_rms_rel <= config.max_residual_rel) {
+    if !(q.fit.residual_rms_rel <= config.limits.max_residual_rel) {
         return Err(Error::NotAnEllipse {
             detail: " (the readings stray from the best ellipsoid by more than max_residual_rel of the field)",
         });
@@ -214,7 +214,7 @@ fn fit_unchecked(
     quality::require_certain(
         &q,
         q.fit.points as f64 - 9.0,
-        config.max_heading_error_bound_deg,
+        config.limits.max_heading_error_bound_deg,
     )?;
     Ok(Solution {
         params: cal,
@@ -245,7 +245,7 @@ fn refine(
         centre: e.centre,
         unit_map,
     };
-    check_axis_ratio(&e, config.max_axis_ratio)?;
+    check_axis_ratio(&e, config.limits.max_axis_ratio)?;
     Ok(e)
 }
 

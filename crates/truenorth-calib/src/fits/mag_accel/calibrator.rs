@@ -63,7 +63,7 @@ use crate::fits::mag_accel::solve::{
     normal_equations, unsym,
 };
 use crate::fits::normalise::Normaliser;
-use crate::quality::{self};
+use crate::quality::{self, FitLimits};
 
 #[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
@@ -161,7 +161,10 @@ pub fn fit_mag_accel(
     let mag: Vec<Vector3<f64>> = samples.iter().map(|s| s.mag).collect();
     // Step 1.
     let start = EllipsoidConfig {
-        max_heading_error_bound_deg: INITIAL_FIT_BOUND_DEG,
+        limits: FitLimits {
+            max_heading_error_bound_deg: INITIAL_FIT_BOUND_DEG,
+            ..config.ellipsoid.limits
+        },
         ..config.ellipsoid
     };
     let acc_fit = fit_ellipsoid(&acc, &start)?;
