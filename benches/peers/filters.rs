@@ -18,7 +18,6 @@
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
 
-use ahrs::Ahrs as _;
 use nalgebra::{Matrix3, Quaternion, Rotation3, UnitQuaternion, Vector3};
 use truenorth::core::{ImuSample, OrientationEstimator as _, ned_to_enu};
 use truenorth::fusion::{QuaternionFilter, QuaternionFilterConfig};
@@ -154,8 +153,8 @@ impl Kind {
     pub fn start(self, use_mag: bool, first: &ImuSample) -> Box<dyn Peer> {
         match self {
             Kind::Truenorth => Box::new(Truenorth::new(use_mag)),
-            Kind::Madgwick => Box::new(Madgwick::new(use_mag, first)),
-            Kind::Mahony => Box::new(Mahony::new(use_mag, first)),
+            Kind::Madgwick => Box::new(madgwick(use_mag, first)),
+            Kind::Mahony => Box::new(mahony(use_mag, first)),
             Kind::Vqf => Box::new(Vqf::new(use_mag)),
         }
     }
@@ -233,98 +232,73 @@ fn to_ahrs(v: Vector3<f64>) -> nalgebra_ahrs::Vector3<f64> {
     nalgebra_ahrs::Vector3::new(v.x, v.y, v.z)
 }
 
-/// An `ahrs` attitude (sensor → NWU) turned into sensor → ENU.
-fn ahrs_to_enu(q: &nalgebra_ahrs::UnitQuaternion<f64>) -> UnitQuaternion<f64> {
-    nwu_to_enu() * UnitQuaternion::new_unchecked(Quaternion::new(q.w, q.i, q.j, q.k))
-}
-
-/// Madgwick's gradient-descent filter (the `ahrs` crate) with β = [`MADGWICK_BETA`].
-pub struct Madgwick {
-    filter: ahrs::Madgwick<f64>,
+/// A filter of the `ahrs` crate (Madgwick or Mahony) in 9-D (`update`) or 6-D
+/// (`update_imu`).
+pub struct AhrsFilter<F> {
+    filter: F,
     use_mag: bool,
+    attitude_nwu: nalgebra_ahrs::UnitQuaternion<f64>,
 }
 
-impl Madgwick {
-    /// Started from the first sample, 9-D (`update`) or 6-D (`update_imu`).
-    pub fn new(use_mag: bool, first: &ImuSample) -> Self {
+impl<F> AhrsFilter<F> {
+    /// `filter`, built on the attitude `start` (sensor → NWU).
+    fn started(filter: F, use_mag: bool, start: nalgebra_ahrs::UnitQuaternion<f64>) -> Self {
         Self {
-            filter: ahrs::Madgwick::new_with_quat(
-                BROAD_DT_S,
-                MADGWICK_BETA,
-                ahrs_start(use_mag, first),
-            ),
+            filter,
             use_mag,
+            attitude_nwu: start,
         }
     }
 }
 
-impl Peer for Madgwick {
+/// Madgwick's gradient-descent filter (Madgwick, Harrison & Vaidyanathan, IEEE ICORR 2011)
+/// with β = [`MADGWICK_BETA`], started from the first sample.
+pub fn madgwick(use_mag: bool, first: &ImuSample) -> AhrsFilter<ahrs::Madgwick<f64>> {
+    let start = ahrs_start(use_mag, first);
+    AhrsFilter::started(
+        ahrs::Madgwick::new_with_quat(BROAD_DT_S, MADGWICK_BETA, start),
+        use_mag,
+        start,
+    )
+}
+
+/// Mahony's explicit complementary filter (Mahony, Hamel & Pflimlin, IEEE Trans. Automatic
+/// Control 53(5):1203–1218, 2008) with Kp = [`MAHONY_KP`], Ki = [`MAHONY_KI`], started from
+/// the first sample.
+pub fn mahony(use_mag: bool, first: &ImuSample) -> AhrsFilter<ahrs::Mahony<f64>> {
+    let start = ahrs_start(use_mag, first);
+    AhrsFilter::started(
+        ahrs::Mahony::new_with_quat(BROAD_DT_S, MAHONY_KP, MAHONY_KI, start),
+        use_mag,
+        start,
+    )
+}
+
+impl<F: ahrs::Ahrs<f64>> Peer for AhrsFilter<F> {
     fn update(&mut self, sample: &ImuSample) {
         let (gyr, acc, mag) = triads(sample);
         let (gyr, acc, mag) = (to_ahrs(gyr), to_ahrs(acc), to_ahrs(mag));
         let r = if self.use_mag {
-            self.filter.update(&gyr, &acc, &mag).map(|_| ())
+            self.filter.update(&gyr, &acc, &mag).copied()
         } else {
-            self.filter.update_imu(&gyr, &acc).map(|_| ())
+            self.filter.update_imu(&gyr, &acc).copied()
         };
         // A zero accelerometer or field reading is refused; the gyro alone carries on.
-        if r.is_err() {
-            self.filter.update_gyro(&gyr);
-        }
+        self.attitude_nwu = r.unwrap_or_else(|_| *self.filter.update_gyro(&gyr));
     }
 
     fn attitude_enu(&self) -> UnitQuaternion<f64> {
-        ahrs_to_enu(&self.filter.quat)
-    }
-}
-
-/// Mahony's complementary filter (the `ahrs` crate) with Kp = [`MAHONY_KP`], Ki =
-/// [`MAHONY_KI`].
-pub struct Mahony {
-    filter: ahrs::Mahony<f64>,
-    use_mag: bool,
-}
-
-impl Mahony {
-    /// Started from the first sample, 9-D (`update`) or 6-D (`update_imu`).
-    pub fn new(use_mag: bool, first: &ImuSample) -> Self {
-        Self {
-            filter: ahrs::Mahony::new_with_quat(
-                BROAD_DT_S,
-                MAHONY_KP,
-                MAHONY_KI,
-                ahrs_start(use_mag, first),
-            ),
-            use_mag,
-        }
-    }
-}
-
-impl Peer for Mahony {
-    fn update(&mut self, sample: &ImuSample) {
-        let (gyr, acc, mag) = triads(sample);
-        let (gyr, acc, mag) = (to_ahrs(gyr), to_ahrs(acc), to_ahrs(mag));
-        let r = if self.use_mag {
-            self.filter.update(&gyr, &acc, &mag).map(|_| ())
-        } else {
-            self.filter.update_imu(&gyr, &acc).map(|_| ())
-        };
-        // A zero accelerometer or field reading is refused; the gyro alone carries on.
-        if r.is_err() {
-            self.filter.update_gyro(&gyr);
-        }
-    }
-
-    fn attitude_enu(&self) -> UnitQuaternion<f64> {
-        ahrs_to_enu(&self.filter.quat)
+        let q = &self.attitude_nwu;
+        nwu_to_enu() * UnitQuaternion::new_unchecked(Quaternion::new(q.w, q.i, q.j, q.k))
     }
 }
 
 /// VQF (Laidig & Seel, *Information Fusion* 91:187–204, 2023; the `vqf-rs` port of its C++
 /// code) with its default parameters (τ_acc 3 s, τ_mag 9 s, rest and motion bias
-/// estimation, magnetic disturbance rejection), which its authors recommend whatever the
-/// rate: the sample time is its only rate-dependent input. It starts from rest at identity
-/// and converges quickly by design (its first field reading sets the heading).
+/// estimation, magnetic disturbance rejection): they are time constants and rates in
+/// physical units, so the defaults hold at any sampling rate, the sample time being the only
+/// rate input. It starts at identity, as its constructor leaves it, and converges in the
+/// opening rest (its first field readings are taken at full weight).
 pub struct Vqf {
     filter: vqf_rs::VQF,
     use_mag: bool,
