@@ -2,9 +2,10 @@
 //! (Laidig, Caruso, Cereatti & Seel, *Data* 6(7):72, 2021) and score it with BROAD's own
 //! metric.
 //!
-//! The metric (BROAD's `example_code/broad_utils.py`): per sample the total, heading and
-//! inclination error angles of [`AttitudeError`]; per trial the RMSE of each over the samples
-//! of the movement phase whose reference is valid; per group the mean of the trial RMSEs.
+//! The metric (BROAD's `example_code/broad_utils.py`) is the library's [`broad_rmse`]: per
+//! trial the RMSE of the total, heading and inclination error angles over the samples of the
+//! movement phase whose reference is valid; per group the mean of the trial RMSEs
+//! ([`BroadRmse::mean`]).
 
 use std::io::{BufRead, BufReader, IsTerminal, Write as _};
 use std::path::{Path, PathBuf};
@@ -12,7 +13,7 @@ use std::path::{Path, PathBuf};
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 use serde::Serialize;
 use truenorth::core::ImuSample;
-use truenorth::fusion::AttitudeError;
+use truenorth::fusion::orientation::{BroadRmse, broad_rmse};
 
 use crate::io::{CliError, CliResult};
 use crate::registry::{OrientationMethod, Timing};
@@ -52,23 +53,12 @@ struct Trial {
     movement: Vec<bool>,
 }
 
-/// RMSE figures, degrees.
-#[derive(Debug, Clone, Copy, Serialize)]
-pub struct Rmse {
-    /// Total error angle.
-    pub total_deg: f64,
-    /// Heading error (rotation about the vertical).
-    pub heading_deg: f64,
-    /// Inclination error.
-    pub inclination_deg: f64,
-}
-
 #[derive(Serialize)]
 struct TrialResult {
     trial: String,
     group: &'static str,
     #[serde(flatten)]
-    rmse: Rmse,
+    rmse: BroadRmse,
 }
 
 #[derive(Serialize)]
@@ -76,7 +66,7 @@ struct GroupResult {
     group: &'static str,
     trials: usize,
     #[serde(flatten)]
-    mean: Rmse,
+    mean: BroadRmse,
 }
 
 #[derive(Serialize)]
@@ -177,24 +167,14 @@ fn group_means(results: &[TrialResult]) -> Vec<GroupResult> {
     ["undisturbed", "disturbed", "all"]
         .into_iter()
         .filter_map(|g| {
-            let members: Vec<&Rmse> = results
+            let members = results
                 .iter()
                 .filter(|r| g == "all" || r.group == g)
-                .map(|r| &r.rmse)
-                .collect();
-            let n = members.len();
-            (n > 0).then(|| {
-                let mean =
-                    |f: fn(&Rmse) -> f64| members.iter().map(|r| f(r)).sum::<f64>() / n as f64;
-                GroupResult {
-                    group: g,
-                    trials: n,
-                    mean: Rmse {
-                        total_deg: mean(|r| r.total_deg),
-                        heading_deg: mean(|r| r.heading_deg),
-                        inclination_deg: mean(|r| r.inclination_deg),
-                    },
-                }
+                .map(|r| &r.rmse);
+            BroadRmse::mean(members.clone()).map(|mean| GroupResult {
+                group: g,
+                trials: members.count(),
+                mean,
             })
         })
         .collect()
@@ -228,36 +208,6 @@ fn print_tables(report: &Report, no_mag: bool) {
             g.mean.inclination_deg
         );
     }
-}
-
-/// BROAD's metric over the samples with `movement` and a valid reference (see the module
-/// documentation); `None` when there is none.
-pub fn broad_rmse(
-    estimate: &[UnitQuaternion<f64>],
-    reference: &[Option<UnitQuaternion<f64>>],
-    movement: &[bool],
-) -> Option<Rmse> {
-    let mut sum = [0.0; 3];
-    let mut n = 0usize;
-    for ((q, r), &m) in estimate.iter().zip(reference).zip(movement) {
-        let (Some(r), true) = (r, m) else {
-            continue;
-        };
-        let e = AttitudeError::between(q, r);
-        let (total, heading, incl) = (e.total_rad, e.heading_rad, e.inclination_rad);
-        for (s, x) in sum.iter_mut().zip([total, heading, incl]) {
-            *s += x * x;
-        }
-        n += 1;
-    }
-    (n > 0).then(|| {
-        let rms = |s: f64| (s / n as f64).sqrt().to_degrees();
-        Rmse {
-            total_deg: rms(sum[0]),
-            heading_deg: rms(sum[1]),
-            inclination_deg: rms(sum[2]),
-        }
-    })
 }
 
 /// Reads one gzip-compressed trial CSV (columns found by name in the header).
@@ -361,24 +311,5 @@ impl Progress {
         if self.terminal {
             let _ = writeln!(std::io::stderr(), "\r\x1b[2K[{}] done", "#".repeat(30));
         }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn only_scored_samples_count() {
-        let q = UnitQuaternion::from_scaled_axis(Vector3::z() * 0.1);
-        let id = UnitQuaternion::identity();
-        let r = broad_rmse(
-            &[q, id, q],
-            &[Some(id), Some(id), None],
-            &[false, true, true],
-        )
-        .unwrap();
-        assert_eq!(r.total_deg, 0.0);
-        assert!(broad_rmse(&[q], &[Some(id)], &[false]).is_none());
     }
 }

@@ -5,6 +5,7 @@
 
 mod attitude_error;
 pub mod attitude_uncertainty;
+mod broad_rmse;
 mod euler_config;
 mod euler_detector;
 mod euler_state;
@@ -24,6 +25,7 @@ mod triad;
 
 pub use attitude_error::AttitudeError;
 pub use attitude_uncertainty::AttitudeUncertaintyConfig;
+pub use broad_rmse::{BroadRmse, broad_rmse};
 pub use euler_config::{
     CorrectionDefinerConfig, EulerDetectorConfig, EulerVariant, GyroConditioning,
     MAX_DEFINER_WINDOW, StartupField, coefficient_table,
