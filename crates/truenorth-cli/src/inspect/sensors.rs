@@ -1,0 +1,330 @@
+//! Each sensor's likely unit and the gyro's axes, judged from the physics the readings must
+//! obey rather than from their headers: an accelerometer at rest reads one gravity, a
+//! magnetometer the Earth's 25–65 µT, and a gyro turns gravity's and the magnetic field's
+//! directions in the body as they are seen to turn (the shared checks of `crate::io`).
+
+use serde::Serialize;
+
+use truenorth::core::VehicleSample;
+
+use super::Recording;
+use crate::io::{
+    AxisFit, GyroUnit, Inertial, InputOptions, Reference, SignedPermutation, acc_unit_name,
+    fit_gyro_axes, fix_columns, fix_pair, gyro_unit_name, likely_acc_unit, median_magnitude,
+};
+use crate::io::{WheelColumns, YawRateCheck};
+
+/// The accelerometer.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct AccReport {
+    /// Median magnitude in the file's numbers.
+    pub median_magnitude: Option<f64>,
+    /// The unit in which that is one gravity (`m/s2`, `g`, `mg`).
+    pub likely_unit: Option<&'static str>,
+    /// The body axis gravity's reaction points along at rest (`+x` … `-z`), when one
+    /// dominates: that axis points up (frd reads it on `-z`).
+    pub up_axis: Option<String>,
+}
+
+/// The gyro's axes against the accelerometer's and magnetometer's.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct AxesReport {
+    /// Median mismatch of the gyro as read, degrees.
+    pub as_read_deg: f64,
+    /// The mapping that agrees best (`x=-y,y=x,z=z`: body axis = column).
+    pub best: String,
+    /// Whether it is a rotation (else a mirror image: a left-handed mapping).
+    pub best_is_rotation: bool,
+    /// Its median mismatch, degrees.
+    pub best_deg: f64,
+    /// The next best mapping.
+    pub runner_up: String,
+    /// Its median mismatch, degrees.
+    pub runner_up_deg: f64,
+    /// Runner-up's mismatch over the best's (larger is surer).
+    pub margin: f64,
+    /// Spans judged on gravity and on the magnetic field.
+    pub spans_gravity: usize,
+    /// See `spans_gravity`.
+    pub spans_magnetic: usize,
+    /// The gyro as read's mismatch over the best's (1 when it is the best; `orientation`
+    /// refuses above 3).
+    pub as_read_margin: f64,
+    /// `ok` (the gyro as read is the best), `wrong` (another mapping is better beyond
+    /// doubt: `orientation` refuses) or `doubtful` (another is better, not by enough).
+    pub verdict: &'static str,
+    /// Whether the verdict is `wrong`.
+    pub wrong: bool,
+    /// The `--column` value that reads the gyro as the best mapping, when that is not as
+    /// read.
+    pub fix: Option<String>,
+}
+
+/// The gyro.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct GyroReport {
+    /// `rad/s` or `deg/s`, when the turns decide it.
+    pub likely_unit: Option<&'static str>,
+    /// The other unit's best mismatch over the likely unit's (larger is surer).
+    pub unit_margin: Option<f64>,
+    /// The turn seen over the turn the rates predict: the factor that takes the file's
+    /// numbers to rad/s (1 for rad/s, 0.0175 for deg/s).
+    pub rad_per_unit: Option<f64>,
+    /// The axes, when there were enough turns to judge.
+    pub axes: Option<AxesReport>,
+}
+
+/// The magnetometer.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct MagReport {
+    /// Median magnitude in the file's numbers.
+    pub median_magnitude: Option<f64>,
+    /// The unit that makes it the nearest to an Earth field (45 µT).
+    pub likely_unit: Option<&'static str>,
+    /// That field, µT.
+    pub field_ut: Option<f64>,
+    /// Other units that give a field between 10 and 300 µT (an uncalibrated sensor's
+    /// offset can triple its magnitude).
+    pub also_possible: Vec<&'static str>,
+}
+
+/// The units a magnetometer is logged in, with the factor to µT.
+const MAG_UNITS: [(&str, f64); 4] = [("uT", 1.0), ("nT", 1e-3), ("G", 100.0), ("mG", 0.1)];
+
+/// The accelerometer's report, if the recording has one.
+pub fn acc(rec: &Recording, rows: &[Inertial]) -> Option<AccReport> {
+    rec.vector("acc")?;
+    let median = median_magnitude(rows, Reference::Gravity);
+    Some(AccReport {
+        median_magnitude: median,
+        likely_unit: median.and_then(likely_acc_unit).map(acc_unit_name),
+        up_axis: median.and_then(|m| up_axis(rows, m)),
+    })
+}
+
+/// The axis most of gravity's reaction lies along over the rows near one gravity (over
+/// 80 % of it on average), with its sign.
+fn up_axis(rows: &[Inertial], median: f64) -> Option<String> {
+    let still: Vec<_> = rows
+        .iter()
+        .filter(|r| (r.acc.norm() / median - 1.0).abs() < 0.05)
+        .map(|r| r.acc.normalize())
+        .collect();
+    if still.is_empty() {
+        return None;
+    }
+    let mean = still.iter().sum::<nalgebra::Vector3<f64>>() / still.len() as f64;
+    let i = mean.iamax();
+    let c = mean[i];
+    (c.abs() > 0.8).then(|| format!("{}{}", if c > 0.0 { "+" } else { "-" }, ['x', 'y', 'z'][i]))
+}
+
+/// The gyro's report, if the recording has one: the unit whose fit of the axes agrees
+/// better, and the axes under it.
+pub fn gyro(rec: &Recording, rows: &[Inertial], opts: &InputOptions) -> Option<GyroReport> {
+    rec.vector("gyr")?;
+    let fits = [GyroUnit::RadPerS, GyroUnit::DegPerS]
+        .map(|u| fit_gyro_axes(rows, u.to_rad_per_s()).map(|f| (u, f)));
+    let [Some(rad), Some(deg)] = fits else {
+        return Some(GyroReport {
+            likely_unit: None,
+            unit_margin: None,
+            rad_per_unit: None,
+            axes: None,
+        });
+    };
+    let (chosen, other) = if rad.1.best_deg <= deg.1.best_deg {
+        (rad, deg)
+    } else {
+        (deg, rad)
+    };
+    Some(GyroReport {
+        likely_unit: Some(gyro_unit_name(chosen.0)),
+        unit_margin: Some(other.1.best_deg / chosen.1.best_deg.max(1e-9)),
+        rad_per_unit: Some(chosen.1.rad_per_unit),
+        axes: Some(axes(&chosen.1, opts)),
+    })
+}
+
+/// The axes part of the gyro's report.
+fn axes(fit: &AxisFit, opts: &InputOptions) -> AxesReport {
+    let wrong = crate::io::axes_are_wrong(fit);
+    let as_read = fit.best == SignedPermutation::IDENTITY;
+    AxesReport {
+        as_read_deg: fit.as_read_deg,
+        best: fit.best.to_string(),
+        best_is_rotation: fit.best.is_proper(),
+        best_deg: fit.best_deg,
+        runner_up: fit.runner_up.to_string(),
+        runner_up_deg: fit.runner_up_deg,
+        margin: fit.margin(),
+        spans_gravity: fit.spans.0,
+        spans_magnetic: fit.spans.1,
+        as_read_margin: fit.as_read_margin(),
+        verdict: match (as_read, wrong) {
+            (true, _) => "ok",
+            (false, true) => "wrong",
+            (false, false) => "doubtful",
+        },
+        wrong,
+        fix: (!as_read).then(|| fix_columns(&fit.best, opts)),
+    }
+}
+
+/// The magnetometer's report, if the recording has one.
+pub fn mag(rec: &Recording) -> Option<MagReport> {
+    let [x, y, z] = rec.vector("mag")?;
+    let mut norms: Vec<f64> = (0..x.len())
+        .map(|k| (x[k] * x[k] + y[k] * y[k] + z[k] * z[k]).sqrt())
+        .filter(|n| n.is_finite() && *n > 0.0)
+        .collect();
+    let median = crate::io::median(&mut norms);
+    let distance = |(_, k): &(&str, f64), m: f64| (m * k / 45.0).ln().abs();
+    let likely = median.and_then(|m| {
+        MAG_UNITS
+            .iter()
+            .min_by(|a, b| distance(a, m).total_cmp(&distance(b, m)))
+            .copied()
+    });
+    Some(MagReport {
+        median_magnitude: median,
+        likely_unit: likely.map(|u| u.0),
+        field_ut: median.zip(likely).map(|(m, u)| m * u.1),
+        also_possible: MAG_UNITS
+            .iter()
+            .filter(|u| Some(u.0) != likely.map(|l| l.0))
+            .filter(|u| median.is_some_and(|m| (10.0..300.0).contains(&(m * u.1))))
+            .map(|u| u.0)
+            .collect(),
+    })
+}
+
+/// The odometer wheels.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct WheelReport {
+    /// `distances` (`dist_l_m,dist_r_m`) or `speeds` (`speed_l_mps,speed_r_mps`).
+    pub columns: &'static str,
+    /// The fastest wheel speed (speeds), or the mean speed over the recording (distances),
+    /// in the file's numbers per second.
+    pub speed: Option<f64>,
+    /// Whether that speed is plausible in m/s (under 70 m/s, 250 km/h); a larger one is
+    /// likely km/h, which the commands do not read.
+    pub plausible_in_mps: Option<bool>,
+}
+
+/// The wheels' report, if the recording has them (distances before speeds, as `drive`
+/// reads them).
+pub fn wheels(rec: &Recording) -> Option<WheelReport> {
+    let finite = |v: &[f64]| {
+        v.iter()
+            .copied()
+            .filter(|x| x.is_finite())
+            .collect::<Vec<_>>()
+    };
+    let (columns, speed) = match (rec.col("dist_l_m"), rec.col("dist_r_m")) {
+        (Some(l), Some(r)) => {
+            let (l, r) = (finite(l), finite(r));
+            let t = finite(&rec.t_s);
+            let span = t
+                .last()
+                .zip(t.first())
+                .map(|(b, a)| b - a)
+                .filter(|d| *d > 0.0);
+            let travelled = |v: &[f64]| v.last().zip(v.first()).map(|(b, a)| (b - a).abs());
+            let mean = travelled(&l)
+                .zip(travelled(&r))
+                .zip(span)
+                .map(|((a, b), s)| 0.5 * (a + b) / s);
+            ("distances", mean)
+        }
+        _ => {
+            let (l, r) = (rec.col("speed_l_mps")?, rec.col("speed_r_mps")?);
+            let fastest = finite(l)
+                .into_iter()
+                .chain(finite(r))
+                .map(f64::abs)
+                .reduce(f64::max);
+            ("speeds", fastest)
+        }
+    };
+    Some(WheelReport {
+        columns,
+        speed,
+        plausible_in_mps: speed.map(|v| v < 70.0),
+    })
+}
+
+/// The yaw gyro against the wheels (a drive log: `gyr_z` and wheel columns).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct YawReport {
+    /// The wheels' distance difference per radian the gyro integrates, over the turning
+    /// seconds (least squares): the track, m, if the gyro is in rad/s and its sign right
+    /// (0.3–3 m for robots and cars; a deg/s gyro gives 57 times less, a flipped one a
+    /// negative track).
+    pub implied_track_m: Option<f64>,
+    /// The squared correlation of the two turns.
+    pub r2: Option<f64>,
+    /// One-second windows in which the wheels turned enough to compare.
+    pub windows: usize,
+    /// `rad/s` or `deg/s` when the implied track says so.
+    pub likely_unit: Option<&'static str>,
+    /// Whether the gyro turns against the wheels (its sign flipped), when judged.
+    pub flipped: Option<bool>,
+    /// The `--column` value that flips it back, when it is flipped.
+    pub fix: Option<String>,
+}
+
+/// The yaw gyro's report, if the recording has `gyr_z` and wheels.
+pub fn yaw(rec: &Recording, opts: &InputOptions) -> Option<YawReport> {
+    let gyr = rec.col("gyr_z")?;
+    let (mut wheels, l, r) = match (rec.col("dist_l_m"), rec.col("dist_r_m")) {
+        (Some(l), Some(r)) => (WheelColumns::Distances([0, 1]), l, r),
+        _ => (
+            WheelColumns::Speeds {
+                columns: [0, 1],
+                last: None,
+                dist: [0.0; 2],
+            },
+            rec.col("speed_l_mps")?,
+            rec.col("speed_r_mps")?,
+        ),
+    };
+    // With a track of 1 m the ratio the check learns is the track the data imply.
+    let mut check = YawRateCheck::new(1.0);
+    for k in 0..rec.t_s.len() {
+        let t = rec.t_s[k];
+        let mut sample = VehicleSample::at(t);
+        if let Ok(Some([dl, dr])) = wheels.cumulative(t, &[l[k], r[k]]) {
+            sample = sample.with_wheels(dl, dr);
+        }
+        if gyr[k].is_finite() {
+            sample = sample.with_gyro(gyr[k]);
+        }
+        check.push(&sample);
+    }
+    let fit = check.ratio();
+    let track = fit.map(|f| f.0.abs());
+    let plausible = |m: f64| (0.1..=10.0).contains(&m);
+    Some(YawReport {
+        implied_track_m: fit.map(|f| f.0),
+        r2: fit.map(|f| f.1),
+        windows: check.windows,
+        likely_unit: track.and_then(|m| {
+            if plausible(m) {
+                Some("rad/s")
+            } else if plausible(m / GyroUnit::DegPerS.to_rad_per_s()) {
+                Some("deg/s")
+            } else {
+                None
+            }
+        }),
+        flipped: fit.map(|f| f.0 < 0.0),
+        fix: fit.filter(|f| f.0 < 0.0).map(|_| {
+            let flip_z = SignedPermutation {
+                source: [0, 1, 2],
+                sign: [1, 1, -1],
+            };
+            fix_pair(&flip_z, 2, opts)
+        }),
+    })
+}
