@@ -3,6 +3,8 @@
 
 use std::fmt::Write as _;
 
+use crate::io::shell_word;
+
 use serde::Serialize;
 
 use super::column_stats::ColumnStats;
@@ -37,7 +39,7 @@ pub struct JsonReport<'a> {
     /// The report.
     #[serde(flatten)]
     pub report: &'a Report,
-    /// [`Report::options`].
+    /// [`Report::options`], each as it is written on a shell's command line.
     pub options: Vec<String>,
 }
 
@@ -56,9 +58,9 @@ impl Report {
             out.push(format!("--acc-unit {u}"));
         }
         if let Some(fix) = self.axes().filter(|a| a.wrong).and_then(|a| a.fix.as_ref()) {
-            out.push(format!("--column {fix}"));
+            out.push(format!("--column {}", shell_word(fix)));
         } else if let Some(fix) = self.yaw.as_ref().and_then(|y| y.fix.as_ref()) {
-            out.push(format!("--column {fix}"));
+            out.push(format!("--column {}", shell_word(fix)));
         }
         out
     }
@@ -197,7 +199,11 @@ impl Report {
 /// The gyro's lines: its unit and, when judged, its axes.
 fn gyro_lines(s: &mut String, g: &GyroReport) {
     let Some(u) = g.likely_unit else {
-        let _ = writeln!(s, "gyro: too few turns near rest to judge its unit or axes");
+        let _ = writeln!(
+            s,
+            "gyro: unit undecided (too few or too small turns near rest; the units' fits differ {:.1}x)",
+            g.unit_margin.unwrap_or(f64::NAN)
+        );
         return;
     };
     let _ = writeln!(
@@ -209,7 +215,7 @@ fn gyro_lines(s: &mut String, g: &GyroReport) {
     if let Some(a) = &g.axes {
         let _ = writeln!(
             s,
-            "gyro axes: as read {:.2} deg ({}, {:.1}x the best); best {} ({}) {:.2} deg, runner-up {} {:.2} deg, margin {:.1}x, over {} gravity + {} magnetic spans",
+            "gyro axes: as read {:.2} deg ({}, {:.1}x the best); best {} ({}) {:.2} deg, runner-up {} {:.2} deg, margin {:.1}x, typical mapping {:.1}x, over {} gravity + {} magnetic spans",
             a.as_read_deg,
             a.verdict,
             a.as_read_margin,
@@ -223,6 +229,7 @@ fn gyro_lines(s: &mut String, g: &GyroReport) {
             a.runner_up,
             a.runner_up_deg,
             a.margin,
+            a.typical_margin,
             a.spans_gravity,
             a.spans_magnetic
         );

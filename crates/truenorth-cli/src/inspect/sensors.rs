@@ -50,13 +50,17 @@ pub struct AxesReport {
     /// The gyro as read's mismatch over the best's (1 when it is the best; `orientation`
     /// refuses above 3).
     pub as_read_margin: f64,
+    /// The typical mapping's mismatch over the best's: under 3 the turns do not tell the
+    /// mappings apart (`undecided`).
+    pub typical_margin: f64,
     /// `ok` (the gyro as read is the best), `wrong` (another mapping is better beyond
-    /// doubt: `orientation` refuses) or `doubtful` (another is better, not by enough).
+    /// doubt: `orientation` refuses), `doubtful` (another is better, not by enough) or
+    /// `undecided` (the turns do not tell the mappings apart).
     pub verdict: &'static str,
     /// Whether the verdict is `wrong`.
     pub wrong: bool,
-    /// The `--column` value that reads the gyro as the best mapping, when that is not as
-    /// read.
+    /// The `--column` value (as the program takes it, unquoted) that reads the gyro as the
+    /// best mapping, when that is not as read.
     pub fix: Option<String>,
 }
 
@@ -87,6 +91,11 @@ pub struct MagReport {
     /// offset can triple its magnitude).
     pub also_possible: Vec<&'static str>,
 }
+
+/// The gyro's unit is named when the other unit's best mapping agrees this many times
+/// worse: the 20 BROAD trials and x-io's recording show 3.3–25 (the test
+/// `inspect_recordings`), a car on a straight road about 1.
+const UNIT_MARGIN: f64 = 2.0;
 
 /// The units a magnetometer is logged in, with the factor to µT.
 const MAG_UNITS: [(&str, f64); 4] = [("uT", 1.0), ("nT", 1e-3), ("G", 100.0), ("mG", 0.1)];
@@ -138,9 +147,10 @@ pub fn gyro(rec: &Recording, rows: &[Inertial], opts: &InputOptions) -> Option<G
     } else {
         (deg, rad)
     };
+    let unit_margin = other.1.best_deg / chosen.1.best_deg.max(1e-9);
     Some(GyroReport {
-        likely_unit: Some(gyro_unit_name(chosen.0)),
-        unit_margin: Some(other.1.best_deg / chosen.1.best_deg.max(1e-9)),
+        likely_unit: (unit_margin >= UNIT_MARGIN).then(|| gyro_unit_name(chosen.0)),
+        unit_margin: Some(unit_margin),
         rad_per_unit: Some(chosen.1.rad_per_unit),
         axes: Some(axes(&chosen.1, opts)),
     })
@@ -150,6 +160,7 @@ pub fn gyro(rec: &Recording, rows: &[Inertial], opts: &InputOptions) -> Option<G
 fn axes(fit: &AxisFit, opts: &InputOptions) -> AxesReport {
     let wrong = crate::io::axes_are_wrong(fit);
     let as_read = fit.best == SignedPermutation::IDENTITY;
+    let informative = fit.is_informative();
     AxesReport {
         as_read_deg: fit.as_read_deg,
         best: fit.best.to_string(),
@@ -161,13 +172,15 @@ fn axes(fit: &AxisFit, opts: &InputOptions) -> AxesReport {
         spans_gravity: fit.spans.0,
         spans_magnetic: fit.spans.1,
         as_read_margin: fit.as_read_margin(),
-        verdict: match (as_read, wrong) {
-            (true, _) => "ok",
-            (false, true) => "wrong",
-            (false, false) => "doubtful",
+        typical_margin: fit.typical_deg / fit.best_deg.max(1e-9),
+        verdict: match (informative, as_read, wrong) {
+            (false, _, _) => "undecided",
+            (true, true, _) => "ok",
+            (true, false, true) => "wrong",
+            (true, false, false) => "doubtful",
         },
         wrong,
-        fix: (!as_read).then(|| fix_columns(&fit.best, opts)),
+        fix: (informative && !as_read).then(|| fix_columns(&fit.best, opts)),
     }
 }
 
@@ -270,7 +283,7 @@ pub struct YawReport {
     pub likely_unit: Option<&'static str>,
     /// Whether the gyro turns against the wheels (its sign flipped), when judged.
     pub flipped: Option<bool>,
-    /// The `--column` value that flips it back, when it is flipped.
+    /// The `--column` value (unquoted) that flips it back, when it is flipped.
     pub fix: Option<String>,
 }
 

@@ -97,6 +97,9 @@ pub struct AxisFit {
     pub runner_up_deg: f64,
     /// The median mismatch of the gyro as it is read, degrees.
     pub as_read_deg: f64,
+    /// The median over the 48 mappings of their mismatch, degrees: what a mapping picked
+    /// at random gives.
+    pub typical_deg: f64,
     /// The spans judged: gravity's and the magnetic field's.
     pub spans: (usize, usize),
     /// The median over the spans of the turn seen over the turn the best mapping's rates
@@ -108,6 +111,14 @@ impl AxisFit {
     /// How much worse the runner-up agrees than the best (≥ 1; larger is surer).
     pub fn margin(&self) -> f64 {
         self.runner_up_deg / self.best_deg.max(1e-9)
+    }
+
+    /// Whether the turns tell the mappings apart at all: the typical mapping agrees more
+    /// than three times worse than the best. Turns too small or too few (a car on a
+    /// straight road, its specific force tilted by braking rather than by turning) leave
+    /// every mapping about as good.
+    pub fn is_informative(&self) -> bool {
+        self.typical_deg > 3.0 * self.best_deg
     }
 
     /// How much worse the gyro as read agrees than the best (1 when it is the best).
@@ -144,6 +155,8 @@ pub fn fit_gyro_axes(rows: &[Inertial], scale: f64) -> Option<AxisFit> {
         .iter()
         .find(|(p, _)| *p == SignedPermutation::IDENTITY)
         .map_or(f64::NAN, |s| s.1);
+    let mut all: Vec<f64> = scored.iter().map(|s| s.1).collect();
+    let typical_deg = super::direction_spans::median(&mut all).unwrap_or(f64::NAN);
     let mut ratios: Vec<f64> = spans
         .iter()
         .filter_map(|s| turn_ratio(rows, s, &best.matrix()))
@@ -155,6 +168,7 @@ pub fn fit_gyro_axes(rows: &[Inertial], scale: f64) -> Option<AxisFit> {
         runner_up,
         runner_up_deg,
         as_read_deg,
+        typical_deg,
         spans: counts,
         rad_per_unit,
     })
@@ -169,6 +183,7 @@ pub fn fit_gyro_axes(rows: &[Inertial], scale: f64) -> Option<AxisFit> {
 /// 2.1 times on some. Found by the test `inspect_recordings`.
 pub fn axes_are_wrong(fit: &AxisFit) -> bool {
     fit.best != SignedPermutation::IDENTITY
+        && fit.is_informative()
         && fit.as_read_deg > 5.0
         && fit.as_read_deg > 3.0 * fit.best_deg
 }
@@ -176,14 +191,15 @@ pub fn axes_are_wrong(fit: &AxisFit) -> bool {
 /// The `--column` pairs that read the gyro as `fix` says under the options already given:
 /// each body axis is read from a sensor column through `opts.axes` and a mapping, so the
 /// fix composes with both (a later `--column` overrides an earlier one for the same name).
+/// The value as the program takes it; [`shell_word`] quotes it for a command line.
 pub fn fix_columns(fix: &SignedPermutation, opts: &InputOptions) -> String {
     let pairs: Vec<String> = (0..3).map(|b| pair(fix, b, opts)).collect();
-    shell_word(&pairs.join(","))
+    pairs.join(",")
 }
 
-/// The one `--column` pair of [`fix_columns`] for body axis `b`, as a shell word.
+/// The one `--column` pair of [`fix_columns`] for body axis `b`.
 pub fn fix_pair(fix: &SignedPermutation, b: usize, opts: &InputOptions) -> String {
-    shell_word(&pair(fix, b, opts))
+    pair(fix, b, opts)
 }
 
 /// `gyr_?=[-]HEADER` that reads body axis `b` as `fix` says.
@@ -263,9 +279,9 @@ mod tests {
             ..InputOptions::default()
         };
         // Under flu body y is −sensor y; flipping it again reads sensor y as it is.
-        assert_eq!(
-            fix_columns(&flip_y, &opts),
-            "'gyr_x=gyr_x,gyr_y=-Gyro Y,gyr_z=gyr_z'"
-        );
+        let fix = fix_columns(&flip_y, &opts);
+        assert_eq!(fix, "gyr_x=gyr_x,gyr_y=-Gyro Y,gyr_z=gyr_z");
+        assert_eq!(shell_word(&fix), "'gyr_x=gyr_x,gyr_y=-Gyro Y,gyr_z=gyr_z'");
+        assert_eq!(shell_word("it's"), r"'it'\''s'");
     }
 }

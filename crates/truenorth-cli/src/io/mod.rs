@@ -47,7 +47,7 @@ pub use columns::InputOptions;
 pub use direction_spans::{Inertial, Reference, median, median_magnitude};
 pub use error::{CliError, CliResult};
 pub use gyro_axes::{
-    AxisFit, SignedPermutation, axes_are_wrong, fit_gyro_axes, fix_columns, fix_pair,
+    AxisFit, SignedPermutation, axes_are_wrong, fit_gyro_axes, fix_columns, fix_pair, shell_word,
 };
 pub use inertial_units::{AccUnit, GyroUnit};
 pub use reader::{ReadSpec, Row, RowReader};

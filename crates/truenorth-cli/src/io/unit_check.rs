@@ -5,7 +5,7 @@
 //! factor, which no sensor error comes near.
 
 use super::direction_spans::{Inertial, Reference, direction_spans, median, mismatch_rad};
-use super::gyro_axes::{axes_are_wrong, fit_gyro_axes, fix_columns};
+use super::gyro_axes::{axes_are_wrong, fit_gyro_axes, fix_columns, shell_word};
 use super::{AccUnit, CliError, CliResult, GyroUnit, InputOptions};
 use nalgebra::Matrix3;
 use truenorth::core::ImuSample;
@@ -70,13 +70,13 @@ pub fn check_inertial(
         findings.push(Finding {
             kind: FindingKind::Axes,
             message: format!(
-                "the gyro's axes do not turn gravity's and the magnetic field's directions as the accelerometer and magnetometer see them (median mismatch {:.1}° over {} spans); read as {} ({}) they do ({:.1}°): pass --column {}",
+                "the gyro's axes do not turn gravity's and the magnetic field's directions as the accelerometer and magnetometer see them (median mismatch {:.1}° over {} spans); with its axes taken as {} (each as it is now read; {}) they do ({:.1}°): pass --column {} after the options given",
                 fit.as_read_deg,
                 fit.spans.0 + fit.spans.1,
                 fit.best,
                 if fit.best.is_proper() { "a rotation" } else { "a mirror image" },
                 fit.best_deg,
-                fix_columns(&fit.best, opts)
+                shell_word(&fix_columns(&fit.best, opts))
             ),
         });
     }

@@ -7,7 +7,7 @@
 
 use truenorth::core::VehicleSample;
 
-use super::gyro_axes::{SignedPermutation, fix_pair};
+use super::gyro_axes::{SignedPermutation, fix_pair, shell_word};
 use super::unit_check::{Finding, FindingKind, gyro_unit_name};
 use super::{GyroUnit, InputOptions};
 
@@ -133,7 +133,7 @@ impl YawRateCheck {
                 message: format!(
                     "gyr_z turns against the wheels over {} turning seconds (wheels per gyro {ratio:.2}, r² {r2:.2}): its sign is flipped (a right turn must read positive): pass --column {}",
                     self.windows,
-                    fix_pair(&flip, 2, opts)
+                    shell_word(&fix_pair(&flip, 2, opts))
                 ),
             });
         }
