@@ -4,12 +4,14 @@
 //! that read it right.
 //!
 //! * [`column_stats`]: one column's rate, gaps and range;
-//! * [`sensors`]: each sensor's likely unit, the gyro's axes;
+//! * [`sensors`]: each inertial sensor's likely unit, the gyro's axes;
+//! * [`wheels`]: the odometer wheels, and a yaw gyro against them;
 //! * [`report`]: the whole report, as a table or JSON, and the options to pass.
 
 pub mod column_stats;
 pub mod report;
 pub mod sensors;
+pub mod wheels;
 
 use nalgebra::Vector3;
 
@@ -112,8 +114,8 @@ pub fn analyse(file: &str, rec: &Recording, opts: &InputOptions) -> Report {
         acc: sensors::acc(rec, &rows),
         gyro: sensors::gyro(rec, &rows, opts),
         mag: sensors::mag(rec),
-        wheels: sensors::wheels(rec),
-        yaw: sensors::yaw(rec, opts),
+        wheels: wheels::wheels(rec),
+        yaw: wheels::yaw(rec, opts),
     }
 }
 

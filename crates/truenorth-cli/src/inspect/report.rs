@@ -8,7 +8,8 @@ use crate::io::shell_word;
 use serde::Serialize;
 
 use super::column_stats::ColumnStats;
-use super::sensors::{AccReport, AxesReport, GyroReport, MagReport, WheelReport, YawReport};
+use super::sensors::{AccReport, AxesReport, GyroReport, MagReport};
+use super::wheels::{WheelReport, YawReport};
 
 /// What `inspect` found.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -123,77 +124,103 @@ impl Report {
     }
 
     fn sensor_lines(&self, s: &mut String) {
-        let num = |v: Option<f64>| v.map_or("-".to_string(), |x| format!("{x:.4}"));
-        let unit = |u: Option<&str>| u.unwrap_or("undecided").to_string();
         if let Some(a) = &self.acc {
-            let up = a.up_axis.as_deref().map_or(String::new(), |u| {
-                format!(
-                    "; at rest gravity's reaction is along {u}{}",
-                    if u == "-z" {
-                        " (frd: z down, as truenorth expects)"
-                    } else {
-                        " (that axis points up; truenorth's frd has -z up: see --axes)"
-                    }
-                )
-            });
-            let _ = writeln!(
-                s,
-                "accelerometer: median |acc| {} -> {}{up}",
-                num(a.median_magnitude),
-                unit(a.likely_unit)
-            );
+            acc_line(s, a);
         }
         if let Some(g) = &self.gyro {
             gyro_lines(s, g);
         }
         if let Some(m) = &self.mag {
-            let also = if m.also_possible.is_empty() {
-                String::new()
-            } else {
-                format!(" (also possible: {})", m.also_possible.join(", "))
-            };
-            let _ = writeln!(
-                s,
-                "magnetometer: median |mag| {} -> {} = {} uT{also}",
-                num(m.median_magnitude),
-                unit(m.likely_unit),
-                num(m.field_ut)
-            );
+            mag_line(s, m);
         }
         if let Some(w) = &self.wheels {
-            let what = if w.columns == "speeds" {
-                "fastest"
-            } else {
-                "mean speed"
-            };
-            let judged = match w.plausible_in_mps {
-                Some(true) => "plausible in m/s",
-                Some(false) => "too fast for m/s: km/h? (convert to m/s)",
-                None => "undecided",
-            };
-            let _ = writeln!(
-                s,
-                "wheels: {}, {what} {} per s: {judged}",
-                w.columns,
-                num(w.speed)
-            );
+            wheels_line(s, w);
         }
         if let Some(y) = &self.yaw {
-            let judged = match (y.likely_unit, y.flipped) {
-                (Some(u), Some(true)) => format!("{u}, sign flipped (turns against the wheels)"),
-                (Some(u), _) => u.to_string(),
-                (None, Some(_)) => "neither rad/s nor deg/s (check the wheels' unit)".to_string(),
-                (None, None) => "too few turns to judge".to_string(),
-            };
-            let _ = writeln!(
-                s,
-                "yaw gyro vs wheels: implied track {} m (r2 {}) over {} turning seconds: {judged}",
-                num(y.implied_track_m),
-                num(y.r2),
-                y.windows
-            );
+            yaw_line(s, y);
         }
     }
+}
+
+/// A value with four decimals, `-` when absent.
+fn num(v: Option<f64>) -> String {
+    v.map_or("-".to_string(), |x| format!("{x:.4}"))
+}
+
+/// A unit, `undecided` when absent.
+fn unit(u: Option<&str>) -> &str {
+    u.unwrap_or("undecided")
+}
+
+/// The accelerometer's line: its unit and which axis points up.
+fn acc_line(s: &mut String, a: &AccReport) {
+    let up = a.up_axis.as_deref().map_or(String::new(), |u| {
+        let meaning = if u == "-z" {
+            " (frd: z down, as truenorth expects)"
+        } else {
+            " (that axis points up; truenorth's frd has -z up: see --axes)"
+        };
+        format!("; at rest gravity's reaction is along {u}{meaning}")
+    });
+    let _ = writeln!(
+        s,
+        "accelerometer: median |acc| {} -> {}{up}",
+        num(a.median_magnitude),
+        unit(a.likely_unit)
+    );
+}
+
+/// The magnetometer's line: its unit and the field it makes.
+fn mag_line(s: &mut String, m: &MagReport) {
+    let also = if m.also_possible.is_empty() {
+        String::new()
+    } else {
+        format!(" (also possible: {})", m.also_possible.join(", "))
+    };
+    let _ = writeln!(
+        s,
+        "magnetometer: median |mag| {} -> {} = {} uT{also}",
+        num(m.median_magnitude),
+        unit(m.likely_unit),
+        num(m.field_ut)
+    );
+}
+
+/// The wheels' line: their columns and whether their speed is plausible in m/s.
+fn wheels_line(s: &mut String, w: &WheelReport) {
+    let what = if w.columns == "speeds" {
+        "fastest"
+    } else {
+        "mean speed"
+    };
+    let judged = match w.plausible_in_mps {
+        Some(true) => "plausible in m/s",
+        Some(false) => "too fast for m/s: km/h? (convert to m/s)",
+        None => "undecided",
+    };
+    let _ = writeln!(
+        s,
+        "wheels: {}, {what} {} per s: {judged}",
+        w.columns,
+        num(w.speed)
+    );
+}
+
+/// The yaw gyro against the wheels: the track it implies, its unit and sign.
+fn yaw_line(s: &mut String, y: &YawReport) {
+    let judged = match (y.likely_unit, y.flipped) {
+        (Some(u), Some(true)) => format!("{u}, sign flipped (turns against the wheels)"),
+        (Some(u), _) => u.to_string(),
+        (None, Some(_)) => "neither rad/s nor deg/s (check the wheels' unit)".to_string(),
+        (None, None) => "too few turns to judge".to_string(),
+    };
+    let _ = writeln!(
+        s,
+        "yaw gyro vs wheels: implied track {} m (r2 {}) over {} turning seconds: {judged}",
+        num(y.implied_track_m),
+        num(y.r2),
+        y.windows
+    );
 }
 
 /// The gyro's lines: its unit and, when judged, its axes.
