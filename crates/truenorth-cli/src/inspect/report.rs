@@ -226,11 +226,11 @@ fn yaw_line(s: &mut String, y: &YawReport) {
 /// The gyro's lines: its unit and, when judged, its axes.
 fn gyro_lines(s: &mut String, g: &GyroReport) {
     let Some(u) = g.likely_unit else {
-        let _ = writeln!(
-            s,
-            "gyro: unit undecided (too few or too small turns near rest; the units' fits differ {:.1}x)",
-            g.unit_margin.unwrap_or(f64::NAN)
-        );
+        let why = match g.unit_margin {
+            Some(m) => format!("the units' best fits differ only {m:.1}x"),
+            None => "too few turns near rest".to_string(),
+        };
+        let _ = writeln!(s, "gyro: unit and axes undecided ({why})");
         return;
     };
     let _ = writeln!(
