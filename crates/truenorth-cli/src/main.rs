@@ -6,6 +6,7 @@
 mod commands;
 mod demo;
 mod eval;
+mod inspect;
 mod io;
 mod plot;
 mod registry;
@@ -14,7 +15,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
-use commands::{calibrate, drive, field, heading, orientation};
+use commands::{calibrate, drive, field, heading, inspect as inspect_cmd, orientation};
 
 /// Calibrated heading, orientation and dead reckoning from low-cost navigation sensors.
 ///
@@ -46,6 +47,9 @@ enum Command {
     /// Vehicle heading and dead reckoning from wheels, an optional yaw gyro and an
     /// uncalibrated compass, every sensor calibrated from the drive itself.
     Drive(drive::Args),
+    /// What a recording holds: each column's rate, gaps and range, each sensor's likely
+    /// unit, the gyro's axes against the other sensors', and the options that read it.
+    Inspect(inspect_cmd::Args),
     /// Evaluate an orientation method on a benchmark with ground truth.
     #[command(subcommand)]
     Eval(EvalCommand),
@@ -66,6 +70,7 @@ fn main() -> ExitCode {
         Command::Field(a) => field::run(&a),
         Command::Orientation(a) => orientation::run(&a),
         Command::Drive(a) => drive::run(&a),
+        Command::Inspect(a) => inspect_cmd::run(&a),
         Command::Eval(EvalCommand::Broad(a)) => eval::broad::run(&a),
     };
     match result {

@@ -14,8 +14,8 @@ use truenorth::odometer::OdometerWheels;
 
 use super::field::Place;
 use crate::io::{
-    CliError, CliResult, CsvOutput, InputOptions, InputPath, ReadSpec, Row, RowReader, VehicleFile,
-    WheelColumns, check_distinct, write_atomically,
+    CliError, CliResult, CsvOutput, GyroUnit, InputOptions, InputPath, ReadSpec, Row, RowReader,
+    VehicleFile, WheelColumns, YawRateCheck, check_distinct, refuse_or_warn, write_atomically,
 };
 use crate::registry::{VehicleMethod, VehicleRun};
 
@@ -33,7 +33,7 @@ refused.
 DRIVE.csv: `t_s` (strictly increasing, seconds) and any of: `dist_l_m,dist_r_m` (cumulative
 distance of the left and right odometer wheels as the odometer reports it) or
 `speed_l_mps,speed_r_mps` (wheel speeds, integrated by the trapezoid rule); `gyr_z` (rad/s,
-raw, positive for a right turn); `mag_x,mag_y` (any unit, uncalibrated; a level compass
+or deg/s with --gyro-unit deg/s; raw, positive for a right turn); `mag_x,mag_y` (any unit, uncalibrated; a level compass
 reads mag_x = H cos(heading), mag_y = -H sin(heading)). Each sensor may come at its own
 rate: an empty cell means no reading on that row, and each row is used for what it carries.
 Wheels or a gyro must be present. Other columns are ignored. Frames: x forward, y right,
@@ -61,7 +61,10 @@ from the start, so that the first minutes are as good as the rest; --single-pass
 each row as it comes (a causal estimate, as a navigation unit would have it).
 --calibration-in/--calibration-out carry what was learned from one drive to the next.
 A time base that contradicts the motion (t_s in milliseconds, a gyro in deg/s) is refused
-with the row where the evidence became clear.";
+with the row where the evidence became clear. Where the drive turns (ten one-second windows
+of 3° or more by the wheels), the gyro is checked against the wheels: one that turns 57 times
+too far or too little is refused naming --gyro-unit, one that turns the other way naming
+--column gyr_z=-HEADER (--accept-units / --accept-axes: warn and go on).";
 
 /// Distance resolution assumed for integrated wheel speeds, m: a CAN bus's 0.01 km/h over
 /// the one second in which the estimator compares wheels with gyro. The pulse default
@@ -112,6 +115,17 @@ pub struct Args {
     /// Write what this drive learned about the sensors.
     #[arg(long, value_name = "JSON")]
     pub calibration_out: Option<PathBuf>,
+    /// Unit of the gyr_z column, e.g. `--gyro-unit deg/s`.
+    #[arg(long, value_enum, value_name = "UNIT", default_value = "rad/s")]
+    pub gyro_unit: GyroUnit,
+    /// Go on (with a warning on stderr) when the gyro's turns contradict its declared unit,
+    /// instead of refusing.
+    #[arg(long)]
+    pub accept_units: bool,
+    /// Go on (with a warning on stderr) when the gyro turns against the wheels (its sign
+    /// flipped), instead of refusing.
+    #[arg(long)]
+    pub accept_axes: bool,
     /// Where and when the drive was made, for true heading.
     #[command(flatten)]
     pub place: Place,
@@ -153,10 +167,14 @@ pub fn run(args: &Args) -> CliResult {
         t: rows.index("t_s").unwrap_or(0),
         wheels: wheel_columns,
         gyr: rows.index("gyr_z"),
+        to_rps: args.gyro_unit.to_rad_per_s(),
         mag: mag_columns(&rows)?,
+        check: YawRateCheck::new(vehicle.track_m),
     };
     let mut writer = Writer::create(args, declination)?;
-    let samples = estimate(&mut rows, &mut columns, method.as_mut(), &mut writer)?;
+    let samples = estimate(&mut rows, &mut columns, method.as_mut(), &mut writer)
+        .map_err(|e| check_gyro(args, &columns.check).err().unwrap_or(e))?;
+    check_gyro(args, &columns.check)?;
     let learned = method.calibration();
     if let (Some(out), Some(learned)) = (&args.calibration_out, &learned) {
         save_calibration(out, learned)?;
@@ -282,12 +300,24 @@ fn build_method(
         .map_err(bad_config)
 }
 
-/// Where each sensor is in a row.
+/// Refuses a drive whose gyro contradicts the wheels' turns (its unit or its sign), or with
+/// `--accept-units` / `--accept-axes` says so on stderr: before the output is committed, and
+/// in place of the estimator's own error when that came from the same contradiction.
+fn check_gyro(args: &Args, check: &YawRateCheck) -> CliResult {
+    let findings = check.findings(args.gyro_unit, &args.input_options);
+    refuse_or_warn(&findings, &args.input, args.accept_units, args.accept_axes)
+}
+
+/// Where each sensor is in a row, and the check of the gyro against the wheels that the
+/// rows feed.
 struct Columns {
     t: usize,
     wheels: Option<WheelColumns>,
     gyr: Option<usize>,
+    /// The declared gyro unit's factor to rad/s.
+    to_rps: f64,
     mag: Option<[usize; 2]>,
+    check: YawRateCheck,
 }
 
 impl Columns {
@@ -304,7 +334,7 @@ impl Columns {
             sample = sample.with_wheels(l, r);
         }
         if let Some(g) = self.gyr.map(|g| v[g]).filter(|g| g.is_finite()) {
-            sample = sample.with_gyro(g);
+            sample = sample.with_gyro(g * self.to_rps);
         }
         if let Some([x, y]) = self
             .mag
@@ -312,6 +342,7 @@ impl Columns {
         {
             sample = sample.with_mag(Vector2::new(v[x], v[y]));
         }
+        self.check.push(&sample);
         Ok(sample)
     }
 }

@@ -1,5 +1,5 @@
-//! The product commands, one file each: `calibrate`, `heading`, `field`, `orientation` and
-//! `drive`; [`mag_unit`] is the magnetometer unit `calibrate` checks a fitted field
+//! The product commands, one file each: `calibrate`, `heading`, `field`, `orientation`,
+//! `drive` and `inspect`; [`mag_unit`] is the magnetometer unit `calibrate` checks a fitted field
 //! against, and [`field::Place`] the place and date every command that turns magnetic into
 //! true north reads.
 
@@ -7,5 +7,6 @@ pub mod calibrate;
 pub mod drive;
 pub mod field;
 pub mod heading;
+pub mod inspect;
 pub mod mag_unit;
 pub mod orientation;

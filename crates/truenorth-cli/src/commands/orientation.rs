@@ -8,7 +8,7 @@ use truenorth::core::{AttitudeEstimate, Axes, EulerZyx, ImuSample, ned_to_enu, r
 
 use crate::io::{
     AccUnit, CliError, CliResult, GyroUnit, InputOptions, InputPath, ReadSpec, Table,
-    check_distinct, check_inertial_units, write_csv,
+    check_distinct, check_inertial, refuse_or_warn, write_csv,
 };
 use crate::plot::{Band, Line, write_timeseries};
 use crate::registry::{Orientation, OrientationMethod, Timing};
@@ -86,6 +86,10 @@ pub struct Args {
     /// of refusing.
     #[arg(long)]
     pub accept_units: bool,
+    /// Go on (with a warning on stderr) when the gyro's axes contradict the accelerometer's
+    /// and magnetometer's (a flipped, swapped or mirrored gyro axis), instead of refusing.
+    #[arg(long)]
+    pub accept_axes: bool,
     /// How to read the file (delimiter, header, column names, axes).
     #[command(flatten)]
     pub input_options: InputOptions,
@@ -147,20 +151,12 @@ pub fn run(args: &Args) -> CliResult {
     Ok(())
 }
 
-/// Refuses a recording whose accelerometer or gyro contradicts its declared unit (or, with
-/// `--accept-units`, says so on stderr and goes on).
+/// Refuses a recording whose accelerometer or gyro contradicts its declared unit, or whose
+/// gyro axes contradict the other sensors' (or, with `--accept-units` / `--accept-axes`, says
+/// so on stderr and goes on).
 fn check_units(args: &Args, samples: &[ImuSample]) -> CliResult {
-    for finding in check_inertial_units(samples, args.gyro_unit, args.acc_unit) {
-        if args.accept_units {
-            eprintln!("warning: {}: {finding}", args.input.display());
-        } else {
-            return Err(CliError::file(
-                &args.input,
-                format!("{finding} (or --accept-units to go on)"),
-            ));
-        }
-    }
-    Ok(())
+    let findings = check_inertial(samples, args.gyro_unit, args.acc_unit, &args.input_options);
+    refuse_or_warn(&findings, &args.input, args.accept_units, args.accept_axes)
 }
 
 /// The recording as IMU samples; a row whose three magnetometer cells are empty has no

@@ -13,6 +13,11 @@
 //!   grow with the file;
 //! * [`Table`]: the whole-table read built on it.
 //!
+//! Checking (the data against what they were declared to be): [`check_inertial`] (the
+//! accelerometer's and gyro's units, the gyro's axes against gravity's and the magnetic
+//! field's turns) and [`YawRateCheck`] (a vehicle's yaw gyro against its wheels), shared by
+//! the commands that refuse and by `inspect`, which reports.
+//!
 //! Writing: [`AtomicOutput`](atomic_write::AtomicOutput) / [`CsvOutput`] / [`write_csv`] / [`write_atomically`] write a
 //! temporary file beside the target, sync it and rename it over the target (`-`: standard
 //! output; `*.gz`: compressed); [`check_distinct`] refuses an output that is one of the
@@ -21,7 +26,9 @@
 mod atomic_write;
 mod calibration_file;
 mod columns;
+mod direction_spans;
 mod error;
+mod gyro_axes;
 mod inertial_units;
 mod reader;
 mod source;
@@ -29,6 +36,7 @@ mod table;
 mod unit_check;
 mod vehicle_file;
 mod wheel_columns;
+mod yaw_rate_check;
 
 pub use atomic_write::{CsvOutput, check_distinct, write_atomically, write_csv};
 pub use calibration_file::{
@@ -36,11 +44,18 @@ pub use calibration_file::{
     GyroPart, QualityReport, finite, gyro_units, matrix_rows, units_block,
 };
 pub use columns::InputOptions;
+pub use direction_spans::{Inertial, Reference, median, median_magnitude};
 pub use error::{CliError, CliResult};
+pub use gyro_axes::{
+    AxisFit, SignedPermutation, axes_are_wrong, fit_gyro_axes, fix_columns, fix_pair, shell_word,
+};
 pub use inertial_units::{AccUnit, GyroUnit};
 pub use reader::{ReadSpec, Row, RowReader};
 pub use source::InputPath;
 pub use table::Table;
-pub use unit_check::check_inertial_units;
+pub use unit_check::{
+    acc_unit_name, check_inertial, gyro_unit_name, likely_acc_unit, refuse_or_warn,
+};
 pub use vehicle_file::VehicleFile;
 pub use wheel_columns::WheelColumns;
+pub use yaw_rate_check::YawRateCheck;

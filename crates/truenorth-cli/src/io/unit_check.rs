@@ -4,68 +4,141 @@
 //! by a constant factor (deg/s read as rad/s, g read as m/s²) breaks one of these by that
 //! factor, which no sensor error comes near.
 
-use nalgebra::{UnitQuaternion, Vector3};
+use super::direction_spans::{Inertial, Reference, direction_spans, median, mismatch_rad};
+use super::gyro_axes::{axes_are_wrong, fit_gyro_axes, fix_columns, shell_word};
+use super::{AccUnit, CliError, CliResult, GyroUnit, InputOptions};
+use nalgebra::Matrix3;
 use truenorth::core::ImuSample;
-
-use super::{AccUnit, GyroUnit};
 
 /// Standard gravity, m/s².
 const G_MPS2: f64 = 9.806_65;
 
-/// Length of the spans over which the gyro's rotation is compared with the turn of gravity's
-/// direction, s: long enough for a hand-held turn of several degrees, short enough that a
-/// consumer gyro's bias (under 1°/s) adds under 0.5°.
-const SPAN_S: f64 = 0.5;
-
-/// A reading is near rest when its magnitude is within this fraction of the recording's
-/// median (the median is unit-free: the test of direction does not depend on the unit).
-const NEAR_REST: f64 = 0.05;
-
-/// Spans whose gravity direction turned by less than this are left out: noise, not motion.
-const MIN_TURN_RAD: f64 = 0.087;
-
 /// Spans needed before the gyro's unit is judged at all.
 const MIN_SPANS: usize = 10;
 
-/// What the check found wrong, as the words of a refusal.
-pub type Finding = String;
+/// Which option a finding is about, and so which `--accept-*` lets a run go on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FindingKind {
+    /// A unit (`--gyro-unit`, `--acc-unit`; `--accept-units`).
+    Units,
+    /// The gyro's axes against the other sensors' (`--column`; `--accept-axes`).
+    Axes,
+}
+
+/// What a check found wrong, in the words of a refusal that names the fix.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Finding {
+    /// What it is about.
+    pub kind: FindingKind,
+    /// The likely problem and the option that fixes it.
+    pub message: String,
+}
 
 /// Checks the accelerometer's magnitude and the gyro's rate scale of `samples` (already
 /// converted from the declared units `gyro` and `acc`, so meant to be rad/s and m/s²) and
 /// says what contradicts them.
 pub fn check_inertial_units(samples: &[ImuSample], gyro: GyroUnit, acc: AccUnit) -> Vec<Finding> {
-    let rows: Vec<(f64, Vector3<f64>, Vector3<f64>)> = samples
-        .iter()
-        .filter_map(|s| Some((s.t_s, s.acc_mps2.as_xyz()?, s.gyr_rps.as_xyz()?)))
-        .filter(|(t, a, g)| t.is_finite() && a.iter().chain(g.iter()).all(|v| v.is_finite()))
-        .collect();
+    let rows = Inertial::from_samples(samples);
     let mut findings = Vec::new();
-    let mut norms: Vec<f64> = rows.iter().map(|(_, a, _)| a.norm()).collect();
-    if norms.is_empty() {
+    let Some(median) = super::direction_spans::median_magnitude(&rows, Reference::Gravity) else {
+        return findings;
+    };
+    let units = |message| Finding {
+        kind: FindingKind::Units,
+        message,
+    };
+    findings.extend(acc_finding(median * acc.to_mps2().recip(), acc).map(units));
+    findings.extend(gyro_finding(&rows, gyro).map(units));
+    findings
+}
+
+/// [`check_inertial_units`], then, when the units hold, the gyro's axes against the
+/// directions of gravity and the magnetic field (`opts`: the options the file was read
+/// with, which the fix composes with).
+pub fn check_inertial(
+    samples: &[ImuSample],
+    gyro: GyroUnit,
+    acc: AccUnit,
+    opts: &InputOptions,
+) -> Vec<Finding> {
+    let mut findings = check_inertial_units(samples, gyro, acc);
+    if findings.iter().any(|f| f.kind == FindingKind::Units) {
         return findings;
     }
-    norms.sort_by(f64::total_cmp);
-    let median = norms[norms.len() / 2];
-    if let Some(finding) = acc_finding(median * acc.to_mps2().recip(), acc) {
-        findings.push(finding);
-    }
-    if let Some(finding) = gyro_finding(&rows, median, gyro) {
-        findings.push(finding);
+    let rows = Inertial::from_samples(samples);
+    if let Some(fit) = fit_gyro_axes(&rows, 1.0).filter(axes_are_wrong) {
+        findings.push(Finding {
+            kind: FindingKind::Axes,
+            message: format!(
+                "the gyro's axes do not turn gravity's and the magnetic field's directions as the accelerometer and magnetometer see them (median mismatch {:.1}° over {} spans); with its axes taken as {} (each as it is now read; {}) they do ({:.1}°): pass --column {} after the options given",
+                fit.as_read_deg,
+                fit.spans.0 + fit.spans.1,
+                fit.best,
+                if fit.best.is_proper() { "a rotation" } else { "a mirror image" },
+                fit.best_deg,
+                shell_word(&fix_columns(&fit.best, opts))
+            ),
+        });
     }
     findings
 }
 
+/// Acts on `findings` about `input`: refuses on the first one not accepted (its message
+/// and the `--accept-*` flag that would go on), says each accepted one on stderr.
+pub fn refuse_or_warn(
+    findings: &[Finding],
+    input: &std::path::Path,
+    accept_units: bool,
+    accept_axes: bool,
+) -> CliResult {
+    for finding in findings {
+        let (accepted, flag) = match finding.kind {
+            FindingKind::Units => (accept_units, "--accept-units"),
+            FindingKind::Axes => (accept_axes, "--accept-axes"),
+        };
+        if accepted {
+            eprintln!("warning: {}: {}", input.display(), finding.message);
+        } else {
+            return Err(CliError::file(
+                input,
+                format!("{} (or {flag} to go on)", finding.message),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The unit in which a median specific force of `raw_median` (in the file's own numbers) is
+/// one gravity within what motion adds: about 9.81 in m/s², 1 in g, 1000 in mg.
+pub fn likely_acc_unit(raw_median: f64) -> Option<AccUnit> {
+    [AccUnit::MetrePerS2, AccUnit::G, AccUnit::MilliG]
+        .into_iter()
+        .find(|unit| (0.7..1.4).contains(&(raw_median * unit.to_mps2() / G_MPS2)))
+}
+
+/// The name of `unit` as the option takes it.
+pub fn acc_unit_name(unit: AccUnit) -> &'static str {
+    match unit {
+        AccUnit::MetrePerS2 => "m/s2",
+        AccUnit::G => "g",
+        AccUnit::MilliG => "mg",
+    }
+}
+
+/// The name of `unit` as the option takes it.
+pub fn gyro_unit_name(unit: GyroUnit) -> &'static str {
+    match unit {
+        GyroUnit::RadPerS => "rad/s",
+        GyroUnit::DegPerS => "deg/s",
+    }
+}
+
 /// Over a whole recording the median specific force is gravity's within what the motion
 /// adds; `raw_median` is that median in the file's own numbers, which say which unit they are
-/// in: about 9.81 in m/s², 1 in g, 1000 in mg.
-fn acc_finding(raw_median: f64, declared: AccUnit) -> Option<Finding> {
-    let (likely, name) = [
-        (AccUnit::MetrePerS2, "m/s2"),
-        (AccUnit::G, "g"),
-        (AccUnit::MilliG, "mg"),
-    ]
-    .into_iter()
-    .find(|(unit, _)| (0.7..1.4).contains(&(raw_median * unit.to_mps2() / G_MPS2)))?;
+/// in.
+fn acc_finding(raw_median: f64, declared: AccUnit) -> Option<String> {
+    let likely = likely_acc_unit(raw_median)?;
+    let name = acc_unit_name(likely);
     (likely != declared).then(|| {
         format!(
             "the accelerometer's median magnitude is {raw_median:.3} in the file, one gravity in {name}, not in the declared unit: pass --acc-unit {name}"
@@ -73,76 +146,33 @@ fn acc_finding(raw_median: f64, declared: AccUnit) -> Option<Finding> {
     })
 }
 
-/// Between two near-rest readings `SPAN_S` apart, gravity's direction in the body turns by
-/// the rotation the gyro integrates. Compares that prediction with the rates as declared and
-/// as the other unit would give them, and reports the other unit when it explains the turns
-/// and the declared one does not.
-fn gyro_finding(
-    rows: &[(f64, Vector3<f64>, Vector3<f64>)],
-    median: f64,
-    declared: GyroUnit,
-) -> Option<Finding> {
-    let (other, name) = match declared {
-        GyroUnit::RadPerS => (GyroUnit::DegPerS, "deg/s"),
-        GyroUnit::DegPerS => (GyroUnit::RadPerS, "rad/s"),
+/// Between two near-rest readings about half a second apart, gravity's direction in the
+/// body turns by the rotation the gyro integrates. Compares that prediction with the rates
+/// as declared and as the other unit would give them, and reports the other unit when it
+/// explains the turns and the declared one does not.
+fn gyro_finding(rows: &[Inertial], declared: GyroUnit) -> Option<String> {
+    let other = match declared {
+        GyroUnit::RadPerS => GyroUnit::DegPerS,
+        GyroUnit::DegPerS => GyroUnit::RadPerS,
     };
+    let name = gyro_unit_name(other);
     // The rates were multiplied by the declared factor; this turns them into the other's.
     let rescale = other.to_rad_per_s() / declared.to_rad_per_s();
-    let still = |a: &Vector3<f64>| (a.norm() / median - 1.0).abs() < NEAR_REST;
-    let mut as_declared = Vec::new();
-    let mut as_other = Vec::new();
-    let mut k = 0;
-    while k + 1 < rows.len() {
-        let (t0, a0, _) = rows[k];
-        let mut end = k + 1;
-        while end < rows.len() && rows[end].0 - t0 < SPAN_S {
-            end += 1;
-        }
-        if end >= rows.len() {
-            break;
-        }
-        let (t1, a1, _) = rows[end];
-        let longest_step_s = rows[k..=end]
-            .windows(2)
-            .map(|w| w[1].0 - w[0].0)
-            .fold(0.0, f64::max);
-        if still(&a0) && still(&a1) && t1 - t0 < 2.0 * SPAN_S && longest_step_s < 0.1 {
-            let (u0, u1) = (a0.normalize(), a1.normalize());
-            if u0.angle(&u1) > MIN_TURN_RAD {
-                as_declared.push(mismatch_rad(&rows[k..=end], 1.0, &u0, &u1));
-                as_other.push(mismatch_rad(&rows[k..=end], rescale, &u0, &u1));
-            }
-        }
-        k = end;
-    }
-    if as_declared.len() < MIN_SPANS {
+    let spans = direction_spans(rows, Reference::Gravity);
+    if spans.len() < MIN_SPANS {
         return None;
     }
-    let median_deg = |v: &mut Vec<f64>| {
-        v.sort_by(f64::total_cmp);
-        v[v.len() / 2].to_degrees()
+    let median_deg = |gyro: Matrix3<f64>| {
+        let mut v: Vec<f64> = spans.iter().map(|s| mismatch_rad(rows, s, &gyro)).collect();
+        median(&mut v).map_or(f64::NAN, f64::to_degrees)
     };
-    let (declared_deg, other_deg) = (median_deg(&mut as_declared), median_deg(&mut as_other));
+    let declared_deg = median_deg(Matrix3::identity());
+    let other_deg = median_deg(Matrix3::identity() * rescale);
     (other_deg * 3.0 < declared_deg && declared_deg > 10.0).then(|| {
         format!(
-            "the gyro columns in the declared unit do not turn gravity's direction as the accelerometer sees it (median mismatch {declared_deg:.1}° over {} spans of {SPAN_S} s near rest); in {name} they do ({other_deg:.1}°): pass --gyro-unit {name}",
-            as_declared.len()
+            "the gyro columns in the declared unit do not turn gravity's direction as the accelerometer sees it (median mismatch {declared_deg:.1}° over {} spans of {} s near rest); in {name} they do ({other_deg:.1}°): pass --gyro-unit {name}",
+            spans.len(),
+            super::direction_spans::SPAN_S
         )
     })
-}
-
-/// The angle between where gravity's direction `u1` is seen at the end of `span` and where
-/// the gyro's rates (times `scale`) carry its start `u0`, radians.
-fn mismatch_rad(
-    span: &[(f64, Vector3<f64>, Vector3<f64>)],
-    scale: f64,
-    u0: &Vector3<f64>,
-    u1: &Vector3<f64>,
-) -> f64 {
-    let mut body = UnitQuaternion::identity();
-    for w in span.windows(2) {
-        body *= UnitQuaternion::from_scaled_axis(w[0].2 * scale * (w[1].0 - w[0].0));
-    }
-    // A fixed vector seen from the body turns against the body's rotation.
-    (body.inverse() * u0).angle(u1)
 }

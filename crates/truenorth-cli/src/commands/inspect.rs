@@ -1,0 +1,54 @@
+//! `truenorth inspect`: what a recording holds and how to read it — each column's rate,
+//! gaps and range, each sensor's likely unit and the gyro's axes against the other
+//! sensors', and the options that read it right.
+
+use std::path::PathBuf;
+
+use crate::inspect::report::JsonReport;
+use crate::inspect::{Recording, analyse};
+use crate::io::{CliError, CliResult, InputOptions, InputPath};
+
+/// Arguments of `truenorth inspect`.
+///
+/// Input: a CSV with `t_s` and any of `gyr_x,gyr_y,gyr_z`, `acc_x,acc_y,acc_z`,
+/// `mag_x,mag_y,mag_z`, `dist_l_m,dist_r_m`, `speed_l_mps,speed_r_mps` (read through the
+/// same options as the other commands; empty or non-finite cells are counted, not refused).
+///
+/// Output (stdout): per column its readings, rate (one over the median step of `t_s`), gaps
+/// (steps over five median steps: count, the longest and where it ends), range and
+/// non-finite cells; per sensor its likely unit (accelerometer: one gravity at rest in m/s2,
+/// g or mg; gyro: rad/s or deg/s, by how gravity's and the magnetic field's directions turn;
+/// magnetometer: the unit that makes its magnitude an Earth field), the gyro's axes (the
+/// best of the 48 signed permutations, with the runner-up and the margin) and the line of
+/// options that reads the file right. `--json`: the same as one JSON object.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// The recording (`-`: standard input; `.gz` or gzip data read as such).
+    pub file: PathBuf,
+    /// Write the report as JSON.
+    #[arg(long)]
+    pub json: bool,
+    /// How to read the file (delimiter, header, column names, axes).
+    #[command(flatten)]
+    pub input_options: InputOptions,
+}
+
+/// Runs the subcommand: read the columns, analyse them, print the report.
+pub fn run(args: &Args) -> CliResult {
+    let input = InputPath::new(&args.file);
+    let recording = Recording::read(&input, &args.input_options)?;
+    let name = input.display_path().display().to_string();
+    let report = analyse(&name, &recording, &args.input_options);
+    if args.json {
+        let json = JsonReport {
+            options: report.options(),
+            report: &report,
+        };
+        let text = serde_json::to_string_pretty(&json)
+            .map_err(|e| CliError::msg(format!("inspect: cannot write the report: {e}")))?;
+        println!("{text}");
+    } else {
+        print!("{}", report.to_table());
+    }
+    Ok(())
+}

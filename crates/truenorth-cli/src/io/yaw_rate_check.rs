@@ -1,0 +1,188 @@
+//! A vehicle's yaw gyro checked against its wheels: over each second in which the vehicle
+//! turns, the odometer wheels' distance difference over the track turns the vehicle by as
+//! much as the gyro integrates (within the few percent of a gyro's scale error and the
+//! 1.5–2.5 times of a skid-steer's wheel slip). A gyro in deg/s read as rad/s turns 57
+//! times too far, one whose sign is flipped turns the other way; neither comes near one.
+//! Streaming: it keeps a few sums, so a log of any length is checked as it is read.
+
+use truenorth::core::VehicleSample;
+
+use super::gyro_axes::{SignedPermutation, fix_pair, shell_word};
+use super::unit_check::{Finding, FindingKind, gyro_unit_name};
+use super::{GyroUnit, InputOptions};
+
+/// Length of a comparison window, s.
+const WINDOW_S: f64 = 1.0;
+/// A window counts when the wheels turned the vehicle by at least this, rad (3°): a
+/// corner, not the wheels' noise.
+const MIN_WINDOW_TURN_RAD: f64 = 0.05;
+/// A step longer than this drops the window (a gap in the log).
+const MAX_STEP_S: f64 = 0.5;
+/// Turning windows needed before the gyro is judged.
+const MIN_WINDOWS: usize = 10;
+/// The share of the wheels' turns the gyro must explain (squared correlation) before its
+/// scale or sign is judged: below it the two do not see the same motion at all.
+const MIN_R2: f64 = 0.5;
+
+/// The running comparison of the gyro's turns with the wheels'.
+#[derive(Debug, Clone, PartialEq)]
+pub struct YawRateCheck {
+    track_m: f64,
+    /// Start of the open window, s.
+    start_s: Option<f64>,
+    /// The wheels' and the gyro's turns in the open window, rad; whether it is still whole.
+    window: (f64, f64, bool),
+    last_wheels: Option<[f64; 2]>,
+    last_gyro: Option<(f64, f64)>,
+    /// Σ wheels·gyro, Σ gyro², Σ wheels² over the turning windows.
+    sums: [f64; 3],
+    /// The number of turning windows.
+    pub windows: usize,
+}
+
+impl YawRateCheck {
+    /// A check for wheels `track_m` apart.
+    pub fn new(track_m: f64) -> Self {
+        Self {
+            track_m,
+            start_s: None,
+            window: (0.0, 0.0, true),
+            last_wheels: None,
+            last_gyro: None,
+            sums: [0.0; 3],
+            windows: 0,
+        }
+    }
+
+    /// Takes one row of the log (the gyro already in rad/s as declared).
+    pub fn push(&mut self, sample: &VehicleSample) {
+        let t = sample.t_s;
+        let start = *self.start_s.get_or_insert(t);
+        if let Some((t0, g0)) = self.last_gyro {
+            let dt = t - t0;
+            self.window.1 += g0 * dt;
+            self.window.2 &= dt <= MAX_STEP_S;
+        }
+        if let Some(g) = sample.gyr_z_rps.filter(|g| g.is_finite()) {
+            self.last_gyro = Some((t, g));
+        }
+        if let Some(w) = sample.wheels {
+            let now = [w.dist_l_m, w.dist_r_m];
+            if let Some([l, r]) = self.last_wheels {
+                // A right turn takes the left wheel further.
+                self.window.0 += ((now[0] - l) - (now[1] - r)) / self.track_m;
+            }
+            self.last_wheels = Some(now);
+        }
+        if t - start >= WINDOW_S {
+            self.close_window(t);
+        }
+    }
+
+    fn close_window(&mut self, t: f64) {
+        let (wheels, gyro, whole) = self.window;
+        let seen = self.last_gyro.is_some() && self.last_wheels.is_some();
+        if whole && seen && wheels.abs() >= MIN_WINDOW_TURN_RAD && wheels.is_finite() {
+            self.sums[0] += wheels * gyro;
+            self.sums[1] += gyro * gyro;
+            self.sums[2] += wheels * wheels;
+            self.windows += 1;
+        }
+        self.window = (0.0, 0.0, true);
+        self.start_s = Some(t);
+    }
+
+    /// The wheels' turn per turn of the gyro (least squares over the turning windows) and
+    /// the squared correlation; `None` before [`MIN_WINDOWS`] turning windows.
+    pub fn ratio(&self) -> Option<(f64, f64)> {
+        let [wg, gg, ww] = self.sums;
+        (self.windows >= MIN_WINDOWS && gg > 0.0 && ww > 0.0)
+            .then(|| (wg / gg, wg * wg / (gg * ww)))
+    }
+
+    /// What contradicts the declared gyro unit or sign, naming the option that fixes it.
+    pub fn findings(&self, declared: GyroUnit, opts: &InputOptions) -> Vec<Finding> {
+        let Some((ratio, r2)) = self.ratio().filter(|(_, r2)| *r2 >= MIN_R2) else {
+            return Vec::new();
+        };
+        let mut findings = Vec::new();
+        let other = match declared {
+            GyroUnit::RadPerS => GyroUnit::DegPerS,
+            GyroUnit::DegPerS => GyroUnit::RadPerS,
+        };
+        let factor = other.to_rad_per_s() / declared.to_rad_per_s();
+        // Within a factor of three of the other unit's ratio (57 apart from this one's).
+        if (ratio.abs() / factor).ln().abs() < 3f64.ln() {
+            let name = gyro_unit_name(other);
+            findings.push(Finding {
+                kind: FindingKind::Units,
+                message: format!(
+                    "gyr_z turns {:.3} times as far as the wheels over {} turning seconds (r² {r2:.2}): it is in {name}, not the declared unit: pass --gyro-unit {name}",
+                    1.0 / ratio.abs(),
+                    self.windows
+                ),
+            });
+        }
+        if ratio < 0.0 {
+            let flip = SignedPermutation {
+                source: [0, 1, 2],
+                sign: [1, 1, -1],
+            };
+            findings.push(Finding {
+                kind: FindingKind::Axes,
+                message: format!(
+                    "gyr_z turns against the wheels over {} turning seconds (wheels per gyro {ratio:.2}, r² {r2:.2}): its sign is flipped (a right turn must read positive): pass --column {}",
+                    self.windows,
+                    shell_word(&fix_pair(&flip, 2, opts))
+                ),
+            });
+        }
+        findings
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A vehicle weaving at up to 0.3 rad/s, its gyro reading `gain` times the truth.
+    fn weave(gain: f64) -> YawRateCheck {
+        let mut check = YawRateCheck::new(1.5);
+        let (mut heading, mut l, mut r) = (0.0f64, 0.0, 0.0);
+        for k in 0..3000 {
+            let t = k as f64 * 0.02;
+            let rate = 0.3 * (0.5 * t).sin();
+            heading += rate * 0.02;
+            l += (10.0 + 0.75 * rate) * 0.02;
+            r += (10.0 - 0.75 * rate) * 0.02;
+            check.push(
+                &VehicleSample::at(t)
+                    .with_wheels(l, r)
+                    .with_gyro(gain * rate),
+            );
+        }
+        assert!(heading.is_finite());
+        check
+    }
+
+    #[test]
+    fn a_gyro_that_agrees_with_the_wheels_passes_and_others_are_named() {
+        let opts = InputOptions::default();
+        let good = weave(1.0);
+        let (ratio, r2) = good.ratio().unwrap();
+        assert!((ratio - 1.0).abs() < 0.05 && r2 > 0.99, "{ratio} {r2}");
+        assert!(good.findings(GyroUnit::RadPerS, &opts).is_empty());
+        let degrees = weave(1f64.to_degrees()).findings(GyroUnit::RadPerS, &opts);
+        assert_eq!(degrees.len(), 1);
+        assert!(
+            degrees[0].message.contains("--gyro-unit deg/s"),
+            "{degrees:?}"
+        );
+        let flipped = weave(-1.0).findings(GyroUnit::RadPerS, &opts);
+        assert_eq!(flipped.len(), 1);
+        assert!(
+            flipped[0].message.contains("--column gyr_z=-gyr_z"),
+            "{flipped:?}"
+        );
+    }
+}
