@@ -92,6 +92,7 @@ fn every_calibrator_on_a_simulated_drive() {
             &ls_sol.params,
             ls_sol.quality.field_magnitude,
         )
+        .quality
         .uncertainty
         .dilution;
         let g2_n = g * g / circle.len() as f64;

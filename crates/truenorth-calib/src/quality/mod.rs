@@ -12,7 +12,7 @@
 //! determine: the dilution of the information matrix, the predicted parameter σ, and the
 //! determination test that replaces a share of direction cells), report (assembly of the
 //! [`CompassQuality`](truenorth_core::CompassQuality), its
-//! [`CompassUncertainty`](truenorth_core::CompassUncertainty) included) and field (the
+//! [`CompassUncertainty`] included) and field (the
 //! fitted field against an expected one). The report's data types and its verdict (good /
 //! usable / poor, [`Verdict`]) live in `truenorth-core`, beside the calibrator trait, and are
 //! re-exported here.

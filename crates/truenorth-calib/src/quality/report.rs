@@ -492,7 +492,7 @@ impl CalibratedBlock {
 }
 
 /// The 3-D quality report of `cal` on `points` and what they determine: coverage as the
-/// information share of an evenly covered sphere ([`CompassUncertainty::efficiency`] of the
+/// information share of an evenly covered sphere ([`CompassUncertainty::efficiency`](truenorth_core::CompassUncertainty::efficiency) of the
 /// support, see the `support` module), residual RMS relative to `field` (the radius of the
 /// calibrated sphere; see [`super::mean_corrected_norm_3d`] if the calibrator defines
 /// none), the condition number of the support's 9-parameter information matrix and the
