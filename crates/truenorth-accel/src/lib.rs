@@ -54,3 +54,8 @@ pub use quasi_static::{QuasiStaticConfig, QuasiStaticDetector};
 pub use specific_force::{AccelTruth, gravity_ned_mps2, specific_force_body_mps2};
 pub use static_tilt::{MIN_SPECIFIC_FORCE_MPS2, pitch_from_forward_axis_rad, static_tilt};
 pub use triad_calibration::{AccelTriadCalibration, MAX_TRIAD_CONDITION};
+
+/// The code blocks of the crate's README, compiled and run as doctests.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeDoctests;

@@ -120,3 +120,8 @@ pub use seed::turn::{
 pub use seed::turn_gyro::{
     MIN_REST_S, RawHeading, TurnCalibration, TurnCalibrator, TurnQuality, TurnSample,
 };
+
+/// The code blocks of the crate's README, compiled and run as doctests.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeDoctests;

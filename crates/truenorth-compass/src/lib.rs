@@ -69,3 +69,8 @@ pub use mz_reconstruction::MzReconstruction;
 pub use phasors::{EllipsePhasors, ITERATIVE_MAX_STEPS};
 pub use soft_iron::{EllipseAxes, ellipse_axes, soft_iron_from_axes};
 pub use tilt::{level_field, tilt_compensated_heading, tilt_compensated_heading_checked};
+
+/// The code blocks of the crate's README, compiled and run as doctests.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeDoctests;

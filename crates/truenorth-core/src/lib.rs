@@ -82,3 +82,8 @@ pub use num_traits::Float;
 
 /// Result type with the workspace error.
 pub type Result<T, E = Error> = core::result::Result<T, E>;
+
+/// The code blocks of the crate's README, compiled and run as doctests.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeDoctests;

@@ -56,3 +56,8 @@ pub use orientation::{
     StartupField, coefficient_table,
 };
 pub use vehicle::{CompassGates, SensorPriors, VehicleConfig, VehicleEstimator};
+
+/// The code blocks of the crate's README, compiled and run as doctests.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeDoctests;

@@ -107,3 +107,8 @@ pub fn total_intensity_nt(lat_rad: f64, lon_rad: f64, height_m: f64, year: f64) 
 pub fn inclination_rad(lat_rad: f64, lon_rad: f64, height_m: f64, year: f64) -> Result<f64> {
     WorldMagneticModel::WMM2025.inclination_rad(lat_rad, lon_rad, height_m, year)
 }
+
+/// The code blocks of the crate's README, compiled and run as doctests.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeDoctests;

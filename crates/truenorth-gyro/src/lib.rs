@@ -83,3 +83,8 @@ pub use yaw_integrator::{YawIntegrator, YawIntegratorConfig};
 
 /// The model of a single-axis yaw gyro, the usual vehicle case (`gyr_z`, positive = right turn).
 pub type YawGyroModel = GyroAxisModel;
+
+/// The code blocks of the crate's README, compiled and run as doctests.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeDoctests;

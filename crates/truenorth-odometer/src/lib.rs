@@ -104,3 +104,8 @@ pub use odometry_step::{OdometryStep, OdometryTurn, differential_gains};
 pub use patent_track::PatentAckermannTrack;
 pub use track_table::EffectiveTrackTable;
 pub use wheels::{OdometerWheels, WheelDistances, WheelGeometry, WheelMotion};
+
+/// The code blocks of the crate's README, compiled and run as doctests.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeDoctests;

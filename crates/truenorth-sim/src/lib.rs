@@ -61,3 +61,8 @@ pub use streams::{
 };
 pub use vehicle::{MAX_SAMPLES, VehicleTruth, simulate};
 pub use vehicle_kind::{RangeVehicle, Slip, SlipProcess, VehicleKind};
+
+/// The code blocks of the crate's README, compiled and run as doctests.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeDoctests;
