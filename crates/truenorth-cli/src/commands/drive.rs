@@ -64,7 +64,17 @@ A time base that contradicts the motion (t_s in milliseconds, a gyro in deg/s) i
 with the row where the evidence became clear. Where the drive turns (ten one-second windows
 of 3° or more by the wheels), the gyro is checked against the wheels: one that turns 57 times
 too far or too little is refused naming --gyro-unit, one that turns the other way naming
---column gyr_z=-HEADER (--accept-units / --accept-axes: warn and go on).";
+--column gyr_z=-HEADER (--accept-units / --accept-axes: warn and go on).
+
+Output heading: degrees clockwise from magnetic north, or from true north with --lat/--lon
+(magnetic + the World Magnetic Model's declination); north_m, east_m in metres from the
+start (NED, z down).
+
+Examples: truenorth drive --vehicle car.json --input drive.csv --output track.csv
+--extra sigma,status; the next drive, starting from what this one learned, in true north:
+truenorth drive --vehicle car.json --input drive2.csv.gz --output track2.csv
+--calibration-in learned.json --lat 51.5 --lon -0.13 --date 2026-06-01
+(with --calibration-out learned.json on the first).";
 
 /// Distance resolution assumed for integrated wheel speeds, m: a CAN bus's 0.01 km/h over
 /// the one second in which the estimator compares wheels with gyro. The pulse default

@@ -30,7 +30,11 @@ accelerometer and aligns it with the magnetometer; with a plain `ellipsoid` cali
 the raw accelerometer is used, assumed to share the magnetometer's axes. Without the
 accelerometer columns, or with a 2-D calibration, the heading ASSUMES A LEVEL SENSOR
 (body x forward, y right, z down, horizontal): a tilt of a few degrees then errs by
-several degrees where the field dips steeply; the summary line on stderr says so.";
+several degrees where the field dips steeply; the summary line on stderr says so.
+
+Examples: truenorth heading --calibration cal.json --input mag.csv --output heading.csv
+(magnetic); truenorth heading --calibration cal.json --input mag.csv --output - --lat 51.5
+--lon -0.13 --date 2026.4 (true north in London).";
 
 /// Arguments of `truenorth heading` (the details are in `AFTER_HELP`, shown by `--help`).
 #[derive(Debug, clap::Args)]

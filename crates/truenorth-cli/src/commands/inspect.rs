@@ -21,6 +21,9 @@ use crate::io::{CliError, CliResult, InputOptions, InputPath};
 /// magnetometer: the unit that makes its magnitude an Earth field), the gyro's axes (the
 /// best of the 48 signed permutations, with the runner-up and the margin) and the line of
 /// options that reads the file right. `--json`: the same as one JSON object.
+///
+/// Examples: `truenorth inspect imu.csv`; `truenorth inspect log.csv.gz --json --column
+/// t_s=time,gyr_x=gx,gyr_y=gy,gyr_z=gz,acc_x=ax,acc_y=ay,acc_z=az`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// The recording (`-`: standard input; `.gz` or gzip data read as such).

@@ -49,6 +49,12 @@ pub enum Frame {
 /// with one line on stderr naming the file and row of the first unusable sample
 /// (non-finite value, time not increasing, a time base whose steps are mostly such gaps:
 /// `t_s` in milliseconds).
+///
+/// Examples: `truenorth orientation --input imu.csv --output attitude.csv --status`;
+/// a logger's file in deg/s and g with x forward, y left, z up:
+/// `truenorth orientation --input log.csv.gz --output attitude.csv --gyro-unit deg/s
+/// --acc-unit g --axes flu --column t_s=time,gyr_x=gx,gyr_y=gy,gyr_z=gz` (run
+/// `truenorth inspect log.csv.gz` first to find the options).
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// Orientation method.

@@ -28,6 +28,8 @@ use truenorth::core::ned_to_enu;
 /// contains `undisturbed` belongs to the undisturbed group, every other to the disturbed
 /// group. Prints per-trial and per-group total, heading and inclination RMSE in degrees
 /// (with `--json`, one JSON document instead); progress goes to stderr.
+///
+/// Example: `truenorth eval broad ../shared/data/broad --method quaternion --no-mag`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// BROAD's folder or its `trials/` folder.
