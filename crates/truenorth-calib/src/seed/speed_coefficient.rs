@@ -21,9 +21,11 @@
 //! "filter distance constant" `T_C` relates the two without saying how).
 
 use serde::{Deserialize, Serialize};
+use truenorth_core::extended_float::check_plain_numbers_finite;
 use truenorth_core::{
-    Calibrator, FitQuality, OnlineCalibrator, Progress, Pushed, Result, ScalarQuality, Solution,
-    TimeStep, Validate, check_finite, check_positive, check_range, mph_to_mps, wrap_pi,
+    Calibrator, Error, FitQuality, OnlineCalibrator, Persistent, Progress, Pushed, Result,
+    ScalarQuality, Solution, TimeStep, Validate, check_finite, check_positive, check_range,
+    mph_to_mps, wrap_pi,
 };
 
 #[cfg(not(feature = "std"))]
@@ -123,7 +125,7 @@ pub struct SpeedStep {
 }
 
 /// Offsets `ψ_c − θ_w` of one window, relative to its first (so they stay unwrapped).
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
 struct Window {
     first: Option<f64>,
     start_s: f64,
@@ -170,15 +172,23 @@ impl Window {
     }
 }
 
-/// Where the refiner is in the cycle straight → turn → straight.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// Where the refiner is in the cycle straight → turn → straight. The offset before the turn
+/// is NaN when the before-window was not consistent (the turn is then waited out unused).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 enum Phase {
     /// Running straight: the before-window slides along.
     Straight,
     /// Turning, with the offset before the turn.
-    Turning { before: f64 },
+    Turning {
+        #[serde(with = "truenorth_core::extended_float::scalar")]
+        before: f64,
+    },
     /// Straight again, waiting out the settle time, then filling the after-window.
-    After { before: f64, straight_s: f64 },
+    After {
+        #[serde(with = "truenorth_core::extended_float::scalar")]
+        before: f64,
+        straight_s: f64,
+    },
 }
 
 /// The patent's adaptive refiner of `a`. Push allocates nothing.
@@ -440,5 +450,109 @@ impl Calibrator for SpeedCoefficientCalibrator {
 impl OnlineCalibrator for SpeedCoefficientCalibrator {
     fn estimate(&self) -> Option<Solution<f64, ScalarQuality>> {
         self.solve().ok()
+    }
+}
+
+/// The saved state of a [`SpeedCoefficientCalibrator`] ([`Persistent::State`]): its
+/// configuration, the coefficient learned and where the refiner is in its cycle.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct SpeedCoefficientState {
+    /// The configuration.
+    pub config: SpeedCoefficientConfig,
+    /// The current `a`, s²/m².
+    pub coefficient_s2_per_m2: f64,
+    /// The last accepted timestamp.
+    pub clock: TimeStep,
+    /// The wheels' heading summed since the start, rad.
+    pub wheel_heading_rad: f64,
+    /// The low-passed wheel heading rate, rad/s.
+    pub rate_rps: f64,
+    /// The wheels' heading change over the turn in progress, rad.
+    pub turn_rad: f64,
+    /// Sum of the speeds over the turn in progress, m/s.
+    pub turn_speed_sum_mps: f64,
+    /// Steps of the turn in progress.
+    pub turn_steps: u32,
+    /// Turns that have refined `a`.
+    pub updates: usize,
+    /// Steps taken.
+    pub steps: usize,
+    /// Sum of the squared clamped errors of those turns, rad².
+    pub error_sq_sum_rad2: f64,
+    /// Straight, turning or after a turn (opaque).
+    phase: Phase,
+    /// The compass window filling now (opaque).
+    window: Window,
+    /// The window before it on the same straight (opaque).
+    earlier: Window,
+}
+
+/// Refuses a window whose count and first offset disagree, or whose sums could not come
+/// from its readings.
+fn check_window(w: &Window) -> Result<()> {
+    if (w.n > 0) != w.first.is_some() || w.sum_sq < 0.0 {
+        return Err(Error::InvalidSnapshot {
+            reason: "a speed-coefficient compass window is inconsistent",
+        });
+    }
+    Ok(())
+}
+
+impl Persistent for SpeedCoefficientCalibrator {
+    type State = SpeedCoefficientState;
+    const SNAPSHOT_VERSION: u32 = 1;
+
+    fn state(&self) -> SpeedCoefficientState {
+        SpeedCoefficientState {
+            config: self.config,
+            coefficient_s2_per_m2: self.a,
+            clock: self.clock,
+            wheel_heading_rad: self.wheel_heading,
+            rate_rps: self.rate_rps,
+            turn_rad: self.turn_rad,
+            turn_speed_sum_mps: self.turn_speed_sum,
+            turn_steps: self.turn_steps,
+            updates: self.updates,
+            steps: self.steps,
+            error_sq_sum_rad2: self.error_sq_sum,
+            phase: self.phase,
+            window: self.window,
+            earlier: self.earlier,
+        }
+    }
+
+    fn from_state(s: SpeedCoefficientState) -> Result<Self> {
+        s.config.validate()?;
+        check_plain_numbers_finite(&s)?;
+        let invalid = |reason| Err(Error::InvalidSnapshot { reason });
+        if let Phase::Turning { before } | Phase::After { before, .. } = s.phase
+            && before.is_infinite()
+        {
+            return invalid("the offset saved before a turn is infinite");
+        }
+        if s.updates > s.steps || (s.steps > 0) != s.clock.last_s().is_some() {
+            return invalid("the speed-coefficient counts do not fit together");
+        }
+        if s.error_sq_sum_rad2 < 0.0 {
+            return invalid("the speed-coefficient sum of squared errors is negative");
+        }
+        check_window(&s.window)?;
+        check_window(&s.earlier)?;
+        Ok(Self {
+            config: s.config,
+            a: s.coefficient_s2_per_m2,
+            clock: s.clock,
+            wheel_heading: s.wheel_heading_rad,
+            rate_rps: s.rate_rps,
+            phase: s.phase,
+            window: s.window,
+            earlier: s.earlier,
+            turn_rad: s.turn_rad,
+            turn_speed_sum: s.turn_speed_sum_mps,
+            turn_steps: s.turn_steps,
+            updates: s.updates,
+            steps: s.steps,
+            error_sq_sum: s.error_sq_sum_rad2,
+        })
     }
 }
