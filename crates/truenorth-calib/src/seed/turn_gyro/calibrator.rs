@@ -221,6 +221,11 @@ impl TurnCalibrator {
         }
     }
 
+    /// The configuration in use.
+    pub fn config(&self) -> &TurnConfig {
+        &self.config
+    }
+
     /// The gyro's zero reading (rad/s), its standard deviation and the standstill's length
     /// (s), once the turn's swing has shown where the standstill ended.
     pub fn zero(&self) -> Option<(f64, f64, f64)> {
