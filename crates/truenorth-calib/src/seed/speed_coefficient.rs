@@ -299,6 +299,95 @@ impl SpeedCoefficientCalibrator {
         self.updates += 1;
         self.error_sq_sum += clamped * clamped;
     }
+    /// Low-passes the wheels' heading rate over a step of `dt` s; true while it says the
+    /// vehicle turns.
+    fn turning(&mut self, step: &SpeedStep, dt: f64) -> bool {
+        let c = &self.config;
+        let alpha = if c.rate_smoothing_s > 0.0 {
+            (dt / c.rate_smoothing_s).min(1.0)
+        } else {
+            1.0
+        };
+        self.rate_rps += alpha * (step.wheel_heading_change_rad / dt - self.rate_rps);
+        self.rate_rps.abs() >= c.turn_rate_dps.to_radians()
+    }
+
+    /// Running straight: a turn starts, or the before-window slides along.
+    fn straight(&mut self, step: &SpeedStep, offset: Option<f64>, turning: bool) {
+        let c = self.config;
+        if turning {
+            // The before-window must be full and consistent, else the turn is not
+            // used (but still waited out).
+            let before = self
+                .window
+                .merged(&self.earlier)
+                .filter(|&(_, s)| s <= c.max_spread_deg.to_radians())
+                .map_or(f64::NAN, |(m, _)| m);
+            self.phase = Phase::Turning { before };
+            self.turn_rad = step.wheel_heading_change_rad;
+            self.turn_speed_sum = step.speed_mps;
+            self.turn_steps = 1;
+        } else {
+            if step.t_s - self.window.start_s > 0.5 * c.window_s {
+                self.earlier = self.window;
+                self.window = Window::default();
+            }
+            if let Some(o) = offset {
+                self.window.push(step.t_s, o);
+            }
+        }
+    }
+
+    /// Turning: the turn grows, until the wheels run straight again.
+    fn turn(&mut self, step: &SpeedStep, dt: f64, before: f64, turning: bool) {
+        self.turn_rad += step.wheel_heading_change_rad;
+        self.turn_speed_sum += step.speed_mps;
+        self.turn_steps += 1;
+        if !turning {
+            self.phase = Phase::After {
+                before,
+                straight_s: dt,
+            };
+            self.window = Window::default();
+            self.earlier = Window::default();
+        }
+    }
+
+    /// Straight again after a turn, for `straight_s`: turning again makes one longer turn;
+    /// otherwise the after-window fills once settled, and when full the turn is finished.
+    fn after(
+        &mut self,
+        step: &SpeedStep,
+        offset: Option<f64>,
+        before: f64,
+        straight_s: f64,
+        turning: bool,
+    ) {
+        let c = self.config;
+        if turning {
+            // Turning again before the after-window filled: one longer turn.
+            self.phase = Phase::Turning { before };
+            self.turn_rad += step.wheel_heading_change_rad;
+            self.turn_speed_sum += step.speed_mps;
+            self.turn_steps += 1;
+            return;
+        }
+        self.phase = Phase::After { before, straight_s };
+        if let (true, Some(o)) = (straight_s > c.settle_s, offset) {
+            self.window.push(step.t_s, o);
+        }
+        if straight_s > c.settle_s + c.window_s {
+            let after = self
+                .window
+                .mean_spread()
+                .filter(|&(_, s)| s <= c.max_spread_deg.to_radians());
+            if let (Some((after, _)), true) = (after, before.is_finite()) {
+                self.finish_turn(before, after);
+            }
+            // The after-window is the next turn's before-window.
+            self.phase = Phase::Straight;
+        }
+    }
 }
 
 impl Calibrator for SpeedCoefficientCalibrator {
@@ -328,77 +417,13 @@ impl Calibrator for SpeedCoefficientCalibrator {
             }
             return Ok(Pushed::Accepted);
         };
-        let c = self.config;
-        let alpha = if c.rate_smoothing_s > 0.0 {
-            (dt / c.rate_smoothing_s).min(1.0)
-        } else {
-            1.0
-        };
-        self.rate_rps += alpha * (step.wheel_heading_change_rad / dt - self.rate_rps);
-        let turning = self.rate_rps.abs() >= c.turn_rate_dps.to_radians();
+        let turning = self.turning(step, dt);
         let before_updates = self.updates;
         match self.phase {
-            Phase::Straight => {
-                if turning {
-                    // The before-window must be full and consistent, else the turn is not
-                    // used (but still waited out).
-                    let before = self
-                        .window
-                        .merged(&self.earlier)
-                        .filter(|&(_, s)| s <= c.max_spread_deg.to_radians())
-                        .map_or(f64::NAN, |(m, _)| m);
-                    self.phase = Phase::Turning { before };
-                    self.turn_rad = step.wheel_heading_change_rad;
-                    self.turn_speed_sum = step.speed_mps;
-                    self.turn_steps = 1;
-                } else {
-                    if step.t_s - self.window.start_s > 0.5 * c.window_s {
-                        self.earlier = self.window;
-                        self.window = Window::default();
-                    }
-                    if let Some(o) = offset {
-                        self.window.push(step.t_s, o);
-                    }
-                }
-            }
-            Phase::Turning { before } => {
-                self.turn_rad += step.wheel_heading_change_rad;
-                self.turn_speed_sum += step.speed_mps;
-                self.turn_steps += 1;
-                if !turning {
-                    self.phase = Phase::After {
-                        before,
-                        straight_s: dt,
-                    };
-                    self.window = Window::default();
-                    self.earlier = Window::default();
-                }
-            }
+            Phase::Straight => self.straight(step, offset, turning),
+            Phase::Turning { before } => self.turn(step, dt, before, turning),
             Phase::After { before, straight_s } => {
-                if turning {
-                    // Turning again before the after-window filled: one longer turn.
-                    self.phase = Phase::Turning { before };
-                    self.turn_rad += step.wheel_heading_change_rad;
-                    self.turn_speed_sum += step.speed_mps;
-                    self.turn_steps += 1;
-                } else {
-                    let straight_s = straight_s + dt;
-                    self.phase = Phase::After { before, straight_s };
-                    if let (true, Some(o)) = (straight_s > c.settle_s, offset) {
-                        self.window.push(step.t_s, o);
-                    }
-                    if straight_s > c.settle_s + c.window_s {
-                        let after = self
-                            .window
-                            .mean_spread()
-                            .filter(|&(_, s)| s <= c.max_spread_deg.to_radians());
-                        if let (Some((after, _)), true) = (after, before.is_finite()) {
-                            self.finish_turn(before, after);
-                        }
-                        // The after-window is the next turn's before-window.
-                        self.phase = Phase::Straight;
-                    }
-                }
+                self.after(step, offset, before, straight_s + dt, turning)
             }
         }
         Ok(if self.updates > before_updates {
