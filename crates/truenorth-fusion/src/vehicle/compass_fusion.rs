@@ -2,7 +2,7 @@
 //! online calibration, averaged into heading corrections, and the first run of consistent
 //! readings referring the heading and the track to north.
 
-use nalgebra::SMatrix;
+use nalgebra::{SMatrix, Vector2};
 use truenorth_core::{VehicleSample, wrap_pi};
 
 use super::compass_learning::Judged;
@@ -103,42 +103,7 @@ impl VehicleEstimator {
             Some((u, ratio))
                 if self.tracking.alignment.done && !self.tracking.alignment.relocking =>
             {
-                // Innovation: the angle from the predicted reading's direction to the
-                // reading's, without an arctangent per reading when it is small.
-                let f = &self.filter;
-                let (sp, cp) = self
-                    .tracking
-                    .trig_compass
-                    .at(self.heading_at(sample.t_s) + f.x[COMPASS_BIAS]);
-                let nu = small_atan2(-u.y * cp - u.x * sp, u.x * cp - u.y * sp);
-                let p_nu = f.p[PSI][PSI]
-                    + 2.0 * f.p[PSI][COMPASS_BIAS]
-                    + f.p[COMPASS_BIAS][COMPASS_BIAS]
-                    + self.tracking.batch.psi_noise();
-                let verdict = self.compass.judge(sample.t_s, nu, ratio, p_nu);
-                let used = matches!(verdict, Verdict::Use { .. });
-                if let Verdict::Use { variance_rad2 } = verdict {
-                    self.take_compass(nu, variance_rad2);
-                }
-                let noise = self.compass.fix().map_or(0.0, |f| f.noise_rad);
-                match self
-                    .tracking
-                    .outage
-                    .count(sample.t_s, self.filter.x[PSI], nu, noise, used)
-                {
-                    Suspect::None => {}
-                    Suspect::Calibration => self.learner.relearn(),
-                    Suspect::DeadReckoning {
-                        offset_rad,
-                        sigma_rad,
-                    } => self.relock(offset_rad, sigma_rad),
-                }
-
-                match (self.tracking.outage.relearning, used) {
-                    (true, _) => Judged::Unjudged,
-                    (false, true) => Judged::Gated,
-                    (false, false) => Judged::Rejected,
-                }
+                self.judge_reading(sample.t_s, &u, ratio)
             }
             Some((u, ratio)) => {
                 if self.compass.field_ok(ratio) {
@@ -149,27 +114,71 @@ impl VehicleEstimator {
             }
             None => Judged::Unjudged,
         };
-        let learn = sample.t_s > self.tracking.learned_until_s;
-        if let Some(s) = learn
-            .then(|| {
-                self.learner
-                    .offer(&raw, sample.t_s, self.filter.x[PSI], judged)
-            })
-            .flatten()
-        {
-            self.compass.set_fix(CompassFix::from_solution(&s));
-            self.tracking.outage = Outage::default();
-            // A new calibration makes a new systematic error, and the averaged
-            // innovations were taken against the old one.
-            self.compass.restart_gates();
-            self.flush();
-            self.tracking.window = CompassWindow::default();
-            self.filter.x[COMPASS_BIAS] = 0.0;
-            self.filter
-                .reset_state(COMPASS_BIAS, self.compass_bias_var().sqrt());
+        if sample.t_s > self.tracking.learned_until_s {
+            self.learn_compass(&raw, sample.t_s, judged);
         }
         self.est.status.compass_calibrated = self.compass.fix().is_some();
         self.est.status.compass_disturbed = self.compass.disturbed();
+    }
+
+    /// A calibrated reading `u` (field ratio `ratio`) at `t_s`, once the heading is referred
+    /// to north: its innovation judged by the gates, used if they pass it, counted against
+    /// the outage; returns what the gates said, for the learner.
+    fn judge_reading(&mut self, t_s: f64, u: &Vector2<f64>, ratio: f64) -> Judged {
+        // Innovation: the angle from the predicted reading's direction to the
+        // reading's, without an arctangent per reading when it is small.
+        let f = &self.filter;
+        let (sp, cp) = self
+            .tracking
+            .trig_compass
+            .at(self.heading_at(t_s) + f.x[COMPASS_BIAS]);
+        let nu = small_atan2(-u.y * cp - u.x * sp, u.x * cp - u.y * sp);
+        let p_nu = f.p[PSI][PSI]
+            + 2.0 * f.p[PSI][COMPASS_BIAS]
+            + f.p[COMPASS_BIAS][COMPASS_BIAS]
+            + self.tracking.batch.psi_noise();
+        let verdict = self.compass.judge(t_s, nu, ratio, p_nu);
+        let used = matches!(verdict, Verdict::Use { .. });
+        if let Verdict::Use { variance_rad2 } = verdict {
+            self.take_compass(nu, variance_rad2);
+        }
+        let noise = self.compass.fix().map_or(0.0, |f| f.noise_rad);
+        match self
+            .tracking
+            .outage
+            .count(t_s, self.filter.x[PSI], nu, noise, used)
+        {
+            Suspect::None => {}
+            Suspect::Calibration => self.learner.relearn(),
+            Suspect::DeadReckoning {
+                offset_rad,
+                sigma_rad,
+            } => self.relock(offset_rad, sigma_rad),
+        }
+
+        match (self.tracking.outage.relearning, used) {
+            (true, _) => Judged::Unjudged,
+            (false, true) => Judged::Gated,
+            (false, false) => Judged::Rejected,
+        }
+    }
+
+    /// Offers the raw reading to the compass learner; a new calibration from it replaces
+    /// the one in use and starts the compass's gates and bias over.
+    fn learn_compass(&mut self, raw: &Vector2<f64>, t_s: f64, judged: Judged) {
+        let Some(s) = self.learner.offer(raw, t_s, self.filter.x[PSI], judged) else {
+            return;
+        };
+        self.compass.set_fix(CompassFix::from_solution(&s));
+        self.tracking.outage = Outage::default();
+        // A new calibration makes a new systematic error, and the averaged
+        // innovations were taken against the old one.
+        self.compass.restart_gates();
+        self.flush();
+        self.tracking.window = CompassWindow::default();
+        self.filter.x[COMPASS_BIAS] = 0.0;
+        self.filter
+            .reset_state(COMPASS_BIAS, self.compass_bias_var().sqrt());
     }
 
     /// Adds a reading's innovation to the window; a full window corrects the heading once.
