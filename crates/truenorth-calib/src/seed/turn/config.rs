@@ -6,7 +6,8 @@ use truenorth_core::{Result, Validate, check_positive, check_range};
 use crate::quality::MIN_ARC_DEG;
 use crate::seed::extrema::ExtremaConfig;
 
-/// Configuration of the [`TurnCompassCalibrator`] (defaults in brackets).
+/// Configuration of the [`TurnCompassCalibrator`](crate::TurnCompassCalibrator) (defaults in
+/// brackets).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct TurnConfig {
@@ -17,7 +18,8 @@ pub struct TurnConfig {
     pub min_arc_deg: f64,
     /// Longest step between two samples, seconds, > 0, that the gyro half
     /// ([`crate::TurnCalibrator`]) integrates its rate across ([`DEFAULT_MAX_GAP_S`]); a
-    /// longer one is refused with [`Error::TimeGap`]. The compass half reads no time.
+    /// longer one is refused with [`Error::TimeGap`](truenorth_core::Error::TimeGap). The
+    /// compass half reads no time.
     pub max_gap_s: f64,
 }
 
