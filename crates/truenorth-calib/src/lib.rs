@@ -112,13 +112,16 @@ pub use seed::merit_circle::{
     MERIT_CIRCLE_MIN_ARC_DEG, MeritCircleCalibrator, MeritCircleConfig, MeritCircleSaved,
     MeritCircleState, RING,
 };
-pub use seed::speed_coefficient::{SpeedCoefficientCalibrator, SpeedCoefficientConfig, SpeedStep};
+pub use seed::speed_coefficient::{
+    SpeedCoefficientCalibrator, SpeedCoefficientConfig, SpeedCoefficientState, SpeedStep,
+};
 pub use seed::turn::{
     DEFAULT_MAX_GAP_S, MIN_TURN_SAMPLES, TurnCompassCalibrator, TurnConfig, TurnEllipse,
     TurnExtrema, TurnExtremaSaved, TurnSaved, TurnTag,
 };
 pub use seed::turn_gyro::{
-    MIN_REST_S, RawHeading, TurnCalibration, TurnCalibrator, TurnQuality, TurnSample,
+    MIN_REST_S, RawHeading, TurnCalibration, TurnCalibrator, TurnCalibratorState, TurnQuality,
+    TurnSample,
 };
 
 /// The code blocks of the crate's README, compiled and run as doctests.

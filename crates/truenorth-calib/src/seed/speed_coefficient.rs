@@ -21,9 +21,11 @@
 //! "filter distance constant" `T_C` relates the two without saying how).
 
 use serde::{Deserialize, Serialize};
+use truenorth_core::extended_float::check_plain_numbers_finite;
 use truenorth_core::{
-    Calibrator, FitQuality, OnlineCalibrator, Progress, Pushed, Result, ScalarQuality, Solution,
-    TimeStep, Validate, check_finite, check_positive, check_range, mph_to_mps, wrap_pi,
+    Calibrator, Error, FitQuality, OnlineCalibrator, Persistent, Progress, Pushed, Result,
+    ScalarQuality, Solution, TimeStep, Validate, check_finite, check_positive, check_range,
+    mph_to_mps, wrap_pi,
 };
 
 #[cfg(not(feature = "std"))]
@@ -123,7 +125,7 @@ pub struct SpeedStep {
 }
 
 /// Offsets `ψ_c − θ_w` of one window, relative to its first (so they stay unwrapped).
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
 struct Window {
     first: Option<f64>,
     start_s: f64,
@@ -170,15 +172,23 @@ impl Window {
     }
 }
 
-/// Where the refiner is in the cycle straight → turn → straight.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// Where the refiner is in the cycle straight → turn → straight. The offset before the turn
+/// is NaN when the before-window was not consistent (the turn is then waited out unused).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 enum Phase {
     /// Running straight: the before-window slides along.
     Straight,
     /// Turning, with the offset before the turn.
-    Turning { before: f64 },
+    Turning {
+        #[serde(with = "truenorth_core::extended_float::scalar")]
+        before: f64,
+    },
     /// Straight again, waiting out the settle time, then filling the after-window.
-    After { before: f64, straight_s: f64 },
+    After {
+        #[serde(with = "truenorth_core::extended_float::scalar")]
+        before: f64,
+        straight_s: f64,
+    },
 }
 
 /// The patent's adaptive refiner of `a`. Push allocates nothing.
@@ -289,6 +299,95 @@ impl SpeedCoefficientCalibrator {
         self.updates += 1;
         self.error_sq_sum += clamped * clamped;
     }
+    /// Low-passes the wheels' heading rate over a step of `dt` s; true while it says the
+    /// vehicle turns.
+    fn turning(&mut self, step: &SpeedStep, dt: f64) -> bool {
+        let c = &self.config;
+        let alpha = if c.rate_smoothing_s > 0.0 {
+            (dt / c.rate_smoothing_s).min(1.0)
+        } else {
+            1.0
+        };
+        self.rate_rps += alpha * (step.wheel_heading_change_rad / dt - self.rate_rps);
+        self.rate_rps.abs() >= c.turn_rate_dps.to_radians()
+    }
+
+    /// Running straight: a turn starts, or the before-window slides along.
+    fn straight(&mut self, step: &SpeedStep, offset: Option<f64>, turning: bool) {
+        let c = self.config;
+        if turning {
+            // The before-window must be full and consistent, else the turn is not
+            // used (but still waited out).
+            let before = self
+                .window
+                .merged(&self.earlier)
+                .filter(|&(_, s)| s <= c.max_spread_deg.to_radians())
+                .map_or(f64::NAN, |(m, _)| m);
+            self.phase = Phase::Turning { before };
+            self.turn_rad = step.wheel_heading_change_rad;
+            self.turn_speed_sum = step.speed_mps;
+            self.turn_steps = 1;
+        } else {
+            if step.t_s - self.window.start_s > 0.5 * c.window_s {
+                self.earlier = self.window;
+                self.window = Window::default();
+            }
+            if let Some(o) = offset {
+                self.window.push(step.t_s, o);
+            }
+        }
+    }
+
+    /// Turning: the turn grows, until the wheels run straight again.
+    fn turn(&mut self, step: &SpeedStep, dt: f64, before: f64, turning: bool) {
+        self.turn_rad += step.wheel_heading_change_rad;
+        self.turn_speed_sum += step.speed_mps;
+        self.turn_steps += 1;
+        if !turning {
+            self.phase = Phase::After {
+                before,
+                straight_s: dt,
+            };
+            self.window = Window::default();
+            self.earlier = Window::default();
+        }
+    }
+
+    /// Straight again after a turn, for `straight_s`: turning again makes one longer turn;
+    /// otherwise the after-window fills once settled, and when full the turn is finished.
+    fn after(
+        &mut self,
+        step: &SpeedStep,
+        offset: Option<f64>,
+        before: f64,
+        straight_s: f64,
+        turning: bool,
+    ) {
+        let c = self.config;
+        if turning {
+            // Turning again before the after-window filled: one longer turn.
+            self.phase = Phase::Turning { before };
+            self.turn_rad += step.wheel_heading_change_rad;
+            self.turn_speed_sum += step.speed_mps;
+            self.turn_steps += 1;
+            return;
+        }
+        self.phase = Phase::After { before, straight_s };
+        if let (true, Some(o)) = (straight_s > c.settle_s, offset) {
+            self.window.push(step.t_s, o);
+        }
+        if straight_s > c.settle_s + c.window_s {
+            let after = self
+                .window
+                .mean_spread()
+                .filter(|&(_, s)| s <= c.max_spread_deg.to_radians());
+            if let (Some((after, _)), true) = (after, before.is_finite()) {
+                self.finish_turn(before, after);
+            }
+            // The after-window is the next turn's before-window.
+            self.phase = Phase::Straight;
+        }
+    }
 }
 
 impl Calibrator for SpeedCoefficientCalibrator {
@@ -318,77 +417,13 @@ impl Calibrator for SpeedCoefficientCalibrator {
             }
             return Ok(Pushed::Accepted);
         };
-        let c = self.config;
-        let alpha = if c.rate_smoothing_s > 0.0 {
-            (dt / c.rate_smoothing_s).min(1.0)
-        } else {
-            1.0
-        };
-        self.rate_rps += alpha * (step.wheel_heading_change_rad / dt - self.rate_rps);
-        let turning = self.rate_rps.abs() >= c.turn_rate_dps.to_radians();
+        let turning = self.turning(step, dt);
         let before_updates = self.updates;
         match self.phase {
-            Phase::Straight => {
-                if turning {
-                    // The before-window must be full and consistent, else the turn is not
-                    // used (but still waited out).
-                    let before = self
-                        .window
-                        .merged(&self.earlier)
-                        .filter(|&(_, s)| s <= c.max_spread_deg.to_radians())
-                        .map_or(f64::NAN, |(m, _)| m);
-                    self.phase = Phase::Turning { before };
-                    self.turn_rad = step.wheel_heading_change_rad;
-                    self.turn_speed_sum = step.speed_mps;
-                    self.turn_steps = 1;
-                } else {
-                    if step.t_s - self.window.start_s > 0.5 * c.window_s {
-                        self.earlier = self.window;
-                        self.window = Window::default();
-                    }
-                    if let Some(o) = offset {
-                        self.window.push(step.t_s, o);
-                    }
-                }
-            }
-            Phase::Turning { before } => {
-                self.turn_rad += step.wheel_heading_change_rad;
-                self.turn_speed_sum += step.speed_mps;
-                self.turn_steps += 1;
-                if !turning {
-                    self.phase = Phase::After {
-                        before,
-                        straight_s: dt,
-                    };
-                    self.window = Window::default();
-                    self.earlier = Window::default();
-                }
-            }
+            Phase::Straight => self.straight(step, offset, turning),
+            Phase::Turning { before } => self.turn(step, dt, before, turning),
             Phase::After { before, straight_s } => {
-                if turning {
-                    // Turning again before the after-window filled: one longer turn.
-                    self.phase = Phase::Turning { before };
-                    self.turn_rad += step.wheel_heading_change_rad;
-                    self.turn_speed_sum += step.speed_mps;
-                    self.turn_steps += 1;
-                } else {
-                    let straight_s = straight_s + dt;
-                    self.phase = Phase::After { before, straight_s };
-                    if let (true, Some(o)) = (straight_s > c.settle_s, offset) {
-                        self.window.push(step.t_s, o);
-                    }
-                    if straight_s > c.settle_s + c.window_s {
-                        let after = self
-                            .window
-                            .mean_spread()
-                            .filter(|&(_, s)| s <= c.max_spread_deg.to_radians());
-                        if let (Some((after, _)), true) = (after, before.is_finite()) {
-                            self.finish_turn(before, after);
-                        }
-                        // The after-window is the next turn's before-window.
-                        self.phase = Phase::Straight;
-                    }
-                }
+                self.after(step, offset, before, straight_s + dt, turning)
             }
         }
         Ok(if self.updates > before_updates {
@@ -440,5 +475,109 @@ impl Calibrator for SpeedCoefficientCalibrator {
 impl OnlineCalibrator for SpeedCoefficientCalibrator {
     fn estimate(&self) -> Option<Solution<f64, ScalarQuality>> {
         self.solve().ok()
+    }
+}
+
+/// The saved state of a [`SpeedCoefficientCalibrator`] ([`Persistent::State`]): its
+/// configuration, the coefficient learned and where the refiner is in its cycle.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct SpeedCoefficientState {
+    /// The configuration.
+    pub config: SpeedCoefficientConfig,
+    /// The current `a`, s²/m².
+    pub coefficient_s2_per_m2: f64,
+    /// The last accepted timestamp.
+    pub clock: TimeStep,
+    /// The wheels' heading summed since the start, rad.
+    pub wheel_heading_rad: f64,
+    /// The low-passed wheel heading rate, rad/s.
+    pub rate_rps: f64,
+    /// The wheels' heading change over the turn in progress, rad.
+    pub turn_rad: f64,
+    /// Sum of the speeds over the turn in progress, m/s.
+    pub turn_speed_sum_mps: f64,
+    /// Steps of the turn in progress.
+    pub turn_steps: u32,
+    /// Turns that have refined `a`.
+    pub updates: usize,
+    /// Steps taken.
+    pub steps: usize,
+    /// Sum of the squared clamped errors of those turns, rad².
+    pub error_sq_sum_rad2: f64,
+    /// Straight, turning or after a turn (opaque).
+    phase: Phase,
+    /// The compass window filling now (opaque).
+    window: Window,
+    /// The window before it on the same straight (opaque).
+    earlier: Window,
+}
+
+/// Refuses a window whose count and first offset disagree, or whose sums could not come
+/// from its readings.
+fn check_window(w: &Window) -> Result<()> {
+    if (w.n > 0) != w.first.is_some() || w.sum_sq < 0.0 {
+        return Err(Error::InvalidSnapshot {
+            reason: "a speed-coefficient compass window is inconsistent",
+        });
+    }
+    Ok(())
+}
+
+impl Persistent for SpeedCoefficientCalibrator {
+    type State = SpeedCoefficientState;
+    const SNAPSHOT_VERSION: u32 = 1;
+
+    fn state(&self) -> SpeedCoefficientState {
+        SpeedCoefficientState {
+            config: self.config,
+            coefficient_s2_per_m2: self.a,
+            clock: self.clock,
+            wheel_heading_rad: self.wheel_heading,
+            rate_rps: self.rate_rps,
+            turn_rad: self.turn_rad,
+            turn_speed_sum_mps: self.turn_speed_sum,
+            turn_steps: self.turn_steps,
+            updates: self.updates,
+            steps: self.steps,
+            error_sq_sum_rad2: self.error_sq_sum,
+            phase: self.phase,
+            window: self.window,
+            earlier: self.earlier,
+        }
+    }
+
+    fn from_state(s: SpeedCoefficientState) -> Result<Self> {
+        s.config.validate()?;
+        check_plain_numbers_finite(&s)?;
+        let invalid = |reason| Err(Error::InvalidSnapshot { reason });
+        if let Phase::Turning { before } | Phase::After { before, .. } = s.phase
+            && before.is_infinite()
+        {
+            return invalid("the offset saved before a turn is infinite");
+        }
+        if s.updates > s.steps || (s.steps > 0) != s.clock.last_s().is_some() {
+            return invalid("the speed-coefficient counts do not fit together");
+        }
+        if s.error_sq_sum_rad2 < 0.0 {
+            return invalid("the speed-coefficient sum of squared errors is negative");
+        }
+        check_window(&s.window)?;
+        check_window(&s.earlier)?;
+        Ok(Self {
+            config: s.config,
+            a: s.coefficient_s2_per_m2,
+            clock: s.clock,
+            wheel_heading: s.wheel_heading_rad,
+            rate_rps: s.rate_rps,
+            phase: s.phase,
+            window: s.window,
+            earlier: s.earlier,
+            turn_rad: s.turn_rad,
+            turn_speed_sum: s.turn_speed_sum_mps,
+            turn_steps: s.turn_steps,
+            updates: s.updates,
+            steps: s.steps,
+            error_sq_sum: s.error_sq_sum_rad2,
+        })
     }
 }

@@ -1,7 +1,7 @@
 //! `truenorth heading`: apply a compass calibration to a recording and write the heading,
 //! tilt-compensated when the recording has the accelerometer and the calibration is 3-D.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use nalgebra::{Vector2, Vector3};
 use truenorth::accel::static_tilt;
@@ -10,7 +10,7 @@ use truenorth::core::{Declination, MagneticHeading, Tilt, rad_to_deg};
 use super::field::Place;
 use crate::io::{
     CalibrationFile, CliError, CliResult, CompassCalibration, CsvOutput, InputOptions, InputPath,
-    ReadSpec, RowReader, check_distinct,
+    ReadSpec, Row, RowReader, check_distinct,
 };
 
 /// The long help of the command (after the options).
@@ -74,46 +74,110 @@ const ACC: [&str; 3] = ["acc_x", "acc_y", "acc_z"];
 
 /// Runs the subcommand.
 pub fn run(args: &Args) -> CliResult {
-    check_distinct(&args.output, &[&args.input, &args.calibration])?;
-    if args.input.as_os_str() == "-" && args.calibration.as_os_str() == "-" {
-        return Err(CliError::msg(
-            "heading: --input and --calibration cannot both be standard input",
-        ));
-    }
+    check_inputs(args)?;
     let (_, cal) = CalibrationFile::read(&args.calibration)?;
     let declination = declination(args)?;
-    let (needed, optional): (&[&str], &[&str]) = match cal {
-        CompassCalibration::TwoD(_) => (&["t_s", "mag_x", "mag_y"], &[]),
-        _ => (&["t_s", "mag_x", "mag_y", "mag_z"], &ACC),
-    };
+    let (needed, optional) = columns_read(&cal);
     let spec = ReadSpec::new(needed).optional(optional).increasing("t_s");
     let mut rows = RowReader::open(&InputPath::new(&args.input), &args.input_options, &spec)?;
-    let ix = |n: &str| rows.index(n).unwrap_or(0);
-    let (t, x, y) = (ix("t_s"), ix("mag_x"), ix("mag_y"));
-    let z = rows.index("mag_z");
-    let acc = match ACC.map(|n| rows.index(n)) {
-        [Some(a), Some(b), Some(c)] => Some([a, b, c]),
-        [None, None, None] => None,
-        _ => {
-            return Err(CliError::row(
-                rows.path(),
-                1,
-                "the input has some of acc_x, acc_y, acc_z but not all three; give all three for tilt compensation, or none to assume a level sensor",
-            ));
-        }
-    };
+    let cols = Columns::locate(&rows)?;
     let mut header = vec!["t_s", "heading_deg"];
-    if acc.is_some() {
+    if cols.acc.is_some() {
         header.extend(["pitch_deg", "roll_deg"]);
     }
     let mut out = CsvOutput::create(&args.output, &header)?;
     let mut count = 0usize;
     let path = rows.path().to_path_buf();
     while let Some(row) = rows.next_row()? {
-        let mag3 = || Vector3::new(row[x], row[y], z.map_or(f64::NAN, |z| row[z]));
-        let acc3 = acc.map(|[a, b, c]| Vector3::new(row[a], row[b], row[c]));
-        let bad = |e: truenorth::core::Error| CliError::row(&path, row.number, e.to_string());
-        let (magnetic, tilt): (MagneticHeading, Option<Tilt>) = match (&cal, acc3) {
+        let (magnetic, tilt) = cols.heading(&cal, row, &path)?;
+        let rad = match declination {
+            Some(d) => magnetic.to_true(d).rad(),
+            None => magnetic.rad(),
+        };
+        write_row(&mut out, row[cols.t], rad, tilt)?;
+        count += 1;
+    }
+    if count == 0 {
+        return Err(CliError::row(&path, 2, "no data rows after the header"));
+    }
+    out.commit()?;
+    let north = if declination.is_some() {
+        "true"
+    } else {
+        "magnetic"
+    };
+    let how = tilt_summary(&cal, cols.acc.is_some());
+    eprintln!("truenorth: heading: {count} rows, {north} north, {how}");
+    Ok(())
+}
+
+/// Refuses an output that is one of the inputs, and two inputs on standard input.
+fn check_inputs(args: &Args) -> CliResult {
+    check_distinct(&args.output, &[&args.input, &args.calibration])?;
+    if args.input.as_os_str() == "-" && args.calibration.as_os_str() == "-" {
+        return Err(CliError::msg(
+            "heading: --input and --calibration cannot both be standard input",
+        ));
+    }
+    Ok(())
+}
+
+/// The columns a calibration needs, and those it reads if present.
+fn columns_read(cal: &CompassCalibration) -> (&'static [&'static str], &'static [&'static str]) {
+    match cal {
+        CompassCalibration::TwoD(_) => (&["t_s", "mag_x", "mag_y"], &[]),
+        _ => (&["t_s", "mag_x", "mag_y", "mag_z"], &ACC),
+    }
+}
+
+/// Where the columns are in a row.
+struct Columns {
+    t: usize,
+    x: usize,
+    y: usize,
+    z: Option<usize>,
+    acc: Option<[usize; 3]>,
+}
+
+impl Columns {
+    /// Finds the columns; refuses an input with some of the accelerometer's but not all.
+    fn locate(rows: &RowReader) -> CliResult<Self> {
+        let ix = |n: &str| rows.index(n).unwrap_or(0);
+        let acc = match ACC.map(|n| rows.index(n)) {
+            [Some(a), Some(b), Some(c)] => Some([a, b, c]),
+            [None, None, None] => None,
+            _ => {
+                return Err(CliError::row(
+                    rows.path(),
+                    1,
+                    "the input has some of acc_x, acc_y, acc_z but not all three; give all three for tilt compensation, or none to assume a level sensor",
+                ));
+            }
+        };
+        Ok(Self {
+            t: ix("t_s"),
+            x: ix("mag_x"),
+            y: ix("mag_y"),
+            z: rows.index("mag_z"),
+            acc,
+        })
+    }
+
+    /// The magnetic heading of one row under `cal`, and the tilt when the accelerometer
+    /// gives it; a row the calibration cannot use is an error naming it.
+    fn heading(
+        &self,
+        cal: &CompassCalibration,
+        row: &Row,
+        path: &Path,
+    ) -> CliResult<(MagneticHeading, Option<Tilt>)> {
+        let (x, y) = (self.x, self.y);
+        let mag3 = || Vector3::new(row[x], row[y], self.z.map_or(f64::NAN, |z| row[z]));
+        let acc3 = self
+            .acc
+            .map(|[a, b, c]| Vector3::new(row[a], row[b], row[c]));
+        let bad = |e: truenorth::core::Error| CliError::row(path, row.number, e.to_string());
+        Ok(match (cal, acc3) {
             (CompassCalibration::TwoD(c), _) => {
                 (c.magnetic_heading(&Vector2::new(row[x], row[y])), None)
             }
@@ -136,32 +200,26 @@ pub fn run(args: &Args) -> CliResult {
                 );
                 (MagneticHeading::new(level), None)
             }
-        };
-        let rad = match declination {
-            Some(d) => magnetic.to_true(d).rad(),
-            None => magnetic.rad(),
-        };
-        match tilt {
-            Some(tilt) => out.row(&[
-                row[t],
-                rad_to_deg(rad),
-                rad_to_deg(tilt.pitch_rad),
-                rad_to_deg(tilt.roll_rad),
-            ])?,
-            None => out.row(&[row[t], rad_to_deg(rad)])?,
-        }
-        count += 1;
+        })
     }
-    if count == 0 {
-        return Err(CliError::row(&path, 2, "no data rows after the header"));
+}
+
+/// One output row: time, heading (`rad`, written in degrees) and the tilt if any.
+fn write_row(out: &mut CsvOutput, t_s: f64, rad: f64, tilt: Option<Tilt>) -> CliResult {
+    match tilt {
+        Some(tilt) => out.row(&[
+            t_s,
+            rad_to_deg(rad),
+            rad_to_deg(tilt.pitch_rad),
+            rad_to_deg(tilt.roll_rad),
+        ]),
+        None => out.row(&[t_s, rad_to_deg(rad)]),
     }
-    out.commit()?;
-    let north = if declination.is_some() {
-        "true"
-    } else {
-        "magnetic"
-    };
-    let how = match (&cal, acc.is_some()) {
+}
+
+/// How the heading was found, for the summary line.
+fn tilt_summary(cal: &CompassCalibration, acc: bool) -> &'static str {
+    match (cal, acc) {
         (CompassCalibration::TwoD(_), _) => {
             "level sensor assumed (a 2-axis calibration cannot compensate tilt)"
         }
@@ -172,7 +230,5 @@ pub fn run(args: &Args) -> CliResult {
             "tilt-compensated with the calibrated accelerometer"
         }
         (_, false) => "level sensor assumed (no acc_x,acc_y,acc_z in the input)",
-    };
-    eprintln!("truenorth: heading: {count} rows, {north} north, {how}");
-    Ok(())
+    }
 }

@@ -62,8 +62,19 @@ pub(super) fn heading_error(truth: &[VehicleTruth], estimate: &[f64]) -> Heading
     }
 }
 
+/// The simulated sensors' errors, then what each sensor gets wrong on its own, before any
+/// method calibrates it.
 pub(super) fn sensor_table(d: &DemoDrive) {
-    let p = &d.params;
+    print_sensor_errors(&d.params);
+    let h0 = d.truth.first().map_or(0.0, |t| t.heading_rad);
+    let mut rows = gyro_alone(d, h0);
+    rows.extend(odometer_alone(d, h0).map(|e| ("odometer, nominal", e)));
+    rows.extend(compass_alone(d));
+    print_alone_table(&rows);
+}
+
+/// The lines that describe the simulation's gyro, odometer and compass errors.
+fn print_sensor_errors(p: &VehicleSensorParams) {
     println!("Sensor errors in the simulation (VehicleSensorParams::typical)");
     println!(
         "  yaw gyro   bias {:.2} deg/s, scale error +{:.1} % right / +{:.1} % left, noise {:.3} deg/s/rtHz, bias walk {:.4} deg/s/rts",
@@ -73,10 +84,9 @@ pub(super) fn sensor_table(d: &DemoDrive) {
         p.gyro.noise_density_rps_per_sqrt_hz.to_degrees(),
         p.gyro.bias_walk_rps_per_sqrt_s.to_degrees()
     );
-    let track_m = p.odometer.wheels.track_m();
     println!(
         "  odometer   rear track {:.2} m, wheel scale errors {:+.1} % left / {:+.1} % right, {} cm pulses",
-        track_m,
+        p.odometer.wheels.track_m(),
         p.odometer.scale_error_l * 100.0,
         p.odometer.scale_error_r * 100.0,
         p.odometer.dist_per_pulse_m.map_or(0.0, |d| d * 100.0)
@@ -92,10 +102,13 @@ pub(super) fn sensor_table(d: &DemoDrive) {
         p.horizontal_field
     );
     println!();
+}
 
-    // What each sensor gets wrong on its own, before any method calibrates it.
-    let h0 = d.truth.first().map_or(0.0, |t| t.heading_rad);
-    let mut rows: Vec<(&str, HeadingError)> = Vec::new();
+/// The gyro integrated raw and with its true zero and scale, from the true start heading
+/// `h0` (rad).
+fn gyro_alone(d: &DemoDrive, h0: f64) -> Vec<(&'static str, HeadingError)> {
+    let p = &d.params;
+    let mut rows = Vec::new();
     for (name, cal) in [
         ("gyro, raw", GyroCalibration::default()),
         (
@@ -121,42 +134,59 @@ pub(super) fn sensor_table(d: &DemoDrive) {
             .collect();
         rows.push((name, heading_error(&d.truth, &est)));
     }
-    if let Ok(mut odo) = FixedTrack::new(track_m)
+    rows
+}
+
+/// The wheels' differential heading with the nominal track, from `h0` (rad).
+fn odometer_alone(d: &DemoDrive, h0: f64) -> Option<HeadingError> {
+    let track_m = d.params.odometer.wheels.track_m();
+    let mut odo = FixedTrack::new(track_m)
         .and_then(|t| DifferentialOdometer::new(t, DifferentialOdometerConfig::default()))
-    {
-        let est: Vec<f64> = d
-            .samples
-            .iter()
-            .map(|s| {
-                let Some(w) = s.wheels else {
-                    return f64::NAN;
-                };
-                let w = WheelSample {
-                    t_s: s.t_s,
-                    dist_l_m: w.dist_l_m,
-                    dist_r_m: w.dist_r_m,
-                };
-                odo.push(&w).map_or(f64::NAN, |_| odo.heading_rad() + h0)
-            })
-            .collect();
-        rows.push(("odometer, nominal", heading_error(&d.truth, &est)));
-    }
+        .ok()?;
+    let est: Vec<f64> = d
+        .samples
+        .iter()
+        .map(|s| {
+            let Some(w) = s.wheels else {
+                return f64::NAN;
+            };
+            let w = WheelSample {
+                t_s: s.t_s,
+                dist_l_m: w.dist_l_m,
+                dist_r_m: w.dist_r_m,
+            };
+            odo.push(&w).map_or(f64::NAN, |_| odo.heading_rad() + h0)
+        })
+        .collect();
+    Some(heading_error(&d.truth, &est))
+}
+
+/// The compass raw and with its true calibration.
+fn compass_alone(d: &DemoDrive) -> Vec<(&'static str, HeadingError)> {
+    let p = &d.params;
     let raw_compass = CompassCalibration2d::identity();
     let true_compass = CompassCalibration2d {
         hard_iron: p.compass_hard_iron,
         soft_iron: p.compass_soft_iron.try_inverse().unwrap_or_default(),
     };
-    for (name, cal) in [
+    [
         ("compass, raw", raw_compass),
         ("compass, true calibration", true_compass),
-    ] {
+    ]
+    .into_iter()
+    .map(|(name, cal)| {
         let est: Vec<f64> = d
             .samples
             .iter()
             .map(|s| s.mag.map_or(f64::NAN, |m| cal.heading_rad(&m)))
             .collect();
-        rows.push((name, heading_error(&d.truth, &est)));
-    }
+        (name, heading_error(&d.truth, &est))
+    })
+    .collect()
+}
+
+/// The table of each sensor alone.
+fn print_alone_table(rows: &[(&str, HeadingError)]) {
     println!("Each sensor alone on the whole demo drive (heading error vs truth)");
     println!(
         "{:<28} {:>9} {:>9} {:>10}",

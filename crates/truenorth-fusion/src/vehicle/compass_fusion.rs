@@ -2,15 +2,16 @@
 //! online calibration, averaged into heading corrections, and the first run of consistent
 //! readings referring the heading and the track to north.
 
-use nalgebra::SMatrix;
+use nalgebra::{SMatrix, Vector2};
 use truenorth_core::{VehicleSample, wrap_pi};
 
 use super::compass_learning::Judged;
 use super::compass_monitor::{CompassFix, Verdict};
-use super::estimator::{CompassWindow, Outage, VehicleEstimator};
+use super::estimator::VehicleEstimator;
 use super::heading_trig::small_atan2;
 use super::innovation_line::InnovationLine;
 use super::nav_filter::{BIAS, COMPASS_BIAS, DIM, EAST, NORTH, PSI, PSI_ODO, state};
+use super::tracking::{CompassWindow, Outage};
 
 #[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
@@ -95,45 +96,14 @@ impl VehicleEstimator {
             return;
         };
         let reading = self.compass.measure(&raw);
-        if self.alignment.done && self.filter.sigma(PSI) > RELOCK_SIGMA_RAD {
-            self.alignment.relocking = true;
+        if self.tracking.alignment.done && self.filter.sigma(PSI) > RELOCK_SIGMA_RAD {
+            self.tracking.alignment.relocking = true;
         }
         let judged = match reading {
-            Some((u, ratio)) if self.alignment.done && !self.alignment.relocking => {
-                // Innovation: the angle from the predicted reading's direction to the
-                // reading's, without an arctangent per reading when it is small.
-                let f = &self.filter;
-                let (sp, cp) = self
-                    .trig_compass
-                    .at(self.heading_at(sample.t_s) + f.x[COMPASS_BIAS]);
-                let nu = small_atan2(-u.y * cp - u.x * sp, u.x * cp - u.y * sp);
-                let p_nu = f.p[PSI][PSI]
-                    + 2.0 * f.p[PSI][COMPASS_BIAS]
-                    + f.p[COMPASS_BIAS][COMPASS_BIAS]
-                    + self.batch.psi_noise();
-                let verdict = self.compass.judge(sample.t_s, nu, ratio, p_nu);
-                let used = matches!(verdict, Verdict::Use { .. });
-                if let Verdict::Use { variance_rad2 } = verdict {
-                    self.take_compass(nu, variance_rad2);
-                }
-                let noise = self.compass.fix().map_or(0.0, |f| f.noise_rad);
-                match self
-                    .outage
-                    .count(sample.t_s, self.filter.x[PSI], nu, noise, used)
-                {
-                    Suspect::None => {}
-                    Suspect::Calibration => self.learner.relearn(),
-                    Suspect::DeadReckoning {
-                        offset_rad,
-                        sigma_rad,
-                    } => self.relock(offset_rad, sigma_rad),
-                }
-
-                match (self.outage.relearning, used) {
-                    (true, _) => Judged::Unjudged,
-                    (false, true) => Judged::Gated,
-                    (false, false) => Judged::Rejected,
-                }
+            Some((u, ratio))
+                if self.tracking.alignment.done && !self.tracking.alignment.relocking =>
+            {
+                self.judge_reading(sample.t_s, &u, ratio)
             }
             Some((u, ratio)) => {
                 if self.compass.field_ok(ratio) {
@@ -144,27 +114,71 @@ impl VehicleEstimator {
             }
             None => Judged::Unjudged,
         };
-        let learn = sample.t_s > self.learned_until_s;
-        if let Some(s) = learn
-            .then(|| {
-                self.learner
-                    .offer(&raw, sample.t_s, self.filter.x[PSI], judged)
-            })
-            .flatten()
-        {
-            self.compass.set_fix(CompassFix::from_solution(&s));
-            self.outage = Outage::default();
-            // A new calibration makes a new systematic error, and the averaged
-            // innovations were taken against the old one.
-            self.compass.restart_gates();
-            self.flush();
-            self.window = CompassWindow::default();
-            self.filter.x[COMPASS_BIAS] = 0.0;
-            self.filter
-                .reset_state(COMPASS_BIAS, self.compass_bias_var().sqrt());
+        if sample.t_s > self.tracking.learned_until_s {
+            self.learn_compass(&raw, sample.t_s, judged);
         }
         self.est.status.compass_calibrated = self.compass.fix().is_some();
         self.est.status.compass_disturbed = self.compass.disturbed();
+    }
+
+    /// A calibrated reading `u` (field ratio `ratio`) at `t_s`, once the heading is referred
+    /// to north: its innovation judged by the gates, used if they pass it, counted against
+    /// the outage; returns what the gates said, for the learner.
+    fn judge_reading(&mut self, t_s: f64, u: &Vector2<f64>, ratio: f64) -> Judged {
+        // Innovation: the angle from the predicted reading's direction to the
+        // reading's, without an arctangent per reading when it is small.
+        let f = &self.filter;
+        let (sp, cp) = self
+            .tracking
+            .trig_compass
+            .at(self.heading_at(t_s) + f.x[COMPASS_BIAS]);
+        let nu = small_atan2(-u.y * cp - u.x * sp, u.x * cp - u.y * sp);
+        let p_nu = f.p[PSI][PSI]
+            + 2.0 * f.p[PSI][COMPASS_BIAS]
+            + f.p[COMPASS_BIAS][COMPASS_BIAS]
+            + self.tracking.batch.psi_noise();
+        let verdict = self.compass.judge(t_s, nu, ratio, p_nu);
+        let used = matches!(verdict, Verdict::Use { .. });
+        if let Verdict::Use { variance_rad2 } = verdict {
+            self.take_compass(nu, variance_rad2);
+        }
+        let noise = self.compass.fix().map_or(0.0, |f| f.noise_rad);
+        match self
+            .tracking
+            .outage
+            .count(t_s, self.filter.x[PSI], nu, noise, used)
+        {
+            Suspect::None => {}
+            Suspect::Calibration => self.learner.relearn(),
+            Suspect::DeadReckoning {
+                offset_rad,
+                sigma_rad,
+            } => self.relock(offset_rad, sigma_rad),
+        }
+
+        match (self.tracking.outage.relearning, used) {
+            (true, _) => Judged::Unjudged,
+            (false, true) => Judged::Gated,
+            (false, false) => Judged::Rejected,
+        }
+    }
+
+    /// Offers the raw reading to the compass learner; a new calibration from it replaces
+    /// the one in use and starts the compass's gates and bias over.
+    fn learn_compass(&mut self, raw: &Vector2<f64>, t_s: f64, judged: Judged) {
+        let Some(s) = self.learner.offer(raw, t_s, self.filter.x[PSI], judged) else {
+            return;
+        };
+        self.compass.set_fix(CompassFix::from_solution(&s));
+        self.tracking.outage = Outage::default();
+        // A new calibration makes a new systematic error, and the averaged
+        // innovations were taken against the old one.
+        self.compass.restart_gates();
+        self.flush();
+        self.tracking.window = CompassWindow::default();
+        self.filter.x[COMPASS_BIAS] = 0.0;
+        self.filter
+            .reset_state(COMPASS_BIAS, self.compass_bias_var().sqrt());
     }
 
     /// Adds a reading's innovation to the window; a full window corrects the heading once.
@@ -176,22 +190,26 @@ impl VehicleEstimator {
     /// averaging while the heading drifts (uncalibrated wheels turn it by degrees a
     /// second) biases nothing.
     fn take_compass(&mut self, nu: f64, variance_rad2: f64) {
-        let w = &mut self.window;
+        let w = &mut self.tracking.window;
         w.n += 1;
         w.sum_nu += nu;
         w.variance_rad2 = variance_rad2;
-        for (s, a) in w.sum_psi_from.iter_mut().zip(self.batch.psi_from()) {
+        for (s, a) in w
+            .sum_psi_from
+            .iter_mut()
+            .zip(self.tracking.batch.psi_from())
+        {
             *s += a;
         }
-        w.sum_noise_at += self.batch.psi_noise();
+        w.sum_noise_at += self.tracking.batch.psi_noise();
     }
 
     /// Corrects the heading with the window's readings, right after the covariance was
     /// carried forward to now (so `A_now = 0` and each reading's row is `−A_k` on the
     /// calibration states).
     pub(super) fn correct_with_compass(&mut self) {
-        let w = self.window;
-        self.window = CompassWindow::default();
+        let w = self.tracking.window;
+        self.tracking.window = CompassWindow::default();
         let n = f64::from(w.n);
         let mut h = [(0, 0.0); DIM];
         h[0] = (PSI, 1.0);
@@ -203,7 +221,7 @@ impl VehicleEstimator {
                 len += 1;
             }
         }
-        let mut learn = self.gates.compass.learnable();
+        let mut learn = self.tracking.gates.compass.learnable();
         if !self.compass.steady() {
             // A field that turns slowly (30-90 s of steel alongside) starts as a trend in
             // the averaged innovation, well before the slow gate rejects it, and a trend
@@ -213,7 +231,7 @@ impl VehicleEstimator {
             // corrects the heading, and the bias's uncertainty still reaches it.
             learn &= !state(BIAS);
         }
-        self.gates.compass_done();
+        self.tracking.gates.compass_done();
         // Each reading missed the heading noise added after it; the mean of those is an
         // upper bound on the variance it adds to the window's mean (the noises are nested,
         // so positively correlated).
@@ -233,7 +251,7 @@ impl VehicleEstimator {
         let Some(fix) = self.compass.fix().copied() else {
             return;
         };
-        let line = &mut self.alignment.line;
+        let line = &mut self.tracking.alignment.line;
         line.push(t_s, wrap_pi(heading - self.filter.x[PSI]));
         if line.len() < self.config.compass.alignment_readings {
             return;
@@ -241,7 +259,9 @@ impl VehicleEstimator {
         let fit = line.fit(fix.noise_rad);
         *line = InnovationLine::default();
         match fit {
-            Some(f) if f.residual_rad <= 3.0 * fix.noise_rad && self.alignment.relocking => {
+            Some(f)
+                if f.residual_rad <= 3.0 * fix.noise_rad && self.tracking.alignment.relocking =>
+            {
                 self.relock(f.offset_rad, f.sigma_rad);
             }
             Some(f) if f.residual_rad <= 3.0 * fix.noise_rad => {
@@ -260,7 +280,7 @@ impl VehicleEstimator {
     /// uncorrelated with the calibration states, and the track turned about the start by the
     /// same error. The wheels' heading keeps its difference from the gyro's.
     fn align(&mut self, offset: f64, sigma: f64) {
-        self.alignment.offset_rad = offset;
+        self.tracking.alignment.offset_rad = offset;
         let bias_var = self.refer_heading(offset);
         let f = &mut self.filter;
         let (s, c) = offset.sin_cos();
@@ -274,7 +294,7 @@ impl VehicleEstimator {
         t[(EAST, NORTH)] = s;
         t[(EAST, EAST)] = c;
         t[(PSI, PSI)] = 0.0;
-        if self.gyro.active {
+        if self.tracking.gyro.active {
             t[(PSI_ODO, PSI)] = -1.0;
         }
         let p = SMatrix::<f64, DIM, DIM>::from_fn(|i, j| f.p[i][j]);
@@ -286,7 +306,7 @@ impl VehicleEstimator {
         }
         let mut g = [0.0; DIM];
         g[PSI] = 1.0;
-        g[PSI_ODO] = if self.gyro.active { 1.0 } else { 0.0 };
+        g[PSI_ODO] = if self.tracking.gyro.active { 1.0 } else { 0.0 };
         g[NORTH] = -f.x[EAST];
         g[EAST] = f.x[NORTH];
         f.add_common_error(&g, sigma);
@@ -303,7 +323,7 @@ impl VehicleEstimator {
                 f.p[i][j] += bias_var * gi * gj;
             }
         }
-        self.alignment.done = true;
+        self.tracking.alignment.done = true;
         self.compass.restart_gates();
     }
 
@@ -316,7 +336,7 @@ impl VehicleEstimator {
         f.x[COMPASS_BIAS] = 0.0;
         f.reset_state(COMPASS_BIAS, bias_var.sqrt());
         f.reset_state(PSI, (sigma * sigma + bias_var).sqrt());
-        if self.gyro.active {
+        if self.tracking.gyro.active {
             // The comparison with the wheels starts again from the new heading.
             f.x[PSI_ODO] = f.x[PSI];
             for k in 0..DIM {
@@ -324,7 +344,7 @@ impl VehicleEstimator {
                 f.p[k][PSI_ODO] = f.p[k][PSI];
             }
         }
-        self.alignment.relocking = false;
+        self.tracking.alignment.relocking = false;
         self.compass.restart_gates();
     }
 
@@ -333,7 +353,7 @@ impl VehicleEstimator {
     /// variance, which both a first alignment and a relock start the compass error from.
     fn refer_heading(&mut self, offset: f64) -> f64 {
         self.flush();
-        self.window = CompassWindow::default();
+        self.tracking.window = CompassWindow::default();
         let f = &mut self.filter;
         let turned = wrap_pi(f.x[PSI] + offset);
         f.x[PSI_ODO] += turned - f.x[PSI];

@@ -11,6 +11,7 @@ use super::nav_filter::{
     TRACK_SCALE, WHEEL_DIFF,
 };
 use super::step_batch::Step;
+use super::tracking::{Alignment, CompassWindow, Rest};
 use super::wheel_odometry::{WheelCalibration, WheelStep};
 
 #[cfg(not(feature = "std"))]
@@ -79,52 +80,53 @@ const GAP_STEERED_SHARE: f64 = 0.05;
 impl VehicleEstimator {
     /// Takes a gyro reading at `t_s`.
     pub(super) fn gyro_reading(&mut self, t_s: f64, raw: f64) {
-        let Some((t0, raw0)) = self.gyro.last else {
+        let Some((t0, raw0)) = self.tracking.gyro.last else {
             self.start_gyro(t_s, raw);
             return;
         };
-        self.gyro.last = Some((t_s, raw));
+        self.tracking.gyro.last = Some((t_s, raw));
         let dt = t_s - t0;
         let gap = dt > self.config.max_gap_s;
         let at_rest = self.resting_at(t_s, raw, dt);
         if !at_rest {
-            self.gates.count_step(gap);
+            self.tracking.gates.count_step(gap);
         }
-        if self.gyro.interval_s == 0.0 {
-            self.gyro.interval_s = dt.min(self.config.max_gap_s);
-        } else if dt <= 1.5 * self.gyro.interval_s {
-            self.gyro.interval_s += INTERVAL_WEIGHT * (dt - self.gyro.interval_s);
+        if self.tracking.gyro.interval_s == 0.0 {
+            self.tracking.gyro.interval_s = dt.min(self.config.max_gap_s);
+        } else if dt <= 1.5 * self.tracking.gyro.interval_s {
+            self.tracking.gyro.interval_s += INTERVAL_WEIGHT * (dt - self.tracking.gyro.interval_s);
         }
         if gap || (self.wheels_fresh(t_s) && dt > self.gyro_bridge_s()) {
             self.bridge_gyro_gap(gap);
             return;
         }
         if at_rest {
-            self.rest.sum_raw += raw;
-            self.rest.n += 1;
-            self.rest.span_s += dt;
-            self.gyro.smoothed_rps = 0.0;
-            self.gyro.rate_rps = 0.0;
-            self.gyro.odo_at_last_rad = self.filter.x[PSI_ODO];
+            self.tracking.rest.sum_raw += raw;
+            self.tracking.rest.n += 1;
+            self.tracking.rest.span_s += dt;
+            self.tracking.gyro.smoothed_rps = 0.0;
+            self.tracking.gyro.rate_rps = 0.0;
+            self.tracking.gyro.odo_at_last_rad = self.filter.x[PSI_ODO];
             return;
         }
-        self.rest = super::estimator::Rest::default();
+        self.tracking.rest = Rest::default();
         let x = &self.filter.x;
         let trapezoid = YawIncrement::new(raw0, raw, dt);
         let increment = trapezoid.angle_rad() - x[BIAS] * dt;
         let alpha = dt / (dt + TURN_SMOOTHING_S);
-        self.gyro.smoothed_rps += alpha * (increment / dt - self.gyro.smoothed_rps);
-        let turning = if self.gyro.smoothed_rps != 0.0 {
-            self.gyro.smoothed_rps
+        self.tracking.gyro.smoothed_rps +=
+            alpha * (increment / dt - self.tracking.gyro.smoothed_rps);
+        let turning = if self.tracking.gyro.smoothed_rps != 0.0 {
+            self.tracking.gyro.smoothed_rps
         } else {
             increment
         };
         let gain_state = if turning >= 0.0 { GAIN_POS } else { GAIN_NEG };
         let gain = 1.0 + x[gain_state];
         let dpsi = increment / gain;
-        self.gyro.rate_rps = dpsi / dt;
+        self.tracking.gyro.rate_rps = dpsi / dt;
         let bias_sigma3 = 3.0 * self.filter.sigma(BIAS);
-        let rate = self.gyro.smoothed_rps.abs();
+        let rate = self.tracking.gyro.smoothed_rps.abs();
         let mut step = Step::default();
         step.psi_from[0] = (BIAS, -dt / gain);
         // The trapezoid is exact for a rate that changes linearly between readings; a
@@ -138,11 +140,12 @@ impl VehicleEstimator {
         } else {
             step.q[PSI] += (self.filter.sigma(gain_state) * dpsi).powi(2);
         }
-        self.gates
+        self.tracking
+            .gates
             .gyro_step(dpsi, rate > GAIN_LEARNING_MIN_RATE_RPS + bias_sigma3);
         self.turn_heading(dpsi, &mut step);
-        self.batch.add(&step);
-        self.gyro.odo_at_last_rad = self.filter.x[PSI_ODO];
+        self.tracking.batch.add(&step);
+        self.tracking.gyro.odo_at_last_rad = self.filter.x[PSI_ODO];
     }
 
     /// Whether the vehicle stands still at `t_s`, as far as a gyro reading `raw` taken
@@ -152,13 +155,12 @@ impl VehicleEstimator {
     /// noise is a turn the wheels missed: a skid-steer pivoting while its wheel readings
     /// drop out).
     fn resting_at(&self, t_s: f64, raw: f64, dt: f64) -> bool {
-        if !self.motion.at_rest {
+        if !self.tracking.motion.at_rest {
             return false;
         }
-        let fresh = self
-            .wheels
-            .last_s()
-            .is_some_and(|t0| t_s - t0 <= 2.0 * self.motion.wheel_interval_s + REST_FRESH_S);
+        let fresh = self.wheels.last_s().is_some_and(|t0| {
+            t_s - t0 <= 2.0 * self.tracking.motion.wheel_interval_s + REST_FRESH_S
+        });
         let spread = (self.filter.p[BIAS][BIAS] + self.coeffs.gyro_noise_rad2_per_s / dt)
             .sqrt()
             .max(REST_NOISE_FLOOR_RPS);
@@ -168,9 +170,9 @@ impl VehicleEstimator {
     /// Switches the heading to the gyro at its first reading: the wheels' heading starts
     /// equal to it, fully correlated.
     fn start_gyro(&mut self, t_s: f64, raw: f64) {
-        self.gyro.active = true;
-        self.gyro.last = Some((t_s, raw));
-        if !self.gyro.restored {
+        self.tracking.gyro.active = true;
+        self.tracking.gyro.last = Some((t_s, raw));
+        if !self.tracking.gyro.restored {
             let s = &self.coeffs.prior_sigma;
             self.filter.reset_state(BIAS, s[BIAS]);
             self.filter.reset_state(GAIN_POS, s[GAIN_POS]);
@@ -189,7 +191,7 @@ impl VehicleEstimator {
             f.p[k][PSI_ODO] = f.p[k][PSI];
         }
         f.p[PSI_ODO][PSI_ODO] = f.p[PSI][PSI];
-        self.gyro.odo_at_last_rad = f.x[PSI_ODO];
+        self.tracking.gyro.odo_at_last_rad = f.x[PSI_ODO];
     }
 
     /// Longest silence of the gyro its readings are integrated across while the wheels can
@@ -197,16 +199,15 @@ impl VehicleEstimator {
     /// misses a turn made inside it — a robot pivots through 90° in a second), within
     /// [`super::VehicleConfig::max_gap_s`].
     pub(super) fn gyro_bridge_s(&self) -> f64 {
-        (3.0 * self.gyro.interval_s).clamp(MIN_BRIDGE_S, self.config.max_gap_s)
+        (3.0 * self.tracking.gyro.interval_s).clamp(MIN_BRIDGE_S, self.config.max_gap_s)
     }
 
     /// Whether the wheels read recently enough to carry the heading at `t_s`.
     fn wheels_fresh(&self, t_s: f64) -> bool {
         self.est.status.position_known
-            && self
-                .wheels
-                .last_s()
-                .is_some_and(|t0| t_s - t0 <= 2.0 * self.motion.wheel_interval_s + REST_FRESH_S)
+            && self.wheels.last_s().is_some_and(|t0| {
+                t_s - t0 <= 2.0 * self.tracking.motion.wheel_interval_s + REST_FRESH_S
+            })
     }
 
     /// The gyro was silent for longer than it can be integrated across (`gap`: longer than
@@ -216,21 +217,21 @@ impl VehicleEstimator {
     /// until the compass refers it to north again.
     fn bridge_gyro_gap(&mut self, gap: bool) {
         self.est.status.gap |= gap;
-        self.gyro.smoothed_rps = 0.0;
-        self.gyro.rate_rps = 0.0;
+        self.tracking.gyro.smoothed_rps = 0.0;
+        self.tracking.gyro.rate_rps = 0.0;
         if self.est.status.position_known {
-            let turned = wrap_pi(self.filter.x[PSI_ODO] - self.gyro.odo_at_last_rad);
+            let turned = wrap_pi(self.filter.x[PSI_ODO] - self.tracking.gyro.odo_at_last_rad);
             let mut step = Step::default();
             step.q[PSI] = (GAP_TURN_SHARE * turned).powi(2);
             self.turn_heading(turned, &mut step);
-            self.batch.add(&step);
-            self.gyro.odo_at_last_rad = self.filter.x[PSI_ODO];
+            self.tracking.batch.add(&step);
+            self.tracking.gyro.odo_at_last_rad = self.filter.x[PSI_ODO];
         } else {
             self.flush();
             self.filter
                 .reset_state(PSI, super::estimator::UNKNOWN_HEADING_SIGMA_RAD);
-            self.alignment = super::estimator::Alignment::default();
-            self.window = super::estimator::CompassWindow::default();
+            self.tracking.alignment = Alignment::default();
+            self.tracking.window = CompassWindow::default();
             self.restart_wheel_heading();
         }
     }
@@ -250,8 +251,8 @@ impl VehicleEstimator {
         let wrapped = wrap_pi(x[PSI] + dpsi);
         let shift = wrapped - (x[PSI] + dpsi);
         x[PSI_ODO] += shift;
-        self.motion.psi_at_wheels_rad += shift;
-        self.gyro.odo_at_last_rad += shift;
+        self.tracking.motion.psi_at_wheels_rad += shift;
+        self.tracking.gyro.odo_at_last_rad += shift;
         x[PSI] = wrapped;
     }
 
@@ -265,21 +266,21 @@ impl VehicleEstimator {
         };
         let Some(wheel) = self.wheels.step(t_s, reading, &cal) else {
             self.est.status.position_known = true;
-            self.motion.psi_at_wheels_rad = self.heading_at(t_s);
+            self.tracking.motion.psi_at_wheels_rad = self.heading_at(t_s);
             return;
         };
         let dt = wheel.dt_s;
         let gap = dt > self.config.max_gap_s;
-        self.motion.still_s = if wheel.moved {
+        self.tracking.motion.still_s = if wheel.moved {
             0.0
         } else {
-            self.motion.still_s + dt
+            self.tracking.motion.still_s + dt
         };
-        self.motion.at_rest =
-            self.motion.still_s >= self.config.standstill_s && self.motion.still_s > 0.0;
-        self.motion.wheel_interval_s = dt;
+        self.tracking.motion.at_rest = self.tracking.motion.still_s >= self.config.standstill_s
+            && self.tracking.motion.still_s > 0.0;
+        self.tracking.motion.wheel_interval_s = dt;
         if wheel.moved {
-            self.gates.count_step(gap);
+            self.tracking.gates.count_step(gap);
             self.est.status.gap |= gap;
         }
         let wheel_q = self.wheel_noise(&wheel, gap);
@@ -291,10 +292,11 @@ impl VehicleEstimator {
         let turned = wheel.heading_change_rad;
         let mut step = Step::default();
         let gyro_silent = self
+            .tracking
             .gyro
             .last
             .is_some_and(|(t0, _)| t_s - t0 > self.gyro_bridge_s());
-        if self.gyro.active {
+        if self.tracking.gyro.active {
             step.odo_from = wheel_from;
             step.q[PSI_ODO] = wheel_q;
             self.filter.x[PSI_ODO] += turned;
@@ -303,9 +305,9 @@ impl VehicleEstimator {
                 step.psi_from = wheel_from;
                 step.q[PSI] = wheel_q;
                 self.turn_heading(turned, &mut step);
-                self.gyro.odo_at_last_rad = self.filter.x[PSI_ODO];
-            } else if !self.motion.at_rest && wheel.moved {
-                self.wheel_check_s += dt;
+                self.tracking.gyro.odo_at_last_rad = self.filter.x[PSI_ODO];
+            } else if !self.tracking.motion.at_rest && wheel.moved {
+                self.tracking.wheel_check_s += dt;
             }
         } else {
             step.psi_from = wheel_from;
@@ -313,14 +315,16 @@ impl VehicleEstimator {
             self.turn_heading(turned, &mut step);
         }
         if wheel.moved {
-            let compared = self.gyro.active && !gyro_silent;
-            self.gates.wheel_step(turned, wheel.speed_mps, compared);
+            let compared = self.tracking.gyro.active && !gyro_silent;
+            self.tracking
+                .gates
+                .wheel_step(turned, wheel.speed_mps, compared);
         }
         self.advance_track(t_s, &wheel, gap, &mut step);
-        self.batch.add(&step);
+        self.tracking.batch.add(&step);
         self.est.speed_mps = wheel.speed_mps;
         self.est.distance_m += wheel.ds_m.abs();
-        self.est.status.at_rest = self.motion.at_rest;
+        self.est.status.at_rest = self.tracking.motion.at_rest;
     }
 
     /// Variance of the wheels' heading change over `wheel`: bumps and pulses per metre,
@@ -331,7 +335,7 @@ impl VehicleEstimator {
         let turned = wheel.heading_change_rad;
         let rate = turned / wheel.dt_s;
         let lateral_g = (wheel.speed_mps * rate).abs() / STANDARD_GRAVITY_MPS2;
-        let slip = self.gates.slip_scale2.sqrt()
+        let slip = self.tracking.gates.slip_scale2.sqrt()
             * (p.wheel_slip
                 + p.wheel_slip_per_g * lateral_g
                 + p.wheel_slip_per_c2 * wheel.ratio * wheel.ratio);
@@ -346,9 +350,12 @@ impl VehicleEstimator {
     /// Draws the track along the heading half-way between this wheel reading and the last.
     fn advance_track(&mut self, t_s: f64, wheel: &WheelStep, gap: bool, step: &mut Step) {
         let psi = self.heading_at(t_s);
-        let change = wrap_pi(psi - self.motion.psi_at_wheels_rad);
-        let (s, c) = self.trig.at(self.motion.psi_at_wheels_rad + 0.5 * change);
-        self.motion.psi_at_wheels_rad = psi;
+        let change = wrap_pi(psi - self.tracking.motion.psi_at_wheels_rad);
+        let (s, c) = self
+            .tracking
+            .trig
+            .at(self.tracking.motion.psi_at_wheels_rad + 0.5 * change);
+        self.tracking.motion.psi_at_wheels_rad = psi;
         let ds = wheel.ds_m;
         step.north_from_psi = -ds * s;
         step.east_from_psi = ds * c;
@@ -368,7 +375,7 @@ impl VehicleEstimator {
     /// calibration states' random walk, composed into the batch as one step (they couple
     /// to nothing within it).
     fn time_passes(&mut self) {
-        let dt = core::mem::take(&mut self.pending_time_s);
+        let dt = core::mem::take(&mut self.tracking.pending_time_s);
         if dt <= 0.0 {
             return;
         }
@@ -379,7 +386,7 @@ impl VehicleEstimator {
         };
         let q = &mut step.q;
         q[COMPASS_BIAS] = self.compass_bias_var() * (1.0 - decay * decay);
-        if self.gyro.active {
+        if self.tracking.gyro.active {
             q[BIAS] = self.coeffs.bias_walk_rad2_per_s3 * dt;
             q[GAIN_POS] = GAIN_WALK * GAIN_WALK * dt;
             q[GAIN_NEG] = q[GAIN_POS];
@@ -390,7 +397,7 @@ impl VehicleEstimator {
         }
         q[TRACK_SCALE] = GAIN_WALK * GAIN_WALK * dt;
         self.filter.x[COMPASS_BIAS] *= decay;
-        self.batch.add(&step);
+        self.tracking.batch.add(&step);
     }
 
     /// Carries the covariance forward through the steps composed so far: before any
@@ -400,35 +407,39 @@ impl VehicleEstimator {
         // The window's readings are tied to the heading through the couplings accumulated
         // since the batch began; the next batch begins now, so refer them to now:
         // A_k − A_now for each reading.
-        let n = f64::from(self.window.n);
-        let w = &mut self.window;
-        for (s, a) in w.sum_psi_from.iter_mut().zip(self.batch.psi_from()) {
+        let n = f64::from(self.tracking.window.n);
+        let w = &mut self.tracking.window;
+        for (s, a) in w
+            .sum_psi_from
+            .iter_mut()
+            .zip(self.tracking.batch.psi_from())
+        {
             *s -= n * a;
         }
-        w.noise_after += n * self.batch.psi_noise() - w.sum_noise_at;
+        w.noise_after += n * self.tracking.batch.psi_noise() - w.sum_noise_at;
         w.sum_noise_at = 0.0;
-        self.batch.apply(&mut self.filter);
+        self.tracking.batch.apply(&mut self.filter);
     }
 
     /// A measurement epoch: the covariance is carried forward once, then every measurement
     /// that is due corrects the state — the compass's averaged readings, the wheels'
     /// heading against the gyro's once a second of driving, the bias once a second of rest.
     pub(super) fn epoch(&mut self) {
-        self.rows_since_epoch = 0;
+        self.tracking.rows_since_epoch = 0;
         self.flush();
-        if self.rest.span_s >= REST_AVERAGE_S {
-            let mean = self.rest.sum_raw / f64::from(self.rest.n);
-            let r = self.coeffs.gyro_noise_rad2_per_s / self.rest.span_s
+        if self.tracking.rest.span_s >= REST_AVERAGE_S {
+            let mean = self.tracking.rest.sum_raw / f64::from(self.tracking.rest.n);
+            let r = self.coeffs.gyro_noise_rad2_per_s / self.tracking.rest.span_s
                 + REST_NOISE_FLOOR_RPS * REST_NOISE_FLOOR_RPS;
             self.filter
                 .update(&[(BIAS, 1.0)], mean - self.filter.x[BIAS], r);
-            self.rest = super::estimator::Rest::default();
+            self.tracking.rest = Rest::default();
         }
-        if self.wheel_check_s >= WHEEL_CHECK_S {
-            self.wheel_check_s = 0.0;
+        if self.tracking.wheel_check_s >= WHEEL_CHECK_S {
+            self.tracking.wheel_check_s = 0.0;
             self.wheels_against_gyro();
         }
-        if self.window.n >= self.config.compass.readings_per_update {
+        if self.tracking.window.n >= self.config.compass.readings_per_update {
             self.correct_with_compass();
         }
         // A wheel pair's difference only grows with speed: `a` is never negative.
@@ -440,7 +451,7 @@ impl VehicleEstimator {
     /// wheels' heading starts again from the gyro's, and the disagreement lowers the
     /// wheels' trust.
     fn wheels_against_gyro(&mut self) {
-        self.gates.time_base_window();
+        self.tracking.gates.time_base_window();
         let t_wheels = self.wheels.last_s().unwrap_or(f64::NAN);
         let ahead = self.heading_at(t_wheels) - self.filter.x[PSI];
         let nu = wrap_pi(self.filter.x[PSI_ODO] - self.filter.x[PSI] - ahead);
@@ -449,8 +460,8 @@ impl VehicleEstimator {
         let f = &self.filter;
         let s = f.p[PSI][PSI] - 2.0 * f.p[PSI][PSI_ODO] + f.p[PSI_ODO][PSI_ODO] + r;
         let nis = nu * nu / s;
-        let learn = self.gates.wheel_check_learnable();
-        self.gates.wheel_check_done(nis);
+        let learn = self.tracking.gates.wheel_check_learnable();
+        self.tracking.gates.wheel_check_done(nis);
         if nis > OUTLIER_NIS || !nis.is_finite() {
             self.restart_wheel_heading();
             return;

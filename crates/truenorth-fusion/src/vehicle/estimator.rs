@@ -36,15 +36,12 @@ use truenorth_core::{
 use super::compass_learning::CompassLearner;
 use super::compass_monitor::{CompassFix, CompassMonitor};
 use super::config::{SensorPriors, VehicleConfig};
-use super::heading_trig::HeadingTrig;
-use super::innovation_line::InnovationLine;
 use super::learned::VehicleCalibration;
-use super::learning_gates::LearningGates;
 use super::nav_filter::{
     BIAS, DIM, GAIN_NEG, GAIN_POS, NavFilter, PSI, SPEED_COEFF, TRACK_SCALE, WHEEL_DIFF,
 };
 use super::observability::unobserved;
-use super::step_batch::StepBatch;
+use super::tracking::{GyroTrack, VehicleTracking};
 use super::wheel_odometry::{TrackModel, WheelOdometry};
 
 #[cfg(not(feature = "std"))]
@@ -106,104 +103,6 @@ impl Coefficients {
     }
 }
 
-/// The gyro between readings.
-#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize, serde::Deserialize)]
-pub(super) struct GyroTrack {
-    /// The gyro carries the heading (a reading has been seen and the method uses it).
-    pub active: bool,
-    /// The gyro's states come from a stored calibration rather than the priors.
-    pub restored: bool,
-    /// The last reading and its time.
-    pub last: Option<(f64, f64)>,
-    /// The corrected rate, low-passed, rad/s: which way the vehicle turns, free of the
-    /// sign flips of noise and vibration.
-    pub smoothed_rps: f64,
-    /// The wheels' heading at the last gyro reading, for a gap the wheels bridge.
-    pub odo_at_last_rad: f64,
-    /// The gyro's usual interval between readings, s (a running mean of the intervals not
-    /// much longer than it).
-    pub interval_s: f64,
-    /// The corrected rate over the last interval, rad/s: the heading carries on at it
-    /// until the next reading, so that a sensor read between two gyro readings is
-    /// compared with the heading at its own time.
-    pub rate_rps: f64,
-}
-
-/// How the vehicle moves, from the wheels.
-#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize, serde::Deserialize)]
-pub(super) struct Motion {
-    /// Time the wheels have stood still, s.
-    pub still_s: f64,
-    /// Stood still for [`VehicleConfig::standstill_s`].
-    pub at_rest: bool,
-    /// The heading at the last wheel reading (for the mid-step heading of the track).
-    pub psi_at_wheels_rad: f64,
-    /// The interval between the last two wheel readings, s.
-    pub wheel_interval_s: f64,
-}
-
-/// Rest and the bias average.
-#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize, serde::Deserialize)]
-pub(super) struct Rest {
-    pub sum_raw: f64,
-    pub n: u32,
-    pub span_s: f64,
-}
-
-/// How long the compass has been rejected, and how far the vehicle turned meanwhile.
-#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize, serde::Deserialize)]
-pub(super) struct Outage {
-    pub rejected_s: f64,
-    pub turned_rad: f64,
-    pub last: Option<(f64, f64)>,
-    /// The calibration in use was found wanting: a new one is being learned from readings
-    /// the gates cannot judge.
-    pub relearning: bool,
-    /// The rejected readings' innovations in time.
-    pub line: InnovationLine,
-}
-
-/// Compass readings taken since the last heading correction, averaged into one.
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
-pub(super) struct CompassWindow {
-    pub n: u32,
-    pub sum_nu: f64,
-    /// Σ over the readings of the heading's accumulated couplings `A_k` at each reading,
-    /// counted from the start of the current batch.
-    pub sum_psi_from: [f64; DIM],
-    /// Σ over the readings of the heading noise the current batch had added by each.
-    pub sum_noise_at: f64,
-    /// Σ over the readings of the heading noise added after each, up to the batch start:
-    /// the reading did not see it, so the window's mean carries a share of it as noise.
-    pub noise_after: f64,
-    pub variance_rad2: f64,
-}
-
-impl Default for CompassWindow {
-    fn default() -> Self {
-        Self {
-            n: 0,
-            sum_nu: 0.0,
-            sum_psi_from: [0.0; DIM],
-            sum_noise_at: 0.0,
-            noise_after: 0.0,
-            variance_rad2: 0.0,
-        }
-    }
-}
-
-/// Alignment: the first run of consistent compass readings.
-#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize, serde::Deserialize)]
-pub(super) struct Alignment {
-    pub done: bool,
-    /// The heading, though referred to north, is too uncertain for a linear correction:
-    /// it is being referred to north again from a run of consistent readings.
-    pub relocking: bool,
-    /// The turn applied to heading and track when they were referred to north, rad.
-    pub offset_rad: f64,
-    pub line: InnovationLine,
-}
-
 /// The fused vehicle estimator. See the module documentation.
 ///
 /// ```
@@ -235,29 +134,8 @@ pub struct VehicleEstimator {
     pub(super) initial_fix: Option<CompassFix>,
     pub(super) learner: CompassLearner,
     pub(super) clock: TimeStep,
-    pub(super) gyro: GyroTrack,
-    pub(super) motion: Motion,
-    pub(super) rest: Rest,
-    /// Seconds of driving since the wheels were last compared with the gyro.
-    pub(super) wheel_check_s: f64,
-    pub(super) gates: LearningGates,
-    pub(super) alignment: Alignment,
-    pub(super) outage: Outage,
-    pub(super) batch: StepBatch,
-    pub(super) window: CompassWindow,
-    /// Sine and cosine of the mid-step heading and of the predicted compass reading.
-    pub(super) trig: HeadingTrig,
-    pub(super) trig_compass: HeadingTrig,
-    /// Time passed since the covariance was last carried forward, s: the calibration
-    /// states' walk and the compass error's decay over it enter once, at the next epoch.
-    pub(super) pending_time_s: f64,
-    /// Rows taken since the last epoch.
-    pub(super) rows_since_epoch: u32,
-    /// When the undetermined states were last refreshed, s.
-    pub(super) unobserved_at_s: f64,
-    /// Readings up to this time are not offered to the compass learner (it has them
-    /// already: the estimator is replaying them).
-    pub(super) learned_until_s: f64,
+    /// The bookkeeping between samples.
+    pub(super) tracking: VehicleTracking,
     pub(super) est: NavEstimate,
 }
 
@@ -286,21 +164,7 @@ impl VehicleEstimator {
             initial_fix: None,
             learner: CompassLearner::new(config.compass)?,
             clock: TimeStep::new(),
-            gyro: GyroTrack::default(),
-            motion: Motion::default(),
-            rest: Rest::default(),
-            wheel_check_s: 0.0,
-            gates: LearningGates::default(),
-            alignment: Alignment::default(),
-            outage: Outage::default(),
-            batch: StepBatch::default(),
-            window: CompassWindow::default(),
-            trig: HeadingTrig::new(0.0),
-            trig_compass: HeadingTrig::new(0.0),
-            pending_time_s: 0.0,
-            rows_since_epoch: 0,
-            unobserved_at_s: f64::NEG_INFINITY,
-            learned_until_s: f64::NEG_INFINITY,
+            tracking: VehicleTracking::start(),
             est,
             config,
         })
@@ -320,7 +184,7 @@ impl VehicleEstimator {
         let mut e = Self::new(config)?;
         calibration.to_filter(&mut e.filter, &e.coeffs.prior_sigma);
         e.initial = e.filter;
-        e.gyro.restored = calibration.gyro_bias_rps.sigma > 0.0;
+        e.tracking.gyro.restored = calibration.gyro_bias_rps.sigma > 0.0;
         e.initial_fix = calibration.compass_fix();
         if let Some(fix) = e.initial_fix {
             e.compass.set_fix(fix);
@@ -332,7 +196,10 @@ impl VehicleEstimator {
     /// (`None` before): estimates made before then are relative to the start heading and
     /// become absolute when turned by it.
     pub fn alignment_offset_rad(&self) -> Option<f64> {
-        self.alignment.done.then_some(self.alignment.offset_rad)
+        self.tracking
+            .alignment
+            .done
+            .then_some(self.tracking.alignment.offset_rad)
     }
 
     /// What the estimator has learned about its sensors so far, to store and give back to
@@ -348,7 +215,7 @@ impl VehicleEstimator {
     pub(crate) fn replay_start(&self) -> Result<Self> {
         let mut e = Self::with_calibration(self.config, &self.calibration())?;
         e.learner = self.learner.clone();
-        e.learned_until_s = self.est.t_s;
+        e.tracking.learned_until_s = self.est.t_s;
         Ok(e)
     }
 
@@ -385,7 +252,7 @@ impl VehicleEstimator {
     /// The factor on the wheels' slip variance that their disagreement with the gyro has
     /// set (1: the wheels behave as their model says).
     pub fn wheel_distrust(&self) -> f64 {
-        self.gates.slip_scale2
+        self.tracking.gates.slip_scale2
     }
 
     /// The estimate at `t_s`: the heading carried on from the gyro's last reading and the
@@ -406,7 +273,7 @@ impl VehicleEstimator {
         e.heading = MagneticHeading::new(wrap_pi(psi));
         // The covariance is carried forward a few times a second; what the steps since
         // then added is composed here.
-        let sigma = self.batch.psi_variance(f).max(0.0).sqrt();
+        let sigma = self.tracking.batch.psi_variance(f).max(0.0).sqrt();
         // A heading known to no better than the whole circle is uniform on it: π/√3.
         e.heading_sigma_rad = sigma.min(UNKNOWN_HEADING_SIGMA_RAD);
         e.position_cov_m2 = if e.status.position_known {
@@ -418,7 +285,7 @@ impl VehicleEstimator {
             // may have changed by a tenth and that the last step's pulses gave to within
             // q²/12 over its interval squared (both ends quantised, two wheels averaged).
             let resolution = self.coeffs.priors.wheel_resolution_m;
-            let speed_quantum = resolution / self.motion.wheel_interval_s.max(1e-3);
+            let speed_quantum = resolution / self.tracking.motion.wheel_interval_s.max(1e-3);
             let floor = resolution * resolution / 24.0
                 + (0.1 * travel).powi(2)
                 + (ahead_s * speed_quantum).powi(2) / 12.0;
@@ -438,7 +305,7 @@ impl VehicleEstimator {
         } else {
             Matrix2::from_element(f64::INFINITY)
         };
-        e.status.heading_absolute = self.alignment.done;
+        e.status.heading_absolute = self.tracking.alignment.done;
         *e
     }
 
@@ -447,9 +314,9 @@ impl VehicleEstimator {
     /// or the heading as it stands when the wheels carry it.
     pub(super) fn heading_at(&self, t_s: f64) -> f64 {
         let psi = self.filter.x[PSI];
-        match self.gyro.last {
-            Some((t0, _)) if self.gyro.active && t_s - t0 <= self.gyro_bridge_s() => {
-                psi + self.gyro.rate_rps * (t_s - t0)
+        match self.tracking.gyro.last {
+            Some((t0, _)) if self.tracking.gyro.active && t_s - t0 <= self.gyro_bridge_s() => {
+                psi + self.tracking.gyro.rate_rps * (t_s - t0)
             }
             _ => psi,
         }
@@ -460,9 +327,9 @@ impl VehicleEstimator {
     pub(super) fn refresh_unobserved(&mut self) {
         let u = unobserved(&self.filter, &self.coeffs.prior_sigma);
         self.est.status.unobserved = Unobserved {
-            gyro_bias: self.gyro.active && u.gyro_bias,
-            gyro_gain_right: self.gyro.active && u.gyro_gain_right,
-            gyro_gain_left: self.gyro.active && u.gyro_gain_left,
+            gyro_bias: self.tracking.gyro.active && u.gyro_bias,
+            gyro_gain_right: self.tracking.gyro.active && u.gyro_gain_right,
+            gyro_gain_left: self.tracking.gyro.active && u.gyro_gain_left,
             wheel_diff: self.est.status.position_known && u.wheel_diff,
             track_scale: self.est.status.position_known && u.track_scale,
             speed_coeff: self.est.status.position_known && u.speed_coeff,
@@ -477,14 +344,14 @@ impl HeadingEstimator for VehicleEstimator {
     /// time in milliseconds) is a typed error and changes nothing.
     fn update(&mut self, sample: &VehicleSample) -> Result<NavEstimate> {
         sample.validate()?;
-        self.gates.check_time_base()?;
+        self.tracking.gates.check_time_base()?;
         if let Some(w) = &sample.wheels {
             self.wheels.check_speed(sample.t_s, w)?;
         }
         let dt = self.clock.dt_s(sample.t_s)?;
         self.est.status.gap = false;
         if let Some(dt) = dt {
-            self.pending_time_s += dt;
+            self.tracking.pending_time_s += dt;
         }
         if let Some(g) = sample.gyr_z_rps {
             self.gyro_reading(sample.t_s, g);
@@ -493,13 +360,13 @@ impl HeadingEstimator for VehicleEstimator {
             self.wheel_reading(sample.t_s, w);
         }
         self.compass_step(sample);
-        self.rows_since_epoch += 1;
-        if self.window.n >= self.config.compass.readings_per_update
-            || self.rows_since_epoch >= MAX_BATCH_ROWS
+        self.tracking.rows_since_epoch += 1;
+        if self.tracking.window.n >= self.config.compass.readings_per_update
+            || self.tracking.rows_since_epoch >= MAX_BATCH_ROWS
         {
             self.epoch();
-            if sample.t_s - self.unobserved_at_s >= UNOBSERVED_REFRESH_S {
-                self.unobserved_at_s = sample.t_s;
+            if sample.t_s - self.tracking.unobserved_at_s >= UNOBSERVED_REFRESH_S {
+                self.tracking.unobserved_at_s = sample.t_s;
                 self.refresh_unobserved();
             }
         }
@@ -518,23 +385,19 @@ impl HeadingEstimator for VehicleEstimator {
             self.compass.set_fix(fix);
         }
         self.learner.reset();
-        self.learned_until_s = f64::NEG_INFINITY;
         self.clock.reset();
-        self.gyro = GyroTrack {
-            restored: self.gyro.restored,
-            ..GyroTrack::default()
+        let t = &self.tracking;
+        self.tracking = VehicleTracking {
+            gyro: GyroTrack {
+                restored: t.gyro.restored,
+                ..GyroTrack::default()
+            },
+            // The sine-cosine caches are not learned state: they carry on from the angle
+            // they were last asked for.
+            trig: t.trig,
+            trig_compass: t.trig_compass,
+            ..VehicleTracking::start()
         };
-        self.motion = Motion::default();
-        self.rest = Rest::default();
-        self.wheel_check_s = 0.0;
-        self.gates = LearningGates::default();
-        self.alignment = Alignment::default();
-        self.outage = Outage::default();
-        self.batch = StepBatch::default();
-        self.window = CompassWindow::default();
-        self.pending_time_s = 0.0;
-        self.rows_since_epoch = 0;
-        self.unobserved_at_s = f64::NEG_INFINITY;
         let mut est = NavEstimate::at_start(f64::NAN, MagneticHeading::new(0.0), 0.0);
         est.position_cov_m2 = Matrix2::from_element(f64::INFINITY);
         self.est = est;

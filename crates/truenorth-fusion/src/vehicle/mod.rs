@@ -48,8 +48,10 @@ mod observability;
 mod seed_blend;
 mod seed_gyro_compass;
 mod seed_odometer_compass;
+mod seed_state;
 mod state;
 mod step_batch;
+mod tracking;
 mod two_pass;
 mod wheel_odometry;
 
@@ -63,7 +65,9 @@ pub use nav_filter::NavFilter;
 pub use seed_blend::{SeedBlend, SeedBlendConfig};
 pub use seed_gyro_compass::{SeedGyroCompass, SeedGyroCompassConfig};
 pub use seed_odometer_compass::{SeedOdometerCompass, SeedOdometerCompassConfig};
-pub use state::{VehicleEstimatorState, VehicleTracking};
+pub use seed_state::{SeedGyroCompassState, SeedOdometerCompassState};
+pub use state::VehicleEstimatorState;
+pub use tracking::VehicleTracking;
 pub use two_pass::{TwoPassConfig, TwoPassStart};
 pub use wheel_odometry::{
     MAX_WHEEL_SPEED_MPS, TrackModel, WheelCalibration, WheelOdometry, WheelOdometryState, WheelStep,

@@ -70,8 +70,9 @@ impl Validate for SeedBlendConfig {
     }
 }
 
-/// The blended heading and the track.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// The blended heading and the track (plain data: a seed configuration's saved state carries
+/// it whole).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct SeedBlend {
     config: SeedBlendConfig,
     /// Heading, rad (from the start heading until aligned).
@@ -114,6 +115,11 @@ impl SeedBlend {
             outliers_since: None,
             lost: false,
         })
+    }
+
+    /// The configuration in use.
+    pub fn config(&self) -> &SeedBlendConfig {
+        &self.config
     }
 
     /// Whether the heading is referred to north.

@@ -56,22 +56,22 @@ impl Validate for SeedGyroCompassConfig {
 /// The gyro-and-compass estimator of EP 0640207. See the module documentation.
 #[derive(Debug, Clone)]
 pub struct SeedGyroCompass {
-    config: SeedGyroCompassConfig,
-    wheels: WheelOdometry,
-    blend: SeedBlend,
-    turn: Option<TurnCalibrator>,
-    calibration: Option<(TurnCalibration, f64)>,
+    pub(super) config: SeedGyroCompassConfig,
+    pub(super) wheels: WheelOdometry,
+    pub(super) blend: SeedBlend,
+    pub(super) turn: Option<TurnCalibrator>,
+    pub(super) calibration: Option<(TurnCalibration, f64)>,
     /// Zero reading: the calibration's, then each standstill's mean (claims 8-9).
-    zero_rps: f64,
-    rest_sum: f64,
-    rest_n: u32,
+    pub(super) zero_rps: f64,
+    pub(super) rest_sum: f64,
+    pub(super) rest_n: u32,
     /// The last gyro reading and its time.
-    last_gyro: Option<(f64, f64)>,
+    pub(super) last_gyro: Option<(f64, f64)>,
     /// The wheels stand still.
-    at_rest: bool,
-    since_solve: u32,
-    clock: TimeStep,
-    est: NavEstimate,
+    pub(super) at_rest: bool,
+    pub(super) since_solve: u32,
+    pub(super) clock: TimeStep,
+    pub(super) est: NavEstimate,
 }
 
 impl SeedGyroCompass {

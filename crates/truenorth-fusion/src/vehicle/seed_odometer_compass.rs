@@ -65,16 +65,16 @@ impl Validate for SeedOdometerCompassConfig {
 /// The wheels-and-compass estimator of US 4,788,645. See the module documentation.
 #[derive(Debug, Clone)]
 pub struct SeedOdometerCompass {
-    config: SeedOdometerCompassConfig,
-    wheels: WheelOdometry,
-    blend: SeedBlend,
-    calibrator: BinnedEllipseCalibrator,
-    compass: Option<(CompassCalibration2d, f64)>,
-    refiner: SpeedCoefficientCalibrator,
-    clock: TimeStep,
+    pub(super) config: SeedOdometerCompassConfig,
+    pub(super) wheels: WheelOdometry,
+    pub(super) blend: SeedBlend,
+    pub(super) calibrator: BinnedEllipseCalibrator,
+    pub(super) compass: Option<(CompassCalibration2d, f64)>,
+    pub(super) refiner: SpeedCoefficientCalibrator,
+    pub(super) clock: TimeStep,
     /// The wheels stand still.
-    at_rest: bool,
-    est: NavEstimate,
+    pub(super) at_rest: bool,
+    pub(super) est: NavEstimate,
 }
 
 impl SeedOdometerCompass {

@@ -15,13 +15,9 @@ use truenorth_core::{Error, NavEstimate, Persistent, Result, TimeStep, Validate}
 use super::compass_learning::{CompassLearner, CompassLearnerState};
 use super::compass_monitor::{CompassFix, CompassMonitor, CompassMonitorState};
 use super::config::VehicleConfig;
-use super::estimator::{
-    Alignment, Coefficients, CompassWindow, GyroTrack, Motion, Outage, Rest, VehicleEstimator,
-};
-use super::heading_trig::HeadingTrig;
-use super::learning_gates::LearningGates;
+use super::estimator::{Coefficients, VehicleEstimator};
 use super::nav_filter::{DIM, NavFilter};
-use super::step_batch::StepBatch;
+use super::tracking::VehicleTracking;
 use super::wheel_odometry::{TrackModel, WheelOdometry, WheelOdometryState};
 
 #[cfg(not(feature = "std"))]
@@ -68,32 +64,6 @@ pub struct VehicleEstimatorState {
     pub learner: CompassLearnerState,
     /// The estimator's own bookkeeping between samples.
     pub tracking: VehicleTracking,
-}
-
-/// The vehicle estimator's bookkeeping between samples (the gyro's and the wheels' last
-/// steps, rest, the learning gates, the compass's alignment, outage and averaging window,
-/// the covariance steps not yet applied); opaque beyond serde.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct VehicleTracking {
-    pub(super) gyro: GyroTrack,
-    pub(super) motion: Motion,
-    pub(super) rest: Rest,
-    pub(super) wheel_check_s: f64,
-    pub(super) gates: LearningGates,
-    pub(super) alignment: Alignment,
-    pub(super) outage: Outage,
-    pub(super) batch: StepBatch,
-    pub(super) window: CompassWindow,
-    pub(super) trig: HeadingTrig,
-    pub(super) trig_compass: HeadingTrig,
-    pub(super) pending_time_s: f64,
-    pub(super) rows_since_epoch: u32,
-    /// `-inf` until the first refresh.
-    #[serde(with = "truenorth_core::extended_float::scalar")]
-    pub(super) unobserved_at_s: f64,
-    /// `-inf` unless the estimator replays readings the learner has seen.
-    #[serde(with = "truenorth_core::extended_float::scalar")]
-    pub(super) learned_until_s: f64,
 }
 
 /// Refuses a filter whose numbers are not finite, whose covariance is not symmetric (to
@@ -159,23 +129,7 @@ impl Persistent for VehicleEstimator {
             wheels: self.wheels.state(),
             compass: self.compass.state(),
             learner: self.learner.state(),
-            tracking: VehicleTracking {
-                gyro: self.gyro,
-                motion: self.motion,
-                rest: self.rest,
-                wheel_check_s: self.wheel_check_s,
-                gates: self.gates,
-                alignment: self.alignment,
-                outage: self.outage,
-                batch: self.batch,
-                window: self.window,
-                trig: self.trig,
-                trig_compass: self.trig_compass,
-                pending_time_s: self.pending_time_s,
-                rows_since_epoch: self.rows_since_epoch,
-                unobserved_at_s: self.unobserved_at_s,
-                learned_until_s: self.learned_until_s,
-            },
+            tracking: self.tracking,
         }
     }
 
@@ -187,7 +141,7 @@ impl Persistent for VehicleEstimator {
         check_estimate(&s.estimate)?;
         check_fix(s.initial_fix.as_ref())?;
         check_fix(s.compass.fix.as_ref())?;
-        let t = s.tracking;
+        let t = &s.tracking;
         if t.unobserved_at_s.is_nan() || t.learned_until_s.is_nan() {
             return Err(Error::InvalidSnapshot {
                 reason: "a saved time is not a number",
@@ -202,21 +156,7 @@ impl Persistent for VehicleEstimator {
             initial_fix: s.initial_fix,
             learner: CompassLearner::with_state(s.config.compass, s.learner)?,
             clock: s.clock,
-            gyro: t.gyro,
-            motion: t.motion,
-            rest: t.rest,
-            wheel_check_s: t.wheel_check_s,
-            gates: t.gates,
-            alignment: t.alignment,
-            outage: t.outage,
-            batch: t.batch,
-            window: t.window,
-            trig: t.trig,
-            trig_compass: t.trig_compass,
-            pending_time_s: t.pending_time_s,
-            rows_since_epoch: t.rows_since_epoch,
-            unobserved_at_s: t.unobserved_at_s,
-            learned_until_s: t.learned_until_s,
+            tracking: s.tracking,
             est: s.estimate,
             config: s.config,
         })

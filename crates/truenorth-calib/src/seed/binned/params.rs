@@ -137,89 +137,9 @@ impl ParamSearch {
     /// One evaluation's worth of the search; `Some` with the parameters (or the refusal)
     /// when it is over.
     pub(crate) fn step(&mut self) -> Option<Result<EllipsePhasors>> {
-        let step = PI / 180.0;
-        let g = 0.5 * (5f64.sqrt() - 1.0);
-        let s = |me: &Self, t: f64| me.weighted(t, false);
         self.search = match self.search {
-            Search::Scan { k, best, best_s } => {
-                let t = k as f64 * step;
-                let v = s(self, t);
-                let (best, best_s) = if v < best_s { (t, v) } else { (best, best_s) };
-                if k + 1 < 180 {
-                    Search::Scan {
-                        k: k + 1,
-                        best,
-                        best_s,
-                    }
-                } else {
-                    let (a, b) = (best - step, best + step);
-                    Search::Golden {
-                        step: 0,
-                        a,
-                        b,
-                        c: b - g * (b - a),
-                        d: a + g * (b - a),
-                        sc: None,
-                        sd: None,
-                    }
-                }
-            }
-            Search::Golden {
-                step: k,
-                a,
-                b,
-                c,
-                d,
-                sc,
-                sd,
-            } => match (sc, sd) {
-                (None, _) => Search::Golden {
-                    step: k,
-                    a,
-                    b,
-                    c,
-                    d,
-                    sc: Some(s(self, c)),
-                    sd,
-                },
-                (Some(sc), None) => Search::Golden {
-                    step: k,
-                    a,
-                    b,
-                    c,
-                    d,
-                    sc: Some(sc),
-                    sd: Some(s(self, d)),
-                },
-                (Some(sc), Some(sd)) if k < GOLDEN_STEPS => {
-                    let (a, b, c, d, sc, sd) = if sc < sd {
-                        let (b, d, sd) = (d, c, sc);
-                        let c = b - g * (b - a);
-                        (a, b, c, d, s(self, c), sd)
-                    } else {
-                        let (a, c, sc) = (c, d, sd);
-                        let d = a + g * (b - a);
-                        (a, b, c, d, sc, s(self, d))
-                    };
-                    Search::Golden {
-                        step: k + 1,
-                        a,
-                        b,
-                        c,
-                        d,
-                        sc: Some(sc),
-                        sd: Some(sd),
-                    }
-                }
-                (Some(_), Some(_)) => {
-                    // Σ R²|X'| = Σ R³|cos(φ − Ω)|.
-                    let omega = 0.5 * (a + b);
-                    Search::Sums {
-                        omega,
-                        sx: Some(self.weighted(omega, true)),
-                    }
-                }
-            },
+            Search::Scan { k, best, best_s } => self.scan_step(k, best, best_s),
+            golden @ Search::Golden { .. } => self.golden_step(golden),
             Search::Sums { omega, sx } => {
                 let sx = sx.unwrap_or_else(|| self.weighted(omega, true));
                 // Σ R²|Y'| = Σ R³|sin(φ − Ω)| = Σ R³|cos(φ − Ω − π/2)|.
@@ -228,6 +148,101 @@ impl ParamSearch {
             }
         };
         None
+    }
+
+    /// Step `k` of the 1° scan (best angle and sum so far `best`, `best_s`); after the
+    /// last, the golden section on the bracket around the best.
+    fn scan_step(&self, k: usize, best: f64, best_s: f64) -> Search {
+        let step = PI / 180.0;
+        let g = golden_ratio();
+        let t = k as f64 * step;
+        let v = self.weighted(t, false);
+        let (best, best_s) = if v < best_s { (t, v) } else { (best, best_s) };
+        if k + 1 < 180 {
+            Search::Scan {
+                k: k + 1,
+                best,
+                best_s,
+            }
+        } else {
+            let (a, b) = (best - step, best + step);
+            Search::Golden {
+                step: 0,
+                a,
+                b,
+                c: b - g * (b - a),
+                d: a + g * (b - a),
+                sc: None,
+                sd: None,
+            }
+        }
+    }
+
+    /// One evaluation of the golden section `search` (its two inner points first, then
+    /// one per step); after [`GOLDEN_STEPS`], the sums at the middle of the bracket.
+    fn golden_step(&self, search: Search) -> Search {
+        let Search::Golden {
+            step: k,
+            a,
+            b,
+            c,
+            d,
+            sc,
+            sd,
+        } = search
+        else {
+            return search;
+        };
+        let g = golden_ratio();
+        let s = |me: &Self, t: f64| me.weighted(t, false);
+        match (sc, sd) {
+            (None, _) => Search::Golden {
+                step: k,
+                a,
+                b,
+                c,
+                d,
+                sc: Some(s(self, c)),
+                sd,
+            },
+            (Some(sc), None) => Search::Golden {
+                step: k,
+                a,
+                b,
+                c,
+                d,
+                sc: Some(sc),
+                sd: Some(s(self, d)),
+            },
+            (Some(sc), Some(sd)) if k < GOLDEN_STEPS => {
+                let (a, b, c, d, sc, sd) = if sc < sd {
+                    let (b, d, sd) = (d, c, sc);
+                    let c = b - g * (b - a);
+                    (a, b, c, d, s(self, c), sd)
+                } else {
+                    let (a, c, sc) = (c, d, sd);
+                    let d = a + g * (b - a);
+                    (a, b, c, d, sc, s(self, d))
+                };
+                Search::Golden {
+                    step: k + 1,
+                    a,
+                    b,
+                    c,
+                    d,
+                    sc: Some(sc),
+                    sd: Some(sd),
+                }
+            }
+            (Some(_), Some(_)) => {
+                // Σ R²|X'| = Σ R³|cos(φ − Ω)|.
+                let omega = 0.5 * (a + b);
+                Search::Sums {
+                    omega,
+                    sx: Some(self.weighted(omega, true)),
+                }
+            }
+        }
     }
 
     fn finish(&self, omega: f64, sx: f64, sy: f64) -> Result<EllipsePhasors> {
@@ -278,4 +293,9 @@ pub fn ellipse_parameters(full: &[Vector2<f64>], origin: &Vector2<f64>) -> Resul
             return r;
         }
     }
+}
+
+/// The golden section's ratio (√5 − 1)/2.
+fn golden_ratio() -> f64 {
+    0.5 * (5f64.sqrt() - 1.0)
 }

@@ -141,61 +141,15 @@ impl RefreshJob {
 
     /// One unit of work; returns its cost in bin operations.
     fn unit(&mut self) -> usize {
-        let n = self.n;
         match self.stage {
             Stage::FullSet {
                 pass,
                 polar_ready: false,
-                next: i,
-            } => {
-                // (angle, magnitude) of each filled bin's reading about the origin, in bin
-                // order, and where each bin's nearest readings are in that list.
-                if i == 0 {
-                    self.k = 0;
-                }
-                let b = self.bins[i];
-                self.slot[i] = NO_READING;
-                if b.state != BinState::Empty {
-                    let d = b.value - self.origin;
-                    if d.norm() > 0.0 {
-                        self.polar[self.k] = (d.y.atan2(d.x), d.norm());
-                        self.slot[i] = self.k as u8;
-                        self.k += 1;
-                    }
-                }
-                if i + 1 < n {
-                    self.stage = Stage::FullSet {
-                        pass,
-                        polar_ready: false,
-                        next: i + 1,
-                    };
-                    return TRIG_COST;
-                }
-                let k = self.k;
-                if k > 0 {
-                    // Before the first reading (going round) the last one is the latest.
-                    let mut last = (k - 1) as u8;
-                    for i in 0..n {
-                        if self.slot[i] != NO_READING {
-                            last = self.slot[i];
-                        }
-                        self.last_at_or_before[i] = last;
-                    }
-                }
-                self.stage = if k < 2 {
-                    self.no_full_set()
-                } else {
-                    Stage::FullSet {
-                        pass,
-                        polar_ready: true,
-                        next: 0,
-                    }
-                };
-                TRIG_COST
-            }
+                next,
+            } => self.polar_unit(pass, next),
             Stage::FullSet { pass, next, .. } => {
                 self.full[next] = self.full_set_bin(next);
-                self.stage = if next + 1 < n {
+                self.stage = if next + 1 < self.n {
                     Stage::FullSet {
                         pass,
                         polar_ready: true,
@@ -206,30 +160,7 @@ impl RefreshJob {
                 };
                 TRIG_COST
             }
-            Stage::Rebin { pass, mean, next } => {
-                // As `rebin`, an old bin at a time.
-                if next == 0 {
-                    self.rebin_from = self.bins;
-                    self.bins = [EMPTY; MAX_BINS];
-                }
-                let b = self.rebin_from[next];
-                rebin_one(&mut self.bins, n, &b, &mean);
-                self.stage = if next + 1 < n {
-                    Stage::Rebin {
-                        pass,
-                        mean,
-                        next: next + 1,
-                    }
-                } else {
-                    self.origin = mean;
-                    Stage::FullSet {
-                        pass: pass + 1,
-                        polar_ready: false,
-                        next: 0,
-                    }
-                };
-                TRIG_COST
-            }
+            Stage::Rebin { pass, mean, next } => self.rebin_unit(pass, mean, next),
             Stage::Params => {
                 let r = match self.search.as_mut() {
                     Some(s) => s.step(),
@@ -242,10 +173,86 @@ impl RefreshJob {
                     self.result = Some(r);
                     self.stage = Stage::Done;
                 }
-                n
+                self.n
             }
             Stage::Done => 0,
         }
+    }
+
+    /// One bin `i` of pass `pass` into polar form: (angle, magnitude) of each filled bin's
+    /// reading about the origin, in bin order, and, after the last bin, where each bin's
+    /// nearest readings are in that list.
+    fn polar_unit(&mut self, pass: usize, i: usize) -> usize {
+        let n = self.n;
+        if i == 0 {
+            self.k = 0;
+        }
+        let b = self.bins[i];
+        self.slot[i] = NO_READING;
+        if b.state != BinState::Empty {
+            let d = b.value - self.origin;
+            if d.norm() > 0.0 {
+                self.polar[self.k] = (d.y.atan2(d.x), d.norm());
+                self.slot[i] = self.k as u8;
+                self.k += 1;
+            }
+        }
+        if i + 1 < n {
+            self.stage = Stage::FullSet {
+                pass,
+                polar_ready: false,
+                next: i + 1,
+            };
+            return TRIG_COST;
+        }
+        let k = self.k;
+        if k > 0 {
+            // Before the first reading (going round) the last one is the latest.
+            let mut last = (k - 1) as u8;
+            for i in 0..n {
+                if self.slot[i] != NO_READING {
+                    last = self.slot[i];
+                }
+                self.last_at_or_before[i] = last;
+            }
+        }
+        self.stage = if k < 2 {
+            self.no_full_set()
+        } else {
+            Stage::FullSet {
+                pass,
+                polar_ready: true,
+                next: 0,
+            }
+        };
+        TRIG_COST
+    }
+
+    /// Old bin `next` of pass `pass` re-binned about `mean` (as `rebin`, an old bin at a
+    /// time); after the last, the next pass starts about `mean`.
+    fn rebin_unit(&mut self, pass: usize, mean: Vector2<f64>, next: usize) -> usize {
+        let n = self.n;
+        if next == 0 {
+            self.rebin_from = self.bins;
+            self.bins = [EMPTY; MAX_BINS];
+        }
+        let b = self.rebin_from[next];
+        rebin_one(&mut self.bins, n, &b, &mean);
+        self.stage = if next + 1 < n {
+            Stage::Rebin {
+                pass,
+                mean,
+                next: next + 1,
+            }
+        } else {
+            self.origin = mean;
+            Stage::FullSet {
+                pass: pass + 1,
+                polar_ready: false,
+                next: 0,
+            }
+        };
+        TRIG_COST
     }
 
     /// No full set (fewer than two readings off the origin). In an iteration pass this ends

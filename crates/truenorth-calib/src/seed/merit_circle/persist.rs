@@ -100,48 +100,8 @@ impl Persistent for MeritCircleCalibrator {
     fn from_state(state: MeritCircleSaved) -> Result<Self> {
         let s = state;
         s.config.validate()?;
-        let invalid = |reason| Err(Error::InvalidSnapshot { reason });
-        let st = &s.stats;
-        let vectors_finite = s
-            .prev
-            .iter()
-            .chain(&s.last_point)
-            .chain(&s.ring)
-            .all(finite2)
-            && s.range.iter().all(|(a, b)| finite2(a) && finite2(b))
-            && st.centre.iter().all(finite2)
-            && finite2(&st.centre_mean);
-        let scalars_ok = [
-            s.step_sum,
-            s.centre_m2,
-            st.centre_mse,
-            st.weight,
-            st.last_merit,
-        ]
-        .iter()
-        .all(|x| x.is_finite() && *x >= 0.0);
-        if !(vectors_finite && scalars_ok) {
-            return invalid("a merit-circle value is negative or not finite");
-        }
-        if s.ring.len() > RING
-            || s.ring_next >= RING
-            || (s.ring.len() < RING && s.ring_next != s.ring.len())
-        {
-            return invalid("the merit-circle ring of data points is inconsistent");
-        }
-        if st.centres + st.degenerate_triples > st.data_points
-            || st.data_points > s.samples
-            || (st.centres > 0) != st.centre.is_some()
-            || (s.samples > 0) != s.range.is_some()
-            || (s.samples > 0) != s.prev.is_some()
-        {
-            return invalid("the merit-circle counts do not fit together");
-        }
-        if let Some(e) = &s.estimate
-            && !(e.params.hard_iron.iter().chain(e.params.soft_iron.iter())).all(|x| x.is_finite())
-        {
-            return invalid("the merit-circle estimate is not finite");
-        }
+        check_values(&s)?;
+        check_counts(&s)?;
         let slots = DirectionSlots::from_slice(&s.slots).ok_or(Error::InvalidSnapshot {
             reason: "the merit-circle direction slots must be 72 finite readings or empty",
         })?;
@@ -163,27 +123,91 @@ impl Persistent for MeritCircleCalibrator {
         c.estimate = s.estimate;
         c.refresh_due = s.refresh_due;
         if let Some(r) = &s.refresh {
-            let cal = &r.calibration;
-            if !(r.points.iter().all(finite2)
-                && cal
-                    .hard_iron
-                    .iter()
-                    .chain(cal.soft_iron.iter())
-                    .all(|x| x.is_finite())
-                && r.field > 0.0
-                && r.field.is_finite())
-                || r.points.len() > SLOTS
-                || r.steps >= SeedJob::STEPS
-                || r.samples_used > s.samples
-            {
-                return invalid("the saved merit-circle refresh in progress is inconsistent");
-            }
-            let mut job = SeedJob::start(&r.points, cal, r.field, r.samples_used);
-            for _ in 0..r.steps {
-                job.step();
-            }
-            c.seed = Some(job);
+            c.seed = Some(resume_refresh(r, s.samples)?);
         }
         Ok(c)
     }
+}
+
+/// Refuses a saved merit circle with a reading, range, centre or estimate that is not
+/// finite, or a sum or statistic that is negative or not finite.
+fn check_values(s: &MeritCircleSaved) -> Result<()> {
+    let invalid = |reason| Err(Error::InvalidSnapshot { reason });
+    let st = &s.stats;
+    let vectors_finite = s
+        .prev
+        .iter()
+        .chain(&s.last_point)
+        .chain(&s.ring)
+        .all(finite2)
+        && s.range.iter().all(|(a, b)| finite2(a) && finite2(b))
+        && st.centre.iter().all(finite2)
+        && finite2(&st.centre_mean);
+    let scalars_ok = [
+        s.step_sum,
+        s.centre_m2,
+        st.centre_mse,
+        st.weight,
+        st.last_merit,
+    ]
+    .iter()
+    .all(|x| x.is_finite() && *x >= 0.0);
+    if !(vectors_finite && scalars_ok) {
+        return invalid("a merit-circle value is negative or not finite");
+    }
+    Ok(())
+}
+
+/// Refuses a saved merit circle whose ring of data points or counts do not fit together,
+/// or whose estimate is not finite.
+fn check_counts(s: &MeritCircleSaved) -> Result<()> {
+    let invalid = |reason| Err(Error::InvalidSnapshot { reason });
+    let st = &s.stats;
+    if s.ring.len() > RING
+        || s.ring_next >= RING
+        || (s.ring.len() < RING && s.ring_next != s.ring.len())
+    {
+        return invalid("the merit-circle ring of data points is inconsistent");
+    }
+    if st.centres + st.degenerate_triples > st.data_points
+        || st.data_points > s.samples
+        || (st.centres > 0) != st.centre.is_some()
+        || (s.samples > 0) != s.range.is_some()
+        || (s.samples > 0) != s.prev.is_some()
+    {
+        return invalid("the merit-circle counts do not fit together");
+    }
+    if let Some(e) = &s.estimate
+        && !(e.params.hard_iron.iter().chain(e.params.soft_iron.iter())).all(|x| x.is_finite())
+    {
+        return invalid("the merit-circle estimate is not finite");
+    }
+    Ok(())
+}
+
+/// The refresh in progress, restarted and replayed to the step it was saved at, after
+/// checking it against the `samples` pushed.
+fn resume_refresh(r: &MeritRefreshSaved, samples: usize) -> Result<SeedJob> {
+    let cal = &r.calibration;
+    if !(r.points.iter().all(finite2)
+        && cal
+            .hard_iron
+            .iter()
+            .chain(cal.soft_iron.iter())
+            .all(|x| x.is_finite())
+        && r.field > 0.0
+        && r.field.is_finite())
+        || r.points.len() > SLOTS
+        || r.steps >= SeedJob::STEPS
+        || r.samples_used > samples
+    {
+        return Err(Error::InvalidSnapshot {
+            reason: "the saved merit-circle refresh in progress is inconsistent",
+        });
+    }
+    let mut job = SeedJob::start(&r.points, cal, r.field, r.samples_used);
+    for _ in 0..r.steps {
+        job.step();
+    }
+    Ok(job)
 }

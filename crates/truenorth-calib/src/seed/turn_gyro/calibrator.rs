@@ -1,35 +1,5 @@
-//! The whole one-turn calibration of EP 0640207: the gyro's zero reading
-//! and conversion constant together with the compass's centre and radii, from a record that
-//! starts at rest and turns through at least one revolution.
-//!
-//! 1. **Zero reading** (claims 8-9): the gyro's mean output while the vehicle stands before
-//!    the turn. The standstill is found afterwards, in constant memory: the first minute is
-//!    kept as quarter-second block summaries, and the leading blocks whose magnetometer
-//!    reading stays within 3 % of the turn's swing of the first one are the standstill.
-//! 2. **Relative heading** `G = ∫(raw − zero) dt` (trapezoid rule), in raw units. It is kept
-//!    as `∫raw dt` and the time, so that the zero can be found after the fact.
-//! 3. **Conversion constant** (claims 1, 6, 7): `G` at an X maximum and the X minimum of the
-//!    same revolution differ by half a turn, so `k = |ΔG|/π` (raw rad per rad); the same for
-//!    Y; the constant is the mean of the X and Y means. The patent reads `G` at the sample
-//!    where each extremum occurs; a cosine is so flat at its peak that, with 1 % noise, that
-//!    sample may lie ten degrees from it (a 5 % error in `k`). Here each extremum is placed
-//!    by fitting `a + b cos u + c sin u` (a sinusoid of one turn per revolution, whatever
-//!    the soft iron) to the readings within ±60° of `G` around it, twice, re-centred on the
-//!    first fit's peak; linear least squares, exact for a noise-free locus, which brings the
-//!    error to about a tenth of a degree.
-//! 4. **Compass** (claims 4, 5, 10): centre `(max + min)/2` and radii `(max − min)/2` from the
-//!    same extrema ([`crate::TurnCompassCalibrator`] and this share [`TurnExtrema`]), with
-//!    each extremum's value read off the fitted sinusoid rather than the largest noisy
-//!    sample, which noise biases outwards.
-//!
-//! The gain found is that of the direction turned (a cheap gyro's gains often differ by a
-//! percent between directions); the calibration applies it to both directions.
-//!
-//! Refusals: no standstill of at least [`MIN_REST_S`] at the start, a turn under 360°, an
-//! extremum at the edge of the record, a turn that reverses, fewer than two readings on
-//! either side of an extremum to place it, and (at the sample after it) a step between
-//! samples longer than [`TurnConfig::max_gap_s`], across which the rate cannot be
-//! integrated: the calibrator never pairs extrema across a gap.
+//! The gyro-and-compass turn calibrator of EP 0640207: the standstill's zero reading, the
+//! extrema placed on the relative heading, the conversion constant and the compass from them.
 
 use core::f64::consts::PI;
 
@@ -58,7 +28,7 @@ pub const MIN_REST_S: f64 = 1.0;
 const BLOCK_S: f64 = 0.25;
 
 /// Blocks kept of the leading record (one minute).
-const BLOCKS: usize = 240;
+pub(super) const BLOCKS: usize = 240;
 
 /// A block belongs to the standstill while its magnetometer reading is within this share of
 /// the turn's swing (half the peak-to-peak range) of the first block's (3 %: 1.7° of turn,
@@ -75,7 +45,7 @@ const REST_MARGIN_BLOCKS: usize = 2;
 
 /// Readings kept for placing extrema, one per [`SPACING_RAD`] of relative heading: 320
 /// cover 160°, enough for ±60° around an extremum with room to spare.
-const RING: usize = 320;
+pub(super) const RING: usize = 320;
 
 /// Relative heading between two kept readings, rad (0.5°).
 const SPACING_RAD: f64 = 0.5 * PI / 180.0;
@@ -84,10 +54,10 @@ const SPACING_RAD: f64 = 0.5 * PI / 180.0;
 const WINDOW_RAD: f64 = 60.0 * PI / 180.0;
 
 /// Extrema confirmed but waiting for the readings on their far side, per axis.
-const PENDING: usize = 8;
+pub(super) const PENDING: usize = 8;
 
 /// Extrema placed per axis (one revolution gives two).
-const PLACED: usize = 64;
+pub(super) const PLACED: usize = 64;
 
 /// One sample of a turn: the raw yaw rate and the raw two-axis compass.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -154,17 +124,17 @@ struct PairSums {
 }
 
 /// A summary of a quarter second of the leading record.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
-struct Block {
-    gyro_sum: f64,
-    gyro_sq: f64,
-    mag_sum: Vector2<f64>,
-    n: u32,
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub(super) struct Block {
+    pub(super) gyro_sum: f64,
+    pub(super) gyro_sq: f64,
+    pub(super) mag_sum: Vector2<f64>,
+    pub(super) n: u32,
 }
 
 /// One kept reading for placing extrema.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
-struct Kept {
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub(super) struct Kept {
     at: RawHeading,
     mag: Vector2<f64>,
 }
@@ -196,27 +166,27 @@ struct Kept {
 /// ```
 #[derive(Debug, Clone)]
 pub struct TurnCalibrator {
-    config: TurnConfig,
-    extrema: TurnExtrema<RawHeading>,
-    slots: DirectionSlots,
-    clock: TimeStep,
-    t0: Option<f64>,
-    last_rate: f64,
-    at: RawHeading,
-    blocks: [Block; BLOCKS],
-    ring: [Kept; RING],
-    ring_len: usize,
-    ring_next: usize,
-    last_kept_integral: f64,
+    pub(super) config: TurnConfig,
+    pub(super) extrema: TurnExtrema<RawHeading>,
+    pub(super) slots: DirectionSlots,
+    pub(super) clock: TimeStep,
+    pub(super) t0: Option<f64>,
+    pub(super) last_rate: f64,
+    pub(super) at: RawHeading,
+    pub(super) blocks: [Block; BLOCKS],
+    pub(super) ring: [Kept; RING],
+    pub(super) ring_len: usize,
+    pub(super) ring_next: usize,
+    pub(super) last_kept_integral: f64,
     /// Extrema placed so far, per axis: (sample index, placed relative heading G*, value).
-    placed: [[(usize, f64, f64); PLACED]; 2],
-    placed_len: [usize; 2],
+    pub(super) placed: [[(usize, f64, f64); PLACED]; 2],
+    pub(super) placed_len: [usize; 2],
     /// Confirmed extrema waiting to be placed, per axis: (sample index, G at the sample,
     /// maximum or not).
-    pending: [[(usize, f64, bool); PENDING]; 2],
-    pending_len: [usize; 2],
-    confirmed: [usize; 2],
-    zero: Option<(f64, f64, f64)>,
+    pub(super) pending: [[(usize, f64, bool); PENDING]; 2],
+    pub(super) pending_len: [usize; 2],
+    pub(super) confirmed: [usize; 2],
+    pub(super) zero: Option<(f64, f64, f64)>,
 }
 
 impl TurnCalibrator {
@@ -228,7 +198,7 @@ impl TurnCalibrator {
 
     /// A calibrator that has seen nothing, from a validated `config` and its empty extremum
     /// trackers (so that `reset` cannot fail).
-    fn fresh(config: TurnConfig, extrema: TurnExtrema<RawHeading>) -> Self {
+    pub(super) fn fresh(config: TurnConfig, extrema: TurnExtrema<RawHeading>) -> Self {
         Self {
             config,
             extrema,
@@ -249,6 +219,11 @@ impl TurnCalibrator {
             confirmed: [0; 2],
             zero: None,
         }
+    }
+
+    /// The configuration in use.
+    pub fn config(&self) -> &TurnConfig {
+        &self.config
     }
 
     /// The gyro's zero reading (rad/s), its standard deviation and the standstill's length
