@@ -107,17 +107,17 @@ pub use seed::binned::{BinState, MAX_BINS, ellipse_parameters};
 pub use seed::binned::{
     BinnedEllipseCalibrator, BinnedEllipseConfig, MAX_INIT_SAMPLES, MAX_UPDATE_PUSHES, UpdatePhase,
 };
-pub use seed::binned::{BinnedEllipseSaved, BinnedUpdateSaved};
+pub use seed::binned::{BinnedEllipseCalibratorState, BinnedUpdateState};
 pub use seed::merit_circle::{
-    MERIT_CIRCLE_MIN_ARC_DEG, MeritCircleCalibrator, MeritCircleConfig, MeritCircleSaved,
+    MERIT_CIRCLE_MIN_ARC_DEG, MeritCircleCalibrator, MeritCircleCalibratorState, MeritCircleConfig,
     MeritCircleState, RING,
 };
 pub use seed::speed_coefficient::{
     SpeedCoefficientCalibrator, SpeedCoefficientConfig, SpeedCoefficientState, SpeedStep,
 };
 pub use seed::turn::{
-    DEFAULT_MAX_GAP_S, MIN_TURN_SAMPLES, TurnCompassCalibrator, TurnConfig, TurnEllipse,
-    TurnExtrema, TurnExtremaSaved, TurnSaved, TurnTag,
+    DEFAULT_MAX_GAP_S, MIN_TURN_SAMPLES, TurnCompassCalibrator, TurnCompassCalibratorState,
+    TurnConfig, TurnEllipse, TurnExtrema, TurnExtremaState, TurnTag,
 };
 pub use seed::turn_gyro::{
     MIN_REST_S, RawHeading, TurnCalibration, TurnCalibrator, TurnCalibratorState, TurnQuality,

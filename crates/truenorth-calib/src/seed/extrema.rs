@@ -346,7 +346,7 @@ impl<T: Copy> ExtremumTracker<T> {
 /// The saved state of an [`ExtremumTracker`]: everything it has learned, with its
 /// configuration. Opaque; restore it with [`ExtremumTracker::from_saved`].
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct ExtremumTrackerSaved<T> {
+pub struct ExtremumTrackerState<T> {
     config: ExtremaConfig,
     phase: Option<Phase<T>>,
     ring: Vec<Option<Extremum<T>>>,
@@ -361,8 +361,8 @@ pub struct ExtremumTrackerSaved<T> {
 
 impl<T: Copy> ExtremumTracker<T> {
     /// The saved state.
-    pub fn saved(&self) -> ExtremumTrackerSaved<T> {
-        ExtremumTrackerSaved {
+    pub fn saved(&self) -> ExtremumTrackerState<T> {
+        ExtremumTrackerState {
             config: self.config,
             phase: self.phase,
             ring: self.ring.to_vec(),
@@ -377,7 +377,7 @@ impl<T: Copy> ExtremumTracker<T> {
 
     /// Rebuilds a tracker from [`Self::saved`], refusing an invalid configuration or
     /// values that are not finite or do not fit together.
-    pub fn from_saved(s: ExtremumTrackerSaved<T>) -> Result<Self> {
+    pub fn from_saved(s: ExtremumTrackerState<T>) -> Result<Self> {
         s.config.validate()?;
         let invalid = |reason| Err(Error::InvalidSnapshot { reason });
         if s.ring.len() != MAX_EXTREMA {

@@ -8,8 +8,8 @@
 
 use serde::{Deserialize, Serialize};
 use truenorth_calib::{
-    BinnedEllipseCalibrator, BinnedEllipseSaved, SpeedCoefficientCalibrator, SpeedCoefficientState,
-    TurnCalibration, TurnCalibrator, TurnCalibratorState,
+    BinnedEllipseCalibrator, BinnedEllipseCalibratorState, SpeedCoefficientCalibrator,
+    SpeedCoefficientState, TurnCalibration, TurnCalibrator, TurnCalibratorState,
 };
 use truenorth_compass::CompassCalibration2d;
 use truenorth_core::extended_float::check_plain_numbers_finite;
@@ -97,7 +97,7 @@ pub struct SeedOdometerCompassState {
     /// The blended heading and the track (opaque beyond serde).
     pub blend: SeedBlend,
     /// The binned-ellipse compass calibrator.
-    pub calibrator: BinnedEllipseSaved,
+    pub calibrator: BinnedEllipseCalibratorState,
     /// The compass calibration in use and the field in the compass's unit, if any.
     pub compass: Option<(CompassCalibration2d, f64)>,
     /// The speed-coefficient refiner.

@@ -15,4 +15,4 @@ pub use calibrator::{
     BinnedEllipseCalibrator, BinnedEllipseConfig, MAX_INIT_SAMPLES, MAX_UPDATE_PUSHES, UpdatePhase,
 };
 pub use params::ellipse_parameters;
-pub use persist::{BinnedEllipseSaved, BinnedUpdateSaved};
+pub use persist::{BinnedEllipseCalibratorState, BinnedUpdateState};

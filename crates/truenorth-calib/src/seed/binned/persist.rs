@@ -23,7 +23,7 @@ use crate::seed::seed_quality::SeedJob;
 
 /// A full-set update in progress, as saved (opaque).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct BinnedUpdateSaved {
+pub struct BinnedUpdateState {
     start_bins: Vec<Bin>,
     start_origin: Vector2<f64>,
     budget: usize,
@@ -37,7 +37,7 @@ pub struct BinnedUpdateSaved {
 /// The saved state of a [`BinnedEllipseCalibrator`] ([`Persistent::State`]). Plain data
 /// without infinities; the bins and any update in progress are opaque.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct BinnedEllipseSaved {
+pub struct BinnedEllipseCalibratorState {
     /// The configuration.
     pub config: BinnedEllipseConfig,
     bins: Vec<Bin>,
@@ -55,7 +55,7 @@ pub struct BinnedEllipseSaved {
     pub restarts: usize,
     /// The current estimate.
     pub estimate: Option<Solution<CompassCalibration2d>>,
-    update: Option<BinnedUpdateSaved>,
+    update: Option<BinnedUpdateState>,
     backlog: Vec<Vector2<f64>>,
 }
 
@@ -89,12 +89,12 @@ fn bins_from(saved: &[Bin], n: usize) -> Result<Bins> {
 }
 
 impl Persistent for BinnedEllipseCalibrator {
-    type State = BinnedEllipseSaved;
+    type State = BinnedEllipseCalibratorState;
     const SNAPSHOT_VERSION: u32 = 3;
 
-    fn state(&self) -> BinnedEllipseSaved {
+    fn state(&self) -> BinnedEllipseCalibratorState {
         let n = self.config.bins;
-        BinnedEllipseSaved {
+        BinnedEllipseCalibratorState {
             config: self.config,
             bins: self.bins[..n].to_vec(),
             origin: self.origin,
@@ -106,7 +106,7 @@ impl Persistent for BinnedEllipseCalibrator {
             restored: self.restored,
             restarts: self.restarts,
             estimate: self.estimate,
-            update: self.update.as_ref().map(|u| BinnedUpdateSaved {
+            update: self.update.as_ref().map(|u| BinnedUpdateState {
                 start_bins: u.start_bins[..n].to_vec(),
                 start_origin: u.start_origin,
                 budget: u.budget,
@@ -120,7 +120,7 @@ impl Persistent for BinnedEllipseCalibrator {
         }
     }
 
-    fn from_state(state: BinnedEllipseSaved) -> Result<Self> {
+    fn from_state(state: BinnedEllipseCalibratorState) -> Result<Self> {
         let s = state;
         s.config.validate()?;
         let n = s.config.bins;
@@ -155,7 +155,7 @@ fn invalid<T>(reason: &'static str) -> Result<T> {
 }
 
 /// Every saved reading finite and every array of its configured length.
-fn check_readings(s: &BinnedEllipseSaved, n: usize) -> Result<()> {
+fn check_readings(s: &BinnedEllipseCalibratorState, n: usize) -> Result<()> {
     if !(s.origin.iter().all(finite2)
         && s.init.iter().all(finite2)
         && s.reference.iter().flatten().all(finite2))
@@ -169,7 +169,7 @@ fn check_readings(s: &BinnedEllipseSaved, n: usize) -> Result<()> {
 }
 
 /// The origin, initial readings, bins, phasors and estimate of one stage of the method.
-fn check_stage(s: &BinnedEllipseSaved, bins: &[Bin]) -> Result<()> {
+fn check_stage(s: &BinnedEllipseCalibratorState, bins: &[Bin]) -> Result<()> {
     // Before the origin exists the initial readings are being collected; after, they
     // were averaged and binned.
     let init_ok = match s.origin {
@@ -197,7 +197,7 @@ fn check_stage(s: &BinnedEllipseSaved, bins: &[Bin]) -> Result<()> {
 }
 
 /// Readings wait only after an update was applied, never during one.
-fn check_backlog(s: &BinnedEllipseSaved) -> Result<()> {
+fn check_backlog(s: &BinnedEllipseCalibratorState) -> Result<()> {
     if s.backlog.len() >= MAX_UPDATE_PUSHES
         || (!s.backlog.is_empty() && s.update.is_some())
         || !s.backlog.iter().all(finite2)
@@ -211,7 +211,7 @@ fn check_backlog(s: &BinnedEllipseSaved) -> Result<()> {
 /// (the refresh job is not saved: replaying rebuilds it exactly), refused where the saved
 /// counts cannot come from a real run.
 fn replay_update(
-    u: BinnedUpdateSaved,
+    u: BinnedUpdateState,
     config: &BinnedEllipseConfig,
     c: &BinnedEllipseCalibrator,
 ) -> Result<Update> {

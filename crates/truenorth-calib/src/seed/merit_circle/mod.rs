@@ -10,4 +10,4 @@ mod tests;
 
 pub use calibrator::{MeritCircleCalibrator, MeritCircleState};
 pub use config::{MERIT_CIRCLE_MIN_ARC_DEG, MeritCircleConfig, RING};
-pub use persist::MeritCircleSaved;
+pub use persist::MeritCircleCalibratorState;

@@ -20,7 +20,7 @@ use crate::seed::merit_circle::config::RING;
 /// configuration and everything it has learned. Unset values are `None` (never an infinity),
 /// so the state is plain JSON-friendly data.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct MeritCircleSaved {
+pub struct MeritCircleCalibratorState {
     /// The configuration.
     pub config: MeritCircleConfig,
     /// Samples pushed.
@@ -50,13 +50,13 @@ pub struct MeritCircleSaved {
     pub refresh_due: bool,
     /// The quality report of a refresh in progress (opaque).
     #[serde(default)]
-    refresh: Option<MeritRefreshSaved>,
+    refresh: Option<MeritRefreshState>,
 }
 
 /// A refresh of the merit-circle estimate in progress, as saved: what its quality report
 /// assesses and how many of its steps are done (restoring replays them).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct MeritRefreshSaved {
+pub struct MeritRefreshState {
     points: Vec<Vector2<f64>>,
     calibration: CompassCalibration2d,
     field: f64,
@@ -69,11 +69,11 @@ fn finite2(v: &Vector2<f64>) -> bool {
 }
 
 impl Persistent for MeritCircleCalibrator {
-    type State = MeritCircleSaved;
+    type State = MeritCircleCalibratorState;
     const SNAPSHOT_VERSION: u32 = 2;
 
-    fn state(&self) -> MeritCircleSaved {
-        MeritCircleSaved {
+    fn state(&self) -> MeritCircleCalibratorState {
+        MeritCircleCalibratorState {
             config: self.config,
             samples: self.samples,
             prev: self.prev,
@@ -87,7 +87,7 @@ impl Persistent for MeritCircleCalibrator {
             slots: self.slots.to_vec(),
             estimate: self.estimate,
             refresh_due: self.refresh_due,
-            refresh: self.seed.as_ref().map(|j| MeritRefreshSaved {
+            refresh: self.seed.as_ref().map(|j| MeritRefreshState {
                 points: j.points().to_vec(),
                 calibration: *j.calibration(),
                 field: j.field(),
@@ -97,7 +97,7 @@ impl Persistent for MeritCircleCalibrator {
         }
     }
 
-    fn from_state(state: MeritCircleSaved) -> Result<Self> {
+    fn from_state(state: MeritCircleCalibratorState) -> Result<Self> {
         let s = state;
         s.config.validate()?;
         check_values(&s)?;
@@ -131,7 +131,7 @@ impl Persistent for MeritCircleCalibrator {
 
 /// Refuses a saved merit circle with a reading, range, centre or estimate that is not
 /// finite, or a sum or statistic that is negative or not finite.
-fn check_values(s: &MeritCircleSaved) -> Result<()> {
+fn check_values(s: &MeritCircleCalibratorState) -> Result<()> {
     let invalid = |reason| Err(Error::InvalidSnapshot { reason });
     let st = &s.stats;
     let vectors_finite = s
@@ -160,7 +160,7 @@ fn check_values(s: &MeritCircleSaved) -> Result<()> {
 
 /// Refuses a saved merit circle whose ring of data points or counts do not fit together,
 /// or whose estimate is not finite.
-fn check_counts(s: &MeritCircleSaved) -> Result<()> {
+fn check_counts(s: &MeritCircleCalibratorState) -> Result<()> {
     let invalid = |reason| Err(Error::InvalidSnapshot { reason });
     let st = &s.stats;
     if s.ring.len() > RING
@@ -187,7 +187,7 @@ fn check_counts(s: &MeritCircleSaved) -> Result<()> {
 
 /// The refresh in progress, restarted and replayed to the step it was saved at, after
 /// checking it against the `samples` pushed.
-fn resume_refresh(r: &MeritRefreshSaved, samples: usize) -> Result<SeedJob> {
+fn resume_refresh(r: &MeritRefreshState, samples: usize) -> Result<SeedJob> {
     let cal = &r.calibration;
     if !(r.points.iter().all(finite2)
         && cal

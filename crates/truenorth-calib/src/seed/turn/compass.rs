@@ -19,7 +19,7 @@ use crate::quality::{calibrated_coverage_2d, require_arc};
 use crate::seed::seed_quality::seed_assessment;
 
 use super::config::TurnConfig;
-use super::turn_extrema::{TurnEllipse, TurnExtrema, TurnExtremaSaved};
+use super::turn_extrema::{TurnEllipse, TurnExtrema, TurnExtremaState};
 
 /// The compass half of the turn calibrator: centre and radii from the extrema of one or more
 /// full turns (EP 0640207 claims 4, 5, 10). Push allocates nothing.
@@ -157,11 +157,11 @@ impl Calibrator for TurnCompassCalibrator {
 /// The saved state of a [`TurnCompassCalibrator`] ([`Persistent::State`]): configuration,
 /// extremum trackers, the kept readings and the last timestamp.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct TurnSaved {
+pub struct TurnCompassCalibratorState {
     /// The configuration.
     pub config: TurnConfig,
     /// The extremum trackers (opaque).
-    pub extrema: TurnExtremaSaved<f64>,
+    pub extrema: TurnExtremaState<f64>,
     /// The kept readings by direction slot (72 entries, `None` where empty).
     pub slots: Vec<Option<Vector2<f64>>>,
     /// The last accepted timestamp, seconds.
@@ -169,11 +169,11 @@ pub struct TurnSaved {
 }
 
 impl Persistent for TurnCompassCalibrator {
-    type State = TurnSaved;
+    type State = TurnCompassCalibratorState;
     const SNAPSHOT_VERSION: u32 = 1;
 
-    fn state(&self) -> TurnSaved {
-        TurnSaved {
+    fn state(&self) -> TurnCompassCalibratorState {
+        TurnCompassCalibratorState {
             config: self.config,
             extrema: self.extrema.saved(),
             slots: self.slots.to_vec(),
@@ -181,7 +181,7 @@ impl Persistent for TurnCompassCalibrator {
         }
     }
 
-    fn from_state(state: TurnSaved) -> Result<Self> {
+    fn from_state(state: TurnCompassCalibratorState) -> Result<Self> {
         let s = state;
         s.config.validate()?;
         let extrema = TurnExtrema::from_saved(s.extrema)?;

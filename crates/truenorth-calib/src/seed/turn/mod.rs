@@ -35,6 +35,6 @@ pub(crate) mod config;
 mod tests;
 pub(crate) mod turn_extrema;
 
-pub use compass::{TurnCompassCalibrator, TurnSaved};
+pub use compass::{TurnCompassCalibrator, TurnCompassCalibratorState};
 pub use config::{DEFAULT_MAX_GAP_S, TurnConfig};
-pub use turn_extrema::{MIN_TURN_SAMPLES, TurnEllipse, TurnExtrema, TurnExtremaSaved, TurnTag};
+pub use turn_extrema::{MIN_TURN_SAMPLES, TurnEllipse, TurnExtrema, TurnExtremaState, TurnTag};

@@ -10,7 +10,7 @@ use truenorth_compass::CompassCalibration2d;
 use truenorth_core::{Error, Result, Validate, angle_diff, check_finite2};
 
 use crate::seed::extrema::{
-    ExtremaConfig, ExtremumKind, ExtremumTracker, ExtremumTrackerSaved, HalfTurnPair, MAX_EXTREMA,
+    ExtremaConfig, ExtremumKind, ExtremumTracker, ExtremumTrackerState, HalfTurnPair, MAX_EXTREMA,
 };
 
 #[cfg(not(feature = "std"))]
@@ -107,8 +107,8 @@ impl<T: Copy> TurnExtrema<T> {
     }
 
     /// The saved state.
-    pub fn saved(&self) -> TurnExtremaSaved<T> {
-        TurnExtremaSaved {
+    pub fn saved(&self) -> TurnExtremaState<T> {
+        TurnExtremaState {
             x: self.x.saved(),
             y: self.y.saved(),
             first: self.first,
@@ -118,7 +118,7 @@ impl<T: Copy> TurnExtrema<T> {
     }
 
     /// Rebuilds the trackers from [`Self::saved`], refusing invalid or inconsistent values.
-    pub fn from_saved(s: TurnExtremaSaved<T>) -> Result<Self> {
+    pub fn from_saved(s: TurnExtremaState<T>) -> Result<Self> {
         let finite = |v: &Vector2<f64>| v.x.is_finite() && v.y.is_finite();
         let t = Self {
             x: ExtremumTracker::from_saved(s.x)?,
@@ -347,9 +347,9 @@ impl<T: Copy> TurnExtrema<T> {
 
 /// The saved state of a [`TurnExtrema`] (opaque; see [`TurnExtrema::from_saved`]).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct TurnExtremaSaved<T> {
-    x: ExtremumTrackerSaved<TurnTag<T>>,
-    y: ExtremumTrackerSaved<TurnTag<T>>,
+pub struct TurnExtremaState<T> {
+    x: ExtremumTrackerState<TurnTag<T>>,
+    y: ExtremumTrackerState<TurnTag<T>>,
     first: Option<Vector2<f64>>,
     last: Option<Vector2<f64>>,
     samples: usize,

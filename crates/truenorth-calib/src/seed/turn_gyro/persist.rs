@@ -10,7 +10,7 @@ use truenorth_core::extended_float::check_plain_numbers_finite;
 use truenorth_core::{Error, Persistent, Result, TimeStep, Validate};
 
 use crate::numerics::direction_slots::DirectionSlots;
-use crate::seed::turn::{TurnConfig, TurnExtrema, TurnExtremaSaved};
+use crate::seed::turn::{TurnConfig, TurnExtrema, TurnExtremaState};
 
 use super::calibrator::{BLOCKS, Block, Kept, PENDING, PLACED, RING, RawHeading, TurnCalibrator};
 
@@ -23,7 +23,7 @@ pub struct TurnCalibratorState {
     pub config: TurnConfig,
     /// The extremum trackers (opaque), tagged with where each sample was on the relative
     /// heading.
-    pub extrema: TurnExtremaSaved<RawHeading>,
+    pub extrema: TurnExtremaState<RawHeading>,
     /// The kept readings by direction slot (72 entries, `None` where empty).
     pub slots: Vec<Option<Vector2<f64>>>,
     /// The last accepted timestamp.
