@@ -372,3 +372,56 @@ mod load_tests {
         );
     }
 }
+
+#[cfg(test)]
+mod precision_tests {
+    use super::*;
+    use proptest::prelude::*;
+    use truenorth_core::angle_diff;
+
+    /// Heading error bound of the `f32` path, rad: the readings (up to 150 units) rounded to
+    /// `f32` (6·10⁻⁸ relative, 9·10⁻⁶ units) against a horizontal field of at least 10 units
+    /// is 9·10⁻⁷ rad, the soft iron's rounding as much again; 10⁻⁵ leaves a factor of 5.
+    const F32_HEADING_TOL_RAD: f64 = 1e-5;
+
+    proptest! {
+        /// The `f32` calibration gives the `f64` heading to within `f32` rounding, in 2-D
+        /// and tilt-compensated in 3-D.
+        #[test]
+        fn f32_heading_matches_f64(
+            heading in -3.1f64..3.1,
+            hard in prop::array::uniform3(-50.0f64..50.0),
+            field in 10.0f64..60.0,
+            stretch in 0.8f64..1.25,
+            pitch in -0.5f64..0.5,
+            roll in -0.5f64..0.5,
+        ) {
+            let cal = CompassCalibration2d {
+                hard_iron: Vector2::new(hard[0], hard[1]),
+                soft_iron: Matrix2::new(stretch, 0.05, 0.05, 1.0 / stretch),
+            };
+            let raw = cal.soft_iron.try_inverse().unwrap()
+                * Vector2::new(field * heading.cos(), -field * heading.sin())
+                + cal.hard_iron;
+            let single = cal.to_precision::<f32>().heading_rad(&raw.cast::<f32>());
+            prop_assert!(
+                angle_diff(f64::from(single), cal.heading_rad(&raw)).abs() < F32_HEADING_TOL_RAD
+            );
+
+            let cal3 = CompassCalibration3d {
+                hard_iron: Vector3::from(hard),
+                soft_iron: Matrix3::from_diagonal(&Vector3::new(stretch, 1.0, 1.0 / stretch)),
+            };
+            let tilt = Tilt { pitch_rad: pitch, roll_rad: roll };
+            // The body reading whose levelled field is (H cos ψ, −H sin ψ, H/2).
+            let level = Vector3::new(field * heading.cos(), -field * heading.sin(), 0.5 * field);
+            let undo_tilt = nalgebra::Rotation3::from_axis_angle(&Vector3::y_axis(), pitch)
+                * nalgebra::Rotation3::from_axis_angle(&Vector3::x_axis(), roll);
+            let raw3 = cal3.soft_iron.try_inverse().unwrap() * (undo_tilt.transpose() * level)
+                + cal3.hard_iron;
+            let double = cal3.heading_rad(&raw3, &tilt);
+            let single = cal3.to_precision::<f32>().heading_rad(&raw3.cast::<f32>(), &tilt);
+            prop_assert!(angle_diff(f64::from(single), double).abs() < F32_HEADING_TOL_RAD);
+        }
+    }
+}
