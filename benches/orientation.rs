@@ -1,5 +1,6 @@
 //! Per-update cost of the orientation estimators (goal for the quaternion filter ≤ 150 ns;
-//! the Euler detector of WO 00/36376 beside it),
+//! the same filter in `f32`, for microcontrollers with a single-precision FPU, and the
+//! Euler detector of WO 00/36376 beside it),
 //! on real BROAD samples when `../shared/data/broad/` is present and on the simulator's
 //! hand-held motion otherwise (the bench says which).
 //!
@@ -70,6 +71,41 @@ fn bench(c: &mut Criterion) {
                 let mut f = QuaternionFilter::new(config).expect("valid config");
                 for s in &samples {
                     black_box(f.update(black_box(s)).expect("valid sample"));
+                }
+            })
+        });
+    }
+    // The f32 filter takes its readings as f32 vectors, converted here once, outside the
+    // timing, as a single-precision driver would deliver them.
+    let single: Vec<_> = samples
+        .iter()
+        .map(|s| {
+            let f32v = |v: Vector3<f64>| v.cast::<f32>();
+            (
+                s.t_s,
+                f32v(s.gyr_rps.as_xyz().expect("three-axis gyro")),
+                s.acc_mps2.as_xyz().map(f32v),
+                s.mag.as_xyz().map(f32v),
+            )
+        })
+        .collect();
+    for (name, use_mag) in [
+        ("quaternion filter 9-D f32", true),
+        ("quaternion filter 6-D f32", false),
+    ] {
+        let config = QuaternionFilterConfig {
+            use_mag,
+            ..Default::default()
+        };
+        g.bench_function(name, |b| {
+            b.iter(|| {
+                let mut f = QuaternionFilter::<f32>::with_precision(config).expect("valid config");
+                for &(t_s, gyr, acc, mag) in &single {
+                    black_box(
+                        f.update_readings(t_s, black_box(gyr), black_box(acc), black_box(mag))
+                            .expect("valid sample"),
+                    );
+                    black_box(f.attitude());
                 }
             })
         });

@@ -18,6 +18,10 @@
 //!   soft-iron matrix, noise and transient [`Disturbance`]s. Each model's
 //!   `true_calibration()` is its exact inverse.
 //!
+//! Applying a calibration and the heading from it are generic over the float type
+//! ([`truenorth_core::Real`]: `f64`, or `f32` for a single-precision FPU):
+//! [`CompassCalibration2d::to_precision`] turns the fitted `f64` parameters into `f32` ones.
+//!
 //! Heading convention: a level compass reads `mag_x = H cos ψ`, `mag_y = −H sin ψ`, so
 //! `ψ = atan2(−mag_y, mag_x)`, clockwise from magnetic north.
 //!
@@ -61,14 +65,20 @@ mod phasors;
 mod soft_iron;
 mod tilt;
 
-pub use calibration::{CompassCalibration2d, CompassCalibration3d, heading_from_horizontal};
+pub use calibration::{
+    CompassCalibration2d, CompassCalibration2dIn, CompassCalibration3d, CompassCalibration3dIn,
+    heading_from_horizontal, heading_from_horizontal_in,
+};
 pub use disturbance::{Disturbance, DisturbanceShape, Disturbances, MAX_DISTURBANCES};
 pub use model2d::{HeadingTruth, MagnetometerModel2d};
 pub use model3d::{AttitudeTruth, MagnetometerModel3d, earth_field_ned};
 pub use mz_reconstruction::MzReconstruction;
 pub use phasors::{EllipsePhasors, ITERATIVE_MAX_STEPS};
 pub use soft_iron::{EllipseAxes, ellipse_axes, soft_iron_from_axes};
-pub use tilt::{level_field, tilt_compensated_heading, tilt_compensated_heading_checked};
+pub use tilt::{
+    level_field, level_field_in, tilt_compensated_heading, tilt_compensated_heading_checked,
+    tilt_compensated_heading_in,
+};
 
 /// The code blocks of the crate's README, compiled and run as doctests.
 #[cfg(doctest)]

@@ -8,12 +8,9 @@
 //! formula with both angles, derived from the rotation.)
 
 use nalgebra::Vector3;
-use truenorth_core::{Result, Tilt, check_finite, check_finite3};
+use truenorth_core::{Real, Result, Tilt, check_finite, check_finite3};
 
-use crate::heading_from_horizontal;
-
-#[cfg(not(feature = "std"))]
-use truenorth_core::Float as _;
+use crate::heading_from_horizontal_in;
 
 /// The field as a level body at the same heading would see it: `Ry(pitch) · Rx(roll) · m`.
 ///
@@ -21,8 +18,15 @@ use truenorth_core::Float as _;
 /// `y = cos φ·m_y − sin φ·m_z`, `z = −sin θ·m_x + cos θ sin φ·m_y + cos θ cos φ·m_z`.
 #[inline]
 pub fn level_field(m_body: &Vector3<f64>, tilt: &Tilt) -> Vector3<f64> {
-    let (sp, cp) = tilt.pitch_rad.sin_cos();
-    let (sr, cr) = tilt.roll_rad.sin_cos();
+    level_field_in(m_body, tilt)
+}
+
+/// [`level_field`] in the reading's float type `T`; the angles are converted to it before
+/// their sines.
+#[inline]
+pub fn level_field_in<T: Real>(m_body: &Vector3<T>, tilt: &Tilt) -> Vector3<T> {
+    let (sp, cp) = T::of(tilt.pitch_rad).sin_cos();
+    let (sr, cr) = T::of(tilt.roll_rad).sin_cos();
     // Rx(φ) first: y' = cos φ·y − sin φ·z, z' = sin φ·y + cos φ·z.
     let y1 = cr * m_body.y - sr * m_body.z;
     let z1 = sr * m_body.y + cr * m_body.z;
@@ -35,7 +39,13 @@ pub fn level_field(m_body: &Vector3<f64>, tilt: &Tilt) -> Vector3<f64> {
 /// [`tilt_compensated_heading_checked`] for a typed error instead).
 #[inline]
 pub fn tilt_compensated_heading(m_body: &Vector3<f64>, tilt: &Tilt) -> f64 {
-    heading_from_horizontal(&level_field(m_body, tilt).xy())
+    tilt_compensated_heading_in(m_body, tilt)
+}
+
+/// [`tilt_compensated_heading`] in the reading's float type `T`.
+#[inline]
+pub fn tilt_compensated_heading_in<T: Real>(m_body: &Vector3<T>, tilt: &Tilt) -> T {
+    heading_from_horizontal_in(&level_field_in(m_body, tilt).xy())
 }
 
 /// [`tilt_compensated_heading`] that refuses non-finite readings or angles with a typed error.
@@ -49,7 +59,7 @@ pub fn tilt_compensated_heading_checked(m_body: &Vector3<f64>, tilt: &Tilt) -> R
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::{AttitudeTruth, earth_field_ned};
+    use crate::{AttitudeTruth, earth_field_ned, heading_from_horizontal};
     use proptest::prelude::*;
     use truenorth_core::{EulerZyx, angle_diff};
 

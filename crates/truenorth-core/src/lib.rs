@@ -37,6 +37,7 @@ mod heading_source;
 mod inertial_calibration;
 mod noise;
 mod persist;
+mod real;
 mod sample;
 mod sensor_model;
 mod units;
@@ -62,6 +63,7 @@ pub use heading_source::{
 pub use inertial_calibration::{InertialCalibration, axis_calibrated};
 pub use noise::{NoiseSource, SplitMix64, ZeroNoise};
 pub use persist::{Persistent, Snapshot, check_snapshot_version};
+pub use real::Real;
 pub use sample::{
     AccelSample, Axes, GyroSample, ImuSample, MAX_YAW_RATE_RPS, Mag2Sample, Mag3Sample,
     VehicleSample, WheelReading, WheelSample,

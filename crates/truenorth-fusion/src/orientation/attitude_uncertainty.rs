@@ -68,12 +68,9 @@
 
 use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
-use truenorth_core::{
-    Error, Result, STANDARD_GRAVITY_MPS2, Validate, check_finite, check_finite3, check_range,
-};
+use truenorth_core::{Error, Real, Result, STANDARD_GRAVITY_MPS2, Validate, check_range};
 
-#[cfg(not(feature = "std"))]
-use truenorth_core::Float as _;
+use super::real_checks::{check_finite_in, check_finite3_in, check_range_in};
 
 /// The sensors' error model behind the filter's σ: what a typical consumer MEMS IMU with a
 /// calibrated magnetometer promises. Units in the names; every value is one standard
@@ -170,31 +167,33 @@ impl Validate for AttitudeUncertaintyConfig {
 
 /// The variance of the error about one kind of reference axis (inclination or heading).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-struct AxisVariance {
+// `Real` includes serde's bounds on `T`.
+#[serde(bound = "")]
+struct AxisVariance<T: Real> {
     /// Angle error driven by the gyro, rad².
-    angle: f64,
+    angle: T,
     /// Covariance of that angle error and the bias error, rad²/s.
-    angle_bias: f64,
+    angle_bias: T,
     /// Bias error, (rad/s)².
-    bias: f64,
+    bias: T,
     /// Angle error left by what the corrections trust, rad².
-    measured: f64,
+    measured: T,
 }
 
-impl AxisVariance {
-    fn new(angle: f64, bias: f64) -> Self {
+impl<T: Real> AxisVariance<T> {
+    fn new(angle: T, bias: T) -> Self {
         Self {
             angle,
-            angle_bias: 0.0,
+            angle_bias: T::zero(),
             bias,
-            measured: 0.0,
+            measured: T::zero(),
         }
     }
 
     /// `dt` of strapdown: `e ← e + β dt + w`, `β ← β + walk`.
     #[inline]
-    fn propagate(&mut self, dt_s: f64, angle_noise: f64, bias_noise: f64) {
-        self.angle += dt_s * (2.0 * self.angle_bias + dt_s * self.bias) + angle_noise;
+    fn propagate(&mut self, dt_s: T, angle_noise: T, bias_noise: T) {
+        self.angle += dt_s * (T::of(2.0) * self.angle_bias + dt_s * self.bias) + angle_noise;
         self.angle_bias += dt_s * self.bias;
         self.bias += bias_noise;
     }
@@ -203,41 +202,44 @@ impl AxisVariance {
     /// whose measurement leaves the variance `target` (reached with the correction's own
     /// time constant).
     #[inline]
-    fn correct(&mut self, k: f64, c: f64, target: f64) {
-        let a = 1.0 - k;
+    fn correct(&mut self, k: T, c: T, target: T) {
+        let a = T::one() - k;
         let (pe, pb) = (self.angle, self.angle_bias);
         self.angle = a * a * pe;
         self.angle_bias = a * (pb - c * pe);
-        self.bias = (self.bias - c * (2.0 * pb - c * pe)).max(0.0);
-        self.measured += (1.0 - a * a) * (target - self.measured);
+        self.bias = (self.bias - c * (T::of(2.0) * pb - c * pe)).max(T::zero());
+        self.measured += (T::one() - a * a) * (target - self.measured);
     }
 }
 
 /// The propagated uncertainty (see the module documentation): part of the
-/// [`crate::QuaternionFilterState`], opaque.
+/// [`crate::QuaternionFilterState`], opaque. In the filter's float type `T` (the error
+/// model stays `f64`, converted where it is used).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct AttitudeUncertainty {
+// `Real` includes serde's bounds on `T`.
+#[serde(bound = "")]
+pub struct AttitudeUncertainty<T: Real = f64> {
     config: AttitudeUncertaintyConfig,
-    inclination: AxisVariance,
-    heading: AxisVariance,
+    inclination: AxisVariance<T>,
+    heading: AxisVariance<T>,
     /// Reference-frame rotation within the inclination and heading loops' time constants.
-    turned_inclination: Vector3<f64>,
-    turned_heading: Vector3<f64>,
+    turned_inclination: Vector3<T>,
+    turned_heading: Vector3<T>,
     /// Recent sum of the inclination corrections about x and y, and the envelope of its
     /// square per axis.
-    accel_moved: [f64; 2],
-    accel_moved_sq: [f64; 2],
+    accel_moved: [T; 2],
+    accel_moved_sq: [T; 2],
     /// Low-passed relative norm and dip departures of the field, and `1/(2 cos² dip)`.
-    norm_departure: f64,
-    dip_departure: f64,
-    half_inv_cos2_dip: f64,
+    norm_departure: T,
+    dip_departure: T,
+    half_inv_cos2_dip: T,
     /// Reference-frame rate and its norm at the last step.
-    rate_ned: Vector3<f64>,
-    rate_rps: f64,
+    rate_ned: Vector3<T>,
+    rate_rps: T,
     /// The inclination correction's constants for the last (gain, time constant, low-pass):
     /// variance target and the envelope's gain, recomputed only when those change; `None`
     /// before the first inclination correction.
-    accel_constants: Option<([f64; 3], f64, f64)>,
+    accel_constants: Option<([T; 3], T, T)>,
 }
 
 /// Inclination σ assumed before the first correction, rad: the tilt the first reading
@@ -247,29 +249,32 @@ const INITIAL_INCLINATION_RAD: f64 = 0.2;
 /// Heading σ of an unknown heading, rad: uniform over the circle, π/√3.
 const UNKNOWN_HEADING_RAD: f64 = core::f64::consts::PI / 1.732_050_807_568_877_2;
 
-impl AttitudeUncertainty {
+impl<T: Real> AttitudeUncertainty<T> {
     /// Before any correction: inclination from one reading of unknown acceleration, heading
     /// unknown (or, with `relative_heading`, zero: heading counted from the start).
     pub(crate) fn new(config: AttitudeUncertaintyConfig, relative_heading: bool) -> Self {
-        let bias = config.gyro_bias_rps * config.gyro_bias_rps;
+        let bias = T::of(config.gyro_bias_rps * config.gyro_bias_rps);
         let heading = if relative_heading {
-            0.0
+            T::zero()
         } else {
-            UNKNOWN_HEADING_RAD * UNKNOWN_HEADING_RAD
+            T::of(UNKNOWN_HEADING_RAD * UNKNOWN_HEADING_RAD)
         };
         Self {
             config,
-            inclination: AxisVariance::new(INITIAL_INCLINATION_RAD * INITIAL_INCLINATION_RAD, bias),
+            inclination: AxisVariance::new(
+                T::of(INITIAL_INCLINATION_RAD * INITIAL_INCLINATION_RAD),
+                bias,
+            ),
             heading: AxisVariance::new(heading, bias),
             turned_inclination: Vector3::zeros(),
             turned_heading: Vector3::zeros(),
-            accel_moved: [0.0; 2],
-            accel_moved_sq: [0.0; 2],
-            norm_departure: 0.0,
-            dip_departure: 0.0,
-            half_inv_cos2_dip: 0.5,
+            accel_moved: [T::zero(); 2],
+            accel_moved_sq: [T::zero(); 2],
+            norm_departure: T::zero(),
+            dip_departure: T::zero(),
+            half_inv_cos2_dip: T::of(0.5),
             rate_ned: Vector3::zeros(),
-            rate_rps: 0.0,
+            rate_rps: T::zero(),
             accel_constants: None,
         }
     }
@@ -280,7 +285,7 @@ impl AttitudeUncertainty {
         let mut fresh = Self::new(self.config, relative_heading);
         let walk = self.config.gyro_bias_walk_rps_per_sqrt_s;
         let prior = fresh.inclination.bias;
-        let bias = |b: f64| (b + walk * walk * gap_s).min(prior);
+        let bias = |b: T| (b + T::of(walk * walk * gap_s)).min(prior);
         fresh.inclination.bias = bias(self.inclination.bias);
         fresh.heading.bias = bias(self.heading.bias);
         *self = fresh;
@@ -291,15 +296,16 @@ impl AttitudeUncertainty {
     #[inline]
     pub(crate) fn propagate(
         &mut self,
-        dt_s: f64,
-        omega_rps: &Vector3<f64>,
-        rate_rps: f64,
-        r: &Matrix3<f64>,
+        dt_s: T,
+        omega_rps: &Vector3<T>,
+        rate_rps: T,
+        r: &Matrix3<T>,
     ) {
         let cfg = &self.config;
-        let angle_noise = cfg.gyro_noise_rps_per_sqrt_hz * cfg.gyro_noise_rps_per_sqrt_hz * dt_s;
+        let angle_noise =
+            T::of(cfg.gyro_noise_rps_per_sqrt_hz * cfg.gyro_noise_rps_per_sqrt_hz) * dt_s;
         let walk = cfg.gyro_bias_walk_rps_per_sqrt_s;
-        let bias_noise = walk * walk * dt_s;
+        let bias_noise = T::of(walk * walk) * dt_s;
         self.inclination.propagate(dt_s, angle_noise, bias_noise);
         self.heading.propagate(dt_s, angle_noise, bias_noise);
         self.rate_ned = r * omega_rps;
@@ -309,8 +315,8 @@ impl AttitudeUncertainty {
         self.turned_heading += step;
         // The body's turn mixes the reference axes' bias uncertainties (two inclination
         // axes and one heading axis), by the fraction of a radian turned.
-        let mix = (rate_rps * dt_s).min(1.0);
-        let mean = (2.0 * self.inclination.bias + self.heading.bias) * (1.0 / 3.0);
+        let mix = (rate_rps * dt_s).min(T::one());
+        let mean = (T::of(2.0) * self.inclination.bias + self.heading.bias) * T::of(1.0 / 3.0);
         self.inclination.bias += mix * (mean - self.inclination.bias);
         self.heading.bias += mix * (mean - self.heading.bias);
     }
@@ -321,24 +327,24 @@ impl AttitudeUncertainty {
     #[inline]
     pub(crate) fn accel_corrected(
         &mut self,
-        k: f64,
-        correction: (f64, f64),
-        tau_s: f64,
-        inv_tau_bias: f64,
-        lowpass_s: f64,
+        k: T,
+        correction: (T, T),
+        tau_s: T,
+        inv_tau_bias: T,
+        lowpass_s: T,
     ) {
         if self.accel_constants.map(|c| c.0) != Some([k, tau_s, lowpass_s]) {
             let cfg = &self.config;
-            let g = STANDARD_GRAVITY_MPS2;
-            let bias = cfg.accel_bias_mps2 / g;
-            let white = cfg.accel_noise_mps2_per_sqrt_hz / g;
-            let target = bias * bias + white * white / (2.0 * (lowpass_s + tau_s));
+            let g = T::of(STANDARD_GRAVITY_MPS2);
+            let bias = T::of(cfg.accel_bias_mps2) / g;
+            let white = T::of(cfg.accel_noise_mps2_per_sqrt_hz) / g;
+            let target = bias * bias + white * white / (T::of(2.0) * (lowpass_s + tau_s));
             // The envelope of the square (below) follows a rise at once (the error an
             // acceleration causes builds as fast as the corrections it causes) and decays
             // over the loop's natural period 2π √(τ_lp τ_acc) (11 s by default), so that it
             // holds through the swings of an acceleration slow enough to pass the loop.
-            let period = core::f64::consts::TAU * (lowpass_s * tau_s).sqrt();
-            let k_env = (k * tau_s / period).min(1.0);
+            let period = T::of(core::f64::consts::TAU) * (lowpass_s * tau_s).sqrt();
+            let k_env = (k * tau_s / period).min(T::one());
             self.accel_constants = Some(([k, tau_s, lowpass_s], target, k_env));
         }
         let Some((_, target, k_env)) = self.accel_constants else {
@@ -346,8 +352,8 @@ impl AttitudeUncertainty {
         };
         let c = self.bias_credit(k, tau_s, inv_tau_bias);
         self.inclination.correct(k, c, target);
-        self.turned_inclination *= 1.0 - k;
-        let a = 1.0 - k;
+        self.turned_inclination *= T::one() - k;
+        let a = T::one() - k;
         for (i, c) in [correction.0, correction.1].into_iter().enumerate() {
             let moved = a * self.accel_moved[i] + c;
             self.accel_moved[i] = moved;
@@ -368,81 +374,83 @@ impl AttitudeUncertainty {
     #[inline]
     pub(crate) fn mag_corrected(
         &mut self,
-        k: f64,
-        tau_s: f64,
-        reading: (f64, f64),
-        reference: (f64, f64),
-        inv_tau_bias: f64,
+        k: T,
+        tau_s: T,
+        reading: (T, T),
+        reference: (T, T),
+        inv_tau_bias: T,
     ) {
         let cfg = &self.config;
         let (h, v) = reading;
         let (h0, v0) = reference;
         let n02 = h0 * h0 + v0 * v0;
         // A reference with no field (never learned) says nothing about the heading.
-        if n02.is_nan() || n02 <= 0.0 {
+        if n02.partial_cmp(&T::zero()) != Some(core::cmp::Ordering::Greater) {
             return;
         }
-        let inv_n02 = 1.0 / n02;
+        let inv_n02 = T::one() / n02;
         // Departures without a square root: (|m|² − |m₀|²)/(2|m₀|²) and the sine of the dip
         // difference, both within a few per cent of exact for the fields that pass the test.
-        let rn = 0.5 * (h * h + v * v - n02) * inv_n02;
+        let rn = T::of(0.5) * (h * h + v * v - n02) * inv_n02;
         let rd = (v * h0 - h * v0) * inv_n02;
         self.norm_departure += k * (rn - self.norm_departure);
         self.dip_departure += k * (rd - self.dip_departure);
         // 1/cos² dip = |m₀|²/h₀², the horizontal field kept above 10⁻³ of the whole.
-        let inv_cos2_dip = n02 / (h0 * h0).max(1e-6 * n02);
-        self.half_inv_cos2_dip = 0.5 * inv_cos2_dip;
-        let tan2_dip = inv_cos2_dip - 1.0;
+        let inv_cos2_dip = n02 / (h0 * h0).max(T::of(1e-6) * n02);
+        self.half_inv_cos2_dip = T::of(0.5) * inv_cos2_dip;
+        let tan2_dip = inv_cos2_dip - T::one();
         // A reading's heading noise, σ/cos dip, through the loop: k/2 of its variance.
-        let white = cfg.mag_noise_rel * cfg.mag_noise_rel * inv_cos2_dip * 0.5 * k;
+        let white = T::of(cfg.mag_noise_rel * cfg.mag_noise_rel) * inv_cos2_dip * T::of(0.5) * k;
         // The inclination error about north is the one the dip turns into heading. The parts
         // of it that persist (the biases' and the scale error's) pass the heading loop
         // whole; the accelerations' varies with the inclination loop's time constant and
         // passes by τ_acc/(τ_acc + τ_mag).
         let passed = match self.accel_constants {
-            Some(([_, tau_acc_s, _], ..)) if tau_acc_s > 0.0 => tau_acc_s / (tau_acc_s + tau_s),
-            _ => 1.0,
+            Some(([_, tau_acc_s, _], ..)) if tau_acc_s > T::zero() => {
+                tau_acc_s / (tau_acc_s + tau_s)
+            }
+            _ => T::one(),
         };
         let acceleration = self.accel_moved_sq[0];
-        let tilt = tan2_dip * (self.inclination_variance(0) - (1.0 - passed) * acceleration);
-        let target = cfg.mag_heading_rad * cfg.mag_heading_rad + white + tilt;
+        let tilt = tan2_dip * (self.inclination_variance(0) - (T::one() - passed) * acceleration);
+        let target = T::of(cfg.mag_heading_rad * cfg.mag_heading_rad) + white + tilt;
         let c = self.bias_credit(k, tau_s, inv_tau_bias);
         self.heading.correct(k, c, target);
-        self.turned_heading *= 1.0 - k;
+        self.turned_heading *= T::one() - k;
     }
 
     /// The share `c` (1/s) of a correction with gain `k` and time constant `tau_s` that the
     /// bias estimate takes, credited by the in-phase response to a bias turning at |ω|.
     #[inline]
-    fn bias_credit(&self, k: f64, tau_s: f64, inv_tau_bias: f64) -> f64 {
-        if inv_tau_bias == 0.0 {
-            return 0.0;
+    fn bias_credit(&self, k: T, tau_s: T, inv_tau_bias: T) -> T {
+        if inv_tau_bias == T::zero() {
+            return T::zero();
         }
         let wt = self.rate_rps * tau_s;
-        k * inv_tau_bias / (1.0 + wt * wt)
+        k * inv_tau_bias / (T::one() + wt * wt)
     }
 
     /// A step at rest: the bias follows the rest detector's mean with gain `k`.
     #[inline]
-    pub(crate) fn at_rest(&mut self, k: f64, mean_tau_s: f64, rest_tau_s: f64) {
+    pub(crate) fn at_rest(&mut self, k: T, mean_tau_s: f64, rest_tau_s: f64) {
         let n = self.config.gyro_noise_rps_per_sqrt_hz;
-        let floor = n * n / (2.0 * (mean_tau_s + rest_tau_s));
-        let a = (1.0 - k) * (1.0 - k);
+        let floor = T::of(n * n / (2.0 * (mean_tau_s + rest_tau_s)));
+        let a = (T::one() - k) * (T::one() - k);
         for axis in [&mut self.inclination, &mut self.heading] {
-            axis.bias = a * axis.bias + (1.0 - a) * floor;
-            axis.angle_bias *= 1.0 - k;
+            axis.bias = a * axis.bias + (T::one() - a) * floor;
+            axis.angle_bias *= T::one() - k;
         }
     }
 
     /// The inclination error's variance about reference axis `i` (0: x, 1: y), without the
     /// latency term.
     #[inline]
-    fn inclination_variance(&self, i: usize) -> f64 {
+    fn inclination_variance(&self, i: usize) -> T {
         let s = self.config.gyro_scale_rel;
         self.inclination.angle
             + self.inclination.measured
             + self.accel_moved_sq[i]
-            + s * s * self.turned_inclination.norm_squared()
+            + T::of(s * s) * self.turned_inclination.norm_squared()
     }
 
     /// Checks a restored uncertainty against the error model `config` of its filter: the
@@ -454,25 +462,25 @@ impl AttitudeUncertainty {
             });
         }
         for axis in [&self.inclination, &self.heading] {
-            check_range("uncertainty angle variance", axis.angle, 0.0, f64::MAX)?;
-            check_range("uncertainty bias variance", axis.bias, 0.0, f64::MAX)?;
-            check_range(
+            check_range_in("uncertainty angle variance", axis.angle, 0.0, f64::MAX)?;
+            check_range_in("uncertainty bias variance", axis.bias, 0.0, f64::MAX)?;
+            check_range_in(
                 "uncertainty measured variance",
                 axis.measured,
                 0.0,
                 f64::MAX,
             )?;
-            check_finite("uncertainty angle-bias covariance", axis.angle_bias)?;
+            check_finite_in("uncertainty angle-bias covariance", axis.angle_bias)?;
         }
         for v in [
             &self.turned_inclination,
             &self.turned_heading,
             &self.rate_ned,
         ] {
-            check_finite3("uncertainty turn", v)?;
+            check_finite3_in("uncertainty turn", v)?;
         }
         for v in self.accel_moved.iter().chain(&self.accel_moved_sq) {
-            check_finite("uncertainty acceleration term", *v)?;
+            check_finite_in("uncertainty acceleration term", *v)?;
         }
         for v in [
             self.norm_departure,
@@ -480,11 +488,11 @@ impl AttitudeUncertainty {
             self.half_inv_cos2_dip,
             self.rate_rps,
         ] {
-            check_finite("uncertainty field term", v)?;
+            check_finite_in("uncertainty field term", v)?;
         }
         if let Some((key, target, k_env)) = self.accel_constants {
             for v in key.iter().chain(&[target, k_env]) {
-                check_finite("uncertainty inclination constant", *v)?;
+                check_finite_in("uncertainty inclination constant", *v)?;
             }
         }
         Ok(())
@@ -492,15 +500,15 @@ impl AttitudeUncertainty {
 
     /// One σ of the error about the reference x, y and z axes, rad.
     #[inline]
-    pub(crate) fn sigma_rad(&self) -> Vector3<f64> {
-        let lag = self.rate_ned * self.config.gyro_latency_s;
+    pub(crate) fn sigma_rad(&self) -> Vector3<T> {
+        let lag = self.rate_ned * T::of(self.config.gyro_latency_s);
         let s = self.config.gyro_scale_rel;
         let disturbance = (self.norm_departure * self.norm_departure
             + self.dip_departure * self.dip_departure)
             * self.half_inv_cos2_dip;
         let heading = self.heading.angle
             + self.heading.measured
-            + s * s * self.turned_heading.norm_squared()
+            + T::of(s * s) * self.turned_heading.norm_squared()
             + disturbance;
         Vector3::new(
             (self.inclination_variance(0) + lag.x * lag.x).sqrt(),

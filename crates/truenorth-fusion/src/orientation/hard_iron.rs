@@ -20,7 +20,9 @@
 
 use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
-use truenorth_core::{Error, Result, Validate, check_finite3, check_positive, check_range};
+use truenorth_core::{Error, Real, Result, Validate, check_positive, check_range};
+
+use super::real_checks::{check_finite3_in, check_range_in};
 
 /// Thresholds of the [`HardIronEstimator`]. Field quantities are relative to the reference
 /// field's norm, so they hold for any magnetometer unit.
@@ -75,23 +77,33 @@ impl Validate for HardIronConfig {
     }
 }
 
-/// The running residual statistics and the adopted offset.
+/// The running residual statistics and the adopted offset, in the float type `T` (the
+/// thresholds stay `f64`, converted where they are compared).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct HardIronEstimator {
+// `Real` includes serde's bounds on `T`.
+#[serde(bound = "")]
+pub struct HardIronEstimator<T: Real = f64> {
     config: HardIronConfig,
-    mean: Vector3<f64>,
-    spread2: f64,
-    turned_rad: f64,
-    consistent_s: f64,
+    mean: Vector3<T>,
+    spread2: T,
+    turned_rad: T,
+    consistent_s: T,
     primed: bool,
-    offset: Option<Vector3<f64>>,
+    offset: Option<Vector3<T>>,
     /// The running statistics' gain for the last interval (recomputed when it changes).
-    gain: (f64, f64),
+    gain: (T, T),
 }
 
 impl HardIronEstimator {
     /// No offset yet; invalid thresholds are refused.
     pub fn new(config: HardIronConfig) -> Result<Self> {
+        Self::with_precision(config)
+    }
+}
+
+impl<T: Real> HardIronEstimator<T> {
+    /// As [`HardIronEstimator::new`], computing in `T` (`HardIronEstimator::<f32>::with_precision(config)`).
+    pub fn with_precision(config: HardIronConfig) -> Result<Self> {
         config.validate()?;
         Ok(Self::with_config(config))
     }
@@ -101,12 +113,12 @@ impl HardIronEstimator {
         Self {
             config,
             mean: Vector3::zeros(),
-            spread2: 0.0,
-            turned_rad: 0.0,
-            consistent_s: 0.0,
+            spread2: T::zero(),
+            turned_rad: T::zero(),
+            consistent_s: T::zero(),
             primed: false,
             offset: None,
-            gain: (0.0, 0.0),
+            gain: (T::zero(), T::zero()),
         }
     }
 
@@ -122,12 +134,12 @@ impl HardIronEstimator {
     /// subtract from `m`, if one is adopted.
     pub fn update(
         &mut self,
-        m: &Vector3<f64>,
-        r: &Matrix3<f64>,
-        reference_ned: &Vector3<f64>,
-        rate_rps: f64,
-        dt_s: f64,
-    ) -> Option<Vector3<f64>> {
+        m: &Vector3<T>,
+        r: &Matrix3<T>,
+        reference_ned: &Vector3<T>,
+        rate_rps: T,
+        dt_s: T,
+    ) -> Option<Vector3<T>> {
         if !self.config.enabled {
             return None;
         }
@@ -138,26 +150,26 @@ impl HardIronEstimator {
             return self.offset;
         }
         if self.gain.0 != dt_s {
-            self.gain = (dt_s, (dt_s / self.config.mean_tau_s).min(1.0));
+            self.gain = (dt_s, (dt_s / T::of(self.config.mean_tau_s)).min(T::one()));
         }
         let k = self.gain.1;
         self.mean += (r - self.mean) * k;
         self.spread2 += ((r - self.mean).norm_squared() - self.spread2) * k;
         let n2 = reference_ned.norm_squared();
-        let min = self.config.min_offset_rel;
-        if self.mean.norm_squared() < 0.25 * min * min * n2 {
+        let min = T::of(self.config.min_offset_rel);
+        if self.mean.norm_squared() < T::of(0.25) * min * min * n2 {
             // The raw reading agrees with the earth's field again: the magnet is gone.
             // (No consistency is asked for: removing it is a transient.)
             self.offset = None;
-            self.turned_rad = 0.0;
-            self.consistent_s = 0.0;
+            self.turned_rad = T::zero();
+            self.consistent_s = T::zero();
             return None;
         }
-        let max_spread = self.config.max_spread_rel;
+        let max_spread = T::of(self.config.max_spread_rel);
         if self.spread2 > max_spread * max_spread * n2 {
             // Not one body-fixed offset (or the attitude is off): keep what was adopted.
-            self.turned_rad = 0.0;
-            self.consistent_s = 0.0;
+            self.turned_rad = T::zero();
+            self.consistent_s = T::zero();
             return self.offset;
         }
         self.turned_rad += rate_rps * dt_s;
@@ -166,8 +178,8 @@ impl HardIronEstimator {
         // offset from a heading error (at rest both are constant), so the offset is adopted
         // and followed only then, and only once the running statistics span twice their
         // time constant of such a period.
-        if self.turned_rad >= self.config.min_turn_rad
-            && self.consistent_s >= 2.0 * self.config.mean_tau_s
+        if self.turned_rad >= T::of(self.config.min_turn_rad)
+            && self.consistent_s >= T::of(2.0 * self.config.mean_tau_s)
             && self.mean.norm_squared() > min * min * n2
         {
             self.offset = Some(self.mean);
@@ -176,7 +188,7 @@ impl HardIronEstimator {
     }
 
     /// The adopted offset (body frame, sensor unit), if any.
-    pub fn offset(&self) -> Option<Vector3<f64>> {
+    pub fn offset(&self) -> Option<Vector3<T>> {
         self.offset
     }
 
@@ -188,15 +200,15 @@ impl HardIronEstimator {
                 reason: "the hard-iron estimator's thresholds differ from the filter's",
             });
         }
-        check_finite3("hard_iron.mean", &self.mean)?;
+        check_finite3_in("hard_iron.mean", &self.mean)?;
         if let Some(b) = &self.offset {
-            check_finite3("hard_iron.offset", b)?;
+            check_finite3_in("hard_iron.offset", b)?;
         }
-        check_range("hard_iron.spread2", self.spread2, 0.0, f64::MAX)?;
-        check_range("hard_iron.turned_rad", self.turned_rad, 0.0, f64::MAX)?;
-        check_range("hard_iron.consistent_s", self.consistent_s, 0.0, f64::MAX)?;
-        check_range("hard_iron.gain", self.gain.1, 0.0, 1.0)?;
-        check_range("hard_iron.gain interval", self.gain.0, 0.0, f64::MAX)?;
+        check_range_in("hard_iron.spread2", self.spread2, 0.0, f64::MAX)?;
+        check_range_in("hard_iron.turned_rad", self.turned_rad, 0.0, f64::MAX)?;
+        check_range_in("hard_iron.consistent_s", self.consistent_s, 0.0, f64::MAX)?;
+        check_range_in("hard_iron.gain", self.gain.1, 0.0, 1.0)?;
+        check_range_in("hard_iron.gain interval", self.gain.0, 0.0, f64::MAX)?;
         Ok(())
     }
 }

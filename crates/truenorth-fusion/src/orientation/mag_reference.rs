@@ -9,7 +9,9 @@
 //! to the sensor) never becomes consistent and stays rejected.
 
 use serde::{Deserialize, Serialize};
-use truenorth_core::{Error, Result, Validate, check_finite, check_positive, check_range};
+use truenorth_core::{Error, Real, Result, Validate, check_positive, check_range};
+
+use super::real_checks::{check_finite_in, check_range_in};
 
 #[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
@@ -65,26 +67,37 @@ impl Validate for MagReferenceConfig {
 /// The learned field reference and the candidate for a new one, each kept as its horizontal
 /// and vertical components in the level frame (so that no angle has to be computed per
 /// sample: the dip test compares `sin(dip − dip_ref)`, a cross product of the two).
+///
+/// In the float type `T`; the tolerances stay `f64`, converted where they are compared.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct MagReference {
+// `Real` includes serde's bounds on `T`.
+#[serde(bound = "")]
+pub struct MagReference<T: Real = f64> {
     config: MagReferenceConfig,
     /// `sin(dip_tol_rad)` (the tolerance is at most 90°).
-    sin_dip_tol: f64,
-    horizontal: f64,
-    vertical: f64,
-    candidate_horizontal: f64,
-    candidate_vertical: f64,
-    candidate_s: f64,
-    candidate_moving_s: f64,
+    sin_dip_tol: T,
+    horizontal: T,
+    vertical: T,
+    candidate_horizontal: T,
+    candidate_vertical: T,
+    candidate_s: T,
+    candidate_moving_s: T,
     valid: bool,
     /// The reference's gain for the last interval (recomputed when it changes).
-    gain: (f64, f64),
+    gain: (T, T),
 }
 
 impl MagReference {
     /// No reference yet: the first field offered becomes it. Invalid tolerances are
     /// refused.
     pub fn new(config: MagReferenceConfig) -> Result<Self> {
+        Self::with_precision(config)
+    }
+}
+
+impl<T: Real> MagReference<T> {
+    /// As [`MagReference::new`], computing in `T` (`MagReference::<f32>::with_precision(config)`).
+    pub fn with_precision(config: MagReferenceConfig) -> Result<Self> {
         config.validate()?;
         Ok(Self::with_config(config))
     }
@@ -93,15 +106,15 @@ impl MagReference {
     pub(crate) fn with_config(config: MagReferenceConfig) -> Self {
         Self {
             config,
-            sin_dip_tol: config.dip_tol_rad.min(core::f64::consts::FRAC_PI_2).sin(),
-            horizontal: 0.0,
-            vertical: 0.0,
-            candidate_horizontal: 0.0,
-            candidate_vertical: 0.0,
-            candidate_s: 0.0,
-            candidate_moving_s: 0.0,
+            sin_dip_tol: T::of(config.dip_tol_rad.min(core::f64::consts::FRAC_PI_2).sin()),
+            horizontal: T::zero(),
+            vertical: T::zero(),
+            candidate_horizontal: T::zero(),
+            candidate_vertical: T::zero(),
+            candidate_s: T::zero(),
+            candidate_moving_s: T::zero(),
             valid: false,
-            gain: (0.0, 0.0),
+            gain: (T::zero(), T::zero()),
         }
     }
 
@@ -114,23 +127,26 @@ impl MagReference {
     /// component in the estimated level frame (sensor unit), taken `dt_s` after the previous
     /// one while rotating at `rate_rps`. Returns `true` when it is undisturbed (and may
     /// correct heading).
-    pub fn update(&mut self, horizontal: f64, vertical: f64, rate_rps: f64, dt_s: f64) -> bool {
+    pub fn update(&mut self, horizontal: T, vertical: T, rate_rps: T, dt_s: T) -> bool {
         if !self.valid {
             self.adopt(horizontal, vertical);
             return true;
         }
         if self.gain.0 != dt_s {
-            self.gain = (dt_s, (dt_s / self.config.reference_tau_s).min(1.0));
+            self.gain = (
+                dt_s,
+                (dt_s / T::of(self.config.reference_tau_s)).min(T::one()),
+            );
         }
         let k = self.gain.1;
         if self.agrees(self.horizontal, self.vertical, horizontal, vertical) {
             self.horizontal += (horizontal - self.horizontal) * k;
             self.vertical += (vertical - self.vertical) * k;
-            self.candidate_s = 0.0;
-            self.candidate_moving_s = 0.0;
+            self.candidate_s = T::zero();
+            self.candidate_moving_s = T::zero();
             return true;
         }
-        if self.candidate_s > 0.0
+        if self.candidate_s > T::zero()
             && self.agrees(
                 self.candidate_horizontal,
                 self.candidate_vertical,
@@ -139,20 +155,21 @@ impl MagReference {
             )
         {
             self.candidate_s += dt_s;
-            if rate_rps >= self.config.new_reference_min_rate_rps {
+            if rate_rps >= T::of(self.config.new_reference_min_rate_rps) {
                 self.candidate_moving_s += dt_s;
             }
-            let kc = (dt_s / self.config.new_reference_s).min(1.0);
+            let kc = (dt_s / T::of(self.config.new_reference_s)).min(T::one());
             self.candidate_horizontal += (horizontal - self.candidate_horizontal) * kc;
             self.candidate_vertical += (vertical - self.candidate_vertical) * kc;
         } else {
             self.candidate_horizontal = horizontal;
             self.candidate_vertical = vertical;
-            self.candidate_s = dt_s.max(f64::MIN_POSITIVE);
-            self.candidate_moving_s = 0.0;
+            // Positive, as it marks a candidate (in `f32` a step may round to 0).
+            self.candidate_s = dt_s.max(T::of(f64::MIN_POSITIVE));
+            self.candidate_moving_s = T::zero();
         }
-        if self.candidate_s >= self.config.new_reference_s
-            && self.candidate_moving_s >= 0.2 * self.config.new_reference_s
+        if self.candidate_s >= T::of(self.config.new_reference_s)
+            && self.candidate_moving_s >= T::of(0.2 * self.config.new_reference_s)
         {
             self.adopt(self.candidate_horizontal, self.candidate_vertical);
             return true;
@@ -162,7 +179,7 @@ impl MagReference {
 
     /// The reference field norm (sensor unit) and dip (rad, positive down), once one was
     /// learned.
-    pub fn reference(&self) -> Option<(f64, f64)> {
+    pub fn reference(&self) -> Option<(T, T)> {
         self.valid.then(|| {
             (
                 self.horizontal.hypot(self.vertical),
@@ -173,19 +190,19 @@ impl MagReference {
 
     /// The reference field in the level frame of magnetic north, `(H, 0, Z)` (north, east,
     /// down), once one was learned.
-    pub fn reference_ned(&self) -> Option<nalgebra::Vector3<f64>> {
+    pub fn reference_ned(&self) -> Option<nalgebra::Vector3<T>> {
         self.valid
-            .then(|| nalgebra::Vector3::new(self.horizontal, 0.0, self.vertical))
+            .then(|| nalgebra::Vector3::new(self.horizontal, T::zero(), self.vertical))
     }
 
     /// Norm within `norm_tol_rel` and dip within `dip_tol_rad` of the reference `(h0, v0)`:
     /// `|sin(dip − dip₀)| = |v·h₀ − h·v₀| / (|m| |m₀|)`, the dips being within ±90°.
-    fn agrees(&self, h0: f64, v0: f64, h: f64, v: f64) -> bool {
+    fn agrees(&self, h0: T, v0: T, h: T, v: T) -> bool {
         // Components of real fields (and of the clamped readings the filter passes) are far
         // from overflowing a square, so no `hypot` is needed.
         let n0 = (h0 * h0 + v0 * v0).sqrt();
         let n = (h * h + v * v).sqrt();
-        (n - n0).abs() <= self.config.norm_tol_rel * n0
+        (n - n0).abs() <= T::of(self.config.norm_tol_rel) * n0
             && (v * h0 - h * v0).abs() <= self.sin_dip_tol * n * n0
     }
 
@@ -203,25 +220,25 @@ impl MagReference {
             self.candidate_horizontal,
             self.candidate_vertical,
         ] {
-            check_finite("mag reference component", v)?;
+            check_finite_in("mag reference component", v)?;
         }
-        check_range("mag.candidate_s", self.candidate_s, 0.0, f64::MAX)?;
-        check_range(
+        check_range_in("mag.candidate_s", self.candidate_s, 0.0, f64::MAX)?;
+        check_range_in(
             "mag.candidate_moving_s",
             self.candidate_moving_s,
             0.0,
             f64::MAX,
         )?;
-        check_range("mag.gain", self.gain.1, 0.0, 1.0)?;
-        check_range("mag.gain interval", self.gain.0, 0.0, f64::MAX)?;
+        check_range_in("mag.gain", self.gain.1, 0.0, 1.0)?;
+        check_range_in("mag.gain interval", self.gain.0, 0.0, f64::MAX)?;
         Ok(())
     }
 
-    fn adopt(&mut self, horizontal: f64, vertical: f64) {
+    fn adopt(&mut self, horizontal: T, vertical: T) {
         self.horizontal = horizontal;
         self.vertical = vertical;
-        self.candidate_s = 0.0;
-        self.candidate_moving_s = 0.0;
+        self.candidate_s = T::zero();
+        self.candidate_moving_s = T::zero();
         self.valid = true;
     }
 }

@@ -2,6 +2,8 @@
 //! the parts the quaternion filter is built from (rest detection, magnetic-disturbance
 //! rejection, online hard-iron re-estimation, the σ of its attitude, small-angle rotations)
 //! and the gap rule both estimators share, with BROAD's error split to score them.
+//! The quaternion filter's per-sample path is generic over the float type (`f64` or
+//! `f32`, [`truenorth_core::Real`]).
 
 mod attitude_error;
 pub mod attitude_uncertainty;
@@ -16,7 +18,9 @@ mod moving_average;
 mod quaternion_config;
 mod quaternion_filter;
 mod quaternion_gains;
+mod quaternion_input;
 mod quaternion_state;
+mod real_checks;
 mod rest_detector;
 mod rotation;
 mod sample_bounds;

@@ -36,51 +36,52 @@
 //! corrections use series that are exact to 10⁻¹⁰ rad at their step sizes
 //! ([`super::rotation`]), the dip test compares sines, and the heading error is taken as
 //! `sin ε = y/|h|` of the horizontal field `h = (x, y)` (±1 beyond ±90°).
+//!
+//! **Float type.** The filter, its parts and its state are generic over the float type
+//! `T` ([`truenorth_core::Real`], `f64` by default): `QuaternionFilter<f32>` runs the same
+//! per-sample path in single precision, for a microcontroller whose FPU has no `f64`. Every
+//! constant is written in `f64` and converted with `T::of`, so that for `f64` each
+//! operation is the one written. The parameters, the timestamps and the estimate record
+//! stay `f64`; how readings in `T` enter is in `quaternion_input`.
 
 use nalgebra::{Matrix3, Quaternion, UnitQuaternion, Vector3};
 use truenorth_core::{
-    AttitudeEstimate, AttitudeStatus, Error, ImuSample, OrientationEstimator, Persistent, Result,
-    STANDARD_GRAVITY_MPS2, Validate,
+    AttitudeEstimate, AttitudeStatus, Real, Result, STANDARD_GRAVITY_MPS2, Validate,
 };
 
 use super::quaternion_config::{GyroTiming, QuaternionFilterConfig};
 use super::quaternion_gains::{Coefficients, effective_tau};
 use super::quaternion_state::QuaternionFilterState;
 use super::rotation::{rotation_from_vector, small_rotation};
-use super::sample_bounds::check_bounds;
-use super::time_gap::Step;
-use super::triad::attitude_from;
-
-#[cfg(not(feature = "std"))]
-use truenorth_core::Float as _;
 
 /// What the parts of one step share.
-struct StepContext {
-    dt_s: f64,
+struct StepContext<T> {
+    dt_s: T,
     /// The step falls in the start-up (fast corrections, no bias learning).
     startup: bool,
-    gains: Coefficients,
+    gains: Coefficients<T>,
     at_rest: bool,
     /// Body → NED after the strapdown, before the step's corrections: one rotation matrix
     /// serves every vector rotated in the step.
-    rotation: Matrix3<f64>,
+    rotation: Matrix3<T>,
     /// |ω − b̂|, rad/s.
-    rate_rps: f64,
+    rate_rps: T,
 }
 
 /// The heading error `sin ε` of the angle ε of the horizontal field `m_ned` (horizontal
 /// norm `horizontal`) east of north, and ±1 beyond ±90°: equal to ε to 0.13 % for
 /// |ε| < 5°, and bounded, so a disturbed reading that slips past the tests pulls no harder
 /// than a 57° error (the angle itself would pull with up to 180°).
-fn heading_error(m_ned: &Vector3<f64>, horizontal: f64) -> f64 {
-    if m_ned.x >= 0.0 {
+fn heading_error<T: Real>(m_ned: &Vector3<T>, horizontal: T) -> T {
+    if m_ned.x >= T::zero() {
         m_ned.y / horizontal
     } else {
-        1f64.copysign(m_ned.y)
+        T::one().copysign(m_ned.y)
     }
 }
 
-/// The quaternion orientation filter (see the module documentation).
+/// The quaternion orientation filter (see the module documentation), computing in `T`
+/// (`f64` by default; [`QuaternionFilter::with_precision`] for another).
 ///
 /// ```
 /// use nalgebra::Vector3;
@@ -105,23 +106,32 @@ fn heading_error(m_ned: &Vector3<f64>, horizontal: f64) -> f64 {
 /// # Ok::<(), truenorth_core::Error>(())
 /// ```
 #[derive(Debug, Clone)]
-pub struct QuaternionFilter {
-    state: QuaternionFilterState,
+pub struct QuaternionFilter<T: Real = f64> {
+    pub(super) state: QuaternionFilterState<T>,
     /// Derived from the parameters and the sample interval.
-    coefficients: Coefficients,
+    coefficients: Coefficients<T>,
 }
 
 impl QuaternionFilter {
-    /// A filter with the given parameters.
+    /// A filter with the given parameters, computing in `f64`.
     pub fn new(config: QuaternionFilterConfig) -> Result<Self> {
+        Self::with_precision(config)
+    }
+}
+
+impl<T: Real> QuaternionFilter<T> {
+    /// A filter with the given parameters, computing in `T`:
+    /// `QuaternionFilter::<f32>::with_precision(config)` for a single-precision FPU. The
+    /// parameters are the same `f64` configuration for every `T`.
+    pub fn with_precision(config: QuaternionFilterConfig) -> Result<Self> {
         config.validate()?;
         Ok(Self::with_state(QuaternionFilterState::initial(config)))
     }
 
     /// The filter continuing from a valid `state`.
-    fn with_state(state: QuaternionFilterState) -> Self {
+    pub(super) fn with_state(state: QuaternionFilterState<T>) -> Self {
         Self {
-            coefficients: Coefficients::new(&state.config, 0.0, false),
+            coefficients: Coefficients::new(&state.config, T::zero(), false),
             state,
         }
     }
@@ -133,21 +143,21 @@ impl QuaternionFilter {
 
     /// The hard-iron offset currently subtracted from the magnetometer (body frame, the
     /// magnetometer's unit), if one was learned.
-    pub fn hard_iron_offset(&self) -> Option<Vector3<f64>> {
+    pub fn hard_iron_offset(&self) -> Option<Vector3<T>> {
         self.state.hard_iron.offset()
     }
 
     /// One step of `dt_s` ending at `t_s`, in the order of the module documentation: the
     /// strapdown, the σ carried through it, the corrections the sample's readings allow
     /// (applied together at the end: at most 10⁻³ rad each), the gyro bias.
-    fn step(
+    pub(super) fn step(
         &mut self,
         t_s: f64,
-        dt_s: f64,
-        gyr: Vector3<f64>,
-        acc: Option<Vector3<f64>>,
-        mag: Option<Vector3<f64>>,
-    ) {
+        dt_s: T,
+        gyr: Vector3<T>,
+        acc: Option<Vector3<T>>,
+        mag: Option<Vector3<T>>,
+    ) -> AttitudeStatus {
         let startup = self.advance_time(dt_s);
         let gains = self.gains(dt_s, startup);
         let omega = self.strapdown(dt_s, gyr);
@@ -168,7 +178,7 @@ impl QuaternionFilter {
         // The step's correction, a rotation vector in the reference frame.
         let mut correction = Vector3::zeros();
         if let Some(a) = acc
-            && a.norm_squared() > 1e-12
+            && a.norm_squared() > T::of(1e-12)
         {
             self.correct_inclination(&step, &a, &mut correction);
             status.accel_used = true;
@@ -182,17 +192,18 @@ impl QuaternionFilter {
             self.estimate_bias(&step, &correction);
         }
         self.state.estimate = Some(self.estimate_at(t_s, status));
+        status
     }
 
     /// Counts the step's time and says whether it falls in the start-up.
-    fn advance_time(&mut self, dt_s: f64) -> bool {
+    fn advance_time(&mut self, dt_s: T) -> bool {
         self.state.since_start_s += dt_s;
-        self.state.since_start_s < self.state.config.startup_s
+        self.state.since_start_s < T::of(self.state.config.startup_s)
     }
 
     /// The gains for a step of `dt_s`: the start-up's computed afresh, the others kept
     /// until the interval changes.
-    fn gains(&mut self, dt_s: f64, startup: bool) -> Coefficients {
+    fn gains(&mut self, dt_s: T, startup: bool) -> Coefficients<T> {
         if startup {
             return Coefficients::new(&self.state.config, dt_s, true);
         }
@@ -204,11 +215,11 @@ impl QuaternionFilter {
 
     /// Strapdown: `q ← q ⊗ exp((ω − b̂) dt / 2)` with the rate the gyro's timing calls for.
     /// Returns the body rate less the bias, `ω − b̂`, rad/s.
-    fn strapdown(&mut self, dt_s: f64, gyr: Vector3<f64>) -> Vector3<f64> {
+    fn strapdown(&mut self, dt_s: T, gyr: Vector3<T>) -> Vector3<T> {
         let s = &mut self.state;
         let rate = match s.config.gyro_timing {
             GyroTiming::IntervalMean => gyr,
-            GyroTiming::Instantaneous => 0.5 * (s.last_gyr_rps.unwrap_or(gyr) + gyr),
+            GyroTiming::Instantaneous => (s.last_gyr_rps.unwrap_or(gyr) + gyr) * T::of(0.5),
         };
         s.last_gyr_rps = Some(gyr);
         let omega = rate - s.gyro_bias_rps;
@@ -219,7 +230,7 @@ impl QuaternionFilter {
     }
 
     /// Carries the σ through the strapdown step at body rate `omega` (bias removed).
-    fn propagate_uncertainty(&mut self, step: &StepContext, omega: &Vector3<f64>) {
+    fn propagate_uncertainty(&mut self, step: &StepContext<T>, omega: &Vector3<T>) {
         self.state
             .uncertainty
             .propagate(step.dt_s, omega, step.rate_rps, &step.rotation);
@@ -227,9 +238,9 @@ impl QuaternionFilter {
 
     /// The in-motion bias estimate's 1/τ as the σ credits it: none while the bias does not
     /// learn from the corrections (start-up, rest).
-    fn bias_inv_tau_credited(&self, step: &StepContext) -> f64 {
+    fn bias_inv_tau_credited(&self, step: &StepContext<T>) -> T {
         if step.startup || step.at_rest {
-            0.0
+            T::zero()
         } else {
             self.state.bias_inv_tau_motion_per_s
         }
@@ -240,9 +251,9 @@ impl QuaternionFilter {
     /// `correction`.
     fn correct_inclination(
         &mut self,
-        step: &StepContext,
-        a: &Vector3<f64>,
-        correction: &mut Vector3<f64>,
+        step: &StepContext<T>,
+        a: &Vector3<T>,
+        correction: &mut Vector3<T>,
     ) {
         let inv_tau_bias = self.bias_inv_tau_credited(step);
         let s = &mut self.state;
@@ -262,11 +273,11 @@ impl QuaternionFilter {
         correction.x = -lp.y * k;
         correction.y = lp.x * k;
         s.uncertainty.accel_corrected(
-            k * STANDARD_GRAVITY_MPS2,
+            k * T::of(STANDARD_GRAVITY_MPS2),
             (correction.x, correction.y),
-            effective_tau(cfg.tau_acc_s, step.startup),
+            effective_tau(T::of(cfg.tau_acc_s), step.startup),
             inv_tau_bias,
-            effective_tau(cfg.acc_lowpass_s, step.startup),
+            effective_tau(T::of(cfg.acc_lowpass_s), step.startup),
         );
     }
 
@@ -275,23 +286,23 @@ impl QuaternionFilter {
     /// `correction`, unless the reading is judged disturbed.
     fn correct_heading(
         &mut self,
-        step: &StepContext,
-        m: &Vector3<f64>,
-        correction: &mut Vector3<f64>,
+        step: &StepContext<T>,
+        m: &Vector3<T>,
+        correction: &mut Vector3<T>,
         status: &mut AttitudeStatus,
     ) {
-        let mag_dt_s = core::mem::take(&mut self.state.since_mag_s);
+        let mag_dt_s = core::mem::replace(&mut self.state.since_mag_s, T::zero());
         let offset = self.learn_hard_iron(step, m, mag_dt_s);
         status.mag_calibrating = offset.is_some();
-        let m_ned = step.rotation * (m - offset.unwrap_or_default());
+        let m_ned = step.rotation * (m - offset.unwrap_or_else(Vector3::zeros));
         let horizontal = m_ned.xy().norm();
-        if horizontal > 0.0 {
+        if horizontal > T::zero() {
             let undisturbed =
                 self.state
                     .mag_reference
                     .update(horizontal, m_ned.z, step.rate_rps, mag_dt_s);
             status.mag_disturbed = !undisturbed;
-            if undisturbed && horizontal > 1e-9 * m_ned.z.abs() {
+            if undisturbed && horizontal > T::of(1e-9) * m_ned.z.abs() {
                 let k = self.heading_gain(step, mag_dt_s);
                 let dz = -k * heading_error(&m_ned, horizontal);
                 correction.z = dz;
@@ -309,13 +320,17 @@ impl QuaternionFilter {
     /// reference is known; `mag_dt_s` is the time since the previous reading.
     fn learn_hard_iron(
         &mut self,
-        step: &StepContext,
-        m: &Vector3<f64>,
-        mag_dt_s: f64,
-    ) -> Option<Vector3<f64>> {
+        step: &StepContext<T>,
+        m: &Vector3<T>,
+        mag_dt_s: T,
+    ) -> Option<Vector3<T>> {
         let reference = self.state.mag_reference.reference_ned()?;
         // A gyro bias not yet learned must not count as turning.
-        let turning_rps = if step.at_rest { 0.0 } else { step.rate_rps };
+        let turning_rps = if step.at_rest {
+            T::zero()
+        } else {
+            step.rate_rps
+        };
         self.state
             .hard_iron
             .update(m, &step.rotation, &reference, turning_rps, mag_dt_s)
@@ -323,7 +338,7 @@ impl QuaternionFilter {
 
     /// The heading correction's gain: at rest or in motion, and covering the samples
     /// without a reading since the last one.
-    fn heading_gain(&self, step: &StepContext, mag_dt_s: f64) -> f64 {
+    fn heading_gain(&self, step: &StepContext<T>, mag_dt_s: T) -> T {
         let c = &step.gains;
         match (step.at_rest, mag_dt_s == step.dt_s) {
             (true, true) => c.mag_rest,
@@ -340,10 +355,10 @@ impl QuaternionFilter {
     /// part `horizontal`), judged against the learned reference.
     fn credit_heading_uncertainty(
         &mut self,
-        step: &StepContext,
-        k: f64,
-        m_ned: &Vector3<f64>,
-        horizontal: f64,
+        step: &StepContext<T>,
+        k: T,
+        m_ned: &Vector3<T>,
+        horizontal: T,
     ) {
         let Some(reference) = self.state.mag_reference.reference_ned() else {
             return;
@@ -357,7 +372,7 @@ impl QuaternionFilter {
         };
         self.state.uncertainty.mag_corrected(
             k,
-            effective_tau(tau, step.startup),
+            effective_tau(T::of(tau), step.startup),
             (horizontal, m_ned.z),
             (reference.x, reference.z),
             inv_tau_bias,
@@ -366,9 +381,9 @@ impl QuaternionFilter {
 
     /// Adds the heading correction `dz` to the turn the 6-D attitude undoes:
     /// `Rz(−H/2) ← Rz(−dz/2) Rz(−H/2)`, first order and renormalised.
-    fn undo_heading_correction(&mut self, dz: f64) {
+    fn undo_heading_correction(&mut self, dz: T) {
         let (c, sn) = self.state.undo_heading;
-        let h = 0.5 * dz;
+        let h = T::of(0.5) * dz;
         let (c, sn) = (c + sn * h, sn - c * h);
         let n = (c * c + sn * sn).sqrt();
         self.state.undo_heading = (c / n, sn / n);
@@ -376,7 +391,7 @@ impl QuaternionFilter {
 
     /// Turns the attitude by the step's `correction` (in the reference frame), and the
     /// low-passed specific force with it so that it stays in the frame of `q`.
-    fn apply_correction(&mut self, correction: &Vector3<f64>) {
+    fn apply_correction(&mut self, correction: &Vector3<T>) {
         if *correction != Vector3::zeros() {
             let s = &mut self.state;
             s.attitude = small_rotation(correction) * s.attitude;
@@ -387,7 +402,7 @@ impl QuaternionFilter {
 
     /// Gyro bias: at rest it follows the rest detector's mean of the raw rate; in motion it
     /// integrates the rate the step's `correction` implies. Clamped to `max_bias_rps`.
-    fn estimate_bias(&mut self, step: &StepContext, correction: &Vector3<f64>) {
+    fn estimate_bias(&mut self, step: &StepContext<T>, correction: &Vector3<T>) {
         if step.at_rest {
             self.learn_bias_at_rest(step);
         } else {
@@ -399,182 +414,71 @@ impl QuaternionFilter {
             let s = &mut self.state;
             s.gyro_bias_rps -= step.rotation.tr_mul(correction) * s.bias_inv_tau_motion_per_s;
         }
-        let lim = self.state.config.max_bias_rps;
+        let lim = T::of(self.state.config.max_bias_rps);
         self.state.gyro_bias_rps = self.state.gyro_bias_rps.map(|b| b.clamp(-lim, lim));
     }
 
     /// The bias at rest, and how well it is known: the in-motion estimate's time constant
     /// moves from `bias_tau_unknown_s` to `bias_tau_motion_s` as rest time accumulates.
-    fn learn_bias_at_rest(&mut self, step: &StepContext) {
+    fn learn_bias_at_rest(&mut self, step: &StepContext<T>) {
         let s = &mut self.state;
         let cfg = &s.config;
         let k = step.gains.bias_rest;
         s.gyro_bias_rps += (s.rest.gyro_mean() - s.gyro_bias_rps) * k;
         s.uncertainty
             .at_rest(k, cfg.rest.mean_tau_s, cfg.bias_tau_rest_s);
-        if s.rest_s < cfg.bias_known_after_rest_s {
+        let known_after_s = T::of(cfg.bias_known_after_rest_s);
+        if s.rest_s < known_after_s {
             s.rest_s += step.dt_s;
-            let known = (s.rest_s / cfg.bias_known_after_rest_s).min(1.0);
-            let tau =
-                cfg.bias_tau_unknown_s + known * (cfg.bias_tau_motion_s - cfg.bias_tau_unknown_s);
-            s.bias_inv_tau_motion_per_s = 1.0 / tau;
+            let known = (s.rest_s / known_after_s).min(T::one());
+            let tau = T::of(cfg.bias_tau_unknown_s)
+                + known * T::of(cfg.bias_tau_motion_s - cfg.bias_tau_unknown_s);
+            s.bias_inv_tau_motion_per_s = T::one() / tau;
         }
     }
 
     /// The estimate after the step: the attitude, the 6-D attitude with every heading
-    /// correction undone, the bias and σ.
+    /// correction undone, the bias and σ, as the `f64` record every estimator returns.
     fn estimate_at(&self, t_s: f64, status: AttitudeStatus) -> AttitudeEstimate {
         let s = &self.state;
-        let (c, sn) = s.undo_heading;
-        let undo = UnitQuaternion::new_unchecked(Quaternion::new(c, 0.0, 0.0, sn));
         AttitudeEstimate {
             t_s,
-            attitude: s.attitude,
-            attitude_6d: Some(undo * s.attitude),
-            gyro_bias_rps: s.gyro_bias_rps,
-            sigma_rad: Some(s.uncertainty.sigma_rad()),
+            attitude: attitude_f64(&s.attitude),
+            attitude_6d: Some(attitude_f64(&self.attitude_6d())),
+            gyro_bias_rps: s.gyro_bias_rps.map(T::to_f64),
+            sigma_rad: Some(s.uncertainty.sigma_rad().map(T::to_f64)),
             status,
         }
     }
 
-    /// Starts again after a gap of `gap_s` that the gyro cannot bridge: the attitude from
-    /// this sample's accelerometer (and magnetometer) when it has one, the start-up's fast
-    /// corrections again, the σ widened; the learned bias, field reference and hard iron
-    /// are properties of the sensor and carry over.
-    fn restart(
-        &mut self,
-        t_s: f64,
-        gap_s: f64,
-        gyr: Vector3<f64>,
-        acc: Option<Vector3<f64>>,
-        mag: Option<Vector3<f64>>,
-    ) -> AttitudeEstimate {
-        let s = &mut self.state;
-        if let Some(q) = acc.and_then(|a| attitude_from(&a, mag.as_ref())) {
-            s.attitude = q;
-        }
-        s.undo_heading = (1.0, 0.0);
-        s.acc_lowpass_ned_mps2 = None;
-        s.last_gyr_rps = Some(gyr);
-        s.since_mag_s = 0.0;
-        s.since_start_s = 0.0;
-        s.uncertainty.restart(false, gap_s);
-        s.rest.reset();
-        let estimate = AttitudeEstimate {
-            t_s,
-            gyro_bias_rps: s.gyro_bias_rps,
-            sigma_rad: Some(s.uncertainty.sigma_rad()),
-            status: AttitudeStatus {
-                gap: true,
-                ..AttitudeStatus::default()
-            },
-            ..AttitudeEstimate::initial(s.attitude)
-        };
-        s.estimate = Some(estimate);
-        estimate
+    /// The attitude after the last sample, body → NED (Hamilton, scalar first): the
+    /// estimate's `attitude`, in the filter's float type.
+    pub fn attitude(&self) -> UnitQuaternion<T> {
+        self.state.attitude
+    }
+
+    /// The 6-D attitude (gyro and accelerometer only, heading relative to the start): the
+    /// estimate's `attitude_6d`, in the filter's float type.
+    pub fn attitude_6d(&self) -> UnitQuaternion<T> {
+        let (c, sn) = self.state.undo_heading;
+        let undo = UnitQuaternion::new_unchecked(Quaternion::new(c, T::zero(), T::zero(), sn));
+        undo * self.state.attitude
+    }
+
+    /// The gyro bias estimate, rad/s, body axes: the estimate's `gyro_bias_rps`, in the
+    /// filter's float type.
+    pub fn gyro_bias_rps(&self) -> Vector3<T> {
+        self.state.gyro_bias_rps
+    }
+
+    /// One σ of the attitude error about north, east and down, rad: the estimate's
+    /// `sigma_rad`, in the filter's float type.
+    pub fn sigma_rad(&self) -> Vector3<T> {
+        self.state.uncertainty.sigma_rad()
     }
 }
 
-impl Default for QuaternionFilter {
-    /// The filter with [`QuaternionFilterConfig::default`], as the calibrators' `Default`.
-    fn default() -> Self {
-        // The default configuration passes validation (held by the test
-        // `the_default_filter_is_the_default_configuration`), so this cannot fail.
-        Self::new(QuaternionFilterConfig::default())
-            .expect("the default quaternion filter configuration is valid")
-    }
-}
-
-impl OrientationEstimator for QuaternionFilter {
-    /// Needs a gyro triad; the accelerometer and magnetometer triads may be absent on any
-    /// sample (a slower sensor). A non-finite value, a reading beyond any sensor's range
-    /// (gyro 10⁴ rad/s, accelerometer 10⁶ m/s², field 10¹²), a timestamp that does not
-    /// increase or a gap over 10⁶ s is an error and changes nothing. A step longer than
-    /// `max_gap_s` restarts the attitude from the sample (status `gap`); a step that would
-    /// make such gaps the majority of the steps is an [`Error::Implausible`] time base.
-    fn update(&mut self, sample: &ImuSample) -> Result<AttitudeEstimate> {
-        let gyr = sample.gyr_rps.as_xyz().ok_or(Error::Unsupported {
-            reason: "the quaternion filter needs a three-axis gyro; use the Euler detector for two gyros",
-        })?;
-        let acc = sample.acc_mps2.as_xyz();
-        let mag = if self.state.config.use_mag {
-            sample.mag.as_xyz()
-        } else {
-            None
-        };
-        // The usual sample is a finite 9-D one: test it in one pass, and let the sample's
-        // own check name the offending reading otherwise.
-        let finite = sample.t_s.is_finite()
-            && gyr.iter().all(|v| v.is_finite())
-            && acc.is_some_and(|a| a.iter().all(|v| v.is_finite()))
-            && sample
-                .mag
-                .as_xyz()
-                .is_some_and(|m| m.iter().all(|v| v.is_finite()));
-        if !finite {
-            sample.check_finite()?;
-        }
-        // Readings beyond any sensor's range could overflow the update; they are refused
-        // before anything changes, so the update needs no copy of the state to fall back to.
-        let mut clock = self.state.clock;
-        let dt = clock.dt_s(sample.t_s)?;
-        check_bounds(&gyr, acc.as_ref(), mag.as_ref(), dt)?;
-        let step = dt.map(|d| self.state.gaps.classify(d)).transpose()?;
-        self.state.clock = clock;
-        if let Some(step) = step {
-            self.state.gaps.count(step);
-        }
-        if let (Some(gap_s), Some(Step::Gap)) = (dt, step) {
-            return Ok(self.restart(sample.t_s, gap_s, gyr, acc, mag));
-        }
-        let Some(dt_s) = dt else {
-            if !self.state.initialised
-                && let Some(q) = acc.and_then(|a| attitude_from(&a, mag.as_ref()))
-            {
-                self.state.attitude = q;
-                self.state.initialised = true;
-            }
-            self.state.last_gyr_rps = Some(gyr);
-            let estimate = AttitudeEstimate {
-                t_s: sample.t_s,
-                sigma_rad: Some(self.state.uncertainty.sigma_rad()),
-                ..AttitudeEstimate::initial(self.state.attitude)
-            };
-            self.state.estimate = Some(estimate);
-            return Ok(estimate);
-        };
-        self.step(sample.t_s, dt_s, gyr, acc, mag);
-        debug_assert!(self.state.attitude.coords.iter().all(|v| v.is_finite()));
-        Ok(self.estimate())
-    }
-
-    /// The estimate after the last sample; before the first, the initial attitude with
-    /// its σ.
-    fn estimate(&self) -> AttitudeEstimate {
-        let s = &self.state;
-        s.estimate.unwrap_or_else(|| AttitudeEstimate {
-            sigma_rad: Some(s.uncertainty.sigma_rad()),
-            ..AttitudeEstimate::initial(s.attitude)
-        })
-    }
-
-    /// Back to the state before any sample, with the same parameters.
-    fn reset(&mut self) {
-        *self = Self::with_state(QuaternionFilterState::initial(self.state.config));
-    }
-}
-
-impl Persistent for QuaternionFilter {
-    type State = QuaternionFilterState;
-    const SNAPSHOT_VERSION: u32 = 1;
-
-    fn state(&self) -> QuaternionFilterState {
-        self.state
-    }
-
-    /// Refuses a state that is not valid (see [`QuaternionFilterState`]'s `validate`).
-    fn from_state(state: QuaternionFilterState) -> Result<Self> {
-        state.validate()?;
-        Ok(Self::with_state(state))
-    }
+/// `q` as an `f64` quaternion (exact: every `T` converts to `f64` exactly).
+pub(super) fn attitude_f64<T: Real>(q: &UnitQuaternion<T>) -> UnitQuaternion<f64> {
+    UnitQuaternion::new_unchecked(Quaternion::from(q.coords.map(T::to_f64)))
 }

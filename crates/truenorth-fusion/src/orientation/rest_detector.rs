@@ -15,10 +15,9 @@
 
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
-use truenorth_core::{Error, Result, Validate, check_finite3, check_positive, check_range};
+use truenorth_core::{Error, Real, Result, Validate, check_positive, check_range};
 
-#[cfg(not(feature = "std"))]
-use truenorth_core::Float as _;
+use super::real_checks::{check_finite3_in, check_range_in};
 
 /// Thresholds of the rest detector (derived values live in [`RestDetector`]).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -62,23 +61,33 @@ impl Validate for RestConfig {
     }
 }
 
-/// Running means and the time the sensor has looked still.
+/// Running means and the time the sensor has looked still, in the float type `T` (the
+/// thresholds stay `f64`, converted where they are compared).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct RestDetector {
+// `Real` includes serde's bounds on `T`.
+#[serde(bound = "")]
+pub struct RestDetector<T: Real = f64> {
     config: RestConfig,
-    gyr_mean: Vector3<f64>,
-    acc_mean: Vector3<f64>,
-    mag_mean: Option<Vector3<f64>>,
-    mag_at_start: Option<Vector3<f64>>,
-    still_s: f64,
+    gyr_mean: Vector3<T>,
+    acc_mean: Vector3<T>,
+    mag_mean: Option<Vector3<T>>,
+    mag_at_start: Option<Vector3<T>>,
+    still_s: T,
     primed: bool,
     /// The running means' gain for the last interval (recomputed when it changes).
-    gain: (f64, f64),
+    gain: (T, T),
 }
 
 impl RestDetector {
     /// A detector with the given thresholds, refused when they are invalid.
     pub fn new(config: RestConfig) -> Result<Self> {
+        Self::with_precision(config)
+    }
+}
+
+impl<T: Real> RestDetector<T> {
+    /// As [`RestDetector::new`], computing in `T` (`RestDetector::<f32>::with_precision(config)`).
+    pub fn with_precision(config: RestConfig) -> Result<Self> {
         config.validate()?;
         Ok(Self::with_config(config))
     }
@@ -91,9 +100,9 @@ impl RestDetector {
             acc_mean: Vector3::zeros(),
             mag_mean: None,
             mag_at_start: None,
-            still_s: 0.0,
+            still_s: T::zero(),
             primed: false,
-            gain: (0.0, 0.0),
+            gain: (T::zero(), T::zero()),
         }
     }
 
@@ -106,10 +115,10 @@ impl RestDetector {
     /// previous one and says whether the sensor is at rest.
     pub fn update(
         &mut self,
-        gyr: &Vector3<f64>,
-        acc: &Vector3<f64>,
-        mag: Option<&Vector3<f64>>,
-        dt_s: f64,
+        gyr: &Vector3<T>,
+        acc: &Vector3<T>,
+        mag: Option<&Vector3<T>>,
+        dt_s: T,
     ) -> bool {
         if !self.primed {
             self.gyr_mean = *gyr;
@@ -119,12 +128,15 @@ impl RestDetector {
             return false;
         }
         if self.gain.0 != dt_s {
-            self.gain = (dt_s, (dt_s / self.config.mean_tau_s).min(1.0));
+            self.gain = (dt_s, (dt_s / T::of(self.config.mean_tau_s)).min(T::one()));
         }
         let k = self.gain.1;
         self.gyr_mean += (gyr - self.gyr_mean) * k;
         self.acc_mean += (acc - self.acc_mean) * k;
-        let (g, a) = (self.config.gyro_dev_rps, self.config.acc_dev_mps2);
+        let (g, a) = (
+            T::of(self.config.gyro_dev_rps),
+            T::of(self.config.acc_dev_mps2),
+        );
         let mut still = (gyr - self.gyr_mean).norm_squared() < g * g
             && (acc - self.acc_mean).norm_squared() < a * a;
         match (mag, self.mag_mean.as_mut()) {
@@ -134,25 +146,25 @@ impl RestDetector {
         }
         if still && let (Some(start), Some(mean)) = (self.mag_at_start, self.mag_mean) {
             // angle < θ ⇔ dot > 0 and |a × b|² < sin²θ |a|² |b|² (θ < 90°): no arccosine.
-            let sin = self.config.mag_turn_rad.min(1.5).sin();
-            still = start.dot(&mean) > 0.0
+            let sin = T::of(self.config.mag_turn_rad).min(T::of(1.5)).sin();
+            still = start.dot(&mean) > T::zero()
                 && start.cross(&mean).norm_squared()
                     < sin * sin * start.norm_squared() * mean.norm_squared();
         }
         if still {
-            if self.still_s == 0.0 {
+            if self.still_s == T::zero() {
                 self.mag_at_start = self.mag_mean;
             }
             self.still_s += dt_s;
         } else {
-            self.still_s = 0.0;
+            self.still_s = T::zero();
             self.mag_at_start = None;
         }
-        self.still_s >= self.config.min_time_s
+        self.still_s >= T::of(self.config.min_time_s)
     }
 
     /// Running mean of the raw gyro, rad/s: the bias while at rest.
-    pub fn gyro_mean(&self) -> Vector3<f64> {
+    pub fn gyro_mean(&self) -> Vector3<T> {
         self.gyr_mean
     }
 
@@ -164,14 +176,14 @@ impl RestDetector {
                 reason: "the rest detector's thresholds differ from the filter's",
             });
         }
-        check_finite3("rest.gyr_mean", &self.gyr_mean)?;
-        check_finite3("rest.acc_mean", &self.acc_mean)?;
+        check_finite3_in("rest.gyr_mean", &self.gyr_mean)?;
+        check_finite3_in("rest.acc_mean", &self.acc_mean)?;
         for m in [self.mag_mean, self.mag_at_start].iter().flatten() {
-            check_finite3("rest.mag_mean", m)?;
+            check_finite3_in("rest.mag_mean", m)?;
         }
-        check_range("rest.still_s", self.still_s, 0.0, f64::MAX)?;
-        check_range("rest.gain", self.gain.1, 0.0, 1.0)?;
-        check_range("rest.gain interval", self.gain.0, 0.0, f64::MAX)?;
+        check_range_in("rest.still_s", self.still_s, 0.0, f64::MAX)?;
+        check_range_in("rest.gain", self.gain.1, 0.0, 1.0)?;
+        check_range_in("rest.gain interval", self.gain.0, 0.0, f64::MAX)?;
         Ok(())
     }
 }

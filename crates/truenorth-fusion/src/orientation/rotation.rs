@@ -3,9 +3,7 @@
 //! radian at the sample rates of an IMU; a correction step by at most 10⁻³ rad).
 
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
-
-#[cfg(not(feature = "std"))]
-use truenorth_core::Float as _;
+use truenorth_core::Real;
 
 /// Below this angle, rad, [`rotation_from_vector`] uses its series.
 const SERIES_MAX_RAD: f64 = 0.1;
@@ -17,12 +15,13 @@ const SERIES_MAX_RAD: f64 = 0.1;
 /// power of x = θ/2; the first term left out is x⁶/720 < 2·10⁻¹¹ at θ = 0.1. Above it the
 /// exact functions are used.
 #[inline]
-pub(crate) fn rotation_from_vector(v: &Vector3<f64>) -> Quaternion<f64> {
+pub(crate) fn rotation_from_vector<T: Real>(v: &Vector3<T>) -> Quaternion<T> {
     let t2 = v.norm_squared();
-    if t2 < SERIES_MAX_RAD * SERIES_MAX_RAD {
-        let x2 = 0.25 * t2;
-        let w = 1.0 - x2 * (0.5 - x2 / 24.0);
-        let s = 0.5 * (1.0 - x2 * (1.0 / 6.0 - x2 / 120.0));
+    let c = T::of;
+    if t2 < c(SERIES_MAX_RAD * SERIES_MAX_RAD) {
+        let x2 = c(0.25) * t2;
+        let w = T::one() - x2 * (c(0.5) - x2 / c(24.0));
+        let s = c(0.5) * (T::one() - x2 * (c(1.0 / 6.0) - x2 / c(120.0)));
         Quaternion::new(w, s * v.x, s * v.y, s * v.z)
     } else {
         UnitQuaternion::from_scaled_axis(*v).into_inner()
@@ -35,15 +34,22 @@ pub(crate) fn rotation_from_vector(v: &Vector3<f64>) -> Quaternion<f64> {
 /// exponential's sine and cosine. A step is limited to 0.1 rad: only a reading far outside
 /// any sensor's range asks for more, and it must not flip the attitude in one sample.
 #[inline]
-pub(crate) fn small_rotation(v: &Vector3<f64>) -> UnitQuaternion<f64> {
+pub(crate) fn small_rotation<T: Real>(v: &Vector3<T>) -> UnitQuaternion<T> {
     const MAX_STEP_RAD: f64 = 0.1;
     let n2 = v.norm_squared();
-    let v = if n2 > MAX_STEP_RAD * MAX_STEP_RAD {
-        v * (MAX_STEP_RAD / n2.sqrt())
+    let max = T::of(MAX_STEP_RAD);
+    let v = if n2 > max * max {
+        v * (max / n2.sqrt())
     } else {
         *v
     };
-    UnitQuaternion::new_normalize(Quaternion::new(1.0, 0.5 * v.x, 0.5 * v.y, 0.5 * v.z))
+    let half = T::of(0.5);
+    UnitQuaternion::new_normalize(Quaternion::new(
+        T::one(),
+        half * v.x,
+        half * v.y,
+        half * v.z,
+    ))
 }
 
 #[cfg(test)]

@@ -2,29 +2,30 @@
 //! [`crate::QuaternionFilter`] starts and restarts.
 
 use nalgebra::{UnitQuaternion, Vector3};
+use truenorth_core::Real;
 
 /// The attitude whose NED up is the measured specific force and, with a magnetometer,
 /// whose north is the horizontal part of the field (the TRIAD construction, Black 1964).
-pub(crate) fn attitude_from(
-    acc: &Vector3<f64>,
-    mag: Option<&Vector3<f64>>,
-) -> Option<UnitQuaternion<f64>> {
+pub(crate) fn attitude_from<T: Real>(
+    acc: &Vector3<T>,
+    mag: Option<&Vector3<T>>,
+) -> Option<UnitQuaternion<T>> {
     // Body-frame directions of NED down, and of north when a field is given. Scaling by
     // the largest component first keeps the norms finite for any finite reading.
-    let unit = |v: &Vector3<f64>| {
+    let unit = |v: &Vector3<T>| {
         let scale = v.amax();
-        (scale > 0.0 && scale.is_finite())
-            .then(|| (v / scale).try_normalize(1e-12))
+        (scale > T::zero() && scale.is_finite())
+            .then(|| (v / scale).try_normalize(T::of(1e-12)))
             .flatten()
     };
     let down = -unit(acc)?;
     let east_hint = mag
         .and_then(unit)
-        .and_then(|m| down.cross(&m).try_normalize(1e-9))
+        .and_then(|m| down.cross(&m).try_normalize(T::of(1e-9)))
         .unwrap_or_else(|| {
             // No field: any heading; take the body x axis as north when it is not vertical.
             down.cross(&Vector3::x())
-                .try_normalize(1e-9)
+                .try_normalize(T::of(1e-9))
                 .unwrap_or_else(|| down.cross(&Vector3::y()).normalize())
         });
     let north = east_hint.cross(&down);
