@@ -12,7 +12,7 @@ use std::path::{Path, PathBuf};
 
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 use truenorth_core::{ImuSample, OrientationEstimator};
-use truenorth_fusion::AttitudeError;
+use truenorth_fusion::broad_rmse;
 
 pub struct Trial {
     pub name: String,
@@ -75,29 +75,17 @@ pub fn read_trial(path: &Path) -> Trial {
     }
 }
 
-/// Body → NED into body → ENU: ENU = (east, north, up) = (NED y, NED x, −NED z), a proper
-/// rotation of 180° about (1, 1, 0)/√2.
+/// Body → NED into body → ENU (the library's frame change).
 pub fn ned_to_enu() -> UnitQuaternion<f64> {
-    let h = core::f64::consts::FRAC_1_SQRT_2;
-    UnitQuaternion::from_quaternion(Quaternion::new(0.0, h, h, 0.0))
+    truenorth_core::ned_to_enu()
 }
 
-/// (total, heading, inclination) RMSE in degrees, BROAD's definition.
+/// (total, heading, inclination) RMSE in degrees, BROAD's definition (the library's
+/// [`broad_rmse`]; NaN when no sample is scored).
 pub fn rmse(est: &[UnitQuaternion<f64>], trial: &Trial) -> [f64; 3] {
-    let mut sum = [0.0; 3];
-    let mut n = 0usize;
-    for (k, q) in est.iter().enumerate() {
-        let (Some(r), true) = (trial.truth[k], trial.movement[k]) else {
-            continue;
-        };
-        let e = AttitudeError::between(q, &r);
-        let (total, heading, incl) = (e.total_rad, e.heading_rad, e.inclination_rad);
-        for (s, x) in sum.iter_mut().zip([total, heading, incl]) {
-            *s += x * x;
-        }
-        n += 1;
-    }
-    sum.map(|s| (s / n as f64).sqrt().to_degrees())
+    broad_rmse(est, &trial.truth, &trial.movement).map_or([f64::NAN; 3], |r| {
+        [r.total_deg, r.heading_deg, r.inclination_deg]
+    })
 }
 
 /// The trial files of `../shared/data/broad/trials/`, sorted; `None` when the folder is
