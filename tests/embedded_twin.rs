@@ -11,7 +11,7 @@ mod shared_run;
 use std::io::Read as _;
 use std::path::{Path, PathBuf};
 
-use nalgebra::Vector3;
+use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 use shared_run::{HEADER_VALUES, SAMPLE_VALUES, UpdateMeter};
 use truenorth_calib::{EllipsoidConfig, fit_ellipsoid};
 use truenorth_core::angle_diff;
@@ -150,48 +150,98 @@ fn embedded_data_is_the_broad_slice() {
     }
 }
 
-/// The shared computation on the host: the lines it prints are the lines the QEMU run must
-/// print (`.ci/embedded` compares them). Held here: the attitude stays a unit quaternion, the
-/// filter's final yaw is within 5° of the motion-capture reference, and the calibrated
-/// compass's tilt-compensated heading within 5° of the filter's yaw (measured 0.04° and
-/// 0.10°). 5° is 2.7 times this filter's mean total RMSE on BROAD (1.86°, the README's
-/// `broad` figure): a single instant of one trial may exceed the RMSE, a broken run (wrong
-/// axes, frame or calibration) misses by tens of degrees.
+/// The output's blocks, one per float type, in order: the float's name (`f32`, `f64`) and
+/// the block's lines, its `float ...` line first.
+fn blocks(out: &str) -> Vec<(&str, Vec<&str>)> {
+    let mut blocks: Vec<(&str, Vec<&str>)> = Vec::new();
+    for l in out.lines() {
+        if let Some(rest) = l.strip_prefix("float ") {
+            let name = rest.split(':').next().expect("split yields a first part");
+            blocks.push((name, Vec::new()));
+        }
+        blocks
+            .last_mut()
+            .unwrap_or_else(|| panic!("a line before the first `float` line: {l}"))
+            .1
+            .push(l);
+    }
+    blocks
+}
+
+/// The numbers of the line `name ...` in a block's lines.
+fn numbers(lines: &[&str], name: &str) -> Vec<f64> {
+    let l = lines
+        .iter()
+        .find(|l| l.starts_with(&format!("{name} ")))
+        .unwrap_or_else(|| panic!("no `{name}` line in:\n{}", lines.join("\n")));
+    l.split_whitespace()
+        .skip(1)
+        .map(|v| v.parse().expect("a number"))
+        .collect()
+}
+
+/// How far the final attitude of the `f32` run may be from the `f64` run's, degrees.
+/// Single precision rounds each operation by up to 2⁻²⁴ ≈ 6·10⁻⁸ relative; one update's
+/// rotation and correction, a few roundings deep, move the attitude by a few 10⁻⁷ rad. Summed
+/// with the same sign over all 600 updates, with no cancellation and no pull-back by the
+/// corrections, that is at most 600 × 4·10⁻⁷ = 2.4·10⁻⁴ rad ≈ 0.014°; 0.02° covers it. A
+/// broken `f32` path (a wrong cast, a lost reading) misses by degrees. Over whole BROAD
+/// trials the `f32` filter's RMSE stays within 0.0013° of the `f64` one's
+/// (`crates/truenorth-fusion/tests/broad_f32.rs`).
+const F32_VS_F64_DEG: f64 = 0.02;
+
+/// The shared computation on the host, in `f32` and then in `f64`: the lines it prints are
+/// the lines the QEMU run must print (`.ci/embedded` compares them). Held here, in both
+/// blocks: the attitude stays a unit quaternion (within 10⁻¹² for f64, within 10⁻⁶, about
+/// 8 ulp, for f32: the filter normalises in its own float), the filter's final yaw is within
+/// 5° of the motion-capture reference, and the calibrated compass's tilt-compensated
+/// heading within 5° of the filter's yaw (measured 0.04° and 0.10° in f64). 5° is 2.7 times
+/// this filter's mean total RMSE on BROAD (1.86°, the README's `broad` figure): a single
+/// instant of one trial may exceed the RMSE, a broken run (wrong axes, frame or
+/// calibration) misses by tens of degrees. And the two final attitudes agree within
+/// [`F32_VS_F64_DEG`].
 #[test]
 fn host_twin() {
     let mut out = String::new();
-    shared_run::run(&mut out, &mut NoMeter).unwrap_or_else(|e| panic!("{e}"));
+    shared_run::run::<f32>(&mut out, &mut NoMeter).unwrap_or_else(|e| panic!("{e}"));
+    shared_run::run::<f64>(&mut out, &mut NoMeter).unwrap_or_else(|e| panic!("{e}"));
     print!("{out}");
     if let Some(path) = std::env::var_os("TRUENORTH_EMBEDDED_TWIN_OUT") {
         std::fs::write(&path, &out).unwrap_or_else(|e| panic!("{path:?}: {e}"));
     }
-    let line = |name: &str| -> Vec<f64> {
-        let l = out
-            .lines()
-            .find(|l| l.starts_with(&format!("{name} ")))
-            .unwrap_or_else(|| panic!("no `{name}` line in:\n{out}"));
-        l.split_whitespace()
-            .skip(1)
-            .map(|v| v.parse().expect("a number"))
-            .collect()
-    };
-    let q = line("final_q");
-    let norm = q.iter().map(|v| v * v).sum::<f64>().sqrt();
-    assert!((norm - 1.0).abs() < 1e-12, "|q| = {norm}");
-    let yaw = line("filter_yaw_pitch_roll_deg")[0];
-    let compass = line("compass_heading_deg")[0];
-    let reference = line("reference_yaw_deg")[0];
+    let blocks = blocks(&out);
+    let names: Vec<&str> = blocks.iter().map(|b| b.0).collect();
+    assert_eq!(names, ["f32", "f64"], "the blocks' floats");
     let diff = |a: f64, b: f64| {
         angle_diff(a.to_radians(), b.to_radians())
             .abs()
             .to_degrees()
     };
+    let mut finals = Vec::new();
+    for (float, lines) in &blocks {
+        let q = numbers(lines, "final_q");
+        let norm = q.iter().map(|v| v * v).sum::<f64>().sqrt();
+        let norm_tol = if *float == "f32" { 1e-6 } else { 1e-12 };
+        assert!((norm - 1.0).abs() < norm_tol, "{float}: |q| = {norm}");
+        let yaw = numbers(lines, "filter_yaw_pitch_roll_deg")[0];
+        let compass = numbers(lines, "compass_heading_deg")[0];
+        let reference = numbers(lines, "reference_yaw_deg")[0];
+        assert!(
+            diff(yaw, reference) < 5.0,
+            "{float}: filter {yaw}° vs reference {reference}°"
+        );
+        assert!(
+            diff(compass, yaw) < 5.0,
+            "{float}: compass {compass}° vs filter {yaw}°"
+        );
+        finals.push(UnitQuaternion::from_quaternion(Quaternion::new(
+            q[0], q[1], q[2], q[3],
+        )));
+    }
+    let apart_deg = finals[0].angle_to(&finals[1]).to_degrees();
+    println!("f32 vs f64 final attitude: {apart_deg:e}°");
     assert!(
-        diff(yaw, reference) < 5.0,
-        "filter {yaw}° vs reference {reference}°"
-    );
-    assert!(
-        diff(compass, yaw) < 5.0,
-        "compass {compass}° vs filter {yaw}°"
+        apart_deg < F32_VS_F64_DEG,
+        "the f32 and f64 final attitudes are {apart_deg}° apart"
     );
 }

@@ -1,7 +1,9 @@
 //! truenorth on a Cortex-M4F: the quaternion filter over a real BROAD slice and a calibrated
-//! compass heading ([`shared_run`], the same file the host twin runs), printed over
-//! semihosting, then the instructions one filter update takes, counted with the SysTick
-//! timer under QEMU's `-icount shift=0` (virtual time advances one step per instruction).
+//! compass heading ([`shared_run`], the same file the host twin runs), first in `f32` (the
+//! product path on this single-precision FPU), then in `f64` for comparison, printed over
+//! semihosting; after each, the instructions one filter update takes, counted with the
+//! SysTick timer under QEMU's `-icount shift=0` (virtual time advances one step per
+//! instruction).
 //!
 //! Run (QEMU's `mps2-an386`, see `.cargo/config.toml`): `cargo run --release`.
 #![no_std]
@@ -113,7 +115,7 @@ fn main() -> ! {
     loop {}
 }
 
-/// The shared run, then the measured cost of an update.
+/// The shared run in `f32`, then in `f64`, each followed by the measured cost of an update.
 fn run() -> Result<(), shared_run::RunError> {
     let mut out = hio::hstdout().map_err(|()| shared_run::RunError::Output(core::fmt::Error))?;
     let mut syst = cortex_m::Peripherals::take()
@@ -127,23 +129,46 @@ fn run() -> Result<(), shared_run::RunError> {
     let start = SYST::get_current();
     known_block();
     let known_ticks = ticks_between(start, SYST::get_current());
-    let instructions_per_tick = f64::from(KNOWN_BLOCK_INSTRUCTIONS) / f64::from(known_ticks);
-    let overhead = meter_overhead_ticks();
+    let calibration = Calibration {
+        instructions_per_tick: f64::from(KNOWN_BLOCK_INSTRUCTIONS) / f64::from(known_ticks),
+        overhead_ticks: meter_overhead_ticks(),
+    };
 
+    run_measured::<f32>(&mut out, &calibration)?;
+    run_measured::<f64>(&mut out, &calibration)
+}
+
+/// What turns summed SysTick ticks into instructions.
+struct Calibration {
+    /// Instructions one tick stands for (from [`known_block`]).
+    instructions_per_tick: f64,
+    /// Ticks an empty measurement costs ([`meter_overhead_ticks`]).
+    overhead_ticks: f64,
+}
+
+/// The shared run in the float type `R`, then a `measured` line with the mean instructions
+/// of one filter update.
+fn run_measured<R: truenorth_core::Real>(
+    out: &mut impl core::fmt::Write,
+    calibration: &Calibration,
+) -> Result<(), shared_run::RunError> {
     let mut meter = SysTickMeter {
         ticks: 0,
         updates: 0,
     };
-    shared_run::run(&mut out, &mut meter)?;
-
+    shared_run::run::<R>(out, &mut meter)?;
+    let Calibration {
+        instructions_per_tick,
+        overhead_ticks,
+    } = *calibration;
     let per_update =
-        (meter.ticks as f64 / f64::from(meter.updates) - overhead) * instructions_per_tick;
+        (meter.ticks as f64 / f64::from(meter.updates) - overhead_ticks) * instructions_per_tick;
     writeln!(
         out,
         "measured instructions_per_update={per_update:.0} updates={} float={} \
-         instructions_per_tick={instructions_per_tick:.3} meter_overhead_ticks={overhead:.3}",
+         instructions_per_tick={instructions_per_tick:.3} meter_overhead_ticks={overhead_ticks:.3}",
         meter.updates,
-        core::any::type_name::<shared_run::Real>()
+        core::any::type_name::<R>()
     )?;
     Ok(())
 }

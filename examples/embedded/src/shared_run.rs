@@ -1,8 +1,9 @@
 //! The computation that the Cortex-M4F binary and its host twin (`tests/embedded_twin.rs` in
 //! the main workspace) both run, from this one file: the quaternion filter over a slice of a
 //! real BROAD recording compiled into the binary, then a tilt-compensated compass heading
-//! with a stored calibration. Every result goes out as text through [`core::fmt::Write`], so
-//! the two outputs can be compared line by line.
+//! with a stored calibration, both in the float type the caller names ([`run`]). Every
+//! result goes out as text through [`core::fmt::Write`], so the two outputs can be compared
+//! line by line.
 //!
 //! Nothing here allocates, reads a clock or knows where it runs; the only hook is
 //! [`UpdateMeter`], which the target uses to count the instructions of each filter update.
@@ -11,14 +12,8 @@ use core::fmt::{self, Write};
 
 use nalgebra::{Matrix3, Quaternion, UnitQuaternion, Vector3};
 use truenorth_compass::CompassCalibration3d;
-use truenorth_core::{EulerZyx, ImuSample, OrientationEstimator, ned_to_enu};
-use truenorth_fusion::QuaternionFilter;
-
-/// The float type the filter runs in. Switching precision is this line and [`Filter`].
-pub type Real = f64;
-
-/// The filter at [`Real`] precision.
-pub type Filter = QuaternionFilter;
+use truenorth_core::{EulerZyx, Real, ned_to_enu};
+use truenorth_fusion::{QuaternionFilter, QuaternionFilterConfig};
 
 /// The recording, as written by `tests/embedded_twin.rs` (`embedded_data_is_the_broad_slice`):
 /// little-endian `f32`s, first [`HEADER_VALUES`] of header, then [`SAMPLE_VALUES`] per
@@ -82,19 +77,19 @@ fn value(i: usize) -> Option<f32> {
     Some(f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
 }
 
-/// `n` consecutive values from `first`, as [`Real`].
-fn values<const N: usize>(first: usize) -> Option<[Real; N]> {
-    let mut out = [0.0; N];
+/// `N` consecutive values from `first`, in the float type `R` (exact: they are `f32`s).
+fn values<R: Real, const N: usize>(first: usize) -> Option<[R; N]> {
+    let mut out = [R::zero(); N];
     for (k, v) in out.iter_mut().enumerate() {
-        *v = Real::from(value(first + k)?);
+        *v = R::of(f64::from(value(first + k)?));
     }
     Some(out)
 }
 
 /// The recording's compass calibration (stored in the header).
 fn calibration() -> Option<CompassCalibration3d> {
-    let h: [f64; 3] = values::<3>(1)?.map(f64::from);
-    let s: [f64; 9] = values::<9>(4)?.map(f64::from);
+    let h: [f64; 3] = values(1)?;
+    let s: [f64; 9] = values(4)?;
     Some(CompassCalibration3d {
         hard_iron: Vector3::from(h),
         soft_iron: Matrix3::from_row_slice(&s),
@@ -103,32 +98,51 @@ fn calibration() -> Option<CompassCalibration3d> {
 
 /// The reference attitude at the last sample, body → NED.
 fn reference_ned() -> Option<UnitQuaternion<f64>> {
-    let [w, x, y, z]: [f64; 4] = values::<4>(13)?.map(f64::from);
+    let [w, x, y, z]: [f64; 4] = values(13)?;
     let enu = UnitQuaternion::from_quaternion(Quaternion::new(w, x, y, z));
     Some(ned_to_enu().inverse() * enu)
 }
 
-/// Sample `k` of the slice, timed from the trial's start.
-fn sample(first_index: f64, k: usize) -> Option<ImuSample> {
-    let v: [Real; SAMPLE_VALUES] = values(HEADER_VALUES + SAMPLE_VALUES * k)?;
-    let t_s = (first_index + k as f64) * SAMPLE_INTERVAL_S;
-    Some(ImuSample::new_9d(
-        t_s,
-        Vector3::new(v[0], v[1], v[2]),
-        Vector3::new(v[3], v[4], v[5]),
-        Vector3::new(v[6], v[7], v[8]),
-    ))
+/// The readings of one sample in the float type `R`: gyro (rad/s), accelerometer (m/s²),
+/// magnetometer (µT), sensor axes.
+struct Readings<R: Real> {
+    gyr_rps: Vector3<R>,
+    acc_mps2: Vector3<R>,
+    mag_ut: Vector3<R>,
+}
+
+/// Sample `k` of the slice.
+fn readings<R: Real>(k: usize) -> Option<Readings<R>> {
+    let v: [R; SAMPLE_VALUES] = values(HEADER_VALUES + SAMPLE_VALUES * k)?;
+    Some(Readings {
+        gyr_rps: Vector3::new(v[0], v[1], v[2]),
+        acc_mps2: Vector3::new(v[3], v[4], v[5]),
+        mag_ut: Vector3::new(v[6], v[7], v[8]),
+    })
 }
 
 /// Degrees of an angle in radians (of either float type), in `f64`.
-fn deg(rad: impl Into<f64>) -> f64 {
-    rad.into().to_degrees()
+fn deg<R: Real>(rad: R) -> f64 {
+    rad.to_f64().to_degrees()
 }
 
-/// Runs the filter over the recording and the compass on its last reading, writing one
-/// `name value...` line per result (numbers in Rust's shortest round-trip form, so equal
-/// text means equal bits).
-pub fn run(out: &mut impl Write, meter: &mut impl UpdateMeter) -> Result<(), RunError> {
+/// An attitude in `f64`, component by component (exact: no renormalisation, so the `f64`
+/// run's attitude keeps its bits).
+fn to_f64<R: Real>(q: &UnitQuaternion<R>) -> UnitQuaternion<f64> {
+    UnitQuaternion::new_unchecked(Quaternion::new(
+        q.w.to_f64(),
+        q.i.to_f64(),
+        q.j.to_f64(),
+        q.k.to_f64(),
+    ))
+}
+
+/// Runs the filter in the float type `R` (`f32` or `f64`) over the recording, then the
+/// compass, also in `R`, on its last reading, writing one `name value...` line per result
+/// (numbers in Rust's shortest round-trip form for `R`, so equal text means equal bits).
+/// The first line names the float: `float f32: ...`; `.ci/embedded` takes the tolerance of
+/// the lines that follow from it.
+pub fn run<R: Real>(out: &mut impl Write, meter: &mut impl UpdateMeter) -> Result<(), RunError> {
     let body = RECORDING
         .len()
         .checked_sub(4 * HEADER_VALUES)
@@ -138,33 +152,36 @@ pub fn run(out: &mut impl Write, meter: &mut impl UpdateMeter) -> Result<(), Run
     }
     let n = body / (4 * SAMPLE_VALUES);
     let first_index = f64::from(value(0).ok_or(RunError::Recording)?);
-    let cal = calibration().ok_or(RunError::Recording)?;
+    let cal = calibration()
+        .ok_or(RunError::Recording)?
+        .to_precision::<R>();
     let reference = reference_ned().ok_or(RunError::Recording)?;
+    let float = core::any::type_name::<R>();
     writeln!(
         out,
-        "recording BROAD trial 01 samples {first_index}..{} ({n} at 2000/7 Hz), filter float {}",
+        "float {float}: the filter and the compass heading in {float}, recording BROAD trial 01 \
+         samples {first_index}..{} ({n} at 2000/7 Hz)",
         first_index + n as f64,
-        core::any::type_name::<Real>()
     )?;
 
-    let mut filter = Filter::default();
+    let mut filter = QuaternionFilter::<R>::with_precision(QuaternionFilterConfig::default())?;
     let mut last_mag = Vector3::zeros();
     for k in 0..n {
-        let s = sample(first_index, k).ok_or(RunError::Recording)?;
-        let estimate = meter.measure(|| filter.update(&s))?;
-        if let Some(m) = s.mag.as_xyz() {
-            last_mag = m;
-        }
+        let s = readings::<R>(k).ok_or(RunError::Recording)?;
+        // The timestamp stays f64 in both precisions (the filter takes it so).
+        let t_s = (first_index + k as f64) * SAMPLE_INTERVAL_S;
+        meter
+            .measure(|| filter.update_readings(t_s, s.gyr_rps, Some(s.acc_mps2), Some(s.mag_ut)))?;
+        last_mag = s.mag_ut;
         if (k + 1).is_multiple_of(PRINT_EVERY) {
-            let q = estimate.attitude;
+            let q = filter.attitude();
             writeln!(out, "q[{}] {} {} {} {}", k + 1, q.w, q.i, q.j, q.k)?;
         }
     }
 
-    let e = filter.estimate();
-    let q = e.attitude;
+    let q = filter.attitude();
     writeln!(out, "final_q {} {} {} {}", q.w, q.i, q.j, q.k)?;
-    let b = e.gyro_bias_rps;
+    let b = filter.gyro_bias_rps();
     writeln!(
         out,
         "gyro_bias_deg_s {} {} {}",
@@ -172,9 +189,9 @@ pub fn run(out: &mut impl Write, meter: &mut impl UpdateMeter) -> Result<(), Run
         deg(b.y),
         deg(b.z)
     )?;
-    // Angles and the compass in f64 whatever the filter's precision (`cast` is the identity
-    // when `Real` is f64).
-    let euler = EulerZyx::from_quaternion(&q.cast::<f64>());
+    // The Euler angles in f64 (the library's `EulerZyx` and `Tilt` are f64; done once, not
+    // per sample); the compass heading in `R`.
+    let euler = EulerZyx::from_quaternion(&to_f64(&q));
     writeln!(
         out,
         "filter_yaw_pitch_roll_deg {} {} {}",
@@ -182,7 +199,7 @@ pub fn run(out: &mut impl Write, meter: &mut impl UpdateMeter) -> Result<(), Run
         deg(euler.pitch_rad),
         deg(euler.roll_rad)
     )?;
-    let compass = cal.heading_rad(&last_mag.cast::<f64>(), &euler.tilt());
+    let compass = cal.heading_rad(&last_mag, &euler.tilt());
     writeln!(out, "compass_heading_deg {}", deg(compass))?;
     let reference_yaw = EulerZyx::from_quaternion(&reference).yaw_rad;
     writeln!(out, "reference_yaw_deg {}", deg(reference_yaw))?;
