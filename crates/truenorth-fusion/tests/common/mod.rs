@@ -12,7 +12,7 @@ use std::path::{Path, PathBuf};
 
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 use truenorth_core::{ImuSample, OrientationEstimator};
-use truenorth_fusion::broad_rmse;
+use truenorth_fusion::orientation::broad_rmse;
 
 pub struct Trial {
     pub name: String,
