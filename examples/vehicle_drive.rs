@@ -1,7 +1,8 @@
 //! Vehicle heading and dead reckoning on a simulated 10 km drive: a yaw gyro with its bias
 //! and gain errors, two odometer wheels of slightly different size and a compass with hard and
 //! soft iron, none of them calibrated at the start. The fused estimator learns every error as
-//! it drives; a patent configuration runs through the same trait for comparison.
+//! it drives; a patent configuration runs through the same trait for comparison. What the
+//! fused estimator learned is saved as JSON and the next drive starts from it.
 //!
 //! Run: `cargo run --release --example vehicle_drive`
 
@@ -79,5 +80,22 @@ fn main() -> Result<(), Error> {
         100.0 * learned.gyro_gain_error_left.sigma,
         100.0 * gyro.scale_error_neg,
     );
+
+    // Saved for the next drive (as `truenorth drive --calibration-out` writes it), then read
+    // back, validated, and driven again from it: north is known from the first rows.
+    let saved = serde_json::to_string(&learned).map_err(|_| Error::InvalidSnapshot {
+        reason: "the learned calibration did not serialise",
+    })?;
+    let loaded = serde_json::from_str(&saved).map_err(|_| Error::InvalidSnapshot {
+        reason: "the saved calibration did not read back",
+    })?;
+    let mut next = VehicleEstimator::with_calibration(
+        VehicleConfig {
+            wheels,
+            ..VehicleConfig::default()
+        },
+        &loaded,
+    )?;
+    score("fused, from the saved calibration", &mut next, &drive)?;
     Ok(())
 }
