@@ -10,7 +10,9 @@ use super::bounds::{
     MONOMIALS_2D, MONOMIALS_3D, QUAD_3D, information_2d, information_3d, monomial_plan_3d,
     noise_rms_deg, worst_2d, worst_3d,
 };
-use super::coverage::{AngleBins, Coverage, sphere_cell, turns};
+use super::coverage::{AngleBins, Coverage};
+use super::direction_bins::turns;
+use super::sphere_cells::sphere_cell;
 use super::support::{Support2d, Support3d, support_dilution};
 use super::uncertainty::bound_and_uncertainty;
 use crate::numerics::blocks::{BLOCK, blocks, dot_block, sum_block};
