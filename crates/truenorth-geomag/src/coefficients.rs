@@ -153,89 +153,17 @@ impl Coefficients {
             }
             let (s0, e0) = fields[0];
             if is_terminator(b, s0, e0) {
-                if !have_header {
-                    return Err(CofError {
-                        line,
-                        kind: CofErrorKind::MissingHeader,
-                    });
-                }
-                return match first_missing(seen) {
-                    Some((n, m)) => Err(CofError {
-                        line: 0,
-                        kind: CofErrorKind::MissingTerm { n, m },
-                    }),
-                    None => Ok(c),
-                };
+                return c.complete(have_header, seen, line);
             }
-            if !have_header {
-                // Header: epoch, model name, release date (the date is informative only).
-                let Some(epoch) = parse_decimal(b, s0, e0) else {
-                    return Err(CofError {
-                        line,
-                        kind: CofErrorKind::MissingHeader,
-                    });
-                };
-                c.epoch_year = epoch;
-                if count >= 2 {
-                    let (s1, e1) = fields[1];
-                    let mut k = 0;
-                    while k < NAME_CAPACITY && s1 + k < e1 && s1 + k < b.len() {
-                        c.name[k] = b[s1 + k];
-                        k += 1;
-                    }
-                    // Keep the name valid UTF-8 if a multi-byte character was cut.
-                    while k > 0 && c.name[k - 1] >= 0x80 {
-                        k -= 1;
-                    }
-                    c.name_len = k;
-                }
-                have_header = true;
-                continue;
-            }
-            if count != 6 {
-                return Err(CofError {
-                    line,
-                    kind: CofErrorKind::WrongFieldCount,
-                });
-            }
-            let (Some(n), Some(m)) = (
-                parse_uint(b, fields[0].0, fields[0].1),
-                parse_uint(b, fields[1].0, fields[1].1),
-            ) else {
-                return Err(CofError {
-                    line,
-                    kind: CofErrorKind::BadNumber,
-                });
+            let read = if have_header {
+                c.read_term(b, &fields, count, line, &mut seen)
+            } else {
+                c.read_header(b, &fields, count, line)
             };
-            if n < 1 || n > MAX_DEGREE || m > n {
-                return Err(CofError {
-                    line,
-                    kind: CofErrorKind::BadDegreeOrOrder,
-                });
+            if let Err(e) = read {
+                return Err(e);
             }
-            let (Some(g), Some(h), Some(gd), Some(hd)) = (
-                parse_decimal(b, fields[2].0, fields[2].1),
-                parse_decimal(b, fields[3].0, fields[3].1),
-                parse_decimal(b, fields[4].0, fields[4].1),
-                parse_decimal(b, fields[5].0, fields[5].1),
-            ) else {
-                return Err(CofError {
-                    line,
-                    kind: CofErrorKind::BadNumber,
-                });
-            };
-            let k = index(n, m);
-            if seen & (1u128 << k) != 0 {
-                return Err(CofError {
-                    line,
-                    kind: CofErrorKind::Duplicate,
-                });
-            }
-            seen |= 1u128 << k;
-            c.g[k] = g;
-            c.h[k] = h;
-            c.g_sv[k] = gd;
-            c.h_sv[k] = hd;
+            have_header = true;
         }
         Err(CofError {
             line,
@@ -245,6 +173,114 @@ impl Coefficients {
                 CofErrorKind::MissingHeader
             },
         })
+    }
+
+    /// At the terminator (on `line`): the coefficients, if the header and every term (bits
+    /// of `seen`) were read.
+    const fn complete(self, have_header: bool, seen: u128, line: usize) -> Result<Self, CofError> {
+        if !have_header {
+            return Err(CofError {
+                line,
+                kind: CofErrorKind::MissingHeader,
+            });
+        }
+        match first_missing(seen) {
+            Some((n, m)) => Err(CofError {
+                line: 0,
+                kind: CofErrorKind::MissingTerm { n, m },
+            }),
+            None => Ok(self),
+        }
+    }
+
+    /// The header `line` (its `count` fields of `b`): epoch, model name, release date (the
+    /// date is informative only).
+    const fn read_header(
+        &mut self,
+        b: &[u8],
+        fields: &[(usize, usize); 7],
+        count: usize,
+        line: usize,
+    ) -> Result<(), CofError> {
+        let (s0, e0) = fields[0];
+        let Some(epoch) = parse_decimal(b, s0, e0) else {
+            return Err(CofError {
+                line,
+                kind: CofErrorKind::MissingHeader,
+            });
+        };
+        self.epoch_year = epoch;
+        if count >= 2 {
+            let (s1, e1) = fields[1];
+            let mut k = 0;
+            while k < NAME_CAPACITY && s1 + k < e1 && s1 + k < b.len() {
+                self.name[k] = b[s1 + k];
+                k += 1;
+            }
+            // Keep the name valid UTF-8 if a multi-byte character was cut.
+            while k > 0 && self.name[k - 1] >= 0x80 {
+                k -= 1;
+            }
+            self.name_len = k;
+        }
+        Ok(())
+    }
+
+    /// A term `line` `n m g h ġ ḣ` (its `count` fields of `b`), stored at its table index
+    /// and marked in `seen`; a term seen before is refused.
+    const fn read_term(
+        &mut self,
+        b: &[u8],
+        fields: &[(usize, usize); 7],
+        count: usize,
+        line: usize,
+        seen: &mut u128,
+    ) -> Result<(), CofError> {
+        if count != 6 {
+            return Err(CofError {
+                line,
+                kind: CofErrorKind::WrongFieldCount,
+            });
+        }
+        let (Some(n), Some(m)) = (
+            parse_uint(b, fields[0].0, fields[0].1),
+            parse_uint(b, fields[1].0, fields[1].1),
+        ) else {
+            return Err(CofError {
+                line,
+                kind: CofErrorKind::BadNumber,
+            });
+        };
+        if n < 1 || n > MAX_DEGREE || m > n {
+            return Err(CofError {
+                line,
+                kind: CofErrorKind::BadDegreeOrOrder,
+            });
+        }
+        let (Some(g), Some(h), Some(gd), Some(hd)) = (
+            parse_decimal(b, fields[2].0, fields[2].1),
+            parse_decimal(b, fields[3].0, fields[3].1),
+            parse_decimal(b, fields[4].0, fields[4].1),
+            parse_decimal(b, fields[5].0, fields[5].1),
+        ) else {
+            return Err(CofError {
+                line,
+                kind: CofErrorKind::BadNumber,
+            });
+        };
+        let k = index(n, m);
+        if *seen & (1u128 << k) != 0 {
+            return Err(CofError {
+                line,
+                kind: CofErrorKind::Duplicate,
+            });
+        }
+        *seen |= 1u128 << k;
+        self.g[k] = g;
+        self.h[k] = h;
+        self.g_sv[k] = gd;
+        self.h_sv[k] = hd;
+        Ok(())
     }
 
     /// The model epoch t₀ as a decimal year (2025.0 for WMM2025).
