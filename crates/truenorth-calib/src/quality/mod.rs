@@ -7,14 +7,14 @@
 //! produced them. The least-squares ellipse fit computes the same 2-D report from the
 //! monomial sums of its direct fit instead of a second pass over the readings.
 //!
-//! The parts live in submodules: coverage (heading bins), sphere_cells (the sphere's
-//! direction cells), arc (the locus's turning and the shortest arc accepted), direction_bins
-//! (the fast direction of a reading and its bin), bounds (information matrices and heading-error bounds), uncertainty (what the readings
-//! determine: the dilution of the information matrix, the predicted parameter σ, and the
-//! determination test that replaces a share of direction cells), report (assembly of the
-//! [`CompassQuality`](truenorth_core::CompassQuality), its
-//! [`CompassUncertainty`] included) and field (the
-//! fitted field against an expected one). The report's data types and its verdict (good /
+//! The parts live in submodules: coverage (heading bins), sphere_cells (the sphere's direction
+//! cells), arc (the locus's turning and the shortest arc accepted), direction_bins (the fast
+//! direction of a reading and its bin), bounds (information matrices and heading-error bounds),
+//! uncertainty (what the readings determine: the dilution of the information matrix, the predicted
+//! parameter σ, and the determination test that replaces a share of direction cells), pass_2d (the
+//! one pass over 2-D readings the report is built from), report (assembly of the
+//! [`CompassQuality`](truenorth_core::CompassQuality), its [`CompassUncertainty`] included) and
+//! field (the fitted field against an expected one). The report's data types and its verdict (good /
 //! usable / poor, [`Verdict`]) live in `truenorth-core`, beside the calibrator trait, and are
 //! re-exported here.
 //!
@@ -48,6 +48,7 @@ mod coverage;
 mod direction_bins;
 mod field;
 mod limits;
+mod pass_2d;
 mod report;
 mod sphere_cells;
 mod support;
@@ -67,10 +68,10 @@ pub use field::{
     mean_corrected_norm_3d, with_expected_field,
 };
 pub use limits::FitLimits;
+pub(crate) use pass_2d::ReportSums;
 pub use report::{Assessment2d, assess_2d, assess_3d, quality_2d};
 pub(crate) use report::{
-    Moments2, ReportSums, SupportFigures, assess_2d_from_moments, direction_harmonics,
-    support_dilution_3d,
+    Moments2, SupportFigures, assess_2d_from_moments, direction_harmonics, support_dilution_3d,
 };
 pub(crate) use sphere_cells::sphere_cell;
 pub use sphere_cells::{
