@@ -7,6 +7,8 @@
 
 use core::fmt;
 
+use crate::cof_text::{is_terminator, line_end, parse_decimal, parse_uint, split_fields};
+
 /// Highest degree (and order) of the WMM spherical-harmonic expansion (WMM2025 Technical
 /// Report, eq. 1: N = 12).
 pub const MAX_DEGREE: usize = 12;
@@ -153,89 +155,17 @@ impl Coefficients {
             }
             let (s0, e0) = fields[0];
             if is_terminator(b, s0, e0) {
-                if !have_header {
-                    return Err(CofError {
-                        line,
-                        kind: CofErrorKind::MissingHeader,
-                    });
-                }
-                return match first_missing(seen) {
-                    Some((n, m)) => Err(CofError {
-                        line: 0,
-                        kind: CofErrorKind::MissingTerm { n, m },
-                    }),
-                    None => Ok(c),
-                };
+                return c.complete(have_header, seen, line);
             }
-            if !have_header {
-                // Header: epoch, model name, release date (the date is informative only).
-                let Some(epoch) = parse_decimal(b, s0, e0) else {
-                    return Err(CofError {
-                        line,
-                        kind: CofErrorKind::MissingHeader,
-                    });
-                };
-                c.epoch_year = epoch;
-                if count >= 2 {
-                    let (s1, e1) = fields[1];
-                    let mut k = 0;
-                    while k < NAME_CAPACITY && s1 + k < e1 && s1 + k < b.len() {
-                        c.name[k] = b[s1 + k];
-                        k += 1;
-                    }
-                    // Keep the name valid UTF-8 if a multi-byte character was cut.
-                    while k > 0 && c.name[k - 1] >= 0x80 {
-                        k -= 1;
-                    }
-                    c.name_len = k;
-                }
-                have_header = true;
-                continue;
-            }
-            if count != 6 {
-                return Err(CofError {
-                    line,
-                    kind: CofErrorKind::WrongFieldCount,
-                });
-            }
-            let (Some(n), Some(m)) = (
-                parse_uint(b, fields[0].0, fields[0].1),
-                parse_uint(b, fields[1].0, fields[1].1),
-            ) else {
-                return Err(CofError {
-                    line,
-                    kind: CofErrorKind::BadNumber,
-                });
+            let read = if have_header {
+                c.read_term(b, &fields, count, line, &mut seen)
+            } else {
+                c.read_header(b, &fields, count, line)
             };
-            if n < 1 || n > MAX_DEGREE || m > n {
-                return Err(CofError {
-                    line,
-                    kind: CofErrorKind::BadDegreeOrOrder,
-                });
+            if let Err(e) = read {
+                return Err(e);
             }
-            let (Some(g), Some(h), Some(gd), Some(hd)) = (
-                parse_decimal(b, fields[2].0, fields[2].1),
-                parse_decimal(b, fields[3].0, fields[3].1),
-                parse_decimal(b, fields[4].0, fields[4].1),
-                parse_decimal(b, fields[5].0, fields[5].1),
-            ) else {
-                return Err(CofError {
-                    line,
-                    kind: CofErrorKind::BadNumber,
-                });
-            };
-            let k = index(n, m);
-            if seen & (1u128 << k) != 0 {
-                return Err(CofError {
-                    line,
-                    kind: CofErrorKind::Duplicate,
-                });
-            }
-            seen |= 1u128 << k;
-            c.g[k] = g;
-            c.h[k] = h;
-            c.g_sv[k] = gd;
-            c.h_sv[k] = hd;
+            have_header = true;
         }
         Err(CofError {
             line,
@@ -245,6 +175,114 @@ impl Coefficients {
                 CofErrorKind::MissingHeader
             },
         })
+    }
+
+    /// At the terminator (on `line`): the coefficients, if the header and every term (bits
+    /// of `seen`) were read.
+    const fn complete(self, have_header: bool, seen: u128, line: usize) -> Result<Self, CofError> {
+        if !have_header {
+            return Err(CofError {
+                line,
+                kind: CofErrorKind::MissingHeader,
+            });
+        }
+        match first_missing(seen) {
+            Some((n, m)) => Err(CofError {
+                line: 0,
+                kind: CofErrorKind::MissingTerm { n, m },
+            }),
+            None => Ok(self),
+        }
+    }
+
+    /// The header `line` (its `count` fields of `b`): epoch, model name, release date (the
+    /// date is informative only).
+    const fn read_header(
+        &mut self,
+        b: &[u8],
+        fields: &[(usize, usize); 7],
+        count: usize,
+        line: usize,
+    ) -> Result<(), CofError> {
+        let (s0, e0) = fields[0];
+        let Some(epoch) = parse_decimal(b, s0, e0) else {
+            return Err(CofError {
+                line,
+                kind: CofErrorKind::MissingHeader,
+            });
+        };
+        self.epoch_year = epoch;
+        if count >= 2 {
+            let (s1, e1) = fields[1];
+            let mut k = 0;
+            while k < NAME_CAPACITY && s1 + k < e1 && s1 + k < b.len() {
+                self.name[k] = b[s1 + k];
+                k += 1;
+            }
+            // Keep the name valid UTF-8 if a multi-byte character was cut.
+            while k > 0 && self.name[k - 1] >= 0x80 {
+                k -= 1;
+            }
+            self.name_len = k;
+        }
+        Ok(())
+    }
+
+    /// A term `line` `n m g h ġ ḣ` (its `count` fields of `b`), stored at its table index
+    /// and marked in `seen`; a term seen before is refused.
+    const fn read_term(
+        &mut self,
+        b: &[u8],
+        fields: &[(usize, usize); 7],
+        count: usize,
+        line: usize,
+        seen: &mut u128,
+    ) -> Result<(), CofError> {
+        if count != 6 {
+            return Err(CofError {
+                line,
+                kind: CofErrorKind::WrongFieldCount,
+            });
+        }
+        let (Some(n), Some(m)) = (
+            parse_uint(b, fields[0].0, fields[0].1),
+            parse_uint(b, fields[1].0, fields[1].1),
+        ) else {
+            return Err(CofError {
+                line,
+                kind: CofErrorKind::BadNumber,
+            });
+        };
+        if n < 1 || n > MAX_DEGREE || m > n {
+            return Err(CofError {
+                line,
+                kind: CofErrorKind::BadDegreeOrOrder,
+            });
+        }
+        let (Some(g), Some(h), Some(gd), Some(hd)) = (
+            parse_decimal(b, fields[2].0, fields[2].1),
+            parse_decimal(b, fields[3].0, fields[3].1),
+            parse_decimal(b, fields[4].0, fields[4].1),
+            parse_decimal(b, fields[5].0, fields[5].1),
+        ) else {
+            return Err(CofError {
+                line,
+                kind: CofErrorKind::BadNumber,
+            });
+        };
+        let k = index(n, m);
+        if *seen & (1u128 << k) != 0 {
+            return Err(CofError {
+                line,
+                kind: CofErrorKind::Duplicate,
+            });
+        }
+        *seen |= 1u128 << k;
+        self.g[k] = g;
+        self.h[k] = h;
+        self.g_sv[k] = gd;
+        self.h_sv[k] = hd;
+        Ok(())
     }
 
     /// The model epoch t₀ as a decimal year (2025.0 for WMM2025).
@@ -282,125 +320,6 @@ impl Coefficients {
             h_sv_nt_per_yr: *self.h_sv.get(k)?,
         })
     }
-}
-
-/// Index of the next `\n` at or after `start`, or the end of the text.
-const fn line_end(b: &[u8], start: usize) -> usize {
-    let mut i = start;
-    while i < b.len() && b[i] != b'\n' {
-        i += 1;
-    }
-    i
-}
-
-const fn is_space(c: u8) -> bool {
-    c == b' ' || c == b'\t' || c == b'\r'
-}
-
-/// Splits `b[start..end]` at whitespace into at most `out.len()` fields (start, end);
-/// returns the number found, `out.len()` meaning "that many or more".
-const fn split_fields(b: &[u8], start: usize, end: usize, out: &mut [(usize, usize); 7]) -> usize {
-    let end = if end < b.len() { end } else { b.len() };
-    let mut count = 0;
-    let mut i = start;
-    while i < end && count < out.len() {
-        while i < end && is_space(b[i]) {
-            i += 1;
-        }
-        if i >= end {
-            break;
-        }
-        let s = i;
-        while i < end && !is_space(b[i]) {
-            i += 1;
-        }
-        out[count] = (s, i);
-        count += 1;
-    }
-    count
-}
-
-/// The closing line of a `.COF` file is a long run of 9s.
-const fn is_terminator(b: &[u8], s: usize, e: usize) -> bool {
-    if e <= s || e - s < 8 || e > b.len() {
-        return false;
-    }
-    let mut i = s;
-    while i < e {
-        if b[i] != b'9' {
-            return false;
-        }
-        i += 1;
-    }
-    true
-}
-
-/// A small unsigned integer (degree or order), at most three digits.
-const fn parse_uint(b: &[u8], s: usize, e: usize) -> Option<usize> {
-    if e <= s || e - s > 3 || e > b.len() {
-        return None;
-    }
-    let mut v = 0usize;
-    let mut i = s;
-    while i < e {
-        let c = b[i];
-        if !c.is_ascii_digit() {
-            return None;
-        }
-        v = v * 10 + (c - b'0') as usize;
-        i += 1;
-    }
-    Some(v)
-}
-
-/// Exact powers of ten (every one up to 10²² is representable in an f64).
-const POW10: [f64; 23] = [
-    1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15, 1e16,
-    1e17, 1e18, 1e19, 1e20, 1e21, 1e22,
-];
-
-/// A plain decimal `[+-]digits[.digits]`. With at most 15 significant digits the mantissa
-/// and the power of ten are both exact, so the single division rounds correctly: the result
-/// is the same f64 that `str::parse` gives.
-const fn parse_decimal(b: &[u8], s: usize, e: usize) -> Option<f64> {
-    if e <= s || e > b.len() {
-        return None;
-    }
-    let mut i = s;
-    let negative = b[i] == b'-';
-    if b[i] == b'-' || b[i] == b'+' {
-        i += 1;
-    }
-    let mut mantissa: u64 = 0;
-    let mut digits = 0;
-    let mut frac_digits = 0;
-    let mut seen_point = false;
-    while i < e {
-        let c = b[i];
-        if c == b'.' {
-            if seen_point {
-                return None;
-            }
-            seen_point = true;
-        } else if c.is_ascii_digit() {
-            digits += 1;
-            if digits > 15 {
-                return None;
-            }
-            mantissa = mantissa * 10 + (c - b'0') as u64;
-            if seen_point {
-                frac_digits += 1;
-            }
-        } else {
-            return None;
-        }
-        i += 1;
-    }
-    if digits == 0 {
-        return None;
-    }
-    let v = mantissa as f64 / POW10[frac_digits];
-    Some(if negative { -v } else { v })
 }
 
 /// The first (n, m) of the model never read, if any.
@@ -509,20 +428,6 @@ mod tests {
         assert!(e.to_string().contains("line 2"));
     }
 
-    #[test]
-    fn decimal_parser_edges() {
-        let p = |s: &str| parse_decimal(s.as_bytes(), 0, s.len());
-        assert_eq!(p("-29351.8"), Some(-29351.8));
-        assert_eq!(p("+0.5"), Some(0.5));
-        assert_eq!(p("7."), Some(7.0));
-        assert_eq!(p(".25"), Some(0.25));
-        assert_eq!(p("-"), None);
-        assert_eq!(p("."), None);
-        assert_eq!(p("1.2.3"), None);
-        assert_eq!(p("1e5"), None);
-        assert_eq!(p("1234567890123456"), None);
-    }
-
     proptest! {
         /// Any text, however broken, gives a typed error naming a line of it (or the file
         /// as a whole, line 0), never a panic; 400 characters cannot hold the 90 terms of a
@@ -559,12 +464,5 @@ mod tests {
             }
         }
 
-        /// Numbers written with at most 15 digits parse to exactly what `str::parse` gives.
-        #[test]
-        fn decimal_parser_matches_std(int in 0u64..10_000_000, frac in 0u64..100_000_000, neg: bool) {
-            let s = format!("{}{int}.{frac}", if neg { "-" } else { "" });
-            let ours = parse_decimal(s.as_bytes(), 0, s.len());
-            prop_assert_eq!(ours, Some(s.parse::<f64>().unwrap()));
-        }
     }
 }

@@ -51,6 +51,7 @@
 #![cfg_attr(not(feature = "std"), no_std)]
 
 mod coefficients;
+mod cof_text;
 mod date;
 mod field;
 mod geodetic;

@@ -7,13 +7,14 @@
 //! produced them. The least-squares ellipse fit computes the same 2-D report from the
 //! monomial sums of its direct fit instead of a second pass over the readings.
 //!
-//! The parts live in submodules: coverage (heading bins, sphere cells, the locus's turning),
-//! bounds (information matrices and heading-error bounds), uncertainty (what the readings
-//! determine: the dilution of the information matrix, the predicted parameter σ, and the
-//! determination test that replaces a share of direction cells), report (assembly of the
-//! [`CompassQuality`](truenorth_core::CompassQuality), its
-//! [`CompassUncertainty`] included) and field (the
-//! fitted field against an expected one). The report's data types and its verdict (good /
+//! The parts live in submodules: coverage (heading bins), sphere_cells (the sphere's direction
+//! cells), arc (the locus's turning and the shortest arc accepted), direction_bins (the fast
+//! direction of a reading and its bin), bounds (information matrices and heading-error bounds),
+//! uncertainty (what the readings determine: the dilution of the information matrix, the predicted
+//! parameter σ, and the determination test that replaces a share of direction cells), pass_2d (the
+//! one pass over 2-D readings the report is built from), report (assembly of the
+//! [`CompassQuality`](truenorth_core::CompassQuality), its [`CompassUncertainty`] included) and
+//! field (the fitted field against an expected one). The report's data types and its verdict (good /
 //! usable / poor, [`Verdict`]) live in `truenorth-core`, beside the calibrator trait, and are
 //! re-exported here.
 //!
@@ -41,34 +42,41 @@
 //!
 //! The bound's derivation is in the `bounds` module.
 
+mod arc;
 mod bounds;
 mod coverage;
+mod direction_bins;
 mod field;
 mod limits;
+mod pass_2d;
 mod report;
+mod sphere_cells;
 mod support;
 mod uncertainty;
 
 #[cfg(test)]
 mod tests;
 
+pub use arc::{ARC_END_NOISE_SIGMAS, MIN_ARC_DEG, locus_turning_rad, require_arc};
 pub use bounds::BOUND_SIGMAS;
 pub(crate) use bounds::{regressor_2d, regressor_3d};
-pub use coverage::{
-    ARC_END_NOISE_SIGMAS, COVERAGE_BINS, Coverage, MIN_ARC_DEG, MIN_SPHERE_COVERAGE, SPHERE_BANDS,
-    SPHERE_CELLS, SPHERE_SECTORS, calibrated_coverage_2d, coverage, locus_turning_rad, require_arc,
-    require_sphere_coverage, sphere_coverage,
-};
-pub(crate) use coverage::{calibrated_directions_2d, sphere_cell, turns};
+pub(crate) use coverage::calibrated_directions_2d;
+pub use coverage::{COVERAGE_BINS, Coverage, calibrated_coverage_2d, coverage};
+pub(crate) use direction_bins::turns;
 pub use field::{
     FIELD_RATIO_TOLERANCE, FieldMismatch, field_mismatch, mean_corrected_norm_2d,
     mean_corrected_norm_3d, with_expected_field,
 };
 pub use limits::FitLimits;
+pub(crate) use pass_2d::ReportSums;
 pub use report::{Assessment2d, assess_2d, assess_3d, quality_2d};
 pub(crate) use report::{
-    Moments2, ReportSums, SupportFigures, assess_2d_from_moments, direction_harmonics,
-    support_dilution_3d,
+    Moments2, SupportFigures, assess_2d_from_moments, direction_harmonics, support_dilution_3d,
+};
+pub(crate) use sphere_cells::sphere_cell;
+pub use sphere_cells::{
+    MIN_SPHERE_COVERAGE, SPHERE_BANDS, SPHERE_CELLS, SPHERE_SECTORS, require_sphere_coverage,
+    sphere_coverage,
 };
 pub(crate) use support::GAP_BINS;
 pub use truenorth_core::compass_quality::{

@@ -10,7 +10,9 @@ use super::bounds::{
     MONOMIALS_2D, MONOMIALS_3D, QUAD_3D, information_2d, information_3d, monomial_plan_3d,
     noise_rms_deg, worst_2d, worst_3d,
 };
-use super::coverage::{AngleBins, Coverage, sphere_cell, turns};
+use super::coverage::Coverage;
+use super::pass_2d::{ReportSums, sums_2d};
+use super::sphere_cells::sphere_cell;
 use super::support::{Support2d, Support3d, support_dilution};
 use super::uncertainty::bound_and_uncertainty;
 use crate::numerics::blocks::{BLOCK, blocks, dot_block, sum_block};
@@ -19,18 +21,6 @@ use crate::quality::SPHERE_CELLS;
 
 #[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
-
-/// What the one pass over the readings of [`assess_2d`] leaves for the report: the sums of
-/// the information matrix's twelve monomials, the sum of the squared residuals, the count of
-/// usable readings, their coverage and the support of their directions.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct ReportSums {
-    pub sums: [f64; 12],
-    pub ss: f64,
-    pub n: usize,
-    pub coverage: Coverage,
-    pub support: Support2d,
-}
 
 /// A 2-D quality report and the coverage behind it.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -74,89 +64,6 @@ impl Assessment2d {
     /// [`assess_2d`] returns.
     pub(crate) fn from_sums(s: &ReportSums, support: SupportFigures, field: f64) -> Self {
         report_2d_with(&s.sums, s.ss, s.n, s.coverage, field, support)
-    }
-}
-
-/// The pass of [`assess_2d`].
-fn sums_2d(points: &[Vector2<f64>], cal: &CompassCalibration2d, field: f64) -> ReportSums {
-    let mut bins = AngleBins::new();
-    // Sums of the squared residuals and of the monomials of `u` that make up the
-    // information matrix (see `information_2d`).
-    let mut sums = [0.0; MONOMIALS_2D];
-    let mut ss = 0.0;
-    let mut n = 0usize;
-    let inv_f = 1.0 / field;
-    let (s, c) = (&cal.soft_iron, &cal.hard_iron);
-    // A block of points at a time (see `crate::numerics::blocks::BLOCK`): first every point's direction,
-    // its products, its residual and its heading, then the sums and the bins.
-    let mut ux = [0.0; BLOCK];
-    let mut uy = [0.0; BLOCK];
-    let mut xx = [0.0; BLOCK];
-    let mut xy = [0.0; BLOCK];
-    let mut yy = [0.0; BLOCK];
-    let mut r2 = [0.0; BLOCK];
-    let mut t = [0.0; BLOCK];
-    for ([px, py], len) in blocks(points) {
-        for i in 0..BLOCK {
-            // h = soft_iron · (p − hard_iron), as `CompassCalibration2d::correct`.
-            let (dx, dy) = (px[i] - c.x, py[i] - c.y);
-            let (hx, hy) = (
-                s[(0, 0)] * dx + s[(0, 1)] * dy,
-                s[(1, 0)] * dx + s[(1, 1)] * dy,
-            );
-            let rho = (hx * hx + hy * hy).sqrt();
-            // Non-finite readings are skipped, and the rows past the end of the data: their
-            // direction is set to zero, which adds nothing to the sums and marks the row
-            // as skipped for the bins (a kept row's direction is a unit vector).
-            let keep = rho > 0.0 && rho.is_finite() && i < len;
-            let inv_rho = 1.0 / rho;
-            let (x, y) = if keep {
-                (hx * inv_rho, hy * inv_rho)
-            } else {
-                (0.0, 0.0)
-            };
-            let r = rho * inv_f - 1.0;
-            ux[i] = x;
-            uy[i] = y;
-            xx[i] = x * x;
-            xy[i] = x * y;
-            yy[i] = y * y;
-            r2[i] = if keep { r * r } else { 0.0 };
-            t[i] = turns(hy, hx);
-        }
-        // In the order of `information_2d`: x², xy, y², x³, x²y, xy², y³, x⁴, x³y, x²y²,
-        // xy³, y⁴.
-        let products = [
-            (&ux, &ux),
-            (&ux, &uy),
-            (&uy, &uy),
-            (&xx, &ux),
-            (&xx, &uy),
-            (&yy, &ux),
-            (&yy, &uy),
-            (&xx, &xx),
-            (&xx, &xy),
-            (&xx, &yy),
-            (&xy, &yy),
-            (&yy, &yy),
-        ];
-        for (sk, (a, b)) in sums.iter_mut().zip(products) {
-            *sk += dot_block(a, b);
-        }
-        ss += sum_block(&r2);
-        for i in 0..len {
-            if ux[i] != 0.0 || uy[i] != 0.0 {
-                bins.mark(t[i]);
-                n += 1;
-            }
-        }
-    }
-    ReportSums {
-        sums,
-        ss,
-        n,
-        coverage: bins.coverage(),
-        support: bins.support(),
     }
 }
 

@@ -11,7 +11,7 @@
 //! So the geometry is judged on the support: the directions binned into cells, each
 //! occupied cell counted once with the mean of `φφᵀ` over its readings (2-D: the centre
 //! direction of each occupied 0.5° bin, which lies within 0.25° of every reading in it;
-//! 3-D: the mean over the readings of each of the [`super::coverage::SPHERE_CELLS`] equal-area cells,
+//! 3-D: the mean over the readings of each of the [`super::SPHERE_CELLS`] equal-area cells,
 //! which keeps readings on a great circle exactly on it, so that a single-axis turn stays
 //! exactly undetermined). More readings in directions already seen change nothing; readings
 //! in a new cell add a positive semi-definite term. Normalised by the number of occupied

@@ -4,7 +4,7 @@ use super::bounds::{
     BOUND_DIRECTIONS_3D, MONOMIALS_2D, MONOMIALS_3D, bound_3d, direction_jacobian_3d,
     information_2d, information_3d, monomial_tuples_3d, monomials_2d,
 };
-use super::coverage::turns;
+use super::direction_bins::turns;
 use super::*;
 use core::f64::consts::TAU;
 use nalgebra::{SMatrix, Vector2, Vector3};

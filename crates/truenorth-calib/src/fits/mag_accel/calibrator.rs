@@ -147,6 +147,62 @@ pub fn fit_mag_accel(
     config: &MagAccelConfig,
 ) -> Result<Solution<MagAccelCalibration, MagAccelQuality>> {
     config.validate()?;
+    check_readings(samples)?;
+    let acc: Vec<Vector3<f64>> = samples.iter().map(|s| s.acc).collect();
+    let mag: Vec<Vector3<f64>> = samples.iter().map(|s| s.mag).collect();
+    // Step 1.
+    let Start {
+        acc_fit,
+        mag_fit,
+        na,
+        nm,
+        data,
+        mut theta,
+    } = start(&acc, &mag, config)?;
+    // Step 2.
+    let (r0, s0) = initial_alignment(&data, &theta)?;
+    theta[S] = s0;
+    let mut w = initial_weights(&data, &r0, &theta, &acc_fit, &mag_fit);
+    // Step 3.
+    let no_runs: Vec<Range<usize>> = Vec::new();
+    theta = refine(&data, &no_runs, &mut w, &r0, theta, config)?;
+    // Step 4.
+    let (no_runs_theta, no_runs_w) = (theta, w);
+    let mut runs = Vec::new();
+    if config.find_runs {
+        runs = aimed_runs(&data, samples.len(), &r0, &theta, config);
+        if !runs.is_empty() {
+            w.aim = 1.0 / aim_rms(&data, &runs, &r0, &theta).max(SIGMA_FLOOR);
+            theta = refine(&data, &runs, &mut w, &r0, theta, config)?;
+        }
+    }
+    // Step 5.
+    let report = |theta: &SVector<f64, P>, runs: &[Range<usize>], w: &Weights| {
+        finish(
+            samples,
+            &data,
+            (&na, &nm),
+            &r0,
+            theta,
+            runs,
+            w,
+            &mag,
+            config,
+        )
+    };
+    let with_runs = report(&theta, &runs, &w);
+    if runs.is_empty() || with_runs.is_ok() {
+        return with_runs;
+    }
+    // The runs are an option, not a condition: runs found by chance in a long recording
+    // (a few consecutive readings rolling about the pointing axis) can leave the pointing
+    // axis less certain than the calibration without them. Those readings still count as
+    // readings; only the pointing axis falls back to the accelerometer's x.
+    report(&no_runs_theta, &[], &no_runs_w).or(with_runs)
+}
+
+/// Refuses too few readings and non-finite ones.
+fn check_readings(samples: &[MagAccelSample]) -> Result<()> {
     if samples.len() < MIN_MAG_ACCEL_READINGS {
         return Err(Error::TooFewPoints {
             got: samples.len(),
@@ -157,9 +213,23 @@ pub fn fit_mag_accel(
         check_finite3("magnetometer reading", &s.mag)?;
         check_finite3("accelerometer reading", &s.acc)?;
     }
-    let acc: Vec<Vector3<f64>> = samples.iter().map(|s| s.acc).collect();
-    let mag: Vec<Vector3<f64>> = samples.iter().map(|s| s.mag).collect();
-    // Step 1.
+    Ok(())
+}
+
+/// Step 1's outcome: each sensor's own ellipsoid, the normalisers of the two sensors'
+/// readings, the normalised readings, and the joint parameters the ellipsoids give.
+struct Start {
+    acc_fit: Solution<CompassCalibration3d>,
+    mag_fit: Solution<CompassCalibration3d>,
+    na: Normaliser<3>,
+    nm: Normaliser<3>,
+    data: Data,
+    theta: SVector<f64, P>,
+}
+
+/// Step 1: each sensor's ellipsoid, accepted up to [`INITIAL_FIT_BOUND_DEG`], as the start
+/// of the joint fit, in the normalised readings' units.
+fn start(acc: &[Vector3<f64>], mag: &[Vector3<f64>], config: &MagAccelConfig) -> Result<Start> {
     let start = EllipsoidConfig {
         limits: FitLimits {
             max_heading_error_bound_deg: INITIAL_FIT_BOUND_DEG,
@@ -167,10 +237,10 @@ pub fn fit_mag_accel(
         },
         ..config.ellipsoid
     };
-    let acc_fit = fit_ellipsoid(&acc, &start)?;
-    let mag_fit = fit_ellipsoid(&mag, &start)?;
-    let na = Normaliser::of(&acc)?;
-    let nm = Normaliser::of(&mag)?;
+    let acc_fit = fit_ellipsoid(acc, &start)?;
+    let mag_fit = fit_ellipsoid(mag, &start)?;
+    let na = Normaliser::of(acc)?;
+    let nm = Normaliser::of(mag)?;
     let data = Data {
         acc: acc.iter().map(|a| (a - na.centre) / na.scale).collect(),
         mag: mag.iter().map(|m| (m - nm.centre) / nm.scale).collect(),
@@ -190,71 +260,55 @@ pub fn fit_mag_accel(
     };
     put(&mut theta, CA, BA, &acc_fit, &na);
     put(&mut theta, CM, BM, &mag_fit, &nm);
-    // Step 2.
-    let (r0, s0) = initial_alignment(&data, &theta)?;
-    theta[S] = s0;
+    Ok(Start {
+        acc_fit,
+        mag_fit,
+        na,
+        nm,
+        data,
+        theta,
+    })
+}
+
+/// Step 2's weights: each sensor's from the residual of its own ellipsoid, the dip's from
+/// its residual at the closed-form alignment.
+fn initial_weights(
+    data: &Data,
+    r0: &Rotation3<f64>,
+    theta: &SVector<f64, P>,
+    acc_fit: &Solution<CompassCalibration3d>,
+    mag_fit: &Solution<CompassCalibration3d>,
+) -> Weights {
     let mut w = Weights {
         acc: 1.0 / acc_fit.quality.fit.residual_rms_rel.max(SIGMA_FLOOR),
         mag: 1.0 / mag_fit.quality.fit.residual_rms_rel.max(SIGMA_FLOOR),
         dip: 1.0,
         aim: 1.0,
     };
-    w.dip = 1.0 / dip_rms(&data, &r0, &theta).max(SIGMA_FLOOR);
-    // Step 3.
-    let no_runs: Vec<Range<usize>> = Vec::new();
-    theta = refine(&data, &no_runs, &mut w, &r0, theta, config)?;
-    // Step 4.
-    let (no_runs_theta, no_runs_w) = (theta, w);
-    let mut runs = Vec::new();
-    if config.find_runs {
-        let frames: Vec<Option<Matrix3<f64>>> = (0..samples.len())
-            .map(|i| level_frame(&data, i, &r0, &theta))
-            .collect();
-        runs = find_runs(
-            &frames,
-            &Vector3::x(),
-            &RunRule {
-                tolerance_rad: config.run_tolerance_deg.to_radians(),
-                min_roll_rad: config.run_min_roll_deg.to_radians(),
-                min_shots: config.run_min_shots,
-            },
-        );
-        if !runs.is_empty() {
-            w.aim = 1.0 / aim_rms(&data, &runs, &r0, &theta).max(SIGMA_FLOOR);
-            theta = refine(&data, &runs, &mut w, &r0, theta, config)?;
-        }
-    }
-    // Step 5.
-    let with_runs = finish(
-        samples,
-        &data,
-        (&na, &nm),
-        &r0,
-        &theta,
-        &runs,
-        &w,
-        &mag,
-        config,
-    );
-    if runs.is_empty() || with_runs.is_ok() {
-        return with_runs;
-    }
-    // The runs are an option, not a condition: runs found by chance in a long recording
-    // (a few consecutive readings rolling about the pointing axis) can leave the pointing
-    // axis less certain than the calibration without them. Those readings still count as
-    // readings; only the pointing axis falls back to the accelerometer's x.
-    finish(
-        samples,
-        &data,
-        (&na, &nm),
-        &r0,
-        &no_runs_theta,
-        &[],
-        &no_runs_w,
-        &mag,
-        config,
+    w.dip = 1.0 / dip_rms(data, r0, theta).max(SIGMA_FLOOR);
+    w
+}
+
+/// Step 4: the runs of shots sharing a pointing direction among the `n` readings, from
+/// their level frames at the refined calibration.
+fn aimed_runs(
+    data: &Data,
+    n: usize,
+    r0: &Rotation3<f64>,
+    theta: &SVector<f64, P>,
+    config: &MagAccelConfig,
+) -> Vec<Range<usize>> {
+    let frames: Vec<Option<Matrix3<f64>>> =
+        (0..n).map(|i| level_frame(data, i, r0, theta)).collect();
+    find_runs(
+        &frames,
+        &Vector3::x(),
+        &RunRule {
+            tolerance_rad: config.run_tolerance_deg.to_radians(),
+            min_roll_rad: config.run_min_roll_deg.to_radians(),
+            min_shots: config.run_min_shots,
+        },
     )
-    .or(with_runs)
 }
 
 /// Step 5: the covariance, the calibration and its report, and the refusal on the heading

@@ -213,62 +213,16 @@ pub(crate) fn normal_equations(
     let mut cost = 0.0;
     let mut sums = GroupSums::default();
     for (a, mg) in data.acc.iter().zip(&data.mag) {
-        let da = a - m.c_a;
-        let u = m.b_a * da;
-        let nu = u.norm();
-        let dm = mg - m.c_m;
-        let v = m.b_m * dm;
-        let nv = v.norm();
-        if !(nu > 1e-12 && nv > 1e-12) {
-            return None;
+        let [acc, mag, dip] = reading_rows(&m, a, mg)?;
+        for ((row, r), weight, group) in [
+            (acc, w.acc, &mut sums.acc),
+            (mag, w.mag, &mut sums.mag),
+            (dip, w.dip, &mut sums.dip),
+        ] {
+            add_row(&mut jtj, &mut jtr, &mut cost, &(row * weight), r * weight);
+            group.0 += r * r;
+            group.1 += 1;
         }
-        let (u_hat, v_hat) = (u / nu, v / nv);
-        // |u| − 1.
-        let mut row = SVector::<f64, P>::zeros();
-        chain_to_ellipsoid(&mut row, CA, BA, &m.b_a, &da, &u_hat);
-        let r = nu - 1.0;
-        add_row(&mut jtj, &mut jtr, &mut cost, &(row * w.acc), r * w.acc);
-        sums.acc.0 += r * r;
-        sums.acc.1 += 1;
-        // |v| − 1.
-        let mut row = SVector::<f64, P>::zeros();
-        chain_to_ellipsoid(&mut row, CM, BM, &m.b_m, &dm, &v_hat);
-        let r = nv - 1.0;
-        add_row(&mut jtj, &mut jtr, &mut cost, &(row * w.mag), r * w.mag);
-        sums.mag.0 += r * r;
-        sums.mag.1 += 1;
-        // ûᵀ R v̂ − s.
-        let g = m.rot * v_hat;
-        let r = u_hat.dot(&g) - m.s;
-        let mut row = SVector::<f64, P>::zeros();
-        chain_to_ellipsoid(
-            &mut row,
-            CA,
-            BA,
-            &m.b_a,
-            &da,
-            &unit_gradient(&g, &u_hat, nu),
-        );
-        let rtu = m.rot.transpose() * u_hat;
-        chain_to_ellipsoid(
-            &mut row,
-            CM,
-            BM,
-            &m.b_m,
-            &dm,
-            &unit_gradient(&rtu, &v_hat, nv),
-        );
-        // d/dδ ûᵀR exp([δ]×) v̂ at δ = 0 is v̂ × Rᵀû. At ω ≠ 0 this is the derivative in
-        // the right-perturbation of R, which differs from ∂/∂ω by an invertible 3×3 factor:
-        // the stationary points, and so the solution, are the same.
-        let dw = v_hat.cross(&rtu);
-        for k in 0..3 {
-            row[OMEGA + k] = dw[k];
-        }
-        row[S] = -1.0;
-        add_row(&mut jtj, &mut jtr, &mut cost, &(row * w.dip), r * w.dip);
-        sums.dip.0 += r * r;
-        sums.dip.1 += 1;
     }
     if runs.is_empty() {
         // No run: the pointing axis is x. A stiff prior keeps the normal equations regular.
@@ -290,6 +244,62 @@ pub(crate) fn normal_equations(
     }
     let ne = NormalEquations { cost, jtj, jtr };
     (ne.cost.is_finite() && ne.jtj.iter().all(|x| x.is_finite())).then_some((ne, sums))
+}
+
+/// The unweighted Jacobian rows and residuals of one reading `(a, mg)` under the model `m`:
+/// the accelerometer's `|u| − 1`, the magnetometer's `|v| − 1` and the dip's `ûᵀ R v̂ − s`;
+/// `None` for a reading at a sensor's centre.
+fn reading_rows(
+    m: &Model,
+    a: &Vector3<f64>,
+    mg: &Vector3<f64>,
+) -> Option<[(SVector<f64, P>, f64); 3]> {
+    let da = a - m.c_a;
+    let u = m.b_a * da;
+    let nu = u.norm();
+    let dm = mg - m.c_m;
+    let v = m.b_m * dm;
+    let nv = v.norm();
+    if !(nu > 1e-12 && nv > 1e-12) {
+        return None;
+    }
+    let (u_hat, v_hat) = (u / nu, v / nv);
+    // |u| − 1.
+    let mut acc = SVector::<f64, P>::zeros();
+    chain_to_ellipsoid(&mut acc, CA, BA, &m.b_a, &da, &u_hat);
+    // |v| − 1.
+    let mut mag = SVector::<f64, P>::zeros();
+    chain_to_ellipsoid(&mut mag, CM, BM, &m.b_m, &dm, &v_hat);
+    // ûᵀ R v̂ − s.
+    let g = m.rot * v_hat;
+    let r = u_hat.dot(&g) - m.s;
+    let mut dip = SVector::<f64, P>::zeros();
+    chain_to_ellipsoid(
+        &mut dip,
+        CA,
+        BA,
+        &m.b_a,
+        &da,
+        &unit_gradient(&g, &u_hat, nu),
+    );
+    let rtu = m.rot.transpose() * u_hat;
+    chain_to_ellipsoid(
+        &mut dip,
+        CM,
+        BM,
+        &m.b_m,
+        &dm,
+        &unit_gradient(&rtu, &v_hat, nv),
+    );
+    // d/dδ ûᵀR exp([δ]×) v̂ at δ = 0 is v̂ × Rᵀû. At ω ≠ 0 this is the derivative in
+    // the right-perturbation of R, which differs from ∂/∂ω by an invertible 3×3 factor:
+    // the stationary points, and so the solution, are the same.
+    let dw = v_hat.cross(&rtu);
+    for k in 0..3 {
+        dip[OMEGA + k] = dw[k];
+    }
+    dip[S] = -1.0;
+    Some([(acc, nu - 1.0), (mag, nv - 1.0), (dip, r)])
 }
 
 /// The level-frame direction of the pointing axis for shot `i` under `theta`.

@@ -1,0 +1,179 @@
+//! The output of `truenorth drive`: its columns (the contract's and the `--extra` groups)
+//! and how each estimate becomes a row.
+
+use std::path::Path;
+
+use truenorth::core::{Declination, MagneticHeading, NavEstimate, rad_to_deg, wrap_two_pi};
+use truenorth::fusion::vehicle::NavFilter;
+
+use crate::io::{CliError, CliResult, CsvOutput};
+
+/// Optional output column groups.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum Extra {
+    /// heading_sigma_deg, north_sigma_m, east_sigma_m.
+    Sigma,
+    /// heading_absolute, compass_used, compass_disturbed, at_rest.
+    Status,
+    /// The learned sensor errors (fused method only).
+    Calibration,
+    /// gap and the unobserved_* flags: where the estimate leans on the prior rather than
+    /// on the data.
+    Trust,
+}
+
+/// The output columns and how each row is written.
+pub(super) struct Writer {
+    pub(super) out: CsvOutput,
+    pub(super) extra: Vec<Extra>,
+    pub(super) declination: Option<Declination>,
+    pub(super) rows: usize,
+    /// Rows where a sensor resumed after a gap.
+    pub(super) gaps: usize,
+    pub(super) error: Option<CliError>,
+    pub(super) last: Option<NavEstimate>,
+}
+
+impl Writer {
+    /// Creates the output `output` with the contract's columns and the `extra` groups;
+    /// headings turned to true north by `declination` when given.
+    pub(super) fn create(
+        output: &Path,
+        extra: &[Extra],
+        declination: Option<Declination>,
+    ) -> CliResult<Self> {
+        Ok(Self {
+            out: CsvOutput::create(output, &Self::header(extra))?,
+            extra: extra.to_vec(),
+            declination,
+            rows: 0,
+            gaps: 0,
+            error: None,
+            last: None,
+        })
+    }
+
+    fn header(extra: &[Extra]) -> Vec<&'static str> {
+        let mut h = vec!["t_s", "north_m", "east_m", "heading_deg"];
+        for e in extra {
+            h.extend_from_slice(match e {
+                Extra::Sigma => &["heading_sigma_deg", "north_sigma_m", "east_sigma_m"],
+                Extra::Status => &[
+                    "heading_absolute",
+                    "compass_used",
+                    "compass_disturbed",
+                    "at_rest",
+                ],
+                Extra::Calibration => &[
+                    "gyro_bias_dps",
+                    "gyro_gain_right",
+                    "gyro_gain_left",
+                    "wheel_diff",
+                    "track_scale",
+                    "speed_coeff_s2_per_m2",
+                ],
+                Extra::Trust => &[
+                    "gap",
+                    "unobserved_gyro_bias",
+                    "unobserved_gyro_gain_right",
+                    "unobserved_gyro_gain_left",
+                    "unobserved_wheel_diff",
+                    "unobserved_track_scale",
+                    "unobserved_speed_coeff",
+                ],
+            });
+        }
+        h
+    }
+
+    /// Writes one estimate (nothing after a write has failed: the error is kept for the
+    /// caller).
+    pub(super) fn write(&mut self, e: &NavEstimate, filter: Option<&NavFilter>) {
+        if self.error.is_some() {
+            return;
+        }
+        let mut row = self.position_and_heading(e);
+        for x in &self.extra {
+            extra_cells(*x, e, filter, &mut row);
+        }
+        if let Err(err) = self.out.row(&row) {
+            self.error = Some(err);
+        }
+        self.rows += 1;
+        self.gaps += usize::from(e.status.gap);
+        self.last = Some(*e);
+    }
+
+    /// The contract's columns: `t_s,north_m,east_m,heading_deg`.
+    fn position_and_heading(&self, e: &NavEstimate) -> Vec<f64> {
+        let (mut n, mut east, mut heading) = (e.north_m, e.east_m, e.heading.rad());
+        if let Some(d) = self.declination {
+            // True north: the heading and the whole track turn by the declination.
+            heading = MagneticHeading::new(heading).to_true(d).rad();
+            let (s, c) = d.0.sin_cos();
+            (n, east) = (c * n - s * east, s * n + c * east);
+        }
+        if !e.status.position_known {
+            // No wheels: no position, written as empty cells.
+            (n, east) = (f64::NAN, f64::NAN);
+        }
+        vec![e.t_s, n, east, rad_to_deg(wrap_two_pi(heading))]
+    }
+}
+
+/// The cells of one `--extra` group, appended to `row`.
+fn extra_cells(x: Extra, e: &NavEstimate, filter: Option<&NavFilter>, row: &mut Vec<f64>) {
+    let flags = |b: &[bool]| {
+        b.iter()
+            .map(|&b| f64::from(u8::from(b)))
+            .collect::<Vec<_>>()
+    };
+    match x {
+        Extra::Sigma => {
+            let p = e.position_cov_m2;
+            let known = e.status.position_known;
+            let sigma = |v: f64| if known { v.max(0.0).sqrt() } else { f64::NAN };
+            row.extend([
+                rad_to_deg(e.heading_sigma_rad),
+                sigma(p[(0, 0)]),
+                sigma(p[(1, 1)]),
+            ]);
+        }
+        Extra::Status => {
+            let s = e.status;
+            row.extend(flags(&[
+                s.heading_absolute,
+                s.compass_used,
+                s.compass_disturbed,
+                s.at_rest,
+            ]));
+        }
+        Extra::Calibration => match filter {
+            Some(f) => {
+                let x = &f.x;
+                use truenorth::fusion::vehicle::nav_filter::*;
+                row.extend([
+                    rad_to_deg(x[BIAS]),
+                    1.0 + x[GAIN_POS],
+                    1.0 + x[GAIN_NEG],
+                    x[WHEEL_DIFF],
+                    x[TRACK_SCALE],
+                    x[SPEED_COEFF],
+                ]);
+            }
+            None => row.extend([f64::NAN; 6]),
+        },
+        Extra::Trust => {
+            let u = e.status.unobserved;
+            row.extend(flags(&[
+                e.status.gap,
+                u.gyro_bias,
+                u.gyro_gain_right,
+                u.gyro_gain_left,
+                u.wheel_diff,
+                u.track_scale,
+                u.speed_coeff,
+            ]));
+        }
+    }
+}
