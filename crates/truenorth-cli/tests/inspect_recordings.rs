@@ -8,7 +8,7 @@ mod common;
 use std::io::Read as _;
 use std::path::{Path, PathBuf};
 
-use common::{p, run, scratch};
+use common::{broad_trials, p, run, scratch};
 use serde_json::Value;
 
 /// x-io's recording: its column names, read with x forward, y left, z up.
@@ -31,19 +31,6 @@ fn orientation(file: &Path, out: &Path, extra: &[&str]) -> (bool, String) {
         o.status.success(),
         String::from_utf8_lossy(&o.stderr).into_owned(),
     )
-}
-
-/// The BROAD trials, sorted; `None` (skipped) without the shared data.
-fn broad_trials() -> Option<Vec<PathBuf>> {
-    let dir = truenorth_sim::shared_data::folder("broad").unwrap()?;
-    let mut trials: Vec<PathBuf> = std::fs::read_dir(dir.join("trials"))
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.to_string_lossy().ends_with(".csv.gz"))
-        .collect();
-    trials.sort();
-    assert_eq!(trials.len(), 20);
-    Some(trials)
 }
 
 /// The margins a report gives, on one line.

@@ -1,6 +1,8 @@
 //! `truenorth orientation` reads a recording as it comes: other column names, another
 //! delimiter, gyro in deg/s, accelerometer in g, sensor axes x forward, y left, z up.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -202,16 +204,9 @@ fn in_degrees(trial: &Path) -> PathBuf {
 /// about ten qualifying spans is judged or not on the last digit of its rewritten values.
 #[test]
 fn no_broad_trial_is_refused_for_its_units() {
-    let Some(dir) = truenorth_sim::shared_data::folder("broad").unwrap() else {
+    let Some(trials) = common::broad_trials() else {
         return;
     };
-    let mut trials: Vec<PathBuf> = std::fs::read_dir(dir.join("trials"))
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.to_string_lossy().ends_with(".csv.gz"))
-        .collect();
-    trials.sort();
-    assert_eq!(trials.len(), 20);
     let mut refused_in_degrees = 0;
     for t in &trials {
         let (ok, err) = orientation_result(t, &[]);

@@ -7,10 +7,11 @@
 //! the rest of the drive. Every later estimate and the final state must equal, bit for bit,
 //! those of the run that never stopped.
 
+mod common;
+
+use common::persistence::{check_continues, json};
 use proptest::prelude::*;
-use serde::Serialize;
-use serde::de::DeserializeOwned;
-use truenorth_core::{Error, HeadingEstimator, NavEstimate, Persistent, Snapshot, VehicleSample};
+use truenorth_core::{Error, HeadingEstimator, Persistent, Snapshot, VehicleSample};
 use truenorth_fusion::{SensorPriors, VehicleConfig, VehicleEstimator};
 use truenorth_sim::{RangeDrive, RangeSpec, VehicleKind};
 
@@ -39,46 +40,6 @@ fn drive(seed: u64, kind: VehicleKind, gyro: bool) -> (VehicleConfig, Vec<Vehicl
         })
         .collect();
     (config, samples)
-}
-
-/// JSON text of `v`: with `float_roundtrip` and shortest-form output, two equal texts are
-/// two bit-identical values (non-finite ones are written by name).
-fn json<T: Serialize>(v: &T) -> String {
-    serde_json::to_string(v).unwrap()
-}
-
-/// Through JSON and back.
-fn through_json<S: Serialize + DeserializeOwned>(s: &S) -> S {
-    serde_json::from_str(&json(s)).unwrap()
-}
-
-/// Runs `make()` over every sample, and again stopped at `cut`, saved to JSON, restored and
-/// continued: every estimate after the cut, and the final state, must agree bit for bit.
-fn check_continues<E>(make: impl Fn() -> E, samples: &[VehicleSample], cut: usize)
-where
-    E: HeadingEstimator + Persistent,
-{
-    let mut whole = make();
-    let expected: Vec<String> = samples
-        .iter()
-        .map(|s| json(&whole.update(s).unwrap()))
-        .collect();
-    let mut first = make();
-    for s in &samples[..cut] {
-        first.update(s).unwrap();
-    }
-    let saved = through_json(&first.snapshot());
-    let mut second = E::restore(saved).unwrap();
-    assert_eq!(
-        json(&second.state()),
-        json(&first.state()),
-        "state at the cut"
-    );
-    for (k, s) in samples.iter().enumerate().skip(cut) {
-        let e: NavEstimate = second.update(s).unwrap();
-        assert_eq!(json(&e), expected[k], "estimate {k} after a cut at {cut}");
-    }
-    assert_eq!(json(&second.state()), json(&whole.state()), "final state");
 }
 
 fn kind() -> impl Strategy<Value = VehicleKind> {

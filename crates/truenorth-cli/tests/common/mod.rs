@@ -60,3 +60,16 @@ pub fn ok_with(args: &[&str], stdin: Option<&[u8]>) -> Output {
 pub fn p(path: &Path) -> &str {
     path.to_str().unwrap()
 }
+
+/// The BROAD trials, sorted; `None` (skipped) without the shared data.
+pub fn broad_trials() -> Option<Vec<PathBuf>> {
+    let dir = truenorth_sim::shared_data::folder("broad").unwrap()?;
+    let mut trials: Vec<PathBuf> = std::fs::read_dir(dir.join("trials"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.to_string_lossy().ends_with(".csv.gz"))
+        .collect();
+    trials.sort();
+    assert_eq!(trials.len(), 20);
+    Some(trials)
+}

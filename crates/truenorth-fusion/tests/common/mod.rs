@@ -6,6 +6,7 @@
 #![allow(dead_code)]
 
 pub mod consistency;
+pub mod persistence;
 
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
