@@ -11,7 +11,7 @@ use core::f64::consts::TAU;
 
 use nalgebra::{Matrix2, Matrix3, SMatrix, SVector, Vector2, Vector3};
 use truenorth_compass::CompassCalibration2d;
-use truenorth_core::{CompassUncertainty, Error, FitQuality, Mag2Sample, Result, Solution};
+use truenorth_core::{Error, FitQuality, Mag2Sample, Result, Solution};
 
 use crate::fits::ellipse::direct::{
     Ellipse, conic_to_ellipse, denormalise, from_params, solve_direct, to_params,
@@ -389,13 +389,13 @@ impl Refresh {
         let dilution = self.support_l_inv.map_or(f64::INFINITY, |l| {
             (self.support_cells as f64 * worst_over_headings(&l)).sqrt()
         });
-        let uncertainty = match self.l_inv {
-            Some(l) => quality::uncertainty_from_factor(&l, self.sigma, self.field, 2, dilution),
-            None => CompassUncertainty {
-                dilution,
-                ..CompassUncertainty::UNDETERMINED
-            },
-        };
+        let uncertainty = quality::uncertainty_from_factor(
+            self.l_inv.as_ref(),
+            self.sigma,
+            self.field,
+            2,
+            dilution,
+        );
         let fit = FitQuality {
             points: self.base.sums.count as usize,
             coverage: self.coverage.fraction,

@@ -77,21 +77,30 @@ pub(super) fn bound_and_uncertainty<const P: usize>(
     let w = worst(&l_inv);
     (
         bound_deg(sigma, w),
-        uncertainty_from_factor(&l_inv, sigma, field, dimensions, dilution),
+        uncertainty_from_factor(Some(&l_inv), sigma, field, dimensions, dilution),
     )
 }
 
 /// What the readings determine, from the inverse Cholesky factor `L⁻¹` of the information
 /// matrix (`A⁻¹ = L⁻ᵀL⁻¹`, in the parameters of [`bound_and_uncertainty`], scaled so that
 /// `σ²A⁻¹` is the parameters' covariance), the per-reading noise `sigma` (relative to the
-/// field), the field, and the support's `dilution`. Non-finite figures are reported as +∞.
+/// field), the field, and the support's `dilution`; without a factor (the information
+/// matrix not positive definite) the parameters are undetermined. Non-finite figures are
+/// reported as +∞.
 pub(crate) fn uncertainty_from_factor<const P: usize>(
-    l_inv: &SMatrix<f64, P, P>,
+    l_inv: Option<&SMatrix<f64, P, P>>,
     sigma: f64,
     field: f64,
     dimensions: usize,
     dilution: f64,
 ) -> CompassUncertainty {
+    let finite = |v: f64| if v.is_finite() { v } else { f64::INFINITY };
+    let Some(l_inv) = l_inv else {
+        return CompassUncertainty {
+            dilution: finite(dilution),
+            ..CompassUncertainty::UNDETERMINED
+        };
+    };
     // (A⁻¹)_kk = ‖column k of L⁻¹‖², since A⁻¹ = L⁻ᵀL⁻¹.
     let var = |k: usize| l_inv.column(k).norm_squared();
     let mut hard_iron_sigma = [0.0; 3];
@@ -101,7 +110,6 @@ pub(crate) fn uncertainty_from_factor<const P: usize>(
     let soft_iron_sigma_rel = (dimensions..P)
         .map(|k| sigma * var(k).sqrt())
         .fold(0.0, f64::max);
-    let finite = |v: f64| if v.is_finite() { v } else { f64::INFINITY };
     CompassUncertainty {
         dilution: finite(dilution),
         hard_iron_sigma: hard_iron_sigma.map(finite),

@@ -117,16 +117,6 @@ impl Refresh {
             Some(_) => (self.support_cells as f64 * self.support_worst).sqrt(),
             None => f64::INFINITY,
         };
-        match self.l_inv {
-            Some(l) => quality::uncertainty_from_factor(&l, self.sigma, self.field, 3, dilution),
-            None => CompassUncertainty {
-                dilution: if dilution.is_finite() {
-                    dilution
-                } else {
-                    f64::INFINITY
-                },
-                ..CompassUncertainty::UNDETERMINED
-            },
-        }
+        quality::uncertainty_from_factor(self.l_inv.as_ref(), self.sigma, self.field, 3, dilution)
     }
 }
