@@ -3,13 +3,7 @@
 //! each subcommand's `--help`. Errors exit non-zero with one line on stderr naming the file, the row and the
 //! problem.
 
-mod commands;
-mod demo;
-mod eval;
-mod inspect;
-mod io;
-mod plot;
-mod registry;
+use truenorth_cli::{commands, demo, eval};
 
 use std::process::ExitCode;
 
