@@ -76,7 +76,8 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("truenorth: {e}");
+            // Never panics, whatever stderr is (see io::console).
+            io::errln!("truenorth: {e}");
             ExitCode::FAILURE
         }
     }
