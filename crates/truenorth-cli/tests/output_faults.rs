@@ -121,6 +121,10 @@ impl Delays {
 #[derive(Debug, Default)]
 struct KillOutcomes {
     kills: usize,
+    /// Kills sent while the temporary was being written (at a random share of its size).
+    sent_mid_write: usize,
+    /// Kills sent at a random time before the writing began.
+    sent_early: usize,
     stopped_by_the_signal: usize,
     finished_first: usize,
     previous_output_kept: usize,
@@ -128,21 +132,34 @@ struct KillOutcomes {
     temporaries_left: usize,
 }
 
-/// Runs `heading` `kills` times, alternating its input, and stops each run with `signal`
-/// after a random share of a full run's time. After each: the output is the previous one
-/// byte for byte or the complete new one; after SIGTERM no temporary is left.
+/// Waits until `temp` holds at least `bytes` (true), or the run ended first (false).
+fn wait_for_size(temp: &Path, bytes: u64, child: &mut std::process::Child) -> bool {
+    let deadline = Instant::now() + Duration::from_secs(60);
+    while Instant::now() < deadline {
+        if std::fs::metadata(temp).is_ok_and(|m| m.len() >= bytes) {
+            return true;
+        }
+        if child.try_wait().unwrap().is_some() {
+            return false;
+        }
+        std::thread::sleep(Duration::from_micros(500));
+    }
+    false
+}
+
+/// Runs `heading` `kills` times, each time on the input whose output is not there yet, and stops each run with `signal`:
+/// one in five at a random time before its writing begins, the others once its temporary
+/// holds a random share of the output (one in ten: all of it, as it is synced and renamed). After each: the output is the previous one byte for
+/// byte or the complete new one; after SIGTERM no temporary is left.
 fn kill_repeatedly(name: &str, signal: &str, kills: usize, seed: u64) -> KillOutcomes {
     let dir = scratch(name);
     let s = setup(&dir, 300_000);
     let output = dir.join("out.csv");
     let out = p(&output);
-    // The complete output of each input, and a full run's time.
+    // The complete output of each input, and how long starting a run takes.
     let mut complete = Vec::new();
-    let mut full_run = Duration::ZERO;
     for input in [1, 0] {
-        let started = Instant::now();
         ok(&heading_args(&s, input, out));
-        full_run = full_run.max(started.elapsed());
         complete.push(std::fs::read(&output).unwrap());
     }
     complete.reverse();
@@ -150,13 +167,30 @@ fn kill_repeatedly(name: &str, signal: &str, kills: usize, seed: u64) -> KillOut
         complete[0], complete[1],
         "the two inputs give different outputs"
     );
+    let started = Instant::now();
+    ok(&["field", "--lat", "0", "--lon", "0", "--date", "2026"]);
+    let start_up = started.elapsed();
     let mut delays = Delays(seed);
     let mut found = KillOutcomes::default();
     for k in 0..kills {
-        let input = (k + 1) % 2;
+        // The input whose output differs from what is there, so the two are told apart.
         let previous = std::fs::read(&output).unwrap();
+        let input = usize::from(previous == complete[0]);
         let mut child = spawn(&heading_args(&s, input, out));
-        std::thread::sleep(full_run.mul_f64(1.2 * delays.next_fraction()));
+        let temp = dir.join(format!(".out.csv.tmp-{}", child.id()));
+        let share = delays.next_fraction();
+        if share < 0.2 {
+            std::thread::sleep(start_up.mul_f64(share * 5.0));
+            found.sent_early += 1;
+        } else {
+            // One in ten waits for the whole output: the kill lands while it is synced
+            // and renamed, or just after.
+            let whole = complete[input].len() as f64;
+            let bytes = (whole * ((share - 0.2) / 0.7).min(1.0)) as u64;
+            if wait_for_size(&temp, bytes.max(1), &mut child) {
+                found.sent_mid_write += 1;
+            }
+        }
         if signal == "KILL" {
             let _ = child.kill();
         } else {
@@ -205,8 +239,8 @@ fn kill_repeatedly(name: &str, signal: &str, kills: usize, seed: u64) -> KillOut
     let _ = std::fs::remove_dir_all(&dir);
     eprintln!("SIG{signal}: {found:?}");
     assert!(
-        found.stopped_by_the_signal * 2 >= kills,
-        "most kills land while the run is on: {found:?}"
+        found.sent_mid_write * 2 >= kills,
+        "most kills land while the output is written: {found:?}"
     );
     found
 }
