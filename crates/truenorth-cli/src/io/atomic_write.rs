@@ -4,7 +4,7 @@
 //! leaves an existing output as it was. A symbolic link is followed: the file it points to
 //! is replaced and the link stays. `-` (standard output), a device and a FIFO are written
 //! into directly: they are not files to replace. Temporaries are `.NAME.tmp-PID`; how the
-//! ones of a stopped run are removed is in [`temporaries`](super::temporaries).
+//! ones of a stopped run are removed is in [`temporaries`].
 
 use std::fs::File;
 use std::io::{BufWriter, ErrorKind, Write};

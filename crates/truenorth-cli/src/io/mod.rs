@@ -21,10 +21,11 @@
 //! Writing: [`AtomicOutput`](atomic_write::AtomicOutput) / [`CsvOutput`] / [`write_csv`] / [`write_atomically`] write a
 //! temporary file beside the target, sync it and rename it over the target (through a
 //! symbolic link, the file it points to; `-`, a device or a FIFO: written into directly;
-//! `*.gz`: compressed); the temporaries of a run stopped by a signal are removed
-//! ([`temporaries`]); [`check_distinct`] refuses an output that is one of the inputs before
-//! anything is read. Console text goes through [`outln!`] / [`errln!`]
-//! ([`console`]): a closed pipe ends the run quietly, a full disk is an error.
+//! `*.gz`: compressed); the temporaries of a run stopped by a signal are removed, those a
+//! killed run left by the next run writing the same output; [`check_distinct`] refuses an
+//! output that is one of the inputs before anything is read. Console text goes through
+//! `outln!` / `errln!`: a closed pipe ends the run quietly (status 141), a full disk is an
+//! error.
 
 mod atomic_write;
 mod calibration_file;
