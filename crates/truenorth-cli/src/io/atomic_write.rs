@@ -370,6 +370,32 @@ mod tests {
         assert!(leftovers(&d).is_empty());
     }
 
+    #[cfg(unix)]
+    #[test]
+    fn a_link_is_followed_a_device_written_into_and_permissions_kept() {
+        use std::os::unix::fs::PermissionsExt as _;
+        let d = dir("kinds");
+        let real = d.join("real.csv");
+        std::fs::write(&real, "old\n").unwrap();
+        std::fs::set_permissions(&real, std::fs::Permissions::from_mode(0o640)).unwrap();
+        let link = d.join("link.csv");
+        std::os::unix::fs::symlink("real.csv", &link).unwrap();
+        write_csv(&link, &["a"], [vec![2.0]]).unwrap();
+        assert!(std::fs::symlink_metadata(&link).unwrap().is_symlink());
+        assert_eq!(std::fs::read_to_string(&real).unwrap(), "a\n2\n");
+        let mode = std::fs::metadata(&real).unwrap().permissions().mode();
+        assert_eq!(mode & 0o777, 0o640, "{mode:o}");
+        assert!(leftovers(&d).is_empty());
+        write_csv(Path::new("/dev/null"), &["a"], [vec![1.0]]).unwrap();
+        use std::os::unix::fs::FileTypeExt as _;
+        let null = std::fs::metadata("/dev/null").unwrap();
+        assert!(null.file_type().is_char_device());
+        assert!(
+            check_distinct(Path::new("/dev/null"), &[Path::new("/dev/null")]).is_ok(),
+            "writing into a device destroys no input"
+        );
+    }
+
     #[test]
     fn gz_outputs_are_compressed_and_read_back() {
         let d = dir("gz");
