@@ -76,8 +76,8 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            // Never panics, whatever stderr is (see io::console).
-            io::errln!("truenorth: {e}");
+            // Never panics, whatever stderr is (a closed pipe, a full disk).
+            io::write_stderr(format_args!("truenorth: {e}\n"));
             ExitCode::FAILURE
         }
     }
