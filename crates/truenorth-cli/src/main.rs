@@ -70,7 +70,8 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("truenorth: {e}");
+            // Never panics, whatever stderr is (a closed pipe, a full disk).
+            io::write_stderr(format_args!("truenorth: {e}\n"));
             ExitCode::FAILURE
         }
     }

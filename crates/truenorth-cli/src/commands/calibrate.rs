@@ -17,6 +17,7 @@ use truenorth::core::{Calibrator, CompassQuality, Mag2Sample, Mag3Sample, Soluti
 
 use super::field::Place;
 use super::mag_unit::{MagUnit, check_field};
+use crate::io::errln;
 use crate::io::{
     AccelPart, CALIBRATION_FORMAT, CALIBRATION_VERSION, CalibrationFile, CliError, CliResult,
     GyroPart, InputOptions, InputPath, QualityReport, ReadSpec, Table, check_distinct, finite,
@@ -170,7 +171,7 @@ pub fn run(args: &Args) -> CliResult {
         }
     };
     let input = InputPath::new(&args.input).display_path();
-    let warn = |w: &str| eprintln!("truenorth: warning: {}: {w}", input.display());
+    let warn = |w: &str| errln!("truenorth: warning: {}: {w}", input.display());
     if let Some(problem) = check_field(
         fitted.quality.field_magnitude,
         args.mag_unit,
@@ -205,7 +206,7 @@ pub fn run(args: &Args) -> CliResult {
         }
     }
     fitted.file.write(&args.output)?;
-    eprintln!("truenorth: {}", summary(&fitted.file, &verdict));
+    errln!("truenorth: {}", summary(&fitted.file, &verdict));
     Ok(())
 }
 

@@ -11,6 +11,7 @@ use truenorth::fusion::{SensorPriors, VehicleConfig, VehicleEstimator};
 use truenorth::odometer::OdometerWheels;
 
 use super::field::Place;
+use crate::io::errln;
 use crate::io::{
     CliError, CliResult, GyroUnit, InputOptions, InputPath, ReadSpec, Row, RowReader, VehicleFile,
     WheelColumns, YawRateCheck, check_distinct, refuse_or_warn, write_atomically,
@@ -438,5 +439,5 @@ fn summary(
     if gaps > 0 {
         line += &format!("; {gaps} gaps in the log, widened rather than bridged");
     }
-    eprintln!("{line}");
+    errln!("{line}");
 }

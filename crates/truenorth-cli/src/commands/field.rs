@@ -14,6 +14,7 @@ use truenorth::geomag::{
 };
 
 use crate::io::{CliError, CliResult};
+use crate::io::{errln, outln};
 
 /// The CSV header of the contract.
 pub const HEADER: &str = "x_nt,y_nt,z_nt,h_nt,f_nt,incl_deg,decl_deg";
@@ -63,8 +64,8 @@ pub struct Place {
 /// Runs the subcommand: the CSV on stdout, an extrapolation warning (if any) on stderr.
 pub fn run(args: &Args) -> CliResult {
     let field = args.place.field()?;
-    println!("{HEADER}");
-    println!("{}", csv_row(&field));
+    outln!("{HEADER}")?;
+    outln!("{}", csv_row(&field))?;
     Ok(())
 }
 
@@ -83,10 +84,10 @@ impl Place {
         };
         let field = evaluate(self, year)?;
         if let Some(w) = field.extrapolated {
-            eprintln!("truenorth: warning: {w}");
+            errln!("truenorth: warning: {w}");
         }
         if let Some(w) = weak_horizontal_field(&field) {
-            eprintln!("truenorth: warning: {w}");
+            errln!("truenorth: warning: {w}");
         }
         Ok(field)
     }

@@ -8,6 +8,7 @@ use truenorth::accel::static_tilt;
 use truenorth::core::{Declination, MagneticHeading, Tilt, rad_to_deg};
 
 use super::field::Place;
+use crate::io::errln;
 use crate::io::{
     CalibrationFile, CliError, CliResult, CompassCalibration, CsvOutput, InputOptions, InputPath,
     ReadSpec, Row, RowReader, check_distinct,
@@ -107,7 +108,7 @@ pub fn run(args: &Args) -> CliResult {
         "magnetic"
     };
     let how = tilt_summary(&cal, cols.acc.is_some());
-    eprintln!("truenorth: heading: {count} rows, {north} north, {how}");
+    errln!("truenorth: heading: {count} rows, {north} north, {how}");
     Ok(())
 }
 

@@ -7,6 +7,7 @@ use std::path::PathBuf;
 use crate::inspect::report::JsonReport;
 use crate::inspect::{Recording, analyse};
 use crate::io::{CliError, CliResult, InputOptions, InputPath};
+use crate::io::{out, outln};
 
 /// Arguments of `truenorth inspect`.
 ///
@@ -49,9 +50,9 @@ pub fn run(args: &Args) -> CliResult {
         };
         let text = serde_json::to_string_pretty(&json)
             .map_err(|e| CliError::msg(format!("inspect: cannot write the report: {e}")))?;
-        println!("{text}");
+        outln!("{text}")?;
     } else {
-        print!("{}", report.to_table());
+        out!("{}", report.to_table())?;
     }
     Ok(())
 }

@@ -6,6 +6,7 @@ use std::path::PathBuf;
 use nalgebra::{UnitQuaternion, Vector3};
 use truenorth::core::{AttitudeEstimate, Axes, EulerZyx, ImuSample, ned_to_enu, rad_to_deg};
 
+use crate::io::errln;
 use crate::io::{
     AccUnit, CliError, CliResult, GyroUnit, InputOptions, InputPath, ReadSpec, Table,
     check_distinct, check_inertial, refuse_or_warn, write_csv,
@@ -152,7 +153,7 @@ pub fn run(args: &Args) -> CliResult {
     }
     write_csv(&args.output, &header, out.rows)?;
     if !out.gaps.is_empty() {
-        eprintln!("{}", gap_summary(&args.input, &out.gaps));
+        errln!("{}", gap_summary(&args.input, &out.gaps));
     }
     Ok(())
 }

@@ -6,6 +6,7 @@ use truenorth::compass::CompassCalibration2d;
 use truenorth::core::Mag2Sample;
 
 use super::sensors::{DemoDrive, HeadingError, heading_error};
+use crate::io::outln;
 use crate::io::{CliError, CliResult};
 use crate::plot::{Series, Style, write_plot};
 use crate::registry::{CalibrationMethod, Planar};
@@ -32,14 +33,14 @@ pub(super) fn compass_section(d: &DemoDrive, out: &std::path::Path) -> CliResult
         .filter(|s| s.t_s <= d.circle_end_s)
         .filter_map(|s| s.mag.map(|mag| Mag2Sample { t_s: s.t_s, mag }))
         .collect();
-    print_header(d, cal_samples.len());
+    print_header(d, cal_samples.len())?;
     let mut methods = calibrators()?;
-    let ls_fit = fit_table(d, &cal_samples, &mut methods);
-    half_circle(d, &cal_samples, &mut methods);
+    let ls_fit = fit_table(d, &cal_samples, &mut methods)?;
+    half_circle(d, &cal_samples, &mut methods)?;
     if let Some((cal, field)) = ls_fit {
         plot_fit(&cal_samples, &cal, field, out)?;
     }
-    println!();
+    outln!()?;
     Ok(())
 }
 
@@ -55,27 +56,41 @@ fn whole_drive_error(d: &DemoDrive, cal: &CompassCalibration2d) -> HeadingError 
 
 /// The section's title, the table's header and its first row: the true calibration's
 /// error, which is the noise floor.
-fn print_header(d: &DemoDrive, samples: usize) {
+fn print_header(d: &DemoDrive, samples: usize) -> CliResult {
     let p = &d.params;
-    println!(
+    outln!(
         "Compass calibration: each method fitted on the opening circle ({} samples, hard iron {:.2} x field, soft iron 1.3 rotated 30 deg, noise {:.0} % of field), then applied to the whole drive",
         samples,
         p.compass_hard_iron.norm() / p.horizontal_field,
         p.compass_noise / p.horizontal_field * 100.0
-    );
-    println!(
+    )?;
+    outln!(
         "{:<26} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>11}",
-        "method", "RMS deg", "max deg", "3sd deg", "sys deg", "noise deg", "coverage", "residual %"
-    );
+        "method",
+        "RMS deg",
+        "max deg",
+        "3sd deg",
+        "sys deg",
+        "noise deg",
+        "coverage",
+        "residual %"
+    )?;
     let truth_cal = CompassCalibration2d {
         hard_iron: p.compass_hard_iron,
         soft_iron: p.compass_soft_iron.try_inverse().unwrap_or_default(),
     };
     let floor = whole_drive_error(d, &truth_cal);
-    println!(
+    outln!(
         "{:<26} {:>9.2} {:>9.2} {:>9} {:>9} {:>9} {:>9} {:>11}",
-        "(noise floor: true cal.)", floor.rms_deg, floor.max_deg, "-", "-", "-", "-", "-"
-    );
+        "(noise floor: true cal.)",
+        floor.rms_deg,
+        floor.max_deg,
+        "-",
+        "-",
+        "-",
+        "-",
+        "-"
+    )
 }
 
 /// Each method's calibrator, from the registry.
@@ -98,7 +113,7 @@ fn fit_table(
     d: &DemoDrive,
     cal_samples: &[Mag2Sample],
     methods: &mut [(&str, Box<Planar>)],
-) -> Option<(CompassCalibration2d, f64)> {
+) -> CliResult<Option<(CompassCalibration2d, f64)>> {
     let mut ls_fit: Option<(CompassCalibration2d, f64)> = None;
     for (name, cal) in methods.iter_mut() {
         for s in cal_samples {
@@ -108,7 +123,7 @@ fn fit_table(
         match cal.solve() {
             Ok(sol) => {
                 let e = whole_drive_error(d, &sol.params);
-                println!(
+                outln!(
                     "{:<26} {:>9.2} {:>9.2} {:>9.2} {:>9.2} {:>9.2} {:>8.0}% {:>11.2}",
                     name,
                     e.rms_deg,
@@ -118,20 +133,24 @@ fn fit_table(
                     sol.quality.heading_noise_rms_deg,
                     sol.quality.fit.coverage * 100.0,
                     sol.quality.fit.residual_rms_rel * 100.0
-                );
+                )?;
                 if ls_fit.is_none() {
                     ls_fit = Some((sol.params, sol.quality.field_magnitude));
                 }
             }
-            Err(e) => println!("{name:<26} refused: {e}"),
+            Err(e) => outln!("{name:<26} refused: {e}")?,
         }
     }
-    ls_fit
+    Ok(ls_fit)
 }
 
 /// Feeds each method the first half circle, which must be refused, and prints the
 /// legend and how many refused.
-fn half_circle(d: &DemoDrive, cal_samples: &[Mag2Sample], methods: &mut [(&str, Box<Planar>)]) {
+fn half_circle(
+    d: &DemoDrive,
+    cal_samples: &[Mag2Sample],
+    methods: &mut [(&str, Box<Planar>)],
+) -> CliResult {
     // A half circle is not enough for any method: each must refuse, not guess.
     let half: Vec<&Mag2Sample> = cal_samples
         .iter()
@@ -147,16 +166,16 @@ fn half_circle(d: &DemoDrive, cal_samples: &[Mag2Sample], methods: &mut [(&str, 
         }
         refused += usize::from(cal.solve().is_err());
     }
-    println!(
+    outln!(
         "RMS/max: heading error on the whole drive, noise included. 3sd: three standard deviations of the\n\
          heading error from the fitted parameters' uncertainty; sys: the error the method's model leaves\n\
          whatever the data; noise: RMS noise of one calibrated reading. residual: RMS distance from the\n\
          fitted circle divided by the field."
-    );
-    println!(
+    )?;
+    outln!(
         "half circle (< 180 deg of turn): {refused} of {} methods refuse, as they must",
         methods.len()
-    );
+    )
 }
 
 /// The raw readings, the fitted ellipse and the corrected circle.
@@ -210,6 +229,6 @@ fn plot_fit(
             },
         ],
     )?;
-    println!("plot: {}", path.display());
+    outln!("plot: {}", path.display())?;
     Ok(())
 }

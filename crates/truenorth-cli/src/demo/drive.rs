@@ -10,6 +10,7 @@ use truenorth::fusion::{VehicleConfig, VehicleEstimator};
 use truenorth::odometer::OdometerWheels;
 use truenorth_sim::{DriveScore, DriveSpec, DriveWheels, SimulatedDrive};
 
+use crate::io::outln;
 use crate::io::{CliError, CliResult};
 use crate::plot::{Series, Style, write_plot};
 use crate::registry::VehicleMethod;
@@ -124,25 +125,28 @@ pub(super) fn drive_section(seed: u64, out: &Path) -> CliResult {
         .iter()
         .map(|d| d.distance_m() / 1e3)
         .collect();
-    println!(
+    outln!(
         "\nVehicle dead reckoning on {DRIVES} simulated mixed drives of {:.1}-{:.1} km per wheel set (seeds {seed}-{}): every sensor uncalibrated at the start, disturbances on the road; goals: with gyro heading <= 0.5 deg RMS and final error <= 0.3 % of distance, without <= 1 %",
         km.iter().copied().fold(f64::INFINITY, f64::min),
         km.iter().copied().fold(0.0, f64::max),
         seed.wrapping_add(DRIVES - 1)
-    );
-    println!(
+    )?;
+    outln!(
         "{:<32} {:<6} {:>16} {:>22}",
-        "configuration", "wheels", "heading RMS deg", "final % mean (worst)"
-    );
+        "configuration",
+        "wheels",
+        "heading RMS deg",
+        "final % mean (worst)"
+    )?;
     for (wheels, c, r) in table(seed).map_err(err)? {
-        println!(
+        outln!(
             "{:<32} {:<6} {:>16.2} {:>14.3} ({:.3})",
             c.name(),
             format!("{wheels:?}").to_lowercase(),
             r.heading_rms_deg,
             r.final_mean_pct,
             r.final_worst_pct
-        );
+        )?;
     }
     let drive = SimulatedDrive::new(DriveSpec::new(seed)).map_err(err)?;
     let track = |e: &[NavEstimate]| e.iter().map(|e| (e.east_m, e.north_m)).collect();
@@ -172,10 +176,10 @@ pub(super) fn drive_section(seed: u64, out: &Path) -> CliResult {
         "north (m)",
         &series,
     )?;
-    println!("plot: {}", path.display());
-    println!(
+    outln!("plot: {}", path.display())?;
+    outln!(
         "(more drives: `cargo test --release -p truenorth-fusion --test vehicle_drives -- --ignored --nocapture`)"
-    );
+    )?;
     Ok(())
 }
 

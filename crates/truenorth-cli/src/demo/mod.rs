@@ -12,6 +12,7 @@ mod sensors;
 
 use std::path::PathBuf;
 
+use crate::io::outln;
 use crate::io::{CliError, CliResult};
 
 /// Arguments of `truenorth demo`.
@@ -29,10 +30,10 @@ pub struct Args {
 pub fn run(args: &Args) -> CliResult {
     std::fs::create_dir_all(&args.out)
         .map_err(|e| CliError::file(&args.out, format!("cannot create the output folder: {e}")))?;
-    println!("truenorth demo (seed {})\n", args.seed);
+    outln!("truenorth demo (seed {})\n", args.seed)?;
     scenarios::scenario_table()?;
     let drive = sensors::DemoDrive::new(args.seed)?;
-    sensors::sensor_table(&drive);
+    sensors::sensor_table(&drive)?;
     compass::compass_section(&drive, &args.out)?;
     drive::drive_section(args.seed, &args.out)?;
     orientation::orientation_section(args.seed, &args.out)?;

@@ -9,6 +9,7 @@ use truenorth::core::{AttitudeEstimate, Result};
 use truenorth::fusion::AttitudeError;
 use truenorth_sim::{HandheldParams, ImuSensorParams, handheld_motion, imu_streams};
 
+use crate::io::outln;
 use crate::io::{CliError, CliResult};
 use crate::plot::{Line, write_timeseries};
 use crate::registry::{OrientationMethod, Timing};
@@ -62,13 +63,15 @@ fn run(
 
 /// Prints the orientation table and writes `orientation_error.svg` into `out`.
 pub(super) fn orientation_section(seed: u64, out: &Path) -> CliResult {
-    println!(
+    outln!(
         "\nOrientation on 300 s of simulated hand-held motion (consumer IMU: gyro bias 0.3 deg/s per axis, never at rest), errors after the first 30 s"
-    );
-    println!(
+    )?;
+    outln!(
         "{:<34} {:>16} {:>20}",
-        "estimator", "heading RMS deg", "inclination RMS deg"
-    );
+        "estimator",
+        "heading RMS deg",
+        "inclination RMS deg"
+    )?;
     let err = |e: truenorth::core::Error| CliError::msg(e.to_string());
     // The simulator's gyro reads the instantaneous rate at each sample.
     let run_method = |method: OrientationMethod, use_mag: bool| -> Result<Run> {
@@ -88,7 +91,7 @@ pub(super) fn orientation_section(seed: u64, out: &Path) -> CliResult {
         } else {
             "drifts".to_string()
         };
-        println!("{name:<34} {h:>16} {:>20.2}", r.inclination_deg);
+        outln!("{name:<34} {h:>16} {:>20.2}", r.inclination_deg)?;
     }
     let path = out.join("orientation_error.svg");
     write_timeseries(
@@ -110,10 +113,10 @@ pub(super) fn orientation_section(seed: u64, out: &Path) -> CliResult {
         ],
         &[],
     )?;
-    println!("plot: {}", path.display());
-    println!(
+    outln!("plot: {}", path.display())?;
+    outln!(
         "(real recordings: `truenorth eval broad ../shared/data/broad [--method euler-detector]`)"
-    );
+    )?;
     Ok(())
 }
 

@@ -3,6 +3,7 @@
 use truenorth::core::angle_diff;
 use truenorth_sim::{Route, VehicleTruth, scenario, simulate};
 
+use crate::io::outln;
 use crate::io::{CliError, CliResult};
 
 /// The calibration circle that opens the demo drive.
@@ -65,17 +66,23 @@ pub(super) fn scenario_table() -> CliResult {
         ("parking", scenario::parking()),
         ("whole demo drive", scenario::demo_drive()),
     ];
-    println!("Scenarios (rear-axle kinematic model, truth at {RATE_HZ} Hz)");
-    println!(
+    outln!("Scenarios (rear-axle kinematic model, truth at {RATE_HZ} Hz)")?;
+    outln!(
         "{:<20} {:>9} {:>11} {:>11} {:>9} {:>6} {:>10}",
-        "scenario", "time s", "distance m", "turned deg", "turns>45", "stops", "max km/h"
-    );
+        "scenario",
+        "time s",
+        "distance m",
+        "turned deg",
+        "turns>45",
+        "stops",
+        "max km/h"
+    )?;
     for (name, route) in scenarios {
         let route = route.map_err(|e| CliError::msg(format!("scenario {name}: {e}")))?;
         let truth = simulate(&route, 0.0, RATE_HZ)
             .map_err(|e| CliError::msg(format!("scenario {name}: {e}")))?;
         let s = summarise(&route, &truth);
-        println!(
+        outln!(
             "{:<20} {:>9.1} {:>11.1} {:>11.1} {:>9} {:>6} {:>10.1}",
             name,
             s.duration_s,
@@ -84,8 +91,8 @@ pub(super) fn scenario_table() -> CliResult {
             s.turns_over_45deg,
             s.stops,
             s.max_speed_mps * 3.6
-        );
+        )?;
     }
-    println!();
+    outln!()?;
     Ok(())
 }

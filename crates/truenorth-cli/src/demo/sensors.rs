@@ -7,6 +7,7 @@ use truenorth::odometer::{DifferentialOdometer, DifferentialOdometerConfig, Fixe
 use truenorth_sim::{VehicleSensorParams, VehicleTruth, scenario, simulate, vehicle_streams};
 
 use super::scenarios::{RATE_HZ, opening_circle};
+use crate::io::outln;
 use crate::io::{CliError, CliResult};
 
 /// The demo drive with its sensor streams.
@@ -64,44 +65,44 @@ pub(super) fn heading_error(truth: &[VehicleTruth], estimate: &[f64]) -> Heading
 
 /// The simulated sensors' errors, then what each sensor gets wrong on its own, before any
 /// method calibrates it.
-pub(super) fn sensor_table(d: &DemoDrive) {
-    print_sensor_errors(&d.params);
+pub(super) fn sensor_table(d: &DemoDrive) -> CliResult {
+    print_sensor_errors(&d.params)?;
     let h0 = d.truth.first().map_or(0.0, |t| t.heading_rad);
     let mut rows = gyro_alone(d, h0);
     rows.extend(odometer_alone(d, h0).map(|e| ("odometer, nominal", e)));
     rows.extend(compass_alone(d));
-    print_alone_table(&rows);
+    print_alone_table(&rows)
 }
 
 /// The lines that describe the simulation's gyro, odometer and compass errors.
-fn print_sensor_errors(p: &VehicleSensorParams) {
-    println!("Sensor errors in the simulation (VehicleSensorParams::typical)");
-    println!(
+fn print_sensor_errors(p: &VehicleSensorParams) -> CliResult {
+    outln!("Sensor errors in the simulation (VehicleSensorParams::typical)")?;
+    outln!(
         "  yaw gyro   bias {:.2} deg/s, scale error +{:.1} % right / +{:.1} % left, noise {:.3} deg/s/rtHz, bias walk {:.4} deg/s/rts",
         p.gyro.bias_rps.to_degrees(),
         p.gyro.scale_error_pos * 100.0,
         p.gyro.scale_error_neg * 100.0,
         p.gyro.noise_density_rps_per_sqrt_hz.to_degrees(),
         p.gyro.bias_walk_rps_per_sqrt_s.to_degrees()
-    );
-    println!(
+    )?;
+    outln!(
         "  odometer   rear track {:.2} m, wheel scale errors {:+.1} % left / {:+.1} % right, {} cm pulses",
         p.odometer.wheels.track_m(),
         p.odometer.scale_error_l * 100.0,
         p.odometer.scale_error_r * 100.0,
         p.odometer.dist_per_pulse_m.map_or(0.0, |d| d * 100.0)
-    );
+    )?;
     let hard = p.compass_hard_iron.norm() / p.horizontal_field;
     let eig = p.compass_soft_iron.symmetric_eigen();
     let (major, minor) = (eig.eigenvalues.max(), eig.eigenvalues.min());
-    println!(
+    outln!(
         "  compass    hard iron {:.2} x field, soft iron axis ratio {:.2}, noise {:.1} % of the {:.0} uT horizontal field",
         hard,
         major / minor,
         p.compass_noise / p.horizontal_field * 100.0,
         p.horizontal_field
-    );
-    println!();
+    )?;
+    outln!()
 }
 
 /// The gyro integrated raw and with its true zero and scale, from the true start heading
@@ -186,17 +187,23 @@ fn compass_alone(d: &DemoDrive) -> Vec<(&'static str, HeadingError)> {
 }
 
 /// The table of each sensor alone.
-fn print_alone_table(rows: &[(&str, HeadingError)]) {
-    println!("Each sensor alone on the whole demo drive (heading error vs truth)");
-    println!(
+fn print_alone_table(rows: &[(&str, HeadingError)]) -> CliResult {
+    outln!("Each sensor alone on the whole demo drive (heading error vs truth)")?;
+    outln!(
         "{:<28} {:>9} {:>9} {:>10}",
-        "source", "RMS deg", "max deg", "final deg"
-    );
+        "source",
+        "RMS deg",
+        "max deg",
+        "final deg"
+    )?;
     for (name, e) in rows {
-        println!(
+        outln!(
             "{:<28} {:>9.2} {:>9.2} {:>10.2}",
-            name, e.rms_deg, e.max_deg, e.final_deg
-        );
+            name,
+            e.rms_deg,
+            e.max_deg,
+            e.final_deg
+        )?;
     }
-    println!();
+    outln!()
 }

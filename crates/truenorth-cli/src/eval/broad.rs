@@ -7,7 +7,7 @@
 //! movement phase whose reference is valid; per group the mean of the trial RMSEs
 //! ([`BroadRmse::mean`]).
 
-use std::io::{BufRead, BufReader, IsTerminal, Write as _};
+use std::io::{BufRead, BufReader, IsTerminal};
 use std::path::{Path, PathBuf};
 
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
@@ -16,6 +16,7 @@ use truenorth::core::ImuSample;
 use truenorth::fusion::orientation::{BroadRmse, broad_rmse};
 
 use crate::io::{CliError, CliResult};
+use crate::io::{errln, outln, write_stderr};
 use crate::registry::{OrientationMethod, Timing};
 use truenorth::core::ned_to_enu;
 
@@ -104,9 +105,9 @@ pub fn run(args: &Args) -> CliResult {
     if args.json {
         let text = serde_json::to_string_pretty(&report)
             .map_err(|e| CliError::msg(format!("cannot write JSON: {e}")))?;
-        println!("{text}");
+        outln!("{text}")?;
     } else {
-        print_tables(&report, args.no_mag);
+        print_tables(&report, args.no_mag)?;
     }
     Ok(())
 }
@@ -183,33 +184,40 @@ fn group_means(results: &[TrialResult]) -> Vec<GroupResult> {
 }
 
 /// The per-trial table and the group means.
-fn print_tables(report: &Report, no_mag: bool) {
-    println!(
+fn print_tables(report: &Report, no_mag: bool) -> CliResult {
+    outln!(
         "BROAD, {} trials, method {}{} (RMSE in degrees, BROAD's metric)",
         report.trials.len(),
         report.method,
         if no_mag { ", 6-D" } else { "" }
-    );
-    println!(
+    )?;
+    outln!(
         "{:<46} {:>8} {:>8} {:>12}",
-        "trial", "total", "heading", "inclination"
-    );
+        "trial",
+        "total",
+        "heading",
+        "inclination"
+    )?;
     for r in &report.trials {
-        println!(
+        outln!(
             "{:<46} {:8.2} {:8.2} {:12.2}",
-            r.trial, r.rmse.total_deg, r.rmse.heading_deg, r.rmse.inclination_deg
-        );
+            r.trial,
+            r.rmse.total_deg,
+            r.rmse.heading_deg,
+            r.rmse.inclination_deg
+        )?;
     }
-    println!();
+    outln!()?;
     for g in &report.groups {
-        println!(
+        outln!(
             "{:<46} {:8.2} {:8.2} {:12.2}",
             format!("mean, {} ({} trials)", g.group, g.trials),
             g.mean.total_deg,
             g.mean.heading_deg,
             g.mean.inclination_deg
-        );
+        )?;
     }
+    Ok(())
 }
 
 /// Reads one gzip-compressed trial CSV (columns found by name in the header).
@@ -299,19 +307,17 @@ impl Progress {
             self.done + 1,
             self.total
         );
-        let mut err = std::io::stderr();
         if self.terminal {
-            let _ = write!(err, "\r\x1b[2K{bar}");
+            write_stderr(format_args!("\r\x1b[2K{bar}"));
         } else {
-            let _ = writeln!(err, "{bar}");
+            errln!("{bar}");
         }
-        let _ = err.flush();
         self.done += 1;
     }
 
     fn finish(&self) {
         if self.terminal {
-            let _ = writeln!(std::io::stderr(), "\r\x1b[2K[{}] done", "#".repeat(30));
+            errln!("\r\x1b[2K[{}] done", "#".repeat(30));
         }
     }
 }

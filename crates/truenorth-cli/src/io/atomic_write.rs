@@ -1,35 +1,66 @@
 //! Outputs that appear whole or not at all: written to a temporary file in the target's
 //! folder, flushed to disk, then renamed over the target (a rename within one file system
 //! replaces the name in one step, POSIX `rename(2)`), so a run that fails or is killed
-//! leaves an existing output as it was. `-` writes to standard output instead.
+//! leaves an existing output as it was. A symbolic link is followed: the file it points to
+//! is replaced and the link stays. `-` (standard output), a device and a FIFO are written
+//! into directly: they are not files to replace. Temporaries are `.NAME.tmp-PID`; how the
+//! ones of a stopped run are removed is in [`temporaries`].
 
 use std::fs::File;
-use std::io::{BufWriter, Write};
+use std::io::{BufWriter, ErrorKind, Write};
 use std::path::{Path, PathBuf};
 
-use super::source::{InputPath, STDIO};
+use super::console::end_on_closed_pipe;
+use super::output_target::OutputTarget;
+use super::source::InputPath;
+use super::temporaries;
 use super::{CliError, CliResult};
 
-/// Where the bytes go while an [`AtomicOutput`] is open.
-enum Sink {
-    Stdout(BufWriter<std::io::Stdout>),
-    Temp {
-        file: BufWriter<File>,
-        temp: PathBuf,
-        target: PathBuf,
-    },
-    Gzip {
-        encoder: flate2::write::GzEncoder<BufWriter<File>>,
-        temp: PathBuf,
-        target: PathBuf,
-    },
+/// The bytes' destination: standard output or an open file (a temporary, or a device or
+/// FIFO written directly). Its reader closing the pipe ends the run quietly (see
+/// [`console`](super::console)).
+enum Dest {
+    Stdout(std::io::Stdout),
+    File(File),
+}
+
+impl Write for Dest {
+    fn write(&mut self, bytes: &[u8]) -> std::io::Result<usize> {
+        let written = match self {
+            Self::Stdout(s) => s.write(bytes),
+            Self::File(f) => f.write(bytes),
+        };
+        match written {
+            Err(e) if e.kind() == ErrorKind::BrokenPipe => end_on_closed_pipe(),
+            other => other,
+        }
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        let flushed = match self {
+            Self::Stdout(s) => s.flush(),
+            Self::File(f) => f.flush(),
+        };
+        match flushed {
+            Err(e) if e.kind() == ErrorKind::BrokenPipe => end_on_closed_pipe(),
+            other => other,
+        }
+    }
+}
+
+/// The (possibly compressing) writer over a [`Dest`].
+enum Body {
+    Plain(BufWriter<Dest>),
+    Gzip(flate2::write::GzEncoder<BufWriter<Dest>>),
 }
 
 /// A streaming output: write to it, then [`AtomicOutput::commit`]. Dropped without a
 /// commit (an error on the way, a panic), it removes its temporary file and the target is
 /// untouched. A target named `*.gz` is gzip-compressed.
 pub struct AtomicOutput {
-    sink: Option<Sink>,
+    body: Option<Body>,
+    /// The temporary and the file it replaces, for a target that is replaced.
+    replace: Option<(PathBuf, PathBuf)>,
     name: PathBuf,
 }
 
@@ -42,43 +73,60 @@ impl std::fmt::Debug for AtomicOutput {
 }
 
 impl AtomicOutput {
-    /// Starts writing `path` (`-`: standard output).
+    /// Starts writing `path` (`-`: standard output; a device or FIFO: into it; a link: the
+    /// file it points to). Leftover temporaries of `path` from runs that were killed are
+    /// removed first.
     pub fn create(path: &Path) -> CliResult<Self> {
-        if path.as_os_str() == STDIO {
-            return Ok(Self {
-                sink: Some(Sink::Stdout(BufWriter::new(std::io::stdout()))),
-                name: PathBuf::from("<stdout>"),
-            });
-        }
-        let name = path
-            .file_name()
-            .ok_or_else(|| CliError::file(path, "not a file name"))?;
-        let mut tmp_name = std::ffi::OsString::from(".");
-        tmp_name.push(name);
-        tmp_name.push(format!(".tmp-{}", std::process::id()));
-        let temp = path.with_file_name(tmp_name);
-        let file =
-            File::create(&temp).map_err(|e| CliError::file(path, format!("cannot create: {e}")))?;
-        let file = BufWriter::with_capacity(1 << 16, file);
+        let cannot_create = |e: std::io::Error| CliError::file(path, format!("cannot create: {e}"));
+        let (dest, replace, name) = match OutputTarget::of(path)? {
+            OutputTarget::Stdout => (
+                Dest::Stdout(std::io::stdout()),
+                None,
+                PathBuf::from("<stdout>"),
+            ),
+            OutputTarget::Direct(target) => {
+                // No create, no truncate: the device or FIFO is there and has no length.
+                let file = std::fs::OpenOptions::new()
+                    .write(true)
+                    .open(&target)
+                    .map_err(cannot_create)?;
+                (Dest::File(file), None, path.to_path_buf())
+            }
+            OutputTarget::Replace(target) => {
+                let temp = temporaries::name_for(&target)
+                    .ok_or_else(|| CliError::file(path, "not a file name"))?;
+                temporaries::remove_stale(&target);
+                temporaries::register(&temp);
+                let file = match File::create(&temp) {
+                    Ok(f) => f,
+                    Err(e) => {
+                        temporaries::discard(&temp);
+                        return Err(cannot_create(e));
+                    }
+                };
+                // The replacement keeps the permissions of the file it replaces.
+                if let Ok(m) = std::fs::metadata(&target) {
+                    let _ = file.set_permissions(m.permissions());
+                }
+                (Dest::File(file), Some((temp, target)), path.to_path_buf())
+            }
+        };
+        let writer = BufWriter::with_capacity(1 << 16, dest);
         let gz = path
             .extension()
             .is_some_and(|e| e.eq_ignore_ascii_case("gz"));
-        let sink = if gz {
-            Sink::Gzip {
-                encoder: flate2::write::GzEncoder::new(file, flate2::Compression::default()),
-                temp,
-                target: path.to_path_buf(),
-            }
+        let body = if gz {
+            Body::Gzip(flate2::write::GzEncoder::new(
+                writer,
+                flate2::Compression::default(),
+            ))
         } else {
-            Sink::Temp {
-                file,
-                temp,
-                target: path.to_path_buf(),
-            }
+            Body::Plain(writer)
         };
         Ok(Self {
-            sink: Some(sink),
-            name: path.to_path_buf(),
+            body: Some(body),
+            replace,
+            name,
         })
     }
 
@@ -88,10 +136,9 @@ impl AtomicOutput {
     }
 
     fn writer(&mut self) -> &mut dyn Write {
-        match self.sink.as_mut() {
-            Some(Sink::Stdout(w)) => w,
-            Some(Sink::Temp { file, .. }) => file,
-            Some(Sink::Gzip { encoder, .. }) => encoder,
+        match self.body.as_mut() {
+            Some(Body::Plain(w)) => w,
+            Some(Body::Gzip(encoder)) => encoder,
             None => unreachable!("a committed output is consumed"),
         }
     }
@@ -104,39 +151,33 @@ impl AtomicOutput {
             .map_err(|e| CliError::file(&name, format!("cannot write: {e}")))
     }
 
-    /// Finishes the output: flushed, synced to disk and renamed over the target (whose
-    /// folder is then synced too, so the new name survives a power cut).
+    /// Finishes the output. A replaced file is flushed, synced to disk and renamed over
+    /// the target (whose folder is then synced too, so the new name survives a power cut);
+    /// standard output, a device or a FIFO is flushed.
     pub fn commit(mut self) -> CliResult {
         let name = self.name.clone();
         let err = |e: std::io::Error| CliError::file(&name, format!("cannot write: {e}"));
-        let (file, temp, target) = match self.sink.take() {
-            Some(Sink::Stdout(mut w)) => return w.flush().map_err(err),
-            Some(Sink::Temp { file, temp, target }) => (file, temp, target),
-            Some(Sink::Gzip {
-                encoder,
-                temp,
-                target,
-            }) => {
-                let file = encoder.finish().map_err(|e| {
-                    let _ = std::fs::remove_file(&temp);
-                    err(e)
-                })?;
-                (file, temp, target)
-            }
+        let writer = match self.body.take() {
+            Some(Body::Plain(w)) => w,
+            Some(Body::Gzip(encoder)) => encoder.finish().map_err(err)?,
             None => return Ok(()),
         };
-        let synced = file
-            .into_inner()
-            .map_err(|e| e.into_error())
-            .and_then(|f| f.sync_all());
+        let dest = writer.into_inner().map_err(|e| err(e.into_error()))?;
+        let Some((temp, target)) = self.replace.take() else {
+            let mut dest = dest;
+            return dest.flush().map_err(err);
+        };
+        // From here on the temporary is this function's to remove on failure.
+        let synced = match dest {
+            Dest::File(f) => f.sync_all(),
+            Dest::Stdout(_) => Ok(()),
+        };
         if let Err(e) = synced {
-            let _ = std::fs::remove_file(&temp);
+            temporaries::discard(&temp);
             return Err(err(e));
         }
-        if let Err(e) = std::fs::rename(&temp, &target) {
-            let _ = std::fs::remove_file(&temp);
-            return Err(CliError::file(&name, format!("cannot replace: {e}")));
-        }
+        temporaries::publish(&temp, &target)
+            .map_err(|e| CliError::file(&name, format!("cannot replace: {e}")))?;
         // Best effort: not every platform can open a folder to sync it.
         if let Some(dir) = target.parent() {
             let dir = if dir.as_os_str().is_empty() {
@@ -154,8 +195,10 @@ impl AtomicOutput {
 
 impl Drop for AtomicOutput {
     fn drop(&mut self) {
-        if let Some(Sink::Temp { temp, .. } | Sink::Gzip { temp, .. }) = self.sink.take() {
-            let _ = std::fs::remove_file(temp);
+        // Close the file before removing its name.
+        drop(self.body.take());
+        if let Some((temp, _)) = self.replace.take() {
+            temporaries::discard(&temp);
         }
     }
 }
@@ -235,9 +278,13 @@ pub fn write_csv(
 
 /// Refuses an output path that names one of the inputs (it would destroy the recording),
 /// before anything is read: the same path, the same file through a link, or the same file
-/// under another name (same device and inode). Standard input and output never clash.
+/// under another name (same device and inode). Standard input and output never clash, nor
+/// does an output that is not a file (a device or FIFO is written into, never replaced).
 pub fn check_distinct(output: &Path, inputs: &[&Path]) -> CliResult {
-    if output.as_os_str() == STDIO {
+    if matches!(
+        OutputTarget::of(output),
+        Ok(OutputTarget::Stdout | OutputTarget::Direct(_))
+    ) {
         return Ok(());
     }
     for input in inputs {
@@ -321,6 +368,32 @@ mod tests {
         write_csv(&target, &["a", "b"], [vec![1.5, -2.0]]).unwrap();
         assert_eq!(std::fs::read_to_string(&target).unwrap(), "a,b\n1.5,-2\n");
         assert!(leftovers(&d).is_empty());
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_link_is_followed_a_device_written_into_and_permissions_kept() {
+        use std::os::unix::fs::PermissionsExt as _;
+        let d = dir("kinds");
+        let real = d.join("real.csv");
+        std::fs::write(&real, "old\n").unwrap();
+        std::fs::set_permissions(&real, std::fs::Permissions::from_mode(0o640)).unwrap();
+        let link = d.join("link.csv");
+        std::os::unix::fs::symlink("real.csv", &link).unwrap();
+        write_csv(&link, &["a"], [vec![2.0]]).unwrap();
+        assert!(std::fs::symlink_metadata(&link).unwrap().is_symlink());
+        assert_eq!(std::fs::read_to_string(&real).unwrap(), "a\n2\n");
+        let mode = std::fs::metadata(&real).unwrap().permissions().mode();
+        assert_eq!(mode & 0o777, 0o640, "{mode:o}");
+        assert!(leftovers(&d).is_empty());
+        write_csv(Path::new("/dev/null"), &["a"], [vec![1.0]]).unwrap();
+        use std::os::unix::fs::FileTypeExt as _;
+        let null = std::fs::metadata("/dev/null").unwrap();
+        assert!(null.file_type().is_char_device());
+        assert!(
+            check_distinct(Path::new("/dev/null"), &[Path::new("/dev/null")]).is_ok(),
+            "writing into a device destroys no input"
+        );
     }
 
     #[test]

@@ -19,20 +19,27 @@
 //! the commands that refuse and by `inspect`, which reports.
 //!
 //! Writing: [`AtomicOutput`](atomic_write::AtomicOutput) / [`CsvOutput`] / [`write_csv`] / [`write_atomically`] write a
-//! temporary file beside the target, sync it and rename it over the target (`-`: standard
-//! output; `*.gz`: compressed); [`check_distinct`] refuses an output that is one of the
-//! inputs before anything is read.
+//! temporary file beside the target, sync it and rename it over the target (through a
+//! symbolic link, the file it points to; `-`, a device or a FIFO: written into directly;
+//! `*.gz`: compressed); the temporaries of a run stopped by a signal are removed, those a
+//! killed run left by the next run writing the same output; [`check_distinct`] refuses an
+//! output that is one of the inputs before anything is read. Console text goes through
+//! `outln!` / `errln!`: a closed pipe ends the run quietly (status 141), a full disk is an
+//! error.
 
 mod atomic_write;
 mod calibration_file;
 mod columns;
+mod console;
 mod direction_spans;
 mod error;
 mod gyro_axes;
 mod inertial_units;
+mod output_target;
 mod reader;
 mod source;
 mod table;
+mod temporaries;
 mod unit_check;
 mod vehicle_file;
 mod wheel_columns;
@@ -44,6 +51,8 @@ pub use calibration_file::{
     GyroPart, QualityReport, finite, gyro_units, matrix_rows, units_block,
 };
 pub use columns::InputOptions;
+pub(crate) use console::{errln, out, outln};
+pub use console::{write_stderr, write_stdout};
 pub use direction_spans::{Inertial, Reference, median, median_magnitude};
 pub use error::{CliError, CliResult};
 pub use gyro_axes::{

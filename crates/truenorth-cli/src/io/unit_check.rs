@@ -5,6 +5,7 @@
 //! factor, which no sensor error comes near.
 
 use super::direction_spans::{Inertial, Reference, direction_spans, median, mismatch_rad};
+use super::errln;
 use super::gyro_axes::{axes_are_wrong, fit_gyro_axes, fix_columns, shell_word};
 use super::{AccUnit, CliError, CliResult, GyroUnit, InputOptions};
 use nalgebra::Matrix3;
@@ -97,7 +98,7 @@ pub fn refuse_or_warn(
             FindingKind::Axes => (accept_axes, "--accept-axes"),
         };
         if accepted {
-            eprintln!("warning: {}: {}", input.display(), finding.message);
+            errln!("warning: {}: {}", input.display(), finding.message);
         } else {
             return Err(CliError::file(
                 input,
