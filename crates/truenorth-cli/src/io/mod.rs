@@ -31,6 +31,7 @@ mod error;
 mod gyro_axes;
 mod inertial_units;
 mod reader;
+mod records;
 mod source;
 mod table;
 mod unit_check;
