@@ -7,6 +7,7 @@ use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
+use super::number_format::Precision;
 use super::source::{InputPath, STDIO};
 use super::{CliError, CliResult};
 
@@ -197,18 +198,15 @@ impl CsvOutput {
         })
     }
 
-    /// Appends one row; a NaN is written as an empty cell (no value, as an empty cell
-    /// reads on input).
-    pub fn row(&mut self, values: &[f64]) -> CliResult {
-        use std::fmt::Write as _;
+    /// Appends one row, the numbers written at `precision` (see [`Precision`]); a NaN is
+    /// written as an empty cell (no value, as an empty cell reads on input).
+    pub fn row(&mut self, values: &[f64], precision: Precision) -> CliResult {
         self.line.clear();
-        for (k, v) in values.iter().enumerate() {
+        for (k, &v) in values.iter().enumerate() {
             if k > 0 {
                 self.line.push(',');
             }
-            if !v.is_nan() {
-                let _ = write!(self.line, "{v}");
-            }
+            precision.write(&mut self.line, v);
         }
         self.line.push('\n');
         self.out.write_all(self.line.as_bytes())
@@ -225,10 +223,11 @@ pub fn write_csv(
     path: &Path,
     header: &[&str],
     rows: impl IntoIterator<Item = Vec<f64>>,
+    precision: Precision,
 ) -> CliResult {
     let mut out = CsvOutput::create(path, header)?;
     for r in rows {
-        out.row(&r)?;
+        out.row(&r, precision)?;
     }
     out.commit()
 }
@@ -306,7 +305,7 @@ mod tests {
         std::fs::write(&target, "old\n").unwrap();
         {
             let mut out = CsvOutput::create(&target, &["a"]).unwrap();
-            out.row(&[1.0]).unwrap();
+            out.row(&[1.0], Precision::default()).unwrap();
             // Dropped without commit, as on an error half way.
         }
         assert_eq!(std::fs::read_to_string(&target).unwrap(), "old\n");
@@ -318,7 +317,13 @@ mod tests {
         assert!(failed.is_err());
         assert_eq!(std::fs::read_to_string(&target).unwrap(), "old\n");
         assert!(leftovers(&d).is_empty());
-        write_csv(&target, &["a", "b"], [vec![1.5, -2.0]]).unwrap();
+        write_csv(
+            &target,
+            &["a", "b"],
+            [vec![1.5, -2.0]],
+            Precision::default(),
+        )
+        .unwrap();
         assert_eq!(std::fs::read_to_string(&target).unwrap(), "a,b\n1.5,-2\n");
         assert!(leftovers(&d).is_empty());
     }
@@ -327,7 +332,7 @@ mod tests {
     fn gz_outputs_are_compressed_and_read_back() {
         let d = dir("gz");
         let target = d.join("out.csv.gz");
-        write_csv(&target, &["t_s"], [vec![0.25]]).unwrap();
+        write_csv(&target, &["t_s"], [vec![0.25]], Precision::default()).unwrap();
         let mut text = String::new();
         use std::io::Read as _;
         InputPath::new(&target)
