@@ -4,6 +4,7 @@
 #
 # Usage: scripts/io_speed.sh [ROWS...]        (default: 100000 1000000 10000000)
 # Env:   TRUENORTH=path/to/truenorth (default: target/release/truenorth, built if absent)
+#        TRUENORTH_BEFORE=another build, to measure its calibrate ellipse and heading beside
 #        IO_SPEED_DIR=scratch dir (default: a temporary directory, removed at the end)
 #
 # For each size it writes a 2-D compass file (t_s,mag_x,mag_y: ten turns of a tilted
@@ -61,12 +62,14 @@ measure() { # measure LABEL ROWS COMMAND...
     local wall mem
     wall=$(awk -F': ' '/Elapsed \(wall clock\)/ { n = split($2, p, ":"); s = 0; for (i = 1; i <= n; i++) s = s * 60 + p[i]; printf "%.2f", s }' "$log")
     mem=$(awk -F': ' '/Maximum resident set size/ { printf "%.1f", $2 / 1024 }' "$log")
-    printf '| %-28s | %9s | %7s | %8s | %s\n' "$label" "$rows" "$wall" "$mem" "$status"
+    local note
+    note=$(head -c 200 "$dir/stdout")
+    printf '| %-34s | %9s | %7s | %8s | %s %s\n' "$label" "$rows" "$wall" "$mem" "$status" "$note"
     if [ "$status" != ok ]; then grep -v '^\s' "$log" | grep -v '^Command' | head -2 | sed 's/^/|   /'; fi
 }
 
-echo "| command                      |      rows |  wall s |  peak MB | status"
-echo "|------------------------------|-----------|---------|----------|-------"
+echo "| command                            |      rows |  wall s |  peak MB | status (python: the read_csv call alone, without the interpreter's start)"
+echo "|------------------------------------|-----------|---------|----------|-------"
 echo '{"track_m": 1.55, "odometer_wheels": "rear"}' > "$dir/vehicle.json"
 for n in "${sizes[@]}"; do
     for kind in 2d 3d imu drive; do gen "$kind" "$n" "$dir/$kind.csv"; done
@@ -78,16 +81,20 @@ for n in "${sizes[@]}"; do
         measure "calibrate $m (3-D)" "$n" "$bin" calibrate --method "$m" --input "$dir/3d.csv" --output "$dir/cal-$m.json" --accept-poor
     done
     measure "heading" "$n" "$bin" heading --calibration "$dir/cal-ellipse.json" --input "$dir/2d.csv" --output "$dir/heading.csv"
+    if [ -n "${TRUENORTH_BEFORE:-}" ]; then
+        measure "before: calibrate ellipse" "$n" "$TRUENORTH_BEFORE" calibrate --method ellipse --input "$dir/2d.csv" --output "$dir/cal-before.json" --accept-poor
+        measure "before: heading" "$n" "$TRUENORTH_BEFORE" heading --calibration "$dir/cal-ellipse.json" --input "$dir/2d.csv" --output "$dir/heading-before.csv"
+    fi
     measure "heading --precision 7" "$n" "$bin" heading --calibration "$dir/cal-ellipse.json" --input "$dir/2d.csv" --output "$dir/heading7.csv" --precision 7
     measure "orientation" "$n" "$bin" orientation --input "$dir/imu.csv" --output "$dir/att.csv" --accept-units --accept-axes
     measure "drive" "$n" "$bin" drive --vehicle "$dir/vehicle.json" --input "$dir/drive.csv" --output "$dir/track.csv"
     if have pandas; then
-        measure "pandas read_csv (${size} MB)" "$n" "$py" -c "import pandas, sys; pandas.read_csv(sys.argv[1])" "$dir/2d.csv"
+        measure "pandas read_csv (${size} MB)" "$n" "$py" -c "import pandas, sys, time; t = time.perf_counter(); pandas.read_csv(sys.argv[1]); print(f'read_csv {time.perf_counter() - t:.2f} s')" "$dir/2d.csv"
     else
         echo "| pandas read_csv: skipped (python3 -c 'import pandas' fails; pip install pandas)"
     fi
     if have polars; then
-        measure "polars read_csv (${size} MB)" "$n" "$py" -c "import polars, sys; polars.read_csv(sys.argv[1])" "$dir/2d.csv"
+        measure "polars read_csv (${size} MB)" "$n" "$py" -c "import polars, sys, time; t = time.perf_counter(); polars.read_csv(sys.argv[1]); print(f'read_csv {time.perf_counter() - t:.2f} s')" "$dir/2d.csv"
     else
         echo "| polars read_csv: skipped (python3 -c 'import polars' fails; pip install polars)"
     fi

@@ -282,8 +282,8 @@ fn endless_lines_directories_and_devices_are_refused() {
         vec!["drive", "--vehicle", p(&vehicle), "--output", &out],
     ];
     for c in commands {
-        // orientation refuses long.csv earlier, for its missing gyro columns.
-        let inputs = if c[0] == "orientation" {
+        // orientation and drive refuse long.csv earlier, for its columns.
+        let inputs = if matches!(c[0], "orientation" | "drive") {
             vec!["/dev/zero"]
         } else {
             vec!["/dev/zero", p(&long)]

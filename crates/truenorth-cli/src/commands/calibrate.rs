@@ -38,6 +38,13 @@ rest: an accelerometer that reports gravity instead is negated with
 orientations that determine the ellipsoid (3-D: a tumble, or a few dozen shots in
 assorted directions and rolled about a target).
 
+The input is read once, row by row, straight into the method: the online methods
+(online-ellipse, online-ellipsoid, binned-ellipse, merit-circle) and `turn` without
+`gyr_z` keep running state whose size does not depend on the file; the batch fits
+(ellipse, ellipsoid, ellipsoid-accel, turn with `gyr_z`) keep the one copy of the
+readings their fit needs (ellipse about 16 bytes per row, ellipsoid 24), nothing else. A line longer than 64 KiB, or
+a file without line breaks, is refused with its row.
+
 `turn` with a `gyr_z` column (yaw rate, rad/s, positive turning right; needs `t_s`)
 calibrates the gyro too (EP 0640207): the record must start with the vehicle at rest for
 at least 1 s (the gyro's zero is its mean there) and then turn one way through at least
