@@ -3,7 +3,7 @@
 //! each subcommand's `--help`. Errors exit non-zero with one line on stderr naming the file, the row and the
 //! problem.
 
-use truenorth_cli::{commands, demo, eval};
+use truenorth_cli::{commands, demo, eval, io};
 
 use std::process::ExitCode;
 

@@ -8,7 +8,7 @@
 //! methods are the same with `Mag3Sample` and `CompassCalibration3d`, and `ellipsoid-accel`
 //! fits both sensors together.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use nalgebra::{SMatrix, SVector, Vector2, Vector3};
 use truenorth::calib::quality::{self, Cause, Grade, Verdict};
@@ -20,8 +20,8 @@ use super::mag_unit::{MagUnit, check_field};
 use crate::io::errln;
 use crate::io::{
     AccelPart, CALIBRATION_FORMAT, CALIBRATION_VERSION, CalibrationFile, CliError, CliResult,
-    GyroPart, InputOptions, InputPath, QualityReport, ReadSpec, Table, check_distinct, finite,
-    gyro_units, matrix_rows, units_block,
+    GyroPart, InputOptions, InputPath, QualityReport, ReadSpec, Row, RowReader, check_distinct,
+    finite, gyro_units, matrix_rows, units_block,
 };
 use crate::registry::{
     CalibrationMethod, CompassCalibrator, MagAccel, Planar, Spatial, TurnWithGyro,
@@ -38,6 +38,13 @@ rest: an accelerometer that reports gravity instead is negated with
 `--column acc_x=-acc_x,...`). The readings should cover a full turn (2-D, level) or
 orientations that determine the ellipsoid (3-D: a tumble, or a few dozen shots in
 assorted directions and rolled about a target).
+
+The input is read once, row by row, straight into the method: the online methods
+(online-ellipse, online-ellipsoid, binned-ellipse, merit-circle) and `turn` without
+`gyr_z` keep running state whose size does not depend on the file; the batch fits
+(ellipse, ellipsoid, ellipsoid-accel, turn with `gyr_z`) keep the one copy of the
+readings their fit needs (ellipse about 16 bytes per row, ellipsoid 24), nothing else. A line longer than 64 KiB, or
+a file without line breaks, is refused with its row.
 
 `turn` with a `gyr_z` column (yaw rate, rad/s, positive turning right; needs `t_s`)
 calibrates the gyro too (EP 0640207): the record must start with the vehicle at rest for
@@ -251,67 +258,64 @@ fn library(e: truenorth::core::Error) -> CliError {
     CliError::msg(e.to_string())
 }
 
-/// Reads the `columns` of the input, and `t_s` (strictly increasing) where present. Without
-/// `t_s`, the rows are taken as one second apart.
-fn read_input(args: &Args, columns: &[&str]) -> CliResult<(Table, Vec<f64>)> {
-    read_input_with(args, columns, &["t_s"])
-}
-
-/// [`read_input`] with more `optional` columns (which must include `t_s`).
-fn read_input_with(
-    args: &Args,
-    columns: &[&str],
-    optional: &[&str],
-) -> CliResult<(Table, Vec<f64>)> {
+/// Opens the input for the `columns`, with `optional` ones (`t_s`, strictly increasing,
+/// among them) read where present.
+fn open_input(args: &Args, columns: &[&str], optional: &[&str]) -> CliResult<RowReader> {
     let spec = ReadSpec::new(columns).optional(optional).increasing("t_s");
-    let table = Table::read_with(&InputPath::new(&args.input), &args.input_options, &spec)?;
-    table.require_rows()?;
-    let t = match table.col("t_s") {
-        Some(t) => t.to_vec(),
-        None => (0..table.len()).map(|k| k as f64).collect(),
-    };
-    Ok((table, t))
+    RowReader::open(&InputPath::new(&args.input), &args.input_options, &spec)
 }
 
-/// Three columns of a table as vectors.
-fn vectors(table: &Table, names: [&str; 3]) -> CliResult<Vec<Vector3<f64>>> {
-    let (x, y, z) = (
-        table.req(names[0])?,
-        table.req(names[1])?,
-        table.req(names[2])?,
-    );
-    Ok((0..table.len())
-        .map(|k| Vector3::new(x[k], y[k], z[k]))
-        .collect())
+/// The position of a column the reader was asked for (required, so present).
+fn at(rows: &RowReader, name: &str) -> usize {
+    rows.index(name).unwrap_or(0)
+}
+
+/// Reads the input once, row by row, pushing the sample `sample` makes of each row and its
+/// time into `cal` (a rejected sample names its row). Without `t_s` the rows are taken as
+/// one second apart. Nothing is kept here: a batch method keeps its own one copy of the
+/// readings it fits, an online one its running state.
+fn push_rows<C>(
+    rows: &mut RowReader,
+    cal: &mut C,
+    mut sample: impl FnMut(&Row, f64) -> C::Sample,
+) -> CliResult
+where
+    C: Calibrator + ?Sized,
+{
+    let t_col = rows.index("t_s");
+    let path = rows.path().to_path_buf();
+    let mut count = 0usize;
+    while let Some(row) = rows.next_row()? {
+        let t_s = t_col.map_or(count as f64, |i| row[i]);
+        cal.push(&sample(row, t_s))
+            .map_err(|e| CliError::row(&path, row.number, e.to_string()))?;
+        count += 1;
+    }
+    if count == 0 {
+        return Err(CliError::row(&path, 2, "no data rows after the header"));
+    }
+    Ok(())
 }
 
 /// Feeds every row to a 2-D calibrator, solves, and builds the output file.
 fn calibrate_2d(args: &Args, cal: Box<Planar>, expected: Option<f64>) -> CliResult<Fitted> {
-    let (table, t) = read_input(args, &["mag_x", "mag_y"])?;
-    solve_2d(args, &table, &t, cal, expected)
+    let mut rows = open_input(args, &["mag_x", "mag_y"], &["t_s"])?;
+    solve_2d(args, &mut rows, cal, expected)
 }
 
-/// The magnetometer readings of a 2-D table.
-fn mag2(table: &Table) -> CliResult<Vec<Vector2<f64>>> {
-    let (x, y) = (table.req("mag_x")?, table.req("mag_y")?);
-    Ok((0..table.len()).map(|k| Vector2::new(x[k], y[k])).collect())
-}
-
-/// [`calibrate_2d`] on a table already read, with its times `t`.
+/// [`calibrate_2d`] on an input already opened.
 fn solve_2d(
     args: &Args,
-    table: &Table,
-    t: &[f64],
+    rows: &mut RowReader,
     mut cal: Box<Planar>,
     expected: Option<f64>,
 ) -> CliResult<Fitted> {
-    let points = mag2(table)?;
-    let samples: Vec<Mag2Sample> = points
-        .iter()
-        .zip(t)
-        .map(|(&mag, &t_s)| Mag2Sample { t_s, mag })
-        .collect();
-    let sol = feed_and_solve(args, table, &mut *cal, &samples, expected)?;
+    let (x, y) = (at(rows, "mag_x"), at(rows, "mag_y"));
+    push_rows(rows, &mut *cal, |r, t_s| Mag2Sample {
+        t_s,
+        mag: Vector2::new(r[x], r[y]),
+    })?;
+    let sol = solve(args, rows.path(), &mut *cal, expected)?;
     Ok(fitted(
         args,
         &sol.params.hard_iron,
@@ -330,25 +334,23 @@ fn calibrate_turn(
     mut with_gyro: Box<TurnWithGyro>,
     expected: Option<f64>,
 ) -> CliResult<Fitted> {
-    let (table, t) = read_input_with(args, &["mag_x", "mag_y"], &["t_s", "gyr_z"])?;
-    let Some(gyr) = table.col("gyr_z") else {
-        return solve_2d(args, &table, &t, compass, expected);
+    let mut rows = open_input(args, &["mag_x", "mag_y"], &["t_s", "gyr_z"])?;
+    let Some(g) = rows.index("gyr_z") else {
+        return solve_2d(args, &mut rows, compass, expected);
     };
-    if table.col("t_s").is_none() {
+    if rows.index("t_s").is_none() {
         return Err(CliError::file(
-            &table.path,
+            rows.path(),
             "`gyr_z` needs a `t_s` column: the gyro's rate is integrated over time (or drop `gyr_z` to calibrate the compass alone)",
         ));
     }
-    let points = mag2(&table)?;
-    let samples: Vec<TurnSample> = (0..table.len())
-        .map(|k| TurnSample {
-            t_s: t[k],
-            gyr_z_rps: gyr[k],
-            mag: points[k],
-        })
-        .collect();
-    let sol = feed_and_solve(args, &table, &mut *with_gyro, &samples, expected)?;
+    let (x, y) = (at(&rows, "mag_x"), at(&rows, "mag_y"));
+    push_rows(&mut rows, &mut *with_gyro, |r, t_s| TurnSample {
+        t_s,
+        gyr_z_rps: r[g],
+        mag: Vector2::new(r[x], r[y]),
+    })?;
+    let sol = solve(args, rows.path(), &mut *with_gyro, expected)?;
     let (c, q) = (sol.params, sol.quality);
     let mut f = fitted(args, &c.compass.hard_iron, &c.compass.soft_iron, q.compass);
     f.file.units.extend(gyro_units());
@@ -365,16 +367,20 @@ fn calibrate_turn(
     Ok(f)
 }
 
+/// Three columns of a row as a vector.
+fn vector(r: &Row, [x, y, z]: [usize; 3]) -> Vector3<f64> {
+    Vector3::new(r[x], r[y], r[z])
+}
+
 /// Feeds every row to a 3-D calibrator, solves, and builds the output file.
 fn calibrate_3d(args: &Args, mut cal: Box<Spatial>, expected: Option<f64>) -> CliResult<Fitted> {
-    let (table, t) = read_input(args, &["mag_x", "mag_y", "mag_z"])?;
-    let mags = vectors(&table, ["mag_x", "mag_y", "mag_z"])?;
-    let samples: Vec<Mag3Sample> = mags
-        .iter()
-        .zip(&t)
-        .map(|(m, &t_s)| Mag3Sample { t_s, mag: *m })
-        .collect();
-    let sol = feed_and_solve(args, &table, &mut *cal, &samples, expected)?;
+    let mut rows = open_input(args, &MAG3, &["t_s"])?;
+    let m = MAG3.map(|n| at(&rows, n));
+    push_rows(&mut rows, &mut *cal, |r, t_s| Mag3Sample {
+        t_s,
+        mag: vector(r, m),
+    })?;
+    let sol = solve(args, rows.path(), &mut *cal, expected)?;
     Ok(fitted(
         args,
         &sol.params.hard_iron,
@@ -383,23 +389,20 @@ fn calibrate_3d(args: &Args, mut cal: Box<Spatial>, expected: Option<f64>) -> Cl
     ))
 }
 
+const MAG3: [&str; 3] = ["mag_x", "mag_y", "mag_z"];
+const ACC3: [&str; 3] = ["acc_x", "acc_y", "acc_z"];
+
 /// The joint magnetometer + accelerometer calibration (the expected field is in its
 /// configuration).
 fn calibrate_joint(args: &Args, mut cal: Box<MagAccel>) -> CliResult<Fitted> {
-    let (table, t) = read_input(
-        args,
-        &["mag_x", "mag_y", "mag_z", "acc_x", "acc_y", "acc_z"],
-    )?;
-    let mags = vectors(&table, ["mag_x", "mag_y", "mag_z"])?;
-    let accs = vectors(&table, ["acc_x", "acc_y", "acc_z"])?;
-    let samples: Vec<MagAccelSample> = (0..table.len())
-        .map(|k| MagAccelSample {
-            t_s: t[k],
-            mag: mags[k],
-            acc: accs[k],
-        })
-        .collect();
-    let sol = feed_and_solve(args, &table, &mut *cal, &samples, None)?;
+    let mut rows = open_input(args, &[MAG3, ACC3].concat(), &["t_s"])?;
+    let (m, a) = (MAG3.map(|n| at(&rows, n)), ACC3.map(|n| at(&rows, n)));
+    push_rows(&mut rows, &mut *cal, |r, t_s| MagAccelSample {
+        t_s,
+        mag: vector(r, m),
+        acc: vector(r, a),
+    })?;
+    let sol = solve(args, rows.path(), &mut *cal, None)?;
     let (c, q) = (sol.params, sol.quality);
     let mut f = fitted(args, &c.mag.hard_iron, &c.mag.soft_iron, q.mag);
     f.file.units = units_block(true);
@@ -462,26 +465,20 @@ impl HasCompassQuality for MagAccelQuality {
     }
 }
 
-/// Pushes the samples (a rejected one names its row) and solves; a refusal names the file
-/// and the reason.
-fn feed_and_solve<C>(
+/// Solves a calibrator fed with every row; a refusal names the file and the reason.
+fn solve<C>(
     args: &Args,
-    table: &Table,
+    path: &Path,
     cal: &mut C,
-    samples: &[C::Sample],
     expected: Option<f64>,
 ) -> CliResult<Solution<C::Params, C::Quality>>
 where
     C: Calibrator + ?Sized,
     C::Quality: HasCompassQuality,
 {
-    for (k, s) in samples.iter().enumerate() {
-        cal.push(s)
-            .map_err(|e| CliError::row(&table.path, table.row_number(k), e.to_string()))?;
-    }
     let mut sol = cal.solve().map_err(|e| {
         CliError::file(
-            &table.path,
+            path,
             format!(
                 "cannot calibrate with method `{}`: {}",
                 args.method.name(),

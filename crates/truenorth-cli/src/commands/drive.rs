@@ -13,8 +13,9 @@ use truenorth::odometer::OdometerWheels;
 use super::field::Place;
 use crate::io::errln;
 use crate::io::{
-    CliError, CliResult, GyroUnit, InputOptions, InputPath, ReadSpec, Row, RowReader, VehicleFile,
-    WheelColumns, YawRateCheck, check_distinct, refuse_or_warn, write_atomically,
+    CliError, CliResult, GyroUnit, InputOptions, InputPath, OutputOptions, ReadSpec, Row,
+    RowReader, VehicleFile, WheelColumns, YawRateCheck, check_distinct, refuse_or_warn,
+    write_atomically,
 };
 use crate::registry::{VehicleMethod, VehicleRun};
 
@@ -132,6 +133,9 @@ pub struct Args {
     /// How to read the input.
     #[command(flatten)]
     pub input_options: InputOptions,
+    /// How to write the numbers.
+    #[command(flatten)]
+    pub output_options: OutputOptions,
 }
 
 /// The optional columns of a drive log.
@@ -171,7 +175,12 @@ pub fn run(args: &Args) -> CliResult {
         mag: mag_columns(&rows)?,
         check: YawRateCheck::new(vehicle.track_m),
     };
-    let mut writer = Writer::create(&args.output, &args.extra, declination)?;
+    let mut writer = Writer::create(
+        &args.output,
+        &args.extra,
+        declination,
+        args.output_options.precision,
+    )?;
     let samples = estimate(&mut rows, &mut columns, method.as_mut(), &mut writer)
         .map_err(|e| check_gyro(args, &columns.check).err().unwrap_or(e))?;
     check_gyro(args, &columns.check)?;

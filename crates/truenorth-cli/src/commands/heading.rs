@@ -11,7 +11,7 @@ use super::field::Place;
 use crate::io::errln;
 use crate::io::{
     CalibrationFile, CliError, CliResult, CompassCalibration, CsvOutput, InputOptions, InputPath,
-    ReadSpec, Row, RowReader, check_distinct,
+    OutputOptions, Precision, ReadSpec, Row, RowReader, check_distinct,
 };
 
 /// The long help of the command (after the options).
@@ -56,6 +56,9 @@ pub struct Args {
     /// How to read the input.
     #[command(flatten)]
     pub input_options: InputOptions,
+    /// How to write the numbers.
+    #[command(flatten)]
+    pub output_options: OutputOptions,
 }
 
 /// The declination that turns magnetic into true heading, if a place was given.
@@ -95,7 +98,13 @@ pub fn run(args: &Args) -> CliResult {
             Some(d) => magnetic.to_true(d).rad(),
             None => magnetic.rad(),
         };
-        write_row(&mut out, row[cols.t], rad, tilt)?;
+        write_row(
+            &mut out,
+            args.output_options.precision,
+            row[cols.t],
+            rad,
+            tilt,
+        )?;
         count += 1;
     }
     if count == 0 {
@@ -206,15 +215,24 @@ impl Columns {
 }
 
 /// One output row: time, heading (`rad`, written in degrees) and the tilt if any.
-fn write_row(out: &mut CsvOutput, t_s: f64, rad: f64, tilt: Option<Tilt>) -> CliResult {
+fn write_row(
+    out: &mut CsvOutput,
+    precision: Precision,
+    t_s: f64,
+    rad: f64,
+    tilt: Option<Tilt>,
+) -> CliResult {
     match tilt {
-        Some(tilt) => out.row(&[
-            t_s,
-            rad_to_deg(rad),
-            rad_to_deg(tilt.pitch_rad),
-            rad_to_deg(tilt.roll_rad),
-        ]),
-        None => out.row(&[t_s, rad_to_deg(rad)]),
+        Some(tilt) => out.row(
+            &[
+                t_s,
+                rad_to_deg(rad),
+                rad_to_deg(tilt.pitch_rad),
+                rad_to_deg(tilt.roll_rad),
+            ],
+            precision,
+        ),
+        None => out.row(&[t_s, rad_to_deg(rad)], precision),
     }
 }
 

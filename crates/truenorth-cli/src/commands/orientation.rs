@@ -7,9 +7,10 @@ use nalgebra::{UnitQuaternion, Vector3};
 use truenorth::core::{AttitudeEstimate, Axes, EulerZyx, ImuSample, ned_to_enu, rad_to_deg};
 
 use crate::io::errln;
+use super::mag_unit::{MagUnit, check_field};
 use crate::io::{
-    AccUnit, CliError, CliResult, GyroUnit, InputOptions, InputPath, ReadSpec, Table,
-    check_distinct, check_inertial, refuse_or_warn, write_csv,
+    AccUnit, CliError, CliResult, GyroUnit, InputOptions, InputPath, OutputOptions, ReadSpec,
+    Table, check_distinct, check_inertial, median, refuse_or_warn, write_csv,
 };
 use crate::plot::{Band, Line, write_timeseries};
 use crate::registry::{Orientation, OrientationMethod, Timing};
@@ -89,6 +90,12 @@ pub struct Args {
     /// Unit of the accelerometer columns, e.g. `--acc-unit g`.
     #[arg(long, value_enum, value_name = "UNIT", default_value = "m/s2")]
     pub acc_unit: AccUnit,
+    /// Unit of the magnetometer columns (nT, uT, mG or G): the median field the
+    /// magnetometer reads must then be a plausible Earth field in it (as `calibrate
+    /// --mag-unit` checks its fit), else the run is refused with the unit the data are
+    /// probably in (or, with --accept-units, warned about).
+    #[arg(long, value_enum, value_name = "UNIT")]
+    pub mag_unit: Option<MagUnit>,
     /// Go on (with a warning on stderr) when the data contradict the declared units, instead
     /// of refusing.
     #[arg(long)]
@@ -100,6 +107,9 @@ pub struct Args {
     /// How to read the file (delimiter, header, column names, axes).
     #[command(flatten)]
     pub input_options: InputOptions,
+    /// How to write the numbers.
+    #[command(flatten)]
+    pub output_options: OutputOptions,
 }
 
 const HEADER: [&str; 8] = [
@@ -151,7 +161,12 @@ pub fn run(args: &Args) -> CliResult {
             header.extend(SIGMA_HEADER);
         }
     }
-    write_csv(&args.output, &header, out.rows)?;
+    write_csv(
+        &args.output,
+        &header,
+        out.rows,
+        args.output_options.precision,
+    )?;
     if !out.gaps.is_empty() {
         errln!("{}", gap_summary(&args.input, &out.gaps));
     }
@@ -163,7 +178,27 @@ pub fn run(args: &Args) -> CliResult {
 /// so on stderr and goes on).
 fn check_units(args: &Args, samples: &[ImuSample]) -> CliResult {
     let findings = check_inertial(samples, args.gyro_unit, args.acc_unit, &args.input_options);
-    refuse_or_warn(&findings, &args.input, args.accept_units, args.accept_axes)
+    refuse_or_warn(&findings, &args.input, args.accept_units, args.accept_axes)?;
+    let mut norms: Vec<f64> = samples
+        .iter()
+        .filter_map(|s| s.mag.as_xyz())
+        .map(|m| m.norm())
+        .filter(|n| n.is_finite())
+        .collect();
+    // The raw magnitude includes any hard iron; the Earth-field range is wide enough that
+    // only a wrong unit (a factor of 100 or more) falls outside it.
+    let problem = median(&mut norms).and_then(|f| check_field(f, args.mag_unit, None, 3));
+    match problem {
+        Some(p) if args.accept_units => {
+            errln!("warning: {}: magnetometer: {p}", args.input.display());
+            Ok(())
+        }
+        Some(p) => Err(CliError::file(
+            &args.input,
+            format!("magnetometer: {p} (or --accept-units to go on)"),
+        )),
+        None => Ok(()),
+    }
 }
 
 /// The recording as IMU samples; a row whose three magnetometer cells are empty has no

@@ -7,7 +7,7 @@
 //! movement phase whose reference is valid; per group the mean of the trial RMSEs
 //! ([`BroadRmse::mean`]).
 
-use std::io::{BufRead, BufReader, IsTerminal};
+use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
@@ -15,8 +15,10 @@ use serde::Serialize;
 use truenorth::core::ImuSample;
 use truenorth::fusion::orientation::{BroadRmse, broad_rmse};
 
-use crate::io::{CliError, CliResult};
 use crate::io::{errln, outln, write_stderr};
+use crate::io::{
+    AccUnit, CliError, CliResult, GyroUnit, InputOptions, InputPath, ReadSpec, RowReader,
+};
 use crate::registry::{OrientationMethod, Timing};
 use truenorth::core::ned_to_enu;
 
@@ -47,6 +49,16 @@ pub struct Args {
     /// Print one JSON document (per-trial and per-group figures) instead of tables.
     #[arg(long)]
     pub json: bool,
+    /// Unit of the gyro columns (BROAD's own: rad/s).
+    #[arg(long, value_enum, value_name = "UNIT", default_value = "rad/s")]
+    pub gyro_unit: GyroUnit,
+    /// Unit of the accelerometer columns (BROAD's own: m/s2).
+    #[arg(long, value_enum, value_name = "UNIT", default_value = "m/s2")]
+    pub acc_unit: AccUnit,
+    /// How to read the trial files (delimiter, header, column names, axes), as for the
+    /// other commands.
+    #[command(flatten)]
+    pub input_options: InputOptions,
 }
 
 /// One trial as read from its file.
@@ -137,7 +149,7 @@ fn trial_paths(dir: &Path) -> CliResult<Vec<PathBuf>> {
 /// Runs the method over one trial (a fresh estimator, as BROAD scores each trial) and
 /// scores it.
 fn evaluate_trial(args: &Args, path: &Path, name: String) -> CliResult<TrialResult> {
-    let trial = read_trial(path)?;
+    let trial = read_trial(path, args)?;
     let mut method = args
         .method
         .pipeline(!args.no_mag, args.gyro_timing)
@@ -220,55 +232,37 @@ fn print_tables(report: &Report, no_mag: bool) -> CliResult {
     Ok(())
 }
 
-/// Reads one gzip-compressed trial CSV (columns found by name in the header).
-fn read_trial(path: &Path) -> CliResult<Trial> {
-    let file =
-        std::fs::File::open(path).map_err(|e| CliError::file(path, format!("cannot open: {e}")))?;
-    let mut lines = BufReader::new(flate2::read::GzDecoder::new(file)).lines();
-    let header: Vec<String> = match lines.next() {
-        Some(Ok(h)) => h.split(',').map(|c| c.trim().to_string()).collect(),
-        _ => return Err(CliError::file(path, "no header row (not a gzip CSV?)")),
-    };
-    const COLUMNS: [&str; 15] = [
-        "t_s", "gyr_x", "gyr_y", "gyr_z", "acc_x", "acc_y", "acc_z", "mag_x", "mag_y", "mag_z",
-        "qw", "qx", "qy", "qz", "movement",
-    ];
+/// The columns of a trial after `t_s`: the IMU's, the reference quaternion and the
+/// movement flag.
+const TRIAL_COLUMNS: [&str; 14] = [
+    "gyr_x", "gyr_y", "gyr_z", "acc_x", "acc_y", "acc_z", "mag_x", "mag_y", "mag_z", "qw", "qx",
+    "qy", "qz", "movement",
+];
+
+/// Reads one trial CSV (gzip or not) through the shared reader under the input options:
+/// every column must be there; a `NaN` cell (an invalid reference) reads as NaN.
+fn read_trial(path: &Path, args: &Args) -> CliResult<Trial> {
+    // Optional only so that NaN cells read as NaN; their presence is checked below.
+    let spec = ReadSpec::new(&["t_s"]).optional(&TRIAL_COLUMNS);
+    let mut rows = RowReader::open(&InputPath::new(path), &args.input_options, &spec)?;
     let mut idx = [0usize; 15];
-    for (i, name) in COLUMNS.iter().enumerate() {
-        idx[i] = header
-            .iter()
-            .position(|h| h == name)
-            .ok_or_else(|| CliError::file(path, format!("missing column `{name}`")))?;
+    for (i, name) in std::iter::once("t_s").chain(TRIAL_COLUMNS).enumerate() {
+        idx[i] = rows
+            .index(name)
+            .ok_or_else(|| CliError::row(path, 1, format!("missing column `{name}`")))?;
     }
+    let (to_rps, to_mps2) = (args.gyro_unit.to_rad_per_s(), args.acc_unit.to_mps2());
     let mut t = Trial {
         samples: Vec::new(),
         reference: Vec::new(),
         movement: Vec::new(),
     };
-    let mut v = [0.0; 15];
-    for (k, line) in lines.enumerate() {
-        let row = k + 2;
-        let line = line.map_err(|e| CliError::row(path, row, format!("cannot read: {e}")))?;
-        if line.trim().is_empty() {
-            continue;
-        }
-        let cells: Vec<&str> = line.split(',').collect();
-        for (i, &c) in idx.iter().enumerate() {
-            let cell = cells
-                .get(c)
-                .ok_or_else(|| CliError::row(path, row, "too few cells"))?
-                .trim();
-            v[i] = if cell.eq_ignore_ascii_case("nan") {
-                f64::NAN
-            } else {
-                cell.parse()
-                    .map_err(|_| CliError::row(path, row, format!("`{cell}` is not a number")))?
-            };
-        }
+    while let Some(row) = rows.next_row()? {
+        let v = idx.map(|i| row[i]);
         t.samples.push(ImuSample::new_9d(
             v[0],
-            Vector3::new(v[1], v[2], v[3]),
-            Vector3::new(v[4], v[5], v[6]),
+            Vector3::new(v[1], v[2], v[3]) * to_rps,
+            Vector3::new(v[4], v[5], v[6]) * to_mps2,
             Vector3::new(v[7], v[8], v[9]),
         ));
         let q = Quaternion::new(v[10], v[11], v[12], v[13]);

@@ -14,6 +14,7 @@ use super::console::end_on_closed_pipe;
 use super::output_target::OutputTarget;
 use super::source::InputPath;
 use super::temporaries;
+use super::number_format::Precision;
 use super::{CliError, CliResult};
 
 /// The bytes' destination: standard output or an open file (a temporary, or a device or
@@ -240,18 +241,15 @@ impl CsvOutput {
         })
     }
 
-    /// Appends one row; a NaN is written as an empty cell (no value, as an empty cell
-    /// reads on input).
-    pub fn row(&mut self, values: &[f64]) -> CliResult {
-        use std::fmt::Write as _;
+    /// Appends one row, the numbers written at `precision` (see [`Precision`]); a NaN is
+    /// written as an empty cell (no value, as an empty cell reads on input).
+    pub fn row(&mut self, values: &[f64], precision: Precision) -> CliResult {
         self.line.clear();
-        for (k, v) in values.iter().enumerate() {
+        for (k, &v) in values.iter().enumerate() {
             if k > 0 {
                 self.line.push(',');
             }
-            if !v.is_nan() {
-                let _ = write!(self.line, "{v}");
-            }
+            precision.write(&mut self.line, v);
         }
         self.line.push('\n');
         self.out.write_all(self.line.as_bytes())
@@ -268,10 +266,11 @@ pub fn write_csv(
     path: &Path,
     header: &[&str],
     rows: impl IntoIterator<Item = Vec<f64>>,
+    precision: Precision,
 ) -> CliResult {
     let mut out = CsvOutput::create(path, header)?;
     for r in rows {
-        out.row(&r)?;
+        out.row(&r, precision)?;
     }
     out.commit()
 }
@@ -353,7 +352,7 @@ mod tests {
         std::fs::write(&target, "old\n").unwrap();
         {
             let mut out = CsvOutput::create(&target, &["a"]).unwrap();
-            out.row(&[1.0]).unwrap();
+            out.row(&[1.0], Precision::default()).unwrap();
             // Dropped without commit, as on an error half way.
         }
         assert_eq!(std::fs::read_to_string(&target).unwrap(), "old\n");
@@ -365,7 +364,13 @@ mod tests {
         assert!(failed.is_err());
         assert_eq!(std::fs::read_to_string(&target).unwrap(), "old\n");
         assert!(leftovers(&d).is_empty());
-        write_csv(&target, &["a", "b"], [vec![1.5, -2.0]]).unwrap();
+        write_csv(
+            &target,
+            &["a", "b"],
+            [vec![1.5, -2.0]],
+            Precision::default(),
+        )
+        .unwrap();
         assert_eq!(std::fs::read_to_string(&target).unwrap(), "a,b\n1.5,-2\n");
         assert!(leftovers(&d).is_empty());
     }
@@ -400,7 +405,7 @@ mod tests {
     fn gz_outputs_are_compressed_and_read_back() {
         let d = dir("gz");
         let target = d.join("out.csv.gz");
-        write_csv(&target, &["t_s"], [vec![0.25]]).unwrap();
+        write_csv(&target, &["t_s"], [vec![0.25]], Precision::default()).unwrap();
         let mut text = String::new();
         use std::io::Read as _;
         InputPath::new(&target)

@@ -35,8 +35,10 @@ mod direction_spans;
 mod error;
 mod gyro_axes;
 mod inertial_units;
+mod number_format;
 mod output_target;
 mod reader;
+mod records;
 mod source;
 mod table;
 mod temporaries;
@@ -59,6 +61,7 @@ pub use gyro_axes::{
     AxisFit, SignedPermutation, axes_are_wrong, fit_gyro_axes, fix_columns, fix_pair, shell_word,
 };
 pub use inertial_units::{AccUnit, GyroUnit};
+pub use number_format::{OutputOptions, Precision};
 pub use reader::{ReadSpec, Row, RowReader};
 pub use source::InputPath;
 pub use table::Table;

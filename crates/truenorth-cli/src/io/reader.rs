@@ -11,11 +11,12 @@
 //! }
 //! ```
 
-use std::io::{BufRead, Read};
 use std::path::{Path, PathBuf};
 
 use super::columns::{ColumnSource, Delimiter, Header, InputOptions};
+use super::records::{RecordError, Records, parse_number, shown};
 use super::source::InputPath;
+use super::errln;
 use super::{CliError, CliResult};
 
 /// The columns a command reads.
@@ -69,112 +70,6 @@ impl std::ops::Index<usize> for Row {
     }
 }
 
-/// The records of a file, one line each: blank lines and lines starting with `#` are
-/// skipped (and counted, so that row numbers are the file's line numbers). A field may be
-/// enclosed in double quotes, which are dropped; a quoted field cannot span lines (sensor
-/// logs never need it).
-struct Records {
-    source: Box<dyn BufRead>,
-    delimiter: Delimiter,
-    line: String,
-    spans: Vec<(usize, usize)>,
-    line_number: usize,
-}
-
-impl Records {
-    fn new(source: Box<dyn BufRead>, delimiter: Delimiter) -> Self {
-        Self {
-            source,
-            delimiter,
-            line: String::new(),
-            spans: Vec::new(),
-            line_number: 0,
-        }
-    }
-
-    /// Advances to the next record; `Ok(false)` at the end.
-    fn advance(&mut self) -> Result<bool, String> {
-        loop {
-            self.line.clear();
-            let n = self
-                .source
-                .read_line(&mut self.line)
-                .map_err(|e| e.to_string())?;
-            if n == 0 {
-                return Ok(false);
-            }
-            self.line_number += 1;
-            let text = self.line.trim_start_matches('\u{feff}').trim();
-            if text.is_empty() || text.starts_with('#') {
-                continue;
-            }
-            self.split();
-            return Ok(true);
-        }
-    }
-
-    /// Finds the fields of the current line.
-    fn split(&mut self) {
-        self.spans.clear();
-        let line = self.line.trim_end_matches(['\n', '\r']);
-        match self.delimiter {
-            Delimiter::Byte(d) => {
-                let bytes = line.as_bytes();
-                let mut start = 0;
-                let mut quoted = false;
-                for (i, &b) in bytes.iter().enumerate() {
-                    if b == b'"' {
-                        quoted = !quoted;
-                    } else if b == d && !quoted {
-                        self.spans.push(field_span(line, start, i));
-                        start = i + 1;
-                    }
-                }
-                self.spans.push(field_span(line, start, bytes.len()));
-            }
-            _ => {
-                let base = line.as_ptr() as usize;
-                for field in line.split_whitespace() {
-                    let a = field.as_ptr() as usize - base;
-                    self.spans.push((a, a + field.len()));
-                }
-            }
-        }
-    }
-
-    /// Field `i` of the current record.
-    fn field(&self, i: usize) -> Option<&str> {
-        self.spans.get(i).map(|&(a, b)| &self.line[a..b])
-    }
-
-    /// Number of fields of the current record.
-    fn len(&self) -> usize {
-        self.spans.len()
-    }
-
-    /// The 1-based line of the current record.
-    fn line(&self) -> usize {
-        self.line_number
-    }
-
-    fn fields(&self) -> impl Iterator<Item = &str> {
-        (0..self.len()).map(|i| self.field(i).unwrap_or(""))
-    }
-}
-
-/// The byte range of the field `line[a..b]` without surrounding blanks and quotes.
-fn field_span(line: &str, a: usize, b: usize) -> (usize, usize) {
-    let s = &line[a..b];
-    let lead = s.len() - s.trim_start().len();
-    let t = s.trim();
-    let (mut a, mut b) = (a + lead, a + lead + t.len());
-    if t.len() >= 2 && t.starts_with('"') && t.ends_with('"') {
-        a += 1;
-        b -= 1;
-    }
-    (a, b)
-}
-
 /// A streaming reader of the requested numeric columns of a CSV (see the module
 /// documentation). It holds one row at a time.
 pub struct RowReader {
@@ -184,8 +79,12 @@ pub struct RowReader {
     row: Row,
     increasing: Option<usize>,
     previous: Option<f64>,
-    /// The header's field count, to name a short row.
+    /// The header's field count: a row with more fields is refused, as is a last line
+    /// without a line break that has fewer.
     width: usize,
+    /// With `--no-header`: the first record, read to count the columns, is still to be
+    /// returned.
+    pending: bool,
 }
 
 impl std::fmt::Debug for RowReader {
@@ -194,32 +93,6 @@ impl std::fmt::Debug for RowReader {
             .field("path", &self.path)
             .field("columns", &self.columns)
             .finish_non_exhaustive()
-    }
-}
-
-/// Reads the leading comment and blank lines and the first line after them (the header,
-/// or the first data row), and returns them with the rest of the input.
-fn first_line(
-    mut src: Box<dyn BufRead>,
-    name: &Path,
-) -> CliResult<(String, String, Box<dyn BufRead>)> {
-    let mut prefix = String::new();
-    loop {
-        let mut line = String::new();
-        let n = src
-            .read_line(&mut line)
-            .map_err(|e| CliError::file(name, format!("cannot read: {e}")))?;
-        if n == 0 {
-            return Ok((prefix, String::new(), src));
-        }
-        let t = line.trim_start_matches('\u{feff}').trim();
-        if t.is_empty() || t.starts_with('#') {
-            prefix.push_str(&line);
-            continue;
-        }
-        let first = line.clone();
-        prefix.push_str(&line);
-        return Ok((prefix, first, src));
     }
 }
 
@@ -232,26 +105,23 @@ impl RowReader {
     /// it reverses every turn.
     pub fn open(input: &InputPath, opts: &InputOptions, spec: &ReadSpec<'_>) -> CliResult<Self> {
         let path = input.display_path();
-        let (prefix, first, rest) = first_line(input.open()?, &path)?;
-        if first.is_empty() {
+        let mut records = Records::new(input.open()?, Delimiter::Whitespace);
+        let more = records
+            .advance()
+            .map_err(|e| CliError::row(&path, records.line().max(1), e.to_string()))?;
+        if !more {
             return Err(CliError::row(&path, 1, "empty file: no header row"));
         }
         let delimiter = match opts.delimiter {
-            Delimiter::Auto => Delimiter::detect(first.trim_end()),
+            Delimiter::Auto => Delimiter::detect(&records.text()),
             d => d,
         };
-        let chained: Box<dyn BufRead> = Box::new(std::io::BufReader::new(
-            std::io::Cursor::new(prefix.into_bytes()).chain(rest),
-        ));
-        let mut records = Records::new(chained, delimiter);
+        records.resplit(delimiter);
         let header = if opts.no_header {
-            // The first record is data: count its fields, and read it again below.
-            Header::numbered(Delimiter::split_count(&first, delimiter))
+            // The first record is data: count its fields, and return it as the first row.
+            Header::numbered(records.len())
         } else {
-            records
-                .advance()
-                .map_err(|e| CliError::row(&path, 1, format!("cannot read the header: {e}")))?;
-            Header::new(records.fields())
+            Header::new(records.text_fields().iter().map(String::as_str))
         };
         let header_row = if opts.no_header {
             0
@@ -276,7 +146,7 @@ impl RowReader {
             }
         }
         if !opts.axes.is_right_handed() {
-            eprintln!(
+            errln!(
                 "truenorth: warning: {}: --axes {} is a mirror image of frd (left-handed): every turn reads reversed",
                 path.display(),
                 opts.axes
@@ -297,6 +167,7 @@ impl RowReader {
             increasing,
             previous: None,
             width: header.names().len(),
+            pending: opts.no_header,
         })
     }
 
@@ -319,39 +190,54 @@ impl RowReader {
     /// The next row, or `None` at the end of the file. The row is overwritten by the next
     /// call (nothing is allocated per row); see the `Iterator` impl for owned rows.
     pub fn next_row(&mut self) -> CliResult<Option<&Row>> {
-        let more = self.records.advance().map_err(|e| {
-            CliError::row(
-                &self.path,
-                self.row.number + 1,
-                format!("malformed CSV: {e}"),
-            )
-        })?;
-        if !more {
-            return Ok(None);
+        if !std::mem::take(&mut self.pending) {
+            let more = self.records.advance().map_err(|e| self.record_error(&e))?;
+            if !more {
+                return Ok(None);
+            }
         }
         let number = self.records.line();
         self.row.number = number;
+        let fields = self.records.len();
+        if fields > self.width {
+            return Err(CliError::row(
+                &self.path,
+                number,
+                format!(
+                    "has {fields} fields, the header {}: a decimal comma, or a delimiter inside an unquoted value, would shift the values (fix the row, or quote the value)",
+                    self.width
+                ),
+            ));
+        }
+        if fields < self.width && self.records.unterminated() {
+            return Err(CliError::row(
+                &self.path,
+                number,
+                format!(
+                    "the last line has {fields} fields, the header {}, and no line break: the file looks truncated",
+                    self.width
+                ),
+            ));
+        }
         for (k, (c, required)) in self.columns.iter().enumerate() {
             let cell = self.records.field(c.index).ok_or_else(|| {
                 CliError::row(
                     &self.path,
                     number,
                     format!(
-                        "has {} fields, the header {}: no value for `{}`",
-                        self.records.len(),
-                        self.width,
-                        c.name
+                        "has {fields} fields, the header {}: no value for `{}`",
+                        self.width, c.name
                     ),
                 )
             })?;
             let v = if cell.is_empty() && !required {
                 f64::NAN
             } else {
-                cell.parse::<f64>().map_err(|_| {
+                parse_number(cell).ok_or_else(|| {
                     CliError::row(
                         &self.path,
                         number,
-                        format!("column `{}`: `{cell}` is not a number", c.header),
+                        format!("column `{}`: `{}` is not a number", c.header, shown(cell)),
                     )
                 })?
             };
@@ -359,7 +245,7 @@ impl RowReader {
                 return Err(CliError::row(
                     &self.path,
                     number,
-                    format!("column `{}`: `{cell}` is not finite", c.header),
+                    format!("column `{}`: `{}` is not finite", c.header, shown(cell)),
                 ));
             }
             self.row.values[k] = c.sign * v;
@@ -386,14 +272,14 @@ impl RowReader {
     }
 }
 
-impl Delimiter {
-    /// Number of fields of `line` split by `delimiter` (quotes not honoured: used only to
-    /// count the columns of a file without a header).
-    fn split_count(line: &str, delimiter: Delimiter) -> usize {
-        match delimiter {
-            Delimiter::Byte(b) => line.trim_end().split(b as char).count(),
-            _ => line.split_whitespace().count(),
-        }
+impl RowReader {
+    /// A record that could not be read, as the error naming its row.
+    fn record_error(&self, e: &RecordError) -> CliError {
+        let what = match e {
+            RecordError::Io(_) => e.to_string(),
+            RecordError::TooLong => format!("malformed CSV: {e}"),
+        };
+        CliError::row(&self.path, self.records.line().max(1), what)
     }
 }
 

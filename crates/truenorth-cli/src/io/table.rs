@@ -108,7 +108,7 @@ impl Table {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::io::write_csv;
+    use crate::io::{Precision, write_csv};
     use proptest::prelude::*;
     use std::path::Path;
 
@@ -136,7 +136,7 @@ mod tests {
         #[test]
         fn write_then_read_round_trips(rows in proptest::collection::vec((-1e12f64..1e12, -1e6f64..1e6), 1..50)) {
             let path = temp_file("rt", b"");
-            write_csv(&path, &["t_s", "mag_x"], rows.iter().map(|&(a, b)| vec![a, b])).unwrap();
+            write_csv(&path, &["t_s", "mag_x"], rows.iter().map(|&(a, b)| vec![a, b]), Precision::default()).unwrap();
             let t = read(&path, &["t_s", "mag_x"], &["mag_z"]).unwrap();
             prop_assert_eq!(t.len(), rows.len());
             prop_assert!(t.col("mag_z").is_none());

@@ -6,7 +6,7 @@ use std::path::Path;
 use truenorth::core::{Declination, MagneticHeading, NavEstimate, rad_to_deg, wrap_two_pi};
 use truenorth::fusion::vehicle::NavFilter;
 
-use crate::io::{CliError, CliResult, CsvOutput};
+use crate::io::{CliError, CliResult, CsvOutput, Precision};
 
 /// Optional output column groups.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -32,6 +32,8 @@ pub(super) struct Writer {
     pub(super) gaps: usize,
     pub(super) error: Option<CliError>,
     pub(super) last: Option<NavEstimate>,
+    /// How the numbers are written.
+    pub(super) precision: Precision,
 }
 
 impl Writer {
@@ -41,6 +43,7 @@ impl Writer {
         output: &Path,
         extra: &[Extra],
         declination: Option<Declination>,
+        precision: Precision,
     ) -> CliResult<Self> {
         Ok(Self {
             out: CsvOutput::create(output, &Self::header(extra))?,
@@ -50,6 +53,7 @@ impl Writer {
             gaps: 0,
             error: None,
             last: None,
+            precision,
         })
     }
 
@@ -96,7 +100,7 @@ impl Writer {
         for x in &self.extra {
             extra_cells(*x, e, filter, &mut row);
         }
-        if let Err(err) = self.out.row(&row) {
+        if let Err(err) = self.out.row(&row, self.precision) {
             self.error = Some(err);
         }
         self.rows += 1;
