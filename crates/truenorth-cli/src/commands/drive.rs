@@ -32,8 +32,8 @@ odometer wheels' track, m (a skid-steer's physical track: the effective one, 1.5
 is learned); wheelbase_m rear axle to front kingpins, m; pitman_ratio P = 2p/T_F (kingpin
 offset p over half the front track; front wheels only). Optional: \"wheel_resolution_m\"
 (distance per odometer pulse, default 0.02 with distance columns on a car and 0.003 with
-speed columns, a CAN bus's 0.01 km/h over one second; 0.001 on a robot). Unknown keys are
-refused.
+speed columns, a CAN bus's 0.01 km/h over one second; 0.001 on a robot) and \"version\": 1.
+Unknown keys are refused (naming the closest known one), and so are values no vehicle has.
 
 DRIVE.csv: `t_s` (strictly increasing, seconds) and any of: `dist_l_m,dist_r_m` (cumulative
 distance of the left and right odometer wheels as the odometer reports it) or

@@ -312,4 +312,35 @@ mod tests {
             "{flipped:?}"
         );
     }
+
+    /// A ratio of the wheels' turns to the gyro's is named for the unit it fits (3.6 only
+    /// for speeds), else for the track it implies; a plausible one, or the gyro's 1/57, is
+    /// left to the other checks.
+    #[test]
+    fn the_wheels_scale_is_named_for_the_unit_or_the_track_it_fits() {
+        let vehicle = std::path::Path::new("car.json");
+        let at = |ratio: f64, speeds: bool| {
+            Turns {
+                ratio,
+                r2: 0.99,
+                windows: 20,
+                row: Some(7),
+                track_m: 1.5,
+            }
+            .wheel_scale_finding("l, r", speeds, vehicle)
+            .map(|f| f.message)
+        };
+        assert!(at(1e-3, false).unwrap().contains("kilometres"));
+        assert!(at(3.6, true).unwrap().contains("km/h"));
+        let track = at(3.6, false).unwrap();
+        assert!(
+            track.contains("track of 5.40 m") && track.contains("car.json"),
+            "{track}"
+        );
+        assert!(at(1e3, false).unwrap().contains("millimetres"));
+        assert!(at(-0.1, false).unwrap().contains("track of 0.15 m"));
+        for quiet in [1.0, 0.6, 2.5, 1.0 / 57.3] {
+            assert_eq!(at(quiet, false), None, "{quiet}");
+        }
+    }
 }
