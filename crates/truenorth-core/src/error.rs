@@ -36,6 +36,67 @@ impl core::fmt::Display for NetOfNoise {
     }
 }
 
+/// A number as a message shows it: integers and everyday magnitudes in plain decimals with
+/// at most six significant digits, very large or very small ones in exponent form (`1e308`,
+/// not 309 digits), so that a range or a rejected value reads at a glance.
+pub struct Readable(pub f64);
+
+impl core::fmt::Display for Readable {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        let (v, a) = (self.0, self.0.abs());
+        if !v.is_finite() || v == 0.0 {
+            return write!(f, "{v}");
+        }
+        let mut buf = [0u8; 48];
+        let mut w = SliceWriter {
+            buf: &mut buf,
+            len: 0,
+        };
+        if (1e-3..1e6).contains(&a) {
+            // Six significant digits: as many decimals as the integer part leaves.
+            let mut digits = 0usize;
+            let mut x = a;
+            while x >= 1.0 {
+                x /= 10.0;
+                digits += 1;
+            }
+            let decimals = if digits == 0 { 8 } else { 6 - digits };
+            core::fmt::write(&mut w, format_args!("{v:.decimals$}"))?;
+        } else {
+            core::fmt::write(&mut w, format_args!("{v:.3e}"))?;
+        }
+        let len = w.len;
+        let text = core::str::from_utf8(&buf[..len]).map_err(|_| core::fmt::Error)?;
+        let (mantissa, exponent) = match text.find('e') {
+            Some(i) => text.split_at(i),
+            None => (text, ""),
+        };
+        let mantissa = if mantissa.contains('.') {
+            mantissa.trim_end_matches('0').trim_end_matches('.')
+        } else {
+            mantissa
+        };
+        f.write_str(mantissa)?;
+        f.write_str(exponent)
+    }
+}
+
+/// A `core::fmt::Write` into a fixed buffer (the crate is `no_std`).
+struct SliceWriter<'a> {
+    buf: &'a mut [u8],
+    len: usize,
+}
+
+impl core::fmt::Write for SliceWriter<'_> {
+    fn write_str(&mut self, s: &str) -> core::fmt::Result {
+        let end = self.len + s.len();
+        let dest = self.buf.get_mut(self.len..end).ok_or(core::fmt::Error)?;
+        dest.copy_from_slice(s.as_bytes());
+        self.len = end;
+        Ok(())
+    }
+}
+
 /// Everything that can go wrong in truenorth's library code.
 ///
 /// Library code never panics on bad input; it returns one of these.
@@ -67,7 +128,12 @@ pub enum Error {
         dt_s: f64,
     },
     /// A parameter or input outside its valid range.
-    #[error("{what} = {value} is outside its valid range [{min}, {max}]")]
+    #[error(
+        "{what} = {} is outside its valid range [{}, {}]",
+        Readable(*value),
+        Readable(*min),
+        Readable(*max)
+    )]
     OutOfRange {
         /// Which quantity.
         what: &'static str,
@@ -81,7 +147,10 @@ pub enum Error {
     /// The data contradict the units they declare (a time base in milliseconds read as
     /// seconds, a field in nT declared as µT, …): what they say cannot come from real motion.
     #[error(
-        "the data contradict their declared units: {what} is {value:.4}, where real motion gives {min}–{max}; {hint}"
+        "the data contradict their declared units: {what} is {}, where real motion gives {}–{}; {hint}",
+        Readable(*value),
+        Readable(*min),
+        Readable(*max)
     )]
     Implausible {
         /// Which quantity, with its declared unit.
@@ -278,4 +347,40 @@ pub enum Error {
         /// What is missing and what to use instead.
         reason: &'static str,
     },
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    extern crate std;
+    use std::string::ToString;
+
+    /// Ranges and values read at a glance: no 309-digit numbers, no float noise.
+    #[test]
+    fn numbers_in_messages_are_short() {
+        for (v, want) in [
+            (100.0, "100"),
+            (-0.5, "-0.5"),
+            (100.08000000000379, "100.08"),
+            (1e308, "1e308"),
+            (f64::MAX, "1.798e308"),
+            (1.5e-7, "1.5e-7"),
+            (0.0, "0"),
+            (0.0432, "0.0432"),
+            (123456.7, "123457"),
+            (f64::NAN, "NaN"),
+        ] {
+            assert_eq!(Readable(v).to_string(), want, "{v}");
+        }
+        let e = Error::OutOfRange {
+            what: "x",
+            value: 1e308,
+            min: -f64::MAX,
+            max: f64::MAX,
+        };
+        assert_eq!(
+            e.to_string(),
+            "x = 1e308 is outside its valid range [-1.798e308, 1.798e308]"
+        );
+    }
 }

@@ -14,13 +14,14 @@ use super::field::Place;
 use crate::io::errln;
 use crate::io::{
     CliError, CliResult, GyroUnit, InputOptions, InputPath, OutputOptions, ReadSpec, Row,
-    RowReader, VehicleFile, WheelColumns, YawRateCheck, check_distinct, refuse_or_warn,
-    write_atomically,
+    RowReader, VehicleFile, WheelColumns, check_distinct, read_learned, write_learned,
 };
 use crate::registry::{VehicleMethod, VehicleRun};
 
+mod diagnose;
 mod output;
 
+use diagnose::{Context, Diagnosis};
 pub use output::Extra;
 use output::Writer;
 
@@ -32,8 +33,8 @@ odometer wheels' track, m (a skid-steer's physical track: the effective one, 1.5
 is learned); wheelbase_m rear axle to front kingpins, m; pitman_ratio P = 2p/T_F (kingpin
 offset p over half the front track; front wheels only). Optional: \"wheel_resolution_m\"
 (distance per odometer pulse, default 0.02 with distance columns on a car and 0.003 with
-speed columns, a CAN bus's 0.01 km/h over one second; 0.001 on a robot). Unknown keys are
-refused.
+speed columns, a CAN bus's 0.01 km/h over one second; 0.001 on a robot) and \"version\": 1.
+Unknown keys are refused (naming the closest known one), and so are values no vehicle has.
 
 DRIVE.csv: `t_s` (strictly increasing, seconds) and any of: `dist_l_m,dist_r_m` (cumulative
 distance of the left and right odometer wheels as the odometer reports it) or
@@ -173,7 +174,7 @@ pub fn run(args: &Args) -> CliResult {
         gyr: rows.index("gyr_z"),
         to_rps: args.gyro_unit.to_rad_per_s(),
         mag: mag_columns(&rows)?,
-        check: YawRateCheck::new(vehicle.track_m),
+        check: Diagnosis::new(vehicle.track_m, wheels.can_pivot(), speeds),
     };
     let mut writer = Writer::create(
         &args.output,
@@ -181,12 +182,13 @@ pub fn run(args: &Args) -> CliResult {
         declination,
         args.output_options.precision,
     )?;
+    let context = diagnosis_context(args, speeds);
     let samples = estimate(&mut rows, &mut columns, method.as_mut(), &mut writer)
-        .map_err(|e| check_gyro(args, &columns.check).err().unwrap_or(e))?;
-    check_gyro(args, &columns.check)?;
+        .map_err(|e| columns.check.check(&context).err().unwrap_or(e))?;
+    columns.check.check(&context)?;
     let learned = method.calibration();
     if let (Some(out), Some(learned)) = (&args.calibration_out, &learned) {
-        save_calibration(out, learned)?;
+        write_learned(out, learned)?;
     }
     let Writer {
         out,
@@ -295,10 +297,7 @@ fn build_method(
     let bad_config = |e: truenorth::core::Error| CliError::file(&args.vehicle, e.to_string());
     let fused = match &args.calibration_in {
         Some(path) => {
-            let text = std::fs::read_to_string(path)
-                .map_err(|e| CliError::file(path, format!("cannot read: {e}")))?;
-            let learned: VehicleCalibration = serde_json::from_str(&text)
-                .map_err(|e| CliError::file(path, format!("not a drive calibration: {e}")))?;
+            let learned = read_learned(path)?;
             VehicleEstimator::with_calibration(config, &learned)
                 .map_err(|e| CliError::file(path, e.to_string()))?
         }
@@ -309,12 +308,20 @@ fn build_method(
         .map_err(bad_config)
 }
 
-/// Refuses a drive whose gyro contradicts the wheels' turns (its unit or its sign), or with
-/// `--accept-units` / `--accept-axes` says so on stderr: before the output is committed, and
-/// in place of the estimator's own error when that came from the same contradiction.
-fn check_gyro(args: &Args, check: &YawRateCheck) -> CliResult {
-    let findings = check.findings(args.gyro_unit, &args.input_options);
-    refuse_or_warn(&findings, &args.input, args.accept_units, args.accept_axes)
+/// What the diagnosis of the log needs of the arguments. It refuses a drive whose data
+/// contradict how they were declared (a unit, a sign, the wheels' sides, the track), or with
+/// `--accept-units` / `--accept-axes` says so on stderr: before the output is committed,
+/// and in place of the estimator's own error when that came from the same contradiction.
+fn diagnosis_context(args: &Args, speeds: bool) -> Context<'_> {
+    Context {
+        input: args.input.clone(),
+        vehicle: args.vehicle.clone(),
+        gyro_unit: args.gyro_unit,
+        options: &args.input_options,
+        speeds,
+        accept_units: args.accept_units,
+        accept_axes: args.accept_axes,
+    }
 }
 
 /// Where each sensor is in a row, and the check of the gyro against the wheels that the
@@ -326,7 +333,7 @@ struct Columns {
     /// The declared gyro unit's factor to rad/s.
     to_rps: f64,
     mag: Option<[usize; 2]>,
-    check: YawRateCheck,
+    check: Diagnosis,
 }
 
 impl Columns {
@@ -351,7 +358,7 @@ impl Columns {
         {
             sample = sample.with_mag(Vector2::new(v[x], v[y]));
         }
-        self.check.push(&sample);
+        self.check.push(&sample, row.number);
         Ok(sample)
     }
 }
@@ -385,13 +392,6 @@ fn estimate(
         return Err(CliError::file(&path, "has no data rows"));
     }
     Ok(samples)
-}
-
-/// Writes what the drive learned, for `--calibration-in` of the next.
-fn save_calibration(path: &Path, learned: &VehicleCalibration) -> CliResult {
-    let json = serde_json::to_string_pretty(learned)
-        .map_err(|e| CliError::msg(format!("drive: cannot write the calibration: {e}")))?;
-    write_atomically(path, |w| Ok(w.write_all(json.as_bytes())?))
 }
 
 /// One line on stderr: what was done and what was learned.

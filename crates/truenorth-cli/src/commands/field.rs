@@ -9,8 +9,8 @@ use std::time::{SystemTime, UNIX_EPOCH};
 
 use truenorth::core::Error;
 use truenorth::geomag::{
-    Extrapolation, MagneticField, WorldMagneticModel, decimal_year_from_date,
-    decimal_year_from_unix_seconds,
+    EXTRAPOLATION_LIMIT_YEARS, Extrapolation, MagneticField, WorldMagneticModel,
+    decimal_year_from_date, decimal_year_from_unix_seconds,
 };
 
 use crate::io::{CliError, CliResult};
@@ -109,6 +109,11 @@ fn weak_horizontal_field(f: &MagneticField) -> Option<String> {
     })
 }
 
+/// The heights at which the World Magnetic Model is valid, km above the WGS84 ellipsoid:
+/// from 1 km below to 850 km above (Chulliat et al., *The US/UK World Magnetic Model for
+/// 2025-2030*, NOAA technical report, 2024, section 1).
+pub const ALTITUDE_RANGE_KM: (f64, f64) = (-1.0, 850.0);
+
 /// The field for the parsed arguments at decimal year `year`.
 fn evaluate(args: &Place, year: f64) -> CliResult<MagneticField> {
     let lat = parse_number("--lat", required("--lat", &args.lat)?)?;
@@ -122,6 +127,12 @@ fn evaluate(args: &Place, year: f64) -> CliResult<MagneticField> {
         Some(text) => parse_number("--alt-km", text)?,
         None => 0.0,
     };
+    let (lowest, highest) = ALTITUDE_RANGE_KM;
+    if !(lowest..=highest).contains(&alt_km) {
+        return Err(CliError::msg(format!(
+            "--alt-km: {alt_km} is outside {lowest} to {highest} km above the WGS84 ellipsoid, the heights at which the World Magnetic Model holds (it is in kilometres: 0.1 for 100 m)"
+        )));
+    }
     let policy = if args.allow_extrapolation {
         Extrapolation::Allow
     } else {
@@ -134,6 +145,15 @@ fn evaluate(args: &Place, year: f64) -> CliResult<MagneticField> {
             Error::DateOutOfRange { .. } if !args.allow_extrapolation => {
                 CliError::msg(format!("{e} (with --allow-extrapolation)"))
             }
+            Error::DateOutOfRange {
+                year,
+                valid_from,
+                valid_to,
+            } => CliError::msg(format!(
+                "--date: {year} is more than {EXTRAPOLATION_LIMIT_YEARS} years outside the model's validity {valid_from}–{valid_to}, beyond what --allow-extrapolation extends to ({}–{}): no linear secular variation holds that far",
+                valid_from - EXTRAPOLATION_LIMIT_YEARS,
+                valid_to + EXTRAPOLATION_LIMIT_YEARS
+            )),
             e => CliError::msg(e.to_string()),
         })
 }
@@ -269,6 +289,28 @@ mod tests {
         assert!(w.contains("blackout"), "{w}");
         let london = evaluate(&args("51.5", "-0.13"), 2026.0).unwrap();
         assert!(weak_horizontal_field(&london).is_none());
+    }
+
+    /// A height outside the model's range is refused naming the range; a date beyond the
+    /// extrapolation limit says so, not "opt in" again.
+    #[test]
+    fn heights_and_far_dates_are_named() {
+        let deep = Place {
+            alt_km: Some("-1000".into()),
+            ..args("10", "0")
+        };
+        let e = evaluate(&deep, 2026.0).unwrap_err().to_string();
+        assert!(e.contains("--alt-km") && e.contains("-1 to 850 km"), "{e}");
+        let far = Place {
+            allow_extrapolation: true,
+            ..args("10", "0")
+        };
+        let e = evaluate(&far, 1900.0).unwrap_err().to_string();
+        assert!(
+            e.contains("beyond what --allow-extrapolation extends to (1925–2130)")
+                && !e.contains("opt in"),
+            "{e}"
+        );
     }
 
     #[test]

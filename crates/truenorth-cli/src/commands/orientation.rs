@@ -6,8 +6,8 @@ use std::path::PathBuf;
 use nalgebra::{UnitQuaternion, Vector3};
 use truenorth::core::{AttitudeEstimate, Axes, EulerZyx, ImuSample, ned_to_enu, rad_to_deg};
 
-use crate::io::errln;
 use super::mag_unit::{MagUnit, check_field};
+use crate::io::errln;
 use crate::io::{
     AccUnit, CliError, CliResult, GyroUnit, InputOptions, InputPath, OutputOptions, ReadSpec,
     Table, check_distinct, check_inertial, median, refuse_or_warn, write_csv,

@@ -15,10 +15,10 @@ use serde::Serialize;
 use truenorth::core::ImuSample;
 use truenorth::fusion::orientation::{BroadRmse, broad_rmse};
 
-use crate::io::{errln, outln, write_stderr};
 use crate::io::{
     AccUnit, CliError, CliResult, GyroUnit, InputOptions, InputPath, ReadSpec, RowReader,
 };
+use crate::io::{errln, outln, write_stderr};
 use crate::registry::{OrientationMethod, Timing};
 use truenorth::core::ned_to_enu;
 

@@ -11,10 +11,10 @@ use std::io::{BufWriter, ErrorKind, Write};
 use std::path::{Path, PathBuf};
 
 use super::console::end_on_closed_pipe;
+use super::number_format::Precision;
 use super::output_target::OutputTarget;
 use super::source::InputPath;
 use super::temporaries;
-use super::number_format::Precision;
 use super::{CliError, CliResult};
 
 /// The bytes' destination: standard output or an open file (a temporary, or a device or

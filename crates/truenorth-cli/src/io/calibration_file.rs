@@ -11,7 +11,8 @@ use truenorth::compass::{CompassCalibration2d, CompassCalibration3d};
 use truenorth::core::{CompassQuality, Validate};
 
 use super::atomic_write::write_atomically;
-use super::source::InputPath;
+use super::compass_physics::check_compass;
+use super::json_input::{parse_json, parse_value, read_json_text, version_of};
 use super::{CliError, CliResult};
 
 /// The `format` tag of a calibration file written by `truenorth calibrate`.
@@ -27,17 +28,13 @@ pub const CALIBRATION_VERSION: u32 = 2;
 /// The layout versions this build reads.
 pub const READABLE_VERSIONS: [u32; 2] = [1, 2];
 
-/// The largest condition number (largest over smallest singular value) of a soft-iron
-/// matrix accepted on load: 10, the largest axis ratio the ellipsoid fit accepts. A worse
-/// one squashes the field onto a line and reads nearly constant headings.
-pub const MAX_SOFT_IRON_CONDITION: f64 = 10.0;
-
 /// A compass calibration as stored on disk by `truenorth calibrate` and read by
 /// `truenorth heading` (see `truenorth calibrate --help` for the layout).
 ///
 /// Matrices are written row by row (`soft_iron[i][j]` is row i, column j) so the file reads
 /// as printed maths; `corrected = soft_iron · (raw − hard_iron)`.
 #[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct CalibrationFile {
     /// Always [`CALIBRATION_FORMAT`].
     pub format: String,
@@ -83,6 +80,7 @@ pub struct CalibrationFile {
 /// The accelerometer part of a joint calibration:
 /// `specific_force_mps2 = matrix · (raw − bias)`, in body axes.
 #[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct AccelPart {
     /// Bias, accelerometer input unit.
     pub bias: Vec<f64>,
@@ -96,6 +94,7 @@ pub struct AccelPart {
 /// The yaw gyro's calibration from one turn (EP 0640207 claims 1, 6-9):
 /// `rate_rps = (gyr_z − zero_rps) / scale`, positive turning right.
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct GyroPart {
     /// The gyro's reading at rest, rad/s: its mean over the standstill before the turn.
     pub zero_rps: f64,
@@ -119,6 +118,7 @@ pub struct GyroPart {
 /// number that is not finite (an unbounded condition or error bound) is written as `null`,
 /// since JSON has no infinity.
 #[derive(Debug, Clone, PartialEq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct QualityReport {
     /// `good`, `usable` or `poor`.
     #[serde(default)]
@@ -185,6 +185,10 @@ pub struct QualityReport {
     /// shots.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub runs: Option<usize>,
+    /// Layout version 1 only: the fitted field, the same number as the file's `field`
+    /// (read so that version-1 files keep loading, never written).
+    #[serde(default, skip_serializing)]
+    pub field_magnitude: Option<f64>,
     /// See `runs`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub run_shots: Option<usize>,
@@ -341,29 +345,6 @@ fn rows<const N: usize>(
     Ok(nalgebra::SMatrix::<f64, N, N>::from_fn(|i, j| m[i][j]))
 }
 
-/// Refuses a soft iron that is singular, reflecting or too ill-conditioned to give
-/// trustworthy headings.
-fn check_soft_iron(det: f64, singular_values: &[f64]) -> Result<(), String> {
-    // A NaN fails every check instead of slipping through one.
-    if det.is_nan() || det <= 0.0 {
-        return Err(format!(
-            "`soft_iron` has determinant {det:.3e}: a singular matrix collapses every reading onto a line (constant headings) and a negative one mirrors them; recalibrate"
-        ));
-    }
-    let max = singular_values.iter().copied().fold(0.0, f64::max);
-    let min = singular_values
-        .iter()
-        .copied()
-        .fold(f64::INFINITY, f64::min);
-    let condition = max / min;
-    if condition.is_nan() || condition > MAX_SOFT_IRON_CONDITION {
-        return Err(format!(
-            "`soft_iron` has condition number {condition:.1}, more than {MAX_SOFT_IRON_CONDITION}: it would squash the field nearly onto a line; recalibrate"
-        ));
-    }
-    Ok(())
-}
-
 impl CalibrationFile {
     /// Writes the file as pretty-printed JSON (whole or not at all; `-`: standard output).
     pub fn write(&self, path: &Path) -> CliResult {
@@ -375,21 +356,26 @@ impl CalibrationFile {
         })
     }
 
-    /// Reads and checks a calibration file (`-`: standard input, gzip or not).
+    /// Reads and checks a calibration file (`-`: standard input, gzip or not; a
+    /// byte-order mark is skipped): the layout version, no unknown key, and the values
+    /// against physics ([`CalibrationFile::check`]).
     pub fn read(path: &Path) -> CliResult<(Self, CompassCalibration)> {
-        let input = InputPath::new(path);
-        let name = input.display_path();
-        let mut text = String::new();
-        std::io::Read::read_to_string(&mut input.open()?, &mut text)
-            .map_err(|e| CliError::file(&name, format!("cannot read: {e}")))?;
-        let file: Self = serde_json::from_str(&text).map_err(|e| {
-            CliError::file(
-                &name,
-                format!(
-                    "not a truenorth calibration file (write one with `truenorth calibrate`): {e}"
-                ),
-            )
-        })?;
+        let (text, name) = read_json_text(path)?;
+        let not_one = "not a truenorth calibration file (write one with `truenorth calibrate`)";
+        let value = parse_value(&text, not_one).map_err(|m| CliError::file(&name, m))?;
+        match version_of(&value, &READABLE_VERSIONS, "calibration") {
+            Ok(Some(_)) => {}
+            Ok(None) => {
+                return Err(CliError::file(
+                    &name,
+                    format!(
+                        "{not_one}: it has no `version` (every calibration file carries one; this build reads versions {READABLE_VERSIONS:?})"
+                    ),
+                ));
+            }
+            Err(m) => return Err(CliError::file(&name, m)),
+        }
+        let file: Self = parse_json(value, not_one).map_err(|m| CliError::file(&name, m))?;
         let cal = file.check().map_err(|m| CliError::file(&name, m))?;
         Ok((file, cal))
     }
@@ -417,28 +403,29 @@ impl CalibrationFile {
                 "`hard_iron` must have {n} values and `soft_iron` {n} rows of {n} values"
             ));
         }
-        if self.hard_iron.iter().any(|v| !v.is_finite()) {
-            return Err("`hard_iron` must be finite numbers".into());
-        }
-        if !(self.field.is_finite() && self.field > 0.0) {
-            return Err(format!(
-                "`field` is {}, must be a positive number",
-                self.field
-            ));
-        }
         if n == 2 {
             if self.mag_to_body.is_some() || self.accelerometer.is_some() {
                 return Err("a 2-D calibration has no `mag_to_body` or `accelerometer`".into());
             }
             let s = rows::<2>("soft_iron", &self.soft_iron)?;
-            check_soft_iron(s.determinant(), s.singular_values().as_slice())?;
+            check_compass(
+                &self.hard_iron,
+                s.determinant(),
+                s.singular_values().as_slice(),
+                self.field,
+            )?;
             return Ok(CompassCalibration::TwoD(CompassCalibration2d {
                 hard_iron: Vector2::new(self.hard_iron[0], self.hard_iron[1]),
                 soft_iron: s,
             }));
         }
         let s: Matrix3<f64> = rows::<3>("soft_iron", &self.soft_iron)?;
-        check_soft_iron(s.determinant(), s.singular_values().as_slice())?;
+        check_compass(
+            &self.hard_iron,
+            s.determinant(),
+            s.singular_values().as_slice(),
+            self.field,
+        )?;
         let mag = CompassCalibration3d {
             hard_iron: Vector3::new(self.hard_iron[0], self.hard_iron[1], self.hard_iron[2]),
             soft_iron: s,

@@ -30,11 +30,14 @@
 mod atomic_write;
 mod calibration_file;
 mod columns;
+mod compass_physics;
 mod console;
 mod direction_spans;
 mod error;
 mod gyro_axes;
 mod inertial_units;
+mod json_input;
+mod learned_file;
 mod number_format;
 mod output_target;
 mod reader;
@@ -61,13 +64,15 @@ pub use gyro_axes::{
     AxisFit, SignedPermutation, axes_are_wrong, fit_gyro_axes, fix_columns, fix_pair, shell_word,
 };
 pub use inertial_units::{AccUnit, GyroUnit};
+pub use learned_file::{read_learned, write_learned};
 pub use number_format::{OutputOptions, Precision};
 pub use reader::{ReadSpec, Row, RowReader};
 pub use source::InputPath;
 pub use table::Table;
 pub use unit_check::{
-    acc_unit_name, check_inertial, gyro_unit_name, likely_acc_unit, refuse_or_warn,
+    Finding, FindingKind, acc_unit_name, check_inertial, gyro_unit_name, likely_acc_unit,
+    refuse_or_warn,
 };
 pub use vehicle_file::VehicleFile;
 pub use wheel_columns::WheelColumns;
-pub use yaw_rate_check::YawRateCheck;
+pub use yaw_rate_check::{Turns, YawRateCheck};

@@ -14,9 +14,9 @@
 use std::path::{Path, PathBuf};
 
 use super::columns::{ColumnSource, Delimiter, Header, InputOptions};
+use super::errln;
 use super::records::{RecordError, Records, parse_number, shown};
 use super::source::InputPath;
-use super::errln;
 use super::{CliError, CliResult};
 
 /// The columns a command reads.

@@ -33,6 +33,8 @@ pub struct Finding {
     pub kind: FindingKind,
     /// The likely problem and the option that fixes it.
     pub message: String,
+    /// The 1-based row of the input where the evidence became clear, if known.
+    pub row: Option<usize>,
 }
 
 /// Checks the accelerometer's magnitude and the gyro's rate scale of `samples` (already
@@ -47,6 +49,7 @@ pub fn check_inertial_units(samples: &[ImuSample], gyro: GyroUnit, acc: AccUnit)
     let units = |message| Finding {
         kind: FindingKind::Units,
         message,
+        row: None,
     };
     findings.extend(acc_finding(median * acc.to_mps2().recip(), acc).map(units));
     findings.extend(gyro_finding(&rows, gyro).map(units));
@@ -79,6 +82,7 @@ pub fn check_inertial(
                 fit.best_deg,
                 shell_word(&fix_columns(&fit.best, opts))
             ),
+            row: None,
         });
     }
     findings
@@ -100,10 +104,11 @@ pub fn refuse_or_warn(
         if accepted {
             errln!("warning: {}: {}", input.display(), finding.message);
         } else {
-            return Err(CliError::file(
-                input,
-                format!("{} (or {flag} to go on)", finding.message),
-            ));
+            let message = format!("{} (or {flag} to go on)", finding.message);
+            return Err(match finding.row {
+                Some(row) => CliError::row(input, row, message),
+                None => CliError::file(input, message),
+            });
         }
     }
     Ok(())

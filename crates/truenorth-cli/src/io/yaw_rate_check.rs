@@ -20,6 +20,13 @@ const MIN_WINDOW_TURN_RAD: f64 = 0.05;
 const MAX_STEP_S: f64 = 0.5;
 /// Turning windows needed before the gyro is judged.
 const MIN_WINDOWS: usize = 10;
+/// The wheels' turn per gyro turn a vehicle can show: a car's is 1 within the gyro's gain
+/// error and the track's uncertainty, a skid-steer's up to 2.5 (its effective track is
+/// 1.5-2.5 times the physical one); outside this the unit of a column or `track_m` is wrong.
+const PLAUSIBLE_RATIO: (f64, f64) = (0.5, 3.0);
+/// How close (as a factor) a ratio must come to a unit's factor to be named as it.
+const UNIT_TOLERANCE: f64 = 1.15;
+
 /// The share of the wheels' turns the gyro must explain (squared correlation) before its
 /// scale or sign is judged: below it the two do not see the same motion at all.
 const MIN_R2: f64 = 0.5;
@@ -38,6 +45,11 @@ pub struct YawRateCheck {
     sums: [f64; 3],
     /// The number of turning windows.
     pub windows: usize,
+    /// The row given with the last reading ([`YawRateCheck::push_at`]).
+    row: Option<usize>,
+    /// The row at which the last turning window needed for a judgement closed: where the
+    /// evidence became clear.
+    pub judged_at_row: Option<usize>,
 }
 
 impl YawRateCheck {
@@ -51,7 +63,21 @@ impl YawRateCheck {
             last_gyro: None,
             sums: [0.0; 3],
             windows: 0,
+            row: None,
+            judged_at_row: None,
         }
+    }
+
+    /// The track the wheels' turns are computed with, m.
+    pub fn track_m(&self) -> f64 {
+        self.track_m
+    }
+
+    /// [`YawRateCheck::push`] of the reading on `row` of the input (1-based, a header is
+    /// row 1), so that a finding can name the row where its evidence became clear.
+    pub fn push_at(&mut self, sample: &VehicleSample, row: usize) {
+        self.row = Some(row);
+        self.push(sample);
     }
 
     /// Takes one row of the log (the gyro already in rad/s as declared).
@@ -87,6 +113,9 @@ impl YawRateCheck {
             self.sums[1] += gyro * gyro;
             self.sums[2] += wheels * wheels;
             self.windows += 1;
+            if self.windows == MIN_WINDOWS {
+                self.judged_at_row = self.row;
+            }
         }
         self.window = (0.0, 0.0, true);
         self.start_s = Some(t);
@@ -100,9 +129,37 @@ impl YawRateCheck {
             .then(|| (wg / gg, wg * wg / (gg * ww)))
     }
 
+    /// [`YawRateCheck::ratio`] once the gyro and the wheels see the same motion (their
+    /// squared correlation at least [`MIN_R2`]).
+    pub fn agreeing_ratio(&self) -> Option<(f64, f64)> {
+        self.ratio().filter(|(_, r2)| *r2 >= MIN_R2)
+    }
+
+    /// What the size of the wheels' turns against the gyro's says is wrong when it is
+    /// neither one nor 57 (the gyro's unit, [`YawRateCheck::findings`]): wheel speeds in
+    /// km/h (3.6 times), distances in km or mm (1000 times), or else `track_m` (the turns
+    /// give the track). `wheels` names the wheel columns as read (`dist_l_m, dist_r_m`),
+    /// `speeds` whether they are speeds, `vehicle` the vehicle file that gave the track.
+    pub fn wheel_scale_finding(
+        &self,
+        wheels: &str,
+        speeds: bool,
+        vehicle: &std::path::Path,
+    ) -> Option<Finding> {
+        let (ratio, r2) = self.agreeing_ratio()?;
+        let turns = Turns {
+            ratio,
+            r2,
+            windows: self.windows,
+            row: self.judged_at_row,
+            track_m: self.track_m,
+        };
+        turns.wheel_scale_finding(wheels, speeds, vehicle)
+    }
+
     /// What contradicts the declared gyro unit or sign, naming the option that fixes it.
     pub fn findings(&self, declared: GyroUnit, opts: &InputOptions) -> Vec<Finding> {
-        let Some((ratio, r2)) = self.ratio().filter(|(_, r2)| *r2 >= MIN_R2) else {
+        let Some((ratio, r2)) = self.agreeing_ratio() else {
             return Vec::new();
         };
         let mut findings = Vec::new();
@@ -121,6 +178,7 @@ impl YawRateCheck {
                     1.0 / ratio.abs(),
                     self.windows
                 ),
+                row: self.judged_at_row,
             });
         }
         if ratio < 0.0 {
@@ -135,9 +193,78 @@ impl YawRateCheck {
                     self.windows,
                     shell_word(&fix_pair(&flip, 2, opts))
                 ),
+                row: self.judged_at_row,
             });
         }
         findings
+    }
+}
+
+/// A comparison of the wheels' turns with the gyro's over turning windows, however the
+/// windows were chosen: the least-squares ratio, its squared correlation, the windows, the
+/// row where the judgement became possible and the track the wheels' turns assume.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Turns {
+    /// Wheels' turn per gyro turn.
+    pub ratio: f64,
+    /// Squared correlation.
+    pub r2: f64,
+    /// Turning windows behind it.
+    pub windows: usize,
+    /// Row where the evidence became clear.
+    pub row: Option<usize>,
+    /// Track assumed, m.
+    pub track_m: f64,
+}
+
+impl Turns {
+    /// See [`YawRateCheck::wheel_scale_finding`].
+    pub fn wheel_scale_finding(
+        &self,
+        wheels: &str,
+        speeds: bool,
+        vehicle: &std::path::Path,
+    ) -> Option<Finding> {
+        let (r, r2) = (self.ratio.abs(), self.r2);
+        if r2 < MIN_R2 {
+            return None;
+        }
+        let near = |factor: f64| (r / factor).ln().abs() < UNIT_TOLERANCE.ln();
+        let gyro_unit = (r * 1f64.to_degrees()).ln().abs() < 3f64.ln();
+        if gyro_unit || (PLAUSIBLE_RATIO.0..=PLAUSIBLE_RATIO.1).contains(&r) {
+            return None;
+        }
+        let seen = format!(
+            "the wheels ({wheels}) turn the vehicle {r:.4} times as far as gyr_z over {} turning seconds (r² {r2:.2})",
+            self.windows
+        );
+        let message = if speeds && near(3.6) {
+            format!(
+                "{seen}: the wheel speeds are in km/h, not m/s: divide them by 3.6 (speed_l_mps, speed_r_mps are metres per second)"
+            )
+        } else if near(1e-3) || (r / 1e-3).ln().abs() < 3f64.ln() {
+            format!(
+                "{seen}: the wheels' {} are in kilometres, not metres: multiply them by 1000",
+                if speeds { "speeds" } else { "distances" }
+            )
+        } else if (r / 1e3).ln().abs() < 3f64.ln() {
+            format!(
+                "{seen}: the wheels' {} are in millimetres, not metres: divide them by 1000",
+                if speeds { "speeds" } else { "distances" }
+            )
+        } else {
+            format!(
+                "{seen}: track_m = {} m in {} does not fit the turns, which give a track of {:.2} m: check track_m (metres, between the odometer wheels' centres) or the wheel columns' unit",
+                self.track_m,
+                vehicle.display(),
+                self.track_m * r
+            )
+        };
+        Some(Finding {
+            kind: FindingKind::Units,
+            message,
+            row: self.row,
+        })
     }
 }
 
@@ -184,5 +311,36 @@ mod tests {
             flipped[0].message.contains("--column gyr_z=-gyr_z"),
             "{flipped:?}"
         );
+    }
+
+    /// A ratio of the wheels' turns to the gyro's is named for the unit it fits (3.6 only
+    /// for speeds), else for the track it implies; a plausible one, or the gyro's 1/57, is
+    /// left to the other checks.
+    #[test]
+    fn the_wheels_scale_is_named_for_the_unit_or_the_track_it_fits() {
+        let vehicle = std::path::Path::new("car.json");
+        let at = |ratio: f64, speeds: bool| {
+            Turns {
+                ratio,
+                r2: 0.99,
+                windows: 20,
+                row: Some(7),
+                track_m: 1.5,
+            }
+            .wheel_scale_finding("l, r", speeds, vehicle)
+            .map(|f| f.message)
+        };
+        assert!(at(1e-3, false).unwrap().contains("kilometres"));
+        assert!(at(3.6, true).unwrap().contains("km/h"));
+        let track = at(3.6, false).unwrap();
+        assert!(
+            track.contains("track of 5.40 m") && track.contains("car.json"),
+            "{track}"
+        );
+        assert!(at(1e3, false).unwrap().contains("millimetres"));
+        assert!(at(-0.1, false).unwrap().contains("track of 0.15 m"));
+        for quiet in [1.0, 0.6, 2.5, 1.0 / 57.3] {
+            assert_eq!(at(quiet, false), None, "{quiet}");
+        }
     }
 }

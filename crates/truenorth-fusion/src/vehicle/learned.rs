@@ -20,6 +20,7 @@ const DRIFT_SHARE: f64 = 0.1;
 
 /// A learned value and its standard deviation (0: never learned, the prior stands).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Learned {
     /// The value.
     pub value: f64,
@@ -44,6 +45,7 @@ impl Learned {
 
 /// The compass calibration learned, with its quality report.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct LearnedCompass {
     /// Hard and soft iron.
     pub calibration: CompassCalibration2d,
@@ -54,6 +56,7 @@ pub struct LearnedCompass {
 /// Everything the vehicle estimator learns about its sensors. Units: rad/s for the gyro
 /// bias, dimensionless for gains and scales, s²/m² for the speed coefficient.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct VehicleCalibration {
     /// The compass's hard and soft iron, if learned.
     pub compass: Option<LearnedCompass>,
