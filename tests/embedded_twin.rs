@@ -12,7 +12,7 @@ use std::io::Read as _;
 use std::path::{Path, PathBuf};
 
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
-use shared_run::{HEADER_VALUES, SAMPLE_VALUES, UpdateMeter};
+use shared_run::{HEADER_VALUES, SAMPLE_VALUES, TURN_FIELD_UT, TURN_HARD_IRON_UT, UpdateMeter};
 use truenorth_calib::{EllipsoidConfig, fit_ellipsoid};
 use truenorth_core::angle_diff;
 
@@ -190,6 +190,25 @@ fn numbers(lines: &[&str], name: &str) -> Vec<f64> {
 /// (`crates/truenorth-fusion/tests/broad_f32.rs`).
 const F32_VS_F64_DEG: f64 = 0.02;
 
+/// How far the online ellipse calibrator's hard iron may be from the simulated compass's,
+/// relative to the field. The simulated readings carry a second-harmonic wobble of 0.2 % of
+/// the field, which the ellipse absorbs partly into its centre (measured 0.18 %); 0.5 % is
+/// that wobble's size with room, a wrong centre (axes swapped, a lost reading) misses by
+/// tens of percent.
+const ELLIPSE_HARD_IRON_REL: f64 = 5e-3;
+
+/// How far the heading through the learned calibration may be from the simulated heading,
+/// degrees: the wobble's 0.2 % of the field is 0.11° of heading at most, and the centre's
+/// error adds as much again (measured 0.16°); 0.5° leaves room for both.
+const ELLIPSE_HEADING_DEG: f64 = 0.5;
+
+/// How far the `f32` calibrator's hard iron may be from the `f64` one's, relative to the
+/// field: its sums are single precision (the fit runs in `f64` in both), each off by at
+/// most `(n + 4)·2⁻²⁴` of its terms (Higham 2002, §4.2) = 2.2·10⁻⁵ for 360 readings, times
+/// the conditioning of the fit, a few units here (`online_precision.rs` in
+/// truenorth-calib measures both); 10⁻⁴ holds it (measured 4.5·10⁻⁷).
+const ELLIPSE_F32_VS_F64_REL: f64 = 1e-4;
+
 /// The shared computation on the host, in `f32` and then in `f64`: the lines it prints are
 /// the lines the QEMU run must print (`.ci/embedded` compares them). Held here, in both
 /// blocks: the attitude stays a unit quaternion (within 10⁻¹² for f64, within 10⁻⁶, about
@@ -204,7 +223,9 @@ const F32_VS_F64_DEG: f64 = 0.02;
 fn host_twin() {
     let mut out = String::new();
     shared_run::run::<f32>(&mut out, &mut NoMeter).unwrap_or_else(|e| panic!("{e}"));
+    shared_run::calibrate::<f32>(&mut out, &mut NoMeter).unwrap_or_else(|e| panic!("{e}"));
     shared_run::run::<f64>(&mut out, &mut NoMeter).unwrap_or_else(|e| panic!("{e}"));
+    shared_run::calibrate::<f64>(&mut out, &mut NoMeter).unwrap_or_else(|e| panic!("{e}"));
     print!("{out}");
     if let Some(path) = std::env::var_os("TRUENORTH_EMBEDDED_TWIN_OUT") {
         std::fs::write(&path, &out).unwrap_or_else(|e| panic!("{path:?}: {e}"));
@@ -218,7 +239,25 @@ fn host_twin() {
             .to_degrees()
     };
     let mut finals = Vec::new();
+    let mut hard_irons = Vec::new();
     for (float, lines) in &blocks {
+        let hard = numbers(lines, "ellipse_hard_iron_ut");
+        let off = ((hard[0] - TURN_HARD_IRON_UT[0]).powi(2)
+            + (hard[1] - TURN_HARD_IRON_UT[1]).powi(2))
+        .sqrt()
+            / TURN_FIELD_UT;
+        let heading = numbers(lines, "ellipse_heading_deg");
+        assert!(
+            off < ELLIPSE_HARD_IRON_REL,
+            "{float}: hard iron {hard:?}, {off} of the field off"
+        );
+        assert!(
+            diff(heading[0], heading[1]) < ELLIPSE_HEADING_DEG,
+            "{float}: calibrated heading {}° for {}°",
+            heading[0],
+            heading[1]
+        );
+        hard_irons.push(hard);
         let q = numbers(lines, "final_q");
         let norm = q.iter().map(|v| v * v).sum::<f64>().sqrt();
         let norm_tol = if *float == "f32" { 1e-6 } else { 1e-12 };
@@ -238,6 +277,15 @@ fn host_twin() {
             q[0], q[1], q[2], q[3],
         )));
     }
+    let hard_apart = ((hard_irons[0][0] - hard_irons[1][0]).powi(2)
+        + (hard_irons[0][1] - hard_irons[1][1]).powi(2))
+    .sqrt()
+        / TURN_FIELD_UT;
+    println!("f32 vs f64 online ellipse hard iron: {hard_apart:e} of the field");
+    assert!(
+        hard_apart < ELLIPSE_F32_VS_F64_REL,
+        "the f32 and f64 hard irons are {hard_apart} of the field apart"
+    );
     let apart_deg = finals[0].angle_to(&finals[1]).to_degrees();
     println!("f32 vs f64 final attitude: {apart_deg:e}°");
     assert!(

@@ -1,8 +1,9 @@
 //! truenorth on a Cortex-M4F: the quaternion filter over a real BROAD slice and a calibrated
-//! compass heading ([`shared_run`], the same file the host twin runs), first in `f32` (the
-//! product path on this single-precision FPU), then in `f64` for comparison, printed over
-//! semihosting; after each, the instructions one filter update takes, counted with the
-//! SysTick timer under QEMU's `-icount shift=0` (virtual time advances one step per
+//! compass heading, then the online ellipse calibrator learning a compass from a simulated
+//! turn ([`shared_run`], the same file the host twin runs), first in `f32` (the product path
+//! on this single-precision FPU), then in `f64` for comparison, printed over semihosting;
+//! after each part, the instructions one filter update (one calibrator push) takes, counted
+//! with the SysTick timer under QEMU's `-icount shift=0` (virtual time advances one step per
 //! instruction).
 //!
 //! Run (QEMU's `mps2-an386`, see `.cargo/config.toml`): `cargo run --release`.
@@ -22,8 +23,8 @@ use panic_semihosting as _;
 
 use shared_run::UpdateMeter;
 
-/// The library links `alloc` (truenorth-calib's saved states hold `Vec`s) but the filter and
-/// the compass never allocate. This allocator refuses every request, so the run proves it:
+/// The library links `alloc` (truenorth-calib's saved states hold `Vec`s) but the filter, the
+/// compass and the online calibrator (its pushes and its solve) never allocate. This allocator refuses every request, so the run proves it:
 /// an allocation would end it with an allocation-error panic and a failing exit status.
 struct NoHeap;
 
@@ -69,10 +70,26 @@ fn known_block() {
     }
 }
 
-/// Sums the SysTick ticks of each measured update.
+/// Sums the SysTick ticks of each measured update, and separately those of the pushes
+/// classified as the per-sample path alone.
 struct SysTickMeter {
     ticks: u64,
     updates: u32,
+    last_ticks: u32,
+    plain_ticks: u64,
+    plain: u32,
+}
+
+impl SysTickMeter {
+    fn new() -> Self {
+        Self {
+            ticks: 0,
+            updates: 0,
+            last_ticks: 0,
+            plain_ticks: 0,
+            plain: 0,
+        }
+    }
 }
 
 impl UpdateMeter for SysTickMeter {
@@ -80,19 +97,24 @@ impl UpdateMeter for SysTickMeter {
         let start = SYST::get_current();
         let result = update();
         let end = SYST::get_current();
-        self.ticks += u64::from(ticks_between(start, end));
+        self.last_ticks = ticks_between(start, end);
+        self.ticks += u64::from(self.last_ticks);
         self.updates += 1;
         result
+    }
+
+    fn classify_last(&mut self, per_sample_only: bool) {
+        if per_sample_only {
+            self.plain_ticks += u64::from(self.last_ticks);
+            self.plain += 1;
+        }
     }
 }
 
 /// Ticks an empty measurement costs, averaged over many (a tick is tens of instructions).
 fn meter_overhead_ticks() -> f64 {
     const N: u32 = 1000;
-    let mut meter = SysTickMeter {
-        ticks: 0,
-        updates: 0,
-    };
+    let mut meter = SysTickMeter::new();
     for _ in 0..N {
         meter.measure(|| core::hint::black_box(0));
     }
@@ -135,7 +157,9 @@ fn run() -> Result<(), shared_run::RunError> {
     };
 
     run_measured::<f32>(&mut out, &calibration)?;
-    run_measured::<f64>(&mut out, &calibration)
+    calibrate_measured::<f32>(&mut out, &calibration)?;
+    run_measured::<f64>(&mut out, &calibration)?;
+    calibrate_measured::<f64>(&mut out, &calibration)
 }
 
 /// What turns summed SysTick ticks into instructions.
@@ -152,10 +176,7 @@ fn run_measured<R: truenorth_core::Real>(
     out: &mut impl core::fmt::Write,
     calibration: &Calibration,
 ) -> Result<(), shared_run::RunError> {
-    let mut meter = SysTickMeter {
-        ticks: 0,
-        updates: 0,
-    };
+    let mut meter = SysTickMeter::new();
     shared_run::run::<R>(out, &mut meter)?;
     let Calibration {
         instructions_per_tick,
@@ -168,6 +189,34 @@ fn run_measured<R: truenorth_core::Real>(
         "measured instructions_per_update={per_update:.0} updates={} float={} \
          instructions_per_tick={instructions_per_tick:.3} meter_overhead_ticks={overhead_ticks:.3}",
         meter.updates,
+        core::any::type_name::<R>()
+    )?;
+    Ok(())
+}
+
+/// The online ellipse calibrator's part of the shared run in the float type `R`, then a
+/// `measured` line with the mean instructions of one push: over all pushes (refresh stages,
+/// which fit in `f64` in both precisions, included) and over the pushes that ran the
+/// per-sample path alone (sums and slot, in `R`).
+fn calibrate_measured<R: truenorth_core::Real>(
+    out: &mut impl core::fmt::Write,
+    calibration: &Calibration,
+) -> Result<(), shared_run::RunError> {
+    let mut meter = SysTickMeter::new();
+    shared_run::calibrate::<R>(out, &mut meter)?;
+    let Calibration {
+        instructions_per_tick,
+        overhead_ticks,
+    } = *calibration;
+    let mean =
+        |ticks: u64, n: u32| (ticks as f64 / f64::from(n) - overhead_ticks) * instructions_per_tick;
+    writeln!(
+        out,
+        "measured instructions_per_push={:.0} per_sample_path={:.0} pushes={} per_sample_pushes={} float={}",
+        mean(meter.ticks, meter.updates),
+        mean(meter.plain_ticks, meter.plain),
+        meter.updates,
+        meter.plain,
         core::any::type_name::<R>()
     )?;
     Ok(())

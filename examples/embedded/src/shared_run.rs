@@ -1,18 +1,21 @@
 //! The computation that the Cortex-M4F binary and its host twin (`tests/embedded_twin.rs` in
 //! the main workspace) both run, from this one file: the quaternion filter over a slice of a
 //! real BROAD recording compiled into the binary, then a tilt-compensated compass heading
-//! with a stored calibration, both in the float type the caller names ([`run`]). Every
-//! result goes out as text through [`core::fmt::Write`], so the two outputs can be compared
-//! line by line.
+//! with a stored calibration ([`run`]), and the online ellipse calibrator learning a
+//! two-axis compass from a simulated turn, then a heading through what it learned
+//! ([`calibrate`]), all in the float type the caller names. Every result goes out as text
+//! through [`core::fmt::Write`], so the two outputs can be compared line by line.
 //!
 //! Nothing here allocates, reads a clock or knows where it runs; the only hook is
-//! [`UpdateMeter`], which the target uses to count the instructions of each filter update.
+//! [`UpdateMeter`], which the target uses to count the instructions of each filter update
+//! and each calibrator push.
 
 use core::fmt::{self, Write};
 
-use nalgebra::{Matrix3, Quaternion, UnitQuaternion, Vector3};
+use nalgebra::{Matrix2, Matrix3, Quaternion, UnitQuaternion, Vector2, Vector3};
+use truenorth_calib::{OnlineEllipseCalibrator, OnlineEllipseConfig};
 use truenorth_compass::CompassCalibration3d;
-use truenorth_core::{EulerZyx, Real, ned_to_enu};
+use truenorth_core::{Calibrator, EulerZyx, Real, ned_to_enu};
 use truenorth_fusion::{QuaternionFilter, QuaternionFilterConfig};
 
 /// The recording, as written by `tests/embedded_twin.rs` (`embedded_data_is_the_broad_slice`):
@@ -32,18 +35,41 @@ pub const SAMPLE_INTERVAL_S: f64 = 0.0035;
 /// Every how many samples the attitude is printed.
 const PRINT_EVERY: usize = 100;
 
-/// Counts what one filter update costs; the host twin's meter does nothing.
+/// Counts what one filter update (or calibrator push) costs; the host twin's meter does
+/// nothing.
 pub trait UpdateMeter {
     /// Runs `update` and accounts for it.
     fn measure<T>(&mut self, update: impl FnOnce() -> T) -> T;
+
+    /// Says whether the last measured push was the per-sample path alone (`true`), or also
+    /// ran a stage of the calibrator's refresh (`false`).
+    fn classify_last(&mut self, _per_sample_only: bool) {}
 }
+
+/// Readings of the simulated turn fed to the online ellipse calibrator: one per degree.
+pub const TURN_READINGS: usize = 360;
+/// The simulated two-axis compass: hard iron (µT), soft-iron distortion `W` (row-major,
+/// symmetric: the raw locus is `hard + W·h`), horizontal field (µT).
+pub const TURN_HARD_IRON_UT: [f64; 2] = [12.0, -5.0];
+const TURN_W: [f64; 4] = [1.15, 0.08, 0.08, 0.9];
+/// The horizontal field of the simulated compass, µT.
+pub const TURN_FIELD_UT: f64 = 20.0;
+/// Amplitude (µT) of a second-harmonic wobble added to the readings, so the fit has a
+/// residual: 0.2 % of the field.
+const TURN_WOBBLE_UT: f64 = 0.04;
+/// cos 1° and sin 1°: the turn advances by a rotation, with + − × only, so the readings have
+/// the same bits on the target and on the host.
+const COS_1_DEG: f64 = 0.999_847_695_156_391_3;
+const SIN_1_DEG: f64 = 0.017_452_406_437_283_51;
+/// The heading, degrees, of the reading whose heading is printed after the calibration.
+pub const TURN_CHECK_HEADING_DEG: usize = 40;
 
 /// Why the run stopped early.
 #[derive(Debug)]
 pub enum RunError {
     /// The recording's length is not a header plus whole samples.
     Recording,
-    /// The filter refused a sample.
+    /// The filter or the calibrator refused a sample, or the calibrator a solve.
     Filter(truenorth_core::Error),
     /// The output could not be written.
     Output(fmt::Error),
@@ -53,7 +79,7 @@ impl fmt::Display for RunError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             Self::Recording => f.write_str("the recording is not a header plus whole samples"),
-            Self::Filter(e) => write!(f, "the filter refused a sample: {e}"),
+            Self::Filter(e) => write!(f, "the filter or the calibrator refused: {e}"),
             Self::Output(_) => f.write_str("the output could not be written"),
         }
     }
@@ -203,5 +229,60 @@ pub fn run<R: Real>(out: &mut impl Write, meter: &mut impl UpdateMeter) -> Resul
     writeln!(out, "compass_heading_deg {}", deg(compass))?;
     let reference_yaw = EulerZyx::from_quaternion(&reference).yaw_rad;
     writeln!(out, "reference_yaw_deg {}", deg(reference_yaw))?;
+    Ok(())
+}
+
+/// The readings of the simulated turn, in `f64`: heading `k`° for reading `k`, raw
+/// `hard + W·F(cos ψ, −sin ψ)` plus the wobble.
+fn turn_readings() -> [Vector2<f64>; TURN_READINGS] {
+    let hard = Vector2::from(TURN_HARD_IRON_UT);
+    let w = Matrix2::from_row_slice(&TURN_W);
+    let (mut c, mut s) = (1.0, 0.0);
+    let mut out = [Vector2::zeros(); TURN_READINGS];
+    for p in out.iter_mut() {
+        let wobble = Vector2::new(2.0 * c * s, c * c - s * s) * TURN_WOBBLE_UT;
+        *p = hard + w * Vector2::new(c, -s) * TURN_FIELD_UT + wobble;
+        (c, s) = (c * COS_1_DEG - s * SIN_1_DEG, s * COS_1_DEG + c * SIN_1_DEG);
+    }
+    out
+}
+
+/// The online ellipse calibrator in the float type `R` fed the simulated turn, readings in
+/// `R` (its per-sample path runs in `R`; its solve in `f64`, returning the calibration in
+/// `R`), then the calibration and the heading of one reading through it, one line each. Each
+/// push goes through `meter`, classified as the per-sample path alone or a push that also ran
+/// a refresh stage.
+pub fn calibrate<R: Real>(
+    out: &mut impl Write,
+    meter: &mut impl UpdateMeter,
+) -> Result<(), RunError> {
+    let mut cal = OnlineEllipseCalibrator::<R>::with_precision(OnlineEllipseConfig::default())?;
+    let readings = turn_readings();
+    for (k, p) in readings.iter().enumerate() {
+        let mag = p.map(R::of);
+        let idle = cal.refresh_stage().is_none();
+        meter.measure(|| cal.push_reading(k as f64, &mag))?;
+        meter.classify_last(idle && cal.refresh_stage().is_none());
+    }
+    let sol = cal.solve()?;
+    let (h, s) = (sol.params.hard_iron, sol.params.soft_iron);
+    writeln!(out, "ellipse_readings {TURN_READINGS}")?;
+    writeln!(out, "ellipse_hard_iron_ut {} {}", h.x, h.y)?;
+    writeln!(
+        out,
+        "ellipse_soft_iron {} {} {} {}",
+        s[(0, 0)],
+        s[(0, 1)],
+        s[(1, 0)],
+        s[(1, 1)]
+    )?;
+    writeln!(out, "ellipse_field_ut {}", sol.quality.field_magnitude)?;
+    let check = readings[TURN_CHECK_HEADING_DEG].map(R::of);
+    writeln!(
+        out,
+        "ellipse_heading_deg {} {}",
+        deg(sol.params.heading_rad(&check)),
+        TURN_CHECK_HEADING_DEG
+    )?;
     Ok(())
 }

@@ -16,8 +16,8 @@ use nalgebra::SMatrix;
 use nalgebra::SVector;
 use serde::{Deserialize, Serialize};
 use truenorth_core::{
-    CompassQuality, CompassUncertainty, Error, FitQuality, Progress, Pushed, Result, Solution,
-    Validate, check_finite,
+    CompassQuality, CompassUncertainty, Error, FitQuality, Progress, Pushed, Real, Result,
+    Solution, Validate, check_finite,
 };
 
 use crate::online::conic_sums::{
@@ -45,26 +45,26 @@ pub(crate) trait ConicRefresh<const D: usize, const M: usize, const N: usize>:
 {
     /// The calibrator's configuration.
     type Config: OnlineConfig;
-    /// The calibration it fits.
+    /// The calibration it fits (in `f64`, as every fit runs).
     type Cal: Copy + Debug + PartialEq;
-    /// The sample it is fed.
-    type Sample;
+    /// The calibration in the float type `T` of the readings, to sort them by.
+    type CalIn<T: Real>: Copy + Debug;
     /// Number of stages of a refresh.
     const STAGES: u8;
     /// The refusal of a solve whose refresh ended without an outcome.
     const NOT_READY: Error;
-    /// The sample's timestamp and magnetometer reading.
-    fn reading(sample: &Self::Sample) -> (f64, &SVector<f64, D>);
     /// Adds reading `p` to `sums` (see [`ConicSums::add`]).
-    fn add(sums: &mut ConicSums<D, M>, p: &SVector<f64, D>, decay: f64) -> Result<()>;
-    /// The retained-reading slot of `p` under calibration `cal`.
-    fn slot(cal: &Self::Cal, p: &SVector<f64, D>) -> Option<usize>;
+    fn add<T: Real>(sums: &mut ConicSums<T, D, M>, p: &SVector<T, D>, decay: T) -> Result<()>;
+    /// `cal` in the float type `T` (see [`ConicRefresh::CalIn`]).
+    fn narrow<T: Real>(cal: &Self::Cal) -> Self::CalIn<T>;
+    /// The retained-reading slot of `p` under calibration `cal`, computed in `T`.
+    fn slot<T: Real>(cal: &Self::CalIn<T>, p: &SVector<T, D>) -> Option<usize>;
     /// Coverage of the live retained readings about calibration `cal`, as a fraction.
-    fn coverage(slots: &Retained<D, N>, now: u64, lifetime: u64, cal: &Self::Cal) -> f64;
+    fn coverage(slots: &Retained<f64, D, N>, now: u64, lifetime: u64, cal: &Self::Cal) -> f64;
     /// Whether every coefficient of `cal` is finite.
     fn is_finite(cal: &Self::Cal) -> bool;
     /// A refresh of copies of `sums` and `slots`, no stage run yet.
-    fn start(sums: &ConicSums<D, M>, slots: &Retained<D, N>) -> Self;
+    fn start(sums: &ConicSums<f64, D, M>, slots: &Retained<f64, D, N>) -> Self;
     /// Runs stage `stage` (see [`ConicRefresh::step`]).
     fn run_stage(&mut self, stage: u8, cfg: &Self::Config, lifetime: u64);
     /// What every refresh keeps: its copies, its stage, its sorting map and its outcome.
@@ -92,8 +92,8 @@ pub(crate) trait ConicRefresh<const D: usize, const M: usize, const N: usize>:
 /// the outcome once known.
 #[derive(Debug, Clone)]
 pub(crate) struct RefreshBase<const D: usize, const M: usize, const N: usize, C> {
-    pub sums: ConicSums<D, M>,
-    pub slots: Retained<D, N>,
+    pub sums: ConicSums<f64, D, M>,
+    pub slots: Retained<f64, D, N>,
     pub stage: u8,
     pub map: Option<C>,
     pub outcome: Option<Result<Solution<C>>>,
@@ -101,7 +101,7 @@ pub(crate) struct RefreshBase<const D: usize, const M: usize, const N: usize, C>
 
 impl<const D: usize, const M: usize, const N: usize, C> RefreshBase<D, M, N, C> {
     /// Copies of `sums` and `slots`, no stage run yet.
-    pub fn new(sums: &ConicSums<D, M>, slots: &Retained<D, N>) -> Self {
+    pub fn new(sums: &ConicSums<f64, D, M>, slots: &Retained<f64, D, N>) -> Self {
         Self {
             sums: *sums,
             slots: *slots,
@@ -147,7 +147,7 @@ impl<const D: usize, const M: usize, const N: usize, C> RefreshBase<D, M, N, C> 
 /// scaled by `√κ`, so that `‖L⁻¹g‖²` is the variance factor of a gradient `g` directly.
 /// `(∞, None)` when the readings do not outnumber the parameters.
 pub(crate) fn noise_factor<const D: usize, const M: usize, const P: usize>(
-    sums: &ConicSums<D, M>,
+    sums: &ConicSums<f64, D, M>,
     weighted_ss: f64,
     info: &SMatrix<f64, P, P>,
 ) -> (f64, Option<SMatrix<f64, P, P>>) {
@@ -230,27 +230,33 @@ pub(crate) fn refuse_fit(
 }
 
 /// The state and per-sample logic of an online conic calibrator (see the
-/// `online_ellipse` module for the scheme).
+/// `online_ellipse` module for the scheme), its sums and retained readings in `T`.
+///
+/// The per-sample path (the sums, the sorting of a reading into its slot) runs in `T`; a
+/// refresh converts its copies of the sums and readings to `f64` (exact) and fits in
+/// `f64` whatever `T` is, and its calibration is narrowed back to `T` to sort readings by.
 #[derive(Debug, Clone)]
-pub(crate) struct OnlineCore<const D: usize, const M: usize, const N: usize, R>
+pub(crate) struct OnlineCore<T: Real, const D: usize, const M: usize, const N: usize, R>
 where
     R: ConicRefresh<D, M, N>,
 {
     pub config: R::Config,
     /// Per-reading weight factor and retained-reading lifetime, from the config.
-    decay: f64,
+    decay: T,
     lifetime: u64,
-    sums: ConicSums<D, M>,
-    slots: Retained<D, N>,
-    /// The calibration retained readings are sorted by (`None` before the first refresh).
+    sums: ConicSums<T, D, M>,
+    slots: Retained<T, D, N>,
+    /// The calibration retained readings are sorted by (`None` before the first refresh),
+    /// and the same in `T`.
     map: Option<R::Cal>,
+    map_in: Option<R::CalIn<T>>,
     estimate: Option<Solution<R::Cal>>,
     /// Sample count at which the next refresh starts.
     next_refresh: u64,
     pending: Option<R>,
 }
 
-impl<const D: usize, const M: usize, const N: usize, R> OnlineCore<D, M, N, R>
+impl<T: Real, const D: usize, const M: usize, const N: usize, R> OnlineCore<T, D, M, N, R>
 where
     R: ConicRefresh<D, M, N>,
 {
@@ -260,11 +266,12 @@ where
         let (decay, lifetime) = forgetting(config.forgetting_half_life_samples());
         Ok(Self {
             config,
-            decay,
+            decay: T::of(decay),
             lifetime,
             sums: ConicSums::new(),
             slots: Retained::new(),
             map: None,
+            map_in: None,
             estimate: None,
             next_refresh: u64::from(config.min_samples()),
             pending: None,
@@ -276,14 +283,21 @@ where
         self.pending.as_ref().map(|r| r.base().stage)
     }
 
+    /// A refresh of the current sums and retained readings, in `f64`.
+    fn start(&self) -> R {
+        R::start(&self.sums.widened(), &self.slots.widened())
+    }
+
     /// Completes a finished refresh: adopts its sorting map (re-sorting the retained
     /// readings) and, if it succeeded, its estimate. Returns whether the estimate changed.
     fn publish(&mut self, r: R) -> bool {
         let RefreshBase { map, outcome, .. } = r.into_base();
         if let Some(m) = map {
+            let m_in = R::narrow::<T>(&m);
             self.map = Some(m);
+            self.map_in = Some(m_in);
             self.slots
-                .rekey(|p| R::slot(&m, p), self.sums.count, self.lifetime);
+                .rekey(|p| R::slot(&m_in, p), self.sums.count, self.lifetime);
         }
         match outcome {
             Some(Ok(sol)) if self.estimate != Some(sol) => {
@@ -294,18 +308,18 @@ where
         }
     }
 
-    /// See [`truenorth_core::Calibrator::push`] on the calibrators.
-    pub fn push(&mut self, sample: &R::Sample) -> Result<Pushed> {
-        let (t_s, mag) = R::reading(sample);
+    /// See [`truenorth_core::Calibrator::push`] on the calibrators: the reading `mag` at
+    /// time `t_s`.
+    pub fn push(&mut self, t_s: f64, mag: &SVector<T, D>) -> Result<Pushed> {
         check_finite("timestamp t_s", t_s)?;
         for &x in mag.iter() {
-            check_finite("magnetometer reading", x)?;
+            check_finite("magnetometer reading", x.to_f64())?;
         }
         R::add(&mut self.sums, mag, self.decay)?;
         let now = self.sums.count;
         // Before the first refresh there is no calibration to sort by: the first readings
         // take the slots in order, and the first refresh sorts them.
-        let slot = match &self.map {
+        let slot = match &self.map_in {
             Some(m) => R::slot(m, mag),
             None => Some((now - 1) as usize),
         };
@@ -313,7 +327,7 @@ where
             self.slots.offer(k, mag, now, self.lifetime);
         }
         if self.pending.is_none() && now >= self.next_refresh {
-            self.pending = Some(R::start(&self.sums, &self.slots));
+            self.pending = Some(self.start());
             self.next_refresh = now + u64::from(self.config.refresh_interval_samples());
         }
         let done = match &mut self.pending {
@@ -333,7 +347,7 @@ where
     pub fn progress(&self) -> Progress {
         let coverage = self
             .map
-            .map(|m| R::coverage(&self.slots, self.sums.count, self.lifetime, &m))
+            .map(|m| R::coverage(&self.slots.widened(), self.sums.count, self.lifetime, &m))
             .unwrap_or(0.0);
         Progress {
             samples: self.sums.count as usize,
@@ -344,7 +358,7 @@ where
 
     /// See [`truenorth_core::Calibrator::solve`] on the calibrators.
     pub fn solve(&self) -> Result<Solution<R::Cal>> {
-        let mut r = R::start(&self.sums, &self.slots);
+        let mut r = self.start();
         while !r.step(&self.config, self.lifetime) {}
         r.into_base().outcome.unwrap_or(Err(R::NOT_READY))
     }
@@ -354,6 +368,7 @@ where
         self.sums = ConicSums::new();
         self.slots = Retained::new();
         self.map = None;
+        self.map_in = None;
         self.estimate = None;
         self.next_refresh = u64::from(self.config.min_samples());
         self.pending = None;
@@ -382,6 +397,7 @@ where
     }
 
     /// Back from a saved state, refusing one that this calibrator could not have written.
+    /// A refresh in progress was saved in `f64` and is restored so, whatever `T` is.
     pub fn restore(s: OnlineConicState<R::Config, R::Cal>) -> Result<Self> {
         let mut cal = Self::new(s.config)?;
         cal.sums = ConicSums::restore(&s.sums)?;
@@ -394,16 +410,17 @@ where
             });
         }
         cal.map = s.sorting;
+        cal.map_in = s.sorting.as_ref().map(R::narrow::<T>);
         cal.estimate = s.estimate;
         cal.next_refresh = s.next_refresh;
         if let Some(p) = s.pending {
-            let sums = ConicSums::restore(&p.sums)?;
+            let sums = ConicSums::<f64, D, M>::restore(&p.sums)?;
             if sums.count > cal.sums.count || p.stage >= R::STAGES {
                 return Err(Error::InvalidSnapshot {
                     reason: "the saved refresh does not fit the saved sums",
                 });
             }
-            let slots = Retained::restore(&p.retained, sums.count)?;
+            let slots = Retained::<f64, D, N>::restore(&p.retained, sums.count)?;
             let mut r = R::start(&sums, &slots);
             while r.base().stage < p.stage && !r.step(&cal.config, cal.lifetime) {}
             if r.base().outcome.is_some() || r.base().stage != p.stage {

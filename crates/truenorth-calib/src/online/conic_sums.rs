@@ -30,7 +30,7 @@ use alloc::vec::Vec;
 
 use nalgebra::{SMatrix, SVector};
 use serde::{Deserialize, Serialize};
-use truenorth_core::{Error, Result};
+use truenorth_core::{Error, Real, Result};
 
 pub(crate) use crate::online::retained::Retained;
 pub use crate::online::retained::RetainedSnapshot;
@@ -255,17 +255,18 @@ pub(crate) const LAYOUT_2D: Layout<2, 6, MONOMIALS_2D> = Layout::new(TERMS_2D);
 pub(crate) const LAYOUT_3D: Layout<3, 10, MONOMIALS_3D> = Layout::new(TERMS_3D);
 
 /// Weighted sums of the monomials of degree ≤ 4 of the readings, in coordinates relative
-/// to a reference fixed by the first reading.
+/// to a reference fixed by the first reading, in the calibrator's float type `T` (a fit
+/// converts them to `f64` first, see [`ConicSums::widened`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct ConicSums<const D: usize, const M: usize> {
+pub(crate) struct ConicSums<T: Real, const D: usize, const M: usize> {
     /// The first reading (the coordinates' origin).
-    pub origin: SVector<f64, D>,
+    pub origin: SVector<T, D>,
     /// Unit of the coordinates: the norm of the first reading (1 if it was zero).
-    pub scale: f64,
+    pub scale: T,
     /// `Σ w q^α` for every monomial `α` of degree ≤ 4 (the first is `Σ w`).
-    pub sums: [f64; M],
+    pub sums: [T; M],
     /// `Σ w²`, for the effective number of readings under forgetting.
-    pub sum_w2: f64,
+    pub sum_w2: T,
     /// Readings accepted.
     pub count: u64,
 }
@@ -275,18 +276,93 @@ pub(crate) struct ConicSums<const D: usize, const M: usize> {
 /// 1.9e72; the margin keeps the congruences of the fit finite as well).
 pub(crate) const MAX_RELATIVE_COORDINATE: f64 = 1e60;
 
-impl<const D: usize, const M: usize> ConicSums<D, M> {
+/// [`MAX_RELATIVE_COORDINATE`] for sums in `f32`: the fourth root of 3.4e38/2⁶⁴ is 6.6e4;
+/// 1e4 leaves a factor of 1,900 for the products of the fit's first congruences.
+pub(crate) const MAX_RELATIVE_COORDINATE_F32: f64 = 1e4;
+
+/// The largest relative coordinate sums in `T` take: [`MAX_RELATIVE_COORDINATE`] where `T`
+/// holds it (`f64`), [`MAX_RELATIVE_COORDINATE_F32`] otherwise. A constant once
+/// monomorphised.
+#[inline(always)]
+pub(crate) fn max_relative_coordinate<T: Real>() -> T {
+    let wide = T::of(MAX_RELATIVE_COORDINATE);
+    if wide.is_finite() {
+        wide
+    } else {
+        T::of(MAX_RELATIVE_COORDINATE_F32)
+    }
+}
+
+impl<T: Real, const D: usize, const M: usize> ConicSums<T, D, M> {
     /// No readings yet.
-    pub const fn new() -> Self {
+    pub fn new() -> Self {
         Self {
-            origin: SVector::<f64, D>::from_array_storage(nalgebra::ArrayStorage([[0.0; D]; 1])),
-            scale: 1.0,
-            sums: [0.0; M],
-            sum_w2: 0.0,
+            origin: SVector::zeros(),
+            scale: T::one(),
+            sums: [T::zero(); M],
+            sum_w2: T::zero(),
             count: 0,
         }
     }
 
+    /// Adds the finite reading `p` with weight 1 after multiplying the sums by `decay`
+    /// (1 for no forgetting). Refuses, changing nothing, a reading so far from the first that
+    /// its fourth power would overflow (see [`max_relative_coordinate`]). No allocation; one
+    /// product per monomial, all in `T`.
+    #[inline]
+    pub fn add<const K: usize>(
+        &mut self,
+        layout: &Layout<D, K, M>,
+        p: &SVector<T, D>,
+        decay: T,
+    ) -> Result<()> {
+        if self.count == 0 {
+            let n = p.norm();
+            self.origin = *p;
+            self.scale = if n > T::zero() && n.is_finite() {
+                n
+            } else {
+                T::one()
+            };
+        }
+        let q = (p - self.origin) / self.scale;
+        let far = q.amax();
+        let limit = max_relative_coordinate::<T>();
+        if !(far <= limit) {
+            return Err(Error::OutOfRange {
+                what: "magnetometer reading, relative to the first reading and in its unit",
+                value: far.to_f64(),
+                min: -limit.to_f64(),
+                max: limit.to_f64(),
+            });
+        }
+        let mut m = [T::one(); M];
+        for j in 1..M {
+            let (pa, v) = layout.parent[j];
+            m[j] = m[pa as usize] * q[v as usize];
+        }
+        for (s, mj) in self.sums.iter_mut().zip(m) {
+            *s = *s * decay + mj;
+        }
+        self.sum_w2 = self.sum_w2 * decay * decay + T::one();
+        self.count += 1;
+        Ok(())
+    }
+
+    /// The sums in `f64` (exact), for a fit: the fit runs in `f64` whatever `T` is, see
+    /// the `online_ellipse` module.
+    pub fn widened(&self) -> ConicSums<f64, D, M> {
+        ConicSums {
+            origin: self.origin.map(T::to_f64),
+            scale: self.scale.to_f64(),
+            sums: self.sums.map(T::to_f64),
+            sum_w2: self.sum_w2.to_f64(),
+            count: self.count,
+        }
+    }
+}
+
+impl<const D: usize, const M: usize> ConicSums<f64, D, M> {
     /// Sum of the weights.
     pub fn weight(&self) -> f64 {
         self.sums[0]
@@ -300,44 +376,6 @@ impl<const D: usize, const M: usize> ConicSums<D, M> {
         } else {
             0.0
         }
-    }
-
-    /// Adds the finite reading `p` with weight 1 after multiplying the sums by `decay`
-    /// (1 for no forgetting). Refuses, changing nothing, a reading so far from the first that
-    /// its fourth power would overflow. No allocation; one product per monomial.
-    #[inline]
-    pub fn add<const K: usize>(
-        &mut self,
-        layout: &Layout<D, K, M>,
-        p: &SVector<f64, D>,
-        decay: f64,
-    ) -> Result<()> {
-        if self.count == 0 {
-            let n = p.norm();
-            self.origin = *p;
-            self.scale = if n > 0.0 && n.is_finite() { n } else { 1.0 };
-        }
-        let q = (p - self.origin) / self.scale;
-        let far = q.amax();
-        if !(far <= MAX_RELATIVE_COORDINATE) {
-            return Err(Error::OutOfRange {
-                what: "magnetometer reading, relative to the first reading and in its unit",
-                value: far,
-                min: -MAX_RELATIVE_COORDINATE,
-                max: MAX_RELATIVE_COORDINATE,
-            });
-        }
-        let mut m = [1.0; M];
-        for j in 1..M {
-            let (pa, v) = layout.parent[j];
-            m[j] = m[pa as usize] * q[v as usize];
-        }
-        for (s, mj) in self.sums.iter_mut().zip(m) {
-            *s = *s * decay + mj;
-        }
-        self.sum_w2 = self.sum_w2 * decay * decay + 1.0;
-        self.count += 1;
-        Ok(())
     }
 
     /// The weighted scatter matrix in normalised coordinates (centroid at the origin, RMS
@@ -394,40 +432,53 @@ pub struct SumsSnapshot {
     pub count: u64,
 }
 
-impl<const D: usize, const M: usize> ConicSums<D, M> {
-    /// The serialisable form.
+impl<T: Real, const D: usize, const M: usize> ConicSums<T, D, M> {
+    /// The serialisable form (`f64`, exact for either float type).
     pub fn snapshot(&self) -> SumsSnapshot {
+        let wide = self.widened();
         SumsSnapshot {
-            origin: self.origin.iter().copied().collect(),
-            scale: self.scale,
-            sums: self.sums.to_vec(),
-            sum_w2: self.sum_w2,
-            count: self.count,
+            origin: wide.origin.iter().copied().collect(),
+            scale: wide.scale,
+            sums: wide.sums.to_vec(),
+            sum_w2: wide.sum_w2,
+            count: wide.count,
         }
     }
 
-    /// Back from the serialisable form, refusing wrong lengths and non-finite values.
+    /// Back from the serialisable form, refusing wrong lengths and values not finite in `T`
+    /// (a state saved in `f64` and restored in `f32` is rounded to nearest).
     pub fn restore(s: &SumsSnapshot) -> Result<Self> {
         if s.origin.len() != D || s.sums.len() != M {
             return Err(Error::InvalidSnapshot {
                 reason: "the running sums do not have the layout of this calibrator",
             });
         }
-        let finite = s.origin.iter().chain(&s.sums).all(|x| x.is_finite())
-            && s.sum_w2.is_finite()
-            && s.scale.is_finite();
-        if !finite || !(s.scale > 0.0) || s.sum_w2 < 0.0 || (s.count == 0) != (s.sums[0] == 0.0) {
+        let finite = s
+            .origin
+            .iter()
+            .chain(&s.sums)
+            .all(|&x| T::of(x).is_finite())
+            && T::of(s.sum_w2).is_finite()
+            && T::of(s.scale).is_finite();
+        let (scale, weight) = (T::of(s.scale), T::of(s.sums[0]));
+        if !finite
+            || !(scale > T::zero())
+            || s.sum_w2 < 0.0
+            || (s.count == 0) != (weight == T::zero())
+        {
             return Err(Error::InvalidSnapshot {
                 reason: "the running sums are not finite or do not agree with the sample count",
             });
         }
-        let mut sums = [0.0; M];
-        sums.copy_from_slice(&s.sums);
+        let mut sums = [T::zero(); M];
+        for (to, &from) in sums.iter_mut().zip(&s.sums) {
+            *to = T::of(from);
+        }
         Ok(Self {
-            origin: SVector::from_fn(|i, _| s.origin[i]),
-            scale: s.scale,
+            origin: SVector::from_fn(|i, _| T::of(s.origin[i])),
+            scale: T::of(s.scale),
             sums,
-            sum_w2: s.sum_w2,
+            sum_w2: T::of(s.sum_w2),
             count: s.count,
         })
     }
@@ -513,7 +564,7 @@ mod tests {
                 Vector2::new(3.0 + 2.0 * a.cos() + 0.1 * a, -1.0 + a.sin())
             })
             .collect();
-        let mut s = ConicSums::<2, MONOMIALS_2D>::new();
+        let mut s = ConicSums::<f64, 2, MONOMIALS_2D>::new();
         for p in &pts {
             s.add(&LAYOUT_2D, p, 1.0).unwrap();
         }
@@ -550,7 +601,7 @@ mod tests {
 
     #[test]
     fn far_readings_are_refused_and_change_nothing() {
-        let mut s = ConicSums::<2, MONOMIALS_2D>::new();
+        let mut s = ConicSums::<f64, 2, MONOMIALS_2D>::new();
         s.add(&LAYOUT_2D, &Vector2::new(1.0, 0.0), 1.0).unwrap();
         let before = s;
         assert!(s.add(&LAYOUT_2D, &Vector2::new(1e300, 0.0), 1.0).is_err());

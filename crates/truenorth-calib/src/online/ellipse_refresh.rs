@@ -10,8 +10,8 @@
 use core::f64::consts::TAU;
 
 use nalgebra::{Matrix2, Matrix3, SMatrix, SVector, Vector2, Vector3};
-use truenorth_compass::CompassCalibration2d;
-use truenorth_core::{Error, FitQuality, Mag2Sample, Result, Solution};
+use truenorth_compass::{CompassCalibration2d, CompassCalibration2dIn};
+use truenorth_core::{Error, FitQuality, Real, Result, Solution};
 
 use crate::fits::ellipse::direct::{
     Ellipse, conic_to_ellipse, denormalise, from_params, solve_direct, to_params,
@@ -22,7 +22,7 @@ use crate::fits::lm::LmSteps;
 use crate::fits::normalise::Normaliser;
 use crate::numerics::linalg::{condition_from_eigenvalues, sym_eigen2, sym_eigen5, sym_sqrt2};
 use crate::online::conic_sums::{ConicSums, LAYOUT_2D, MONOMIALS_2D, Retained, inverse_factor};
-use crate::quality::{self, COVERAGE_BINS, Coverage, GAP_BINS, turns};
+use crate::quality::{self, COVERAGE_BINS, Coverage, GAP_BINS, turns, turns_in};
 
 use crate::online::conic::{
     ConicRefresh, RefreshBase, bound_deg, direct_fit_bias_rad, noise_factor, refuse_fit, report,
@@ -43,20 +43,23 @@ const PARAMS: usize = 5;
 /// reading per slot, so it may err short by up to a slot.
 pub const ONLINE_SLOTS_2D: usize = 72;
 
-pub(crate) type Sums = ConicSums<2, MONOMIALS_2D>;
-pub(crate) type Slots = Retained<2, ONLINE_SLOTS_2D>;
+pub(crate) type Sums = ConicSums<f64, 2, MONOMIALS_2D>;
+pub(crate) type Slots = Retained<f64, 2, ONLINE_SLOTS_2D>;
 type Base = RefreshBase<2, MONOMIALS_2D, ONLINE_SLOTS_2D, CompassCalibration2d>;
 
 /// The direction slot of reading `p` under calibration `m`: its calibrated direction,
 /// counter-clockwise from +x, in slots of 5°. `None` at the centre or for non-finite values.
+/// In the readings' float type `T`: the slot is a bookkeeping choice, whose rounding in
+/// `f32` moves a reading at most into a neighbouring slot.
 #[inline]
-pub(crate) fn slot_of(m: &CompassCalibration2d, p: &Vector2<f64>) -> Option<usize> {
+pub(crate) fn slot_of<T: Real>(m: &CompassCalibration2dIn<T>, p: &Vector2<T>) -> Option<usize> {
     let h = m.correct(p);
     let r2 = h.norm_squared();
-    if !(r2 > 0.0 && r2.is_finite()) {
+    if !(r2 > T::zero() && r2.is_finite()) {
         return None;
     }
-    Some(((turns(h.y, h.x) * ONLINE_SLOTS_2D as f64) as usize).min(ONLINE_SLOTS_2D - 1))
+    let slot = (turns_in(h.y, h.x) * T::of(ONLINE_SLOTS_2D as f64)).to_f64() as usize;
+    Some(slot.min(ONLINE_SLOTS_2D - 1))
 }
 
 /// Coverage of the live retained readings about calibration `m`, with the bins of
@@ -474,7 +477,7 @@ impl Refresh {
 impl ConicRefresh<2, MONOMIALS_2D, ONLINE_SLOTS_2D> for Refresh {
     type Config = OnlineEllipseConfig;
     type Cal = CompassCalibration2d;
-    type Sample = Mag2Sample;
+    type CalIn<T: Real> = CompassCalibration2dIn<T>;
     const STAGES: u8 = STAGES;
     const NOT_READY: Error = Error::NotReady {
         what: "online ellipse solution",
@@ -482,17 +485,20 @@ impl ConicRefresh<2, MONOMIALS_2D, ONLINE_SLOTS_2D> for Refresh {
     };
 
     #[inline]
-    fn reading(sample: &Mag2Sample) -> (f64, &Vector2<f64>) {
-        (sample.t_s, &sample.mag)
-    }
-
-    #[inline]
-    fn add(sums: &mut Sums, p: &Vector2<f64>, decay: f64) -> Result<()> {
+    fn add<T: Real>(
+        sums: &mut ConicSums<T, 2, MONOMIALS_2D>,
+        p: &Vector2<T>,
+        decay: T,
+    ) -> Result<()> {
         sums.add(&LAYOUT_2D, p, decay)
     }
 
+    fn narrow<T: Real>(cal: &CompassCalibration2d) -> CompassCalibration2dIn<T> {
+        cal.to_precision()
+    }
+
     #[inline]
-    fn slot(cal: &CompassCalibration2d, p: &Vector2<f64>) -> Option<usize> {
+    fn slot<T: Real>(cal: &CompassCalibration2dIn<T>, p: &Vector2<T>) -> Option<usize> {
         slot_of(cal, p)
     }
 

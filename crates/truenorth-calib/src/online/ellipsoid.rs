@@ -10,10 +10,11 @@
 //! alone visits 256 directions, 32 per stage). Coverage is the share of the equal-area
 //! direction cells of [`crate::quality`] holding a retained reading, at most one per cell.
 
-use truenorth_compass::CompassCalibration3d;
+use nalgebra::Vector3;
+use truenorth_compass::{CompassCalibration3d, CompassCalibration3dIn};
 use truenorth_core::{
-    Calibrator, CompassQuality, Mag3Sample, OnlineCalibrator, Persistent, Progress, Pushed, Result,
-    Solution,
+    Calibrator, CompassQuality, Mag3Sample, OnlineCalibrator, Persistent, Progress, Pushed, Real,
+    Result, Solution,
 };
 
 use crate::online::conic::{OnlineConicState, OnlineCore};
@@ -24,6 +25,11 @@ use crate::quality::SPHERE_CELLS;
 
 /// Online least-squares ellipsoid calibrator: the direct fit of
 /// [`crate::EllipsoidCalibrator`] from running sums, O(1) memory and O(1) per push.
+///
+/// As the two-axis [`crate::OnlineEllipseCalibrator`], its sums and retained readings are
+/// in the float type `T` (`f64` by default, [`OnlineEllipsoidCalibrator::with_precision`]
+/// for `f32`), and its fit runs in `f64` (the same reasons, sharper: 35 moments of degree
+/// 4 in 3-D), returning the calibration in `T`.
 ///
 /// ```
 /// use nalgebra::Vector3;
@@ -46,14 +52,30 @@ use crate::quality::SPHERE_CELLS;
 /// # Ok::<(), truenorth_core::Error>(())
 /// ```
 #[derive(Debug, Clone)]
-pub struct OnlineEllipsoidCalibrator {
-    core: OnlineCore<3, MONOMIALS_3D, SPHERE_CELLS, Refresh>,
+pub struct OnlineEllipsoidCalibrator<T: Real = f64> {
+    core: OnlineCore<T, 3, MONOMIALS_3D, SPHERE_CELLS, Refresh>,
 }
 
 impl OnlineEllipsoidCalibrator {
     /// A calibrator with the given configuration, or the first invalid parameter, named.
     pub fn new(config: OnlineEllipsoidConfig) -> Result<Self> {
+        Self::with_precision(config)
+    }
+}
+
+impl<T: Real> OnlineEllipsoidCalibrator<T> {
+    /// As [`OnlineEllipsoidCalibrator::new`], its sums and retained readings in `T`:
+    /// `OnlineEllipsoidCalibrator::<f32>::with_precision(config)` for a single-precision
+    /// FPU. The configuration is the same `f64` one for every `T`.
+    pub fn with_precision(config: OnlineEllipsoidConfig) -> Result<Self> {
         OnlineCore::new(config).map(|core| Self { core })
+    }
+
+    /// Adds the reading `mag` (in `T`) taken at `t_s` seconds: as [`Calibrator::push`]
+    /// without a conversion from `f64`. O(1), no allocation.
+    #[inline]
+    pub fn push_reading(&mut self, t_s: f64, mag: &Vector3<T>) -> Result<Pushed> {
+        self.core.push(t_s, mag)
     }
 
     /// The stage a refresh in progress will run at the next push, if one is in progress
@@ -68,16 +90,24 @@ impl OnlineEllipsoidCalibrator {
     }
 }
 
-impl Calibrator for OnlineEllipsoidCalibrator {
+/// A solution of the `f64` fit with its calibration in `T` (exact for `f64`).
+fn narrowed<T: Real>(sol: Solution<CompassCalibration3d>) -> Solution<CompassCalibration3dIn<T>> {
+    Solution {
+        params: sol.params.to_precision(),
+        quality: sol.quality,
+    }
+}
+
+impl<T: Real> Calibrator for OnlineEllipsoidCalibrator<T> {
     type Sample = Mag3Sample;
-    type Params = CompassCalibration3d;
+    type Params = CompassCalibration3dIn<T>;
     type Quality = CompassQuality;
 
     /// Adds a reading to the sums (and, when its direction cell is free, to the retained
     /// readings), and runs one stage of a refresh when one is due. O(1), no allocation; a
-    /// non-finite sample is refused and changes nothing.
+    /// non-finite sample is refused and changes nothing. The reading is rounded to `T`.
     fn push(&mut self, sample: &Mag3Sample) -> Result<Pushed> {
-        self.core.push(sample)
+        self.core.push(sample.t_s, &sample.mag.map(T::of))
     }
 
     /// Samples accepted, direction-cell coverage of the retained readings about the current
@@ -87,8 +117,8 @@ impl Calibrator for OnlineEllipsoidCalibrator {
         self.core.progress()
     }
 
-    fn solve(&self) -> Result<Solution<CompassCalibration3d>> {
-        self.core.solve()
+    fn solve(&self) -> Result<Solution<CompassCalibration3dIn<T>>> {
+        self.core.solve().map(narrowed)
     }
 
     fn reset(&mut self) {
@@ -96,16 +126,18 @@ impl Calibrator for OnlineEllipsoidCalibrator {
     }
 }
 
-impl OnlineCalibrator for OnlineEllipsoidCalibrator {
+impl<T: Real> OnlineCalibrator for OnlineEllipsoidCalibrator<T> {
     /// The latest refresh's successful solution (a refused refresh keeps the previous one).
-    fn estimate(&self) -> Option<Solution<CompassCalibration3d>> {
-        self.core.estimate()
+    fn estimate(&self) -> Option<Solution<CompassCalibration3dIn<T>>> {
+        self.core.estimate().map(narrowed)
     }
 }
 
 /// The saved state of an [`OnlineEllipsoidCalibrator`].
 pub type OnlineEllipsoidState = OnlineConicState<OnlineEllipsoidConfig, CompassCalibration3d>;
 
+// For `f64` only, as the other per-sample types' persistence (a `T` to infer would make
+// `OnlineEllipsoidCalibrator::restore(state)` ambiguous).
 impl Persistent for OnlineEllipsoidCalibrator {
     type State = OnlineEllipsoidState;
     const SNAPSHOT_VERSION: u32 = 1;

@@ -9,8 +9,8 @@
 //! (1–5) and `support_stages` (6 to the bound), the staged eigen-solver in `jacobi`.
 
 use nalgebra::{SMatrix, SVector, Vector3};
-use truenorth_compass::CompassCalibration3d;
-use truenorth_core::{Error, FitQuality, Mag3Sample, Result, Solution};
+use truenorth_compass::{CompassCalibration3d, CompassCalibration3dIn};
+use truenorth_core::{Error, FitQuality, Real, Result, Solution};
 
 use crate::fits::ellipsoid::config::ORIENTATION_HINT;
 use crate::fits::ellipsoid::direct::{Ellipsoid, Reduced};
@@ -54,8 +54,8 @@ pub(crate) const STAGES: u8 = BOUND_FIRST_STAGE + (BOUND_DIRECTIONS / BOUND_CHUN
 const STRAY: &str =
     " (the readings stray from the best ellipsoid by more than max_residual_rel of the field)";
 
-pub(crate) type Sums = ConicSums<3, MONOMIALS_3D>;
-pub(crate) type Slots = Retained<3, SPHERE_CELLS>;
+pub(crate) type Sums = ConicSums<f64, 3, MONOMIALS_3D>;
+pub(crate) type Slots = Retained<f64, 3, SPHERE_CELLS>;
 type Base = RefreshBase<3, MONOMIALS_3D, SPHERE_CELLS, CompassCalibration3d>;
 
 /// The equal-area direction cell of `h` (as [`quality::sphere_coverage`]: bands uniform in
@@ -166,7 +166,7 @@ impl Refresh {
 impl ConicRefresh<3, MONOMIALS_3D, SPHERE_CELLS> for Refresh {
     type Config = OnlineEllipsoidConfig;
     type Cal = CompassCalibration3d;
-    type Sample = Mag3Sample;
+    type CalIn<T: Real> = CompassCalibration3dIn<T>;
     const STAGES: u8 = STAGES;
     const NOT_READY: Error = Error::NotReady {
         what: "online ellipsoid solution",
@@ -174,18 +174,24 @@ impl ConicRefresh<3, MONOMIALS_3D, SPHERE_CELLS> for Refresh {
     };
 
     #[inline]
-    fn reading(sample: &Mag3Sample) -> (f64, &Vector3<f64>) {
-        (sample.t_s, &sample.mag)
-    }
-
-    #[inline]
-    fn add(sums: &mut Sums, p: &Vector3<f64>, decay: f64) -> Result<()> {
+    fn add<T: Real>(
+        sums: &mut ConicSums<T, 3, MONOMIALS_3D>,
+        p: &Vector3<T>,
+        decay: T,
+    ) -> Result<()> {
         sums.add(&LAYOUT_3D, p, decay)
     }
 
+    fn narrow<T: Real>(cal: &CompassCalibration3d) -> CompassCalibration3dIn<T> {
+        cal.to_precision()
+    }
+
+    /// The calibrated reading in `T`, its cell found in `f64` (the cell's band and sector
+    /// are comparisons on the direction, exact in either type up to the reading's own
+    /// rounding).
     #[inline]
-    fn slot(cal: &CompassCalibration3d, p: &Vector3<f64>) -> Option<usize> {
-        cell(&cal.correct(p))
+    fn slot<T: Real>(cal: &CompassCalibration3dIn<T>, p: &Vector3<T>) -> Option<usize> {
+        cell(&cal.correct(p).map(T::to_f64))
     }
 
     fn coverage(slots: &Slots, now: u64, lifetime: u64, cal: &CompassCalibration3d) -> f64 {

@@ -5,7 +5,7 @@ use alloc::vec::Vec;
 
 use nalgebra::SVector;
 use serde::{Deserialize, Serialize};
-use truenorth_core::{Error, Result};
+use truenorth_core::{Error, Real, Result};
 
 /// Readings kept for coverage: at most one per direction slot, so that how much of the
 /// circle (sphere) the data cover can be measured about any centre without storing every
@@ -16,15 +16,17 @@ use truenorth_core::{Error, Result};
 /// so the ends of an arc are never replaced by readings from its middle. A coverage measured
 /// on these readings is that of a subset of the data, so it never exceeds the batch fit's
 /// coverage about the same centre.
+///
+/// The readings are kept in the calibrator's float type `T`, as they arrived.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct Retained<const D: usize, const N: usize> {
+pub(crate) struct Retained<T: Real, const D: usize, const N: usize> {
     /// The reading in each slot.
-    pub reading: [SVector<f64, D>; N],
+    pub reading: [SVector<T, D>; N],
     /// Its sample number (1 for the first reading accepted); 0 for an empty slot.
     pub stamp: [u64; N],
 }
 
-impl<const D: usize, const N: usize> Retained<D, N> {
+impl<T: Real, const D: usize, const N: usize> Retained<T, D, N> {
     /// No readings.
     pub fn new() -> Self {
         Self {
@@ -42,7 +44,7 @@ impl<const D: usize, const N: usize> Retained<D, N> {
 
     /// Keeps reading `p` (sample number `stamp`) in `slot` unless a live reading is there.
     #[inline]
-    pub fn offer(&mut self, slot: usize, p: &SVector<f64, D>, stamp: u64, lifetime: u64) {
+    pub fn offer(&mut self, slot: usize, p: &SVector<T, D>, stamp: u64, lifetime: u64) {
         if slot < N && !self.is_live(slot, stamp, lifetime) {
             self.reading[slot] = *p;
             self.stamp[slot] = stamp;
@@ -53,7 +55,7 @@ impl<const D: usize, const N: usize> Retained<D, N> {
     /// in a slot the older stays. O(N), no allocation.
     pub fn rekey(
         &mut self,
-        key: impl Fn(&SVector<f64, D>) -> Option<usize>,
+        key: impl Fn(&SVector<T, D>) -> Option<usize>,
         now: u64,
         lifetime: u64,
     ) {
@@ -73,40 +75,49 @@ impl<const D: usize, const N: usize> Retained<D, N> {
     }
 
     /// The live readings at sample `now`.
-    pub fn live(&self, now: u64, lifetime: u64) -> impl Iterator<Item = &SVector<f64, D>> {
+    pub fn live(&self, now: u64, lifetime: u64) -> impl Iterator<Item = &SVector<T, D>> {
         (0..N)
             .filter(move |&j| self.is_live(j, now, lifetime))
             .map(move |j| &self.reading[j])
     }
 
-    /// The serialisable form.
+    /// The readings in `f64` (exact), for a refresh, which computes in `f64`.
+    pub fn widened(&self) -> Retained<f64, D, N> {
+        Retained {
+            reading: self.reading.map(|p| p.map(T::to_f64)),
+            stamp: self.stamp,
+        }
+    }
+
+    /// The serialisable form (`f64`, exact for either float type).
     pub fn snapshot(&self) -> RetainedSnapshot {
         RetainedSnapshot {
             readings: self
                 .reading
                 .iter()
-                .flat_map(|p| p.iter().copied())
+                .flat_map(|p| p.iter().map(|x| x.to_f64()))
                 .collect(),
             stamps: self.stamp.to_vec(),
         }
     }
 
-    /// Back from the serialisable form, refusing wrong lengths, non-finite readings and
-    /// stamps from the future.
+    /// Back from the serialisable form, refusing wrong lengths, readings not finite in `T`
+    /// and stamps from the future.
     pub fn restore(s: &RetainedSnapshot, count: u64) -> Result<Self> {
         if s.readings.len() != N * D || s.stamps.len() != N {
             return Err(Error::InvalidSnapshot {
                 reason: "the retained readings do not have the layout of this calibrator",
             });
         }
-        if !s.readings.iter().all(|x| x.is_finite()) || s.stamps.iter().any(|&t| t > count) {
+        if !s.readings.iter().all(|&x| T::of(x).is_finite()) || s.stamps.iter().any(|&t| t > count)
+        {
             return Err(Error::InvalidSnapshot {
                 reason: "a retained reading is not finite or is newer than the sample count",
             });
         }
         let mut out = Self::new();
         for j in 0..N {
-            out.reading[j] = SVector::from_fn(|i, _| s.readings[j * D + i]);
+            out.reading[j] = SVector::from_fn(|i, _| T::of(s.readings[j * D + i]));
             out.stamp[j] = s.stamps[j];
         }
         Ok(out)

@@ -4,6 +4,8 @@
 
 use core::f64::consts::TAU;
 
+use truenorth_core::Real;
+
 use super::support::GAP_BINS;
 
 /// Direction of `(x, y)` (not both zero) as a share of a full turn in [0, 1), counted
@@ -14,6 +16,13 @@ use super::support::GAP_BINS;
 /// (1964) 4.4.49 for `atan z` on [0, 1] (|error| ≤ 2·10⁻⁸ rad) with an octant reduction.
 #[inline]
 pub(crate) fn turns(y: f64, x: f64) -> f64 {
+    turns_in(y, x)
+}
+
+/// [`turns`] in the float type `T` (the same operations, so the same bits for `f64`), for
+/// the per-sample paths that run in `f32`.
+#[inline]
+pub(crate) fn turns_in<T: Real>(y: T, x: T) -> T {
     use core::f64::consts::{FRAC_PI_2, PI};
     const A: [f64; 8] = [
         -0.333_331_452_8,
@@ -32,20 +41,24 @@ pub(crate) fn turns(y: f64, x: f64) -> f64 {
     let (num, den) = if swap { (ax, ay) } else { (ay, ax) };
     let z = num / den;
     let z2 = z * z;
-    let mut poly = A[7];
+    let mut poly = T::of(A[7]);
     for &a in A[..7].iter().rev() {
-        poly = poly * z2 + a;
+        poly = poly * z2 + T::of(a);
     }
     let first = z + z * z2 * poly;
-    let mut a = if swap { FRAC_PI_2 - first } else { first };
-    if x < 0.0 {
-        a = PI - a;
+    let mut a = if swap {
+        T::of(FRAC_PI_2) - first
+    } else {
+        first
+    };
+    if x < T::zero() {
+        a = T::of(PI) - a;
     }
-    if y < 0.0 {
-        a = TAU - a;
+    if y < T::zero() {
+        a = T::of(TAU) - a;
     }
-    let t = a / TAU;
-    if t >= 1.0 { 0.0 } else { t }
+    let t = a / T::of(TAU);
+    if t >= T::one() { T::zero() } else { t }
 }
 
 /// The fine bin of the direction `t` (a share of a full turn in [0, 1), from [`turns`]).

@@ -62,7 +62,7 @@ pub use bounds::BOUND_SIGMAS;
 pub(crate) use bounds::{regressor_2d, regressor_3d};
 pub(crate) use coverage::calibrated_directions_2d;
 pub use coverage::{COVERAGE_BINS, Coverage, calibrated_coverage_2d, coverage};
-pub(crate) use direction_bins::turns;
+pub(crate) use direction_bins::{turns, turns_in};
 pub use field::{
     FIELD_RATIO_TOLERANCE, FieldMismatch, field_mismatch, mean_corrected_norm_2d,
     mean_corrected_norm_3d, with_expected_field,
