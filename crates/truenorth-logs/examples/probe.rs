@@ -1,4 +1,4 @@
-//! Prints what each PX4 sample log holds and how long it takes to read:
+//! Prints what each log (ULog or MCAP) holds and how long it takes to read:
 //! `cargo run --release -p truenorth-logs --example probe -- FILE...`.
 
 use std::time::Instant;
