@@ -4,6 +4,7 @@
 use numpy::ndarray::{Array1, Array2, ArrayView2};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
+use pyo3::types::PyDict;
 use serde::Serialize;
 use serde::de::DeserializeOwned;
 
@@ -31,18 +32,32 @@ pub fn arg_err(msg: impl Into<String>) -> PyErr {
     TruenorthError::new_err(msg.into())
 }
 
-/// A configuration from a Python dictionary (`None`: the type's defaults); unknown or
-/// mistyped fields are refused with serde's message.
-pub fn config_from<T: DeserializeOwned + Default>(
+/// A configuration from a Python dictionary (`None`: the type's defaults); mistyped
+/// fields are refused with serde's message, and so are top-level names the configuration
+/// does not have (several configurations ignore unknown fields when read from a file, but
+/// a misspelt keyword in a script should not pass unnoticed).
+pub fn config_from<T: DeserializeOwned + Serialize + Default>(
     config: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<T> {
-    match config {
-        None => Ok(T::default()),
-        Some(c) if c.is_none() => Ok(T::default()),
-        Some(c) => {
-            pythonize::depythonize(c).map_err(|e| arg_err(format!("invalid configuration: {e}")))
+    let Some(c) = config.filter(|c| !c.is_none()) else {
+        return Ok(T::default());
+    };
+    if let Ok(given) = c.cast::<PyDict>() {
+        let known = to_py(c.py(), &T::default())?;
+        for key in given.keys() {
+            if !known.contains(&key)? {
+                let names: Vec<String> = known
+                    .try_iter()?
+                    .filter_map(|k| k.ok().map(|k| k.to_string()))
+                    .collect();
+                return Err(arg_err(format!(
+                    "invalid configuration: unknown field `{key}`; the fields are {}",
+                    names.join(", ")
+                )));
+            }
         }
     }
+    pythonize::depythonize(c).map_err(|e| arg_err(format!("invalid configuration: {e}")))
 }
 
 /// Any serde value as Python data (dictionaries, lists, floats, strings).
