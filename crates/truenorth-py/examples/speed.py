@@ -5,7 +5,8 @@ filter against the Rust loop over the same recording (`examples/array_loop.rs`).
     python examples/speed.py ../../../shared/data/broad/trials/01_undisturbed_slow_rotation_A.csv.gz
 
 Prints ns per sample for: the array call (`update_array`, loop in Rust), the Rust loop
-alone (when the example binary is built), and one `update` call per sample from Python.
+alone (when the example binary is built), and one `update` call per sample from Python;
+and the fixed cost of one array call (an array of one row).
 """
 
 import gzip
@@ -38,6 +39,10 @@ def main(path: str, repeats: int = 20) -> None:
     array_s = best_of(lambda: tn.QuaternionFilter().update_array(t, gyr, acc, mag), repeats)
     print(f"python array call: {n} samples, best of {repeats}: {array_s * 1e3:.3f} ms, "
           f"{array_s * 1e9 / n:.1f} ns/sample")
+    f = tn.QuaternionFilter()
+    one = (t[:1], gyr[:1], acc[:1], mag[:1])
+    call_s = best_of(lambda: [(f.reset(), f.update_array(*one)) for _ in range(1000)], 5) / 1000
+    print(f"python array call of one row with a reset (the per-array overhead): {call_s * 1e9:.0f} ns")
     m = 5000
     lists = [(t[k], gyr[k].tolist(), acc[k].tolist(), mag[k].tolist()) for k in range(m)]
 
