@@ -1,0 +1,229 @@
+"""Type stubs of the truenorth package (the native module `truenorth._truenorth`)."""
+
+from typing import Any, Literal, Optional, Sequence, TypedDict
+
+import numpy as np
+import numpy.typing as npt
+
+FloatArray = npt.NDArray[np.float64]
+BoolArray = npt.NDArray[np.bool_]
+
+METHODS: list[str]
+"""The calibration methods, as the CLI's `--method`."""
+
+class TruenorthError(ValueError):
+    """An error of the library, with its message (naming the row for an array)."""
+
+class Uncertainty:
+    """What the readings determine."""
+    dilution: float
+    hard_iron_sigma: tuple[float, float, float]
+    soft_iron_sigma_rel: float
+    geometry_error_deg: float
+
+class Verdict:
+    """`good`, `usable` or `poor`, with the numbers behind it."""
+    grade: Literal["good", "usable", "poor"]
+    cause: Literal["none", "calibration", "noise"]
+    bound_deg: float
+    noise_deg: float
+    reason: str
+    def to_dict(self) -> dict[str, Any]: ...
+
+class Quality:
+    """A compass calibration's quality report."""
+    @property
+    def points(self) -> int: ...
+    @property
+    def coverage(self) -> float: ...
+    @property
+    def residual_rms_rel(self) -> float: ...
+    @property
+    def condition(self) -> float: ...
+    @property
+    def heading_error_bound_deg(self) -> float: ...
+    @property
+    def heading_error_3sigma_deg(self) -> float: ...
+    @property
+    def heading_error_systematic_deg(self) -> float: ...
+    @property
+    def heading_noise_rms_deg(self) -> float: ...
+    @property
+    def field_magnitude(self) -> float: ...
+    @property
+    def field_ratio_to_expected(self) -> Optional[float]: ...
+    @property
+    def uncertainty(self) -> Uncertainty: ...
+    @property
+    def verdict(self) -> Verdict: ...
+    def to_dict(self) -> dict[str, Any]: ...
+
+class Calibration:
+    """A compass calibration: corrected = soft_iron @ (raw - hard_iron)."""
+    @property
+    def method(self) -> str: ...
+    @property
+    def dimensions(self) -> Literal[2, 3]: ...
+    @property
+    def hard_iron(self) -> FloatArray: ...
+    @property
+    def soft_iron(self) -> FloatArray: ...
+    @property
+    def field(self) -> float: ...
+    @property
+    def quality(self) -> Quality: ...
+    @property
+    def verdict(self) -> Verdict: ...
+    def heading(self, mag: FloatArray, acc: Optional[FloatArray] = None) -> FloatArray:
+        """Magnetic heading, degrees in [0, 360), one per row (as `truenorth heading`)."""
+    def to_dict(self) -> dict[str, Any]:
+        """The layout of the CLI's calibration file."""
+
+class Progress(TypedDict):
+    samples: int
+    coverage: float
+    ready: bool
+
+class Calibrator:
+    """A compass calibrator by the CLI's method name (see METHODS)."""
+    def __init__(self, method: str, config: Optional[dict[str, Any]] = None) -> None: ...
+    @property
+    def method(self) -> str: ...
+    def push(
+        self, t_s: float, mag: Sequence[float], acc: Optional[Sequence[float]] = None
+    ) -> Literal["ignored", "accepted", "new_estimate"]: ...
+    def push_array(
+        self,
+        mag: FloatArray,
+        t_s: Optional[FloatArray] = None,
+        acc: Optional[FloatArray] = None,
+    ) -> int: ...
+    def progress(self) -> Progress: ...
+    def solve(self) -> Calibration: ...
+    def estimate(self) -> Optional[Calibration]: ...
+    def reset(self) -> None: ...
+
+def calibrate(
+    method: str,
+    mag: FloatArray,
+    t_s: Optional[FloatArray] = None,
+    acc: Optional[FloatArray] = None,
+    config: Optional[dict[str, Any]] = None,
+) -> Calibration:
+    """Calibrates in one call, as `truenorth calibrate --method METHOD`."""
+
+class Attitude:
+    """One attitude estimate (body -> NED on magnetic north)."""
+    t_s: float
+    quaternion: tuple[float, float, float, float]
+    yaw_deg: float
+    pitch_deg: float
+    roll_deg: float
+    gyro_bias_rps: tuple[float, float, float]
+    sigma_deg: Optional[tuple[float, float, float]]
+    at_rest: bool
+    mag_used: bool
+    mag_disturbed: bool
+    mag_calibrating: bool
+    gap: bool
+
+class OrientationArrays(TypedDict):
+    t_s: FloatArray
+    quaternion: FloatArray
+    euler_deg: FloatArray
+    gyro_bias_rps: FloatArray
+    sigma_deg: FloatArray
+    at_rest: BoolArray
+    mag_used: BoolArray
+    mag_disturbed: BoolArray
+    mag_calibrating: BoolArray
+    gap: BoolArray
+
+class OrientationEstimator:
+    """Base class of the orientation estimators."""
+    def update(
+        self,
+        t_s: float,
+        gyr: Sequence[float],
+        acc: Sequence[float],
+        mag: Optional[Sequence[float]] = None,
+    ) -> Attitude: ...
+    def update_array(
+        self,
+        t_s: FloatArray,
+        gyr: FloatArray,
+        acc: FloatArray,
+        mag: Optional[FloatArray] = None,
+        frame: Literal["ned", "enu"] = "ned",
+    ) -> OrientationArrays: ...
+    def estimate(self) -> Attitude: ...
+    def reset(self) -> None: ...
+
+class QuaternionFilter(OrientationEstimator):
+    def __init__(self, config: Optional[dict[str, Any]] = None) -> None: ...
+
+class EulerDetector(OrientationEstimator):
+    def __init__(self, config: Optional[dict[str, Any]] = None) -> None: ...
+
+class VehicleRow(TypedDict):
+    t_s: float
+    north_m: float
+    east_m: float
+    heading_deg: float
+
+class VehicleArrays(TypedDict):
+    t_s: FloatArray
+    north_m: FloatArray
+    east_m: FloatArray
+    heading_deg: FloatArray
+    heading_sigma_deg: FloatArray
+    speed_mps: FloatArray
+    distance_m: FloatArray
+    gap: BoolArray
+
+class VehicleEstimator:
+    """The fused vehicle estimator (wheels, yaw gyro, compass)."""
+    def __init__(self, config: Optional[dict[str, Any]] = None) -> None: ...
+    def update(
+        self,
+        t_s: float,
+        dist_l_m: Optional[float] = None,
+        dist_r_m: Optional[float] = None,
+        gyr_z: Optional[float] = None,
+        mag: Optional[tuple[float, float]] = None,
+    ) -> VehicleRow: ...
+    def update_array(
+        self,
+        t_s: FloatArray,
+        dist_l_m: Optional[FloatArray] = None,
+        dist_r_m: Optional[FloatArray] = None,
+        gyr_z: Optional[FloatArray] = None,
+        mag: Optional[FloatArray] = None,
+    ) -> VehicleArrays: ...
+    def calibration(self) -> dict[str, Any]: ...
+    def reset(self) -> None: ...
+
+class MagneticField:
+    """The WMM2025 field at a place and date."""
+    x_nt: float
+    y_nt: float
+    z_nt: float
+    h_nt: float
+    f_nt: float
+    incl_deg: float
+    decl_deg: float
+    year: float
+    def to_dict(self) -> dict[str, float]: ...
+
+def field(lat_deg: float, lon_deg: float, year: float, alt_km: float = 0.0) -> MagneticField:
+    """The World Magnetic Model 2025 field (as `truenorth field`)."""
+
+class BroadRmse(TypedDict):
+    total_deg: float
+    heading_deg: float
+    inclination_deg: float
+
+def broad_rmse(
+    estimate: FloatArray, reference: FloatArray, movement: BoolArray
+) -> Optional[BroadRmse]:
+    """BROAD's metric: RMSE of the total, heading and inclination error angles, degrees."""

@@ -1,0 +1,190 @@
+//! The fused vehicle estimator over arrays (and one sample at a time): wheels, yaw gyro and
+//! compass in, position and heading out, as `truenorth drive --single-pass` computes them.
+
+use numpy::PyReadonlyArray1;
+use numpy::PyReadonlyArray2;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use truenorth::core::{HeadingEstimator, NavEstimate, VehicleSample, rad_to_deg, wrap_two_pi};
+use truenorth::fusion::VehicleEstimator as CoreVehicle;
+use truenorth::nalgebra::Vector2;
+
+use crate::convert::{array1, bools, config_from, lib_err, row_err, rows, same_rows, to_py};
+
+/// The row at `t_s` with whichever readings are finite.
+fn vehicle_sample(
+    t_s: f64,
+    wheels: Option<(f64, f64)>,
+    gyr_z: Option<f64>,
+    mag: Option<(f64, f64)>,
+) -> VehicleSample {
+    let mut s = VehicleSample::at(t_s);
+    if let Some((l, r)) = wheels.filter(|(l, r)| !(l.is_nan() && r.is_nan())) {
+        s = s.with_wheels(l, r);
+    }
+    if let Some(g) = gyr_z.filter(|g| !g.is_nan()) {
+        s = s.with_gyro(g);
+    }
+    if let Some((x, y)) = mag.filter(|(x, y)| !(x.is_nan() && y.is_nan())) {
+        s = s.with_mag(Vector2::new(x, y));
+    }
+    s
+}
+
+/// The estimate as `(north_m, east_m, heading_deg)` of the drive output: the position NaN
+/// while no wheel has given it, the heading in [0, 360).
+fn contract_row(e: &NavEstimate) -> [f64; 3] {
+    let (n, east) = if e.status.position_known {
+        (e.north_m, e.east_m)
+    } else {
+        (f64::NAN, f64::NAN)
+    };
+    [n, east, rad_to_deg(wrap_two_pi(e.heading.rad()))]
+}
+
+/// The fused vehicle estimator: cumulative wheel distances (m), raw yaw rate (rad/s,
+/// positive turning right), raw horizontal magnetometer (any unit), each optional per row;
+/// every sensor calibrated online. `config`: the library's `VehicleConfig` as a dictionary,
+/// e.g. `{"wheels": {"rear": {"track_m": 1.6}}}` (missing fields take their defaults).
+#[pyclass(module = "truenorth")]
+pub struct VehicleEstimator {
+    inner: CoreVehicle,
+}
+
+#[pymethods]
+impl VehicleEstimator {
+    #[new]
+    #[pyo3(signature = (config=None))]
+    fn new(config: Option<&Bound<'_, PyAny>>) -> PyResult<Self> {
+        Ok(Self {
+            inner: CoreVehicle::new(config_from(config)?).map_err(lib_err)?,
+        })
+    }
+
+    /// Feeds one row; any reading may be `None`. Returns `{"t_s", "north_m", "east_m",
+    /// "heading_deg"}` after it.
+    #[pyo3(signature = (t_s, dist_l_m=None, dist_r_m=None, gyr_z=None, mag=None))]
+    fn update<'py>(
+        &mut self,
+        py: Python<'py>,
+        t_s: f64,
+        dist_l_m: Option<f64>,
+        dist_r_m: Option<f64>,
+        gyr_z: Option<f64>,
+        mag: Option<(f64, f64)>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let wheels = dist_l_m.zip(dist_r_m);
+        let e = self
+            .inner
+            .update(&vehicle_sample(t_s, wheels, gyr_z, mag))
+            .map_err(lib_err)?;
+        let [n, east, h] = contract_row(&e);
+        let d = PyDict::new(py);
+        d.set_item("t_s", e.t_s)?;
+        d.set_item("north_m", n)?;
+        d.set_item("east_m", east)?;
+        d.set_item("heading_deg", h)?;
+        Ok(d)
+    }
+
+    /// Runs every row (the loop in Rust, without the GIL): `t_s` (N, s), and any of
+    /// `dist_l_m`, `dist_r_m` (N, cumulative), `gyr_z` (N, rad/s), `mag` (N×2), NaN where a
+    /// row has no reading. Returns a dict of arrays: `t_s`, `north_m`, `east_m` (NaN before
+    /// the wheels give a position), `heading_deg` ([0, 360), magnetic north),
+    /// `heading_sigma_deg`, `speed_mps`, `distance_m`, `gap` (bool).
+    #[pyo3(signature = (t_s, dist_l_m=None, dist_r_m=None, gyr_z=None, mag=None))]
+    fn update_array<'py>(
+        &mut self,
+        py: Python<'py>,
+        t_s: PyReadonlyArray1<'py, f64>,
+        dist_l_m: Option<PyReadonlyArray1<'py, f64>>,
+        dist_r_m: Option<PyReadonlyArray1<'py, f64>>,
+        gyr_z: Option<PyReadonlyArray1<'py, f64>>,
+        mag: Option<PyReadonlyArray2<'py, f64>>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let t = t_s.as_array();
+        let n = t.len();
+        let col =
+            |a: &Option<PyReadonlyArray1<'py, f64>>, name: &str| -> PyResult<Option<Vec<f64>>> {
+                match a {
+                    Some(a) => {
+                        let v = a.as_array();
+                        same_rows(name, v.len(), n)?;
+                        Ok(Some(v.to_vec()))
+                    }
+                    None => Ok(None),
+                }
+            };
+        let (l, r, g) = (
+            col(&dist_l_m, "dist_l_m")?,
+            col(&dist_r_m, "dist_r_m")?,
+            col(&gyr_z, "gyr_z")?,
+        );
+        let m = match &mag {
+            Some(m) => {
+                let m = rows(m, "mag", &[2])?;
+                same_rows("mag", m.nrows(), n)?;
+                Some(m)
+            }
+            None => None,
+        };
+        let inner = &mut self.inner;
+        let out = py.detach(|| {
+            let mut out: [Vec<f64>; 6] = std::array::from_fn(|_| Vec::with_capacity(n));
+            let mut gap = Vec::with_capacity(n);
+            for k in 0..n {
+                let wheels = match (&l, &r) {
+                    (Some(l), Some(r)) => Some((l[k], r[k])),
+                    _ => None,
+                };
+                let s = vehicle_sample(
+                    t[k],
+                    wheels,
+                    g.as_ref().map(|g| g[k]),
+                    m.as_ref().map(|m| (m[(k, 0)], m[(k, 1)])),
+                );
+                let e = inner.update(&s).map_err(|e| (k, e))?;
+                let [north, east, h] = contract_row(&e);
+                for (v, x) in out.iter_mut().zip([
+                    north,
+                    east,
+                    h,
+                    rad_to_deg(e.heading_sigma_rad),
+                    e.speed_mps,
+                    e.distance_m,
+                ]) {
+                    v.push(x);
+                }
+                gap.push(e.status.gap);
+            }
+            Ok::<_, (usize, truenorth::Error)>((out, gap))
+        });
+        let (out, gap) = out.map_err(|(k, e)| row_err(k, e))?;
+        let d = PyDict::new(py);
+        d.set_item("t_s", array1(py, t.to_vec()))?;
+        let names = [
+            "north_m",
+            "east_m",
+            "heading_deg",
+            "heading_sigma_deg",
+            "speed_mps",
+            "distance_m",
+        ];
+        for (name, v) in names.into_iter().zip(out) {
+            d.set_item(name, array1(py, v))?;
+        }
+        d.set_item("gap", bools(py, gap))?;
+        Ok(d)
+    }
+
+    /// What the estimator has learned about the sensors, as a dictionary (the form a later
+    /// drive starts from, as `truenorth drive --calibration-out` writes it).
+    fn calibration<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        to_py(py, &self.inner.calibration())
+    }
+
+    /// Back to the state before the first sample.
+    fn reset(&mut self) {
+        self.inner.reset();
+    }
+}

@@ -1,0 +1,157 @@
+"""The package's API on its own: shapes, per-sample and array paths, reports, errors."""
+
+import math
+
+import numpy as np
+import pytest
+
+import truenorth as tn
+from conftest import load_csv
+
+
+def circle(n=720, hard=(8.0, -3.0), field=20.0, turns=2.0):
+    psi = np.linspace(0.0, 2 * math.pi * turns, n, endpoint=False)
+    mag = np.column_stack([hard[0] + field * np.cos(psi), hard[1] - field * np.sin(psi)])
+    return np.arange(n) * 0.1, mag, psi
+
+
+def test_errors_are_one_value_error_with_the_librarys_message():
+    assert issubclass(tn.TruenorthError, ValueError)
+    with pytest.raises(tn.TruenorthError, match="too few points"):
+        tn.calibrate("ellipse", np.zeros((3, 2)))
+    with pytest.raises(ValueError, match="unknown calibration method `nope`"):
+        tn.Calibrator("nope")
+    with pytest.raises(tn.TruenorthError, match="columns"):
+        tn.calibrate("ellipsoid", np.zeros((10, 2)))
+    with pytest.raises(tn.TruenorthError, match="invalid configuration"):
+        tn.QuaternionFilter({"no_such_field": 1})
+    with pytest.raises(tn.TruenorthError, match="row 1"):
+        tn.QuaternionFilter().update_array(
+            np.array([0.0, 0.0]), np.zeros((2, 3)), np.tile([0.0, 0.0, -9.81], (2, 1)))
+    with pytest.raises(tn.TruenorthError):
+        tn.field(51.5, -0.13, 2040.0)
+
+
+def test_a_circle_calibrates_with_its_hard_iron_and_a_good_verdict():
+    t, mag, psi = circle()
+    cal = tn.calibrate("ellipse", mag, t_s=t)
+    assert cal.dimensions == 2 and cal.method == "ellipse"
+    assert np.allclose(cal.hard_iron, [8.0, -3.0], atol=1e-9)
+    assert cal.soft_iron.shape == (2, 2)
+    assert cal.field == pytest.approx(20.0, rel=1e-9)
+    assert cal.verdict.grade == "good" and cal.verdict.reason
+    q = cal.quality
+    assert q.points == len(t) and q.coverage > 0.99
+    assert q.uncertainty.dilution == pytest.approx(2.0, rel=0.05)
+    d = cal.to_dict()
+    assert d["quality"]["verdict"]["grade"] == "good"
+    assert d["soft_iron"] == cal.soft_iron.tolist()
+    # Heading: psi clockwise from north, in [0, 360).
+    h = cal.heading(mag)
+    err = (h - np.degrees(psi) + 180.0) % 360.0 - 180.0
+    assert np.max(np.abs(err)) < 1e-6
+    assert h.min() >= 0.0 and h.max() < 360.0
+
+
+def test_per_sample_push_equals_the_array_push():
+    t, mag, _ = circle()
+    one = tn.Calibrator("online-ellipse")
+    for k in range(len(t)):
+        assert one.push(t[k], mag[k].tolist()) in ("ignored", "accepted", "new_estimate")
+    many = tn.Calibrator("online-ellipse")
+    assert many.push_array(mag, t_s=t) > 0
+    a, b = one.estimate(), many.estimate()
+    assert a is not None and b is not None
+    assert a.to_dict() == b.to_dict()
+    assert many.progress()["ready"]
+    many.reset()
+    assert many.progress()["samples"] == 0
+    assert tn.Calibrator("ellipse").estimate() is None
+
+
+@pytest.mark.parametrize("method", ["binned-ellipse", "merit-circle", "turn"])
+def test_the_seed_methods_run(method):
+    t, mag, _ = circle(n=1440, turns=4.0)
+    cal = tn.calibrate(method, mag, t_s=t)
+    assert np.allclose(cal.hard_iron, [8.0, -3.0], atol=0.5)
+
+
+def test_configuration_dicts_reach_the_library():
+    t, mag, _ = circle()
+    cal = tn.calibrate("ellipse", mag, t_s=t, config={"expected_field": 40.0})
+    assert cal.quality.field_ratio_to_expected == pytest.approx(0.5, rel=1e-6)
+
+
+def test_orientation_per_sample_equals_the_array_call():
+    n = 500
+    t = np.arange(n) * 0.01
+    gyr = np.column_stack([np.zeros(n), np.zeros(n), np.full(n, 0.3)])
+    acc = np.tile([0.0, 0.0, -9.81], (n, 1))
+    mag = np.tile([20.0, 0.0, 40.0], (n, 1))
+    mag[::2] = np.nan  # a magnetometer at half the rate
+    for cls in (tn.QuaternionFilter, tn.EulerDetector):
+        arrays = cls().update_array(t, gyr, acc, mag)
+        f = cls()
+        for k in range(n):
+            m = None if np.isnan(mag[k, 0]) else mag[k].tolist()
+            a = f.update(t[k], gyr[k].tolist(), acc[k].tolist(), m)
+        assert a.quaternion == tuple(arrays["quaternion"][-1])
+        assert a.yaw_deg == arrays["euler_deg"][-1, 0]
+        assert f.estimate().t_s == t[-1]
+        assert arrays["quaternion"].shape == (n, 4) and arrays["at_rest"].dtype == bool
+    # Level: the body's z axis stays down; pitch and roll near zero.
+    assert np.max(np.abs(arrays["euler_deg"][:, 1:])) < 1.0
+
+
+def test_6d_filter_and_enu_frame():
+    n = 200
+    t = np.arange(n) * 0.01
+    r = tn.QuaternionFilter({"use_mag": False}).update_array(
+        t, np.zeros((n, 3)), np.tile([0.0, 0.0, -9.81], (n, 1)), frame="enu")
+    w, x, y, z = r["quaternion"][-1]
+    # NED → ENU of a level body facing north: a half turn about the NE bisector.
+    assert abs(w) < 1e-6 and abs(z) < 1e-6
+    with pytest.raises(tn.TruenorthError, match="frame"):
+        tn.QuaternionFilter().update_array(t, np.zeros((n, 3)), np.zeros((n, 3)), frame="xyz")
+
+
+def test_vehicle_estimator_drives_straight_north_with_its_compass():
+    n = 600
+    t = np.arange(n) * 0.1
+    dist = t * 10.0
+    mag = np.tile([20.0, 0.0], (n, 1))
+    v = tn.VehicleEstimator({"wheels": {"rear": {"track_m": 1.6}}})
+    r = v.update_array(t, dist_l_m=dist, dist_r_m=dist, gyr_z=np.zeros(n), mag=mag)
+    assert r["north_m"][-1] == pytest.approx(dist[-1], rel=0.01)
+    assert abs(r["east_m"][-1]) < 1.0
+    one = tn.VehicleEstimator({"wheels": {"rear": {"track_m": 1.6}}})
+    for k in range(n):
+        last = one.update(t[k], dist[k], dist[k], 0.0, (20.0, 0.0))
+    assert last["north_m"] == r["north_m"][-1]
+    assert isinstance(v.calibration(), dict)
+
+
+def test_wmm_matches_the_official_test_values(data):
+    """WMM2025_TEST_VALUES.txt: date, height km, lat, lon, X, Y, Z (nT), ..."""
+    path = data / "wmm2025" / "WMM2025_TEST_VALUES.txt"
+    rows = [l.split() for l in path.read_text().splitlines() if l.strip() and not l.startswith("#")]
+    assert rows
+    for r in rows:
+        year, alt, lat, lon = map(float, r[:4])
+        f = tn.field(lat, lon, year, alt_km=alt)
+        # The file gives X, Y, Z to 0.1 nT.
+        assert f.x_nt == pytest.approx(float(r[4]), abs=0.06)
+        assert f.y_nt == pytest.approx(float(r[5]), abs=0.06)
+        assert f.z_nt == pytest.approx(float(r[6]), abs=0.06)
+
+
+def test_ellipsoid_accel_reports_its_joint_figures(data):
+    _, rows = load_csv(data / "magcal_ck_explorer" / "acc_mag_log.csv")
+    cal = tn.calibrate("ellipsoid-accel", rows[:, 3:6], acc=rows[:, 0:3])
+    d = cal.to_dict()
+    assert "joint" in d["quality"] and "dip_deg" in d
+    assert np.array(d["mag_to_body"]).shape == (3, 3)
+    h = cal.heading(rows[:100, 3:6], acc=rows[:100, 0:3])
+    assert h.shape == (100,)
+    with pytest.raises(tn.TruenorthError, match="needs `acc`"):
+        tn.calibrate("ellipsoid-accel", rows[:, 3:6])
