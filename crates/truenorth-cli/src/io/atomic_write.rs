@@ -385,13 +385,19 @@ mod tests {
         std::fs::set_permissions(&real, std::fs::Permissions::from_mode(0o640)).unwrap();
         let link = d.join("link.csv");
         std::os::unix::fs::symlink("real.csv", &link).unwrap();
-        write_csv(&link, &["a"], [vec![2.0]]).unwrap();
+        write_csv(&link, &["a"], [vec![2.0]], Precision::default()).unwrap();
         assert!(std::fs::symlink_metadata(&link).unwrap().is_symlink());
         assert_eq!(std::fs::read_to_string(&real).unwrap(), "a\n2\n");
         let mode = std::fs::metadata(&real).unwrap().permissions().mode();
         assert_eq!(mode & 0o777, 0o640, "{mode:o}");
         assert!(leftovers(&d).is_empty());
-        write_csv(Path::new("/dev/null"), &["a"], [vec![1.0]]).unwrap();
+        write_csv(
+            Path::new("/dev/null"),
+            &["a"],
+            [vec![1.0]],
+            Precision::default(),
+        )
+        .unwrap();
         use std::os::unix::fs::FileTypeExt as _;
         let null = std::fs::metadata("/dev/null").unwrap();
         assert!(null.file_type().is_char_device());
