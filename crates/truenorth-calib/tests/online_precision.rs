@@ -23,7 +23,7 @@ mod recordings;
 use common::Model2;
 use nalgebra::{DMatrix, Matrix3, SMatrix, Vector2, Vector3};
 use proptest::prelude::*;
-use recordings::{read_rows, recording};
+use recordings::sunsided_mag;
 use truenorth_calib::{
     OnlineEllipseCalibrator, OnlineEllipseConfig, OnlineEllipsoidCalibrator, OnlineEllipsoidConfig,
 };
@@ -212,18 +212,6 @@ fn simulated_tumble_f32_against_f64() {
     compare_3d(&pts).check("simulated tumble, hard iron 0.6 × field");
 }
 
-fn sunsided(rec: &str) -> Option<Vec<Vector3<f64>>> {
-    let p = recording("magcal_sunsided_mpu6050_hmc5883l")?
-        .join(rec)
-        .join("mag.csv.gz");
-    Some(
-        read_rows(&p)
-            .iter()
-            .map(|r| Vector3::new(r[1], r[2], r[3]))
-            .collect(),
-    )
-}
-
 /// The single-axis turns of the sunsided recording, each on the two axes perpendicular to
 /// its turn (as `real_data.rs`), and its full-sphere tumble in 3-D.
 #[test]
@@ -234,13 +222,13 @@ fn real_magcal_f32_against_f64() {
         ("rotate-ccw-around-x-pointing-forward", 1, 2),
         ("rotate-ccw-around-y-pointing-left", 0, 2),
     ] {
-        let Some(pts3) = sunsided(rec) else {
+        let Some(pts3) = sunsided_mag(rec) else {
             return;
         };
         let pts: Vec<Vector2<f64>> = pts3.iter().map(|p| Vector2::new(p[i], p[j])).collect();
         compare_2d(&pts).check(&format!("sunsided {rec}, {} readings", pts.len()));
     }
-    let Some(pts) = sunsided("full-sphere") else {
+    let Some(pts) = sunsided_mag("full-sphere") else {
         return;
     };
     compare_3d(&pts).check(&format!("sunsided full-sphere, {} readings", pts.len()));

@@ -7,24 +7,12 @@
 
 mod recordings;
 
-use recordings::{read_rows, readme_figure, recording, rel_std};
+use recordings::{read_rows, readme_figure, recording, rel_std, sunsided_mag};
 
 use nalgebra::{Matrix3, Vector2, Vector3};
 use truenorth_calib::{EllipseConfig, EllipsoidConfig, fit_ellipse, fit_ellipsoid};
 use truenorth_compass::CompassCalibration3d;
 use truenorth_core::angle_diff;
-
-fn sunsided_mag(rec: &str) -> Option<Vec<Vector3<f64>>> {
-    let p = recording("magcal_sunsided_mpu6050_hmc5883l")?
-        .join(rec)
-        .join("mag.csv.gz");
-    Some(
-        read_rows(&p)
-            .iter()
-            .map(|r| Vector3::new(r[1], r[2], r[3]))
-            .collect(),
-    )
-}
 
 fn full_sphere_calibration() -> Option<CompassCalibration3d> {
     // `sunsided_mag` has printed the reason when it returns `None`.

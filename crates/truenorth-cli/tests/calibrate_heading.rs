@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 
 use common::{ok, p, truenorth};
 
-fn scratch(name: &str) -> PathBuf {
+fn scratch(name: &str) -> common::ScratchDir {
     common::scratch("cli_calibrate_heading", name)
 }
 
@@ -73,19 +73,13 @@ fn ellipse_calibration_then_heading() {
     let input = dir.join("turn.csv");
     std::fs::write(&input, csv).unwrap();
     let cal = dir.join("cal.json");
-    ok(&[
-        "calibrate",
-        "--method",
+    common::succeeded(common::calibrate(
         "ellipse",
-        "--input",
-        p(&input),
-        "--output",
-        p(&cal),
-        "--expected-field",
-        "20",
-    ]);
-    let json: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&cal).unwrap()).unwrap();
+        &input,
+        &cal,
+        &["--expected-field", "20"],
+    ));
+    let json: serde_json::Value = common::read_json(&cal);
     assert_eq!(json["format"], "truenorth-compass-calibration");
     assert_eq!(json["version"], 2);
     assert_eq!(json["method"], "ellipse");
@@ -131,15 +125,7 @@ fn ellipse_calibration_then_heading() {
     assert!((ratio - 1.3f64.sqrt()).abs() < 0.01, "{ratio}");
 
     let headings = dir.join("heading.csv");
-    ok(&[
-        "heading",
-        "--calibration",
-        p(&cal),
-        "--input",
-        p(&input),
-        "--output",
-        p(&headings),
-    ]);
+    common::succeeded(common::heading(&cal, &input, &headings, &[]));
     let got = read_headings(&headings);
     assert_eq!(got.len(), 360);
     assert!(got.iter().all(|(_, h)| (0.0..360.0).contains(h)));
@@ -177,17 +163,8 @@ fn ellipsoid_calibration_then_level_heading() {
     let input = dir.join("tumble.csv");
     std::fs::write(&input, csv).unwrap();
     let cal = dir.join("cal3.json");
-    ok(&[
-        "calibrate",
-        "--method",
-        "ellipsoid",
-        "--input",
-        p(&input),
-        "--output",
-        p(&cal),
-    ]);
-    let json: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&cal).unwrap()).unwrap();
+    common::succeeded(common::calibrate("ellipsoid", &input, &cal, &[]));
+    let json: serde_json::Value = common::read_json(&cal);
     assert_eq!(json["dimensions"], 3);
     assert_eq!(
         json["quality"]["field_ratio_to_expected"],
@@ -210,15 +187,7 @@ fn ellipsoid_calibration_then_level_heading() {
     let level_in = dir.join("level.csv");
     std::fs::write(&level_in, level).unwrap();
     let headings = dir.join("heading3.csv");
-    ok(&[
-        "heading",
-        "--calibration",
-        p(&cal),
-        "--input",
-        p(&level_in),
-        "--output",
-        p(&headings),
-    ]);
+    common::succeeded(common::heading(&cal, &level_in, &headings, &[]));
     let rms = rms_deg(&read_headings(&headings), &truth);
     assert!(rms < 0.01, "heading RMS {rms}°");
 }
@@ -230,15 +199,7 @@ fn refused(name: &str, method: &str, csv: &str) -> (Option<i32>, String, PathBuf
     let input = dir.join(format!("{name}.csv"));
     std::fs::write(&input, csv).unwrap();
     let cal = dir.join("cal.json");
-    let out = truenorth(&[
-        "calibrate",
-        "--method",
-        method,
-        "--input",
-        p(&input),
-        "--output",
-        p(&cal),
-    ]);
+    let out = common::calibrate(method, &input, &cal, &[]);
     let stderr = String::from_utf8(out.stderr).unwrap();
     assert_eq!(
         stderr.lines().count(),
@@ -330,15 +291,7 @@ fn bad_calibration_file_is_refused() {
         r#"{"format":"truenorth-compass-calibration","version":1,"method":"x","dimensions":2,"hard_iron":[1],"soft_iron":[[1,0],[0,1]],"field":1}"#,
     )
     .unwrap();
-    let out = truenorth(&[
-        "heading",
-        "--calibration",
-        p(&cal),
-        "--input",
-        p(&input),
-        "--output",
-        p(&dir.join("h.csv")),
-    ]);
+    let out = common::heading(&cal, &input, &dir.join("h.csv"), &[]);
     assert_eq!(out.status.code(), Some(1));
     let err = String::from_utf8(out.stderr).unwrap();
     assert_eq!(err.lines().count(), 1);
@@ -347,15 +300,7 @@ fn bad_calibration_file_is_refused() {
 
 #[test]
 fn unknown_method_is_a_usage_error() {
-    let out = truenorth(&[
-        "calibrate",
-        "--method",
-        "magic",
-        "--input",
-        "x.csv",
-        "--output",
-        "y.json",
-    ]);
+    let out = common::calibrate("magic", Path::new("x.csv"), Path::new("y.json"), &[]);
     assert!(!out.status.success());
 }
 
@@ -403,21 +348,12 @@ fn every_2d_method_calibrates_a_full_turn_and_refuses_a_half() {
         let out = ok(&args);
         let err = String::from_utf8_lossy(&out.stderr);
         assert_eq!(err.contains("warning"), poor, "{err}");
-        let json: serde_json::Value =
-            serde_json::from_str(&std::fs::read_to_string(&cal).unwrap()).unwrap();
+        let json: serde_json::Value = common::read_json(&cal);
         assert_eq!(json["method"], method);
         assert_eq!(json["dimensions"], 2);
         assert_eq!(json["quality"]["verdict"] == "poor", poor, "{method}");
         let h = dir.join(format!("{method}.csv"));
-        ok(&[
-            "heading",
-            "--calibration",
-            p(&cal),
-            "--input",
-            p(&input),
-            "--output",
-            p(&h),
-        ]);
+        common::succeeded(common::heading(&cal, &input, &h, &[]));
         assert_eq!(read_headings(&h).len(), 400);
 
         let (half, _) = turn_csv(181);

@@ -12,14 +12,12 @@
 mod common;
 
 use std::fmt::Write as _;
-use std::path::PathBuf;
 
-use common::{ok, p};
 use nalgebra::{Matrix3, Rotation3, Vector3};
 use truenorth::core::{NoiseSource, SplitMix64};
 use truenorth_sim::{HandheldParams, handheld_motion};
 
-fn scratch(name: &str) -> PathBuf {
+fn scratch(name: &str) -> common::ScratchDir {
     common::scratch("cli_calibrate_judgement", name)
 }
 
@@ -29,16 +27,8 @@ fn calibrate(name: &str, method: &str, csv: &str) -> (serde_json::Value, String)
     let input = dir.join(format!("{name}.csv"));
     std::fs::write(&input, csv).unwrap();
     let cal = dir.join(format!("{method}.json"));
-    let out = ok(&[
-        "calibrate",
-        "--method",
-        method,
-        "--input",
-        p(&input),
-        "--output",
-        p(&cal),
-    ]);
-    let json = serde_json::from_str(&std::fs::read_to_string(&cal).unwrap()).unwrap();
+    let out = common::succeeded(common::calibrate(method, &input, &cal, &[]));
+    let json = common::read_json(&cal);
     (json, String::from_utf8(out.stderr).unwrap())
 }
 

@@ -9,10 +9,10 @@ mod common;
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
-use common::{ok, p, truenorth};
+use common::{ScratchDir, p};
 use truenorth_sim::{DriveSpec, SimulatedDrive};
 
-fn scratch(name: &str) -> PathBuf {
+fn scratch(name: &str) -> common::ScratchDir {
     common::scratch("cli_calibrate_turn_gyro", name)
 }
 
@@ -68,34 +68,25 @@ fn csv(rows: &[[f64; 4]], header: &[&str]) -> String {
 const ALL: [&str; 4] = ["t_s", "mag_x", "mag_y", "gyr_z"];
 
 /// Writes `text` as `name`.csv and runs `calibrate --method turn` on it; returns the run,
-/// the input and the output path. The turn method's compass half cannot remove the soft
+/// the input and the output path, and the folder that holds them (removed when dropped). The turn method's compass half cannot remove the soft
 /// iron's rotation, so its verdict may be `poor`: `--accept-poor` writes it anyway, as the
 /// gyro is what is checked here.
-fn run_turn(name: &str, text: &str) -> (std::process::Output, PathBuf, PathBuf) {
+fn run_turn(name: &str, text: &str) -> (std::process::Output, PathBuf, PathBuf, ScratchDir) {
     let dir = scratch(name);
     let input = dir.join(format!("{name}.csv"));
     std::fs::write(&input, text).unwrap();
     let cal = dir.join("cal.json");
-    let out = truenorth(&[
-        "calibrate",
-        "--method",
-        "turn",
-        "--input",
-        p(&input),
-        "--output",
-        p(&cal),
-        "--accept-poor",
-    ]);
-    (out, input, cal)
+    let out = common::calibrate("turn", &input, &cal, &["--accept-poor"]);
+    (out, input, cal, dir)
 }
 
-/// [`run_turn`] on a record it must accept: the JSON, the input and stderr.
-fn calibrate(name: &str, text: &str) -> (serde_json::Value, PathBuf, String) {
-    let (out, input, cal) = run_turn(name, text);
+/// [`run_turn`] on a record it must accept: the JSON, the input, stderr and the folder.
+fn calibrate(name: &str, text: &str) -> (serde_json::Value, PathBuf, String, ScratchDir) {
+    let (out, input, cal, dir) = run_turn(name, text);
     let stderr = String::from_utf8(out.stderr).unwrap();
     assert!(out.status.success(), "{name}: {stderr}");
-    let json = serde_json::from_str(&std::fs::read_to_string(&cal).unwrap()).unwrap();
-    (json, input, stderr)
+    let json = common::read_json(&cal);
+    (json, input, stderr, dir)
 }
 
 /// Scale within 0.3 % of the simulated gain of the direction turned (the goal for the
@@ -107,7 +98,7 @@ fn calibrate(name: &str, text: &str) -> (serde_json::Value, PathBuf, String) {
 fn gyro_zero_and_scale_from_simulated_turns() {
     for seed in 0..6 {
         let (rows, drive, turning) = opening_turn(seed);
-        let (json, input, stderr) = calibrate(&format!("seed{seed}"), &csv(&rows, &ALL));
+        let (json, input, stderr, dir) = calibrate(&format!("seed{seed}"), &csv(&rows, &ALL));
         let g = &drive.params.gyro;
         let right = drive.truth[turning + 200].yaw_rate_rps > 0.0;
         let true_scale = 1.0
@@ -149,17 +140,8 @@ fn gyro_zero_and_scale_from_simulated_turns() {
         assert_eq!(json["method"], "turn");
         assert_eq!(json["version"], 2);
         assert_eq!(json["dimensions"], 2);
-        let dir = input.parent().unwrap();
         let h = dir.join("h.csv");
-        ok(&[
-            "heading",
-            "--calibration",
-            p(&dir.join("cal.json")),
-            "--input",
-            p(&input),
-            "--output",
-            p(&h),
-        ]);
+        common::succeeded(common::heading(&dir.join("cal.json"), &input, &h, &[]));
         let lines = std::fs::read_to_string(&h).unwrap().lines().count();
         assert_eq!(lines, rows.len() + 1);
     }
@@ -169,7 +151,7 @@ fn gyro_zero_and_scale_from_simulated_turns() {
 #[test]
 fn without_gyr_z_only_the_compass() {
     let (rows, _, _) = opening_turn(2);
-    let (json, _, _) = calibrate("no_gyro", &csv(&rows, &["t_s", "mag_x", "mag_y"]));
+    let (json, ..) = calibrate("no_gyro", &csv(&rows, &["t_s", "mag_x", "mag_y"]));
     assert!(json.get("gyro").is_none(), "{json}");
     assert!(json["units"].get("gyro.scale").is_none());
     assert_eq!(json["hard_iron"].as_array().unwrap().len(), 2);
@@ -178,7 +160,7 @@ fn without_gyr_z_only_the_compass() {
 /// [`run_turn`] on a record it must refuse: exit 1, one line on stderr naming the file,
 /// no output. Returns the line.
 fn refused(name: &str, text: &str) -> String {
-    let (out, input, cal) = run_turn(name, text);
+    let (out, input, cal, _dir) = run_turn(name, text);
     assert_eq!(out.status.code(), Some(1), "{name}");
     let stderr = String::from_utf8(out.stderr).unwrap();
     assert_eq!(stderr.lines().count(), 1, "{stderr:?}");

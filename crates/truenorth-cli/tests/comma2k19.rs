@@ -244,10 +244,7 @@ impl Run {
 /// over one comparison of the wheels with the gyro (0.01 km/h × 1 s = 2.8 mm), not the
 /// 2 cm of ABS pulses.
 fn write_vehicle(dir: &Path) -> std::path::PathBuf {
-    let path = dir.join("vehicle.json");
-    let json = format!(r#"{{"track_m": {TRACK_M}, "odometer_wheels": "rear"}}"#);
-    std::fs::write(&path, json).unwrap();
-    path
+    common::rear_vehicle(dir, TRACK_M)
 }
 
 /// Runs the command on `input` with `extra` arguments and compares its rows with `r`.
@@ -277,7 +274,7 @@ fn drive(dir: &Path, name: &'static str, input: &Path, extra: &[&str], r: &Refer
         rows,
         errors,
         stderr: String::from_utf8_lossy(&o.stderr).into_owned(),
-        learned: serde_json::from_str(&std::fs::read_to_string(&learned).unwrap()).unwrap(),
+        learned: common::read_json(&learned),
     }
 }
 

@@ -6,7 +6,7 @@ mod common;
 use std::fmt::Write as _;
 use std::path::Path;
 
-use common::{ok, p, scratch, truenorth};
+use common::{p, scratch};
 use truenorth_sim::{DriveSpec, DriveWheels, SimulatedDrive, vehicle_streams_disturbed};
 
 /// Writes `drive` as DRIVE.csv (distances or speeds; with or without the gyro).
@@ -50,13 +50,7 @@ fn write_drive(drive: &SimulatedDrive, path: &Path, speeds: bool, gyro: bool) {
 }
 
 fn read_rows(path: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
-    let text = std::fs::read_to_string(path).unwrap();
-    let mut lines = text.lines();
-    let header = lines.next().unwrap().split(',').map(String::from).collect();
-    let rows = lines
-        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
-        .collect();
-    (header, rows)
+    common::table(path, false)
 }
 
 fn vehicle(dir: &Path, wheels: DriveWheels) -> std::path::PathBuf {
@@ -105,15 +99,7 @@ fn a_drive_from_distances_with_a_gyro_and_front_wheels_from_speeds() {
         write_drive(&drive, &input, speeds, gyro);
         let out = dir.join("out.csv");
         let veh = vehicle(&dir, wheels);
-        let o = ok(&[
-            "drive",
-            "--vehicle",
-            p(&veh),
-            "--input",
-            p(&input),
-            "--output",
-            p(&out),
-        ]);
+        let o = common::succeeded(common::drive(&veh, &input, &out, &[]));
         let (header, rows) = read_rows(&out);
         assert_eq!(header, ["t_s", "north_m", "east_m", "heading_deg"]);
         let (final_pct, heading_rms) = errors(&drive, &rows);
@@ -143,19 +129,17 @@ fn extra_columns_true_north_and_the_learned_calibration_carried_over() {
     write_drive(&drive, &input, false, true);
     let veh = vehicle(&dir, DriveWheels::Rear);
     let (out, cal) = (dir.join("out.csv"), dir.join("learned.json"));
-    ok(&[
-        "drive",
-        "--vehicle",
-        p(&veh),
-        "--input",
-        p(&input),
-        "--output",
-        p(&out),
-        "--extra",
-        "sigma,status,calibration",
-        "--calibration-out",
-        p(&cal),
-    ]);
+    common::succeeded(common::drive(
+        &veh,
+        &input,
+        &out,
+        &[
+            "--extra",
+            "sigma,status,calibration",
+            "--calibration-out",
+            p(&cal),
+        ],
+    ));
     let (header, rows) = read_rows(&out);
     assert_eq!(header.len(), 4 + 3 + 4 + 6);
     assert_eq!(
@@ -176,21 +160,12 @@ fn extra_columns_true_north_and_the_learned_calibration_carried_over() {
     );
     // True north: the track and the heading turn by the declination.
     let true_out = dir.join("true.csv");
-    ok(&[
-        "drive",
-        "--vehicle",
-        p(&veh),
-        "--input",
-        p(&input),
-        "--output",
-        p(&true_out),
-        "--lat",
-        "52.5",
-        "--lon",
-        "13.4",
-        "--date",
-        "2026.5",
-    ]);
+    common::succeeded(common::drive(
+        &veh,
+        &input,
+        &true_out,
+        &["--lat", "52.5", "--lon", "13.4", "--date", "2026.5"],
+    ));
     let (_, t_rows) = read_rows(&true_out);
     let (m, t) = (rows.last().unwrap(), t_rows.last().unwrap());
     let decl = truenorth::core::angle_diff(t[3].to_radians(), m[3].to_radians()).to_degrees();
@@ -211,20 +186,18 @@ fn extra_columns_true_north_and_the_learned_calibration_carried_over() {
     let input2 = dir.join("drive2.csv");
     write_drive(&second, &input2, false, true);
     let out2 = dir.join("out2.csv");
-    ok(&[
-        "drive",
-        "--vehicle",
-        p(&veh),
-        "--input",
-        p(&input2),
-        "--output",
-        p(&out2),
-        "--calibration-in",
-        p(&cal),
-        "--single-pass",
-        "--extra",
-        "status",
-    ]);
+    common::succeeded(common::drive(
+        &veh,
+        &input2,
+        &out2,
+        &[
+            "--calibration-in",
+            p(&cal),
+            "--single-pass",
+            "--extra",
+            "status",
+        ],
+    ));
     let (_, rows2) = read_rows(&out2);
     let first_absolute = rows2
         .iter()
@@ -254,15 +227,7 @@ fn refusals_name_the_file_and_the_problem() {
     ];
     for (text, expect) in cases {
         std::fs::write(&input, text).unwrap();
-        let o = truenorth(&[
-            "drive",
-            "--vehicle",
-            p(&veh),
-            "--input",
-            p(&input),
-            "--output",
-            p(&out),
-        ]);
+        let o = common::drive(&veh, &input, &out, &[]);
         let err = String::from_utf8_lossy(&o.stderr);
         assert!(!o.status.success(), "{text}");
         assert!(
@@ -273,26 +238,10 @@ fn refusals_name_the_file_and_the_problem() {
     }
     // The output may not be an input; a front-wheel vehicle needs its geometry.
     std::fs::write(&input, "t_s,dist_l_m,dist_r_m\n0,0,0\n1,1,1\n").unwrap();
-    let o = truenorth(&[
-        "drive",
-        "--vehicle",
-        p(&veh),
-        "--input",
-        p(&input),
-        "--output",
-        p(&input),
-    ]);
+    let o = common::drive(&veh, &input, &input, &[]);
     assert!(!o.status.success());
     let front = dir.join("front.json");
     std::fs::write(&front, r#"{"track_m": 1.5, "odometer_wheels": "front"}"#).unwrap();
-    let o = truenorth(&[
-        "drive",
-        "--vehicle",
-        p(&front),
-        "--input",
-        p(&input),
-        "--output",
-        p(&out),
-    ]);
+    let o = common::drive(&front, &input, &out, &[]);
     assert!(String::from_utf8_lossy(&o.stderr).contains("pitman_ratio"));
 }

@@ -6,7 +6,7 @@ mod common;
 use std::fmt::Write as _;
 use std::path::Path;
 
-use common::{p, scratch, truenorth};
+use common::scratch;
 use truenorth_sim::{Fitted, RangeDrive, RangeSpec, VehicleKind};
 
 /// Writes `drive` as the command reads it, with an empty cell wherever a sensor did not
@@ -77,22 +77,7 @@ fn write_vehicle(drive: &RangeDrive, path: &Path) {
 
 /// The output's rows, empty cells read as NaN.
 fn read_rows(path: &Path) -> Vec<Vec<f64>> {
-    std::fs::read_to_string(path)
-        .unwrap()
-        .lines()
-        .skip(1)
-        .map(|l| {
-            l.split(',')
-                .map(|v| {
-                    if v.is_empty() {
-                        f64::NAN
-                    } else {
-                        v.parse().unwrap()
-                    }
-                })
-                .collect()
-        })
-        .collect()
+    common::table(path, true).1
 }
 
 fn run_drive(dir: &Path, drive: &RangeDrive, time_scale: f64) -> std::process::Output {
@@ -105,18 +90,7 @@ fn run_drive(dir: &Path, drive: &RangeDrive, time_scale: f64) -> std::process::O
 
 /// `truenorth drive` on `vehicle` and `input`, writing `out.csv` in `dir`.
 fn drive_files(dir: &Path, vehicle: &Path, input: &Path, extra: &[&str]) -> std::process::Output {
-    let output = dir.join("out.csv");
-    let mut args = vec![
-        "drive",
-        "--vehicle",
-        p(vehicle),
-        "--input",
-        p(input),
-        "--output",
-        p(&output),
-    ];
-    args.extend_from_slice(extra);
-    truenorth(&args)
+    common::drive(vehicle, input, &dir.join("out.csv"), extra)
 }
 
 /// Heading RMS error, degrees, over the rows referred to north.

@@ -6,7 +6,7 @@ mod common;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use common::{p, run, scratch};
+use common::scratch;
 use truenorth_sim::{DriveSpec, SimulatedDrive};
 
 /// How a log is spoiled.
@@ -78,29 +78,8 @@ fn write(drive: &SimulatedDrive, path: &Path, spoil: Spoil) {
 
 /// Runs `drive` with a vehicle of `track_m`: (success, stderr).
 fn drive(dir: &Path, input: &Path, track_m: f64) -> (bool, String) {
-    let vehicle = dir.join("vehicle.json");
-    std::fs::write(
-        &vehicle,
-        format!(r#"{{"track_m": {track_m}, "odometer_wheels": "rear"}}"#),
-    )
-    .unwrap();
-    let out = dir.join("out.csv");
-    let o = run(
-        &[
-            "drive",
-            "--vehicle",
-            p(&vehicle),
-            "--input",
-            p(input),
-            "--output",
-            p(&out),
-        ],
-        None,
-    );
-    (
-        o.status.success(),
-        String::from_utf8_lossy(&o.stderr).into_owned(),
-    )
+    let vehicle = common::rear_vehicle(dir, track_m);
+    common::outcome(&common::drive(&vehicle, input, &dir.join("out.csv"), &[]))
 }
 
 /// Each mistake is refused with one line naming the log (or the vehicle file), the row

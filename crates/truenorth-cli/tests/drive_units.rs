@@ -29,24 +29,8 @@ fn write_drive(drive: &SimulatedDrive, path: &Path, gyro_factor: f64) {
 
 /// Runs `drive` on `input` with `extra`: (success, stderr).
 fn drive(dir: &Path, input: &Path, extra: &[&str]) -> (bool, String) {
-    let vehicle = dir.join("vehicle.json");
-    std::fs::write(&vehicle, r#"{"track_m": 1.55, "odometer_wheels": "rear"}"#).unwrap();
-    let out = dir.join("out.csv");
-    let mut args = vec![
-        "drive",
-        "--vehicle",
-        p(&vehicle),
-        "--input",
-        p(input),
-        "--output",
-        p(&out),
-    ];
-    args.extend_from_slice(extra);
-    let o = run(&args, None);
-    (
-        o.status.success(),
-        String::from_utf8_lossy(&o.stderr).into_owned(),
-    )
+    let vehicle = common::rear_vehicle(dir, 1.55);
+    common::outcome(&common::drive(&vehicle, input, &dir.join("out.csv"), extra))
 }
 
 #[test]

@@ -4,14 +4,14 @@
 mod common;
 
 use std::fmt::Write as _;
-use std::path::PathBuf;
+use std::path::Path;
 
-use common::{ok, p, truenorth};
+use common::p;
 
 use truenorth::core::{SplitMix64, angle_diff};
 use truenorth_sim::{FewShotInstrument, Shot, protocol_shots, random_attitude};
 
-fn scratch(name: &str) -> PathBuf {
+fn scratch(name: &str) -> common::ScratchDir {
     common::scratch("cli_ellipsoid_accel", name)
 }
 
@@ -49,27 +49,24 @@ fn ellipsoid_accel_then_tilt_compensated_heading() {
     let input = dir.join("shots.csv");
     std::fs::write(&input, csv(&shots, true)).unwrap();
     let cal = dir.join("cal.json");
-    let out = ok(&[
-        "calibrate",
-        "--method",
+    let out = common::succeeded(common::calibrate(
         "ellipsoid-accel",
-        "--input",
-        p(&input),
-        "--output",
-        p(&cal),
-        "--column",
-        "acc_x=-gx,acc_y=-gy,acc_z=-gz",
-        "--mag-unit",
-        "uT",
-    ]);
+        &input,
+        &cal,
+        &[
+            "--column",
+            "acc_x=-gx,acc_y=-gy,acc_z=-gz",
+            "--mag-unit",
+            "uT",
+        ],
+    ));
     let summary = String::from_utf8(out.stderr).unwrap();
     assert_eq!(summary.lines().count(), 1, "{summary}");
     assert!(
         summary.contains("ellipsoid-accel") && summary.contains("dip"),
         "{summary}"
     );
-    let json: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&cal).unwrap()).unwrap();
+    let json: serde_json::Value = common::read_json(&cal);
     assert_eq!(json["version"], 2);
     assert_eq!(json["dimensions"], 3);
     assert!(
@@ -101,17 +98,12 @@ fn ellipsoid_accel_then_tilt_compensated_heading() {
         .collect();
     let test = dir.join("fresh.csv");
     std::fs::write(&test, csv(&fresh, true)).unwrap();
-    let out = ok(&[
-        "heading",
-        "--calibration",
-        p(&cal),
-        "--input",
-        p(&test),
-        "--output",
-        "-",
-        "--column",
-        "acc_x=-gx,acc_y=-gy,acc_z=-gz",
-    ]);
+    let out = common::succeeded(common::heading(
+        &cal,
+        &test,
+        Path::new("-"),
+        &["--column", "acc_x=-gx,acc_y=-gy,acc_z=-gz"],
+    ));
     let note = String::from_utf8_lossy(&out.stderr);
     assert!(
         note.contains("tilt-compensated with the calibrated accelerometer"),
@@ -147,15 +139,7 @@ fn ellipsoid_accel_then_tilt_compensated_heading() {
         .map(|l| l.splitn(5, ',').take(4).collect::<Vec<_>>().join(",") + "\n")
         .collect();
     std::fs::write(&level, text).unwrap();
-    let out = ok(&[
-        "heading",
-        "--calibration",
-        p(&cal),
-        "--input",
-        p(&level),
-        "--output",
-        "-",
-    ]);
+    let out = common::succeeded(common::heading(&cal, &level, Path::new("-"), &[]));
     let note = String::from_utf8_lossy(&out.stderr);
     assert!(note.contains("level sensor assumed"), "{note}");
     let (header, _) = rows(&String::from_utf8(out.stdout).unwrap());
@@ -222,15 +206,7 @@ fn unusable_calibrations_are_refused_on_load() {
         let cal = dir.join(format!("{name}.json"));
         std::fs::write(&cal, text).unwrap();
         let out_path = dir.join(format!("{name}.csv"));
-        let out = truenorth(&[
-            "heading",
-            "--calibration",
-            p(&cal),
-            "--input",
-            p(&input),
-            "--output",
-            p(&out_path),
-        ]);
+        let out = common::heading(&cal, &input, &out_path, &[]);
         assert_eq!(out.status.code(), Some(1), "{name}");
         let err = String::from_utf8_lossy(&out.stderr);
         assert_eq!(err.lines().count(), 1, "{err}");

@@ -2,20 +2,15 @@
 //! progress lines and refusals, on small trials made here from the simulator; and the
 //! figures on the real benchmark when `../shared/data/broad/` is present.
 
-use std::io::Write as _;
-use std::path::{Path, PathBuf};
-use std::process::Command;
+mod common;
 
+use std::path::Path;
+
+use common::{IMU_HEADER, ScratchDir, csv_cells, gzip, imu_cells, p, truenorth};
 use truenorth_sim::{HandheldParams, ImuSensorParams, handheld_motion, imu_streams};
 
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_truenorth"))
-}
-
-fn dir(tag: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("truenorth-eval-{tag}-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
+fn dir(tag: &str) -> ScratchDir {
+    common::scratch("cli_eval_broad", tag)
 }
 
 /// A BROAD-format trial (gzip CSV, ENU reference) of simulated hand-held motion; the first
@@ -31,15 +26,8 @@ fn write_trial(path: &Path, seed: u64) {
     let h = std::f64::consts::FRAC_1_SQRT_2;
     let to_enu =
         nalgebra::UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(0.0, h, h, 0.0));
-    let mut csv = String::from(
-        "t_s,gyr_x,gyr_y,gyr_z,acc_x,acc_y,acc_z,mag_x,mag_y,mag_z,qw,qx,qy,qz,movement\n",
-    );
+    let mut csv = format!("{IMU_HEADER},qw,qx,qy,qz,movement\n");
     for (k, (s, t)) in samples.iter().zip(&truth).enumerate() {
-        let (g, a, m) = (
-            s.gyr_rps.as_xyz().unwrap(),
-            s.acc_mps2.as_xyz().unwrap(),
-            s.mag.as_xyz().unwrap(),
-        );
         let q = to_enu * t.attitude;
         let qs = if k % 50 == 0 {
             "NaN,NaN,NaN,NaN".to_string()
@@ -47,24 +35,12 @@ fn write_trial(path: &Path, seed: u64) {
             format!("{},{},{},{}", q.w, q.i, q.j, q.k)
         };
         csv += &format!(
-            "{},{},{},{},{},{},{},{},{},{},{qs},{}\n",
-            s.t_s,
-            g.x,
-            g.y,
-            g.z,
-            a.x,
-            a.y,
-            a.z,
-            m.x,
-            m.y,
-            m.z,
+            "{},{qs},{}\n",
+            csv_cells(&imu_cells(s), ","),
             u8::from(s.t_s >= 5.0)
         );
     }
-    let f = std::fs::File::create(path).unwrap();
-    let mut gz = flate2::write::GzEncoder::new(f, flate2::Compression::fast());
-    gz.write_all(csv.as_bytes()).unwrap();
-    gz.finish().unwrap();
+    std::fs::write(path, gzip(csv.as_bytes())).unwrap();
 }
 
 #[test]
@@ -74,10 +50,7 @@ fn scores_a_folder_of_trials_as_json() {
     std::fs::create_dir_all(&trials).unwrap();
     write_trial(&trials.join("01_undisturbed_sim.csv.gz"), 1);
     write_trial(&trials.join("02_disturbed_sim.csv.gz"), 2);
-    let o = bin()
-        .args(["eval", "broad", d.to_str().unwrap(), "--json"])
-        .output()
-        .unwrap();
+    let o = truenorth(&["eval", "broad", p(&d), "--json"]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     let t = v["trials"].as_array().unwrap();
@@ -96,16 +69,7 @@ fn scores_a_folder_of_trials_as_json() {
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(err.contains("1/2") && err.contains("2/2"), "{err}");
     // The table form and the Euler detector.
-    let o = bin()
-        .args([
-            "eval",
-            "broad",
-            trials.to_str().unwrap(),
-            "--method",
-            "euler-detector",
-        ])
-        .output()
-        .unwrap();
+    let o = truenorth(&["eval", "broad", p(&trials), "--method", "euler-detector"]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert!(String::from_utf8_lossy(&o.stdout).contains("mean, all (2 trials)"));
 }
@@ -113,21 +77,12 @@ fn scores_a_folder_of_trials_as_json() {
 #[test]
 fn refuses_a_folder_without_trials_and_a_broken_file() {
     let d = dir("empty");
-    let o = bin()
-        .args(["eval", "broad", d.to_str().unwrap()])
-        .output()
-        .unwrap();
+    let o = truenorth(&["eval", "broad", p(&d)]);
     assert!(!o.status.success());
     assert!(String::from_utf8_lossy(&o.stderr).contains("no BROAD trial files"));
     let bad = d.join("01_undisturbed_bad.csv.gz");
-    let f = std::fs::File::create(&bad).unwrap();
-    let mut gz = flate2::write::GzEncoder::new(f, flate2::Compression::fast());
-    gz.write_all(b"t_s,gyr_x\n0,1\n").unwrap();
-    gz.finish().unwrap();
-    let o = bin()
-        .args(["eval", "broad", d.to_str().unwrap()])
-        .output()
-        .unwrap();
+    std::fs::write(&bad, gzip(b"t_s,gyr_x\n0,1\n")).unwrap();
+    let o = truenorth(&["eval", "broad", p(&d)]);
     assert!(!o.status.success());
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(
@@ -143,10 +98,7 @@ fn real_broad_within_the_goal() {
     let Some(broad) = truenorth_sim::shared_data::folder("broad").unwrap() else {
         return;
     };
-    let o = bin()
-        .args(["eval", "broad", broad.to_str().unwrap(), "--json"])
-        .output()
-        .unwrap();
+    let o = truenorth(&["eval", "broad", p(&broad), "--json"]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!(v["trials"].as_array().unwrap().len(), 20);

@@ -5,62 +5,27 @@
 
 mod common;
 
-use std::f64::consts::TAU;
 use std::path::{Path, PathBuf};
 
-use common::{ok, p, run};
+use common::{ScratchDir, TURN_HEADER, p, run};
 
-fn scratch(name: &str) -> PathBuf {
+fn scratch(name: &str) -> ScratchDir {
     common::scratch("cli_hostile_input", name)
 }
 
 /// A level compass turning through a full circle: `t_s,mag_x,mag_y` rows.
 fn turn_rows(n: usize) -> String {
-    (0..n)
-        .map(|k| {
-            let h = TAU * k as f64 / n as f64;
-            format!(
-                "{},{},{}\n",
-                0.1 * k as f64,
-                4.0 + 20.0 * h.cos(),
-                -3.0 - 20.0 * h.sin()
-            )
-        })
-        .collect()
+    common::turn_rows(n, 0.1, 20.0, [4.0, -3.0], 0.0)
 }
 
 /// A 2-D calibration in `dir`, fitted to a clean turn.
 fn calibration(dir: &Path) -> PathBuf {
-    let input = dir.join("turn.csv");
-    std::fs::write(&input, format!("t_s,mag_x,mag_y\n{}", turn_rows(72))).unwrap();
-    let cal = dir.join("cal.json");
-    ok(&[
-        "calibrate",
-        "--method",
-        "ellipse",
-        "--input",
-        p(&input),
-        "--output",
-        p(&cal),
-    ]);
-    cal
+    common::ellipse_calibration(dir, &format!("{TURN_HEADER}{}", turn_rows(72)), &[]).1
 }
 
 /// Runs `heading` on `input`; the output file is in the same folder.
 fn heading(dir: &Path, cal: &Path, input: &str) -> std::process::Output {
-    let out = dir.join("out.csv");
-    run(
-        &[
-            "heading",
-            "--calibration",
-            p(cal),
-            "--input",
-            input,
-            "--output",
-            p(&out),
-        ],
-        None,
-    )
+    common::heading(cal, Path::new(input), &dir.join("out.csv"), &[])
 }
 
 /// Asserts one line on stderr, exit status 1, the file named, and every part in `expect`.
@@ -78,12 +43,7 @@ fn refused(out: &std::process::Output, file: &str, expect: &[&str]) -> String {
 
 /// The headings a successful run wrote.
 fn headings(dir: &Path) -> Vec<f64> {
-    std::fs::read_to_string(dir.join("out.csv"))
-        .unwrap()
-        .lines()
-        .skip(1)
-        .map(|l| l.split(',').nth(1).unwrap().parse().unwrap())
-        .collect()
+    common::headings(&std::fs::read_to_string(dir.join("out.csv")).unwrap())
 }
 
 /// Each malformed file: its bytes and what the one line must say.
@@ -176,18 +136,7 @@ fn malformed_files_get_one_line_naming_the_row() {
         let out = heading(&dir, &cal, p(&f));
         refused(&out, &format!("{name}.csv"), &expect);
         // calibrate reads through the same reader, and says the same.
-        let c = run(
-            &[
-                "calibrate",
-                "--method",
-                "ellipse",
-                "--input",
-                p(&f),
-                "--output",
-                p(&dir.join("c.json")),
-            ],
-            None,
-        );
+        let c = common::calibrate("ellipse", &f, &dir.join("c.json"), &[]);
         refused(&c, &format!("{name}.csv"), &expect);
     }
 }
@@ -199,18 +148,10 @@ fn harmless_variants_read_as_the_plain_file() {
     let dir = scratch("harmless");
     let cal = calibration(&dir);
     let rows = turn_rows(36);
-    let plain = format!("t_s,mag_x,mag_y\n{rows}");
+    let plain = format!("{TURN_HEADER}{rows}");
     let f = dir.join("plain.csv");
     std::fs::write(&f, &plain).unwrap();
-    ok(&[
-        "heading",
-        "--calibration",
-        p(&cal),
-        "--input",
-        p(&f),
-        "--output",
-        p(&dir.join("out.csv")),
-    ]);
+    common::succeeded(heading(&dir, &cal, p(&f)));
     let expected = headings(&dir);
     let quoted: String = rows
         .lines()
@@ -316,7 +257,7 @@ fn a_fifo_is_read_as_a_stream() {
     let writer = {
         let fifo = fifo.clone();
         std::thread::spawn(move || {
-            std::fs::write(&fifo, format!("t_s,mag_x,mag_y\n{}", turn_rows(36))).unwrap();
+            std::fs::write(&fifo, format!("{TURN_HEADER}{}", turn_rows(36))).unwrap();
         })
     };
     let out = heading(&dir, &cal, p(&fifo));

@@ -8,21 +8,17 @@ mod common;
 use std::f64::consts::TAU;
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
+use std::process::Stdio;
 
-use common::{p, run};
+use common::{gzip, p};
 
-fn scratch(name: &str) -> PathBuf {
+fn scratch(name: &str) -> common::ScratchDir {
     common::scratch("cli_input_files", name)
 }
 
-fn ok(args: &[&str], stdin: Option<&[u8]>) -> std::process::Output {
-    common::ok_with(args, stdin)
-}
-
-fn failed(args: &[&str]) -> String {
-    let out = run(args, None);
-    assert_eq!(out.status.code(), Some(1), "{args:?} should fail");
+/// The one line on stderr of a run that failed with status 1.
+fn failed(out: std::process::Output) -> String {
+    assert_eq!(out.status.code(), Some(1), "should fail");
     let err = String::from_utf8(out.stderr).unwrap();
     assert_eq!(err.lines().count(), 1, "one line on stderr: {err:?}");
     err
@@ -54,12 +50,6 @@ fn headings(text: &str) -> Vec<f64> {
         .collect()
 }
 
-fn gzip(bytes: &[u8]) -> Vec<u8> {
-    let mut gz = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::fast());
-    gz.write_all(bytes).unwrap();
-    gz.finish().unwrap()
-}
-
 /// The same turn as a plain file, a `.gz` file, gzip on standard input, and semicolon
 /// separated with headers in capitals: one calibration, the same headings.
 #[test]
@@ -69,33 +59,11 @@ fn gzip_stdin_case_and_delimiters_read_the_same() {
     let plain = dir.join("turn.csv");
     std::fs::write(&plain, csv("t_s,mag_x,mag_y", ",", &rows)).unwrap();
     let cal = dir.join("cal.json");
-    let out = ok(
-        &[
-            "calibrate",
-            "--method",
-            "ellipse",
-            "--input",
-            p(&plain),
-            "--output",
-            p(&cal),
-        ],
-        None,
-    );
+    let out = common::succeeded(common::calibrate("ellipse", &plain, &cal, &[]));
     // One summary line on success.
     let summary = String::from_utf8(out.stderr).unwrap();
     assert_eq!(summary.lines().count(), 1, "{summary:?}");
-    let reference = ok(
-        &[
-            "heading",
-            "--calibration",
-            p(&cal),
-            "--input",
-            p(&plain),
-            "--output",
-            "-",
-        ],
-        None,
-    );
+    let reference = common::succeeded(common::heading(&cal, &plain, Path::new("-"), &[]));
     let reference = headings(&String::from_utf8(reference.stdout).unwrap());
     assert_eq!(reference.len(), 90);
 
@@ -123,7 +91,7 @@ fn gzip_stdin_case_and_delimiters_read_the_same() {
             "-",
         ];
         args.extend_from_slice(extra);
-        let out = ok(&args, stdin.as_deref());
+        let out = common::ok_with(&args, stdin.as_deref());
         assert_eq!(
             headings(&String::from_utf8(out.stdout).unwrap()),
             reference,
@@ -145,38 +113,24 @@ fn column_mapping_negation_and_no_time() {
     let input = dir.join("logger.csv");
     std::fs::write(&input, text).unwrap();
     let cal = dir.join("cal.json");
-    ok(
-        &[
-            "calibrate",
-            "--method",
-            "ellipse",
-            "--input",
-            p(&input),
-            "--output",
-            p(&cal),
-            "--column",
-            "mag_x=MX,mag_y=-my_inverted",
-        ],
-        None,
-    );
-    let json: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&cal).unwrap()).unwrap();
+    common::succeeded(common::calibrate(
+        "ellipse",
+        &input,
+        &cal,
+        &["--column", "mag_x=MX,mag_y=-my_inverted"],
+    ));
+    let json: serde_json::Value = common::read_json(&cal);
     let hard: Vec<f64> = serde_json::from_value(json["hard_iron"].clone()).unwrap();
     assert!(
         (hard[0] - 4.0).abs() < 1e-6 && (hard[1] + 3.0).abs() < 1e-6,
         "{hard:?}"
     );
-    let e = failed(&[
-        "calibrate",
-        "--method",
+    let e = failed(common::calibrate(
         "ellipse",
-        "--input",
-        p(&input),
-        "--output",
-        p(&cal),
-        "--column",
-        "mag_x=nothing",
-    ]);
+        &input,
+        &cal,
+        &["--column", "mag_x=nothing"],
+    ));
     assert!(
         e.contains("no column `nothing`") && e.contains("row 1"),
         "{e}"
@@ -210,20 +164,12 @@ fn axis_convention_turns_a_flu_sensor_into_frd() {
     )
     .unwrap();
     let heading = |input: &Path, axes: &str| {
-        let out = ok(
-            &[
-                "heading",
-                "--calibration",
-                p(&cal),
-                "--input",
-                p(input),
-                "--output",
-                "-",
-                "--axes",
-                axes,
-            ],
-            None,
-        );
+        let out = common::succeeded(common::heading(
+            &cal,
+            input,
+            Path::new("-"),
+            &["--axes", axes],
+        ));
         headings(&String::from_utf8(out.stdout).unwrap())
     };
     let reference = heading(&frd_in, "frd");
@@ -244,15 +190,7 @@ fn duplicate_column_is_an_error() {
     }
     std::fs::write(&input, text).unwrap();
     let cal = dir.join("cal.json");
-    let e = failed(&[
-        "calibrate",
-        "--method",
-        "ellipse",
-        "--input",
-        p(&input),
-        "--output",
-        p(&cal),
-    ]);
+    let e = failed(common::calibrate("ellipse", &input, &cal, &[]));
     assert!(
         e.contains("mag_x") && e.contains("2 times") && e.contains("row 1"),
         "{e}"
@@ -269,40 +207,13 @@ fn output_naming_an_input_is_refused() {
     let text = csv("t_s,mag_x,mag_y", ",", &turn(60));
     std::fs::write(&input, &text).unwrap();
     let cal = dir.join("cal.json");
-    ok(
-        &[
-            "calibrate",
-            "--method",
-            "ellipse",
-            "--input",
-            p(&input),
-            "--output",
-            p(&cal),
-        ],
-        None,
-    );
+    common::succeeded(common::calibrate("ellipse", &input, &cal, &[]));
     let cal_text = std::fs::read_to_string(&cal).unwrap();
-    let e = failed(&[
-        "calibrate",
-        "--method",
-        "ellipse",
-        "--input",
-        p(&input),
-        "--output",
-        p(&input),
-    ]);
+    let e = failed(common::calibrate("ellipse", &input, &input, &[]));
     assert!(e.contains("would overwrite the input"), "{e}");
     let dotted = dir.join(".").join("cal.json");
     for output in [&input, &dotted] {
-        let e = failed(&[
-            "heading",
-            "--calibration",
-            p(&cal),
-            "--input",
-            p(&input),
-            "--output",
-            p(output),
-        ]);
+        let e = failed(common::heading(&cal, &input, output, &[]));
         assert!(e.contains("would overwrite the input"), "{e}");
     }
     assert_eq!(std::fs::read_to_string(&input).unwrap(), text);
@@ -311,36 +222,14 @@ fn output_naming_an_input_is_refused() {
 
 /// A folder with a calibration (`cal`) of a turn and the heading output (`out`) of that
 /// turn: (folder, cal, out).
-fn calibrated_with_output(name: &str) -> (PathBuf, PathBuf, PathBuf) {
+fn calibrated_with_output(name: &str) -> (common::ScratchDir, PathBuf, PathBuf) {
     let dir = scratch(name);
     let good = dir.join("turn.csv");
     std::fs::write(&good, csv("t_s,mag_x,mag_y", ",", &turn(60))).unwrap();
     let cal = dir.join("cal.json");
-    ok(
-        &[
-            "calibrate",
-            "--method",
-            "ellipse",
-            "--input",
-            p(&good),
-            "--output",
-            p(&cal),
-        ],
-        None,
-    );
+    common::succeeded(common::calibrate("ellipse", &good, &cal, &[]));
     let out = dir.join("heading.csv");
-    ok(
-        &[
-            "heading",
-            "--calibration",
-            p(&cal),
-            "--input",
-            p(&good),
-            "--output",
-            p(&out),
-        ],
-        None,
-    );
+    common::succeeded(common::heading(&cal, &good, &out, &[]));
     (dir, cal, out)
 }
 
@@ -354,15 +243,7 @@ fn a_failed_run_leaves_the_old_output() {
     let mut text = csv("t_s,mag_x,mag_y", ",", &turn(60));
     text += "99,oops,1\n";
     std::fs::write(&bad, text).unwrap();
-    let e = failed(&[
-        "heading",
-        "--calibration",
-        p(&cal),
-        "--input",
-        p(&bad),
-        "--output",
-        p(&out),
-    ]);
+    let e = failed(common::heading(&cal, &bad, &out, &[]));
     assert!(e.contains("row 62") && e.contains("not a number"), "{e}");
     assert_eq!(std::fs::read_to_string(&out).unwrap(), before);
     let stray: Vec<_> = std::fs::read_dir(&dir)
@@ -380,7 +261,7 @@ fn a_failed_run_leaves_the_old_output() {
 fn a_killed_run_leaves_the_old_output() {
     let (dir, cal, out) = calibrated_with_output("killed_run");
     let before = std::fs::read(&out).unwrap();
-    let mut child = Command::new(env!("CARGO_BIN_EXE_truenorth"))
+    let mut child = common::binary()
         .args([
             "heading",
             "--calibration",

@@ -5,20 +5,22 @@
 
 mod common;
 
-use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use common::{p, run, scratch};
+use common::{TURN_HEADER, p, run, scratch};
 use serde_json::Value;
-use truenorth_sim::{DriveSpec, SimulatedDrive};
 
 /// Runs the binary: (success, stderr).
 fn outcome(args: &[&str]) -> (bool, String) {
-    let o = run(args, None);
-    let err = String::from_utf8_lossy(&o.stderr).into_owned();
-    println!("{:?} -> {}", &args[..1], err.trim());
+    checked(run(args, None))
+}
+
+/// (success, stderr) of a run, which must not have panicked.
+fn checked(o: std::process::Output) -> (bool, String) {
+    let (ran, err) = common::outcome(&o);
+    println!("-> {}", err.trim());
     assert!(!err.contains("panicked"), "{err}");
-    (o.status.success(), err)
+    (ran, err)
 }
 
 /// Asserts a refusal of one line that names `file` and holds every `want`.
@@ -34,27 +36,14 @@ fn refused(result: (bool, String), file: &Path, want: &[&str]) {
 
 /// A level compass turning a full circle, as `t_s,mag_x,mag_y`.
 fn turn_csv(dir: &Path) -> PathBuf {
-    let mut s = String::from("t_s,mag_x,mag_y\n");
-    for k in 0..72 {
-        let a = (k as f64 * 5.0).to_radians();
-        writeln!(s, "{k},{},{}", 20.0 * a.cos() + 3.0, -20.0 * a.sin() - 1.0).unwrap();
-    }
     let path = dir.join("turn.csv");
-    std::fs::write(&path, s).unwrap();
+    let rows = common::turn_rows(72, 1.0, 20.0, [3.0, -1.0], 0.0);
+    std::fs::write(&path, TURN_HEADER.to_string() + &rows).unwrap();
     path
 }
 
 fn heading(dir: &Path, cal: &Path, input: &Path) -> (bool, String) {
-    let out = dir.join("h.csv");
-    outcome(&[
-        "heading",
-        "--calibration",
-        p(cal),
-        "--input",
-        p(input),
-        "--output",
-        p(&out),
-    ])
+    checked(common::heading(cal, input, &dir.join("h.csv"), &[]))
 }
 
 const GOOD_CAL: &str = r#"{"format":"truenorth-compass-calibration","version":2,"method":"hand","dimensions":2,"hard_iron":[3,-1],"soft_iron":[[1,0],[0,1]],"field":20}"#;
@@ -117,44 +106,11 @@ fn calibration_files_are_versioned_strict_and_physical() {
 
 /// A drive log with a compass, and the vehicle file for it.
 fn drive_files(dir: &Path) -> (PathBuf, PathBuf) {
-    let sim = SimulatedDrive::new(DriveSpec {
-        length_m: 2000.0,
-        ..DriveSpec::new(3)
-    })
-    .unwrap();
-    let mut s = String::from("t_s,dist_l_m,dist_r_m,gyr_z,mag_x,mag_y\n");
-    for x in &sim.samples {
-        let (w, m) = (x.wheels.unwrap(), x.mag.unwrap());
-        writeln!(
-            s,
-            "{},{},{},{},{},{}",
-            x.t_s,
-            w.dist_l_m,
-            w.dist_r_m,
-            x.gyr_z_rps.unwrap(),
-            m.x,
-            m.y
-        )
-        .unwrap();
-    }
-    let log = dir.join("drive.csv");
-    std::fs::write(&log, s).unwrap();
-    (log, dir.join("vehicle.json"))
+    (common::compass_drive_log(dir), dir.join("vehicle.json"))
 }
 
 fn drive(dir: &Path, log: &Path, vehicle: &Path, extra: &[&str]) -> (bool, String) {
-    let out = dir.join("track.csv");
-    let mut args = vec![
-        "drive",
-        "--vehicle",
-        p(vehicle),
-        "--input",
-        p(log),
-        "--output",
-        p(&out),
-    ];
-    args.extend_from_slice(extra);
-    outcome(&args)
+    checked(common::drive(vehicle, log, &dir.join("track.csv"), extra))
 }
 
 #[test]
@@ -206,7 +162,7 @@ fn learned_state_files_are_versioned_strict_and_physical() {
     let learned = dir.join("learned.json");
     let (ran, err) = drive(&dir, &log, &vehicle, &["--calibration-out", p(&learned)]);
     assert!(ran, "{err}");
-    let written: Value = serde_json::from_str(&std::fs::read_to_string(&learned).unwrap()).unwrap();
+    let written: Value = common::read_json(&learned);
     assert_eq!(written["format"], "truenorth-drive-calibration");
     assert_eq!(written["version"], 2);
     assert!(written["compass"].is_object(), "{written}");

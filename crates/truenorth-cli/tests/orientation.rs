@@ -1,19 +1,15 @@
 //! `truenorth orientation`: the CSV contract, the frames, and refusals.
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
+mod common;
 
+use std::path::{Path, PathBuf};
+
+use common::{IMU_HEADER, ScratchDir, csv_line, imu_cells};
 use nalgebra::{Quaternion, UnitQuaternion};
 use truenorth_sim::{HandheldParams, ImuSensorParams, MotionTruth, handheld_motion, imu_streams};
 
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_truenorth"))
-}
-
-fn dir(tag: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("truenorth-orient-{tag}-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
+fn dir(tag: &str) -> ScratchDir {
+    common::scratch("cli_orientation", tag)
 }
 
 /// Two minutes of simulated hand-held motion with a typical consumer IMU, as the CLI's input.
@@ -33,53 +29,28 @@ fn recording_with_time(
     })
     .unwrap();
     let samples = imu_streams(&truth, &ImuSensorParams::typical(), 11).unwrap();
-    let mut csv = String::from("t_s,gyr_x,gyr_y,gyr_z,acc_x,acc_y,acc_z,mag_x,mag_y,mag_z\n");
+    let mut csv = format!("{IMU_HEADER}\n");
     for s in &samples {
-        let (g, a, m) = (
-            s.gyr_rps.as_xyz().unwrap(),
-            s.acc_mps2.as_xyz().unwrap(),
-            s.mag.as_xyz().unwrap(),
-        );
-        let cells = [time(s.t_s), g.x, g.y, g.z, a.x, a.y, a.z, m.x, m.y, m.z];
-        csv += &cells.map(|v| v.to_string()).join(",");
-        csv.push('\n');
+        let mut cells = imu_cells(s);
+        cells[0] = time(cells[0]);
+        csv += &csv_line(&cells, ",");
     }
     let path = dir.join(name);
     std::fs::write(&path, csv).unwrap();
     (path, truth)
 }
 
-fn run(args: &[&str]) -> std::process::Output {
-    bin().arg("orientation").args(args).output().unwrap()
-}
-
 /// Runs the default method on `input`, which must be refused without creating `output`;
 /// returns what it said on stderr.
 fn refused(input: &Path, output: &Path) -> String {
-    let o = run(&[
-        "--input",
-        input.to_str().unwrap(),
-        "--output",
-        output.to_str().unwrap(),
-    ]);
+    let o = common::orientation(input, output, &[]);
     assert!(!o.status.success());
     assert!(!output.exists());
     String::from_utf8_lossy(&o.stderr).into_owned()
 }
 
 fn rows(path: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
-    let text = std::fs::read_to_string(path).unwrap();
-    let mut lines = text.lines();
-    let header = lines
-        .next()
-        .unwrap()
-        .split(',')
-        .map(str::to_string)
-        .collect();
-    let rows = lines
-        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
-        .collect();
-    (header, rows)
+    common::table(path, false)
 }
 
 /// The quaternion filter's error on the recording (NED output rows) after 20 s stays within
@@ -113,18 +84,18 @@ fn attitude_follows_the_simulated_motion_in_both_frames() {
     let (input, truth) = recording(&d);
     let (ned, enu) = (d.join("ned.csv"), d.join("enu.csv"));
     for (out, frame) in [(&ned, "ned"), (&enu, "enu")] {
-        let o = run(&[
-            "--input",
-            input.to_str().unwrap(),
-            "--output",
-            out.to_str().unwrap(),
-            "--frame",
-            frame,
-            "--status",
-            // The simulator's gyro reads the instantaneous rate.
-            "--gyro-timing",
-            "instantaneous",
-        ]);
+        // The simulator's gyro reads the instantaneous rate.
+        let o = common::orientation(
+            &input,
+            out,
+            &[
+                "--frame",
+                frame,
+                "--status",
+                "--gyro-timing",
+                "instantaneous",
+            ],
+        );
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     }
     let (header, ned_rows) = rows(&ned);
@@ -171,12 +142,7 @@ fn refusals_name_the_file_and_row() {
     let d = dir("refusals");
     let (input, _) = recording(&d);
     // The output may not overwrite the recording.
-    let o = run(&[
-        "--input",
-        input.to_str().unwrap(),
-        "--output",
-        input.to_str().unwrap(),
-    ]);
+    let o = common::orientation(&input, &input, &[]);
     assert!(!o.status.success());
     assert!(String::from_utf8_lossy(&o.stderr).contains("overwrite"));
     // A non-finite gyro reading is refused with its row; the output is not created.
@@ -192,12 +158,7 @@ fn refusals_name_the_file_and_row() {
     assert!(err.contains("row 6"), "{err}");
     // A failed run leaves an existing output as it was.
     std::fs::write(&out, "kept\n").unwrap();
-    let o = run(&[
-        "--input",
-        bad.to_str().unwrap(),
-        "--output",
-        out.to_str().unwrap(),
-    ]);
+    let o = common::orientation(&bad, &out, &[]);
     assert!(!o.status.success());
     assert_eq!(std::fs::read_to_string(&out).unwrap(), "kept\n");
 }
@@ -207,16 +168,16 @@ fn euler_detector_and_plot() {
     let d = dir("euler");
     let (input, truth) = recording(&d);
     let (out, plot) = (d.join("euler.csv"), d.join("euler.svg"));
-    let o = run(&[
-        "--method",
-        "euler-detector",
-        "--input",
-        input.to_str().unwrap(),
-        "--output",
-        out.to_str().unwrap(),
-        "--plot",
-        plot.to_str().unwrap(),
-    ]);
+    let o = common::orientation(
+        &input,
+        &out,
+        &[
+            "--method",
+            "euler-detector",
+            "--plot",
+            plot.to_str().unwrap(),
+        ],
+    );
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let (header, rows) = rows(&out);
     assert_eq!(header.len(), 8);
@@ -237,14 +198,7 @@ fn euler_detector_and_plot() {
     let svg = std::fs::read_to_string(&plot).unwrap();
     assert!(svg.starts_with("<svg") && svg.contains("yaw") && svg.trim_end().ends_with("</svg>"));
     // The plot may not overwrite an input.
-    let o = run(&[
-        "--input",
-        input.to_str().unwrap(),
-        "--output",
-        out.to_str().unwrap(),
-        "--plot",
-        input.to_str().unwrap(),
-    ]);
+    let o = common::orientation(&input, &out, &["--plot", input.to_str().unwrap()]);
     assert!(!o.status.success());
 }
 
@@ -257,15 +211,11 @@ fn a_gap_restarts_the_attitude_and_is_reported() {
     let (input, truth) =
         recording_with_time(&d, "gap.csv", |t| if t >= 60.0 { t + 3600.0 } else { t });
     let out = d.join("out.csv");
-    let o = run(&[
-        "--input",
-        input.to_str().unwrap(),
-        "--output",
-        out.to_str().unwrap(),
-        "--status",
-        "--gyro-timing",
-        "instantaneous",
-    ]);
+    let o = common::orientation(
+        &input,
+        &out,
+        &["--status", "--gyro-timing", "instantaneous"],
+    );
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let (header, rows) = rows(&out);
     let gap = header.iter().position(|h| h == "gap").unwrap();

@@ -4,58 +4,38 @@
 mod common;
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
+use common::{IMU_HEADER, csv_line, imu_cells, outcome, scratch};
 use nalgebra::{Quaternion, UnitQuaternion};
 use truenorth_sim::{HandheldParams, ImuSensorParams, handheld_motion, imu_streams};
-
-fn scratch(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("truenorth-orient-units-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d.join(name)
-}
 
 /// One minute of simulated hand-held motion written twice: in the contract's columns and
 /// units, and as a logger might write it (`time;wx;wy;wz;ax;ay;az;mx;my;mz`, deg/s, g,
 /// axes x forward, y left, z up).
-fn recordings() -> (PathBuf, PathBuf) {
+fn recordings(dir: &Path) -> (PathBuf, PathBuf) {
     let truth = handheld_motion(&HandheldParams::default()).unwrap();
     let samples = imu_streams(&truth, &ImuSensorParams::typical(), 5).unwrap();
-    let mut plain = String::from("t_s,gyr_x,gyr_y,gyr_z,acc_x,acc_y,acc_z,mag_x,mag_y,mag_z\n");
+    let mut plain = format!("{IMU_HEADER}\n");
     let mut logged = String::from("time;wx;wy;wz;ax;ay;az;mx;my;mz\n");
     for s in &samples {
-        let (g, a, m) = (
-            s.gyr_rps.as_xyz().unwrap(),
-            s.acc_mps2.as_xyz().unwrap(),
-            s.mag.as_xyz().unwrap(),
-        );
-        let cells = [s.t_s, g.x, g.y, g.z, a.x, a.y, a.z, m.x, m.y, m.z];
-        plain += &cells.map(|v| v.to_string()).join(",");
-        plain.push('\n');
-        let (dg, gs) = (g.map(f64::to_degrees), a / 9.80665);
+        let c = imu_cells(s);
+        plain += &csv_line(&c, ",");
+        let dg = [c[1], c[2], c[3]].map(f64::to_degrees);
+        let gs = [c[4], c[5], c[6]].map(|a| a / 9.80665);
         // frd → flu: y and z change sign.
         let cells = [
-            s.t_s, dg.x, -dg.y, -dg.z, gs.x, -gs.y, -gs.z, m.x, -m.y, -m.z,
+            c[0], dg[0], -dg[1], -dg[2], gs[0], -gs[1], -gs[2], c[7], -c[8], -c[9],
         ];
-        logged += &cells.map(|v| v.to_string()).join(";");
-        logged.push('\n');
+        logged += &csv_line(&cells, ";");
     }
-    let (p, l) = (scratch("plain.csv"), scratch("logged.csv"));
+    let (p, l) = (dir.join("plain.csv"), dir.join("logged.csv"));
     std::fs::write(&p, plain).unwrap();
     std::fs::write(&l, logged).unwrap();
     (p, l)
 }
 
 fn orientation(input: &Path, output: &Path, extra: &[&str]) {
-    let o = Command::new(env!("CARGO_BIN_EXE_truenorth"))
-        .args(["orientation", "--input"])
-        .arg(input)
-        .arg("--output")
-        .arg(output)
-        .args(extra)
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    common::succeeded(common::orientation(input, output, extra));
 }
 
 fn attitudes(path: &Path) -> Vec<UnitQuaternion<f64>> {
@@ -81,11 +61,12 @@ fn largest_difference_deg(a: &[UnitQuaternion<f64>], b: &[UnitQuaternion<f64>]) 
 
 #[test]
 fn a_logged_recording_with_its_units_and_axes_declared_gives_the_contract_run() {
-    let (plain, logged) = recordings();
+    let dir = scratch("cli_orientation_units", "logged");
+    let (plain, logged) = recordings(&dir);
     let (out_plain, out_logged, out_unconverted) = (
-        scratch("plain.out.csv"),
-        scratch("logged.out.csv"),
-        scratch("unconverted.out.csv"),
+        dir.join("plain.out.csv"),
+        dir.join("logged.out.csv"),
+        dir.join("unconverted.out.csv"),
     );
     orientation(&plain, &out_plain, &[]);
     let mapping = [
@@ -104,7 +85,7 @@ fn a_logged_recording_with_its_units_and_axes_declared_gives_the_contract_run() 
     assert!(same < 1e-6, "declared units: attitudes differ by {same}°");
     // Without the units the file is refused (the unit check), and forced through it is read
     // as rad/s and m/s² with attitudes far off: the conversion is what makes them agree.
-    let (ok, err) = orientation_result(&logged, &mapping);
+    let (ok, err) = orientation_result(&dir, &logged, &mapping);
     assert!(!ok && err.contains("--acc-unit g"), "{err}");
     orientation(
         &logged,
@@ -118,20 +99,13 @@ fn a_logged_recording_with_its_units_and_axes_declared_gives_the_contract_run() 
     );
 }
 
-/// Runs `orientation` and returns (success, stderr).
-fn orientation_result(input: &Path, extra: &[&str]) -> (bool, String) {
-    let o = Command::new(env!("CARGO_BIN_EXE_truenorth"))
-        .args(["orientation", "--input"])
-        .arg(input)
-        .arg("--output")
-        .arg(scratch("checked.out.csv"))
-        .args(extra)
-        .output()
-        .unwrap();
-    (
-        o.status.success(),
-        String::from_utf8_lossy(&o.stderr).into_owned(),
-    )
+/// Runs `orientation` (its output in `dir`) and returns (success, stderr).
+fn orientation_result(dir: &Path, input: &Path, extra: &[&str]) -> (bool, String) {
+    outcome(&common::orientation(
+        input,
+        &dir.join("checked.out.csv"),
+        extra,
+    ))
 }
 
 /// x-io's example recording as it is published (deg/s, g, µT; x forward, y left, z up; its
@@ -139,20 +113,22 @@ fn orientation_result(input: &Path, extra: &[&str]) -> (bool, String) {
 /// refused, the message naming the unit the data are in.
 #[test]
 fn the_xio_recording_runs_as_published_and_its_units_are_checked() {
-    let Some(dir) = truenorth_sim::shared_data::folder("xio_fusion").unwrap() else {
+    let Some(data) = truenorth_sim::shared_data::folder("xio_fusion").unwrap() else {
         return;
     };
-    let input = dir.join("sensor_data.csv");
+    let dir = scratch("cli_orientation_units", "xio");
+    let input = data.join("sensor_data.csv");
     let columns = "t_s=Time (s),gyr_x=Gyroscope X (deg/s),gyr_y=Gyroscope Y (deg/s),gyr_z=Gyroscope Z (deg/s),acc_x=Accelerometer X (g),acc_y=Accelerometer Y (g),acc_z=Accelerometer Z (g),mag_x=Magnetometer X (uT),mag_y=Magnetometer Y (uT),mag_z=Magnetometer Z (uT)";
     let base = ["--column", columns, "--axes", "flu"];
     let units = ["--gyro-unit", "deg/s", "--acc-unit", "g"];
-    let (ok, err) = orientation_result(&input, &[&base[..], &units[..]].concat());
+    let (ok, err) = orientation_result(&dir, &input, &[&base[..], &units[..]].concat());
     assert!(ok, "{err}");
-    let (ok, err) = orientation_result(&input, &[&base[..], &units[2..]].concat());
+    let (ok, err) = orientation_result(&dir, &input, &[&base[..], &units[2..]].concat());
     assert!(!ok && err.contains("--gyro-unit deg/s"), "{err}");
-    let (ok, err) = orientation_result(&input, &[&base[..], &units[..2]].concat());
+    let (ok, err) = orientation_result(&dir, &input, &[&base[..], &units[..2]].concat());
     assert!(!ok && err.contains("--acc-unit g"), "{err}");
     let (ok, err) = orientation_result(
+        &dir,
         &input,
         &[&base[..], &units[..2], &["--accept-units"][..]].concat(),
     );
@@ -160,7 +136,7 @@ fn the_xio_recording_runs_as_published_and_its_units_are_checked() {
 }
 
 /// `trial` (gzip CSV, rad/s) rewritten with its gyro columns in deg/s.
-fn in_degrees(trial: &Path) -> PathBuf {
+fn in_degrees(dir: &Path, trial: &Path) -> PathBuf {
     use std::io::Read;
     let mut text = String::new();
     flate2::read::GzDecoder::new(std::fs::File::open(trial).unwrap())
@@ -192,7 +168,7 @@ fn in_degrees(trial: &Path) -> PathBuf {
         .unwrap()
         .to_string_lossy()
         .replace(".gz", "");
-    let path = scratch(&format!("deg-{name}"));
+    let path = dir.join(format!("deg-{name}"));
     std::fs::write(&path, out).unwrap();
     path
 }
@@ -207,11 +183,12 @@ fn no_broad_trial_is_refused_for_its_units() {
     let Some(trials) = common::broad_trials() else {
         return;
     };
+    let dir = scratch("cli_orientation_units", "broad");
     let mut refused_in_degrees = 0;
     for t in &trials {
-        let (ok, err) = orientation_result(t, &[]);
+        let (ok, err) = orientation_result(&dir, t, &[]);
         assert!(ok, "{}: {err}", t.display());
-        let (ok, err) = orientation_result(&in_degrees(t), &[]);
+        let (ok, err) = orientation_result(&dir, &in_degrees(&dir, t), &[]);
         if !ok {
             assert!(err.contains("--gyro-unit deg/s"), "{err}");
             refused_in_degrees += 1;

@@ -13,12 +13,12 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-use common::{ok, p, truenorth};
+use common::{TURN_HEADER, ok, p, truenorth};
 
 /// The status of a run that stopped because its reader closed the pipe (128 + SIGPIPE).
 const CLOSED_PIPE: i32 = 141;
 
-fn scratch(name: &str) -> PathBuf {
+fn scratch(name: &str) -> common::ScratchDir {
     common::scratch("cli_output_faults", name)
 }
 
@@ -30,28 +30,9 @@ struct Setup {
 }
 
 fn setup(dir: &Path, rows: usize) -> Setup {
-    let mut turn = String::from("t_s,mag_x,mag_y\n");
-    for k in 0..360 {
-        let a = f64::from(k).to_radians();
-        turn += &format!(
-            "{},{},{}\n",
-            f64::from(k) * 0.05,
-            12.0 + 20.0 * a.cos(),
-            -7.0 - 20.0 * a.sin()
-        );
-    }
-    let turn_path = dir.join("turn.csv");
-    std::fs::write(&turn_path, turn).unwrap();
-    let calibration = dir.join("cal.json");
-    ok(&[
-        "calibrate",
-        "--method",
-        "ellipse",
-        "--input",
-        p(&turn_path),
-        "--output",
-        p(&calibration),
-    ]);
+    let turn = common::turn_rows(360, 0.05, 20.0, [12.0, -7.0], 0.0);
+    let (_, calibration) =
+        common::ellipse_calibration(dir, &(TURN_HEADER.to_string() + &turn), &[]);
     let inputs = [0.0, 1.0].map(|offset: f64| {
         let mut csv = String::with_capacity(rows * 24);
         csv += "t_s,mag_x,mag_y\n";
@@ -87,7 +68,7 @@ fn heading_args<'a>(s: &'a Setup, input: usize, output: &'a str) -> Vec<&'a str>
 }
 
 fn spawn(args: &[&str]) -> std::process::Child {
-    Command::new(env!("CARGO_BIN_EXE_truenorth"))
+    common::binary()
         .args(args)
         .stdin(Stdio::null())
         .stdout(Stdio::piped())
@@ -347,7 +328,7 @@ fn a_full_disk_is_one_line_and_a_failure() {
         heading_args(&s, 0, "-"),
     ];
     for args in commands {
-        let out = Command::new(env!("CARGO_BIN_EXE_truenorth"))
+        let out = common::binary()
             .args(&args)
             .stdin(Stdio::null())
             .stdout(dev_full().unwrap())
@@ -365,7 +346,7 @@ fn a_closed_pipe_ends_the_run_quietly() {
     let dir = scratch("pipe");
     let s = setup(&dir, 20_000);
     // `truenorth heading --output - | head -1`: read one line, close the pipe.
-    let mut child = Command::new(env!("CARGO_BIN_EXE_truenorth"))
+    let mut child = common::binary()
         .args(heading_args(&s, 0, "-"))
         .stdin(Stdio::null())
         .stdout(Stdio::piped())
@@ -395,7 +376,7 @@ fn a_closed_pipe_ends_the_run_quietly() {
         vec!["demo", "--out", p(&demo_out)],
     ];
     for args in commands {
-        let mut child = Command::new(env!("CARGO_BIN_EXE_truenorth"))
+        let mut child = common::binary()
             .args(&args)
             .stdin(Stdio::null())
             .stdout(Stdio::piped())

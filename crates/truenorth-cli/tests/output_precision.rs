@@ -3,55 +3,16 @@
 
 mod common;
 
-use std::f64::consts::TAU;
-
-use common::{ok, p};
-
-fn column(text: &str, k: usize) -> Vec<String> {
-    text.lines()
-        .skip(1)
-        .map(|l| l.split(',').nth(k).unwrap().to_string())
-        .collect()
-}
+use common::{TURN_HEADER, column};
 
 #[test]
 fn heading_precision_rounds_to_significant_digits() {
     let dir = common::scratch("cli_output_precision", "heading");
-    let input = dir.join("turn.csv");
-    let mut text = String::from("t_s,mag_x,mag_y\n");
-    for k in 0..90 {
-        let h = TAU * k as f64 / 90.0 + 0.0123;
-        text += &format!(
-            "{},{},{}\n",
-            0.1 * k as f64,
-            4.0 + 20.0 * h.cos(),
-            -3.0 - 20.0 * h.sin()
-        );
-    }
-    std::fs::write(&input, text).unwrap();
-    let cal = dir.join("cal.json");
-    ok(&[
-        "calibrate",
-        "--method",
-        "ellipse",
-        "--input",
-        p(&input),
-        "--output",
-        p(&cal),
-    ]);
+    let text = common::turn_rows(90, 0.1, 20.0, [4.0, -3.0], 0.0123);
+    let (input, cal) = common::ellipse_calibration(&dir, &format!("{TURN_HEADER}{text}"), &[]);
     let run = |name: &str, extra: &[&str]| {
         let out = dir.join(name);
-        let mut args = vec![
-            "heading",
-            "--calibration",
-            p(&cal),
-            "--input",
-            p(&input),
-            "--output",
-            p(&out),
-        ];
-        args.extend(extra);
-        ok(&args);
+        common::succeeded(common::heading(&cal, &input, &out, extra));
         std::fs::read_to_string(&out).unwrap()
     };
     let full = run("full.csv", &[]);
@@ -70,19 +31,6 @@ fn heading_precision_rounds_to_significant_digits() {
     }
     // Every column is rounded, the time too (0.1 · 3 = 0.30000000000000004 in the input).
     assert_eq!(column(&short, 0)[3], "0.3");
-    let bad = common::run(
-        &[
-            "heading",
-            "--calibration",
-            p(&cal),
-            "--input",
-            p(&input),
-            "--output",
-            p(&dir.join("x.csv")),
-            "--precision",
-            "0",
-        ],
-        None,
-    );
+    let bad = common::heading(&cal, &input, &dir.join("x.csv"), &["--precision", "0"]);
     assert_eq!(bad.status.code(), Some(2), "clap refuses a precision of 0");
 }

@@ -1,53 +1,22 @@
 //! `heading --lat/--lon/--date`: true heading is magnetic heading plus the declination that
 //! `truenorth field` reports for the same place and date, added exactly once.
 
+mod common;
+
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_truenorth"))
-}
-
-fn run_ok(cmd: &mut Command) -> String {
-    let out = cmd.output().expect("the binary runs");
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8_lossy(&out.stdout).into_owned()
-}
+use common::{ScratchDir, TURN_HEADER, calibrate, heading, ok, succeeded};
 
 fn headings(path: &Path) -> Vec<f64> {
-    std::fs::read_to_string(path)
-        .expect("output written")
-        .lines()
-        .skip(1)
-        .map(|l| {
-            l.split(',')
-                .nth(1)
-                .and_then(|h| h.parse().ok())
-                .expect("a number")
-        })
-        .collect()
+    common::headings(&std::fs::read_to_string(path).expect("output written"))
 }
 
 /// A fresh folder holding `turn.csv`: a level compass turning through 360° one degree per
 /// row, reading `field·(cos h, −sin h) + hard_iron`. Returns (folder, csv path).
-fn level_turn(tag: &str, field: f64, hard_iron: (f64, f64)) -> (PathBuf, PathBuf) {
-    let dir = std::env::temp_dir().join(format!("truenorth-{tag}-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+fn level_turn(tag: &str, field: f64, hard_iron: [f64; 2]) -> (ScratchDir, PathBuf) {
+    let dir = common::scratch("cli_true_heading", tag);
     let input = dir.join("turn.csv");
-    let mut csv = String::from("t_s,mag_x,mag_y\n");
-    for k in 0..360 {
-        let h = f64::from(k).to_radians();
-        csv += &format!(
-            "{},{},{}\n",
-            f64::from(k) * 0.1,
-            field * h.cos() + hard_iron.0,
-            -field * h.sin() + hard_iron.1
-        );
-    }
+    let csv = TURN_HEADER.to_string() + &common::turn_rows(360, 0.1, field, hard_iron, 0.0);
     std::fs::write(&input, csv).unwrap();
     (dir, input)
 }
@@ -55,42 +24,18 @@ fn level_turn(tag: &str, field: f64, hard_iron: (f64, f64)) -> (PathBuf, PathBuf
 #[test]
 fn true_heading_adds_the_wmm_declination_once() {
     // A level compass turning through a full circle with hard iron (3, -2) on a 20 µT field.
-    let (dir, input) = level_turn("true-heading", 20.0, (3.0, -2.0));
+    let (dir, input) = level_turn("true-heading", 20.0, [3.0, -2.0]);
     let cal = dir.join("cal.json");
-    run_ok(
-        bin()
-            .args(["calibrate", "--method", "ellipse", "--input"])
-            .arg(&input)
-            .arg("--output")
-            .arg(&cal),
-    );
+    succeeded(calibrate("ellipse", &input, &cal, &[]));
 
     let magnetic = dir.join("magnetic.csv");
-    run_ok(
-        bin()
-            .arg("heading")
-            .arg("--calibration")
-            .arg(&cal)
-            .arg("--input")
-            .arg(&input)
-            .arg("--output")
-            .arg(&magnetic),
-    );
+    succeeded(heading(&cal, &input, &magnetic, &[]));
     let truth = dir.join("true.csv");
     let place = ["--lat", "51.5", "--lon", "-0.13", "--date", "2026.5"];
-    run_ok(
-        bin()
-            .arg("heading")
-            .arg("--calibration")
-            .arg(&cal)
-            .arg("--input")
-            .arg(&input)
-            .arg("--output")
-            .arg(&truth)
-            .args(place),
-    );
+    succeeded(heading(&cal, &input, &truth, &place));
 
-    let field = run_ok(bin().arg("field").args(place));
+    let field = ok(&[&["field"][..], &place[..]].concat()).stdout;
+    let field = String::from_utf8_lossy(&field);
     let decl: f64 = field
         .lines()
         .nth(1)
@@ -113,42 +58,28 @@ fn true_heading_adds_the_wmm_declination_once() {
     }
 
     // A date without a place is refused with one line.
-    let out = bin()
-        .arg("heading")
-        .arg("--calibration")
-        .arg(&cal)
-        .arg("--input")
-        .arg(&input)
-        .arg("--output")
-        .arg(dir.join("x.csv"))
-        .args(["--date", "2026.5"])
-        .output()
-        .unwrap();
+    let out = heading(&cal, &input, &dir.join("x.csv"), &["--date", "2026.5"]);
     assert!(!out.status.success());
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(err.lines().count(), 1, "{err}");
     assert!(err.contains("--lat"), "{err}");
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 #[test]
 fn calibrate_compares_the_fit_with_the_wmm_field() {
     // 19.6 µT: London's horizontal field in 2026 (WMM2025 gives 19.56 µT).
-    let (dir, input) = level_turn("expected-field", 19.6, (0.0, 0.0));
+    let (dir, input) = level_turn("expected-field", 19.6, [0.0, 0.0]);
     let cal = dir.join("cal.json");
     let place = ["--lat", "51.5", "--lon", "-0.13", "--date", "2026.5"];
-    let calibrate = |unit: &str| {
-        bin()
-            .args(["calibrate", "--method", "ellipse", "--input"])
-            .arg(&input)
-            .arg("--output")
-            .arg(&cal)
-            .args(place)
-            .args(["--mag-unit", unit])
-            .output()
-            .unwrap()
+    let with_unit = |unit: &str| {
+        calibrate(
+            "ellipse",
+            &input,
+            &cal,
+            &[&place[..], &["--mag-unit", unit]].concat(),
+        )
     };
-    let ok = calibrate("uT");
+    let ok = with_unit("uT");
     assert!(ok.status.success());
     // One summary line, no warning.
     let summary = String::from_utf8_lossy(&ok.stderr);
@@ -169,7 +100,7 @@ fn calibrate_compares_the_fit_with_the_wmm_field() {
     // Readings in µT declared as mG: ten times too small a field, which no site makes. The
     // calibration is refused, naming the unit the data are in; nothing is written.
     std::fs::remove_file(&cal).unwrap();
-    let wrong = calibrate("mG");
+    let wrong = with_unit("mG");
     assert_eq!(wrong.status.code(), Some(1));
     let err = String::from_utf8_lossy(&wrong.stderr);
     assert_eq!(err.lines().count(), 1, "{err}");
@@ -179,15 +110,12 @@ fn calibrate_compares_the_fit_with_the_wmm_field() {
     );
     assert!(!cal.exists());
     // Accepted on request, with the warning and the summary.
-    let forced = bin()
-        .args(["calibrate", "--method", "ellipse", "--input"])
-        .arg(&input)
-        .arg("--output")
-        .arg(&cal)
-        .args(place)
-        .args(["--mag-unit", "mG", "--accept-field-mismatch"])
-        .output()
-        .unwrap();
+    let forced = calibrate(
+        "ellipse",
+        &input,
+        &cal,
+        &[&place[..], &["--mag-unit", "mG", "--accept-field-mismatch"]].concat(),
+    );
     assert!(forced.status.success());
     let err = String::from_utf8_lossy(&forced.stderr);
     assert_eq!(err.lines().count(), 2, "{err}");
@@ -196,15 +124,7 @@ fn calibrate_compares_the_fit_with_the_wmm_field() {
         "{err}"
     );
     // --mag-unit alone checks the field against the Earth's range.
-    let alone = bin()
-        .args(["calibrate", "--method", "ellipse", "--input"])
-        .arg(&input)
-        .arg("--output")
-        .arg(&cal)
-        .args(["--mag-unit", "nT"])
-        .output()
-        .unwrap();
+    let alone = calibrate("ellipse", &input, &cal, &["--mag-unit", "nT"]);
     assert_eq!(alone.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&alone.stderr).contains("probably in uT"));
-    std::fs::remove_dir_all(&dir).ok();
 }

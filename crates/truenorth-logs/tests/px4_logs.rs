@@ -2,6 +2,8 @@
 //! what each holds, at which rates, and the quaternion filter run on `sample.ulg` against
 //! PX4's own attitude estimate. Absent logs skip visibly; under CI they fail.
 
+mod common;
+
 use std::path::PathBuf;
 
 use truenorth_core::{OrientationEstimator, angle_diff, rad_to_deg};
@@ -124,20 +126,7 @@ fn a_cut_log_is_refused_or_its_prefix_kept() {
     let Some(dir) = folder() else { return };
     let bytes = std::fs::read(dir.join("sample.ulg")).unwrap();
     let cut = &bytes[..bytes.len() / 2 + 7];
-    let strict = LogReader::new(LogConfig::default())
-        .unwrap()
-        .read_bytes(cut);
-    assert!(
-        matches!(strict, Err(LogError::Incomplete { .. })),
-        "{strict:?}"
-    );
-    let lenient = LogReader::new(LogConfig {
-        accept_incomplete: true,
-        ..LogConfig::default()
-    })
-    .unwrap()
-    .read_bytes(cut)
-    .unwrap();
+    let lenient = common::refused_or_prefix_kept(cut);
     assert!(!lenient.complete);
     assert!(
         lenient.imu.len() > 5000 && lenient.imu.len() < 17070,
@@ -146,13 +135,7 @@ fn a_cut_log_is_refused_or_its_prefix_kept() {
     );
     // Cut inside the definitions: nothing is usable.
     let header_only = &bytes[..2000];
-    let err = LogReader::new(LogConfig {
-        accept_incomplete: true,
-        ..LogConfig::default()
-    })
-    .unwrap()
-    .read_bytes(header_only)
-    .unwrap_err();
+    let err = common::lenient().read_bytes(header_only).unwrap_err();
     assert!(
         matches!(
             err,

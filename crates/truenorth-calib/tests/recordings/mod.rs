@@ -13,6 +13,20 @@ pub fn recording(name: &str) -> Option<PathBuf> {
     truenorth_sim::shared_data::folder(name).unwrap_or_else(|e| panic!("{e}"))
 }
 
+/// The magnetometer readings of one sunsided recording (`rec`: `full-sphere`, `x-axis`, …):
+/// `None` as [`recording`] says.
+pub fn sunsided_mag(rec: &str) -> Option<Vec<nalgebra::Vector3<f64>>> {
+    let p = recording("magcal_sunsided_mpu6050_hmc5883l")?
+        .join(rec)
+        .join("mag.csv.gz");
+    Some(
+        read_rows(&p)
+            .iter()
+            .map(|r| nalgebra::Vector3::new(r[1], r[2], r[3]))
+            .collect(),
+    )
+}
+
 /// Rows of a CSV file (optionally gzipped, read through the system's `gzip`), header
 /// skipped. The folder is present (see [`recording`]), so a file in it that cannot be read
 /// is a failure, not a skip.

@@ -330,11 +330,12 @@ fn same_file(a: &Path, b: &Path) -> bool {
 mod tests {
     use super::*;
 
-    fn dir(tag: &str) -> PathBuf {
-        let d = std::env::temp_dir().join(format!("truenorth-atomic-{tag}-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&d);
-        std::fs::create_dir_all(&d).unwrap();
-        d
+    /// A scratch folder, removed when dropped (also when a test fails).
+    fn dir(tag: &str) -> tempfile::TempDir {
+        tempfile::Builder::new()
+            .prefix(&format!("truenorth-atomic-{tag}-"))
+            .tempdir()
+            .unwrap()
     }
 
     fn leftovers(d: &Path) -> Vec<String> {
@@ -347,7 +348,8 @@ mod tests {
 
     #[test]
     fn an_abandoned_output_leaves_the_old_file_and_no_temporary() {
-        let d = dir("abandon");
+        let scratch = dir("abandon");
+        let d = scratch.path();
         let target = d.join("out.csv");
         std::fs::write(&target, "old\n").unwrap();
         {
@@ -356,14 +358,14 @@ mod tests {
             // Dropped without commit, as on an error half way.
         }
         assert_eq!(std::fs::read_to_string(&target).unwrap(), "old\n");
-        assert!(leftovers(&d).is_empty(), "{:?}", leftovers(&d));
+        assert!(leftovers(d).is_empty(), "{:?}", leftovers(d));
         let failed = write_atomically(&target, |w| {
             w.write_all(b"partial")?;
             Err("stopped".into())
         });
         assert!(failed.is_err());
         assert_eq!(std::fs::read_to_string(&target).unwrap(), "old\n");
-        assert!(leftovers(&d).is_empty());
+        assert!(leftovers(d).is_empty());
         write_csv(
             &target,
             &["a", "b"],
@@ -372,14 +374,15 @@ mod tests {
         )
         .unwrap();
         assert_eq!(std::fs::read_to_string(&target).unwrap(), "a,b\n1.5,-2\n");
-        assert!(leftovers(&d).is_empty());
+        assert!(leftovers(d).is_empty());
     }
 
     #[cfg(unix)]
     #[test]
     fn a_link_is_followed_a_device_written_into_and_permissions_kept() {
         use std::os::unix::fs::PermissionsExt as _;
-        let d = dir("kinds");
+        let scratch = dir("kinds");
+        let d = scratch.path();
         let real = d.join("real.csv");
         std::fs::write(&real, "old\n").unwrap();
         std::fs::set_permissions(&real, std::fs::Permissions::from_mode(0o640)).unwrap();
@@ -390,7 +393,7 @@ mod tests {
         assert_eq!(std::fs::read_to_string(&real).unwrap(), "a\n2\n");
         let mode = std::fs::metadata(&real).unwrap().permissions().mode();
         assert_eq!(mode & 0o777, 0o640, "{mode:o}");
-        assert!(leftovers(&d).is_empty());
+        assert!(leftovers(d).is_empty());
         write_csv(
             Path::new("/dev/null"),
             &["a"],
@@ -409,7 +412,8 @@ mod tests {
 
     #[test]
     fn gz_outputs_are_compressed_and_read_back() {
-        let d = dir("gz");
+        let scratch = dir("gz");
+        let d = scratch.path();
         let target = d.join("out.csv.gz");
         write_csv(&target, &["t_s"], [vec![0.25]], Precision::default()).unwrap();
         let mut text = String::new();
@@ -424,7 +428,8 @@ mod tests {
 
     #[test]
     fn an_output_that_is_an_input_is_refused() {
-        let d = dir("distinct");
+        let scratch = dir("distinct");
+        let d = scratch.path();
         let input = d.join("in.csv");
         std::fs::write(&input, "x\n").unwrap();
         let e = check_distinct(&input, &[&input]).unwrap_err().to_string();

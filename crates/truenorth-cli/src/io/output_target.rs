@@ -72,8 +72,12 @@ mod tests {
 
     #[test]
     fn each_kind_of_path_is_recognised() {
-        let d = std::env::temp_dir().join(format!("truenorth-target-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&d);
+        // Removed when dropped, also when the test fails.
+        let scratch = tempfile::Builder::new()
+            .prefix("truenorth-target-")
+            .tempdir()
+            .unwrap();
+        let d = scratch.path();
         std::fs::create_dir_all(d.join("sub")).unwrap();
         assert_eq!(
             OutputTarget::of(Path::new("-")).unwrap(),
@@ -114,6 +118,5 @@ mod tests {
             let e = OutputTarget::of(&looped).unwrap_err().to_string();
             assert!(e.contains("symbolic links"), "{e}");
         }
-        let _ = std::fs::remove_dir_all(&d);
     }
 }

@@ -118,14 +118,14 @@ mod tests {
         Table::read_with(&InputPath::new(path), &InputOptions::default(), &spec)
     }
 
-    fn temp_file(tag: &str, contents: &[u8]) -> PathBuf {
-        let path = std::env::temp_dir().join(format!(
-            "truenorth-io-{tag}-{}-{:?}",
-            std::process::id(),
-            std::thread::current().id()
-        ));
-        std::fs::write(&path, contents).expect("temp dir is writable");
-        path
+    /// A file holding `contents`, removed when dropped (also when a case fails).
+    fn temp_file(tag: &str, contents: &[u8]) -> tempfile::NamedTempFile {
+        let file = tempfile::Builder::new()
+            .prefix(&format!("truenorth-io-{tag}-"))
+            .tempfile()
+            .expect("temp dir is writable");
+        std::fs::write(file.path(), contents).expect("temp dir is writable");
+        file
     }
 
     proptest! {
@@ -135,23 +135,24 @@ mod tests {
         /// text that parses back to the same f64).
         #[test]
         fn write_then_read_round_trips(rows in proptest::collection::vec((-1e12f64..1e12, -1e6f64..1e6), 1..50)) {
-            let path = temp_file("rt", b"");
-            write_csv(&path, &["t_s", "mag_x"], rows.iter().map(|&(a, b)| vec![a, b]), Precision::default()).unwrap();
-            let t = read(&path, &["t_s", "mag_x"], &["mag_z"]).unwrap();
+            let file = temp_file("rt", b"");
+            let path = file.path();
+            write_csv(path, &["t_s", "mag_x"], rows.iter().map(|&(a, b)| vec![a, b]), Precision::default()).unwrap();
+            let t = read(path, &["t_s", "mag_x"], &["mag_z"]).unwrap();
             prop_assert_eq!(t.len(), rows.len());
             prop_assert!(t.col("mag_z").is_none());
             for (k, &(a, b)) in rows.iter().enumerate() {
                 prop_assert_eq!(t.req("t_s").unwrap()[k], a);
                 prop_assert_eq!(t.req("mag_x").unwrap()[k], b);
             }
-            std::fs::remove_file(&path).ok();
         }
 
         /// Any bytes at all: a table or a one-line error naming the file, never a panic.
         #[test]
         fn any_file_reads_or_fails_with_one_line(bytes in proptest::collection::vec(any::<u8>(), 0..400)) {
-            let path = temp_file("any", &bytes);
-            match read(&path, &["t_s"], &["mag_x"]) {
+            let file = temp_file("any", &bytes);
+            let path = file.path();
+            match read(path, &["t_s"], &["mag_x"]) {
                 Ok(t) => prop_assert!(t.req("t_s").unwrap().iter().all(|v| v.is_finite())),
                 Err(e) => {
                     let line = e.to_string();
@@ -159,7 +160,6 @@ mod tests {
                     prop_assert!(line.contains("truenorth-io-any"), "{}", line);
                 }
             }
-            std::fs::remove_file(&path).ok();
         }
     }
 }

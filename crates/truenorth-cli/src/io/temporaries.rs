@@ -162,9 +162,12 @@ mod tests {
 
     #[test]
     fn stale_temporaries_of_gone_processes_are_removed_and_live_ones_kept() {
-        let d = std::env::temp_dir().join(format!("truenorth-stale-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&d);
-        std::fs::create_dir_all(&d).unwrap();
+        // Removed when dropped, also when the test fails.
+        let scratch = tempfile::Builder::new()
+            .prefix("truenorth-stale-")
+            .tempdir()
+            .unwrap();
+        let d = scratch.path();
         let target = d.join("out.csv");
         // Above any pid_max Linux allows (2^22): no process has it.
         let gone = d.join(".out.csv.tmp-4294967");
@@ -184,7 +187,6 @@ mod tests {
             "another output's temporary is not touched"
         );
         assert!(not_a_pid.exists(), "a name that is not ours is not touched");
-        let _ = std::fs::remove_dir_all(&d);
     }
 
     #[test]
