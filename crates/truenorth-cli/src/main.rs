@@ -5,8 +5,10 @@
 
 use truenorth_cli::{commands, demo, eval, io};
 
+use std::io::IsTerminal as _;
 use std::process::ExitCode;
 
+use clap::error::ErrorKind;
 use clap::{Parser, Subcommand};
 
 use commands::{calibrate, drive, field, heading, inspect as inspect_cmd, orientation};
@@ -56,7 +58,10 @@ enum EvalCommand {
 }
 
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => return help_or_usage_error(&e),
+    };
     let result = match cli.command {
         Command::Demo(a) => demo::run(&a),
         Command::Calibrate(a) => calibrate::run(&a),
@@ -72,6 +77,24 @@ fn main() -> ExitCode {
         Err(e) => {
             // Never panics, whatever stderr is (a closed pipe, a full disk).
             io::write_stderr(format_args!("truenorth: {e}\n"));
+            ExitCode::FAILURE
+        }
+    }
+}
+
+/// The help or version text that `e` carries, on standard output; a usage error as clap
+/// reports it. clap's own printing ignores a failed write (`--help >/dev/full` would succeed),
+/// so the text goes through [`io::write_stdout`] as every other output does; a terminal
+/// keeps clap's printing, with its colours.
+fn help_or_usage_error(e: &clap::Error) -> ExitCode {
+    let shown = matches!(e.kind(), ErrorKind::DisplayHelp | ErrorKind::DisplayVersion);
+    if !shown || std::io::stdout().is_terminal() {
+        e.exit();
+    }
+    match io::write_stdout(format_args!("{}", e.render())) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(err) => {
+            io::write_stderr(format_args!("truenorth: {err}\n"));
             ExitCode::FAILURE
         }
     }

@@ -5,9 +5,29 @@
 use std::fmt;
 use std::str::FromStr;
 
+use super::closest_name::likely_meant;
+
 /// The sensor vectors whose `_x`, `_y`, `_z` columns the axis convention turns into body
 /// axes.
 pub const VECTOR_STEMS: [&str; 3] = ["mag", "acc", "gyr"];
+
+/// The columns of the CSV contract (ARCHITECTURE.md, "CLI contract") by name.
+const CONTRACT_COLUMNS: [&str; 14] = [
+    "t_s",
+    "mag_x",
+    "mag_y",
+    "mag_z",
+    "acc_x",
+    "acc_y",
+    "acc_z",
+    "gyr_x",
+    "gyr_y",
+    "gyr_z",
+    "dist_l_m",
+    "dist_r_m",
+    "speed_l_mps",
+    "speed_r_mps",
+];
 
 /// The options every command that reads a CSV takes (flatten into its arguments).
 #[derive(Debug, Clone, Default, clap::Args)]
@@ -322,7 +342,8 @@ impl Header {
                 sign: axis_sign * map_sign,
             })),
             Err(LookupError::Missing(_)) if mapping.is_some() => Err(format!(
-                "--column {sensor_name}={header}: no column `{header}`{via} (header has: {})",
+                "--column {sensor_name}={header}: no column `{header}`{via}{} (header has: {})",
+                self.did_you_mean(header),
                 self.names.join(",")
             )),
             Err(LookupError::Missing(_)) => Ok(None),
@@ -346,9 +367,25 @@ impl Header {
             format!(" (body `{name}` under --axes {})", opts.axes)
         };
         format!(
-            "missing column `{sensor_name}`{via} (header has: {}); name it with --column {sensor_name}=HEADER",
+            "missing column `{sensor_name}`{via}{} (header has: {}); name it with --column {sensor_name}=HEADER",
+            self.did_you_mean(&sensor_name),
             self.names.join(",")
         )
+    }
+
+    /// ` (did you mean `HEADER`?)` when a header looks like a misspelling of `name`. A
+    /// header that is itself a column of the contract (`mag_x` beside a missing `mag_z`)
+    /// is that column, not a misspelling.
+    fn did_you_mean(&self, name: &str) -> String {
+        let names: Vec<&str> = self
+            .names
+            .iter()
+            .map(String::as_str)
+            .filter(|h| !CONTRACT_COLUMNS.iter().any(|c| c.eq_ignore_ascii_case(h)))
+            .collect();
+        likely_meant(name, &names)
+            .map(|h| format!(" (did you mean `{h}`?)"))
+            .unwrap_or_default()
     }
 }
 
@@ -381,6 +418,28 @@ mod tests {
             columns: columns.iter().map(|c| c.parse().unwrap()).collect(),
             ..InputOptions::default()
         }
+    }
+
+    #[test]
+    fn a_misspelt_header_is_suggested_and_a_contract_column_is_not() {
+        let h = Header::new(["t_s", "mag_x", "mag_yy"]);
+        let m = h.missing("mag_y", &InputOptions::default());
+        assert!(
+            m.contains("missing column `mag_y` (did you mean `mag_yy`?)"),
+            "{m}"
+        );
+        let h = Header::new(["t_s", "mag_x", "mag_y"]);
+        let m = h.missing("mag_z", &InputOptions::default());
+        assert!(!m.contains("did you mean"), "{m}");
+        let e = h
+            .resolve("mag_x", &opts("frd", &["mag_x=mag_xx"]))
+            .unwrap_err();
+        assert!(!e.contains("did you mean"), "{e}");
+        let h = Header::new(["time", "MagX", "MagY"]);
+        let e = h
+            .resolve("mag_x", &opts("frd", &["mag_x=magx_"]))
+            .unwrap_err();
+        assert!(e.contains("(did you mean `MagX`?)"), "{e}");
     }
 
     #[test]

@@ -9,7 +9,7 @@ use truenorth::fusion::vehicle::VehicleCalibration;
 
 use super::atomic_write::write_atomically;
 use super::compass_physics::check_compass;
-use super::json_input::{parse_json, parse_value, read_json_text, version_of};
+use super::json_input::{parse_json_strict, parse_value, read_json_text, version_of};
 use super::{CliError, CliResult};
 
 /// The `format` tag of a learned-state file.
@@ -38,8 +38,10 @@ pub fn write_learned(path: &Path, learned: &VehicleCalibration) -> CliResult {
 }
 
 /// Reads and checks a learned-state file: a byte-order mark skipped, the format and
-/// version checked (a file with neither is a version-1 file), no unknown key, and the
-/// values against physics ([`check_learned`]).
+/// version checked (a file with neither is a version-1 file), no unknown key at any depth
+/// (the library's types inside, such as the compass's quality report, ignore unknown keys
+/// for their other readers; this file is the CLI's own, and a misspelt key in it would
+/// silently drop what was learned), and the values against physics ([`check_learned`]).
 pub fn read_learned(path: &Path) -> CliResult<VehicleCalibration> {
     let (text, name) = read_json_text(path)?;
     let what = "not a drive calibration (write one with `truenorth drive --calibration-out`)";
@@ -64,7 +66,7 @@ pub fn read_learned(path: &Path) -> CliResult<VehicleCalibration> {
         }
         _ => {}
     }
-    let learned: VehicleCalibration = parse_json(value, what).map_err(fail)?;
+    let learned: VehicleCalibration = parse_json_strict(value, what).map_err(fail)?;
     check_learned(&learned).map_err(fail)?;
     Ok(learned)
 }

@@ -29,6 +29,7 @@
 
 mod atomic_write;
 mod calibration_file;
+mod closest_name;
 mod columns;
 mod compass_physics;
 mod console;
