@@ -325,9 +325,9 @@ fn solve_2d(
 }
 
 /// The turn method (EP 0640207). With `gyr_z`, the whole calibration of one
-/// turn ([`TurnCalibrator`]): the gyro's zero and scale, and the compass from the same
+/// turn ([`TurnCalibrator`](truenorth::calib::TurnCalibrator)): the gyro's zero and scale, and the compass from the same
 /// extrema (placed by the sinusoid fit the gyro's relative heading allows). Without it, the
-/// compass half alone ([`TurnCompassCalibrator`]).
+/// compass half alone ([`TurnCompassCalibrator`](truenorth::calib::TurnCompassCalibrator)).
 fn calibrate_turn(
     args: &Args,
     compass: Box<Planar>,

@@ -1,8 +1,8 @@
 //! `truenorth demo`: the simulator and every method on it, with a results table.
 //!
-//! The sections in the order they print: the scenarios ([`scenarios`]), each sensor alone
-//! ([`sensors`]), compass calibration ([`compass`]), vehicle dead reckoning ([`drive`]) and
-//! orientation ([`orientation`]).
+//! The sections in the order they print, one private module each: the scenarios
+//! (`scenarios`), each sensor alone (`sensors`), compass calibration (`compass`), vehicle
+//! dead reckoning (`drive`) and orientation (`orientation`).
 
 mod compass;
 mod drive;

@@ -34,7 +34,7 @@ pub struct ColumnStats {
     pub max: Option<f64>,
     /// Readings per second: one over the median step of `t_s` between readings, Hz.
     pub rate_hz: Option<f64>,
-    /// Steps longer than [`GAP_FACTOR`] median steps.
+    /// Steps longer than `GAP_FACTOR` median steps.
     pub gaps: Gaps,
 }
 

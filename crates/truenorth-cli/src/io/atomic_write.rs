@@ -204,7 +204,7 @@ impl Drop for AtomicOutput {
     }
 }
 
-/// Writes `path` through `fill`, whole or not at all (see [`AtomicOutput`]).
+/// Writes `path` through `fill`, whole or not at all (see `AtomicOutput`).
 pub fn write_atomically(
     path: &Path,
     fill: impl FnOnce(&mut dyn Write) -> Result<(), Box<dyn std::error::Error>>,
@@ -215,7 +215,7 @@ pub fn write_atomically(
     out.commit()
 }
 
-/// A CSV written row by row into an [`AtomicOutput`]: numbers in Rust's shortest form that
+/// A CSV written row by row into an `AtomicOutput`: numbers in Rust's shortest form that
 /// reads back to the same `f64`.
 pub struct CsvOutput {
     out: AtomicOutput,

@@ -138,7 +138,7 @@ pub fn reference_spans(rows: &[Inertial]) -> (Vec<DirectionSpan>, (usize, usize)
 }
 
 /// Tries the 48 mappings on `rows` with the gyro's rates times `scale` (a unit factor);
-/// `None` with fewer than [`MIN_SPANS`] spans to judge on.
+/// `None` with fewer than `MIN_SPANS` spans to judge on.
 pub fn fit_gyro_axes(rows: &[Inertial], scale: f64) -> Option<AxisFit> {
     let (spans, counts) = reference_spans(rows);
     if spans.len() < MIN_SPANS {

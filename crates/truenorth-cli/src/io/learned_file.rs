@@ -41,7 +41,7 @@ pub fn write_learned(path: &Path, learned: &VehicleCalibration) -> CliResult {
 /// version checked (a file with neither is a version-1 file), no unknown key at any depth
 /// (the library's types inside, such as the compass's quality report, ignore unknown keys
 /// for their other readers; this file is the CLI's own, and a misspelt key in it would
-/// silently drop what was learned), and the values against physics ([`check_learned`]).
+/// silently drop what was learned), and the values against physics (`check_learned`).
 pub fn read_learned(path: &Path) -> CliResult<VehicleCalibration> {
     let (text, name) = read_json_text(path)?;
     let what = "not a drive calibration (write one with `truenorth drive --calibration-out`)";

@@ -18,7 +18,7 @@
 //! field's turns) and [`YawRateCheck`] (a vehicle's yaw gyro against its wheels), shared by
 //! the commands that refuse and by `inspect`, which reports.
 //!
-//! Writing: [`AtomicOutput`](atomic_write::AtomicOutput) / [`CsvOutput`] / [`write_csv`] / [`write_atomically`] write a
+//! Writing: `AtomicOutput` / [`CsvOutput`] / [`write_csv`] / [`write_atomically`] write a
 //! temporary file beside the target, sync it and rename it over the target (through a
 //! symbolic link, the file it points to; `-`, a device or a FIFO: written into directly;
 //! `*.gz`: compressed); the temporaries of a run stopped by a signal are removed, those a

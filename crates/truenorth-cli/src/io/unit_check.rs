@@ -56,7 +56,7 @@ pub fn check_inertial_units(samples: &[ImuSample], gyro: GyroUnit, acc: AccUnit)
     findings
 }
 
-/// [`check_inertial_units`], then, when the units hold, the gyro's axes against the
+/// `check_inertial_units`, then, when the units hold, the gyro's axes against the
 /// directions of gravity and the magnetic field (`opts`: the options the file was read
 /// with, which the fix composes with).
 pub fn check_inertial(

@@ -26,7 +26,7 @@ const RESOLUTION_RANGE_M: (f64, f64) = (1e-6, 5.0);
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct VehicleFile {
-    /// Layout version, [`VEHICLE_VERSION`] (optional: a file without one reads as it).
+    /// Layout version, `VEHICLE_VERSION` (optional: a file without one reads as it).
     #[serde(default)]
     pub version: Option<u32>,
     /// Track of the odometer wheels, m.
