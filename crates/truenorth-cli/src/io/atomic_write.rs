@@ -330,12 +330,8 @@ fn same_file(a: &Path, b: &Path) -> bool {
 mod tests {
     use super::*;
 
-    /// A scratch folder, removed when dropped (also when a test fails).
     fn dir(tag: &str) -> tempfile::TempDir {
-        tempfile::Builder::new()
-            .prefix(&format!("truenorth-atomic-{tag}-"))
-            .tempdir()
-            .unwrap()
+        crate::io::scratch::scratch_dir(&format!("atomic-{tag}"))
     }
 
     fn leftovers(d: &Path) -> Vec<String> {

@@ -43,6 +43,8 @@ mod number_format;
 mod output_target;
 mod reader;
 mod records;
+#[cfg(test)]
+mod scratch;
 mod source;
 mod table;
 mod temporaries;

@@ -72,11 +72,7 @@ mod tests {
 
     #[test]
     fn each_kind_of_path_is_recognised() {
-        // Removed when dropped, also when the test fails.
-        let scratch = tempfile::Builder::new()
-            .prefix("truenorth-target-")
-            .tempdir()
-            .unwrap();
+        let scratch = crate::io::scratch::scratch_dir("target");
         let d = scratch.path();
         std::fs::create_dir_all(d.join("sub")).unwrap();
         assert_eq!(

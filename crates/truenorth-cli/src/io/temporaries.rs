@@ -162,11 +162,7 @@ mod tests {
 
     #[test]
     fn stale_temporaries_of_gone_processes_are_removed_and_live_ones_kept() {
-        // Removed when dropped, also when the test fails.
-        let scratch = tempfile::Builder::new()
-            .prefix("truenorth-stale-")
-            .tempdir()
-            .unwrap();
+        let scratch = crate::io::scratch::scratch_dir("stale");
         let d = scratch.path();
         let target = d.join("out.csv");
         // Above any pid_max Linux allows (2^22): no process has it.
