@@ -25,8 +25,12 @@ fn copy_dir(from: &Path, to: &Path) {
 #[test]
 fn a_program_using_the_facade_alone_builds_and_runs() {
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
-    let work = std::env::temp_dir().join(format!("truenorth-downstream-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&work);
+    // Removed when dropped, also when the test fails.
+    let scratch = tempfile::Builder::new()
+        .prefix("truenorth-downstream-")
+        .tempdir()
+        .unwrap();
+    let work = scratch.path().join("downstream");
     copy_dir(&root.join("tests/downstream"), &work);
     let manifest = std::fs::read_to_string(work.join("Cargo.toml.in"))
         .unwrap()
@@ -43,7 +47,6 @@ fn a_program_using_the_facade_alone_builds_and_runs() {
         .env("CARGO_TARGET_DIR", &target)
         .output()
         .expect("cargo runs");
-    let _ = std::fs::remove_dir_all(&work);
     let stdout = String::from_utf8_lossy(&out.stdout);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(
