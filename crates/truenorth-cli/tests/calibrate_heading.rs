@@ -70,16 +70,8 @@ fn rms_deg(got: &[(f64, f64)], truth: &[f64]) -> f64 {
 fn ellipse_calibration_then_heading() {
     let dir = scratch("ellipse");
     let (csv, truth) = turn_csv(360);
-    let input = dir.join("turn.csv");
-    std::fs::write(&input, csv).unwrap();
-    let cal = dir.join("cal.json");
-    common::succeeded(common::calibrate(
-        "ellipse",
-        &input,
-        &cal,
-        &["--expected-field", "20"],
-    ));
-    let json: serde_json::Value = common::read_json(&cal);
+    let (input, cal) = common::ellipse_calibration(&dir, &csv, &["--expected-field", "20"]);
+    let json = common::read_json(&cal);
     assert_eq!(json["format"], "truenorth-compass-calibration");
     assert_eq!(json["version"], 2);
     assert_eq!(json["method"], "ellipse");
@@ -164,7 +156,7 @@ fn ellipsoid_calibration_then_level_heading() {
     std::fs::write(&input, csv).unwrap();
     let cal = dir.join("cal3.json");
     common::succeeded(common::calibrate("ellipsoid", &input, &cal, &[]));
-    let json: serde_json::Value = common::read_json(&cal);
+    let json = common::read_json(&cal);
     assert_eq!(json["dimensions"], 3);
     assert_eq!(
         json["quality"]["field_ratio_to_expected"],
@@ -348,7 +340,7 @@ fn every_2d_method_calibrates_a_full_turn_and_refuses_a_half() {
         let out = ok(&args);
         let err = String::from_utf8_lossy(&out.stderr);
         assert_eq!(err.contains("warning"), poor, "{err}");
-        let json: serde_json::Value = common::read_json(&cal);
+        let json = common::read_json(&cal);
         assert_eq!(json["method"], method);
         assert_eq!(json["dimensions"], 2);
         assert_eq!(json["quality"]["verdict"] == "poor", poor, "{method}");

@@ -66,7 +66,7 @@ fn ellipsoid_accel_then_tilt_compensated_heading() {
         summary.contains("ellipsoid-accel") && summary.contains("dip"),
         "{summary}"
     );
-    let json: serde_json::Value = common::read_json(&cal);
+    let json = common::read_json(&cal);
     assert_eq!(json["version"], 2);
     assert_eq!(json["dimensions"], 3);
     assert!(

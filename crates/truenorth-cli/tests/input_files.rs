@@ -110,16 +110,9 @@ fn column_mapping_negation_and_no_time() {
     for r in &rows {
         text += &format!("{},{},21.5\n", r[1], -r[2]);
     }
-    let input = dir.join("logger.csv");
-    std::fs::write(&input, text).unwrap();
-    let cal = dir.join("cal.json");
-    common::succeeded(common::calibrate(
-        "ellipse",
-        &input,
-        &cal,
-        &["--column", "mag_x=MX,mag_y=-my_inverted"],
-    ));
-    let json: serde_json::Value = common::read_json(&cal);
+    let (input, cal) =
+        common::ellipse_calibration(&dir, &text, &["--column", "mag_x=MX,mag_y=-my_inverted"]);
+    let json = common::read_json(&cal);
     let hard: Vec<f64> = serde_json::from_value(json["hard_iron"].clone()).unwrap();
     assert!(
         (hard[0] - 4.0).abs() < 1e-6 && (hard[1] + 3.0).abs() < 1e-6,
