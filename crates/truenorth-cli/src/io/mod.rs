@@ -42,6 +42,7 @@ mod number_format;
 mod output_target;
 mod reader;
 mod records;
+mod row_blocks;
 mod source;
 mod table;
 mod temporaries;

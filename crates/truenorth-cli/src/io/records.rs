@@ -43,7 +43,7 @@ impl std::fmt::Display for RecordError {
 /// enclosed in double quotes, which are dropped; a quoted field cannot span lines (sensor
 /// logs never need it).
 pub struct Records {
-    source: Box<dyn BufRead>,
+    source: Box<dyn BufRead + Send>,
     delimiter: Delimiter,
     line: Vec<u8>,
     spans: Vec<(usize, usize)>,
@@ -54,7 +54,7 @@ pub struct Records {
 
 impl Records {
     /// Records of `source` split at `delimiter` (not `Auto`: detect it first).
-    pub fn new(source: Box<dyn BufRead>, delimiter: Delimiter) -> Self {
+    pub fn new(source: Box<dyn BufRead + Send>, delimiter: Delimiter) -> Self {
         Self {
             source,
             delimiter,
