@@ -50,6 +50,8 @@ fn rows_are_written_as_estimated_whatever_follows() {
 
 #[test]
 fn a_long_recording_is_checked_on_its_first_part_and_never_passed_silently() {
+    // The command's help quotes the figure.
+    assert_eq!(CHECKED_ROWS, 131_072);
     let d = scratch("orientation-streaming", "long");
     let rows = CHECKED_ROWS + 2000;
     // Still throughout: no turns near rest to judge the gyro by, so a warning says the

@@ -48,6 +48,11 @@ pub enum Frame {
 /// since the start). `--plot FILE.svg` draws yaw, pitch and roll over time with the samples
 /// judged magnetically disturbed shaded.
 ///
+/// The recording is read once, row by row, each output row written as it is estimated:
+/// memory does not grow with the recording. The units (and the gyro's axes) are checked on
+/// its first 131072 rows, all of a shorter recording; when a longer one shows too little
+/// there to judge by, a line on stderr says that they went unchecked.
+///
 /// After a gap a line on stderr says how many there were and at which rows. Exit status 1
 /// with one line on stderr naming the file and row of the first unusable sample
 /// (non-finite value, time not increasing, a time base whose steps are mostly such gaps:
