@@ -10,7 +10,9 @@
 # For each size it writes a 2-D compass file (t_s,mag_x,mag_y: ten turns of a tilted
 # ellipse with noise), a 3-D one (t_s,mag_x,mag_y,mag_z: a tumble), an IMU file
 # (t_s,gyr_*,acc_*,mag_*) and a drive log (t_s,dist_l_m,dist_r_m,gyr_z), then prints one
-# table row per command: wall time (s) and peak resident memory (MB) from /usr/bin/time -v.
+# table row per command: wall time (s), CPU time (user + system, s: the work done, which a
+# machine loaded by other jobs stretches less than the wall time) and peak resident memory
+# (MB), from /usr/bin/time -v.
 # pandas and polars are measured only when importable (a line says when they are skipped).
 set -euo pipefail
 
@@ -59,17 +61,18 @@ measure() { # measure LABEL ROWS COMMAND...
     local label=$1 rows=$2 log="$dir/time.log"
     shift 2
     if /usr/bin/time -v "$@" >"$dir/stdout" 2>"$log"; then status=ok; else status="exit $?"; fi
-    local wall mem
+    local wall cpu mem
+    cpu=$(awk -F': ' '/User time \(seconds\)|System time \(seconds\)/ { s += $2 } END { printf "%.2f", s }' "$log")
     wall=$(awk -F': ' '/Elapsed \(wall clock\)/ { n = split($2, p, ":"); s = 0; for (i = 1; i <= n; i++) s = s * 60 + p[i]; printf "%.2f", s }' "$log")
     mem=$(awk -F': ' '/Maximum resident set size/ { printf "%.1f", $2 / 1024 }' "$log")
     local note
     note=$(head -c 200 "$dir/stdout")
-    printf '| %-34s | %9s | %7s | %8s | %s %s\n' "$label" "$rows" "$wall" "$mem" "$status" "$note"
+    printf '| %-34s | %9s | %7s | %7s | %8s | %s %s\n' "$label" "$rows" "$wall" "$cpu" "$mem" "$status" "$note"
     if [ "$status" != ok ]; then grep -v '^\s' "$log" | grep -v '^Command' | head -2 | sed 's/^/|   /'; fi
 }
 
-echo "| command                            |      rows |  wall s |  peak MB | status (python: the read_csv call alone, without the interpreter's start)"
-echo "|------------------------------------|-----------|---------|----------|-------"
+echo "| command                            |      rows |  wall s |   cpu s |  peak MB | status (python: the read_csv call alone, without the interpreter's start)"
+echo "|------------------------------------|-----------|---------|---------|----------|-------"
 echo '{"track_m": 1.55, "odometer_wheels": "rear"}' > "$dir/vehicle.json"
 for n in "${sizes[@]}"; do
     for kind in 2d 3d imu drive; do gen "$kind" "$n" "$dir/$kind.csv"; done

@@ -9,10 +9,11 @@ use truenorth::core::{AttitudeEstimate, Axes, EulerZyx, ImuSample, ned_to_enu, r
 use super::mag_unit::{MagUnit, check_field};
 use crate::io::errln;
 use crate::io::{
-    AccUnit, CliError, CliResult, GyroUnit, InputOptions, InputPath, OutputOptions, ReadSpec,
-    Table, check_distinct, check_inertial, median, refuse_or_warn, write_csv,
+    AccUnit, CliError, CliResult, CsvOutput, GyroUnit, Inertial, InputOptions, InputPath,
+    OutputOptions, ReadSpec, Reference, RowReader, check_distinct, check_inertial, fit_gyro_axes,
+    median, median_magnitude, refuse_or_warn,
 };
-use crate::plot::{Band, Line, write_timeseries};
+use crate::plot::{Band, Envelope, Line, write_timeseries};
 use crate::registry::{Orientation, OrientationMethod, Timing};
 
 /// Reference frame of the output quaternion.
@@ -46,6 +47,11 @@ pub enum Frame {
 /// about the north, east and down axes (the last is heading's; with `--no-mag`, its drift
 /// since the start). `--plot FILE.svg` draws yaw, pitch and roll over time with the samples
 /// judged magnetically disturbed shaded.
+///
+/// The recording is read once, row by row, each output row written as it is estimated:
+/// memory does not grow with the recording. The units (and the gyro's axes) are checked on
+/// its first 131072 rows, all of a shorter recording; when a longer one shows too little
+/// there to judge by, a line on stderr says that they went unchecked.
 ///
 /// After a gap a line on stderr says how many there were and at which rows. Exit status 1
 /// with one line on stderr naming the file and row of the first unusable sample
@@ -137,40 +143,58 @@ const SIGMA_HEADER: [&str; 3] = ["sigma_x_deg", "sigma_y_deg", "sigma_z_deg"];
 /// Gaps listed by row in the summary line; more are counted.
 const GAPS_LISTED: usize = 5;
 
-/// Runs the subcommand: read the recording, run the method over it, write the rows (and
-/// the plot), and say where the gyro could not bridge a gap.
+/// Rows the unit and axis check reads: the first part of the recording, held in memory
+/// (about 150 bytes a row, 20 MB), then run through the filter and dropped.
+///
+/// The check needs moments of near rest half a second apart (at least ten turns of
+/// gravity's direction between them) and a median specific force; a recording shows them
+/// within its first minutes when it shows them at all, and 2¹⁷ rows are 22 minutes at
+/// 100 Hz, 2 minutes at 1 kHz. Every recording up to this length is checked whole, exactly
+/// as the check was designed; a longer one is checked on its first part, and when that part
+/// holds too little evidence to judge the units or axes, a warning on stderr says so
+/// (never a silent pass).
+pub const CHECKED_ROWS: usize = 1 << 17;
+
+/// Most shaded bands in a plot: past this, bands closer than twice the joining gap are
+/// joined (a plot 900 pixels wide cannot show more).
+const MAX_BANDS: usize = 4096;
+
+/// Disturbed stretches closer than this (s) are shaded as one band.
+const BAND_JOIN_S: f64 = 0.2;
+
+/// Runs the subcommand: read the recording, check its units on its first part, run the
+/// method over it row by row while writing the rows (and gathering the plot's lines), and
+/// say where the gyro could not bridge a gap. Memory does not grow with the recording past
+/// [`CHECKED_ROWS`].
 pub fn run(args: &Args) -> CliResult {
     check_distinct(&args.output, &[&args.input])?;
     if let Some(p) = &args.plot {
         check_distinct(p, &[&args.input, &args.output])?;
     }
-    let samples = read_samples(args)?;
-    check_units(args, &samples)?;
+    let mut samples = read_samples(args)?;
+    let first = samples.first_part(CHECKED_ROWS)?;
+    check_units(args, &first)?;
+    if samples.peek()?.is_some() {
+        check_evidence(args, &first);
+    }
     let mut method = args
         .method
         .pipeline(!args.no_mag, args.gyro_timing)
         .map_err(|e| CliError::msg(e.to_string()))?;
-    let out = estimate(args, &mut method, &samples)?;
-    if let Some(p) = &args.plot {
-        plot(p, &out.rows, &out.disturbed)?;
-    }
     let mut header: Vec<&str> = HEADER.to_vec();
     if args.status {
         header.extend(STATUS_HEADER);
-        if out.reports_sigma {
-            header.extend(SIGMA_HEADER);
-        }
     }
-    write_csv(
-        &args.output,
-        &header,
-        out.rows,
-        args.output_options.precision,
-    )?;
-    if !out.gaps.is_empty() {
-        errln!("{}", gap_summary(&args.input, &out.gaps));
+    // Whether the method reports σ is known from its first estimate; the header waits for it.
+    let mut run = Estimation::new(args);
+    for sample in &first {
+        run.step(&mut method, sample, &header)?;
     }
-    Ok(())
+    drop(first);
+    while let Some(sample) = samples.next_sample()? {
+        run.step(&mut method, &sample, &header)?;
+    }
+    run.finish(args)
 }
 
 /// Refuses a recording whose accelerometer or gyro contradicts its declared unit, or whose
@@ -201,183 +225,344 @@ fn check_units(args: &Args, samples: &[ImuSample]) -> CliResult {
     }
 }
 
-/// The recording as IMU samples; a row whose three magnetometer cells are empty has no
-/// magnetometer reading, and with `--no-mag` none has.
-fn read_samples(args: &Args) -> CliResult<Vec<ImuSample>> {
+/// Says on stderr when the first [`CHECKED_ROWS`] rows of a longer recording (`first`) hold
+/// too little to judge the units and axes by: no median specific force, or fewer spans near
+/// rest than the axis fit needs. The rest of the recording is not checked.
+fn check_evidence(args: &Args, first: &[ImuSample]) {
+    let rows = Inertial::from_samples(first);
+    let judged = median_magnitude(&rows, Reference::Gravity).is_some()
+        && fit_gyro_axes(&rows, 1.0).is_some();
+    if !judged {
+        errln!(
+            "warning: {}: the first {CHECKED_ROWS} rows hold too few moments near rest to check the gyro's and accelerometer's units and the gyro's axes, and later rows are not checked: make sure --gyro-unit, --acc-unit and the axes are right",
+            args.input.display()
+        );
+    }
+}
+
+/// The recording as IMU samples, one row at a time.
+fn read_samples(args: &Args) -> CliResult<ImuRows> {
     let spec = ReadSpec::new(&["t_s", "gyr_x", "gyr_y", "gyr_z", "acc_x", "acc_y", "acc_z"])
-        .optional(&["mag_x", "mag_y", "mag_z"]);
-    let table = Table::read_with(&InputPath::new(&args.input), &args.input_options, &spec)?;
-    let (to_rps, to_mps2) = (args.gyro_unit.to_rad_per_s(), args.acc_unit.to_mps2());
-    table.require_rows()?;
-    table.check_increasing_time()?;
-    let col = |n: &str| table.req(n);
-    let (t, gx, gy, gz) = (col("t_s")?, col("gyr_x")?, col("gyr_y")?, col("gyr_z")?);
-    let (ax, ay, az) = (col("acc_x")?, col("acc_y")?, col("acc_z")?);
-    let mag = match (table.col("mag_x"), table.col("mag_y"), table.col("mag_z")) {
-        (Some(x), Some(y), Some(z)) if !args.no_mag => Some((x, y, z)),
-        _ => None,
-    };
-    Ok((0..table.len())
-        .map(|k| ImuSample {
-            t_s: t[k],
-            gyr_rps: Axes::xyz(Vector3::new(gx[k], gy[k], gz[k]) * to_rps),
-            acc_mps2: Axes::xyz(Vector3::new(ax[k], ay[k], az[k]) * to_mps2),
-            mag: match mag {
-                Some((x, y, z)) if x[k].is_nan() && y[k].is_nan() && z[k].is_nan() => Axes::NONE,
-                Some((x, y, z)) => Axes::xyz(Vector3::new(x[k], y[k], z[k])),
+        .optional(&["mag_x", "mag_y", "mag_z"])
+        .increasing("t_s");
+    let rows = RowReader::open(&InputPath::new(&args.input), &args.input_options, &spec)?;
+    ImuRows::new(args, rows)
+}
+
+/// The rows of a recording as IMU samples; a row whose three magnetometer cells are empty
+/// has no magnetometer reading, and with `--no-mag` none has.
+struct ImuRows {
+    rows: RowReader,
+    t: usize,
+    gyr: [usize; 3],
+    acc: [usize; 3],
+    mag: Option<[usize; 3]>,
+    to_rps: f64,
+    to_mps2: f64,
+    peeked: Option<ImuSample>,
+}
+
+impl ImuRows {
+    fn new(args: &Args, rows: RowReader) -> CliResult<Self> {
+        let col = |n: &str| {
+            rows.index(n)
+                .ok_or_else(|| CliError::file(rows.path(), format!("missing column `{n}`")))
+        };
+        let mag = match (
+            rows.index("mag_x"),
+            rows.index("mag_y"),
+            rows.index("mag_z"),
+        ) {
+            (Some(x), Some(y), Some(z)) if !args.no_mag => Some([x, y, z]),
+            _ => None,
+        };
+        Ok(Self {
+            t: col("t_s")?,
+            gyr: [col("gyr_x")?, col("gyr_y")?, col("gyr_z")?],
+            acc: [col("acc_x")?, col("acc_y")?, col("acc_z")?],
+            mag,
+            to_rps: args.gyro_unit.to_rad_per_s(),
+            to_mps2: args.acc_unit.to_mps2(),
+            peeked: None,
+            rows,
+        })
+    }
+
+    /// The next sample, `None` at the end.
+    fn next_sample(&mut self) -> CliResult<Option<ImuSample>> {
+        if let Some(s) = self.peeked.take() {
+            return Ok(Some(s));
+        }
+        let Some(r) = self.rows.next_row()? else {
+            return Ok(None);
+        };
+        let v = |[x, y, z]: [usize; 3]| Vector3::new(r[x], r[y], r[z]);
+        Ok(Some(ImuSample {
+            t_s: r[self.t],
+            gyr_rps: Axes::xyz(v(self.gyr) * self.to_rps),
+            acc_mps2: Axes::xyz(v(self.acc) * self.to_mps2),
+            mag: match self.mag {
+                Some([x, y, z]) if r[x].is_nan() && r[y].is_nan() && r[z].is_nan() => Axes::NONE,
+                Some(m) => Axes::xyz(v(m)),
                 None => Axes::NONE,
             },
-        })
-        .collect())
+        }))
+    }
+
+    /// The next sample, left to be returned by [`ImuRows::next_sample`].
+    fn peek(&mut self) -> CliResult<Option<&ImuSample>> {
+        if self.peeked.is_none() {
+            self.peeked = self.next_sample()?;
+        }
+        Ok(self.peeked.as_ref())
+    }
+
+    /// The first `n` samples (all of a shorter recording); a recording without any is
+    /// refused.
+    fn first_part(&mut self, n: usize) -> CliResult<Vec<ImuSample>> {
+        let mut first = Vec::new();
+        while first.len() < n {
+            match self.next_sample()? {
+                Some(s) => first.push(s),
+                None => break,
+            }
+        }
+        if first.is_empty() {
+            return Err(CliError::row(
+                self.rows.path(),
+                2,
+                "no data rows after the header",
+            ));
+        }
+        Ok(first)
+    }
 }
 
-/// What the run gives: the output rows, which samples were magnetically disturbed, the
-/// gaps as (row, t_s, gap length), and whether the method reports σ.
-struct Estimated {
-    rows: Vec<Vec<f64>>,
-    disturbed: Vec<bool>,
+/// The run in progress: the output written row by row, the gaps, the plot's lines.
+struct Estimation {
+    to_frame: UnitQuaternion<f64>,
+    status: bool,
+    precision: crate::io::Precision,
+    input: PathBuf,
+    output: PathBuf,
+    out: Option<CsvOutput>,
+    line: Vec<f64>,
+    /// Rows done.
+    k: usize,
+    previous_t: Option<f64>,
+    /// The first [`GAPS_LISTED`] gaps as (row, t_s, gap length), and how many in all.
     gaps: Vec<(usize, f64, f64)>,
+    gap_count: usize,
     reports_sigma: bool,
+    plot: Option<PlotLines>,
 }
 
-/// Runs `method` over `samples`, one output row each.
-fn estimate(args: &Args, method: &mut Orientation, samples: &[ImuSample]) -> CliResult<Estimated> {
-    let to_frame = match args.frame {
-        Frame::Ned => UnitQuaternion::identity(),
-        Frame::Enu => ned_to_enu(),
-    };
-    let mut out = Estimated {
-        rows: Vec::with_capacity(samples.len()),
-        disturbed: Vec::with_capacity(samples.len()),
-        gaps: Vec::new(),
-        reports_sigma: false,
-    };
-    for (k, sample) in samples.iter().enumerate() {
+impl Estimation {
+    fn new(args: &Args) -> Self {
+        Self {
+            to_frame: match args.frame {
+                Frame::Ned => UnitQuaternion::identity(),
+                Frame::Enu => ned_to_enu(),
+            },
+            status: args.status,
+            precision: args.output_options.precision,
+            input: args.input.clone(),
+            output: args.output.clone(),
+            out: None,
+            line: Vec::with_capacity(HEADER.len() + STATUS_HEADER.len() + SIGMA_HEADER.len()),
+            k: 0,
+            previous_t: None,
+            gaps: Vec::new(),
+            gap_count: 0,
+            reports_sigma: false,
+            plot: args.plot.as_ref().map(|_| PlotLines::default()),
+        }
+    }
+
+    /// Runs `method` on the next sample and writes its row (the output is started, with
+    /// `header` and the σ columns if the method reports σ, at the first).
+    fn step(&mut self, method: &mut Orientation, sample: &ImuSample, header: &[&str]) -> CliResult {
+        let k = self.k;
+        // Row k + 2: the data rows counted after the header.
         let est = method
             .update(sample)
-            .map_err(|e| CliError::row(&args.input, k + 2, e.to_string()))?
+            .map_err(|e| CliError::row(&self.input, k + 2, e.to_string()))?
             .estimate;
         if est.status.gap {
-            let since = k
-                .checked_sub(1)
-                .map_or(0.0, |j| sample.t_s - samples[j].t_s);
-            out.gaps.push((k + 2, sample.t_s, since));
+            let since = self.previous_t.map_or(0.0, |p| sample.t_s - p);
+            if self.gaps.len() < GAPS_LISTED {
+                self.gaps.push((k + 2, sample.t_s, since));
+            }
+            self.gap_count += 1;
         }
         if k == 0 {
-            out.reports_sigma = est.sigma_rad.is_some();
+            self.reports_sigma = est.sigma_rad.is_some();
+            let mut header = header.to_vec();
+            if self.status && self.reports_sigma {
+                header.extend(SIGMA_HEADER);
+            }
+            self.out = Some(CsvOutput::create(&self.output, &header)?);
         }
-        out.rows
-            .push(row(args, sample.t_s, &to_frame, &est, out.reports_sigma));
-        out.disturbed.push(est.status.mag_disturbed);
+        self.fill_row(sample.t_s, &est);
+        if let Some(out) = &mut self.out {
+            out.row(&self.line, self.precision)?;
+        }
+        if let Some(p) = &mut self.plot {
+            p.push(&self.line, est.status.mag_disturbed);
+        }
+        self.previous_t = Some(sample.t_s);
+        self.k += 1;
+        Ok(())
     }
-    Ok(out)
-}
 
-/// One output row at `t_s`: the attitude in the chosen frame, the Z-Y-X angles from NED, and with
-/// `--status` the flags and σ.
-fn row(
-    args: &Args,
-    t_s: f64,
-    to_frame: &UnitQuaternion<f64>,
-    est: &AttitudeEstimate,
-    reports_sigma: bool,
-) -> Vec<f64> {
-    let q = to_frame * est.attitude;
-    let e = EulerZyx::from_quaternion(&est.attitude);
-    let mut row = vec![
-        t_s,
-        q.w,
-        q.i,
-        q.j,
-        q.k,
-        rad_to_deg(e.yaw_rad),
-        rad_to_deg(e.pitch_rad),
-        rad_to_deg(e.roll_rad),
-    ];
-    if args.status {
-        let flag = |b: bool| f64::from(u8::from(b));
-        row.extend(est.gyro_bias_rps.iter());
+    /// One output row at `t_s` into `self.line`: the attitude in the chosen frame, the Z-Y-X
+    /// angles from NED, and with `--status` the flags and σ.
+    fn fill_row(&mut self, t_s: f64, est: &AttitudeEstimate) {
+        let q = self.to_frame * est.attitude;
+        let e = EulerZyx::from_quaternion(&est.attitude);
+        let row = &mut self.line;
+        row.clear();
         row.extend([
-            flag(est.status.at_rest),
-            flag(est.status.mag_used),
-            flag(est.status.mag_disturbed),
-            flag(est.status.mag_calibrating),
-            flag(est.status.gap),
+            t_s,
+            q.w,
+            q.i,
+            q.j,
+            q.k,
+            rad_to_deg(e.yaw_rad),
+            rad_to_deg(e.pitch_rad),
+            rad_to_deg(e.roll_rad),
         ]);
-        if let Some(sigma) = est.sigma_rad.filter(|_| reports_sigma) {
-            row.extend(sigma.iter().map(|v| rad_to_deg(*v)));
+        if self.status {
+            let flag = |b: bool| f64::from(u8::from(b));
+            row.extend(est.gyro_bias_rps.iter());
+            row.extend([
+                flag(est.status.at_rest),
+                flag(est.status.mag_used),
+                flag(est.status.mag_disturbed),
+                flag(est.status.mag_calibrating),
+                flag(est.status.gap),
+            ]);
+            if let Some(sigma) = est.sigma_rad.filter(|_| self.reports_sigma) {
+                row.extend(sigma.iter().map(|v| rad_to_deg(*v)));
+            }
         }
     }
-    row
+
+    /// Writes the plot, finishes the output and says where the gaps were.
+    fn finish(self, args: &Args) -> CliResult {
+        if let (Some(p), Some(lines)) = (&args.plot, self.plot) {
+            lines.write(p)?;
+        }
+        if let Some(out) = self.out {
+            out.commit()?;
+        }
+        if self.gap_count > 0 {
+            errln!("{}", gap_summary(&args.input, &self.gaps, self.gap_count));
+        }
+        Ok(())
+    }
 }
 
 /// One line: how many gaps, where, and what was done about them.
-fn gap_summary(input: &std::path::Path, gaps: &[(usize, f64, f64)]) -> String {
+/// `gaps` holds the first [`GAPS_LISTED`] of `count`.
+fn gap_summary(input: &std::path::Path, gaps: &[(usize, f64, f64)], count: usize) -> String {
     let listed: Vec<String> = gaps
         .iter()
         .take(GAPS_LISTED)
         .map(|(row, t, gap)| format!("row {row} (t_s {t}, after {gap:.3} s)"))
         .collect();
-    let more = match gaps.len().saturating_sub(GAPS_LISTED) {
+    let more = match count.saturating_sub(GAPS_LISTED) {
         0 => String::new(),
         n => format!(" and {n} more"),
     };
     format!(
         "truenorth orientation: {}: {} gap{} longer than the gyro can bridge at {}{more}; the attitude restarted there from the accelerometer and magnetometer (column gap with --status)",
         input.display(),
-        gaps.len(),
-        if gaps.len() == 1 { "" } else { "s" },
+        count,
+        if count == 1 { "" } else { "s" },
         listed.join(", "),
     )
 }
 
-/// Yaw, pitch and roll (columns 5–7 of the output rows) over time, disturbed samples shaded.
-fn plot(path: &std::path::Path, rows: &[Vec<f64>], disturbed: &[bool]) -> CliResult {
-    let series = |i: usize| rows.iter().map(|r| (r[0], r[i])).collect::<Vec<_>>();
-    let mut bands: Vec<Band> = Vec::new();
-    let mut start = None;
-    for (r, &d) in rows.iter().zip(disturbed) {
-        match (d, start) {
-            (true, None) => start = Some(r[0]),
+/// What the plot draws, gathered row by row in bounded memory: yaw, pitch and roll
+/// (columns 5–7 of the output rows) over time, and the bands of disturbed samples.
+#[derive(Default)]
+struct PlotLines {
+    yaw: Envelope,
+    pitch: Envelope,
+    roll: Envelope,
+    bands: Vec<Band>,
+    /// Start of the disturbed stretch under way.
+    start: Option<f64>,
+    last_t: Option<f64>,
+    /// Disturbed stretches closer than this (s) join ([`BAND_JOIN_S`], doubled each time
+    /// the bands would exceed [`MAX_BANDS`]).
+    join_s: f64,
+}
+
+impl PlotLines {
+    /// Adds an output row and whether its sample was disturbed.
+    fn push(&mut self, row: &[f64], disturbed: bool) {
+        let t = row[0];
+        self.yaw.push(t, row[5]);
+        self.pitch.push(t, row[6]);
+        self.roll.push(t, row[7]);
+        if self.join_s == 0.0 {
+            self.join_s = BAND_JOIN_S;
+        }
+        match (disturbed, self.start) {
+            (true, None) => self.start = Some(t),
             (false, Some(t0)) => {
                 // A gap shorter than a few samples joins the bands on either side.
-                match bands.last_mut() {
-                    Some(b) if t0 - b.to < 0.2 => b.to = r[0],
-                    _ => bands.push(Band { from: t0, to: r[0] }),
+                match self.bands.last_mut() {
+                    Some(b) if t0 - b.to < self.join_s => b.to = t,
+                    _ => self.bands.push(Band { from: t0, to: t }),
                 }
-                start = None;
+                self.start = None;
+                if self.bands.len() > MAX_BANDS {
+                    self.join_s *= 2.0;
+                    let bands = std::mem::take(&mut self.bands);
+                    for b in bands {
+                        match self.bands.last_mut() {
+                            Some(last) if b.from - last.to < self.join_s => last.to = b.to,
+                            _ => self.bands.push(b),
+                        }
+                    }
+                }
             }
             _ => {}
         }
+        self.last_t = Some(t);
     }
-    if let (Some(t0), Some(last)) = (start, rows.last()) {
-        bands.push(Band {
-            from: t0,
-            to: last[0],
-        });
+
+    /// Draws the lines and bands to `path`.
+    fn write(mut self, path: &std::path::Path) -> CliResult {
+        if let (Some(t0), Some(last)) = (self.start, self.last_t) {
+            self.bands.push(Band { from: t0, to: last });
+        }
+        write_timeseries(
+            path,
+            "Orientation (shaded: magnetic field judged disturbed)",
+            "t (s)",
+            "angle (deg)",
+            &[
+                Line {
+                    label: "yaw",
+                    colour: "#1f77b4",
+                    points: self.yaw.points(),
+                },
+                Line {
+                    label: "pitch",
+                    colour: "#2ca02c",
+                    points: self.pitch.points(),
+                },
+                Line {
+                    label: "roll",
+                    colour: "#d62728",
+                    points: self.roll.points(),
+                },
+            ],
+            &self.bands,
+        )
     }
-    write_timeseries(
-        path,
-        "Orientation (shaded: magnetic field judged disturbed)",
-        "t (s)",
-        "angle (deg)",
-        &[
-            Line {
-                label: "yaw",
-                colour: "#1f77b4",
-                points: series(5),
-            },
-            Line {
-                label: "pitch",
-                colour: "#2ca02c",
-                points: series(6),
-            },
-            Line {
-                label: "roll",
-                colour: "#d62728",
-                points: series(7),
-            },
-        ],
-        &bands,
-    )
 }

@@ -10,7 +10,8 @@
 //!   column named twice is an error;
 //! * [`RowReader`]: the streaming read, one row at a time, the requested columns by name as
 //!   `f64` with the row number for messages, time order checked on the way; memory does not
-//!   grow with the file;
+//!   grow with the file; the splitting and parsing run on a second thread a few blocks of
+//!   rows ahead, so that they overlap the command's own work;
 //! * [`Table`]: the whole-table read built on it.
 //!
 //! Checking (the data against what they were declared to be): [`check_inertial`] (the
@@ -43,6 +44,7 @@ mod number_format;
 mod output_target;
 mod reader;
 mod records;
+mod row_blocks;
 #[cfg(test)]
 mod scratch;
 mod source;

@@ -16,6 +16,7 @@ use std::path::{Path, PathBuf};
 use super::columns::{ColumnSource, Delimiter, Header, InputOptions};
 use super::errln;
 use super::records::{RecordError, Records, parse_number, shown};
+use super::row_blocks::{RowBlocks, RowSource};
 use super::source::InputPath;
 use super::{CliError, CliResult};
 
@@ -71,12 +72,31 @@ impl std::ops::Index<usize> for Row {
 }
 
 /// A streaming reader of the requested numeric columns of a CSV (see the module
-/// documentation). It holds one row at a time.
+/// documentation). It holds one row at a time; the file is split and parsed on a second
+/// thread, a few blocks of rows ahead (see the `row_blocks` module), with the same numbers
+/// and errors as a read on one thread.
 pub struct RowReader {
+    path: PathBuf,
+    names: Vec<String>,
+    blocks: RowBlocks,
+    row: Row,
+}
+
+impl std::fmt::Debug for RowReader {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("RowReader")
+            .field("path", &self.path)
+            .field("columns", &self.names)
+            .finish_non_exhaustive()
+    }
+}
+
+/// The parsing of the rows after the header: split, convert, check (run on the reader
+/// thread).
+struct RowParser {
     path: PathBuf,
     records: Records,
     columns: Vec<(ColumnSource, bool)>,
-    row: Row,
     increasing: Option<usize>,
     previous: Option<f64>,
     /// The header's field count: a row with more fields is refused, as is a last line
@@ -85,15 +105,6 @@ pub struct RowReader {
     /// With `--no-header`: the first record, read to count the columns, is still to be
     /// returned.
     pending: bool,
-}
-
-impl std::fmt::Debug for RowReader {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("RowReader")
-            .field("path", &self.path)
-            .field("columns", &self.columns)
-            .finish_non_exhaustive()
-    }
 }
 
 impl RowReader {
@@ -156,18 +167,26 @@ impl RowReader {
             .increasing
             .and_then(|n| columns.iter().position(|(c, _)| c.name == n));
         let n = columns.len();
-        Ok(Self {
-            path,
+        let names = columns.iter().map(|(c, _)| c.name.clone()).collect();
+        let parser = RowParser {
+            path: path.clone(),
             records,
             columns,
-            row: Row {
-                number: header_row,
-                values: vec![0.0; n],
-            },
             increasing,
             previous: None,
             width: header.names().len(),
             pending: opts.no_header,
+        };
+        let blocks = RowBlocks::spawn(parser, n)
+            .map_err(|e| CliError::file(&path, format!("cannot start the reader: {e}")))?;
+        Ok(Self {
+            path,
+            names,
+            blocks,
+            row: Row {
+                number: header_row,
+                values: vec![0.0; n],
+            },
         })
     }
 
@@ -179,17 +198,29 @@ impl RowReader {
     /// The position of column `name` in each row's values; `None` for an optional column
     /// the file does not have.
     pub fn index(&self, name: &str) -> Option<usize> {
-        self.columns.iter().position(|(c, _)| c.name == name)
+        self.names.iter().position(|c| c == name)
     }
 
     /// The names of the columns read, in row order.
     pub fn names(&self) -> impl Iterator<Item = &str> {
-        self.columns.iter().map(|(c, _)| c.name.as_str())
+        self.names.iter().map(String::as_str)
     }
 
     /// The next row, or `None` at the end of the file. The row is overwritten by the next
     /// call (nothing is allocated per row); see the `Iterator` impl for owned rows.
     pub fn next_row(&mut self) -> CliResult<Option<&Row>> {
+        match self.blocks.next_into(&mut self.row.values)? {
+            Some(number) => {
+                self.row.number = number;
+                Ok(Some(&self.row))
+            }
+            None => Ok(None),
+        }
+    }
+}
+
+impl RowSource for RowParser {
+    fn parse_next(&mut self, values: &mut [f64]) -> CliResult<Option<usize>> {
         if !std::mem::take(&mut self.pending) {
             let more = self.records.advance().map_err(|e| self.record_error(&e))?;
             if !more {
@@ -197,7 +228,6 @@ impl RowReader {
             }
         }
         let number = self.records.line();
-        self.row.number = number;
         let fields = self.records.len();
         if fields > self.width {
             return Err(CliError::row(
@@ -248,10 +278,10 @@ impl RowReader {
                     format!("column `{}`: `{}` is not finite", c.header, shown(cell)),
                 ));
             }
-            self.row.values[k] = c.sign * v;
+            values[k] = c.sign * v;
         }
         if let Some(k) = self.increasing {
-            let t = self.row.values[k];
+            let t = values[k];
             if let Some(prev) = self.previous
                 && t.partial_cmp(&prev) != Some(std::cmp::Ordering::Greater)
             {
@@ -268,11 +298,11 @@ impl RowReader {
                 self.previous = Some(t);
             }
         }
-        Ok(Some(&self.row))
+        Ok(Some(number))
     }
 }
 
-impl RowReader {
+impl RowParser {
     /// A record that could not be read, as the error naming its row.
     fn record_error(&self, e: &RecordError) -> CliError {
         let what = match e {

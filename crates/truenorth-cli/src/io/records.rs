@@ -43,7 +43,7 @@ impl std::fmt::Display for RecordError {
 /// enclosed in double quotes, which are dropped; a quoted field cannot span lines (sensor
 /// logs never need it).
 pub struct Records {
-    source: Box<dyn BufRead>,
+    source: Box<dyn BufRead + Send>,
     delimiter: Delimiter,
     line: Vec<u8>,
     spans: Vec<(usize, usize)>,
@@ -54,7 +54,7 @@ pub struct Records {
 
 impl Records {
     /// Records of `source` split at `delimiter` (not `Auto`: detect it first).
-    pub fn new(source: Box<dyn BufRead>, delimiter: Delimiter) -> Self {
+    pub fn new(source: Box<dyn BufRead + Send>, delimiter: Delimiter) -> Self {
         Self {
             source,
             delimiter,
@@ -108,6 +108,18 @@ impl Records {
         self.spans.clear();
         let line = &self.line[..b];
         match self.delimiter {
+            // Without a quote on the line (a sensor log's rows), every delimiter splits: one
+            // comparison a byte.
+            Delimiter::Byte(d) if !line[a..].contains(&b'"') => {
+                let mut start = a;
+                for (i, &c) in line.iter().enumerate().skip(a) {
+                    if c == d {
+                        self.spans.push(field_span(line, start, i));
+                        start = i + 1;
+                    }
+                }
+                self.spans.push(field_span(line, start, b));
+            }
             Delimiter::Byte(d) => {
                 let mut start = a;
                 let mut quoted = false;
@@ -263,6 +275,26 @@ mod tests {
         );
         let got = all(b"  1 \t 2  3\n", Delimiter::Whitespace).unwrap();
         assert_eq!(got[0].1, vec!["1", "2", "3"]);
+    }
+
+    proptest::proptest! {
+        /// A line without quotes splits at every delimiter, each field trimmed of blanks,
+        /// as `str::split` would.
+        #[test]
+        fn lines_without_quotes_split_at_every_delimiter(
+            cells in proptest::collection::vec("[ 0-9.eE+-]{0,6}", 1..8),
+            d in proptest::sample::select(vec![b',', b';', b'\t', b'|']),
+        ) {
+            let line = cells.join(&(d as char).to_string());
+            proptest::prop_assume!(!line.trim().is_empty());
+            let got = all(format!("{line}\n").as_bytes(), Delimiter::Byte(d)).unwrap();
+            let want: Vec<String> = line
+                .trim()
+                .split(d as char)
+                .map(|c| c.trim().to_string())
+                .collect();
+            proptest::prop_assert_eq!(&got[0].1, &want);
+        }
     }
 
     #[test]

@@ -50,10 +50,10 @@ impl InputPath {
     /// Opens the input for buffered reading, decompressing gzip transparently: a stream
     /// that starts with the gzip magic bytes is decompressed whatever its name, and a file
     /// named `*.gz` that does not start with them is refused.
-    pub fn open(&self) -> CliResult<Box<dyn BufRead>> {
+    pub fn open(&self) -> CliResult<Box<dyn BufRead + Send>> {
         let name = self.display_path();
-        let raw: Box<dyn Read> = match self {
-            Self::Stdin => Box::new(std::io::stdin().lock()),
+        let raw: Box<dyn Read + Send> = match self {
+            Self::Stdin => Box::new(std::io::stdin()),
             Self::File(p) => Box::new(
                 File::open(p).map_err(|e| CliError::file(&name, format!("cannot open: {e}")))?,
             ),
