@@ -268,8 +268,17 @@ impl RowReader {
                 self.previous = Some(t);
             }
         }
+        ROWS_READ.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
         Ok(Some(&self.row))
     }
+}
+
+/// Rows every [`RowReader`] of the process has returned, for `batch`'s results table.
+static ROWS_READ: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+
+/// How many rows the process's readers have returned so far.
+pub fn rows_read() -> u64 {
+    ROWS_READ.load(std::sync::atomic::Ordering::Relaxed)
 }
 
 impl RowReader {
