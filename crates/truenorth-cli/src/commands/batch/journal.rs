@@ -35,6 +35,11 @@ pub struct Entry {
 }
 
 impl Entry {
+    /// What the journal looks entries up by (the hash is compared on the entry found).
+    fn key(&self) -> (String, Vec<String>) {
+        (self.name.clone(), self.command.clone())
+    }
+
     /// Whether the run settled the file: it succeeded, or the command itself declined it
     /// (refused, or failed with its own message). A run ended by a signal, a crash or that
     /// never started is tried again; so is any failure with `retry_failed`.
@@ -47,10 +52,10 @@ impl Entry {
     }
 }
 
-/// The last entry of every name in the journal, to look runs up in.
+/// The last entry of every name and command in the journal, to look runs up in.
 #[derive(Debug, Clone, Default)]
 pub struct Known {
-    last: HashMap<String, Entry>,
+    last: HashMap<(String, Vec<String>), Entry>,
 }
 
 impl Known {
@@ -63,8 +68,8 @@ impl Known {
         retry_failed: bool,
     ) -> Option<&Entry> {
         self.last
-            .get(name)
-            .filter(|e| e.row.hash == hash && e.command == command && e.settled(retry_failed))
+            .get(&(name.to_string(), command.to_vec()))
+            .filter(|e| e.row.hash == hash && e.settled(retry_failed))
     }
 }
 
@@ -94,7 +99,7 @@ impl Journal {
         for line in bytes.split(|&b| b == b'\n') {
             // A torn line (a kill mid-write) does not parse and is skipped.
             if let Ok(entry) = serde_json::from_slice::<Entry>(line) {
-                last.insert(entry.name.clone(), entry);
+                last.insert(entry.key(), entry);
             }
         }
         if bytes.last().is_some_and(|&b| b != b'\n') {
@@ -122,7 +127,7 @@ impl Journal {
             .write_all(&line)
             .and_then(|()| self.file.sync_data())
             .map_err(|e| CliError::file(&self.path, format!("cannot write the journal: {e}")))?;
-        self.known.last.insert(entry.name.clone(), entry);
+        self.known.last.insert(entry.key(), entry);
         Ok(())
     }
 }
@@ -181,7 +186,7 @@ mod tests {
         drop(j);
         let j = Journal::open(&d).unwrap();
         assert!(
-            j.known().last.contains_key("b"),
+            j.known().last.contains_key(&("b".into(), cmd.clone())),
             "the line after a torn one reads"
         );
         assert!(

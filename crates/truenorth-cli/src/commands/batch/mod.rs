@@ -3,8 +3,8 @@
 //! The parts, one file each: [`jobs`] (which files, their output names, their content
 //! hash), [`passthrough`] (the command after `--`), [`child`] (one file's run as a child
 //! process), [`pool`] (the workers), [`journal`] (what makes a rerun skip what is done),
-//! [`results`] (the table), [`progress`] (the line on a terminal) and [`summary`] (the
-//! counts, the throughput and the exit code).
+//! [`results`] (the table), [`progress`] (the line on a terminal), [`summary`] (the
+//! counts, the throughput and the exit code) and [`sweep`] (what killed runs left behind).
 
 pub mod child;
 pub mod jobs;
@@ -14,6 +14,7 @@ pub mod pool;
 pub mod progress;
 pub mod results;
 pub mod summary;
+pub mod sweep;
 
 use std::num::NonZeroUsize;
 use std::path::{Path, PathBuf};
@@ -130,6 +131,7 @@ pub fn run(args: &Args) -> CliResult<u8> {
     let plan = plan(&jobs, &command, &args.out, &results_path)?;
     let exe = std::env::current_exe()
         .map_err(|e| CliError::msg(format!("batch: cannot find its own executable: {e}")))?;
+    sweep::remove_stale_temporaries(&args.out);
     let mut journal = Journal::open(&args.out)?;
     let known = journal.known().clone();
     let workers = args
@@ -174,6 +176,7 @@ pub fn run(args: &Args) -> CliResult<u8> {
     ran?;
     let rows: Vec<Row> = rows.into_iter().flatten().collect();
     results::write(&results_path, &rows)?;
+    sweep::remove_stale_temporaries(&args.out);
     let counts = Counts::of(&rows, plan.len());
     outln!(
         "{}; results: {}",
