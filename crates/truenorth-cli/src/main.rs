@@ -11,7 +11,7 @@ use std::process::ExitCode;
 use clap::error::ErrorKind;
 use clap::{Parser, Subcommand};
 
-use commands::{calibrate, drive, field, heading, inspect as inspect_cmd, orientation};
+use commands::{batch, calibrate, drive, field, heading, inspect as inspect_cmd, orientation};
 
 /// Calibrated heading, orientation and dead reckoning from low-cost navigation sensors.
 ///
@@ -46,6 +46,10 @@ enum Command {
     /// What a recording holds: each column's rate, gaps and range, each sensor's likely
     /// unit, the gyro's axes against the other sensors', and the options that read it.
     Inspect(inspect_cmd::Args),
+    /// Run calibrate, heading, orientation, drive or inspect over folders of recordings,
+    /// one process per file on every core, with a results table; a rerun skips what is
+    /// done.
+    Batch(batch::Args),
     /// Evaluate an orientation method on a benchmark with ground truth.
     #[command(subcommand)]
     Eval(EvalCommand),
@@ -71,7 +75,19 @@ fn main() -> ExitCode {
         Command::Drive(a) => drive::run(&a),
         Command::Inspect(a) => inspect_cmd::run(&a),
         Command::Eval(EvalCommand::Broad(a)) => eval::broad::run(&a),
+        Command::Batch(a) => match batch::run(&a) {
+            Ok(code) => return ExitCode::from(code),
+            Err(e) => Err(e),
+        },
     };
+    if std::env::var_os(batch::child::CHILD_ENV).is_some() {
+        // For the batch that started this run: the rows read, on the last line.
+        io::write_stderr(format_args!(
+            "{}{}\n",
+            batch::child::STATS_PREFIX,
+            io::rows_read()
+        ));
+    }
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {

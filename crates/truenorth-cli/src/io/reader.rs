@@ -212,6 +212,7 @@ impl RowReader {
         match self.blocks.next_into(&mut self.row.values)? {
             Some(number) => {
                 self.row.number = number;
+                ROWS_READ.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
                 Ok(Some(&self.row))
             }
             None => Ok(None),
@@ -300,6 +301,15 @@ impl RowSource for RowParser {
         }
         Ok(Some(number))
     }
+}
+
+/// Rows every [`RowReader`] of the process has handed to its command, for `batch`'s
+/// results table.
+static ROWS_READ: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+
+/// How many rows the process's readers have handed to their commands so far.
+pub fn rows_read() -> u64 {
+    ROWS_READ.load(std::sync::atomic::Ordering::Relaxed)
 }
 
 impl RowParser {
