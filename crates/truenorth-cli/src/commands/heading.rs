@@ -9,8 +9,9 @@ use truenorth::core::{Declination, MagneticHeading, Tilt, rad_to_deg};
 
 use super::field::Place;
 use crate::io::errln;
+use crate::io::log_input;
 use crate::io::{
-    CalibrationFile, CliError, CliResult, CompassCalibration, CsvOutput, InputOptions, InputPath,
+    CalibrationFile, CliError, CliResult, CompassCalibration, CsvOutput, InputOptions,
     OutputOptions, Precision, ReadSpec, Row, RowReader, check_distinct,
 };
 
@@ -83,7 +84,8 @@ pub fn run(args: &Args) -> CliResult {
     let declination = declination(args)?;
     let (needed, optional) = columns_read(&cal);
     let spec = ReadSpec::new(needed).optional(optional).increasing("t_s");
-    let mut rows = RowReader::open(&InputPath::new(&args.input), &args.input_options, &spec)?;
+    let input = log_input::source(&args.input, &args.input_options, &spec, &[])?;
+    let mut rows = RowReader::open(&input, &args.input_options, &spec)?;
     let cols = Columns::locate(&rows)?;
     let mut header = vec!["t_s", "heading_deg"];
     if cols.acc.is_some() {

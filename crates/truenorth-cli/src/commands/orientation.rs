@@ -8,9 +8,10 @@ use truenorth::core::{AttitudeEstimate, Axes, EulerZyx, ImuSample, ned_to_enu, r
 
 use super::mag_unit::{MagUnit, check_field};
 use crate::io::errln;
+use crate::io::log_input;
 use crate::io::{
-    AccUnit, CliError, CliResult, GyroUnit, InputOptions, InputPath, OutputOptions, ReadSpec,
-    Table, check_distinct, check_inertial, median, refuse_or_warn, write_csv,
+    AccUnit, CliError, CliResult, GyroUnit, InputOptions, OutputOptions, ReadSpec, Table,
+    check_distinct, check_inertial, median, refuse_or_warn, write_csv,
 };
 use crate::plot::{Band, Line, write_timeseries};
 use crate::registry::{Orientation, OrientationMethod, Timing};
@@ -206,7 +207,16 @@ fn check_units(args: &Args, samples: &[ImuSample]) -> CliResult {
 fn read_samples(args: &Args) -> CliResult<Vec<ImuSample>> {
     let spec = ReadSpec::new(&["t_s", "gyr_x", "gyr_y", "gyr_z", "acc_x", "acc_y", "acc_z"])
         .optional(&["mag_x", "mag_y", "mag_z"]);
-    let table = Table::read_with(&InputPath::new(&args.input), &args.input_options, &spec)?;
+    let csv_only = [
+        ("--gyro-unit", args.gyro_unit != GyroUnit::default()),
+        ("--acc-unit", args.acc_unit != AccUnit::default()),
+        (
+            "--mag-unit",
+            args.mag_unit.is_some_and(|u| u != MagUnit::MicroTesla),
+        ),
+    ];
+    let input = log_input::source(&args.input, &args.input_options, &spec, &csv_only)?;
+    let table = Table::read_with(&input, &args.input_options, &spec)?;
     let (to_rps, to_mps2) = (args.gyro_unit.to_rad_per_s(), args.acc_unit.to_mps2());
     table.require_rows()?;
     table.check_increasing_time()?;

@@ -11,7 +11,9 @@
 //! * [`RowReader`]: the streaming read, one row at a time, the requested columns by name as
 //!   `f64` with the row number for messages, time order checked on the way; memory does not
 //!   grow with the file;
-//! * [`Table`]: the whole-table read built on it.
+//! * [`Table`]: the whole-table read built on it;
+//! * [`log_input`]: a PX4 ULog or ROS 2 MCAP input, found by its magic number, read as the
+//!   CSV the command takes (the topic options flatten into [`InputOptions`]).
 //!
 //! Checking (the data against what they were declared to be): [`check_inertial`] (the
 //! accelerometer's and gyro's units, the gyro's axes against gravity's and the magnetic
@@ -38,6 +40,7 @@ mod gyro_axes;
 mod inertial_units;
 mod json_input;
 mod learned_file;
+pub mod log_input;
 mod number_format;
 mod output_target;
 mod reader;
