@@ -41,6 +41,7 @@ mod inertial_units;
 mod json_input;
 mod learned_file;
 pub mod log_input;
+mod log_rows;
 mod number_format;
 mod output_target;
 mod reader;
