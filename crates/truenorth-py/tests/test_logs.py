@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import truenorth as tn
-from conftest import REPO
+from conftest import REPO, missing
 
 MCAP = REPO / "crates" / "truenorth-logs" / "tests" / "data" / "ros2_small.mcap"
 
@@ -17,8 +17,6 @@ MCAP = REPO / "crates" / "truenorth-logs" / "tests" / "data" / "ros2_small.mcap"
 def sample_ulg(data):
     path = data / "px4_ulog_samples" / "sample.ulg"
     if not path.is_file():
-        from conftest import missing
-
         missing(f"no {path}")
     return path
 

@@ -102,7 +102,8 @@ pub struct Args {
     /// Calibration method.
     #[arg(long, value_enum)]
     pub method: CalibrationMethod,
-    /// Input CSV (`-`: standard input; `.gz` or gzip data read as such).
+    /// Input CSV, or a PX4 ULog / ROS 2 MCAP log (found by its magic number; its
+    /// magnetometer) (`-`: standard input; `.gz` or gzip data read as such).
     #[arg(long)]
     pub input: PathBuf,
     /// Output JSON (`-`: standard output).

@@ -96,7 +96,8 @@ pub struct Args {
     /// "differential"), wheelbase_m and pitman_ratio for front wheels.
     #[arg(long)]
     pub vehicle: PathBuf,
-    /// Drive CSV (`-`: standard input; `.gz` or gzip data read as such).
+    /// Drive CSV, or a ROS 2 MCAP log with odometry (found by its magic number; read as a
+    /// rigid axle's wheel speeds) (`-`: standard input; `.gz` or gzip data read as such).
     #[arg(long)]
     pub input: PathBuf,
     /// Output CSV (`-`: standard output; `*.gz`: compressed).

@@ -45,7 +45,8 @@ pub struct Args {
     /// Calibration JSON written by `truenorth calibrate` (`-`: standard input).
     #[arg(long)]
     pub calibration: PathBuf,
-    /// Input CSV (`-`: standard input; `.gz` or gzip data read as such).
+    /// Input CSV, or a PX4 ULog / ROS 2 MCAP log (found by its magic number; its
+    /// magnetometer and accelerometer) (`-`: standard input; `.gz` or gzip data read as such).
     #[arg(long)]
     pub input: PathBuf,
     /// Output CSV (`-`: standard output; `*.gz`: compressed).

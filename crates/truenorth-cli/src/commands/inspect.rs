@@ -27,7 +27,8 @@ use crate::io::{out, outln};
 /// t_s=time,gyr_x=gx,gyr_y=gy,gyr_z=gz,acc_x=ax,acc_y=ay,acc_z=az`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// The recording (`-`: standard input; `.gz` or gzip data read as such).
+    /// The recording: a CSV, or a PX4 ULog / ROS 2 MCAP log (its topics are listed)
+    /// (`-`: standard input; `.gz` or gzip data read as such).
     pub file: PathBuf,
     /// Write the report as JSON.
     #[arg(long)]

@@ -63,7 +63,8 @@ pub struct Args {
     /// Orientation method.
     #[arg(long, value_enum, default_value = "quaternion")]
     pub method: OrientationMethod,
-    /// Input CSV (`-`: standard input; `.gz` or gzip data read as such).
+    /// Input CSV, or a PX4 ULog / ROS 2 MCAP log (found by its magic number; its IMU with
+    /// the magnetometer) (`-`: standard input; `.gz` or gzip data read as such).
     #[arg(long)]
     pub input: PathBuf,
     /// Output CSV.

@@ -200,8 +200,14 @@ fn refused(name: &Path, e: LogError) -> CliError {
 }
 
 /// The log format announced by the input's first bytes, if any (gzip-compressed files are
-/// looked into; standard input only when not compressed).
+/// looked into; standard input only when not compressed). A FIFO or a device is not looked
+/// into: its bytes cannot be read twice, and it is read as CSV.
 fn detect(input: &InputPath) -> CliResult<Option<LogFormat>> {
+    if let InputPath::File(p) = input
+        && !std::fs::metadata(p).is_ok_and(|m| m.is_file())
+    {
+        return Ok(None);
+    }
     let head =
         match input {
             // Peeking at standard input's own buffer consumes nothing: the CSV reader that
