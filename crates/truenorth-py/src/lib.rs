@@ -6,7 +6,8 @@
 //! seconds, in the units and body axes of the `truenorth` command's contract (x forward,
 //! y right, z down; gyro rad/s, specific force m/s², magnetometer any unit); loops over
 //! arrays run in Rust without the GIL; the library's errors are raised as
-//! `truenorth.TruenorthError`, a `ValueError`, with the library's message.
+//! `truenorth.TruenorthError`, a `ValueError`, with the library's message. `read_log` reads
+//! PX4 ULog and ROS 2 MCAP files into arrays of the same frames and units.
 //!
 //! The bindings wrap the library's public types only (the registry's method names, the
 //! traits' samples and estimates), so this crate holds conversions and no method of its own.
@@ -30,6 +31,7 @@ mod calibration;
 mod calibrators;
 mod convert;
 mod geomag;
+mod logs;
 mod orientation;
 mod quality;
 mod vehicle;
@@ -56,5 +58,6 @@ fn _truenorth(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(calibrators::calibrate, m)?)?;
     m.add_function(wrap_pyfunction!(geomag::field, m)?)?;
     m.add_function(wrap_pyfunction!(broad::broad_rmse, m)?)?;
+    m.add_function(wrap_pyfunction!(logs::read_log, m)?)?;
     Ok(())
 }

@@ -18,6 +18,7 @@ use truenorth::core::{Calibrator, CompassQuality, Mag2Sample, Mag3Sample, Soluti
 use super::field::Place;
 use super::mag_unit::{MagUnit, check_field};
 use crate::io::errln;
+use crate::io::log_input;
 use crate::io::{
     AccelPart, CALIBRATION_FORMAT, CALIBRATION_VERSION, CalibrationFile, CliError, CliResult,
     GyroPart, InputOptions, InputPath, QualityReport, ReadSpec, Row, RowReader, check_distinct,
@@ -101,7 +102,8 @@ pub struct Args {
     /// Calibration method.
     #[arg(long, value_enum)]
     pub method: CalibrationMethod,
-    /// Input CSV (`-`: standard input; `.gz` or gzip data read as such).
+    /// Input CSV, or a PX4 ULog / ROS 2 MCAP log (found by its magic number; its
+    /// magnetometer) (`-`: standard input; `.gz` or gzip data read as such).
     #[arg(long)]
     pub input: PathBuf,
     /// Output JSON (`-`: standard output).
@@ -262,7 +264,12 @@ fn library(e: truenorth::core::Error) -> CliError {
 /// among them) read where present.
 fn open_input(args: &Args, columns: &[&str], optional: &[&str]) -> CliResult<RowReader> {
     let spec = ReadSpec::new(columns).optional(optional).increasing("t_s");
-    RowReader::open(&InputPath::new(&args.input), &args.input_options, &spec)
+    let csv_only = [(
+        "--mag-unit",
+        args.mag_unit.is_some_and(|u| u != MagUnit::MicroTesla),
+    )];
+    let input = log_input::source(&args.input, &args.input_options, &spec, &csv_only)?;
+    RowReader::open(&input, &args.input_options, &spec)
 }
 
 /// The position of a column the reader was asked for (required, so present).

@@ -12,9 +12,10 @@ use truenorth::odometer::OdometerWheels;
 
 use super::field::Place;
 use crate::io::errln;
+use crate::io::log_input::{self, AxleTrack};
 use crate::io::{
-    CliError, CliResult, GyroUnit, InputOptions, InputPath, OutputOptions, ReadSpec, Row,
-    RowReader, VehicleFile, WheelColumns, check_distinct, read_learned, write_learned,
+    CliError, CliResult, GyroUnit, InputOptions, OutputOptions, ReadSpec, Row, RowReader,
+    VehicleFile, WheelColumns, check_distinct, read_learned, write_learned,
 };
 use crate::registry::{VehicleMethod, VehicleRun};
 
@@ -95,7 +96,8 @@ pub struct Args {
     /// "differential"), wheelbase_m and pitman_ratio for front wheels.
     #[arg(long)]
     pub vehicle: PathBuf,
-    /// Drive CSV (`-`: standard input; `.gz` or gzip data read as such).
+    /// Drive CSV, or a ROS 2 MCAP log with odometry (found by its magic number; read as a
+    /// rigid axle's wheel speeds) (`-`: standard input; `.gz` or gzip data read as such).
     #[arg(long)]
     pub input: PathBuf,
     /// Output CSV (`-`: standard output; `*.gz`: compressed).
@@ -157,7 +159,12 @@ pub fn run(args: &Args) -> CliResult {
     let spec = ReadSpec::new(&["t_s"])
         .optional(&OPTIONAL)
         .increasing("t_s");
-    let mut rows = RowReader::open(&InputPath::new(&args.input), &args.input_options, &spec)?;
+    let csv_only = [("--gyro-unit", args.gyro_unit != GyroUnit::default())];
+    let input =
+        log_input::drive_source(&args.input, &args.input_options, &spec, &csv_only, || {
+            axle(args)
+        })?;
+    let mut rows = RowReader::open(&input, &args.input_options, &spec)?;
     let wheel_columns = wheel_columns(&rows)?;
     let vehicle = VehicleFile::read(&args.vehicle)?;
     let wheels = vehicle.wheels(&args.vehicle)?;
@@ -306,6 +313,25 @@ fn build_method(
     args.method
         .runner(wheels, fused, args.single_pass)
         .map_err(bad_config)
+}
+
+/// How a flight or robot log's odometry becomes the wheels read: the speeds of a rigid axle
+/// with the vehicle's track, or why the vehicle's wheels are not one.
+fn axle(args: &Args) -> CliResult<Result<AxleTrack, String>> {
+    let wheels = VehicleFile::read(&args.vehicle)?.wheels(&args.vehicle)?;
+    Ok(match wheels {
+        OdometerWheels::Rear { track_m } | OdometerWheels::Differential { track_m } => {
+            Ok(AxleTrack { track_m })
+        }
+        other => Err(format!(
+            "a log's odometry gives the body's speed and turn, read as the wheels of a rigid axle that do not slide; {} has {} odometer wheels: describe it as \"rear\" or \"differential\" with the same track_m",
+            args.vehicle.display(),
+            match other {
+                OdometerWheels::Front(_) => "steered (front)",
+                _ => "sliding (skid_steer)",
+            }
+        )),
+    })
 }
 
 /// What the diagnosis of the log needs of the arguments. It refuses a drive whose data

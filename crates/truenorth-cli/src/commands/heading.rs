@@ -9,8 +9,9 @@ use truenorth::core::{Declination, MagneticHeading, Tilt, rad_to_deg};
 
 use super::field::Place;
 use crate::io::errln;
+use crate::io::log_input;
 use crate::io::{
-    CalibrationFile, CliError, CliResult, CompassCalibration, CsvOutput, InputOptions, InputPath,
+    CalibrationFile, CliError, CliResult, CompassCalibration, CsvOutput, InputOptions,
     OutputOptions, Precision, ReadSpec, Row, RowReader, check_distinct,
 };
 
@@ -44,7 +45,8 @@ pub struct Args {
     /// Calibration JSON written by `truenorth calibrate` (`-`: standard input).
     #[arg(long)]
     pub calibration: PathBuf,
-    /// Input CSV (`-`: standard input; `.gz` or gzip data read as such).
+    /// Input CSV, or a PX4 ULog / ROS 2 MCAP log (found by its magic number; its
+    /// magnetometer and accelerometer) (`-`: standard input; `.gz` or gzip data read as such).
     #[arg(long)]
     pub input: PathBuf,
     /// Output CSV (`-`: standard output; `*.gz`: compressed).
@@ -83,7 +85,8 @@ pub fn run(args: &Args) -> CliResult {
     let declination = declination(args)?;
     let (needed, optional) = columns_read(&cal);
     let spec = ReadSpec::new(needed).optional(optional).increasing("t_s");
-    let mut rows = RowReader::open(&InputPath::new(&args.input), &args.input_options, &spec)?;
+    let input = log_input::source(&args.input, &args.input_options, &spec, &[])?;
+    let mut rows = RowReader::open(&input, &args.input_options, &spec)?;
     let cols = Columns::locate(&rows)?;
     let mut header = vec!["t_s", "heading_deg"];
     if cols.acc.is_some() {

@@ -5,8 +5,8 @@
 use std::path::PathBuf;
 
 use crate::inspect::report::JsonReport;
-use crate::inspect::{Recording, analyse};
-use crate::io::{CliError, CliResult, InputOptions, InputPath};
+use crate::inspect::{COLUMNS, Recording, analyse};
+use crate::io::{CliError, CliResult, InputOptions, InputPath, ReadSpec, log_input};
 use crate::io::{out, outln};
 
 /// Arguments of `truenorth inspect`.
@@ -27,7 +27,8 @@ use crate::io::{out, outln};
 /// t_s=time,gyr_x=gx,gyr_y=gy,gyr_z=gz,acc_x=ax,acc_y=ay,acc_z=az`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// The recording (`-`: standard input; `.gz` or gzip data read as such).
+    /// The recording: a CSV, or a PX4 ULog / ROS 2 MCAP log (its topics are listed)
+    /// (`-`: standard input; `.gz` or gzip data read as such).
     pub file: PathBuf,
     /// Write the report as JSON.
     #[arg(long)]
@@ -39,20 +40,54 @@ pub struct Args {
 
 /// Runs the subcommand: read the columns, analyse them, print the report.
 pub fn run(args: &Args) -> CliResult {
-    let input = InputPath::new(&args.file);
+    let spec = ReadSpec::new(&["t_s"]).optional(&COLUMNS);
+    let log = log_input::open(&args.file, &args.input_options, &spec, &[], None)?;
+    let input = log
+        .as_ref()
+        .map_or_else(|| InputPath::new(&args.file), |l| l.csv.clone());
     let recording = Recording::read(&input, &args.input_options)?;
     let name = input.display_path().display().to_string();
     let report = analyse(&name, &recording, &args.input_options);
+    let failed =
+        |e: serde_json::Error| CliError::msg(format!("inspect: cannot write the report: {e}"));
     if args.json {
+        // A log's units and axes are its format's: no CSV option reads it otherwise.
+        let options = if log.is_some() {
+            Vec::new()
+        } else {
+            report.options()
+        };
         let json = JsonReport {
-            options: report.options(),
+            options,
             report: &report,
         };
-        let text = serde_json::to_string_pretty(&json)
-            .map_err(|e| CliError::msg(format!("inspect: cannot write the report: {e}")))?;
+        let text = match &log {
+            // The report's keys, then the log's (a JSON value would sort them).
+            Some(log) => {
+                let text = serde_json::to_string_pretty(&json).map_err(failed)?;
+                let summary =
+                    serde_json::to_string_pretty(&log_input::summary_json(log)).map_err(failed)?;
+                format!(
+                    "{},\n  \"log\": {}\n}}",
+                    text.trim_end().trim_end_matches('}').trim_end(),
+                    summary.replace('\n', "\n  ")
+                )
+            }
+            None => serde_json::to_string_pretty(&json).map_err(failed)?,
+        };
         outln!("{text}")?;
     } else {
-        out!("{}", report.to_table())?;
+        for line in log.iter().flat_map(log_input::summary) {
+            outln!("{line}")?;
+        }
+        let table = report.to_table();
+        if log.is_some() {
+            for line in table.lines().filter(|l| !l.starts_with("options: ")) {
+                outln!("{line}")?;
+            }
+        } else {
+            out!("{table}")?;
+        }
     }
     Ok(())
 }

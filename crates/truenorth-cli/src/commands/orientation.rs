@@ -8,10 +8,11 @@ use truenorth::core::{AttitudeEstimate, Axes, EulerZyx, ImuSample, ned_to_enu, r
 
 use super::mag_unit::{MagUnit, check_field};
 use crate::io::errln;
+use crate::io::log_input;
 use crate::io::{
-    AccUnit, CliError, CliResult, CsvOutput, GyroUnit, Inertial, InputOptions, InputPath,
-    OutputOptions, ReadSpec, Reference, RowReader, check_distinct, check_inertial, fit_gyro_axes,
-    median, median_magnitude, refuse_or_warn,
+    AccUnit, CliError, CliResult, CsvOutput, GyroUnit, Inertial, InputOptions, OutputOptions,
+    ReadSpec, Reference, RowReader, check_distinct, check_inertial, fit_gyro_axes, median,
+    median_magnitude, refuse_or_warn,
 };
 use crate::plot::{Band, Envelope, Line, write_timeseries};
 use crate::registry::{Orientation, OrientationMethod, Timing};
@@ -68,7 +69,8 @@ pub struct Args {
     /// Orientation method.
     #[arg(long, value_enum, default_value = "quaternion")]
     pub method: OrientationMethod,
-    /// Input CSV (`-`: standard input; `.gz` or gzip data read as such).
+    /// Input CSV, or a PX4 ULog / ROS 2 MCAP log (found by its magic number; its IMU with
+    /// the magnetometer) (`-`: standard input; `.gz` or gzip data read as such).
     #[arg(long)]
     pub input: PathBuf,
     /// Output CSV.
@@ -245,7 +247,16 @@ fn read_samples(args: &Args) -> CliResult<ImuRows> {
     let spec = ReadSpec::new(&["t_s", "gyr_x", "gyr_y", "gyr_z", "acc_x", "acc_y", "acc_z"])
         .optional(&["mag_x", "mag_y", "mag_z"])
         .increasing("t_s");
-    let rows = RowReader::open(&InputPath::new(&args.input), &args.input_options, &spec)?;
+    let csv_only = [
+        ("--gyro-unit", args.gyro_unit != GyroUnit::default()),
+        ("--acc-unit", args.acc_unit != AccUnit::default()),
+        (
+            "--mag-unit",
+            args.mag_unit.is_some_and(|u| u != MagUnit::MicroTesla),
+        ),
+    ];
+    let input = log_input::source(&args.input, &args.input_options, &spec, &csv_only)?;
+    let rows = RowReader::open(&input, &args.input_options, &spec)?;
     ImuRows::new(args, rows)
 }
 

@@ -53,6 +53,9 @@ pub struct InputOptions {
     /// readings are turned into frd before anything else (mag_, acc_ and gyr_ columns).
     #[arg(long, value_name = "XYZ", default_value = "frd")]
     pub axes: AxisConvention,
+    /// What to read from a PX4 ULog or ROS 2 MCAP input (found by its magic number).
+    #[command(flatten)]
+    pub log: super::log_input::LogOptions,
 }
 
 /// How the fields of a row are separated.

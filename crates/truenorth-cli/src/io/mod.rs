@@ -12,7 +12,9 @@
 //!   `f64` with the row number for messages, time order checked on the way; memory does not
 //!   grow with the file; the splitting and parsing run on a second thread a few blocks of
 //!   rows ahead, so that they overlap the command's own work;
-//! * [`Table`]: the whole-table read built on it.
+//! * [`Table`]: the whole-table read built on it;
+//! * [`log_input`]: a PX4 ULog or ROS 2 MCAP input, found by its magic number, read as the
+//!   CSV the command takes (the topic options flatten into [`InputOptions`]).
 //!
 //! Checking (the data against what they were declared to be): [`check_inertial`] (the
 //! accelerometer's and gyro's units, the gyro's axes against gravity's and the magnetic
@@ -40,6 +42,8 @@ mod gyro_axes;
 mod inertial_units;
 mod json_input;
 mod learned_file;
+pub mod log_input;
+mod log_rows;
 mod number_format;
 mod output_target;
 mod reader;

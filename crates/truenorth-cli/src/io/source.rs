@@ -3,6 +3,7 @@
 use std::fs::File;
 use std::io::{BufRead, BufReader, Read};
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 use super::{CliError, CliResult};
 
@@ -19,6 +20,14 @@ pub enum InputPath {
     Stdin,
     /// A file.
     File(PathBuf),
+    /// Text made in memory from another input (a flight log as the CSV a command reads),
+    /// under the name of the file it came from.
+    Memory {
+        /// The file it came from, for messages.
+        name: PathBuf,
+        /// The text.
+        bytes: Arc<[u8]>,
+    },
 }
 
 impl InputPath {
@@ -36,13 +45,14 @@ impl InputPath {
         match self {
             Self::Stdin => PathBuf::from("<stdin>"),
             Self::File(p) => p.clone(),
+            Self::Memory { name, .. } => name.clone(),
         }
     }
 
     /// The file, if this is one.
     pub fn file(&self) -> Option<&Path> {
         match self {
-            Self::Stdin => None,
+            Self::Stdin | Self::Memory { .. } => None,
             Self::File(p) => Some(p),
         }
     }
@@ -57,6 +67,7 @@ impl InputPath {
             Self::File(p) => Box::new(
                 File::open(p).map_err(|e| CliError::file(&name, format!("cannot open: {e}")))?,
             ),
+            Self::Memory { bytes, .. } => Box::new(std::io::Cursor::new(Arc::clone(bytes))),
         };
         let mut buffered = BufReader::with_capacity(1 << 16, raw);
         let head = buffered

@@ -23,6 +23,7 @@ from ._truenorth import (
     broad_rmse,
     calibrate,
     field,
+    read_log,
 )
 
 __all__ = [
@@ -42,4 +43,5 @@ __all__ = [
     "broad_rmse",
     "calibrate",
     "field",
+    "read_log",
 ]

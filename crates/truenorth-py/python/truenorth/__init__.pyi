@@ -1,5 +1,6 @@
 """Type stubs of the truenorth package (the native module `truenorth._truenorth`)."""
 
+import os
 from typing import Any, Literal, Optional, Sequence, TypedDict
 
 import numpy as np
@@ -227,3 +228,41 @@ def broad_rmse(
     estimate: FloatArray, reference: FloatArray, movement: BoolArray
 ) -> Optional[BroadRmse]:
     """BROAD's metric: RMSE of the total, heading and inclination error angles, degrees."""
+
+class LogTopic(TypedDict):
+    name: str
+    kind: str
+    messages: int
+
+class LogStream(TypedDict):
+    role: Literal["imu", "mag", "attitude", "odometry"]
+    topic: str
+    samples: int
+    dropped: int
+    rate_hz: float
+
+class Log(TypedDict):
+    format: Literal["PX4 ULog", "MCAP"]
+    complete: bool
+    time_origin_s: float
+    topics: list[LogTopic]
+    streams: list[LogStream]
+    imu: dict[str, FloatArray]
+    """`t_s` (N), `gyr_rps`, `acc_mps2`, `mag_uT` (N x 3; NaN rows: no reading)."""
+    mag: dict[str, FloatArray]
+    """`t_s` (M), `mag_uT` (M x 3), the magnetometer at its own rate."""
+    attitude: dict[str, FloatArray]
+    """`t_s` (K), `quaternion` (K x 4, qw qx qy qz, body -> NED)."""
+    odometry: dict[str, FloatArray]
+    """`t_s` (J), `velocity_mps` (J x 3, body axes), `yaw_rate_rps` (J, + turning right)."""
+
+def read_log(
+    path: str | os.PathLike[str],
+    imu_topic: Optional[str] = None,
+    mag_topic: Optional[str] = None,
+    attitude_topic: Optional[str] = None,
+    odometry_topic: Optional[str] = None,
+    accept_incomplete: bool = False,
+) -> Log:
+    """A PX4 ULog or ROS 2 MCAP log as arrays per stream (seconds, FRD body axes, rad/s,
+    m/s^2, uT), as the `truenorth` command reads it; `mag_topic="none"`: no magnetometer."""
