@@ -7,7 +7,10 @@
 use nalgebra::Vector2;
 use proptest::prelude::*;
 use truenorth_core::{HeadingEstimator, NavEstimate, VehicleSample, WheelReading};
-use truenorth_fusion::vehicle::{TwoPassConfig, TwoPassStart};
+use truenorth_fusion::vehicle::{
+    SeedGyroCompass, SeedGyroCompassConfig, SeedOdometerCompass, SeedOdometerCompassConfig,
+    TwoPassConfig, TwoPassStart,
+};
 use truenorth_fusion::{VehicleConfig, VehicleEstimator};
 use truenorth_odometer::{AckermannParams, OdometerWheels, TRACK_RANGE_M};
 
@@ -20,7 +23,13 @@ fn value(typical: f64, bound: f64) -> impl Strategy<Value = f64> {
 
 fn step() -> impl Strategy<Value = Step> {
     (
-        prop_oneof![8 => Just(0.1), 2 => 1e-3f64..1.0, 1 => 1.0f64..10.0, 1 => Just(3600.0)],
+        prop_oneof![
+            16 => Just(0.1),
+            4 => 1e-3f64..1.0,
+            2 => 1.0f64..10.0,
+            2 => Just(3600.0),
+            1 => Just(1e300),
+        ],
         proptest::option::weighted(0.8, (value(2.0, 1e4), value(2.0, 1e4))),
         proptest::option::weighted(0.7, value(0.5, 30.0)),
         proptest::option::weighted(0.6, (value(60.0, 1e6), value(60.0, 1e6))),
@@ -105,6 +114,55 @@ proptest! {
         }
         prop_assert!(bad.is_none(), "{bad:?}");
     }
+
+    /// The seed methods (EP 0640207 and the odometer–compass configuration), likewise.
+    #[test]
+    fn every_seed_estimate_is_a_number(
+        steps in proptest::collection::vec(step(), 1..250),
+        kind in 0usize..4,
+        u in 0.0f64..=1.0,
+    ) {
+        let wheels = wheels(kind, track_m(u));
+        let input = samples(&steps);
+        let runs: Vec<Box<dyn HeadingEstimator>> = [
+            SeedGyroCompass::new(SeedGyroCompassConfig { wheels, ..Default::default() })
+                .map(|e| Box::new(e) as Box<dyn HeadingEstimator>),
+            SeedOdometerCompass::new(SeedOdometerCompassConfig { wheels, ..Default::default() })
+                .map(|e| Box::new(e) as Box<dyn HeadingEstimator>),
+        ]
+        .into_iter()
+        .flatten()
+        .collect();
+        for mut est in runs {
+            for s in &input {
+                if let Ok(e) = est.update(s) {
+                    prop_assert!(numbers(&e), "{e:?} from {s:?}");
+                }
+            }
+        }
+    }
+}
+
+/// The fuzzer's second finding: the gyro-and-compass seed method integrated a rate across a
+/// step of 1e308 s into an infinite heading. A step longer than its turn calibrator
+/// bridges is not integrated.
+#[test]
+fn the_seed_gyro_method_does_not_integrate_across_an_endless_gap() {
+    let mut est = SeedGyroCompass::new(SeedGyroCompassConfig::default()).unwrap();
+    let s = |t_s: f64, d: f64| VehicleSample {
+        t_s,
+        wheels: Some(WheelReading {
+            dist_l_m: d,
+            dist_r_m: d,
+        }),
+        gyr_z_rps: Some(0.3),
+        mag: None,
+    };
+    for (k, t_s) in [0.0, 0.1, 0.2, 1e308].into_iter().enumerate() {
+        let e = est.update(&s(t_s, k as f64)).unwrap();
+        assert!(numbers(&e) && e.heading.rad().is_finite(), "{e:?}");
+    }
+    assert!(est.estimate().status.gap);
 }
 
 /// The fuzzer's finding: a differential robot with a track of 4·10⁻³⁰⁸ m, which turned each
