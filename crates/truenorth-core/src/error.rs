@@ -81,6 +81,23 @@ impl core::fmt::Display for Readable {
     }
 }
 
+/// A number as a message shows it when every digit may matter (a timestamp that names the
+/// row, a gap): its shortest form that reads back exactly, in plain decimals for everyday
+/// magnitudes (`17664.399999999998`, as `{}` shows it) and in exponent form outside them
+/// (`1e308`, `5e-324`), where plain decimals would run to hundreds of digits.
+pub struct Precise(pub f64);
+
+impl core::fmt::Display for Precise {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        let (v, a) = (self.0, self.0.abs());
+        if !v.is_finite() || v == 0.0 || (1e-4..1e15).contains(&a) {
+            write!(f, "{v}")
+        } else {
+            write!(f, "{v:e}")
+        }
+    }
+}
+
 /// A `core::fmt::Write` into a fixed buffer (the crate is `no_std`).
 struct SliceWriter<'a> {
     buf: &'a mut [u8],
@@ -113,7 +130,9 @@ pub enum Error {
     },
     /// A timestamp did not increase.
     #[error(
-        "timestamp {t_s} s does not come after the previous one ({prev_s} s); sort samples by time and drop duplicates"
+        "timestamp {} s does not come after the previous one ({} s); sort samples by time and drop duplicates",
+        Precise(*t_s),
+        Precise(*prev_s)
     )]
     NonIncreasingTime {
         /// Previous accepted timestamp, seconds.
@@ -122,7 +141,7 @@ pub enum Error {
         t_s: f64,
     },
     /// A time step that is zero, negative or not finite.
-    #[error("time step dt = {dt_s} s is not a positive finite number")]
+    #[error("time step dt = {} s is not a positive finite number", Precise(*dt_s))]
     InvalidDt {
         /// The rejected time step, seconds.
         dt_s: f64,
@@ -219,9 +238,10 @@ pub enum Error {
     /// The orientations seen do not determine a calibration, however many readings were
     /// taken in them: a geometric property of the directions, not of their number or noise.
     #[error(
-        "the orientations seen do not determine the calibration: their dilution is {dilution:.1} (an evenly covered {even_shape} has {even_dilution:.1}), so an error of {:.1} % of the field per reading could turn the result {}, more than the {max_deg}° accepted; more readings in the same orientations will not help: {hint}",
+        "the orientations seen do not determine the calibration: their dilution is {dilution:.1} (an evenly covered {even_shape} has {even_dilution:.1}), so an error of {:.1} % of the field per reading could turn the result {}, more than the {}° accepted; more readings in the same orientations will not help: {hint}",
         100.0 * model_error_rel,
-        UpTo(*error_deg)
+        UpTo(*error_deg),
+        Precise(*max_deg)
     )]
     Undetermined {
         /// The dilution of the directions seen, each direction counted once (infinite when
@@ -244,8 +264,9 @@ pub enum Error {
     /// The readings are too noisy for the orientations they were taken in: the fit is
     /// outside the range where its own error figures hold.
     #[error(
-        "each reading scatters {:.1} % of the field about the fit and the orientations' dilution is {dilution:.1}: their product, {product:.2}, exceeds the {max_product} within which a least-squares calibration's error figures hold (beyond it the fit can drift along what the orientations leave loose, and more readings do not stop it); record orientations that determine the calibration better (a fuller tumble: an evenly covered sphere has a dilution of 3.7) or use a quieter sensor",
-        100.0 * noise_rel
+        "each reading scatters {:.1} % of the field about the fit and the orientations' dilution is {dilution:.1}: their product, {product:.2}, exceeds the {} within which a least-squares calibration's error figures hold (beyond it the fit can drift along what the orientations leave loose, and more readings do not stop it); record orientations that determine the calibration better (a fuller tumble: an evenly covered sphere has a dilution of 3.7) or use a quieter sensor",
+        100.0 * noise_rel,
+        Precise(*max_product)
     )]
     TooNoisyForOrientations {
         /// Per-reading noise, relative to the field.
@@ -259,7 +280,8 @@ pub enum Error {
     },
     /// The calibration's own uncertainty is too large for the readings' noise and number.
     #[error(
-        "the calibration itself could err by up to {bound_deg:.2}° (3 sigma{widened}), more than the {max_deg}° accepted: {points} readings with a noise of {:.2} % of the field each are too few for the orientations they cover; the error falls as 1/sqrt(readings), so record more readings, or turn (tumble) through more orientations",
+        "the calibration itself could err by up to {bound_deg:.2}° (3 sigma{widened}), more than the {}° accepted: {points} readings with a noise of {:.2} % of the field each are too few for the orientations they cover; the error falls as 1/sqrt(readings), so record more readings, or turn (tumble) through more orientations",
+        Precise(*max_deg),
         100.0 * noise_rel
     )]
     TooUncertain {
@@ -276,7 +298,10 @@ pub enum Error {
     },
     /// Two consecutive samples are further apart in time than a method can bridge.
     #[error(
-        "the record has a gap of {gap_s} s before t = {t_s} s, longer than the {max_gap_s} s that {what} can bridge; split the record at the gap and calibrate each part on its own (or start the calibrator again from this sample)"
+        "the record has a gap of {} s before t = {} s, longer than the {} s that {what} can bridge; split the record at the gap and calibrate each part on its own (or start the calibrator again from this sample)",
+        Precise(*gap_s),
+        Precise(*t_s),
+        Precise(*max_gap_s)
     )]
     TimeGap {
         /// What cannot bridge it (e.g. "the gyro's integrated heading").
@@ -298,7 +323,8 @@ pub enum Error {
     },
     /// A date outside the validity of a geomagnetic model.
     #[error(
-        "date {year} is outside the model's validity {valid_from}–{valid_to}; use a model for that epoch or opt in to extrapolation"
+        "date {} is outside the model's validity {valid_from}–{valid_to}; use a model for that epoch or opt in to extrapolation",
+        Precise(*year)
     )]
     DateOutOfRange {
         /// Requested decimal year.
@@ -354,6 +380,31 @@ mod tests {
     use super::*;
     extern crate std;
     use std::string::ToString;
+
+    /// Timestamps and gaps keep every digit at everyday magnitudes and go to exponent form
+    /// beyond them.
+    #[test]
+    fn precise_numbers_are_exact_and_short() {
+        assert_eq!(
+            Precise(17664.399999999998).to_string(),
+            "17664.399999999998"
+        );
+        assert_eq!(Precise(1e308).to_string(), "1e308");
+        assert_eq!(Precise(-5e-324).to_string(), "-5e-324");
+        assert_eq!(Precise(0.01).to_string(), "0.01");
+        let e = Error::NonIncreasingTime {
+            prev_s: 1e308,
+            t_s: 1.5,
+        };
+        assert!(e.to_string().len() < 120, "{e}");
+        let e = Error::TimeGap {
+            what: "w",
+            t_s: 1e308,
+            gap_s: 1e308,
+            max_gap_s: 2.0,
+        };
+        assert!(e.to_string().len() < 250, "{e}");
+    }
 
     /// Ranges and values read at a glance: no 309-digit numbers, no float noise.
     #[test]

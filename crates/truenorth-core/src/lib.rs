@@ -51,7 +51,7 @@ pub use calibrator::{
     Solution,
 };
 pub use compass_quality::{CompassQuality, CompassUncertainty};
-pub use error::{Error, Readable};
+pub use error::{Error, Precise, Readable};
 pub use estimator::{
     AttitudeEstimate, AttitudeStatus, HeadingEstimator, NavEstimate, NavStatus,
     OrientationEstimator, Unobserved,

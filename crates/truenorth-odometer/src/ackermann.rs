@@ -76,10 +76,10 @@ impl AckermannParams {
 }
 
 impl Validate for AckermannParams {
-    /// B > 0, T_F > 0, 0 ≤ p < min(T_F/2, B), all finite.
+    /// B > 0, T_F within [`crate::TRACK_RANGE_M`], 0 ≤ p < min(T_F/2, B), all finite.
     fn validate(&self) -> Result<()> {
         check_positive("wheelbase_m", self.wheelbase_m)?;
-        check_positive("front track_m", self.track_m)?;
+        crate::check_track("front track_m", self.track_m)?;
         // p = T_F/2 would put both kingpins on the centre line; p ≥ B would let the inner
         // wheel's contact point reach the turn centre. check_range includes its upper end,
         // so that end is refused separately.

@@ -103,7 +103,9 @@ pub use odometer_model::{
 pub use odometry_step::{OdometryStep, OdometryTurn, differential_gains};
 pub use patent_track::PatentAckermannTrack;
 pub use track_table::EffectiveTrackTable;
-pub use wheels::{OdometerWheels, WheelDistances, WheelGeometry, WheelMotion};
+pub use wheels::{
+    OdometerWheels, TRACK_RANGE_M, WheelDistances, WheelGeometry, WheelMotion, check_track,
+};
 
 /// The code blocks of the crate's README, compiled and run as doctests.
 #[cfg(doctest)]

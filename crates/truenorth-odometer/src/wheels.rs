@@ -2,7 +2,7 @@
 //! vehicle, the odometer model and the heading computation.
 
 use serde::{Deserialize, Serialize};
-use truenorth_core::{Error, Result, Validate, check_finite, check_positive};
+use truenorth_core::{Error, Result, Validate, check_finite, check_range};
 
 use crate::{AckermannGeometry, AckermannParams, RigidMotion};
 
@@ -55,13 +55,26 @@ impl OdometerWheels {
     }
 }
 
+/// The tracks a wheeled vehicle can have, m: from a 1 cm micro-robot to 100 m, ten times a
+/// mining truck's. A track is the lever that turns the wheels' difference into a turn
+/// (`Δθ = Δd/T`): one far below any vehicle's (10⁻³⁰⁰ m passes a positivity test) turns a
+/// millimetre of difference into 10³⁰⁰ rad, whose square overflows the heading's variance
+/// and leaves NaN behind; one far above it makes every turn nothing.
+pub const TRACK_RANGE_M: (f64, f64) = (0.01, 100.0);
+
+/// Checks a track `value` (named `what`) against [`TRACK_RANGE_M`].
+pub fn check_track(what: &'static str, value: f64) -> Result<f64> {
+    check_range(what, value, TRACK_RANGE_M.0, TRACK_RANGE_M.1)
+}
+
 impl Validate for OdometerWheels {
-    /// A track positive and finite, or valid front-axle dimensions ([`AckermannParams`]).
+    /// A track within [`TRACK_RANGE_M`], or valid front-axle dimensions
+    /// ([`AckermannParams`]).
     fn validate(&self) -> Result<()> {
         match self {
             Self::Rear { track_m }
             | Self::SkidSteer { track_m }
-            | Self::Differential { track_m } => check_positive("track_m", *track_m).map(drop),
+            | Self::Differential { track_m } => check_track("track_m", *track_m).map(drop),
             Self::Front(p) => p.validate(),
         }
     }
@@ -90,7 +103,7 @@ impl WheelGeometry {
             OdometerWheels::Rear { track_m }
             | OdometerWheels::SkidSteer { track_m }
             | OdometerWheels::Differential { track_m } => Self::Rear {
-                track_m: check_positive("track_m", track_m)?,
+                track_m: check_track("track_m", track_m)?,
             },
             OdometerWheels::Front(p) => Self::Front(AckermannGeometry::new(p)?),
         })

@@ -190,12 +190,21 @@ impl<T: Real> AxisVariance<T> {
         }
     }
 
-    /// `dt` of strapdown: `e ← e + β dt + w`, `β ← β + walk`.
+    /// `dt` of strapdown: `e ← e + β dt + w`, `β ← β + walk`. The linear propagation holds
+    /// while the error is a small angle; at [`UNINFORMED_VARIANCE_RAD2`] the angle is
+    /// unknown and stays so (the covariance with the bias kept within Cauchy–Schwarz, so
+    /// that the pair stays a covariance).
     #[inline]
     fn propagate(&mut self, dt_s: T, angle_noise: T, bias_noise: T) {
         self.angle += dt_s * (T::of(2.0) * self.angle_bias + dt_s * self.bias) + angle_noise;
         self.angle_bias += dt_s * self.bias;
         self.bias += bias_noise;
+        let ceiling = T::of(UNINFORMED_VARIANCE_RAD2);
+        if self.angle > ceiling {
+            self.angle = ceiling;
+            let bound = (self.angle * self.bias).sqrt();
+            self.angle_bias = self.angle_bias.clamp(-bound, bound);
+        }
     }
 
     /// One correction with gain `k` whose bias estimate takes `c` (1/s) of the error, and
@@ -208,6 +217,7 @@ impl<T: Real> AxisVariance<T> {
         self.angle = a * a * pe;
         self.angle_bias = a * (pb - c * pe);
         self.bias = (self.bias - c * (T::of(2.0) * pb - c * pe)).max(T::zero());
+        let target = target.min(T::of(UNINFORMED_VARIANCE_RAD2));
         self.measured += (T::one() - a * a) * (target - self.measured);
     }
 }
@@ -248,6 +258,12 @@ pub struct AttitudeUncertainty<T: Real = f64> {
 const INITIAL_INCLINATION_RAD: f64 = 0.2;
 /// Heading σ of an unknown heading, rad: uniform over the circle, π/√3.
 const UNKNOWN_HEADING_RAD: f64 = core::f64::consts::PI / 1.732_050_807_568_877_2;
+/// The largest variance of the error about any axis, rad²: that of an uninformed
+/// attitude, whose error about the axis is uniform over the circle (−π, π], π²/3. An
+/// error angle is defined modulo a turn, so no evidence makes it less known than that,
+/// and the linear propagation, which lets a variance grow without bound, is valid only
+/// well below it.
+pub const UNINFORMED_VARIANCE_RAD2: f64 = UNKNOWN_HEADING_RAD * UNKNOWN_HEADING_RAD;
 
 impl<T: Real> AttitudeUncertainty<T> {
     /// Before any correction: inclination from one reading of unknown acceleration, heading
@@ -447,10 +463,11 @@ impl<T: Real> AttitudeUncertainty<T> {
     #[inline]
     fn inclination_variance(&self, i: usize) -> T {
         let s = self.config.gyro_scale_rel;
-        self.inclination.angle
+        (self.inclination.angle
             + self.inclination.measured
             + self.accel_moved_sq[i]
-            + T::of(s * s) * self.turned_inclination.norm_squared()
+            + T::of(s * s) * self.turned_inclination.norm_squared())
+        .min(T::of(UNINFORMED_VARIANCE_RAD2))
     }
 
     /// Checks a restored uncertainty against the error model `config` of its filter: the
@@ -510,10 +527,14 @@ impl<T: Real> AttitudeUncertainty<T> {
             + self.heading.measured
             + T::of(s * s) * self.turned_heading.norm_squared()
             + disturbance;
+        // Each term is a variance of the same error; their sum, like each, is at most that
+        // of an uninformed attitude (a NaN from an inf − inf cannot arise below it).
+        let ceiling = T::of(UNINFORMED_VARIANCE_RAD2);
+        let sigma = |v: T| v.min(ceiling).sqrt();
         Vector3::new(
-            (self.inclination_variance(0) + lag.x * lag.x).sqrt(),
-            (self.inclination_variance(1) + lag.y * lag.y).sqrt(),
-            (heading + lag.z * lag.z).sqrt(),
+            sigma(self.inclination_variance(0) + lag.x * lag.x),
+            sigma(self.inclination_variance(1) + lag.y * lag.y),
+            sigma(heading + lag.z * lag.z),
         )
     }
 }

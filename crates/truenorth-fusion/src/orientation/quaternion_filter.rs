@@ -268,12 +268,24 @@ impl<T: Real> QuaternionFilter<T> {
             None => f,
         };
         s.acc_lowpass_ned_mps2 = Some(lp);
-        let k = step.gains.acc;
+        // The horizontal part over g is the tilt the low-passed force shows, linearised
+        // (sin θ ≈ θ); a force of g shows at most sin θ = 1, so a horizontal
+        // part beyond g·π/2 (a shock, a saturated or corrupt reading) is no tilt the
+        // linearised correction describes and counts as π/2 of it: the step's correction
+        // stays within `dt/τ_acc · π/2`, and the σ's record of it within π/2.
+        let max_h = T::of(STANDARD_GRAVITY_MPS2 * core::f64::consts::FRAC_PI_2);
+        let h2 = lp.x * lp.x + lp.y * lp.y;
+        let scale = if h2 > max_h * max_h {
+            max_h / h2.sqrt()
+        } else {
+            T::one()
+        };
+        let k = step.gains.acc * scale;
         // down × ẑ with down = −lp/g.
         correction.x = -lp.y * k;
         correction.y = lp.x * k;
         s.uncertainty.accel_corrected(
-            k * T::of(STANDARD_GRAVITY_MPS2),
+            step.gains.acc * T::of(STANDARD_GRAVITY_MPS2),
             (correction.x, correction.y),
             effective_tau(T::of(cfg.tau_acc_s), step.startup),
             inv_tau_bias,
@@ -390,13 +402,17 @@ impl<T: Real> QuaternionFilter<T> {
     }
 
     /// Turns the attitude by the step's `correction` (in the reference frame), and the
-    /// low-passed specific force with it so that it stays in the frame of `q`.
+    /// low-passed specific force by the same rotation so that it stays in the frame of `q`.
+    /// The same rotation (limited as [`small_rotation`] limits it, and norm-preserving):
+    /// a first-order turn `lp + c × lp` by the unlimited correction lengthens `lp` by
+    /// `√(1 + |c|²)`, and as `c` is proportional to `lp`, a force far beyond g grew
+    /// quadratically each step until it overflowed.
     fn apply_correction(&mut self, correction: &Vector3<T>) {
         if *correction != Vector3::zeros() {
             let s = &mut self.state;
-            s.attitude = small_rotation(correction) * s.attitude;
-            // First order, as the step is small.
-            s.acc_lowpass_ned_mps2 = s.acc_lowpass_ned_mps2.map(|lp| lp + correction.cross(&lp));
+            let turn = small_rotation(correction);
+            s.attitude = turn * s.attitude;
+            s.acc_lowpass_ned_mps2 = s.acc_lowpass_ned_mps2.map(|lp| turn * lp);
         }
     }
 

@@ -143,12 +143,20 @@ impl HeadingEstimator for SeedGyroCompass {
         let (zero, gain) = self.calibration.map_or((self.zero_rps, 1.0), |(c, _)| {
             (c.gyro.zero_rps, c.gyro.gain_pos)
         });
+        let mut gap = false;
         if let Some(r) = sample.gyr_z_rps {
             if let Some((t0, p)) = self.last_gyro
                 && !self.at_rest
             {
-                self.blend
-                    .turn(YawIncrement::new(p, r, sample.t_s - t0).corrected_rad(zero, gain));
+                // A step longer than the turn calibrator bridges is not integrated: the turn
+                // made across it is unknown (a rate held over an hour, or over 1e308 s, is
+                // no heading), and the compass, once calibrated, pulls the heading back.
+                let dt_s = sample.t_s - t0;
+                gap = dt_s > self.config.turn.max_gap_s;
+                if !gap {
+                    self.blend
+                        .turn(YawIncrement::new(p, r, dt_s).corrected_rad(zero, gain));
+                }
             }
             self.last_gyro = Some((sample.t_s, r));
             // The zero reading is taken again at every standstill (claims 8-9).
@@ -186,6 +194,7 @@ impl HeadingEstimator for SeedGyroCompass {
         e.status.compass_used = used;
         e.status.at_rest = self.at_rest;
         e.status.position_known = self.wheels.last_s().is_some();
+        e.status.gap = gap;
         Ok(*e)
     }
 

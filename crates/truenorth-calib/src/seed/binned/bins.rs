@@ -52,17 +52,15 @@ pub(crate) fn bin_index(d: &Vector2<f64>, n: usize) -> Option<usize> {
 
 /// Puts reading `p` in its bin about `origin` (claims 1, 3, 4): it replaces what a bin
 /// that holds no measurement has; otherwise it enters the running mean of the last
-/// `memory` readings.
+/// `memory` readings. Returns the bin, if the reading has a direction.
 pub(crate) fn bin_reading(
     bins: &mut Bins,
     n: usize,
     origin: &Vector2<f64>,
     p: &Vector2<f64>,
     memory: u32,
-) {
-    let Some(i) = bin_index(&(p - origin), n) else {
-        return;
-    };
+) -> Option<usize> {
+    let i = bin_index(&(p - origin), n)?;
     let b = &mut bins[i];
     if b.state != BinState::Measured {
         *b = Bin {
@@ -75,6 +73,7 @@ pub(crate) fn bin_reading(
         let w = 1.0 / f64::from(b.count.min(memory));
         b.value += (p - b.value) * w;
     }
+    Some(i)
 }
 
 /// Moves every stored reading to its bin about `new_origin`, merging readings that land in

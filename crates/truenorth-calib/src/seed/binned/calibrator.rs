@@ -130,6 +130,50 @@ pub struct BinnedEllipseCalibrator {
     /// `backlog_len`; never while an update is in progress).
     pub(crate) backlog: [Vector2<f64>; MAX_UPDATE_PUSHES],
     pub(crate) backlog_len: usize,
+    /// Square of the distance from the origin within which a reading's direction is its
+    /// noise's (see [`noise_floor_sq`]); 0 until the initial origin is set.
+    pub(crate) floor_sq: f64,
+    /// The bin of the last reading binned, and how many readings in a row it has taken.
+    pub(crate) last_bin: Option<usize>,
+    pub(crate) bin_run: u32,
+}
+
+/// Most readings in a row into one bin that count towards the next update
+/// ([`BinnedEllipseConfig::update_interval`]). A full-set update re-bins the set about the
+/// moved origin, which merges readings that fall together, so each update costs the set a
+/// little; counting every reading made the updates per turn, and so what the set lost to
+/// them, grow with the sampling rate (a recording of 2 000 readings per degree ran 5 600
+/// updates per turn and kept 15 of 64 bins). Readings that stay in one bin only renew its
+/// value: past the first 16 (the 11 a bin takes at the 2 readings per degree the patent's
+/// turn gives, with room) they bring no update closer, so the updates come per angle
+/// turned, not per reading, at any rate.
+const COUNTED_PER_BIN_RUN: u32 = 16;
+
+/// How many per-axis noise σ a reading must lie from the origin for its direction to be
+/// the locus's rather than its noise's: for noise alone the distance exceeds `cσ` with
+/// probability `exp(−c²/2)`, 4·10⁻⁶ at 5, so that even the thousands of readings a dense
+/// recording takes while it passes its starting point leave no bin to noise.
+const NOISE_FLOOR_SIGMAS: f64 = 5.0;
+
+/// The square of the distance from the initial origin (the mean of `init`, claim 6) within
+/// which a reading shows noise rather than a direction: [`NOISE_FLOOR_SIGMAS`] times the
+/// per-axis noise σ of the initial readings, estimated from their successive differences
+/// (`E|Δ|² = 4σ²` for two axes of independent noise). The initial origin lies on the locus,
+/// not inside it; readings close to it point every way, and a recording dense enough to
+/// take many of them before it moves off (10⁷ readings over ten turns) filled every bin with
+/// that noise, fitted an ellipse to it, and refused, where a sparser recording of the same
+/// turns was accepted. Readings inside the floor carry no direction at any density, so
+/// skipping them keeps more readings from ever refusing what fewer accepted. The motion
+/// between readings adds to the differences, so the floor stays below a quarter of the
+/// field as long as a turn takes at least about as many readings as there are bins, which
+/// filling the bins needs anyway.
+pub(crate) fn noise_floor_sq(init: &[Vector2<f64>]) -> f64 {
+    if init.len() < 2 {
+        return 0.0;
+    }
+    let ss: f64 = init.windows(2).map(|w| (w[1] - w[0]).norm_squared()).sum();
+    let sigma_sq = ss / (4.0 * (init.len() - 1) as f64);
+    NOISE_FLOOR_SIGMAS * NOISE_FLOOR_SIGMAS * sigma_sq
 }
 
 impl Default for BinnedEllipseCalibrator {
@@ -162,6 +206,9 @@ impl BinnedEllipseCalibrator {
             update: None,
             backlog: [Vector2::zeros(); MAX_UPDATE_PUSHES],
             backlog_len: 0,
+            floor_sq: 0.0,
+            last_bin: None,
+            bin_run: 0,
         }
     }
 
@@ -284,14 +331,16 @@ impl BinnedEllipseCalibrator {
                 let init = self.init;
                 let o = init[..k].iter().sum::<Vector2<f64>>() / k as f64;
                 self.origin = Some(o);
+                self.floor_sq = noise_floor_sq(&init[..k]);
                 for q in &init[..k] {
                     self.bin(q);
                 }
             }
             return;
         }
-        self.bin(p);
-        self.since_update += 1;
+        if self.bin(p) {
+            self.since_update += 1;
+        }
         if self.since_update >= self.config.update_interval
             && self.filled_bins() >= self.config.min_filled_bins
         {
@@ -300,16 +349,31 @@ impl BinnedEllipseCalibrator {
         }
     }
 
-    fn bin(&mut self, p: &Vector2<f64>) {
-        if let Some(origin) = self.origin {
-            bin_reading(
-                &mut self.bins,
-                self.config.bins,
-                &origin,
-                p,
-                self.config.bin_memory,
-            );
+    /// Bins `p` if it has a direction about the origin; returns whether it counts towards
+    /// the next update (see [`COUNTED_PER_BIN_RUN`]).
+    fn bin(&mut self, p: &Vector2<f64>) -> bool {
+        let Some(origin) = self.origin else {
+            return false;
+        };
+        if (p - origin).norm_squared() <= self.floor_sq {
+            return false;
         }
+        let Some(i) = bin_reading(
+            &mut self.bins,
+            self.config.bins,
+            &origin,
+            p,
+            self.config.bin_memory,
+        ) else {
+            return false;
+        };
+        if self.last_bin == Some(i) {
+            self.bin_run = self.bin_run.saturating_add(1);
+        } else {
+            self.last_bin = Some(i);
+            self.bin_run = 1;
+        }
+        self.bin_run <= COUNTED_PER_BIN_RUN
     }
 
     /// Starts a full-set update on a copy of the bins, with the refresh spread evenly over

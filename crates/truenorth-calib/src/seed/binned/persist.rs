@@ -57,6 +57,10 @@ pub struct BinnedEllipseCalibratorState {
     pub estimate: Option<Solution<CompassCalibration2d>>,
     update: Option<BinnedUpdateState>,
     backlog: Vec<Vector2<f64>>,
+    #[serde(default)]
+    last_bin: Option<usize>,
+    #[serde(default)]
+    bin_run: u32,
 }
 
 fn finite2(v: &Vector2<f64>) -> bool {
@@ -117,6 +121,8 @@ impl Persistent for BinnedEllipseCalibrator {
                 pending: u.pending[..u.pending_len].to_vec(),
             }),
             backlog: self.backlog[..self.backlog_len].to_vec(),
+            last_bin: self.last_bin,
+            bin_run: self.bin_run,
         }
     }
 
@@ -131,6 +137,11 @@ impl Persistent for BinnedEllipseCalibrator {
         c.origin = s.origin;
         c.init[..s.init.len()].copy_from_slice(&s.init);
         c.init_count = s.init.len();
+        if c.origin.is_some() {
+            c.floor_sq = super::calibrator::noise_floor_sq(&s.init);
+        }
+        c.last_bin = s.last_bin.filter(|&i| i < n);
+        c.bin_run = s.bin_run;
         c.samples = s.samples;
         c.since_update = s.since_update;
         c.reference[..n].copy_from_slice(&s.reference);
