@@ -238,3 +238,42 @@ fn a_compass_reading_that_overflows_the_calibration_leaves_the_heading_a_number(
         assert!(numbers(&e) && e.heading.rad().is_finite(), "row {k}: {e:?}");
     }
 }
+
+/// Found while tracing the fuzzer's finding: with the two-pass start, a row before the
+/// wheels' first reading (position unknown, covariance infinite) was turned onto north
+/// with the rest of the head, and the rotation mixed its infinities into NaN.
+#[test]
+fn a_row_before_the_wheels_keeps_an_unknown_position_through_the_two_pass_start() {
+    let drive = SimulatedDrive::new(DriveSpec {
+        length_m: 1500.0,
+        ..DriveSpec::new(1)
+    })
+    .unwrap();
+    let nav = VehicleEstimator::new(VehicleConfig::default()).unwrap();
+    let mut two = TwoPassStart::new(nav, TwoPassConfig::default()).unwrap();
+    let first = drive.samples[0];
+    let lead = VehicleSample {
+        t_s: first.t_s - 0.1,
+        wheels: None,
+        ..first
+    };
+    let mut rows = Vec::new();
+    let mut keep = |s: &VehicleSample, e: &NavEstimate, _: &VehicleEstimator| rows.push((*s, *e));
+    for s in std::iter::once(&lead).chain(&drive.samples) {
+        two.push(s, &mut keep).unwrap();
+    }
+    two.finish(&mut keep).unwrap();
+    assert_eq!(rows.len(), drive.samples.len() + 1);
+    let (_, e) = rows[0];
+    assert!(
+        e.status.heading_absolute && !e.status.position_known,
+        "{e:?}"
+    );
+    assert!(
+        e.position_cov_m2.iter().all(|v| *v == f64::INFINITY),
+        "{e:?}"
+    );
+    for (s, e) in &rows {
+        assert!(numbers(e), "{e:?} from {s:?}");
+    }
+}
