@@ -191,11 +191,15 @@ impl CompassMonitor {
     }
 
     /// The calibrated horizontal field and its magnitude over the fitted one, if
-    /// calibrated.
+    /// calibrated and the calibrated field is a number: a raw reading near the largest
+    /// float (no sensor reads one; a corrupted word does) overflows the soft-iron
+    /// correction, and a field of infinite magnitude points nowhere, so it is no
+    /// measurement of the heading.
     pub fn measure(&self, raw: &nalgebra::Vector2<f64>) -> Option<(nalgebra::Vector2<f64>, f64)> {
         let fix = self.fix.as_ref()?;
         let u = fix.calibration.correct(raw);
-        Some((u, u.norm() / fix.field))
+        let ratio = u.norm() / fix.field;
+        ratio.is_finite().then_some((u, ratio))
     }
 
     /// Whether a field magnitude ratio is within the tolerance.
@@ -259,6 +263,19 @@ mod tests {
         assert!((fix.calibration.hard_iron - Vector2::new(5.0, -3.0)).norm() < 1e-6);
         let (u, ratio) = m.measure(&Vector2::new(25.0, -3.0)).unwrap();
         assert!((-u.y).atan2(u.x).abs() < 1e-6 && (ratio - 1.0).abs() < 1e-6);
+    }
+
+    #[test]
+    fn a_reading_that_overflows_the_calibration_is_no_measurement() {
+        let m = calibrated();
+        for raw in [
+            Vector2::new(-1146.8, -1.349_105_284_904_501e308),
+            Vector2::new(f64::MAX, -f64::MAX),
+            Vector2::new(1e200, 1e200),
+        ] {
+            assert_eq!(m.measure(&raw), None, "{raw:?}");
+        }
+        assert!(m.measure(&Vector2::new(1e6, -1e6)).is_some());
     }
 
     #[test]

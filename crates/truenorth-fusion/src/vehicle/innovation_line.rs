@@ -44,8 +44,13 @@ impl InnovationLine {
         self.n
     }
 
-    /// Adds innovation `nu_rad` taken at `t_s`.
+    /// Adds innovation `nu_rad` taken at `t_s`. One that is not a number says nothing
+    /// about the heading and is left out: counted, it would turn every sum, and so the
+    /// offset the line gives, into NaN.
     pub fn push(&mut self, t_s: f64, nu_rad: f64) {
+        if !(t_s.is_finite() && nu_rad.is_finite()) {
+            return;
+        }
         let (t0, nu0) = *self.first.get_or_insert((t_s, nu_rad));
         let (t, v) = (t_s - t0, wrap_pi(nu_rad - nu0));
         self.n += 1;
@@ -104,6 +109,24 @@ mod tests {
             // rounding floor is √(ε·Σv²) ≈ 1e-9 here, not ε.
             prop_assert!(fit.residual_rad < 1e-7);
         }
+    }
+
+    #[test]
+    fn an_innovation_that_is_not_a_number_is_left_out() {
+        let mut line = InnovationLine::default();
+        for (k, nu) in [0.1, f64::NAN, 0.2, f64::INFINITY, 0.3]
+            .into_iter()
+            .enumerate()
+        {
+            line.push(3600.0 * k as f64, nu);
+        }
+        assert_eq!(line.len(), 3);
+        let fit = line.fit(0.01).unwrap();
+        assert!((fit.offset_rad - 0.3).abs() < 1e-9, "{fit:?}");
+        assert!(
+            fit.residual_rad < 1e-6 && fit.sigma_rad.is_finite(),
+            "{fit:?}"
+        );
     }
 
     #[test]

@@ -181,7 +181,9 @@ impl TwoPassStart {
 }
 
 /// An estimate made relative to the start heading, turned by `offset` onto north (heading
-/// and track), with the heading uncertainty of the estimate that found the offset.
+/// and track), with the heading uncertainty of the estimate that found the offset. A
+/// position not known yet (before the wheels' first reading) stays unknown in every
+/// direction: its infinite covariance is not turned, which would mix infinities into NaN.
 fn turned(e: &NavEstimate, offset: f64, heading_sigma_rad: f64) -> NavEstimate {
     let (s, c) = offset.sin_cos();
     let mut t = *e;
@@ -189,12 +191,15 @@ fn turned(e: &NavEstimate, offset: f64, heading_sigma_rad: f64) -> NavEstimate {
     t.east_m = s * e.north_m + c * e.east_m;
     t.heading = MagneticHeading::new(e.heading.rad() + offset);
     t.heading_sigma_rad = heading_sigma_rad;
+    t.status.heading_absolute = true;
+    if !e.status.position_known {
+        return t;
+    }
     let r = nalgebra::Matrix2::new(c, -s, s, c);
     // The offset's own error turns the track about the start: across it, in proportion
     // to the distance from the start.
     let across = nalgebra::Vector2::new(-t.east_m, t.north_m);
     t.position_cov_m2 = r * e.position_cov_m2 * r.transpose()
         + heading_sigma_rad * heading_sigma_rad * across * across.transpose();
-    t.status.heading_absolute = true;
     t
 }
