@@ -26,36 +26,7 @@ use common::*;
 use nalgebra::Vector2;
 use proptest::prelude::*;
 use proptest::test_runner::RngSeed;
-use truenorth_calib::{
-    BinnedEllipseCalibrator, EllipseCalibrator, MeritCircleCalibrator, OnlineEllipseCalibrator,
-    TurnCompassCalibrator,
-};
-use truenorth_core::{Calibrator, Error, Mag2Sample, NoiseSource, SplitMix64};
-
-fn solve<C: Calibrator<Sample = Mag2Sample>>(mut c: C, s: &[Mag2Sample]) -> Result<(), Error> {
-    for x in s {
-        c.push(x)?;
-    }
-    c.solve().map(|_| ())
-}
-
-const NAMES_2D: [&str; 5] = [
-    "ellipse",
-    "online-ellipse",
-    "binned-ellipse",
-    "merit-circle",
-    "turn",
-];
-
-fn solve_2d(which: usize, s: &[Mag2Sample]) -> Result<(), Error> {
-    match which {
-        0 => solve(EllipseCalibrator::default(), s),
-        1 => solve(OnlineEllipseCalibrator::new(Default::default()).unwrap(), s),
-        2 => solve(BinnedEllipseCalibrator::default(), s),
-        3 => solve(MeritCircleCalibrator::default(), s),
-        _ => solve(TurnCompassCalibrator::default(), s),
-    }
-}
+use truenorth_core::{Mag2Sample, NoiseSource, SplitMix64};
 
 /// `turns` turns of `m` from `start_deg` at `per_deg` readings per degree, 0.01 s apart,
 /// with per-axis noise `sigma`.

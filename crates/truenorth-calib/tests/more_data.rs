@@ -18,9 +18,8 @@ use proptest::prelude::*;
 use proptest::test_runner::RngSeed;
 use truenorth_calib::quality::{self, MIN_ARC_DEG};
 use truenorth_calib::{
-    BinnedEllipseCalibrator, EllipseCalibrator, EllipsoidCalibrator, MERIT_CIRCLE_MIN_ARC_DEG,
-    MagAccelCalibrator, MagAccelSample, MeritCircleCalibrator, OnlineEllipseCalibrator,
-    OnlineEllipsoidCalibrator, TurnCompassCalibrator,
+    BinnedEllipseCalibrator, EllipsoidCalibrator, MERIT_CIRCLE_MIN_ARC_DEG, MagAccelCalibrator,
+    MagAccelSample, OnlineEllipsoidCalibrator,
 };
 use truenorth_core::{Calibrator, CompassQuality, Error, Mag2Sample, Mag3Sample, SplitMix64};
 
@@ -34,10 +33,6 @@ fn config(cases: u32) -> ProptestConfig {
     }
 }
 
-fn solve<C: Calibrator>(mut c: C, samples: &[C::Sample]) -> Result<(), Error> {
-    solved(&mut c, samples).map(|_| ())
-}
-
 fn solved<C: Calibrator>(
     c: &mut C,
     samples: &[C::Sample],
@@ -47,25 +42,6 @@ fn solved<C: Calibrator>(
     }
     c.solve()
 }
-
-/// The 2-D calibrators, by name.
-fn solve_2d(which: usize, s: &[Mag2Sample]) -> Result<(), Error> {
-    match which {
-        0 => solve(EllipseCalibrator::default(), s),
-        1 => solve(OnlineEllipseCalibrator::new(Default::default()).unwrap(), s),
-        2 => solve(BinnedEllipseCalibrator::default(), s),
-        3 => solve(MeritCircleCalibrator::default(), s),
-        _ => solve(TurnCompassCalibrator::default(), s),
-    }
-}
-
-const NAMES_2D: [&str; 5] = [
-    "ellipse",
-    "online-ellipse",
-    "binned-ellipse",
-    "merit-circle",
-    "turn",
-];
 
 /// A recording of a 2-D compass: a turn of `span_deg` from `start_deg` with `n` readings,
 /// then `extra` readings of kind `kind` where the turn ended (0: swaying ±35° about that

@@ -303,3 +303,38 @@ pub fn shuffle<T>(v: &mut [T], rng: &mut SplitMix64) {
         v.swap(i, j);
     }
 }
+
+/// Pushes every sample into `c` and solves; only whether it was accepted.
+pub fn solve<C: truenorth_core::Calibrator>(
+    mut c: C,
+    samples: &[C::Sample],
+) -> Result<(), truenorth_core::Error> {
+    for s in samples {
+        c.push(s)?;
+    }
+    c.solve().map(|_| ())
+}
+
+/// The 2-D calibrators, by name, in the order [`solve_2d`] takes them.
+pub const NAMES_2D: [&str; 5] = [
+    "ellipse",
+    "online-ellipse",
+    "binned-ellipse",
+    "merit-circle",
+    "turn",
+];
+
+/// Solves `s` with the 2-D calibrator `NAMES_2D[which]`, in its default configuration.
+pub fn solve_2d(which: usize, s: &[Mag2Sample]) -> Result<(), truenorth_core::Error> {
+    use truenorth_calib::{
+        BinnedEllipseCalibrator, EllipseCalibrator, MeritCircleCalibrator, OnlineEllipseCalibrator,
+        TurnCompassCalibrator,
+    };
+    match which {
+        0 => solve(EllipseCalibrator::default(), s),
+        1 => solve(OnlineEllipseCalibrator::new(Default::default()).unwrap(), s),
+        2 => solve(BinnedEllipseCalibrator::default(), s),
+        3 => solve(MeritCircleCalibrator::default(), s),
+        _ => solve(TurnCompassCalibrator::default(), s),
+    }
+}
