@@ -57,6 +57,7 @@
 #![cfg_attr(not(feature = "std"), no_std)]
 
 mod calibration;
+mod distortion;
 mod disturbance;
 mod model2d;
 mod model3d;

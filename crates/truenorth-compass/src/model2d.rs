@@ -4,8 +4,9 @@
 use nalgebra::{Matrix2, Vector2};
 use serde::{Deserialize, Serialize};
 use truenorth_core::check_range;
-use truenorth_core::{Error, NoiseSource, Result, SensorModel, check_finite, check_finite2};
+use truenorth_core::{NoiseSource, Result, SensorModel, check_finite, check_finite2};
 
+use crate::distortion::invert_distortion;
 use crate::{CompassCalibration2d, Disturbance, Disturbances};
 
 #[cfg(not(feature = "std"))]
@@ -58,20 +59,8 @@ impl MagnetometerModel2d {
     /// distortion, which no calibration could undo.
     pub fn new(hard_iron: Vector2<f64>, soft_iron: Matrix2<f64>, noise_sigma: f64) -> Result<Self> {
         check_finite2("hard iron", &hard_iron)?;
-        for &x in soft_iron.iter() {
-            check_finite("soft-iron matrix entry", x)?;
-        }
         check_noise(noise_sigma)?;
-        let scale = soft_iron.norm_squared();
-        let det = soft_iron.determinant();
-        if scale == 0.0 || det.abs() <= 1e-12 * scale {
-            return Err(Error::Degenerate {
-                reason: "the soft-iron distortion matrix is singular; no calibration can undo it",
-            });
-        }
-        let inverse = soft_iron.try_inverse().ok_or(Error::Degenerate {
-            reason: "the soft-iron distortion matrix is singular; no calibration can undo it",
-        })?;
+        let inverse = invert_distortion(&soft_iron)?;
         Ok(Self {
             hard_iron,
             soft_iron,
@@ -181,7 +170,7 @@ mod tests {
     use crate::{DisturbanceShape, soft_iron_from_axes};
     use nalgebra::Vector3;
     use proptest::prelude::*;
-    use truenorth_core::{SplitMix64, ZeroNoise, angle_diff};
+    use truenorth_core::{Error, SplitMix64, ZeroNoise, angle_diff};
 
     fn any_distortion() -> impl Strategy<Value = Matrix2<f64>> {
         (0.5f64..2.0, 0.5f64..2.0, -3.2f64..3.2, -0.3f64..0.3).prop_map(|(g1, g2, a, skew)| {

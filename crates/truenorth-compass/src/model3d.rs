@@ -4,10 +4,9 @@
 
 use nalgebra::{Matrix3, Rotation3, Vector3};
 use serde::{Deserialize, Serialize};
-use truenorth_core::{
-    Error, EulerZyx, NoiseSource, Result, SensorModel, check_finite, check_finite3,
-};
+use truenorth_core::{EulerZyx, NoiseSource, Result, SensorModel, check_finite, check_finite3};
 
+use crate::distortion::invert_distortion;
 use crate::model2d::check_noise;
 use crate::{CompassCalibration3d, Disturbance, Disturbances};
 use truenorth_core::check_range;
@@ -75,19 +74,8 @@ impl MagnetometerModel3d {
     /// non-finite values, negative noise and a (nearly) singular distortion.
     pub fn new(hard_iron: Vector3<f64>, soft_iron: Matrix3<f64>, noise_sigma: f64) -> Result<Self> {
         check_finite3("hard iron", &hard_iron)?;
-        for &x in soft_iron.iter() {
-            check_finite("soft-iron matrix entry", x)?;
-        }
         check_noise(noise_sigma)?;
-        let scale = soft_iron.norm_squared();
-        let det = soft_iron.determinant();
-        const SINGULAR: Error = Error::Degenerate {
-            reason: "the soft-iron distortion matrix is singular; no calibration can undo it",
-        };
-        if scale == 0.0 || det.abs() <= 1e-12 * scale * scale.sqrt() {
-            return Err(SINGULAR);
-        }
-        let inverse = soft_iron.try_inverse().ok_or(SINGULAR)?;
+        let inverse = invert_distortion(&soft_iron)?;
         Ok(Self {
             hard_iron,
             soft_iron,
@@ -179,7 +167,7 @@ mod tests {
     use super::*;
     use crate::{DisturbanceShape, heading_from_horizontal};
     use proptest::prelude::*;
-    use truenorth_core::{ZeroNoise, angle_diff};
+    use truenorth_core::{Error, ZeroNoise, angle_diff};
 
     fn any_distortion() -> impl Strategy<Value = Matrix3<f64>> {
         proptest::array::uniform9(-0.3f64..0.3)
