@@ -390,6 +390,11 @@ fn every_refusal_is_one_line() {
     orientation(&["--imu-topic", "/nope"], "topics present: /chatter");
     orientation(&["--imu-topic", "/imu/mag"], "cannot serve as imu");
     orientation(&["--imu-topic", "none"], "--imu-topic cannot be `none`");
+    // `eval broad` reads CSV trials only: a log option is refused before any folder is read.
+    refused(
+        &["eval", "broad", p(&dir), "--imu-topic", "/imu"],
+        "eval broad reads CSV files only, and --imu-topic applies to a PX4 ULog or MCAP log",
+    );
     refused(
         &[
             "calibrate",

@@ -95,6 +95,7 @@ struct Report {
 /// Runs the subcommand: each trial in name order, then the group means, printed as tables
 /// or as one JSON document.
 pub fn run(args: &Args) -> CliResult {
+    args.input_options.log.refuse_for_csv_only("eval broad")?;
     let paths = trial_paths(&args.dir)?;
     let mut progress = Progress::new(paths.len());
     let mut results = Vec::with_capacity(paths.len());

@@ -73,6 +73,17 @@ impl LogOptions {
     }
 
     /// The options given, by flag, for the message refusing them with a CSV.
+    /// Refuses, in one line, any of these options given to `command`, which reads CSV files
+    /// only (e.g. `eval broad`, whose trials are CSV).
+    pub fn refuse_for_csv_only(&self, command: &str) -> CliResult {
+        match self.given().first() {
+            Some(flag) => Err(CliError::msg(format!(
+                "{command} reads CSV files only, and {flag} applies to a PX4 ULog or MCAP log; leave it out"
+            ))),
+            None => Ok(()),
+        }
+    }
+
     fn given(&self) -> Vec<&'static str> {
         let mut given = Vec::new();
         for (flag, set) in [
