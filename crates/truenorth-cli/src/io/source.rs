@@ -102,8 +102,8 @@ mod tests {
 
     #[test]
     fn gzip_is_found_by_its_magic_bytes_whatever_the_name() {
-        let dir = std::env::temp_dir().join(format!("truenorth-src-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
+        let scratch = crate::io::scratch::scratch_dir("src");
+        let dir = scratch.path();
         let mut gz = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::fast());
         gz.write_all(b"a,b\n1,2\n").unwrap();
         let bytes = gz.finish().unwrap();
@@ -124,7 +124,6 @@ mod tests {
         assert!(e.contains("not gzip"), "{e}");
         let missing = InputPath::new(&dir.join("none.csv")).open().err().unwrap();
         assert!(missing.to_string().contains("cannot open"), "{missing}");
-        std::fs::remove_dir_all(&dir).ok();
     }
 
     #[test]
