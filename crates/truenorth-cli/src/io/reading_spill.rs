@@ -206,7 +206,7 @@ impl<const D: usize> ReadingStore<D> for SpillStore<D> {
             if self.memory.len() == self.memory.capacity() {
                 // Grow by doubling, but never past the share (a plain `push` could
                 // reserve up to twice it).
-                let want = (2 * self.memory.len()).clamp(64, self.memory_readings);
+                let want = (2 * self.memory.len()).max(64).min(self.memory_readings);
                 self.memory.reserve_exact(want - self.memory.len());
             }
             self.memory.push(reading);
@@ -301,7 +301,7 @@ mod tests {
         /// Every reading comes back, in order, in runs that are multiples of the run
         /// length but the last, whatever the memory share.
         #[test]
-        fn replays_in_order(n in 0usize..100_000, memory in 0usize..200_000) {
+        fn replays_in_order(n in 0usize..100_000, memory in prop_oneof![0usize..2_000, 0usize..200_000]) {
             let spill = ReadingSpill::new(std::env::temp_dir(), memory);
             let mut store = spill.store::<3>();
             for k in 0..n {
