@@ -85,15 +85,17 @@ pub use seed::extrema;
 
 pub use fits::ellipse::{
     Ellipse, EllipseCalibrator, EllipseConfig, MIN_POINTS_2D, fit_ellipse, fit_ellipse_direct,
+    fit_ellipse_readings,
 };
 pub use fits::ellipsoid::{
     Ellipsoid, EllipsoidCalibrator, EllipsoidConfig, MIN_POINTS_3D, fit_ellipsoid,
-    fit_ellipsoid_direct,
+    fit_ellipsoid_direct, fit_ellipsoid_readings,
 };
 pub use fits::mag_accel::{
     INITIAL_FIT_BOUND_DEG, MIN_MAG_ACCEL_READINGS, MagAccelCalibration, MagAccelCalibrator,
     MagAccelConfig, MagAccelQuality, MagAccelSample, fit_mag_accel,
 };
+pub use fits::readings::{READINGS_RUN_MULTIPLE, ReadingStore, Readings};
 pub use numerics::circumcentre::{Circumcircle, circumcircle};
 pub use online::conic_sums::{RetainedSnapshot, SumsSnapshot};
 pub use online::ellipse::{

@@ -200,6 +200,32 @@ fn damped_step<const P: usize>(ne: &NormalEquations<P>, lambda: f64) -> Option<S
     step.iter().all(|x| x.is_finite()).then_some(step)
 }
 
+/// [`minimise`] of a problem whose passes over the data can fail (readings replayed from a
+/// store): the first failure stops the evaluations (each later one is an undefined point,
+/// which costs no pass) and is the outer error; the inner result is [`minimise`]'s.
+pub(crate) fn minimise_replayed<const P: usize>(
+    what: &'static str,
+    start: SVector<f64, P>,
+    max_iterations: usize,
+    residuals: usize,
+    mut eval: impl FnMut(&SVector<f64, P>) -> Result<Option<NormalEquations<P>>>,
+) -> Result<Result<LmOutcome<P>>> {
+    let mut failed = None;
+    let out = minimise(what, start, max_iterations, residuals, |p| {
+        if failed.is_some() {
+            return None;
+        }
+        eval(p).unwrap_or_else(|e| {
+            failed = Some(e);
+            None
+        })
+    });
+    match failed {
+        Some(e) => Err(e),
+        None => Ok(out),
+    }
+}
+
 /// Minimises the cost from `start`. `eval` returns `None` where the model is undefined
 /// (e.g. a matrix became singular); such trial points are rejected like uphill ones.
 ///

@@ -8,3 +8,6 @@ pub mod ellipsoid;
 pub(crate) mod lm;
 pub mod mag_accel;
 pub(crate) mod normalise;
+pub mod readings;
+#[cfg(test)]
+mod readings_tests;

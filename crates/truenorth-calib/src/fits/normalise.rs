@@ -16,6 +16,8 @@
 use nalgebra::SVector;
 use truenorth_core::{Error, Result, check_finite};
 
+use crate::fits::readings::{Readings, replay_points};
+
 #[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 
@@ -38,40 +40,60 @@ impl<const D: usize> Normaliser<D> {
     /// `check_finite` before [`Self::of`] would. The check rides on the centroid's sum, which
     /// is finite when every point is: only a non-finite sum needs the points looked at one
     /// by one (they are then either not all finite, or so large that the sum overflowed).
-    pub fn of_finite(points: &[SVector<f64, D>], what: &'static str) -> Result<Self> {
+    /// An error replaying `points` is returned as it is.
+    pub fn of_finite<R: Readings<D> + ?Sized>(points: &R, what: &'static str) -> Result<Self> {
+        Self::of_readings(points, what)?
+    }
+
+    /// [`Self::of_finite`] with the two kinds of error apart: the outer one replaying
+    /// `points`, the inner one the refusal of the points themselves.
+    pub fn of_readings<R: Readings<D> + ?Sized>(
+        points: &R,
+        what: &'static str,
+    ) -> Result<Result<Self>> {
         if points.is_empty() {
-            return Err(Error::TooFewPoints { got: 0, need: 1 });
+            return Ok(Err(Error::TooFewPoints { got: 0, need: 1 }));
         }
         let n = points.len() as f64;
-        let sum = lane_sum(points, |p| *p);
+        let sum = lane_sum(points, |p| *p)?;
         if !sum.iter().all(|x| x.is_finite()) {
-            for &x in points.iter().flat_map(|p| p.iter()) {
-                check_finite(what, x)?;
+            let mut bad: Result<f64> = Ok(0.0);
+            replay_points(points, |p| {
+                for &x in p.iter() {
+                    if bad.is_ok() {
+                        bad = check_finite(what, x);
+                    }
+                }
+            })?;
+            if let Err(e) = bad {
+                return Ok(Err(e));
             }
         }
         let mut centre = sum / n;
         if !centre.iter().all(|x| x.is_finite()) {
             // The plain sum overflowed; the running mean does not.
             centre = SVector::zeros();
-            for (k, p) in points.iter().enumerate() {
-                centre += (p - centre) / (k as f64 + 1.0);
-            }
+            let mut k = 0.0;
+            replay_points(points, |p| {
+                k += 1.0;
+                centre += (p - centre) / k;
+            })?;
         }
         let ss = lane_sum(points, |p| {
             SVector::<f64, 1>::new((p - centre).norm_squared())
-        })[0];
+        })?[0];
         let scale = (ss / n).sqrt();
         if !(scale.is_finite() && centre.iter().all(|x| x.is_finite())) {
-            return Err(Error::Degenerate {
+            return Ok(Err(Error::Degenerate {
                 reason: "the readings are too large to fit in double precision; rescale them (e.g. to µT or gauss) first",
-            });
+            }));
         }
         if !(scale > 0.0) || scale <= f64::EPSILON * centre.amax() {
-            return Err(Error::Degenerate {
+            return Ok(Err(Error::Degenerate {
                 reason: "all readings are equal; the sensor must turn so the field direction changes",
-            });
+            }));
         }
-        Ok(Self { centre, scale })
+        Ok(Ok(Self { centre, scale }))
     }
 
     /// A point in normalised coordinates.
@@ -84,23 +106,27 @@ impl<const D: usize> Normaliser<D> {
 /// `Σ f(p)` over `points` in four interleaved partial sums added pairwise at the end: one
 /// running sum is a chain of dependent additions (several cycles each), four are not, and
 /// the result differs by rounding error only (Higham 2002, *Accuracy and Stability of
-/// Numerical Algorithms*, §4.2).
+/// Numerical Algorithms*, §4.2). The partial sums carry over from one run of the replay to
+/// the next, whose lengths are multiples of four (see [`Readings::replay`]), so a point goes
+/// to the same partial sum however the readings are cut into runs.
 #[inline]
-fn lane_sum<const D: usize, const E: usize>(
-    points: &[SVector<f64, D>],
+fn lane_sum<const D: usize, const E: usize, R: Readings<D> + ?Sized>(
+    points: &R,
     f: impl Fn(&SVector<f64, D>) -> SVector<f64, E>,
-) -> SVector<f64, E> {
+) -> Result<SVector<f64, E>> {
     let mut s = [SVector::<f64, E>::zeros(); 4];
-    let mut chunks = points.chunks_exact(4);
-    for c in &mut chunks {
-        for (sl, p) in s.iter_mut().zip(c) {
+    points.replay(&mut |run| {
+        let mut chunks = run.chunks_exact(4);
+        for c in &mut chunks {
+            for (sl, p) in s.iter_mut().zip(c) {
+                *sl += f(p);
+            }
+        }
+        for (sl, p) in s.iter_mut().zip(chunks.remainder()) {
             *sl += f(p);
         }
-    }
-    for (sl, p) in s.iter_mut().zip(chunks.remainder()) {
-        *sl += f(p);
-    }
-    (s[0] + s[2]) + (s[1] + s[3])
+    })?;
+    Ok((s[0] + s[2]) + (s[1] + s[3]))
 }
 
 #[cfg(test)]

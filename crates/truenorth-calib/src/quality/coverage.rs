@@ -8,7 +8,9 @@ use truenorth_compass::CompassCalibration2d;
 
 use super::direction_bins::{bin_if_clear, coarse_fixed, fine_bin, fine_bin_exact, fine_bin_xy};
 use super::support::{GAP_BINS, Support2d};
-use crate::numerics::blocks::{BLOCK, blocks};
+use crate::fits::readings::{Readings, replay_points};
+use crate::numerics::blocks::{BLOCK, blocks, replay_blocks};
+use truenorth_core::Result;
 
 /// Number of heading bins used for coverage (10° each).
 pub const COVERAGE_BINS: usize = 36;
@@ -114,27 +116,50 @@ pub fn coverage<'a>(
     bins.coverage()
 }
 
+/// Coverage of `readings` seen from `centre`, as [`coverage`] gives for them in one slice.
+pub(crate) fn coverage_of<R: Readings<2> + ?Sized>(
+    readings: &R,
+    centre: &Vector2<f64>,
+) -> Result<Coverage> {
+    let mut bins = AngleBins::new();
+    replay_points(readings, |p| bins.add(&(p - centre)))?;
+    Ok(bins.coverage())
+}
+
 /// Coverage of the calibrated readings `cal(p)` of `points` about the origin, with the same
 /// arithmetic as [`super::assess_2d`] (so a calibrator that refuses on it and reports
 /// [`super::assess_2d`]'s coverage sees the same bins). Non-finite readings are skipped. Allocates
 /// nothing.
 pub fn calibrated_coverage_2d(points: &[Vector2<f64>], cal: &CompassCalibration2d) -> Coverage {
-    calibrated_bins_2d(points, cal).coverage()
+    let mut bins = AngleBins::new();
+    for (p, len) in blocks(points) {
+        mark_calibrated_block(&mut bins, &p, len, cal);
+    }
+    bins.coverage()
 }
 
 /// The coverage of [`calibrated_coverage_2d`] and the support of the same directions (each
-/// 0.5° bin once; see the `support` module), from one pass.
-pub(crate) fn calibrated_directions_2d(
-    points: &[Vector2<f64>],
+/// 0.5° bin once; see the `support` module), from one pass over `readings`.
+pub(crate) fn calibrated_directions_2d<R: Readings<2> + ?Sized>(
+    readings: &R,
     cal: &CompassCalibration2d,
-) -> (Coverage, Support2d) {
-    let bins = calibrated_bins_2d(points, cal);
-    (bins.coverage(), bins.support())
+) -> Result<(Coverage, Support2d)> {
+    let mut bins = AngleBins::new();
+    replay_blocks(readings, |p, len| {
+        mark_calibrated_block(&mut bins, p, len, cal)
+    })?;
+    Ok((bins.coverage(), bins.support()))
 }
 
-/// The direction bins of the calibrated readings of [`calibrated_coverage_2d`].
-fn calibrated_bins_2d(points: &[Vector2<f64>], cal: &CompassCalibration2d) -> AngleBins {
-    let mut bins = AngleBins::new();
+/// Marks in `bins` the directions of the calibrated readings of [`calibrated_coverage_2d`]
+/// of one block (`len` points) of readings `p`.
+#[inline(always)]
+fn mark_calibrated_block(
+    bins: &mut AngleBins,
+    [px, py]: &[[f64; BLOCK]; 2],
+    len: usize,
+    cal: &CompassCalibration2d,
+) {
     let (s, c) = (&cal.soft_iron, &cal.hard_iron);
     let calibrated = |x: f64, y: f64| {
         let (dx, dy) = (x - c.x, y - c.y);
@@ -143,33 +168,30 @@ fn calibrated_bins_2d(points: &[Vector2<f64>], cal: &CompassCalibration2d) -> An
             s[(1, 0)] * dx + s[(1, 1)] * dy,
         )
     };
-    // A block of points at a time (see `crate::numerics::blocks::BLOCK`): every direction first, in a loop
-    // without branches that the compiler vectorises, then the marking, where the few
-    // directions next to a bin boundary are computed again and binned by `turns`.
+    // Every direction first, in a loop without branches that the compiler vectorises (see
+    // `crate::numerics::blocks::BLOCK`), then the marking, where the few directions next to
+    // a bin boundary are computed again and binned by `turns`.
     let mut coarse = [0u32; BLOCK];
     let mut keep = [false; BLOCK];
-    for ([px, py], len) in blocks(points) {
-        for i in 0..BLOCK {
-            let (dx, dy) = (px[i] - c.x, py[i] - c.y);
-            let (hx, hy) = (
-                s[(0, 0)] * dx + s[(0, 1)] * dy,
-                s[(1, 0)] * dx + s[(1, 1)] * dy,
-            );
-            let rho2 = hx * hx + hy * hy;
-            keep[i] = rho2 > 0.0 && rho2.is_finite();
-            coarse[i] = coarse_fixed(hy, hx);
-        }
-        for i in 0..len {
-            if keep[i] {
-                let b = bin_if_clear(coarse[i]).unwrap_or_else(|| {
-                    let (hx, hy) = calibrated(px[i], py[i]);
-                    fine_bin_exact(hy, hx)
-                });
-                bins.mark_bin(b);
-            }
+    for i in 0..BLOCK {
+        let (dx, dy) = (px[i] - c.x, py[i] - c.y);
+        let (hx, hy) = (
+            s[(0, 0)] * dx + s[(0, 1)] * dy,
+            s[(1, 0)] * dx + s[(1, 1)] * dy,
+        );
+        let rho2 = hx * hx + hy * hy;
+        keep[i] = rho2 > 0.0 && rho2.is_finite();
+        coarse[i] = coarse_fixed(hy, hx);
+    }
+    for i in 0..len {
+        if keep[i] {
+            let b = bin_if_clear(coarse[i]).unwrap_or_else(|| {
+                let (hx, hy) = calibrated(px[i], py[i]);
+                fine_bin_exact(hy, hx)
+            });
+            bins.mark_bin(b);
         }
     }
-    bins
 }
 
 #[cfg(test)]

@@ -60,8 +60,8 @@ mod tests;
 pub use arc::{ARC_END_NOISE_SIGMAS, MIN_ARC_DEG, locus_turning_rad, require_arc};
 pub use bounds::BOUND_SIGMAS;
 pub(crate) use bounds::{regressor_2d, regressor_3d};
-pub(crate) use coverage::calibrated_directions_2d;
 pub use coverage::{COVERAGE_BINS, Coverage, calibrated_coverage_2d, coverage};
+pub(crate) use coverage::{calibrated_directions_2d, coverage_of};
 pub(crate) use direction_bins::{turns, turns_in};
 pub use field::{
     FIELD_RATIO_TOLERANCE, FieldMismatch, field_mismatch, mean_corrected_norm_2d,
@@ -71,7 +71,8 @@ pub use limits::FitLimits;
 pub(crate) use pass_2d::ReportSums;
 pub use report::{Assessment2d, assess_2d, assess_3d, quality_2d};
 pub(crate) use report::{
-    Moments2, SupportFigures, assess_2d_from_moments, direction_harmonics, support_dilution_3d,
+    Moments2, SupportFigures, assess_2d_from_moments, assess_3d_of, direction_harmonics,
+    support_dilution_3d,
 };
 pub(crate) use sphere_cells::sphere_cell;
 pub use sphere_cells::{

@@ -15,9 +15,11 @@ use super::pass_2d::{ReportSums, sums_2d};
 use super::sphere_cells::sphere_cell;
 use super::support::{Support2d, Support3d, support_dilution};
 use super::uncertainty::bound_and_uncertainty;
-use crate::numerics::blocks::{BLOCK, blocks, dot_block, sum_block};
+use crate::fits::readings::Readings;
+use crate::numerics::blocks::{BLOCK, blocks, dot_block, replay_blocks, sum_block};
 use crate::numerics::linalg::{condition_from_eigenvalues, sym_eigen5, sym_eigen9};
 use crate::quality::SPHERE_CELLS;
+use truenorth_core::Result;
 
 #[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
@@ -282,18 +284,26 @@ pub fn quality_2d(
     assess_2d(points, cal, field).quality
 }
 
-/// One over the number of kept readings in each equal-area cell of the directions of
-/// `points` under `cal` (0 for an empty cell): the weights of the support.
-fn cell_weights(points: &[Vector3<f64>], cal: &CompassCalibration3d) -> [f64; SPHERE_CELLS] {
-    let mut in_cell = [0u32; SPHERE_CELLS];
-    for (p, len) in blocks(points) {
-        let b = CalibratedBlock::of(&p, len, cal);
-        for i in 0..len {
-            if b.kept[i] > 0.0 {
-                in_cell[b.cell[i] as usize] += 1;
-            }
+/// Counts in `in_cell` the kept readings of one block (`len` points) of readings `p` in
+/// each equal-area cell of their directions under `cal`.
+#[inline(always)]
+fn count_cells(
+    in_cell: &mut [u32; SPHERE_CELLS],
+    p: &[[f64; BLOCK]; 3],
+    len: usize,
+    cal: &CompassCalibration3d,
+) {
+    let b = CalibratedBlock::of(p, len, cal);
+    for i in 0..len {
+        if b.kept[i] > 0.0 {
+            in_cell[b.cell[i] as usize] += 1;
         }
     }
+}
+
+/// One over the number of kept readings in each equal-area cell (0 for an empty cell), from
+/// the counts of [`count_cells`]: the weights of the support.
+fn cell_weights(in_cell: &[u32; SPHERE_CELLS]) -> [f64; SPHERE_CELLS] {
     core::array::from_fn(|k| {
         if in_cell[k] > 0 {
             1.0 / f64::from(in_cell[k])
@@ -307,21 +317,27 @@ fn cell_weights(points: &[Vector3<f64>], cal: &CompassCalibration3d) -> [f64; SP
 /// `support` module), as [`assess_3d`] reports it in [`CompassUncertainty::dilution`], without the
 /// sums of every reading, the residuals and the bound: what a check of the geometry before
 /// a fit needs. Allocates nothing.
-pub(crate) fn support_dilution_3d(points: &[Vector3<f64>], cal: &CompassCalibration3d) -> f64 {
-    let weight = cell_weights(points, cal);
+/// An error replaying `points` is returned as it is.
+pub(crate) fn support_dilution_3d<R: Readings<3> + ?Sized>(
+    points: &R,
+    cal: &CompassCalibration3d,
+) -> Result<f64> {
+    let mut in_cell = [0u32; SPHERE_CELLS];
+    replay_blocks(points, |p, len| count_cells(&mut in_cell, p, len, cal))?;
+    let weight = cell_weights(&in_cell);
     let mut sums = [0.0; MONOMIALS_3D];
     let plan = monomial_plan_3d();
     let mut cols = [[0.0; BLOCK]; 9];
     let mut weighted = [[0.0; BLOCK]; 9];
-    for (p, len) in blocks(points) {
-        CalibratedBlock::of(&p, len, cal).monomials(&weight, &mut cols, &mut weighted);
+    replay_blocks(points, |p, len| {
+        CalibratedBlock::of(p, len, cal).monomials(&weight, &mut cols, &mut weighted);
         for (wk, &(a, c)) in sums.iter_mut().zip(&plan) {
             *wk += dot_block(&weighted[a], &cols[c]);
         }
-    }
+    })?;
     let cells = weight.iter().filter(|&&x| x > 0.0).count();
     let support = Support3d { sums, cells };
-    support_dilution(&support.information(), cells, worst_3d)
+    Ok(support_dilution(&support.information(), cells, worst_3d))
 }
 
 /// A block of readings calibrated (see `crate::numerics::blocks::BLOCK`): `h = soft_iron · (p − hard_iron)`
@@ -410,65 +426,132 @@ pub fn assess_3d(
     cal: &CompassCalibration3d,
     field: f64,
 ) -> CompassQuality {
-    let weight = cell_weights(points, cal);
-    // Sums of the squared residuals and of the monomials of `u` that make up the
-    // information matrix (see `information_3d`), plain and weighted by the cells.
-    let mut sums = [0.0; MONOMIALS_3D];
-    let mut support_sums = [0.0; MONOMIALS_3D];
-    let mut ss = 0.0;
-    let mut n = 0usize;
-    let inv_f = 1.0 / field;
-    let plan = monomial_plan_3d();
-    // A block of points at a time (see `crate::numerics::blocks::BLOCK`): first every point's direction,
-    // its products (`CalibratedBlock::monomials`) and its residual, then the sums.
-    let mut cols = [[0.0; BLOCK]; 9];
-    let mut weighted = [[0.0; BLOCK]; 9];
-    let mut r2 = [0.0; BLOCK];
+    let mut in_cell = [0u32; SPHERE_CELLS];
     for (p, len) in blocks(points) {
-        let b = CalibratedBlock::of(&p, len, cal);
-        b.monomials(&weight, &mut cols, &mut weighted);
+        count_cells(&mut in_cell, &p, len, cal);
+    }
+    let mut sums = Sums3d::new(cell_weights(&in_cell), field);
+    for (p, len) in blocks(points) {
+        sums.add_block(&p, len, cal);
+    }
+    sums.report(field)
+}
+
+/// [`assess_3d`] of readings replayed (see [`Readings`]); an error replaying them is
+/// returned as it is.
+pub(crate) fn assess_3d_of<R: Readings<3> + ?Sized>(
+    points: &R,
+    cal: &CompassCalibration3d,
+    field: f64,
+) -> Result<CompassQuality> {
+    let mut in_cell = [0u32; SPHERE_CELLS];
+    replay_blocks(points, |p, len| count_cells(&mut in_cell, p, len, cal))?;
+    let mut sums = Sums3d::new(cell_weights(&in_cell), field);
+    replay_blocks(points, |p, len| sums.add_block(p, len, cal))?;
+    Ok(sums.report(field))
+}
+
+/// The sums of [`assess_3d`]'s second pass, a block of readings at a time: of the squared
+/// residuals and of the monomials of `u` that make up the information matrix (see
+/// `information_3d`), plain and weighted by the cells.
+struct Sums3d {
+    weight: [f64; SPHERE_CELLS],
+    inv_f: f64,
+    plan: [(usize, usize); MONOMIALS_3D],
+    sums: [f64; MONOMIALS_3D],
+    support_sums: [f64; MONOMIALS_3D],
+    ss: f64,
+    n: usize,
+    // The block's columns, kept between blocks (every entry is written for each block).
+    cols: [[f64; BLOCK]; 9],
+    weighted: [[f64; BLOCK]; 9],
+    r2: [f64; BLOCK],
+}
+
+impl Sums3d {
+    fn new(weight: [f64; SPHERE_CELLS], field: f64) -> Self {
+        Self {
+            weight,
+            inv_f: 1.0 / field,
+            plan: monomial_plan_3d(),
+            sums: [0.0; MONOMIALS_3D],
+            support_sums: [0.0; MONOMIALS_3D],
+            ss: 0.0,
+            n: 0,
+            cols: [[0.0; BLOCK]; 9],
+            weighted: [[0.0; BLOCK]; 9],
+            r2: [0.0; BLOCK],
+        }
+    }
+
+    /// Adds a block (see `crate::numerics::blocks::BLOCK`): first every point's direction,
+    /// its products (`CalibratedBlock::monomials`) and its residual, then the sums.
+    #[inline(always)]
+    fn add_block(&mut self, p: &[[f64; BLOCK]; 3], len: usize, cal: &CompassCalibration3d) {
+        let Self {
+            cols, weighted, r2, ..
+        } = self;
+        let b = CalibratedBlock::of(p, len, cal);
+        b.monomials(&self.weight, cols, weighted);
         for ((sq, rho), kept) in r2.iter_mut().zip(&b.rho).zip(&b.kept) {
-            let r = rho * inv_f - 1.0;
+            let r = rho * self.inv_f - 1.0;
             *sq = if *kept > 0.0 { r * r } else { 0.0 };
         }
-        for ((sk, wk), &(a, c)) in sums.iter_mut().zip(support_sums.iter_mut()).zip(&plan) {
+        for ((sk, wk), &(a, c)) in self
+            .sums
+            .iter_mut()
+            .zip(self.support_sums.iter_mut())
+            .zip(&self.plan)
+        {
             *sk += dot_block(&cols[a], &cols[c]);
             *wk += dot_block(&weighted[a], &cols[c]);
         }
-        ss += sum_block(&r2);
-        n += sum_block(&b.kept) as usize;
+        self.ss += sum_block(r2);
+        self.n += sum_block(&b.kept) as usize;
     }
-    let support = Support3d {
-        sums: support_sums,
-        cells: weight.iter().filter(|&&x| x > 0.0).count(),
-    };
-    let info = information_3d(&sums);
-    let support_info = support.information();
-    let residual_rms_rel = if n > 0 { (ss / n as f64).sqrt() } else { 0.0 };
-    let condition = sym_eigen9(&support_info)
-        .map(|(l, _)| condition_from_eigenvalues(l.as_slice()))
-        .unwrap_or(f64::INFINITY);
-    let (bound, uncertainty) = bound_and_uncertainty(
-        &info,
-        support_dilution(&support_info, support.cells, worst_3d),
-        ss,
-        n,
-        field,
-        3,
-        worst_3d,
-    );
-    CompassQuality {
-        fit: FitQuality {
-            points: n,
-            coverage: uncertainty.efficiency(3),
-            residual_rms_rel,
-            condition,
-        },
-        heading_error_3sigma_deg: bound,
-        heading_error_systematic_deg: 0.0,
-        heading_noise_rms_deg: noise_rms_deg(ss, n, 9),
-        field_magnitude: field,
-        field_ratio_to_expected: None,
-        uncertainty,
+
+    /// The report from the sums.
+    fn report(self, field: f64) -> CompassQuality {
+        let Self {
+            weight,
+            sums,
+            support_sums,
+            ss,
+            n,
+            ..
+        } = self;
+        let support = Support3d {
+            sums: support_sums,
+            cells: weight.iter().filter(|&&x| x > 0.0).count(),
+        };
+        let info = information_3d(&sums);
+        let support_info = support.information();
+        let residual_rms_rel = if n > 0 { (ss / n as f64).sqrt() } else { 0.0 };
+        let condition = sym_eigen9(&support_info)
+            .map(|(l, _)| condition_from_eigenvalues(l.as_slice()))
+            .unwrap_or(f64::INFINITY);
+        let (bound, uncertainty) = bound_and_uncertainty(
+            &info,
+            support_dilution(&support_info, support.cells, worst_3d),
+            ss,
+            n,
+            field,
+            3,
+            worst_3d,
+        );
+        CompassQuality {
+            fit: FitQuality {
+                points: n,
+                coverage: uncertainty.efficiency(3),
+                residual_rms_rel,
+                condition,
+            },
+            heading_error_3sigma_deg: bound,
+            heading_error_systematic_deg: 0.0,
+            heading_noise_rms_deg: noise_rms_deg(ss, n, 9),
+            field_magnitude: field,
+            field_ratio_to_expected: None,
+            uncertainty,
+        }
     }
 }

@@ -19,6 +19,7 @@ use super::field::Place;
 use super::mag_unit::{MagUnit, check_field};
 use crate::io::errln;
 use crate::io::log_input;
+use crate::io::reading_spill::ReadingSpill;
 use crate::io::{
     AccelPart, CALIBRATION_FORMAT, CALIBRATION_VERSION, CalibrationFile, CliError, CliResult,
     GyroPart, InputOptions, InputPath, QualityReport, ReadSpec, Row, RowReader, check_distinct,
@@ -44,8 +45,12 @@ The input is read once, row by row, straight into the method: the online methods
 (online-ellipse, online-ellipsoid, binned-ellipse, merit-circle) and `turn` without
 `gyr_z` keep running state whose size does not depend on the file; the batch fits
 (ellipse, ellipsoid, ellipsoid-accel, turn with `gyr_z`) keep the one copy of the
-readings their fit needs (ellipse about 16 bytes per row, ellipsoid 24), nothing else. A line longer than 64 KiB, or
-a file without line breaks, is refused with its row.
+readings their fit needs (ellipse about 16 bytes per row, ellipsoid 24), nothing else.
+Ellipse and ellipsoid keep the first 32 MiB of it in memory and the rest in a temporary
+file in TMPDIR (default /tmp), removed from the directory as soon as it is made, so
+their memory stays bounded; point TMPDIR at a disk with room for a long recording (a
+full disk is an error saying so). A line longer than 64 KiB, or a file without line
+breaks, is refused with its row.
 
 `turn` with a `gyr_z` column (yaw rate, rad/s, positive turning right; needs `t_s`)
 calibrates the gyro too (EP 0640207): the record must start with the vehicle at rest for
@@ -171,14 +176,22 @@ pub fn run(args: &Args) -> CliResult {
         )));
     }
     let expected = expected_field(args, args.method.dimensions())?;
-    let fitted = match args.method.calibrator(expected).map_err(library)? {
-        CompassCalibrator::Planar(cal) => calibrate_2d(args, cal, expected)?,
-        CompassCalibrator::Spatial(cal) => calibrate_3d(args, cal, expected)?,
-        CompassCalibrator::MagAccel(cal) => calibrate_joint(args, cal)?,
+    // The batch fits keep their readings in memory up to a share, the rest in a temporary
+    // file; a disk that fails them is reported as such, not as what it made the fit say.
+    let spill = ReadingSpill::from_env();
+    let fitted = match args
+        .method
+        .calibrator_spilling(expected, &spill)
+        .map_err(library)?
+    {
+        CompassCalibrator::Planar(cal) => calibrate_2d(args, cal, expected),
+        CompassCalibrator::Spatial(cal) => calibrate_3d(args, cal, expected),
+        CompassCalibrator::MagAccel(cal) => calibrate_joint(args, cal),
         CompassCalibrator::Turn { compass, with_gyro } => {
-            calibrate_turn(args, compass, with_gyro, expected)?
+            calibrate_turn(args, compass, with_gyro, expected)
         }
     };
+    let fitted = fitted.map_err(|e| spill.take_failure().unwrap_or(e))?;
     let input = InputPath::new(&args.input).display_path();
     let warn = |w: &str| errln!("truenorth: warning: {}: {w}", input.display());
     if let Some(problem) = check_field(

@@ -47,6 +47,7 @@ mod log_rows;
 mod number_format;
 mod output_target;
 mod reader;
+pub mod reading_spill;
 mod records;
 mod row_blocks;
 #[cfg(test)]

@@ -10,6 +10,8 @@ use truenorth::calib::{
 use truenorth::compass::{CompassCalibration2d, CompassCalibration3d};
 use truenorth::core::{Calibrator, CompassQuality, Mag2Sample, Mag3Sample, Result};
 
+use crate::io::reading_spill::ReadingSpill;
+
 /// A calibrator of two-axis magnetometer readings.
 pub type Planar =
     dyn Calibrator<Sample = Mag2Sample, Params = CompassCalibration2d, Quality = CompassQuality>;
@@ -114,12 +116,37 @@ impl CalibrationMethod {
     /// fits report the fitted field against it; `ellipsoid-accel` also uses it in the fit).
     /// The seed methods take none: see [`Self::reports_expected_field`].
     pub fn calibrator(self, expected_field: Option<f64>) -> Result<CompassCalibrator> {
+        self.build(expected_field, None)
+    }
+
+    /// [`Self::calibrator`], with the batch ellipse and ellipsoid fits keeping their
+    /// readings in stores of `spill` (memory up to a share, the rest in a temporary file):
+    /// the same results in bounded memory.
+    pub fn calibrator_spilling(
+        self,
+        expected_field: Option<f64>,
+        spill: &ReadingSpill,
+    ) -> Result<CompassCalibrator> {
+        self.build(expected_field, Some(spill))
+    }
+
+    fn build(
+        self,
+        expected_field: Option<f64>,
+        spill: Option<&ReadingSpill>,
+    ) -> Result<CompassCalibrator> {
         use CompassCalibrator as C;
         Ok(match self {
-            Self::Ellipse => C::Planar(Box::new(EllipseCalibrator::new(EllipseConfig {
-                expected_field,
-                ..EllipseConfig::default()
-            })?)),
+            Self::Ellipse => {
+                let config = EllipseConfig {
+                    expected_field,
+                    ..EllipseConfig::default()
+                };
+                C::Planar(match spill {
+                    Some(s) => Box::new(EllipseCalibrator::with_store(config, s.store::<2>())?),
+                    None => Box::new(EllipseCalibrator::new(config)?),
+                })
+            }
             Self::OnlineEllipse => C::Planar(Box::new(OnlineEllipseCalibrator::new(
                 OnlineEllipseConfig {
                     expected_field,
@@ -128,10 +155,16 @@ impl CalibrationMethod {
             )?)),
             Self::BinnedEllipse => C::Planar(Box::new(BinnedEllipseCalibrator::default())),
             Self::MeritCircle => C::Planar(Box::new(MeritCircleCalibrator::default())),
-            Self::Ellipsoid => C::Spatial(Box::new(EllipsoidCalibrator::new(EllipsoidConfig {
-                expected_field,
-                ..EllipsoidConfig::default()
-            })?)),
+            Self::Ellipsoid => {
+                let config = EllipsoidConfig {
+                    expected_field,
+                    ..EllipsoidConfig::default()
+                };
+                C::Spatial(match spill {
+                    Some(s) => Box::new(EllipsoidCalibrator::with_store(config, s.store::<3>())?),
+                    None => Box::new(EllipsoidCalibrator::new(config)?),
+                })
+            }
             Self::OnlineEllipsoid => C::Spatial(Box::new(OnlineEllipsoidCalibrator::new(
                 OnlineEllipsoidConfig {
                     expected_field,

@@ -15,12 +15,18 @@ use truenorth_core::{
 use crate::quality::{self};
 
 use crate::fits::ellipse::config::EllipseConfig;
+#[cfg(doc)]
 use crate::fits::ellipse::fit::fit_ellipse;
+use crate::fits::ellipse::fit::fit_ellipse_readings;
+use crate::fits::readings::{ReadingStore, bbox_centre};
 /// Least-squares ellipse calibrator (batch): stores every reading pushed and fits them all
 /// with [`fit_ellipse`] on `solve`.
 ///
 /// Its memory grows with every push; for calibrating while driving use the online
-/// least-squares calibrator, which keeps only the fit's sums.
+/// least-squares calibrator, which keeps only the fit's sums. The readings go to a
+/// [`ReadingStore`]: a `Vec` by default ([`Self::new`]), or one of the caller's own
+/// ([`Self::with_store`]), e.g. one that keeps most of a long recording on disk; the fit
+/// is the same, bit for bit, whichever store holds them.
 ///
 /// [`Calibrator::progress`] runs the whole fit to decide `ready` (so that it agrees with
 /// `solve` exactly): it costs as much as `solve`, O(n). Call it now and then, not per sample.
@@ -43,24 +49,49 @@ use crate::fits::ellipse::fit::fit_ellipse;
 /// assert!((sol.quality.field_magnitude - 30.0).abs() < 1e-6);
 /// # Ok::<(), truenorth_core::Error>(())
 /// ```
-#[derive(Debug, Clone, Default)]
-pub struct EllipseCalibrator {
-    points: Vec<Vector2<f64>>,
+#[derive(Debug, Clone)]
+pub struct EllipseCalibrator<S = Vec<Vector2<f64>>> {
+    points: S,
     config: EllipseConfig,
 }
 
-impl EllipseCalibrator {
-    /// A calibrator with the given configuration (validated).
-    pub fn new(config: EllipseConfig) -> Result<Self> {
-        config.validate()?;
-        Ok(Self {
+/// The default configuration, readings in memory.
+impl Default for EllipseCalibrator {
+    fn default() -> Self {
+        Self {
             points: Vec::new(),
-            config,
-        })
+            config: EllipseConfig::default(),
+        }
+    }
+}
+
+impl EllipseCalibrator {
+    /// A calibrator with the given configuration (validated), keeping the readings in
+    /// memory.
+    pub fn new(config: EllipseConfig) -> Result<Self> {
+        Self::with_store(config, Vec::new())
     }
 
     /// The readings stored so far.
     pub fn points(&self) -> &[Vector2<f64>] {
+        &self.points
+    }
+}
+
+impl<S: ReadingStore<2>> EllipseCalibrator<S> {
+    /// A calibrator with the given configuration (validated) that keeps its readings in
+    /// `store` (emptied first).
+    pub fn with_store(config: EllipseConfig, mut store: S) -> Result<Self> {
+        config.validate()?;
+        store.clear();
+        Ok(Self {
+            points: store,
+            config,
+        })
+    }
+
+    /// The store holding the readings.
+    pub fn store(&self) -> &S {
         &self.points
     }
 
@@ -70,7 +101,7 @@ impl EllipseCalibrator {
     }
 }
 
-impl Calibrator for EllipseCalibrator {
+impl<S: ReadingStore<2>> Calibrator for EllipseCalibrator<S> {
     type Sample = Mag2Sample;
     type Params = CompassCalibration2d;
     type Quality = CompassQuality;
@@ -78,43 +109,30 @@ impl Calibrator for EllipseCalibrator {
     fn push(&mut self, sample: &Mag2Sample) -> Result<Pushed> {
         check_finite("timestamp t_s", sample.t_s)?;
         check_finite2("magnetometer reading", &sample.mag)?;
-        self.points.push(sample.mag);
+        self.points.push(sample.mag)?;
         Ok(Pushed::Accepted)
     }
 
     /// `ready` runs the fit (see the type's documentation); `coverage` is seen from the
     /// centre of the readings' bounding box (the centre of any full ellipse; an estimate
-    /// before the fit).
+    /// before the fit). A store that cannot replay its readings reports no coverage and not
+    /// ready.
     fn progress(&self) -> Progress {
-        let c = bbox_centre(&self.points);
-        let cov = quality::coverage(&self.points, &c);
+        let coverage = bbox_centre(&self.points)
+            .and_then(|c| quality::coverage_of(&self.points, &c))
+            .map_or(0.0, |cov| cov.fraction);
         Progress {
             samples: self.points.len(),
-            coverage: cov.fraction,
+            coverage,
             ready: self.solve().is_ok(),
         }
     }
 
     fn solve(&self) -> Result<Solution<CompassCalibration2d>> {
-        fit_ellipse(&self.points, &self.config)
+        fit_ellipse_readings(&self.points, &self.config)
     }
 
     fn reset(&mut self) {
         self.points.clear();
-    }
-}
-
-/// Centre of the axis-aligned bounding box (zero for no points).
-fn bbox_centre(points: &[Vector2<f64>]) -> Vector2<f64> {
-    let mut lo = Vector2::repeat(f64::INFINITY);
-    let mut hi = Vector2::repeat(f64::NEG_INFINITY);
-    for p in points {
-        lo = lo.inf(p);
-        hi = hi.sup(p);
-    }
-    if points.is_empty() {
-        Vector2::zeros()
-    } else {
-        (lo + hi) * 0.5
     }
 }

@@ -9,6 +9,7 @@ use truenorth_compass::CompassCalibration2d;
 use truenorth_core::{Error, Result};
 
 use crate::fits::normalise::Normaliser;
+use crate::fits::readings::{Readings, replay_points};
 use crate::numerics::linalg::{constrained_min3, sym_eigen2, sym_eigen3, sym_sqrt2};
 use crate::quality::Moments2;
 
@@ -63,8 +64,8 @@ pub fn fit_ellipse_direct(points: &[Vector2<f64>]) -> Result<Ellipse> {
 
 /// Refuses too few or non-finite points, normalises, checks for collinear data, fits.
 /// Returns the normaliser and the ellipse in normalised coordinates.
-pub(crate) fn direct_normalised(
-    points: &[Vector2<f64>],
+pub(crate) fn direct_normalised<R: Readings<2> + ?Sized>(
+    points: &R,
     max_axis_ratio: f64,
 ) -> Result<(Normaliser<2>, Ellipse, Moments2)> {
     if points.len() < MIN_POINTS_2D {
@@ -74,7 +75,7 @@ pub(crate) fn direct_normalised(
         });
     }
     let norm = Normaliser::of_finite(points, "magnetometer reading")?;
-    let (s, cov, table) = moments(points, &norm);
+    let (s, cov, table) = moments(points, &norm)?;
     // Collinear: the spread across the best line is nil compared with the spread along it
     // (the trace of `cov` is 1 after normalisation).
     let (l, _) = sym_eigen2(&cov).ok_or(Error::Degenerate {
@@ -92,17 +93,17 @@ pub(crate) fn direct_normalised(
 /// The moments `Σ qqᵀ`-style sums the direct fit needs, in normalised coordinates: the
 /// 6×6 scatter matrix of `(x², xy, y², x, y, 1)`, the 2×2 covariance, and the same sums as
 /// a table `Σ xⁱ yʲ` for the quality report.
-fn moments(
-    points: &[Vector2<f64>],
+fn moments<R: Readings<2> + ?Sized>(
+    points: &R,
     norm: &Normaliser<2>,
-) -> (SMatrix<f64, 6, 6>, Matrix2<f64>, Moments2) {
+) -> Result<(SMatrix<f64, 6, 6>, Matrix2<f64>, Moments2)> {
     // The 15 distinct monomials of degree ≤ 4, accumulated separately so the loop is plain
     // arithmetic (the 10k-point benchmark lives here).
     let (mut x4, mut x3y, mut x2y2, mut xy3, mut y4) = (0.0, 0.0, 0.0, 0.0, 0.0);
     let (mut x3, mut x2y, mut xy2, mut y3) = (0.0, 0.0, 0.0, 0.0);
     let (mut x2, mut xy, mut y2, mut sx, mut sy) = (0.0, 0.0, 0.0, 0.0, 0.0);
     let inv = 1.0 / norm.scale;
-    for p in points {
+    replay_points(points, |p| {
         let x = (p.x - norm.centre.x) * inv;
         let y = (p.y - norm.centre.y) * inv;
         let (xx, xyv, yy) = (x * x, x * y, y * y);
@@ -120,7 +121,7 @@ fn moments(
         y2 += yy;
         sx += x;
         sy += y;
-    }
+    })?;
     let n = points.len() as f64;
     #[rustfmt::skip]
     let s = SMatrix::<f64, 6, 6>::from_row_slice(&[
@@ -137,7 +138,7 @@ fn moments(
     table[2][..3].copy_from_slice(&[x2, x2y, x2y2]);
     table[3][..2].copy_from_slice(&[x3, x3y]);
     table[4][0] = x4;
-    (s, Matrix2::new(x2, xy, xy, y2) / n, table)
+    Ok((s, Matrix2::new(x2, xy, xy, y2) / n, table))
 }
 
 /// Halíř & Flusser (1998): split the scatter matrix into the quadratic (`S1`), mixed (`S2`)

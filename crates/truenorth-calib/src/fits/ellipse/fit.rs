@@ -50,7 +50,8 @@ use truenorth_core::{Error, Result, Solution, Validate};
 
 use crate::fits::lm::{self, NormalAccumulator, NormalEquations};
 use crate::fits::normalise::Normaliser;
-use crate::numerics::blocks::{BLOCK, blocks};
+use crate::fits::readings::{Readings, replay_points};
+use crate::numerics::blocks::{BLOCK, replay_blocks};
 use crate::numerics::linalg::{sym_eigen2, sym_sqrt2};
 use crate::quality::{self, Assessment2d, BOUND_SIGMAS, Moments2};
 
@@ -81,6 +82,17 @@ pub(crate) fn sampson_normal_equations(
     norm: &Normaliser<2>,
     p: &SVector<f64, 5>,
 ) -> Option<NormalEquations<5>> {
+    // A slice replays without failing.
+    sampson_normal_equations_of(points, norm, p).unwrap_or(None)
+}
+
+/// [`sampson_normal_equations`] of readings replayed (see [`Readings`]); an error replaying
+/// them is the `Err`.
+fn sampson_normal_equations_of<R: Readings<2> + ?Sized>(
+    points: &R,
+    norm: &Normaliser<2>,
+    p: &SVector<f64, 5>,
+) -> Result<Option<NormalEquations<5>>> {
     let (cx, cy) = (p[0], p[1]);
     let b = Matrix2::new(p[2], p[3], p[3], p[4]);
     let a = b * b;
@@ -90,7 +102,7 @@ pub(crate) fn sampson_normal_equations(
     let mut acc = NormalAccumulator::<5, 6>::new();
     // A block of points at a time (see `BLOCK`): first every point's gradient row and
     // residual, then the sums.
-    for ([qx, qy], len) in blocks(points) {
+    replay_blocks(points, |[qx, qy], len| {
         let [j0, j1, j2, j3, j4, res] = &mut acc.cols;
         for i in 0..BLOCK {
             let vx = (qx[i] - mx) * inv - cx;
@@ -116,8 +128,10 @@ pub(crate) fn sampson_normal_equations(
             res[i] = if keep { r } else { 0.0 };
         }
         acc.add_block();
-    }
-    acc.finish()?.reparametrised(&square_jacobian(&b))
+    })?;
+    Ok(acc
+        .finish()
+        .and_then(|ne| ne.reparametrised(&square_jacobian(&b))))
 }
 
 /// `∂(c, A)/∂(c, B)` for `A = B²`, `B` symmetric, from the parameters
@@ -148,9 +162,21 @@ pub fn fit_ellipse(
     points: &[Vector2<f64>],
     config: &EllipseConfig,
 ) -> Result<Solution<CompassCalibration2d>> {
+    fit_ellipse_readings(points, config)
+}
+
+/// [`fit_ellipse`] of readings replayed from wherever they are kept (see [`Readings`]): the
+/// same result, bit for bit, as of the same readings in one slice. An error replaying them
+/// is returned as it is.
+pub fn fit_ellipse_readings<R: Readings<2> + ?Sized>(
+    points: &R,
+    config: &EllipseConfig,
+) -> Result<Solution<CompassCalibration2d>> {
     config.validate()?;
-    let mut sol =
-        fit_unchecked(points, config).map_err(|e| explain_short_arc(points, config, e))?;
+    let mut sol = match fit_unchecked(points, config) {
+        Ok(sol) => sol,
+        Err(e) => return Err(explain_short_arc(points, config, e)?),
+    };
     sol.quality = quality::with_expected_field(sol.quality, config.expected_field);
     Ok(sol)
 }
@@ -158,45 +184,56 @@ pub fn fit_ellipse(
 /// A fit that failed on a short arc is better explained by the arc than by the symptom
 /// (a hyperbola, a refinement that wanders along a flat valley): if the readings span
 /// less than the minimum arc seen from their best-fitting circle, say so instead.
-fn explain_short_arc(points: &[Vector2<f64>], config: &EllipseConfig, e: Error) -> Error {
+/// An error replaying the readings is returned as the `Err`.
+fn explain_short_arc<R: Readings<2> + ?Sized>(
+    points: &R,
+    config: &EllipseConfig,
+    e: Error,
+) -> Result<Error> {
     if !matches!(
         e,
         Error::NotAnEllipse { .. } | Error::NoConvergence { .. } | Error::Degenerate { .. }
     ) {
-        return e;
+        return Ok(e);
     }
-    match circle_centre(points) {
+    Ok(match circle_centre(points)? {
         Some(c) => {
-            let cov = quality::coverage(points, &c);
+            let cov = quality::coverage_of(points, &c)?;
             quality::require_arc(&cov, 0.0, config.min_arc_deg)
                 .err()
                 .unwrap_or(e)
         }
         None => e,
-    }
+    })
 }
 
 /// Centre of the algebraic best-fitting circle `x² + y² + D x + E y + F = 0` (Kåsa 1976),
 /// a linear least-squares problem that any three non-collinear points determine. Used only
 /// to measure the arc when the ellipse fit fails.
-fn circle_centre(points: &[Vector2<f64>]) -> Option<Vector2<f64>> {
-    let norm = Normaliser::of(points).ok()?;
+/// An error replaying the readings is the `Err`; `Ok(None)` when there is no such circle.
+fn circle_centre<R: Readings<2> + ?Sized>(points: &R) -> Result<Option<Vector2<f64>>> {
+    let Ok(norm) = Normaliser::of_readings(points, "point")? else {
+        return Ok(None);
+    };
     let mut a = Matrix3::zeros();
     let mut rhs = Vector3::zeros();
-    for p in points {
+    replay_points(points, |p| {
         let q = norm.apply(p);
         let row = Vector3::new(q.x, q.y, 1.0);
         a += row * row.transpose();
         rhs -= row * q.norm_squared();
-    }
-    let sol = a.cholesky()?.solve(&rhs);
+    })?;
+    let Some(chol) = a.cholesky() else {
+        return Ok(None);
+    };
+    let sol = chol.solve(&rhs);
     let c = Vector2::new(-0.5 * sol[0], -0.5 * sol[1]);
     let c = norm.centre + c * norm.scale;
-    c.iter().all(|x| x.is_finite()).then_some(c)
+    Ok(c.iter().all(|x| x.is_finite()).then_some(c))
 }
 
-fn fit_unchecked(
-    points: &[Vector2<f64>],
+fn fit_unchecked<R: Readings<2> + ?Sized>(
+    points: &R,
     config: &EllipseConfig,
 ) -> Result<Solution<CompassCalibration2d>> {
     let (norm, direct, moments) = direct_normalised(points, config.limits.max_axis_ratio)?;
@@ -210,48 +247,66 @@ fn fit_unchecked(
             need: MIN_POINTS_JUDGED_2D,
         });
     }
-    // The report of an ellipse (in normalised coordinates) from the moments the direct fit
-    // already has, and one pass for the coverage.
-    let assess = |e: &Ellipse| -> Result<(CompassCalibration2d, Assessment2d)> {
+    // The calibration of an ellipse (in normalised coordinates), refused when not finite,
+    // and its report from the moments the direct fit already has, and one pass for the
+    // coverage.
+    let calibration = |e: &Ellipse| -> Result<(CompassCalibration2d, f64)> {
         let (cal, field) = denormalise(&norm, e).calibration();
         if !(field.is_finite() && field > 0.0 && cal.soft_iron.iter().all(|x| x.is_finite())) {
             return Err(Error::Degenerate {
                 reason: "the fitted ellipse is not finite; check the input scale",
             });
         }
-        let directions = quality::calibrated_directions_2d(points, &cal);
-        let a = quality::assess_2d_from_moments(
+        Ok((cal, field))
+    };
+    let report = |e: &Ellipse, cal: &CompassCalibration2d, field: f64| -> Result<Assessment2d> {
+        let directions = quality::calibrated_directions_2d(points, cal)?;
+        Ok(quality::assess_2d_from_moments(
             &moments,
             points.len(),
             &e.centre,
             &e.unit_map,
             directions,
             field,
-        );
-        Ok((cal, a))
+        ))
     };
-    let (mut cal, mut a) = assess(&direct)?;
-    if config.refine && refinement_could_matter(&moments, &direct, &a) {
-        let out = lm::minimise(
-            "ellipse geometric refinement",
-            to_params(&direct),
-            config.max_iterations,
-            points.len(),
-            |p| sampson_normal_equations(points, &norm, p),
-        )?;
-        let e = from_params(&out.params);
-        // |B v| depends on B only through B², so take the positive-definite root of B²
-        // (the refinement may have flipped the sign of B).
-        let unit_map = sym_sqrt2(&(e.unit_map * e.unit_map)).ok_or(Error::Degenerate {
-            reason: "the refined ellipse collapsed to a line; record a fuller turn",
-        })?;
-        let e = Ellipse {
-            centre: e.centre,
-            unit_map,
-        };
-        check_axis_ratio(&e, config.limits.max_axis_ratio)?;
-        (cal, a) = assess(&e)?;
-    }
+    let (direct_cal, direct_field) = calibration(&direct)?;
+    // Where the refinement runs whatever the direct fit's report says, that report would go
+    // unread: its pass over the readings is skipped.
+    let direct_report = if config.refine && surely_refined(&moments, points.len(), &direct) {
+        None
+    } else {
+        Some(report(&direct, &direct_cal, direct_field)?)
+    };
+    let refined = match &direct_report {
+        Some(a) => config.refine && refinement_could_matter(&moments, &direct, a),
+        None => true,
+    };
+    let (cal, a) = match direct_report {
+        Some(a) if !refined => (direct_cal, a),
+        _ => {
+            let out = lm::minimise_replayed(
+                "ellipse geometric refinement",
+                to_params(&direct),
+                config.max_iterations,
+                points.len(),
+                |p| sampson_normal_equations_of(points, &norm, p),
+            )??;
+            let e = from_params(&out.params);
+            // |B v| depends on B only through B², so take the positive-definite root of B²
+            // (the refinement may have flipped the sign of B).
+            let unit_map = sym_sqrt2(&(e.unit_map * e.unit_map)).ok_or(Error::Degenerate {
+                reason: "the refined ellipse collapsed to a line; record a fuller turn",
+            })?;
+            let e = Ellipse {
+                centre: e.centre,
+                unit_map,
+            };
+            check_axis_ratio(&e, config.limits.max_axis_ratio)?;
+            let (cal, field) = calibration(&e)?;
+            (cal, report(&e, &cal, field)?)
+        }
+    };
     quality::require_arc(
         &a.coverage,
         a.quality.heading_noise_rms_deg.to_radians(),
@@ -318,15 +373,10 @@ const MAX_UNEVENNESS_UNREFINED: f64 = 0.1;
 /// readings.
 fn refinement_could_matter(m: &Moments2, e: &Ellipse, a: &Assessment2d) -> bool {
     let q = &a.quality;
-    if q.fit.points <= 5 {
+    if surely_refined(m, q.fit.points, e) {
         return true;
     }
-    // Every quantity here is a rotation invariant of the readings (no heading bins), so
-    // rotating the input never changes the choice.
     let (h1, h2) = quality::direction_harmonics(m, q.fit.points, &e.centre, &e.unit_map);
-    if !(h1 + h2 <= MAX_UNEVENNESS_UNREFINED) {
-        return true;
-    }
     let sigma = q.heading_noise_rms_deg.to_radians();
     let s = (q.heading_error_3sigma_deg / BOUND_SIGMAS).to_radians();
     let Some((l, _)) = sym_eigen2(&(e.unit_map * e.unit_map)) else {
@@ -336,4 +386,18 @@ fn refinement_could_matter(m: &Moments2, e: &Ellipse, a: &Assessment2d) -> bool 
     let bias = 4.0 * sigma * sigma * (kappa + h1 + h2);
     let step = (bias * bias + 0.5 * kappa * kappa * s * s).sqrt();
     !(step <= SKIPPED_STEP_SHARE_OF_BOUND * BOUND_SIGMAS * s)
+}
+
+/// The part of [`refinement_could_matter`] that needs no report: whether the refinement runs
+/// whatever the direct fit's bound, for `n` readings with moments `m` and the direct fit
+/// `e` (too few readings to judge it, or readings spread too unevenly round the circle for
+/// the perturbation argument).
+fn surely_refined(m: &Moments2, n: usize, e: &Ellipse) -> bool {
+    if n <= 5 {
+        return true;
+    }
+    // Every quantity here is a rotation invariant of the readings (no heading bins), so
+    // rotating the input never changes the choice.
+    let (h1, h2) = quality::direction_harmonics(m, n, &e.centre, &e.unit_map);
+    !(h1 + h2 <= MAX_UNEVENNESS_UNREFINED)
 }

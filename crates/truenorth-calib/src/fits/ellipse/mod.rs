@@ -12,4 +12,4 @@ mod tests;
 pub use calibrator::EllipseCalibrator;
 pub use config::{EllipseConfig, MIN_POINTS_2D};
 pub use direct::{Ellipse, fit_ellipse_direct};
-pub use fit::fit_ellipse;
+pub use fit::{fit_ellipse, fit_ellipse_readings};

@@ -8,7 +8,8 @@ use truenorth_compass::CompassCalibration3d;
 use truenorth_core::{Error, Result};
 
 use crate::fits::normalise::Normaliser;
-use crate::numerics::blocks::{BLOCK, blocks, dot_block};
+use crate::fits::readings::Readings;
+use crate::numerics::blocks::{BLOCK, dot_block, replay_blocks};
 use crate::numerics::linalg::{constrained_min6, sym_eigen3, sym_eigen6, sym_sqrt3};
 
 use crate::fits::ellipsoid::config::MIN_POINTS_3D;
@@ -59,8 +60,8 @@ pub fn fit_ellipsoid_direct(points: &[Vector3<f64>]) -> Result<Ellipsoid> {
     Ok(denormalise(&norm, &e))
 }
 
-pub(crate) fn direct_normalised(
-    points: &[Vector3<f64>],
+pub(crate) fn direct_normalised<R: Readings<3> + ?Sized>(
+    points: &R,
     max_axis_ratio: f64,
 ) -> Result<(Normaliser<3>, Ellipsoid)> {
     if points.len() < MIN_POINTS_3D {
@@ -70,7 +71,7 @@ pub(crate) fn direct_normalised(
         });
     }
     let norm = Normaliser::of_finite(points, "magnetometer reading")?;
-    let (s, cov) = moments(points, &norm);
+    let (s, cov) = moments(points, &norm)?;
     let (l, _) = sym_eigen3(&cov).ok_or(Error::Degenerate {
         reason: "the readings could not be analysed",
     })?;
@@ -126,10 +127,10 @@ fn moment_pairs() -> ([[u8; 3]; 35], [(usize, usize); 35]) {
 
 /// The 10×10 scatter matrix of `(x², y², z², 2yz, 2xz, 2xy, 2x, 2y, 2z, 1)` and the 3×3
 /// covariance, in normalised coordinates.
-pub(crate) fn moments(
-    points: &[Vector3<f64>],
+pub(crate) fn moments<R: Readings<3> + ?Sized>(
+    points: &R,
     norm: &Normaliser<3>,
-) -> (SMatrix<f64, 10, 10>, Matrix3<f64>) {
+) -> Result<(SMatrix<f64, 10, 10>, Matrix3<f64>)> {
     // The scatter matrix has 55 distinct entries but only 35 distinct values up to the
     // factors of 2 (the sums of the monomials of degree ≤ 4): sum those, a block of points
     // at a time (see `BLOCK`), and multiply the factors in afterwards (exactly: they are
@@ -139,7 +140,7 @@ pub(crate) fn moments(
     let inv = 1.0 / norm.scale;
     let c = norm.centre;
     let mut t = [[0.0; BLOCK]; 10];
-    for ([x, y, z], len) in blocks(points) {
+    replay_blocks(points, |[x, y, z], len| {
         for i in 0..BLOCK {
             // Rows past the end of the data are zeros, which add nothing.
             let live = i < len;
@@ -165,7 +166,7 @@ pub(crate) fn moments(
         for (sk, &(a, b)) in sums.iter_mut().zip(&pairs) {
             *sk += dot_block(&t[a], &t[b]);
         }
-    }
+    })?;
     let mut s = SMatrix::<f64, 10, 10>::zeros();
     for a in 0..TERMS.len() {
         for b in a..TERMS.len() {
@@ -177,7 +178,7 @@ pub(crate) fn moments(
         }
     }
     let cov = second_moments(&s, points.len() as f64);
-    (s, cov)
+    Ok((s, cov))
 }
 
 /// `Σ qqᵀ / weight` from the scatter's quadratic moments in the constant term's column:

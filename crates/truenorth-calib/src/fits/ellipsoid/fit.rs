@@ -41,7 +41,8 @@ use truenorth_core::{Error, Result, Solution, Validate};
 
 use crate::fits::lm::{self, NormalAccumulator, NormalEquations};
 use crate::fits::normalise::Normaliser;
-use crate::numerics::blocks::{BLOCK, blocks};
+use crate::fits::readings::{Readings, bbox_centre, replay_points};
+use crate::numerics::blocks::{BLOCK, replay_blocks};
 use crate::numerics::linalg::sym_sqrt3;
 use crate::quality::{self, CompassUncertainty};
 
@@ -68,11 +69,23 @@ use truenorth_core::Float as _;
 /// `∂r/∂A_kl = v_k v_l/ρ` (`v_k²/(2ρ)` on the diagonal). The chain rule through `A = B²`, a
 /// linear map of the parameter changes that is the same for every point, then gives the
 /// normal equations in the refinement's parameters `(c, B)` (see [`square_jacobian`]).
+#[cfg(test)]
 pub(crate) fn radial_normal_equations(
     points: &[Vector3<f64>],
     norm: &Normaliser<3>,
     p: &SVector<f64, 9>,
 ) -> Option<NormalEquations<9>> {
+    // A slice replays without failing.
+    radial_normal_equations_of(points, norm, p).unwrap_or(None)
+}
+
+/// [`radial_normal_equations`] of readings replayed (see [`Readings`]); an error replaying
+/// them is the `Err`.
+fn radial_normal_equations_of<R: Readings<3> + ?Sized>(
+    points: &R,
+    norm: &Normaliser<3>,
+    p: &SVector<f64, 9>,
+) -> Result<Option<NormalEquations<9>>> {
     let e = from_params(p);
     let (c, b) = (e.centre, e.unit_map);
     let a = b * b;
@@ -82,7 +95,7 @@ pub(crate) fn radial_normal_equations(
     let mut acc = NormalAccumulator::<9, 10>::new();
     // A block of points at a time (see `BLOCK`): first every point's gradient row and
     // residual, then the sums.
-    for ([qx, qy, qz], len) in blocks(points) {
+    replay_blocks(points, |[qx, qy, qz], len| {
         let cols = &mut acc.cols;
         for i in 0..BLOCK {
             let v = [
@@ -111,8 +124,10 @@ pub(crate) fn radial_normal_equations(
             cols[9][i] = if keep { rho - 1.0 } else { 0.0 };
         }
         acc.add_block();
-    }
-    acc.finish()?.reparametrised(&square_jacobian(&b))
+    })?;
+    Ok(acc
+        .finish()
+        .and_then(|ne| ne.reparametrised(&square_jacobian(&b))))
 }
 
 /// `∂(c, A)/∂(c, B)` for `A = B²`, `B` symmetric, in the parameter order of [`to_params`]:
@@ -139,31 +154,45 @@ pub fn fit_ellipsoid(
     points: &[Vector3<f64>],
     config: &EllipsoidConfig,
 ) -> Result<Solution<CompassCalibration3d>> {
+    fit_ellipsoid_readings(points, config)
+}
+
+/// [`fit_ellipsoid`] of readings replayed from wherever they are kept (see [`Readings`]):
+/// the same result, bit for bit, as of the same readings in one slice. An error replaying
+/// them is returned as it is.
+pub fn fit_ellipsoid_readings<R: Readings<3> + ?Sized>(
+    points: &R,
+    config: &EllipsoidConfig,
+) -> Result<Solution<CompassCalibration3d>> {
     config.validate()?;
     let mut sol = fit_unchecked(points, config)?;
     sol.quality = quality::with_expected_field(sol.quality, config.expected_field);
     Ok(sol)
 }
 
-fn fit_unchecked(
-    points: &[Vector3<f64>],
+fn fit_unchecked<R: Readings<3> + ?Sized>(
+    points: &R,
     config: &EllipsoidConfig,
 ) -> Result<Solution<CompassCalibration3d>> {
-    if points.len() >= MIN_POINTS_3D && points.iter().all(|p| p.iter().all(|x| x.is_finite())) {
+    let mut all_finite = true;
+    if points.len() >= MIN_POINTS_3D {
+        replay_points(points, |p| all_finite &= p.iter().all(|x| x.is_finite()))?;
+    }
+    if points.len() >= MIN_POINTS_3D && all_finite {
         // Before fitting, seen from the bounding-box centre (the centre of any complete
         // ellipsoid) without a soft iron, so that a single-axis turn or a small patch of
         // orientations is refused for what it is rather than for a failed fit. Those
         // directions are distorted by the soft iron and by a centre a few shots place
         // roughly, which can raise the dilution a few times: the bound is taken
         // PRE_FIT_SLACK times looser here, and exactly after the fit.
-        let centre = bbox_centre(points);
+        let centre = bbox_centre(points)?;
         let raw = CompassCalibration3d {
             hard_iron: centre,
             soft_iron: Matrix3::identity(),
         };
         // Only the dilution is judged here; the fit's own figures come after it.
         let pre = CompassUncertainty {
-            dilution: quality::support_dilution_3d(points, &raw),
+            dilution: quality::support_dilution_3d(points, &raw)?,
             ..CompassUncertainty::UNDETERMINED
         };
         quality::require_determined(
@@ -180,7 +209,11 @@ fn fit_unchecked(
     // fall without end towards an ever larger ellipsoid (found by `tests/more_data.rs`: a
     // cap of orientations at 8 % noise with a long dwell).
     let e = if config.refine {
-        refine(points, &norm, &direct, config).unwrap_or(direct)
+        match refine(points, &norm, &direct, config) {
+            Ok(e) => e,
+            Err(Refusal::Replay(e)) => return Err(e),
+            Err(Refusal::Fit) => direct,
+        }
     } else {
         direct
     };
@@ -190,7 +223,7 @@ fn fit_unchecked(
             reason: "the fitted ellipsoid is not finite; check the input scale",
         });
     }
-    let q = quality::assess_3d(points, &cal, field);
+    let q = quality::assess_3d_of(points, &cal, field)?;
     quality::require_determined(
         &q.uncertainty,
         3,
@@ -222,43 +255,38 @@ fn fit_unchecked(
     })
 }
 
+/// Why [`refine`] gave no ellipsoid: the refinement failed (the direct fit then stands), or
+/// the readings could not be replayed (the whole fit fails).
+enum Refusal {
+    /// It did not converge, collapsed to a plane or ended flatter than any plausible soft iron.
+    Fit,
+    /// The readings could not be replayed.
+    Replay(Error),
+}
+
 /// Step 5 of the module documentation: the geometric refinement of the direct fit `direct`
 /// (normalised coordinates).
-fn refine(
-    points: &[Vector3<f64>],
+fn refine<R: Readings<3> + ?Sized>(
+    points: &R,
     norm: &Normaliser<3>,
     direct: &Ellipsoid,
     config: &EllipsoidConfig,
-) -> Result<Ellipsoid> {
-    let out = lm::minimise(
+) -> core::result::Result<Ellipsoid, Refusal> {
+    let out = lm::minimise_replayed(
         "ellipsoid geometric refinement",
         to_params(direct),
         config.max_iterations,
         points.len(),
-        |p| radial_normal_equations(points, norm, p),
-    )?;
+        |p| radial_normal_equations_of(points, norm, p),
+    )
+    .map_err(Refusal::Replay)?
+    .map_err(|_| Refusal::Fit)?;
     let e = from_params(&out.params);
-    let unit_map = sym_sqrt3(&(e.unit_map * e.unit_map)).ok_or(Error::Degenerate {
-        reason: "the refined ellipsoid collapsed to a plane; tumble the sensor through more orientations",
-    })?;
+    let unit_map = sym_sqrt3(&(e.unit_map * e.unit_map)).ok_or(Refusal::Fit)?;
     let e = Ellipsoid {
         centre: e.centre,
         unit_map,
     };
-    check_axis_ratio(&e, config.limits.max_axis_ratio)?;
+    check_axis_ratio(&e, config.limits.max_axis_ratio).map_err(|_| Refusal::Fit)?;
     Ok(e)
-}
-
-pub(crate) fn bbox_centre(points: &[Vector3<f64>]) -> Vector3<f64> {
-    let mut lo = Vector3::repeat(f64::INFINITY);
-    let mut hi = Vector3::repeat(f64::NEG_INFINITY);
-    for p in points {
-        lo = lo.inf(p);
-        hi = hi.sup(p);
-    }
-    if points.is_empty() {
-        Vector3::zeros()
-    } else {
-        (lo + hi) * 0.5
-    }
 }

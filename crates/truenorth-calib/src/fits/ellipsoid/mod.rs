@@ -13,4 +13,4 @@ mod tests;
 pub use calibrator::EllipsoidCalibrator;
 pub use config::{EllipsoidConfig, MIN_POINTS_3D};
 pub use direct::{Ellipsoid, fit_ellipsoid_direct};
-pub use fit::fit_ellipsoid;
+pub use fit::{fit_ellipsoid, fit_ellipsoid_readings};

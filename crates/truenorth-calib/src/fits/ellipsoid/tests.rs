@@ -99,7 +99,7 @@ fn normal_equations_through_b_squared_match_direct_rows() {
 fn moments_match_outer_products() {
     let (pts, _, _) = distorted(75);
     let norm = Normaliser::of(&pts).unwrap();
-    let (s, cov) = moments(&pts, &norm);
+    let (s, cov) = moments(&pts, &norm).unwrap();
     let mut reference = SMatrix::<f64, 10, 10>::zeros();
     for p in &pts {
         let q = norm.apply(p);

@@ -1,0 +1,347 @@
+//! A store for the readings of a batch fit that keeps the first of them in memory and the
+//! rest in an anonymous temporary file, so that a calibration's memory stays bounded
+//! whatever the length of the recording (as `sort(1)` spills to disk).
+//!
+//! The fits pass over the readings several times; the store replays them in the order they
+//! came, in runs whose lengths are multiples of [`READINGS_RUN_MULTIPLE`], so the fit is the
+//! same, bit for bit, as with every reading in memory (see
+//! [`Readings`]). The file is created in the temporary directory
+//! (`std::env::temp_dir()`: `TMPDIR` on Unix) under a fresh name and removed from the
+//! directory at once: the open file lives on until the process ends, and nothing is left
+//! behind however it ends (killed included). It is made only once the readings outgrow
+//! the memory share, so a short recording never touches the disk.
+//!
+//! A write or a read that fails (a full disk, an unwritable directory) is one error line
+//! naming the directory and saying to point `TMPDIR` at a disk with room: the store keeps
+//! the first such failure in the [`ReadingSpill`] it came from, for the command to report
+//! in place of the library's error (the library's [`truenorth::core::Error`] has no variant for an I/O
+//! failure; the store hands it [`truenorth::core::Error::Unsupported`] to stop the fit).
+
+use std::cell::RefCell;
+use std::fs::{File, OpenOptions};
+use std::io::{self, Write};
+use std::path::PathBuf;
+use std::rc::Rc;
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use nalgebra::SVector;
+use truenorth::calib::{READINGS_RUN_MULTIPLE, ReadingStore, Readings};
+use truenorth::core::{Error, Result};
+
+use super::CliError;
+
+/// Memory the readings of one fit may take before the rest go to the temporary file.
+pub const SPILL_MEMORY_BYTES: usize = 32 << 20;
+
+/// Environment variable that overrides [`SPILL_MEMORY_BYTES`] (bytes), for tests that need a
+/// recording to spill without writing a large file.
+pub const SPILL_MEMORY_ENV: &str = "TRUENORTH_TEST_SPILL_MEMORY_BYTES";
+
+/// Readings per chunk of the file: written a chunk at a time and read back a chunk at a
+/// time into one buffer (a multiple of [`READINGS_RUN_MULTIPLE`]).
+const CHUNK_READINGS: usize = 1 << 15;
+
+/// The reason the store gives the library when the disk fails it (the command reports the
+/// failure kept in [`ReadingSpill`] instead).
+const STOPPED: Error = Error::Unsupported {
+    reason: "the readings kept in a temporary file could not be written or read back; set TMPDIR to a directory on a disk with room",
+};
+
+/// Where the stores of one command spill, how much they keep in memory, and the first
+/// failure any of them met.
+#[derive(Debug, Clone)]
+pub struct ReadingSpill {
+    dir: PathBuf,
+    memory_bytes: usize,
+    failure: Rc<RefCell<Option<String>>>,
+}
+
+impl ReadingSpill {
+    /// Spilling to the temporary directory past [`SPILL_MEMORY_BYTES`] (or the bytes in
+    /// [`SPILL_MEMORY_ENV`], when set to a number).
+    pub fn from_env() -> Self {
+        let memory_bytes = std::env::var(SPILL_MEMORY_ENV)
+            .ok()
+            .and_then(|v| v.trim().parse().ok())
+            .unwrap_or(SPILL_MEMORY_BYTES);
+        Self::new(std::env::temp_dir(), memory_bytes)
+    }
+
+    /// Spilling to `dir` past `memory_bytes` of readings.
+    pub fn new(dir: PathBuf, memory_bytes: usize) -> Self {
+        Self {
+            dir,
+            memory_bytes,
+            failure: Rc::new(RefCell::new(None)),
+        }
+    }
+
+    /// An empty store of `D`-dimensional readings.
+    pub fn store<const D: usize>(&self) -> SpillStore<D> {
+        let per_reading = D * size_of::<f64>();
+        let fit = self.memory_bytes / per_reading.max(1);
+        SpillStore {
+            spill: self.clone(),
+            memory: Vec::new(),
+            memory_readings: fit - fit % READINGS_RUN_MULTIPLE,
+            file: None,
+            on_disk: 0,
+            pending: Vec::new(),
+            bytes: RefCell::new(Vec::new()),
+            chunk: RefCell::new(Vec::new()),
+        }
+    }
+
+    /// The first failure of a store, as the command's error line (taken: a second call
+    /// gives `None`).
+    pub fn take_failure(&self) -> Option<CliError> {
+        self.failure.borrow_mut().take().map(CliError::msg)
+    }
+
+    /// Keeps the first failure, `doing` what on which error.
+    fn fail(&self, doing: &str, e: &io::Error) -> Error {
+        let mut failure = self.failure.borrow_mut();
+        if failure.is_none() {
+            *failure = Some(format!(
+                "cannot {doing} the readings kept for the fit in a temporary file in {}: {e}; set TMPDIR to a directory on a disk with room",
+                self.dir.display()
+            ));
+        }
+        STOPPED
+    }
+}
+
+/// Readings in memory up to a share, the rest in an anonymous temporary file (see the
+/// module documentation).
+#[derive(Debug)]
+pub struct SpillStore<const D: usize> {
+    spill: ReadingSpill,
+    /// The first readings (at most `memory_readings`).
+    memory: Vec<SVector<f64, D>>,
+    /// How many readings stay in memory: a multiple of [`READINGS_RUN_MULTIPLE`].
+    memory_readings: usize,
+    /// The file, once the memory share is full.
+    file: Option<File>,
+    /// Readings written to the file (whole chunks).
+    on_disk: usize,
+    /// Readings after the memory share not yet written (less than a chunk).
+    pending: Vec<SVector<f64, D>>,
+    /// The bytes of one chunk, written or read.
+    bytes: RefCell<Vec<u8>>,
+    /// One chunk read back.
+    chunk: RefCell<Vec<SVector<f64, D>>>,
+}
+
+impl<const D: usize> SpillStore<D> {
+    /// Whether the readings went beyond memory.
+    pub fn spilled(&self) -> bool {
+        self.on_disk > 0 || !self.pending.is_empty()
+    }
+
+    /// Writes the pending chunk to the file (made on the first chunk).
+    fn write_pending(&mut self) -> io::Result<()> {
+        let file = match &mut self.file {
+            Some(f) => f,
+            None => self.file.insert(anonymous_file(&self.spill.dir)?),
+        };
+        let mut bytes = self.bytes.borrow_mut();
+        bytes.clear();
+        for p in &self.pending {
+            for x in p.iter() {
+                bytes.extend_from_slice(&x.to_le_bytes());
+            }
+        }
+        file.write_all(&bytes)?;
+        self.on_disk += self.pending.len();
+        self.pending.clear();
+        Ok(())
+    }
+
+    /// Reads back chunk `k` of the file into `chunk`.
+    fn read_chunk(&self, k: usize, chunk: &mut Vec<SVector<f64, D>>) -> io::Result<()> {
+        let Some(file) = &self.file else {
+            return Err(io::Error::other("the temporary file is missing"));
+        };
+        let per_reading = D * size_of::<f64>();
+        let mut bytes = self.bytes.borrow_mut();
+        bytes.resize(CHUNK_READINGS * per_reading, 0);
+        read_exact_at(file, &mut bytes, (k * CHUNK_READINGS * per_reading) as u64)?;
+        chunk.clear();
+        for r in bytes.chunks_exact(per_reading) {
+            chunk.push(SVector::from_fn(|d, _| {
+                let mut x = [0; 8];
+                x.copy_from_slice(&r[8 * d..8 * d + 8]);
+                f64::from_le_bytes(x)
+            }));
+        }
+        Ok(())
+    }
+}
+
+impl<const D: usize> Readings<D> for SpillStore<D> {
+    fn len(&self) -> usize {
+        self.memory.len() + self.on_disk + self.pending.len()
+    }
+
+    fn replay(&self, run: &mut dyn FnMut(&[SVector<f64, D>])) -> Result<()> {
+        if !self.memory.is_empty() {
+            run(&self.memory);
+        }
+        let mut chunk = self.chunk.borrow_mut();
+        for k in 0..self.on_disk / CHUNK_READINGS {
+            self.read_chunk(k, &mut chunk)
+                .map_err(|e| self.spill.fail("read back", &e))?;
+            run(&chunk);
+        }
+        if !self.pending.is_empty() {
+            run(&self.pending);
+        }
+        Ok(())
+    }
+}
+
+impl<const D: usize> ReadingStore<D> for SpillStore<D> {
+    fn push(&mut self, reading: SVector<f64, D>) -> Result<()> {
+        if self.memory.len() < self.memory_readings {
+            if self.memory.len() == self.memory.capacity() {
+                // Grow by doubling, but never past the share (a plain `push` could
+                // reserve up to twice it).
+                let want = (2 * self.memory.len()).max(64).min(self.memory_readings);
+                self.memory.reserve_exact(want - self.memory.len());
+            }
+            self.memory.push(reading);
+            return Ok(());
+        }
+        if self.pending.capacity() == 0 {
+            self.pending.reserve_exact(CHUNK_READINGS);
+        }
+        self.pending.push(reading);
+        if self.pending.len() == CHUNK_READINGS {
+            self.write_pending()
+                .map_err(|e| self.spill.fail("write", &e))?;
+        }
+        Ok(())
+    }
+
+    fn clear(&mut self) {
+        self.memory = Vec::new();
+        self.pending = Vec::new();
+        // A new file for the next readings; this one goes with its handle.
+        self.file = None;
+        self.on_disk = 0;
+    }
+}
+
+/// A new file in `dir`, open for reading and writing, already removed from the directory.
+fn anonymous_file(dir: &std::path::Path) -> io::Result<File> {
+    static COUNT: AtomicU64 = AtomicU64::new(0);
+    let nanos = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| d.subsec_nanos());
+    for _ in 0..16 {
+        let name = format!(
+            ".truenorth-readings-{}-{nanos:08x}-{}",
+            std::process::id(),
+            COUNT.fetch_add(1, Ordering::Relaxed)
+        );
+        let path = dir.join(name);
+        let mut options = OpenOptions::new();
+        options.read(true).write(true).create_new(true);
+        #[cfg(unix)]
+        std::os::unix::fs::OpenOptionsExt::mode(&mut options, 0o600);
+        match options.open(&path) {
+            Ok(file) => {
+                // Gone from the directory at once; the open handle keeps the data (on
+                // systems that refuse to remove an open file, it stays until the end).
+                let _ = std::fs::remove_file(&path);
+                return Ok(file);
+            }
+            Err(e) if e.kind() == io::ErrorKind::AlreadyExists => continue,
+            Err(e) => return Err(e),
+        }
+    }
+    Err(io::Error::new(
+        io::ErrorKind::AlreadyExists,
+        "no free temporary file name",
+    ))
+}
+
+/// Reads `buf.len()` bytes of `file` at `offset`, without moving its cursor.
+#[cfg(unix)]
+fn read_exact_at(file: &File, buf: &mut [u8], offset: u64) -> io::Result<()> {
+    std::os::unix::fs::FileExt::read_exact_at(file, buf, offset)
+}
+
+/// Reads `buf.len()` bytes of `file` at `offset`.
+#[cfg(windows)]
+fn read_exact_at(file: &File, mut buf: &mut [u8], mut offset: u64) -> io::Result<()> {
+    while !buf.is_empty() {
+        match std::os::windows::fs::FileExt::seek_read(file, buf, offset) {
+            Ok(0) => return Err(io::ErrorKind::UnexpectedEof.into()),
+            Ok(n) => {
+                buf = &mut buf[n..];
+                offset += n as u64;
+            }
+            Err(e) if e.kind() == io::ErrorKind::Interrupted => {}
+            Err(e) => return Err(e),
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::Vector3;
+    use proptest::prelude::*;
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(32))]
+
+        /// Every reading comes back, in order, in runs that are multiples of the run
+        /// length but the last, whatever the memory share.
+        #[test]
+        fn replays_in_order(n in 0usize..100_000, memory in prop_oneof![0usize..2_000, 0usize..200_000]) {
+            let spill = ReadingSpill::new(std::env::temp_dir(), memory);
+            let mut store = spill.store::<3>();
+            for k in 0..n {
+                let x = k as f64;
+                store.push(Vector3::new(x, -x, 0.5 * x)).unwrap();
+            }
+            prop_assert_eq!(Readings::len(&store), n);
+            let mut seen = 0usize;
+            let mut last_short = false;
+            store
+                .replay(&mut |run| {
+                    assert!(!last_short, "a short run before the last");
+                    last_short = run.len() % READINGS_RUN_MULTIPLE != 0;
+                    for p in run {
+                        let x = seen as f64;
+                        assert_eq!(*p, Vector3::new(x, -x, 0.5 * x));
+                        seen += 1;
+                    }
+                })
+                .unwrap();
+            prop_assert_eq!(seen, n);
+            prop_assert!(spill.take_failure().is_none());
+        }
+    }
+
+    #[test]
+    fn an_unwritable_directory_is_one_error_naming_it() {
+        let dir = std::env::temp_dir().join("truenorth-no-such-directory-for-readings");
+        let spill = ReadingSpill::new(dir.clone(), 0);
+        let mut store = spill.store::<2>();
+        let mut result = Ok(());
+        for _ in 0..CHUNK_READINGS {
+            result = store.push(SVector::<f64, 2>::new(1.0, 2.0));
+            if result.is_err() {
+                break;
+            }
+        }
+        assert_eq!(result, Err(STOPPED));
+        let e = spill.take_failure().unwrap().to_string();
+        assert!(e.contains(&dir.display().to_string()), "{e}");
+        assert!(e.contains("TMPDIR"), "{e}");
+    }
+}
