@@ -309,6 +309,11 @@ mod tests {
                 store.push(Vector3::new(x, -x, 0.5 * x)).unwrap();
             }
             prop_assert_eq!(Readings::len(&store), n);
+            // The memory held is bounded whatever `n`: the share (at least one block of
+            // 64 readings) and one chunk of the file, never more.
+            let per_reading = size_of::<Vector3<f64>>();
+            prop_assert!(store.memory.capacity() <= (memory / per_reading).max(64));
+            prop_assert!(store.pending.capacity() <= CHUNK_READINGS);
             let mut seen = 0usize;
             let mut last_short = false;
             store
