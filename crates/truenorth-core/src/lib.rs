@@ -32,6 +32,7 @@ pub mod compass_quality;
 mod error;
 mod estimator;
 pub mod extended_float;
+mod fixed;
 mod heading;
 mod heading_source;
 mod inertial_calibration;
@@ -56,6 +57,7 @@ pub use estimator::{
     AttitudeEstimate, AttitudeStatus, HeadingEstimator, NavEstimate, NavStatus,
     OrientationEstimator, Unobserved,
 };
+pub use fixed::Fixed;
 pub use heading::{Declination, MagneticHeading, TrueHeading};
 pub use heading_source::{
     AbsoluteHeading, AbsoluteHeadingSource, RelativeHeadingSource, RelativeStep,

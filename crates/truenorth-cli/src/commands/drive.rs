@@ -5,7 +5,7 @@
 use std::path::{Path, PathBuf};
 
 use nalgebra::Vector2;
-use truenorth::core::{NavEstimate, VehicleSample, rad_to_deg};
+use truenorth::core::{Fixed, NavEstimate, VehicleSample, rad_to_deg};
 use truenorth::fusion::vehicle::VehicleCalibration;
 use truenorth::fusion::{SensorPriors, VehicleConfig, VehicleEstimator};
 use truenorth::odometer::OdometerWheels;
@@ -438,8 +438,8 @@ fn summary(
         "magnetic north"
     };
     let mut line = format!(
-        "truenorth drive: {samples} rows → {written}, {:.0} m, heading {reference}",
-        e.distance_m
+        "truenorth drive: {samples} rows → {written}, {} m, heading {reference}",
+        Fixed(e.distance_m, 0)
     );
     if !e.status.position_known {
         line += " (no wheels: no position)";

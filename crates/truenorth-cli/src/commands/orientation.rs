@@ -4,7 +4,9 @@
 use std::path::PathBuf;
 
 use nalgebra::{UnitQuaternion, Vector3};
-use truenorth::core::{AttitudeEstimate, Axes, EulerZyx, ImuSample, ned_to_enu, rad_to_deg};
+use truenorth::core::{
+    AttitudeEstimate, Axes, EulerZyx, Fixed, ImuSample, Precise, ned_to_enu, rad_to_deg,
+};
 
 use super::mag_unit::{MagUnit, check_field};
 use crate::io::errln;
@@ -480,7 +482,13 @@ fn gap_summary(input: &std::path::Path, gaps: &[(usize, f64, f64)], count: usize
     let listed: Vec<String> = gaps
         .iter()
         .take(GAPS_LISTED)
-        .map(|(row, t, gap)| format!("row {row} (t_s {t}, after {gap:.3} s)"))
+        .map(|(row, t, gap)| {
+            format!(
+                "row {row} (t_s {}, after {} s)",
+                Precise(*t),
+                Fixed(*gap, 3)
+            )
+        })
         .collect();
     let more = match count.saturating_sub(GAPS_LISTED) {
         0 => String::new(),
