@@ -1,7 +1,7 @@
 //! The workspace error type. Each variant says what was wrong and what to do about it, so that
 //! a calibration that cannot be trusted is refused with a reason instead of returned silently.
 
-use crate::Fixed;
+use crate::{Fixed, Precise, Readable};
 use thiserror::Error;
 
 /// "by up to X°" for an angle that a first-order figure can give, "by any angle" beyond half
@@ -34,84 +34,6 @@ impl core::fmt::Display for NetOfNoise {
         } else {
             Ok(())
         }
-    }
-}
-
-/// A number as a message shows it: integers and everyday magnitudes in plain decimals with
-/// at most six significant digits, very large or very small ones in exponent form (`1e308`,
-/// not 309 digits), so that a range or a rejected value reads at a glance.
-pub struct Readable(pub f64);
-
-impl core::fmt::Display for Readable {
-    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        let (v, a) = (self.0, self.0.abs());
-        if !v.is_finite() || v == 0.0 {
-            return write!(f, "{v}");
-        }
-        let mut buf = [0u8; 48];
-        let mut w = SliceWriter {
-            buf: &mut buf,
-            len: 0,
-        };
-        if (1e-3..1e6).contains(&a) {
-            // Six significant digits: as many decimals as the integer part leaves.
-            let mut digits = 0usize;
-            let mut x = a;
-            while x >= 1.0 {
-                x /= 10.0;
-                digits += 1;
-            }
-            let decimals = if digits == 0 { 8 } else { 6 - digits };
-            core::fmt::write(&mut w, format_args!("{v:.decimals$}"))?;
-        } else {
-            core::fmt::write(&mut w, format_args!("{v:.3e}"))?;
-        }
-        let len = w.len;
-        let text = core::str::from_utf8(&buf[..len]).map_err(|_| core::fmt::Error)?;
-        let (mantissa, exponent) = match text.find('e') {
-            Some(i) => text.split_at(i),
-            None => (text, ""),
-        };
-        let mantissa = if mantissa.contains('.') {
-            mantissa.trim_end_matches('0').trim_end_matches('.')
-        } else {
-            mantissa
-        };
-        f.write_str(mantissa)?;
-        f.write_str(exponent)
-    }
-}
-
-/// A number as a message shows it when every digit may matter (a timestamp that names the
-/// row, a gap): its shortest form that reads back exactly, in plain decimals for everyday
-/// magnitudes (`17664.399999999998`, as `{}` shows it) and in exponent form outside them
-/// (`1e308`, `5e-324`), where plain decimals would run to hundreds of digits.
-pub struct Precise(pub f64);
-
-impl core::fmt::Display for Precise {
-    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        let (v, a) = (self.0, self.0.abs());
-        if !v.is_finite() || v == 0.0 || (1e-4..1e15).contains(&a) {
-            write!(f, "{v}")
-        } else {
-            write!(f, "{v:e}")
-        }
-    }
-}
-
-/// A `core::fmt::Write` into a fixed buffer (the crate is `no_std`).
-struct SliceWriter<'a> {
-    buf: &'a mut [u8],
-    len: usize,
-}
-
-impl core::fmt::Write for SliceWriter<'_> {
-    fn write_str(&mut self, s: &str) -> core::fmt::Result {
-        let end = self.len + s.len();
-        let dest = self.buf.get_mut(self.len..end).ok_or(core::fmt::Error)?;
-        dest.copy_from_slice(s.as_bytes());
-        self.len = end;
-        Ok(())
     }
 }
 

@@ -32,10 +32,10 @@ pub mod compass_quality;
 mod error;
 mod estimator;
 pub mod extended_float;
-mod fixed;
 mod heading;
 mod heading_source;
 mod inertial_calibration;
+mod message_numbers;
 mod noise;
 mod persist;
 mod real;
@@ -52,17 +52,17 @@ pub use calibrator::{
     Solution,
 };
 pub use compass_quality::{CompassQuality, CompassUncertainty};
-pub use error::{Error, Precise, Readable};
+pub use error::Error;
 pub use estimator::{
     AttitudeEstimate, AttitudeStatus, HeadingEstimator, NavEstimate, NavStatus,
     OrientationEstimator, Unobserved,
 };
-pub use fixed::Fixed;
 pub use heading::{Declination, MagneticHeading, TrueHeading};
 pub use heading_source::{
     AbsoluteHeading, AbsoluteHeadingSource, RelativeHeadingSource, RelativeStep,
 };
 pub use inertial_calibration::{InertialCalibration, axis_calibrated};
+pub use message_numbers::{Fixed, Precise, Readable};
 pub use noise::{NoiseSource, SplitMix64, ZeroNoise};
 pub use persist::{Persistent, Snapshot, check_snapshot_version};
 pub use real::Real;
