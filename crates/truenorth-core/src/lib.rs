@@ -39,6 +39,7 @@ mod message_numbers;
 mod noise;
 mod persist;
 mod real;
+mod refusal;
 mod sample;
 mod sensor_model;
 mod units;

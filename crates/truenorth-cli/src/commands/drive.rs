@@ -301,12 +301,13 @@ fn build_method(
         priors: Some(priors),
         ..VehicleConfig::default()
     };
-    let bad_config = |e: truenorth::core::Error| CliError::file(&args.vehicle, e.to_string());
+    let bad_config =
+        |e: truenorth::core::Error| CliError::file(&args.vehicle, e.to_string()).kind_of(&e);
     let fused = match &args.calibration_in {
         Some(path) => {
             let learned = read_learned(path)?;
             VehicleEstimator::with_calibration(config, &learned)
-                .map_err(|e| CliError::file(path, e.to_string()))?
+                .map_err(|e| CliError::file(path, e.to_string()).kind_of(&e))?
         }
         None => VehicleEstimator::new(config).map_err(bad_config)?,
     };
@@ -402,7 +403,7 @@ fn estimate(
         let sample = columns.sample(row, &path)?;
         method
             .push(&sample, &mut |e, filter| writer.write(e, filter))
-            .map_err(|e| CliError::row(&path, row.number, e.to_string()))?;
+            .map_err(|e| CliError::row(&path, row.number, e.to_string()).kind_of(&e))?;
         if let Some(e) = writer.error.take() {
             return Err(e);
         }
@@ -410,7 +411,7 @@ fn estimate(
     }
     method
         .finish(&mut |e, filter| writer.write(e, filter))
-        .map_err(|e| CliError::file(&path, e.to_string()))?;
+        .map_err(|e| CliError::file(&path, e.to_string()).kind_of(&e))?;
     if let Some(e) = writer.error.take() {
         return Err(e);
     }

@@ -184,7 +184,7 @@ pub fn run(args: &Args) -> CliResult {
     let mut method = args
         .method
         .pipeline(!args.no_mag, args.gyro_timing)
-        .map_err(|e| CliError::msg(e.to_string()))?;
+        .map_err(CliError::from)?;
     let mut header: Vec<&str> = HEADER.to_vec();
     if args.status {
         header.extend(STATUS_HEADER);
@@ -399,7 +399,7 @@ impl Estimation {
         // Row k + 2: the data rows counted after the header.
         let est = method
             .update(sample)
-            .map_err(|e| CliError::row(&self.input, k + 2, e.to_string()))?
+            .map_err(|e| CliError::row(&self.input, k + 2, e.to_string()).kind_of(&e))?
             .estimate;
         if est.status.gap {
             let since = self.previous_t.map_or(0.0, |p| sample.t_s - p);
