@@ -12,7 +12,10 @@
 //!   density changes which reading that is, not what it is; the one way density entered was
 //!   the readings close to the initial origin (which lies on the locus), whose directions are
 //!   their noise's: a dense start filled every bin with them. Readings within five noise σ of
-//!   the origin are not binned, at any density.
+//!   the origin are not binned, at any density. And each full-set update merges a few
+//!   readings (re-binning about the moved origin), so the updates must come per angle turned:
+//!   a bin's readings count towards the next update only up to a cap per update, which a
+//!   dense recording's readings dithering across a bin's edge reach as a sparse one's do.
 //! - `merit-circle`, `turn`: they follow the locus reading by reading and judge the arc it
 //!   turned through and the scatter about their circle, neither of which grows with the
 //!   number of readings along the same path.
@@ -83,32 +86,34 @@ proptest! {
     }
 }
 
-/// The recording of `scripts/io_speed.sh` (a tilted ellipse with uniform noise of ±0.5 on a
-/// field of about 30), at 20 and at 2 000 readings per degree: every 2-D
-/// calibrator that accepts the first accepts the second.
+/// `turns` turns of the recording of `scripts/io_speed.sh` (a tilted ellipse with uniform
+/// noise of ±0.5 on a field of about 30) at `per_deg` readings per degree.
+fn io_speed_ellipse(turns: f64, per_deg: f64) -> Vec<Mag2Sample> {
+    let mut rng = SplitMix64::new(1);
+    let n = (360.0 * turns * per_deg) as usize;
+    (0..n)
+        .map(|k| {
+            let a = (k as f64 / per_deg).to_radians();
+            let mut u = || rng.uniform() - 0.5;
+            let mag = Vector2::new(
+                20.0 + 31.0 * a.cos() + 2.0 * a.sin() + u(),
+                -10.0 + 4.0 * a.cos() + 27.0 * a.sin() + u(),
+            );
+            Mag2Sample {
+                t_s: 0.01 * k as f64,
+                mag,
+            }
+        })
+        .collect()
+}
+
+/// The `io_speed` ellipse at 20 and at 2 000 readings per degree: every 2-D calibrator that
+/// accepts the first accepts the second.
 #[test]
 fn the_io_speed_ellipse_is_accepted_at_any_density() {
-    let ellipse = |turns: f64, per_deg: f64| -> Vec<Mag2Sample> {
-        let mut rng = SplitMix64::new(1);
-        let n = (360.0 * turns * per_deg) as usize;
-        (0..n)
-            .map(|k| {
-                let a = (k as f64 / per_deg).to_radians();
-                let mut u = || rng.uniform() - 0.5;
-                let mag = Vector2::new(
-                    20.0 + 31.0 * a.cos() + 2.0 * a.sin() + u(),
-                    -10.0 + 4.0 * a.cos() + 27.0 * a.sin() + u(),
-                );
-                Mag2Sample {
-                    t_s: 0.01 * k as f64,
-                    mag,
-                }
-            })
-            .collect()
-    };
-    // One and a half turns and two (the script writes ten). A single dense turn is still
-    // refused by the binned ellipse (187° of measured turning against the 200° needed).
-    for turns in [1.5, 2.0] {
+    let ellipse = io_speed_ellipse;
+    // One turn, one and a half and two (the script writes ten).
+    for turns in [1.0, 1.5, 2.0] {
         let (sparse, dense) = (ellipse(turns, 20.0), ellipse(turns, 2000.0));
         for (which, name) in NAMES_2D.iter().enumerate() {
             let s = solve_2d(which, &sparse);
@@ -119,4 +124,36 @@ fn the_io_speed_ellipse_is_accepted_at_any_density() {
             }
         }
     }
+}
+
+/// One turn of the `io_speed` ellipse, swept from 2 to 2 000 readings per degree: once the
+/// binned ellipse accepts it, it accepts every denser sampling of it. (Counting a bin's
+/// readings towards the next update per run of readings in a row, it accepted up to 200
+/// per degree and refused from 500, for 185° of measured turning: the readings dithering
+/// across each bin's edge ran 318 updates in the turn instead of 4–8, and each re-binning
+/// merged readings until 27 of 64 bins were left.)
+#[test]
+fn one_turn_of_the_binned_ellipse_is_accepted_at_every_denser_sampling() {
+    let binned = NAMES_2D
+        .iter()
+        .position(|&n| n == "binned-ellipse")
+        .unwrap_or(2);
+    let mut accepted_at = None;
+    for per_deg in [
+        2.0, 5.0, 10.0, 20.0, 50.0, 100.0, 200.0, 500.0, 1000.0, 2000.0,
+    ] {
+        let verdict = solve_2d(binned, &io_speed_ellipse(1.0, per_deg));
+        match (accepted_at, &verdict) {
+            (None, Ok(())) => accepted_at = Some(per_deg),
+            (Some(first), Err(e)) => {
+                panic!("accepted at {first}/°, refused at {per_deg}/°: {e}")
+            }
+            _ => {}
+        }
+    }
+    assert_eq!(
+        accepted_at,
+        Some(2.0),
+        "one full turn is accepted when sparse"
+    );
 }

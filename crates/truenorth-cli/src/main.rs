@@ -87,6 +87,18 @@ fn main() -> ExitCode {
             batch::child::STATS_PREFIX,
             io::rows_read()
         ));
+        // And whether an error refused the data or failed, where the code that made it
+        // said (the batch judges by the message's words otherwise).
+        if let Err(io::CliError {
+            kind: Some(kind), ..
+        }) = &result
+        {
+            io::write_stderr(format_args!(
+                "{}{}\n",
+                batch::child::KIND_PREFIX,
+                kind.name()
+            ));
+        }
     }
     match result {
         Ok(()) => ExitCode::SUCCESS,

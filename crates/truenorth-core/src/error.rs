@@ -1,6 +1,7 @@
 //! The workspace error type. Each variant says what was wrong and what to do about it, so that
 //! a calibration that cannot be trusted is refused with a reason instead of returned silently.
 
+use crate::{Fixed, Precise, Readable};
 use thiserror::Error;
 
 /// "by up to X°" for an angle that a first-order figure can give, "by any angle" beyond half
@@ -10,7 +11,7 @@ struct UpTo(f64);
 impl core::fmt::Display for UpTo {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         if self.0 <= 180.0 {
-            write!(f, "by up to {:.1}°", self.0)
+            write!(f, "by up to {}°", Fixed(self.0, 1))
         } else {
             f.write_str("by any angle (the first-order figure exceeds 180°)")
         }
@@ -26,91 +27,13 @@ impl core::fmt::Display for NetOfNoise {
         if self.1 > 0.0 {
             write!(
                 f,
-                ", {:.0}° once the noise of the readings at its two ends ({:.0}°) is allowed for",
-                (self.0 - self.1).max(0.0),
-                self.1
+                ", {}° once the noise of the readings at its two ends ({}°) is allowed for",
+                Fixed((self.0 - self.1).max(0.0), 0),
+                Fixed(self.1, 0)
             )
         } else {
             Ok(())
         }
-    }
-}
-
-/// A number as a message shows it: integers and everyday magnitudes in plain decimals with
-/// at most six significant digits, very large or very small ones in exponent form (`1e308`,
-/// not 309 digits), so that a range or a rejected value reads at a glance.
-pub struct Readable(pub f64);
-
-impl core::fmt::Display for Readable {
-    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        let (v, a) = (self.0, self.0.abs());
-        if !v.is_finite() || v == 0.0 {
-            return write!(f, "{v}");
-        }
-        let mut buf = [0u8; 48];
-        let mut w = SliceWriter {
-            buf: &mut buf,
-            len: 0,
-        };
-        if (1e-3..1e6).contains(&a) {
-            // Six significant digits: as many decimals as the integer part leaves.
-            let mut digits = 0usize;
-            let mut x = a;
-            while x >= 1.0 {
-                x /= 10.0;
-                digits += 1;
-            }
-            let decimals = if digits == 0 { 8 } else { 6 - digits };
-            core::fmt::write(&mut w, format_args!("{v:.decimals$}"))?;
-        } else {
-            core::fmt::write(&mut w, format_args!("{v:.3e}"))?;
-        }
-        let len = w.len;
-        let text = core::str::from_utf8(&buf[..len]).map_err(|_| core::fmt::Error)?;
-        let (mantissa, exponent) = match text.find('e') {
-            Some(i) => text.split_at(i),
-            None => (text, ""),
-        };
-        let mantissa = if mantissa.contains('.') {
-            mantissa.trim_end_matches('0').trim_end_matches('.')
-        } else {
-            mantissa
-        };
-        f.write_str(mantissa)?;
-        f.write_str(exponent)
-    }
-}
-
-/// A number as a message shows it when every digit may matter (a timestamp that names the
-/// row, a gap): its shortest form that reads back exactly, in plain decimals for everyday
-/// magnitudes (`17664.399999999998`, as `{}` shows it) and in exponent form outside them
-/// (`1e308`, `5e-324`), where plain decimals would run to hundreds of digits.
-pub struct Precise(pub f64);
-
-impl core::fmt::Display for Precise {
-    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        let (v, a) = (self.0, self.0.abs());
-        if !v.is_finite() || v == 0.0 || (1e-4..1e15).contains(&a) {
-            write!(f, "{v}")
-        } else {
-            write!(f, "{v:e}")
-        }
-    }
-}
-
-/// A `core::fmt::Write` into a fixed buffer (the crate is `no_std`).
-struct SliceWriter<'a> {
-    buf: &'a mut [u8],
-    len: usize,
-}
-
-impl core::fmt::Write for SliceWriter<'_> {
-    fn write_str(&mut self, s: &str) -> core::fmt::Result {
-        let end = self.len + s.len();
-        let dest = self.buf.get_mut(self.len..end).ok_or(core::fmt::Error)?;
-        dest.copy_from_slice(s.as_bytes());
-        self.len = end;
-        Ok(())
     }
 }
 
@@ -121,7 +44,7 @@ impl core::fmt::Write for SliceWriter<'_> {
 #[non_exhaustive]
 pub enum Error {
     /// A value that must be finite was NaN or infinite.
-    #[error("{what} is not finite ({value}); every input value must be a finite number")]
+    #[error("{what} is not finite ({}); every input value must be a finite number", Precise(*value))]
     NonFinite {
         /// Which quantity.
         what: &'static str,
@@ -193,8 +116,10 @@ pub enum Error {
     },
     /// The samples cover too little of a turn to determine a calibration.
     #[error(
-        "the samples cover only {covered_deg:.0}° of heading{}, need at least {need_deg:.0}°; turn further (a full circle is best) before solving",
-        NetOfNoise(*covered_deg, *noise_deg)
+        "the samples cover only {}° of heading{}, need at least {}°; turn further (a full circle is best) before solving",
+        Fixed(*covered_deg, 0),
+        NetOfNoise(*covered_deg, *noise_deg),
+        Fixed(*need_deg, 0)
     )]
     InsufficientCoverage {
         /// Heading span covered, degrees: between the outermost readings.
@@ -208,9 +133,9 @@ pub enum Error {
     },
     /// The orientations seen cover too little of the sphere to determine a 3-D calibration.
     #[error(
-        "the orientations fill only {:.0} % of the sphere's direction cells, need at least {:.0} %; tumble the sensor through more orientations (turns about three axes)",
-        100.0 * covered_fraction,
-        100.0 * need_fraction
+        "the orientations fill only {} % of the sphere's direction cells, need at least {} %; tumble the sensor through more orientations (turns about three axes)",
+        Fixed(100.0 * covered_fraction, 0),
+        Fixed(100.0 * need_fraction, 0)
     )]
     InsufficientSphereCoverage {
         /// Share of direction cells with data, in [0, 1].
@@ -220,7 +145,9 @@ pub enum Error {
     },
     /// A turn-based method saw less than one full revolution.
     #[error(
-        "the turn covered only {turned_deg:.0}°, need at least {need_deg:.0}°; drive a complete circle"
+        "the turn covered only {}°, need at least {}°; drive a complete circle",
+        Fixed(*turned_deg, 0),
+        Fixed(*need_deg, 0)
     )]
     IncompleteTurn {
         /// Heading change seen, degrees.
@@ -238,8 +165,10 @@ pub enum Error {
     /// The orientations seen do not determine a calibration, however many readings were
     /// taken in them: a geometric property of the directions, not of their number or noise.
     #[error(
-        "the orientations seen do not determine the calibration: their dilution is {dilution:.1} (an evenly covered {even_shape} has {even_dilution:.1}), so an error of {:.1} % of the field per reading could turn the result {}, more than the {}° accepted; more readings in the same orientations will not help: {hint}",
-        100.0 * model_error_rel,
+        "the orientations seen do not determine the calibration: their dilution is {} (an evenly covered {even_shape} has {}), so an error of {} % of the field per reading could turn the result {}, more than the {}° accepted; more readings in the same orientations will not help: {hint}",
+        Fixed(*dilution, 1),
+        Fixed(*even_dilution, 1),
+        Fixed(100.0 * model_error_rel, 1),
         UpTo(*error_deg),
         Precise(*max_deg)
     )]
@@ -264,8 +193,10 @@ pub enum Error {
     /// The readings are too noisy for the orientations they were taken in: the fit is
     /// outside the range where its own error figures hold.
     #[error(
-        "each reading scatters {:.1} % of the field about the fit and the orientations' dilution is {dilution:.1}: their product, {product:.2}, exceeds the {} within which a least-squares calibration's error figures hold (beyond it the fit can drift along what the orientations leave loose, and more readings do not stop it); record orientations that determine the calibration better (a fuller tumble: an evenly covered sphere has a dilution of 3.7) or use a quieter sensor",
-        100.0 * noise_rel,
+        "each reading scatters {} % of the field about the fit and the orientations' dilution is {}: their product, {}, exceeds the {} within which a least-squares calibration's error figures hold (beyond it the fit can drift along what the orientations leave loose, and more readings do not stop it); record orientations that determine the calibration better (a fuller tumble: an evenly covered sphere has a dilution of 3.7) or use a quieter sensor",
+        Fixed(100.0 * noise_rel, 1),
+        Fixed(*dilution, 1),
+        Fixed(*product, 2),
         Precise(*max_product)
     )]
     TooNoisyForOrientations {
@@ -280,9 +211,10 @@ pub enum Error {
     },
     /// The calibration's own uncertainty is too large for the readings' noise and number.
     #[error(
-        "the calibration itself could err by up to {bound_deg:.2}° (3 sigma{widened}), more than the {}° accepted: {points} readings with a noise of {:.2} % of the field each are too few for the orientations they cover; the error falls as 1/sqrt(readings), so record more readings, or turn (tumble) through more orientations",
+        "the calibration itself could err by up to {}° (3 sigma{widened}), more than the {}° accepted: {points} readings with a noise of {} % of the field each are too few for the orientations they cover; the error falls as 1/sqrt(readings), so record more readings, or turn (tumble) through more orientations",
+        Fixed(*bound_deg, 2),
         Precise(*max_deg),
-        100.0 * noise_rel
+        Fixed(100.0 * noise_rel, 2)
     )]
     TooUncertain {
         /// The 3σ heading-error bound the refusal judged, degrees.
@@ -323,8 +255,10 @@ pub enum Error {
     },
     /// A date outside the validity of a geomagnetic model.
     #[error(
-        "date {} is outside the model's validity {valid_from}–{valid_to}; use a model for that epoch or opt in to extrapolation",
-        Precise(*year)
+        "date {} is outside the model's validity {}–{}; use a model for that epoch or opt in to extrapolation",
+        Precise(*year),
+        Precise(*valid_from),
+        Precise(*valid_to)
     )]
     DateOutOfRange {
         /// Requested decimal year.
@@ -379,6 +313,7 @@ pub enum Error {
 mod tests {
     use super::*;
     extern crate std;
+    use proptest::prelude::*;
     use std::string::ToString;
 
     /// Timestamps and gaps keep every digit at everyday magnitudes and go to exponent form
@@ -404,6 +339,171 @@ mod tests {
             max_gap_s: 2.0,
         };
         assert!(e.to_string().len() < 250, "{e}");
+    }
+
+    /// The longest run of consecutive digits in `s`.
+    fn longest_digit_run(s: &str) -> usize {
+        s.split(|c: char| !c.is_ascii_digit())
+            .map(str::len)
+            .max()
+            .unwrap_or(0)
+    }
+
+    /// Every variant that carries a float, built from the figures `v`.
+    fn with_figures(v: [f64; 6]) -> std::vec::Vec<Error> {
+        std::vec![
+            Error::NonFinite {
+                what: "x",
+                value: v[0]
+            },
+            Error::NonIncreasingTime {
+                prev_s: v[0],
+                t_s: v[1]
+            },
+            Error::InvalidDt { dt_s: v[0] },
+            Error::OutOfRange {
+                what: "x",
+                value: v[0],
+                min: v[1],
+                max: v[2]
+            },
+            Error::Implausible {
+                what: "x",
+                value: v[0],
+                min: v[1],
+                max: v[2],
+                hint: "h"
+            },
+            Error::InsufficientCoverage {
+                covered_deg: v[0],
+                noise_deg: v[1],
+                need_deg: v[2]
+            },
+            Error::InsufficientSphereCoverage {
+                covered_fraction: v[0],
+                need_fraction: v[1]
+            },
+            Error::IncompleteTurn {
+                turned_deg: v[0],
+                need_deg: v[1]
+            },
+            Error::Undetermined {
+                dilution: v[0],
+                even_dilution: v[1],
+                even_shape: "sphere",
+                model_error_rel: v[2],
+                error_deg: v[3],
+                max_deg: v[4],
+                hint: "h",
+            },
+            Error::TooNoisyForOrientations {
+                noise_rel: v[0],
+                dilution: v[1],
+                product: v[2],
+                max_product: v[3],
+            },
+            Error::TooUncertain {
+                bound_deg: v[0],
+                max_deg: v[1],
+                points: usize::MAX,
+                noise_rel: v[2],
+                widened: "",
+            },
+            Error::TimeGap {
+                what: "w",
+                t_s: v[0],
+                gap_s: v[1],
+                max_gap_s: v[2]
+            },
+            Error::DateOutOfRange {
+                year: v[0],
+                valid_from: v[1],
+                valid_to: v[2]
+            },
+        ]
+    }
+
+    /// The figures a hostile input can put into a message.
+    fn any_figure() -> impl Strategy<Value = f64> {
+        prop_oneof![
+            any::<f64>(),
+            any::<u64>().prop_map(f64::from_bits),
+            prop::sample::select(std::vec![
+                f64::NAN,
+                f64::INFINITY,
+                f64::NEG_INFINITY,
+                f64::MAX,
+                -f64::MAX,
+                f64::MIN_POSITIVE,
+                5e-324,
+                -5e-324,
+                1e200,
+                0.0,
+            ]),
+        ]
+    }
+
+    /// Today's text at everyday magnitudes: the figures quoted in the README and tests.
+    #[test]
+    fn everyday_figures_keep_their_text() {
+        let e = Error::InsufficientCoverage {
+            covered_deg: 187.2,
+            noise_deg: 0.0,
+            need_deg: 200.0,
+        };
+        assert_eq!(
+            e.to_string(),
+            "the samples cover only 187° of heading, need at least 200°; turn further (a full circle is best) before solving"
+        );
+        let e = Error::TooNoisyForOrientations {
+            noise_rel: 0.012,
+            dilution: 21.25,
+            product: 0.255,
+            max_product: 0.2,
+        };
+        assert!(
+            e.to_string()
+                .starts_with("each reading scatters 1.2 % of the field about the fit and the orientations' dilution is 21.2: their product, 0.26, exceeds the 0.2 "),
+            "{e}"
+        );
+        let e = Error::Undetermined {
+            dilution: f64::INFINITY,
+            even_dilution: 2.0,
+            even_shape: "circle",
+            model_error_rel: 0.01,
+            error_deg: f64::INFINITY,
+            max_deg: 5.0,
+            hint: "turn",
+        };
+        assert!(
+            e.to_string().contains("their dilution is not finite (inf)"),
+            "{e}"
+        );
+        assert!(e.to_string().contains("by any angle"), "{e}");
+        let e = Error::IncompleteTurn {
+            turned_deg: 3.2e200,
+            need_deg: 360.0,
+        };
+        assert_eq!(
+            e.to_string(),
+            "the turn covered only 3.2e200°, need at least 360°; drive a complete circle"
+        );
+    }
+
+    proptest! {
+        /// Whatever figures a variant carries, its message stays a readable sentence: at
+        /// most 600 bytes and no run of more than 20 digits.
+        #[test]
+        fn messages_stay_short_for_any_figure(
+            a in any_figure(), b in any_figure(), c in any_figure(),
+            d in any_figure(), e in any_figure(), f in any_figure(),
+        ) {
+            for error in with_figures([a, b, c, d, e, f]) {
+                let text = error.to_string();
+                prop_assert!(text.len() <= 600, "{} bytes: {}", text.len(), text);
+                prop_assert!(longest_digit_run(&text) <= 20, "{}", text);
+            }
+        }
     }
 
     /// Ranges and values read at a glance: no 309-digit numbers, no float noise.

@@ -35,9 +35,11 @@ pub mod extended_float;
 mod heading;
 mod heading_source;
 mod inertial_calibration;
+mod message_numbers;
 mod noise;
 mod persist;
 mod real;
+mod refusal;
 mod sample;
 mod sensor_model;
 mod units;
@@ -51,7 +53,7 @@ pub use calibrator::{
     Solution,
 };
 pub use compass_quality::{CompassQuality, CompassUncertainty};
-pub use error::{Error, Precise, Readable};
+pub use error::Error;
 pub use estimator::{
     AttitudeEstimate, AttitudeStatus, HeadingEstimator, NavEstimate, NavStatus,
     OrientationEstimator, Unobserved,
@@ -61,6 +63,7 @@ pub use heading_source::{
     AbsoluteHeading, AbsoluteHeadingSource, RelativeHeadingSource, RelativeStep,
 };
 pub use inertial_calibration::{InertialCalibration, axis_calibrated};
+pub use message_numbers::{Fixed, Precise, Readable};
 pub use noise::{NoiseSource, SplitMix64, ZeroNoise};
 pub use persist::{Persistent, Snapshot, check_snapshot_version};
 pub use real::Real;

@@ -27,7 +27,7 @@
 
 use core::fmt;
 
-use crate::CompassQuality;
+use crate::{CompassQuality, Fixed};
 use serde::{Deserialize, Serialize};
 
 /// Largest calibration bound of a `good` calibration, degrees.
@@ -145,30 +145,30 @@ impl Verdict {
 impl fmt::Display for Verdict {
     /// The reason, one line: which number decided the grade, and what would help.
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let (b, n) = (self.bound_deg, self.noise_deg);
+        let (b, n) = (Fixed(self.bound_deg, 2), Fixed(self.noise_deg, 2));
         let (limit, noise_limit) = Self::limits_missed(self.grade);
         match self.cause {
             Cause::None => write!(
                 f,
-                "the calibration adds at most {b:.2} deg (3 sigma + systematic, limit {GOOD_DEG}) and each reading scatters {n:.2} deg RMS about it (limit {GOOD_NOISE_DEG})"
+                "the calibration adds at most {b} deg (3 sigma + systematic, limit {GOOD_DEG}) and each reading scatters {n} deg RMS about it (limit {GOOD_NOISE_DEG})"
             ),
             Cause::Calibration => {
                 write!(
                     f,
-                    "the calibration itself may err by up to {b:.2} deg (3 sigma + systematic), more than {limit} deg: too few readings, too little of the circle or sphere, or a method that cannot model this soft iron"
+                    "the calibration itself may err by up to {b} deg (3 sigma + systematic), more than {limit} deg: too few readings, too little of the circle or sphere, or a method that cannot model this soft iron"
                 )?;
-                if !(n <= noise_limit) {
+                if !(self.noise_deg <= noise_limit) {
                     write!(
                         f,
-                        "; and each reading scatters {n:.2} deg RMS about the fit, more than {noise_limit} deg"
+                        "; and each reading scatters {n} deg RMS about the fit, more than {noise_limit} deg"
                     )?;
                 }
                 Ok(())
             }
             Cause::Noise => write!(
                 f,
-                "the sensor is noisy: each reading scatters {n:.2} deg RMS about the fit ({:.1} % of the field), more than {noise_limit} deg, while the calibration itself is determined to {b:.2} deg (3 sigma + systematic); average readings (their noise falls as 1/sqrt of their number) — a scatter that is not random means the readings do not lie on one circle or ellipsoid (a magnetically disturbed site, a sensor moving against its mount, or a tilted 2-axis compass)",
-                100.0 * n.to_radians()
+                "the sensor is noisy: each reading scatters {n} deg RMS about the fit ({} % of the field), more than {noise_limit} deg, while the calibration itself is determined to {b} deg (3 sigma + systematic); average readings (their noise falls as 1/sqrt of their number) — a scatter that is not random means the readings do not lie on one circle or ellipsoid (a magnetically disturbed site, a sensor moving against its mount, or a tilted 2-axis compass)",
+                Fixed(100.0 * self.noise_deg.to_radians(), 1)
             ),
         }
     }
@@ -218,7 +218,44 @@ mod tests {
         assert_eq!(Verdict::of(&report(f64::INFINITY, 0.3)).grade, Grade::Poor);
     }
 
+    /// A hostile figure in either place still gives one short line, with no long run of
+    /// digits and a NaN named as not finite.
+    #[test]
+    fn hostile_figures_read_short() {
+        let specials = [
+            f64::NAN,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::MAX,
+            -f64::MAX,
+            1e200,
+            5e-324,
+        ];
+        for b in specials {
+            for n in specials.iter().copied().chain([0.1, 8.0]) {
+                let text = Verdict::of(&report(b, n)).to_string();
+                assert!(text.len() <= 600, "{text}");
+                let run = text
+                    .split(|c: char| !c.is_ascii_digit())
+                    .map(str::len)
+                    .max();
+                assert!(run.unwrap_or(0) <= 20, "{text}");
+            }
+        }
+        let v = Verdict::of(&report(f64::NAN, 0.3)).to_string();
+        assert!(v.contains("up to not finite (NaN) deg"), "{v}");
+    }
+
     proptest! {
+        /// Any pair of figures gives a short line without a long run of digits.
+        #[test]
+        fn any_figures_read_short(b in any::<f64>(), n in any::<f64>()) {
+            let text = Verdict::of(&report(b, n)).to_string();
+            prop_assert!(text.len() <= 600, "{}", text);
+            let run = text.split(|c: char| !c.is_ascii_digit()).map(str::len).max();
+            prop_assert!(run.unwrap_or(0) <= 20, "{}", text);
+        }
+
         /// The grade never improves as either number grows, the reason is one line, and the
         /// cause is the number that misses the better grade's limit: the noise only when the
         /// bound meets it.

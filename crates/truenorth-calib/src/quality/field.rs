@@ -3,7 +3,7 @@
 
 use nalgebra::{Vector2, Vector3};
 use truenorth_compass::{CompassCalibration2d, CompassCalibration3d};
-use truenorth_core::CompassQuality;
+use truenorth_core::{CompassQuality, Fixed};
 
 /// Sets [`CompassQuality::field_ratio_to_expected`]: the fitted field over `expected_field` (e.g.
 /// from the World Magnetic Model, in the input unit). Leaves it `None` when no positive
@@ -44,10 +44,10 @@ impl core::fmt::Display for FieldMismatch {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         write!(
             f,
-            "the fitted field {:.4} is {:.2} x the expected {:.4}: a magnetically disturbed site, a wrong unit, or a tilted 2-axis sensor",
-            self.fitted,
-            self.ratio(),
-            self.expected
+            "the fitted field {} is {} x the expected {}: a magnetically disturbed site, a wrong unit, or a tilted 2-axis sensor",
+            Fixed(self.fitted, 4),
+            Fixed(self.ratio(), 2),
+            Fixed(self.expected, 4)
         )
     }
 }
@@ -106,6 +106,15 @@ mod tests {
             if let Some(w) = warned {
                 prop_assert!((w.ratio() - ratio).abs() < 1e-12);
             }
+        }
+
+        /// Any fitted field (an overflowed fit, a field of 1e300) gives a short warning.
+        #[test]
+        fn warning_reads_short(fitted in proptest::num::f64::ANY, expected in proptest::num::f64::ANY) {
+            let text = FieldMismatch { fitted, expected }.to_string();
+            prop_assert!(text.len() <= 600, "{}", text);
+            let run = text.split(|c: char| !c.is_ascii_digit()).map(str::len).max();
+            prop_assert!(run.unwrap_or(0) <= 20, "{}", text);
         }
 
         #[test]

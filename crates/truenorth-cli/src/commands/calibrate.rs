@@ -270,7 +270,7 @@ fn summary(file: &CalibrationFile, verdict: &Verdict) -> String {
 
 /// A library error outside any file (an invalid built-in configuration).
 fn library(e: truenorth::core::Error) -> CliError {
-    CliError::msg(e.to_string())
+    CliError::from(e)
 }
 
 /// Opens the input for the `columns`, with `optional` ones (`t_s`, strictly increasing,

@@ -5,7 +5,7 @@
 use std::path::{Path, PathBuf};
 
 use nalgebra::Vector2;
-use truenorth::core::{NavEstimate, VehicleSample, rad_to_deg};
+use truenorth::core::{Fixed, NavEstimate, VehicleSample, rad_to_deg};
 use truenorth::fusion::vehicle::VehicleCalibration;
 use truenorth::fusion::{SensorPriors, VehicleConfig, VehicleEstimator};
 use truenorth::odometer::OdometerWheels;
@@ -301,12 +301,13 @@ fn build_method(
         priors: Some(priors),
         ..VehicleConfig::default()
     };
-    let bad_config = |e: truenorth::core::Error| CliError::file(&args.vehicle, e.to_string());
+    let bad_config =
+        |e: truenorth::core::Error| CliError::file(&args.vehicle, e.to_string()).kind_of(&e);
     let fused = match &args.calibration_in {
         Some(path) => {
             let learned = read_learned(path)?;
             VehicleEstimator::with_calibration(config, &learned)
-                .map_err(|e| CliError::file(path, e.to_string()))?
+                .map_err(|e| CliError::file(path, e.to_string()).kind_of(&e))?
         }
         None => VehicleEstimator::new(config).map_err(bad_config)?,
     };
@@ -402,7 +403,7 @@ fn estimate(
         let sample = columns.sample(row, &path)?;
         method
             .push(&sample, &mut |e, filter| writer.write(e, filter))
-            .map_err(|e| CliError::row(&path, row.number, e.to_string()))?;
+            .map_err(|e| CliError::row(&path, row.number, e.to_string()).kind_of(&e))?;
         if let Some(e) = writer.error.take() {
             return Err(e);
         }
@@ -410,7 +411,7 @@ fn estimate(
     }
     method
         .finish(&mut |e, filter| writer.write(e, filter))
-        .map_err(|e| CliError::file(&path, e.to_string()))?;
+        .map_err(|e| CliError::file(&path, e.to_string()).kind_of(&e))?;
     if let Some(e) = writer.error.take() {
         return Err(e);
     }
@@ -438,8 +439,8 @@ fn summary(
         "magnetic north"
     };
     let mut line = format!(
-        "truenorth drive: {samples} rows → {written}, {:.0} m, heading {reference}",
-        e.distance_m
+        "truenorth drive: {samples} rows → {written}, {} m, heading {reference}",
+        Fixed(e.distance_m, 0)
     );
     if !e.status.position_known {
         line += " (no wheels: no position)";

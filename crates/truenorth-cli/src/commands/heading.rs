@@ -189,7 +189,8 @@ impl Columns {
         let acc3 = self
             .acc
             .map(|[a, b, c]| Vector3::new(row[a], row[b], row[c]));
-        let bad = |e: truenorth::core::Error| CliError::row(path, row.number, e.to_string());
+        let bad =
+            |e: truenorth::core::Error| CliError::row(path, row.number, e.to_string()).kind_of(&e);
         Ok(match (cal, acc3) {
             (CompassCalibration::TwoD(c), _) => {
                 (c.magnetic_heading(&Vector2::new(row[x], row[y])), None)

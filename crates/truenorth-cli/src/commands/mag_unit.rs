@@ -1,6 +1,8 @@
 //! Magnetometer units and the check that a fitted field is an Earth field in the unit the
 //! user declared: a wrong unit is a factor of 10, 100 or 1000, which no disturbance makes.
 
+use truenorth::core::Fixed;
+
 /// Units a magnetometer may report in.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum MagUnit {
@@ -120,8 +122,10 @@ pub fn check_field(
         .map(|u| format!(" (or {})", u.name()))
         .collect();
     let head = format!(
-        "the fitted field {fitted:.6} {} = {fitted_nt:.0} nT is not {expectation}",
-        unit.name()
+        "the fitted field {} {} = {} nT is not {expectation}",
+        Fixed(fitted, 6),
+        unit.name(),
+        Fixed(fitted_nt, 0)
     );
     Some(match (expected, guess) {
         (_, Some(g)) => format!(
@@ -131,8 +135,8 @@ pub fn check_field(
             unit.name()
         ),
         (Some(e), None) => format!(
-            "{head} ({:.2} x): a magnetically disturbed site, a tilted 2-axis sensor, or readings in raw counts",
-            fitted / e
+            "{head} ({} x): a magnetically disturbed site, a tilted 2-axis sensor, or readings in raw counts",
+            Fixed(fitted / e, 2)
         ),
         (None, None) => format!("{head}: a magnetically disturbed site, or readings in raw counts"),
     })

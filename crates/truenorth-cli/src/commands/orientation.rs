@@ -4,7 +4,9 @@
 use std::path::PathBuf;
 
 use nalgebra::{UnitQuaternion, Vector3};
-use truenorth::core::{AttitudeEstimate, Axes, EulerZyx, ImuSample, ned_to_enu, rad_to_deg};
+use truenorth::core::{
+    AttitudeEstimate, Axes, EulerZyx, Fixed, ImuSample, Precise, ned_to_enu, rad_to_deg,
+};
 
 use super::mag_unit::{MagUnit, check_field};
 use crate::io::errln;
@@ -182,7 +184,7 @@ pub fn run(args: &Args) -> CliResult {
     let mut method = args
         .method
         .pipeline(!args.no_mag, args.gyro_timing)
-        .map_err(|e| CliError::msg(e.to_string()))?;
+        .map_err(CliError::from)?;
     let mut header: Vec<&str> = HEADER.to_vec();
     if args.status {
         header.extend(STATUS_HEADER);
@@ -397,7 +399,7 @@ impl Estimation {
         // Row k + 2: the data rows counted after the header.
         let est = method
             .update(sample)
-            .map_err(|e| CliError::row(&self.input, k + 2, e.to_string()))?
+            .map_err(|e| CliError::row(&self.input, k + 2, e.to_string()).kind_of(&e))?
             .estimate;
         if est.status.gap {
             let since = self.previous_t.map_or(0.0, |p| sample.t_s - p);
@@ -480,7 +482,13 @@ fn gap_summary(input: &std::path::Path, gaps: &[(usize, f64, f64)], count: usize
     let listed: Vec<String> = gaps
         .iter()
         .take(GAPS_LISTED)
-        .map(|(row, t, gap)| format!("row {row} (t_s {t}, after {gap:.3} s)"))
+        .map(|(row, t, gap)| {
+            format!(
+                "row {row} (t_s {}, after {} s)",
+                Precise(*t),
+                Fixed(*gap, 3)
+            )
+        })
         .collect();
     let more = match count.saturating_sub(GAPS_LISTED) {
         0 => String::new(),

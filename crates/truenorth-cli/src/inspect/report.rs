@@ -4,6 +4,7 @@
 use std::fmt::Write as _;
 
 use crate::io::shell_word;
+use truenorth::core::Fixed;
 
 use serde::Serialize;
 
@@ -105,7 +106,7 @@ impl Report {
             "max",
             "non_finite"
         );
-        let num = |v: Option<f64>, p: usize| v.map_or("-".to_string(), |x| format!("{x:.p$}"));
+        let num = |v: Option<f64>, p: usize| v.map_or("-".to_string(), |x| figure(x, p));
         for c in &self.columns {
             let _ = writeln!(
                 s,
@@ -144,7 +145,17 @@ impl Report {
 
 /// A value with four decimals, `-` when absent.
 fn num(v: Option<f64>) -> String {
-    v.map_or("-".to_string(), |x| format!("{x:.4}"))
+    v.map_or("-".to_string(), |x| figure(x, 4))
+}
+
+/// A value from the file with `decimals` decimals, in exponent form where those would run to
+/// hundreds of digits; NaN and infinities as `{}` shows them, to keep the table's columns.
+fn figure(x: f64, decimals: usize) -> String {
+    if x.is_finite() {
+        Fixed(x, decimals).to_string()
+    } else {
+        x.to_string()
+    }
 }
 
 /// A unit, `undecided` when absent.

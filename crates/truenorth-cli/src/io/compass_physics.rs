@@ -4,7 +4,7 @@
 //! iron neither singular, nor a mirror image, nor so ill-conditioned that it squashes the
 //! field onto a line, and the hard iron within what a magnetometer can read.
 
-use truenorth::core::Readable;
+use truenorth::core::{Fixed, Readable};
 
 /// The largest condition number (largest over smallest singular value) of a soft-iron
 /// matrix accepted on load: 10, the largest axis ratio the ellipsoid fit accepts. A worse
@@ -69,7 +69,8 @@ pub fn check_soft_iron(det: f64, singular_values: &[f64]) -> Result<(), String> 
     let condition = max / min;
     if condition.is_nan() || condition > MAX_SOFT_IRON_CONDITION {
         return Err(format!(
-            "`soft_iron` has condition number {condition:.1}, more than {MAX_SOFT_IRON_CONDITION}: it would squash the field nearly onto a line; recalibrate"
+            "`soft_iron` has condition number {}, more than {MAX_SOFT_IRON_CONDITION}: it would squash the field nearly onto a line; recalibrate",
+            Fixed(condition, 1)
         ));
     }
     Ok(())

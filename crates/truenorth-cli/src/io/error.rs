@@ -3,6 +3,46 @@
 use std::fmt;
 use std::path::{Path, PathBuf};
 
+/// What kind of error ended a command: the data refused, or something to fix.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ErrorKind {
+    /// The data cannot support the result (too little turn, too few points, a poor
+    /// verdict, a locus that is no ellipse, …): a verdict on the recording, which more or
+    /// better data would change.
+    Refusal,
+    /// Bad input, an I/O error, a wrong option: something to fix before the data can be
+    /// judged.
+    Failure,
+}
+
+impl ErrorKind {
+    /// The kind of a library error ([`truenorth::core::Error::is_refusal`]).
+    pub fn of(e: &truenorth::core::Error) -> Self {
+        if e.is_refusal() {
+            Self::Refusal
+        } else {
+            Self::Failure
+        }
+    }
+
+    /// Its name as a batch child reports it (`refusal` or `failure`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Refusal => "refusal",
+            Self::Failure => "failure",
+        }
+    }
+
+    /// The kind a batch child reported by [`Self::name`].
+    pub fn from_name(name: &str) -> Option<Self> {
+        match name.trim() {
+            "refusal" => Some(Self::Refusal),
+            "failure" => Some(Self::Failure),
+            _ => None,
+        }
+    }
+}
+
 /// A command-line error: one line for stderr.
 #[derive(Debug)]
 pub struct CliError {
@@ -12,6 +52,9 @@ pub struct CliError {
     pub row: Option<usize>,
     /// What was wrong.
     pub message: String,
+    /// Whether the data were refused or something failed; `None` where the code that made
+    /// the error did not say (a batch then judges by the message's words).
+    pub kind: Option<ErrorKind>,
 }
 
 impl CliError {
@@ -21,6 +64,7 @@ impl CliError {
             file: None,
             row: None,
             message: message.into(),
+            kind: None,
         }
     }
 
@@ -30,6 +74,7 @@ impl CliError {
             file: Some(file.to_path_buf()),
             row: None,
             message: message.into(),
+            kind: None,
         }
     }
 
@@ -39,7 +84,26 @@ impl CliError {
             file: Some(file.to_path_buf()),
             row: Some(row),
             message: message.into(),
+            kind: None,
         }
+    }
+
+    /// The same error, of kind `kind`.
+    pub fn with_kind(self, kind: ErrorKind) -> Self {
+        Self {
+            kind: Some(kind),
+            ..self
+        }
+    }
+
+    /// The same error, a refusal of the data.
+    pub fn refusal(self) -> Self {
+        self.with_kind(ErrorKind::Refusal)
+    }
+
+    /// The same error, of the kind of the library error `e` it reports.
+    pub fn kind_of(self, e: &truenorth::core::Error) -> Self {
+        self.with_kind(ErrorKind::of(e))
     }
 }
 
@@ -55,5 +119,38 @@ impl fmt::Display for CliError {
     }
 }
 
+/// A library error outside any file, its kind kept.
+impl From<truenorth::core::Error> for CliError {
+    fn from(e: truenorth::core::Error) -> Self {
+        Self::msg(e.to_string()).kind_of(&e)
+    }
+}
+
 /// Result with [`CliError`].
 pub type CliResult<T = ()> = Result<T, CliError>;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use truenorth::core::Error;
+
+    #[test]
+    fn library_errors_keep_their_kind() {
+        let refused = CliError::from(Error::IncompleteTurn {
+            turned_deg: 90.0,
+            need_deg: 360.0,
+        });
+        assert_eq!(refused.kind, Some(ErrorKind::Refusal));
+        let bad = Error::NonIncreasingTime {
+            prev_s: 2.0,
+            t_s: 1.0,
+        };
+        let failed = CliError::row(Path::new("a.csv"), 3, bad.to_string()).kind_of(&bad);
+        assert_eq!(failed.kind, Some(ErrorKind::Failure));
+        assert_eq!(CliError::msg("x").kind, None);
+        for kind in [ErrorKind::Refusal, ErrorKind::Failure] {
+            assert_eq!(ErrorKind::from_name(kind.name()), Some(kind));
+        }
+        assert_eq!(ErrorKind::from_name("refused"), None);
+    }
+}

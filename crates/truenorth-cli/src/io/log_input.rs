@@ -22,6 +22,7 @@ use std::io::{BufRead, Read};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
+use truenorth::core::Fixed;
 use truenorth_logs::{LogConfig, LogError, LogFormat, LogReader, Recording};
 
 use super::columns::{AxisConvention, Delimiter, InputOptions};
@@ -316,7 +317,7 @@ pub fn summary(log: &LogInput) -> Vec<String> {
     lines.push(format!("topics ({}):", r.topics.len()));
     for t in &r.topics {
         let rate = if span_s > 0.0 && t.messages > 1 {
-            format!(", {:.1} Hz mean", t.messages as f64 / span_s)
+            format!(", {} Hz mean", Fixed(t.messages as f64 / span_s, 1))
         } else {
             String::new()
         };
@@ -328,8 +329,12 @@ pub fn summary(log: &LogInput) -> Vec<String> {
     lines.push("streams read:".to_string());
     for s in &r.streams {
         lines.push(format!(
-            "  {}: {}, {} samples, {:.2} Hz (median step), {} left out",
-            s.role, s.topic, s.samples, s.rate_hz, s.dropped
+            "  {}: {}, {} samples, {} Hz (median step), {} left out",
+            s.role,
+            s.topic,
+            s.samples,
+            Fixed(s.rate_hz, 2),
+            s.dropped
         ));
     }
     let options = match r.format {

@@ -69,7 +69,7 @@ pub use columns::InputOptions;
 pub(crate) use console::{errln, out, outln};
 pub use console::{write_stderr, write_stdout};
 pub use direction_spans::{Inertial, Reference, median, median_magnitude};
-pub use error::{CliError, CliResult};
+pub use error::{CliError, CliResult, ErrorKind};
 pub use gyro_axes::{
     AxisFit, SignedPermutation, axes_are_wrong, fit_gyro_axes, fix_columns, fix_pair, shell_word,
 };

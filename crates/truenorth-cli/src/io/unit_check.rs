@@ -9,7 +9,7 @@ use super::errln;
 use super::gyro_axes::{axes_are_wrong, fit_gyro_axes, fix_columns, shell_word};
 use super::{AccUnit, CliError, CliResult, GyroUnit, InputOptions};
 use nalgebra::Matrix3;
-use truenorth::core::ImuSample;
+use truenorth::core::{Fixed, ImuSample};
 
 /// Standard gravity, m/s².
 const G_MPS2: f64 = 9.806_65;
@@ -147,7 +147,8 @@ fn acc_finding(raw_median: f64, declared: AccUnit) -> Option<String> {
     let name = acc_unit_name(likely);
     (likely != declared).then(|| {
         format!(
-            "the accelerometer's median magnitude is {raw_median:.3} in the file, one gravity in {name}, not in the declared unit: pass --acc-unit {name}"
+            "the accelerometer's median magnitude is {} in the file, one gravity in {name}, not in the declared unit: pass --acc-unit {name}",
+            Fixed(raw_median, 3)
         )
     })
 }

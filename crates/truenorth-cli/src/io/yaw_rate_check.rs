@@ -5,7 +5,7 @@
 //! times too far, one whose sign is flipped turns the other way; neither comes near one.
 //! Streaming: it keeps a few sums, so a log of any length is checked as it is read.
 
-use truenorth::core::VehicleSample;
+use truenorth::core::{Fixed, VehicleSample};
 
 use super::gyro_axes::{SignedPermutation, fix_pair, shell_word};
 use super::unit_check::{Finding, FindingKind, gyro_unit_name};
@@ -174,9 +174,10 @@ impl YawRateCheck {
             findings.push(Finding {
                 kind: FindingKind::Units,
                 message: format!(
-                    "gyr_z turns {:.3} times as far as the wheels over {} turning seconds (r² {r2:.2}): it is in {name}, not the declared unit: pass --gyro-unit {name}",
-                    1.0 / ratio.abs(),
-                    self.windows
+                    "gyr_z turns {} times as far as the wheels over {} turning seconds (r² {}): it is in {name}, not the declared unit: pass --gyro-unit {name}",
+                    Fixed(1.0 / ratio.abs(), 3),
+                    self.windows,
+                    Fixed(r2, 2)
                 ),
                 row: self.judged_at_row,
             });
@@ -189,8 +190,10 @@ impl YawRateCheck {
             findings.push(Finding {
                 kind: FindingKind::Axes,
                 message: format!(
-                    "gyr_z turns against the wheels over {} turning seconds (wheels per gyro {ratio:.2}, r² {r2:.2}): its sign is flipped (a right turn must read positive): pass --column {}",
+                    "gyr_z turns against the wheels over {} turning seconds (wheels per gyro {}, r² {}): its sign is flipped (a right turn must read positive): pass --column {}",
                     self.windows,
+                    Fixed(ratio, 2),
+                    Fixed(r2, 2),
                     shell_word(&fix_pair(&flip, 2, opts))
                 ),
                 row: self.judged_at_row,
@@ -235,8 +238,10 @@ impl Turns {
             return None;
         }
         let seen = format!(
-            "the wheels ({wheels}) turn the vehicle {r:.4} times as far as gyr_z over {} turning seconds (r² {r2:.2})",
-            self.windows
+            "the wheels ({wheels}) turn the vehicle {} times as far as gyr_z over {} turning seconds (r² {})",
+            Fixed(r, 4),
+            self.windows,
+            Fixed(r2, 2)
         );
         let message = if speeds && near(3.6) {
             format!(
@@ -254,10 +259,10 @@ impl Turns {
             )
         } else {
             format!(
-                "{seen}: track_m = {} m in {} does not fit the turns, which give a track of {:.2} m: check track_m (metres, between the odometer wheels' centres) or the wheel columns' unit",
+                "{seen}: track_m = {} m in {} does not fit the turns, which give a track of {} m: check track_m (metres, between the odometer wheels' centres) or the wheel columns' unit",
                 self.track_m,
                 vehicle.display(),
-                self.track_m * r
+                Fixed(self.track_m * r, 2)
             )
         };
         Some(Finding {

@@ -133,21 +133,26 @@ pub struct BinnedEllipseCalibrator {
     /// Square of the distance from the origin within which a reading's direction is its
     /// noise's (see [`noise_floor_sq`]); 0 until the initial origin is set.
     pub(crate) floor_sq: f64,
-    /// The bin of the last reading binned, and how many readings in a row it has taken.
-    pub(crate) last_bin: Option<usize>,
-    pub(crate) bin_run: u32,
+    /// How many readings of each bin counted towards the next update since the last one
+    /// started (see [`COUNTED_PER_BIN`]).
+    pub(crate) counted: [u32; MAX_BINS],
 }
 
-/// Most readings in a row into one bin that count towards the next update
-/// ([`BinnedEllipseConfig::update_interval`]). A full-set update re-bins the set about the
-/// moved origin, which merges readings that fall together, so each update costs the set a
-/// little; counting every reading made the updates per turn, and so what the set lost to
-/// them, grow with the sampling rate (a recording of 2 000 readings per degree ran 5 600
-/// updates per turn and kept 15 of 64 bins). Readings that stay in one bin only renew its
-/// value: past the first 16 (the 11 a bin takes at the 2 readings per degree the patent's
-/// turn gives, with room) they bring no update closer, so the updates come per angle
-/// turned, not per reading, at any rate.
-const COUNTED_PER_BIN_RUN: u32 = 16;
+/// Most readings of one bin that count towards the next update
+/// ([`BinnedEllipseConfig::update_interval`]) between two updates. A full-set update
+/// re-bins the set about the moved origin, which merges readings that fall together, so
+/// each update costs the set a little; counting every reading made the updates per turn,
+/// and so what the set lost to them, grow with the sampling rate (a recording of 2 000
+/// readings per degree ran 5 600 updates per turn and kept 15 of 64 bins). Readings past
+/// the first 16 of a bin (the 11 a bin takes at the 2 readings per degree the patent's turn
+/// gives, with room) only renew its value and bring no update closer, so the updates come
+/// per angle turned, not per reading, at any rate. The cap is per bin and update, not per
+/// run of readings in a row: near a bin's edge noise moves a dense recording's readings
+/// back and forth between two bins hundreds of times as the turn crosses it, and a cap per
+/// run counted every crossing (one turn of the `io_speed` ellipse at 500 readings per
+/// degree ran 318 updates, kept 27 of 64 bins and was refused for 185° of turning; see
+/// `tests/denser_data.rs`). Never below what lets half the bins start an update.
+const COUNTED_PER_BIN: usize = 16;
 
 /// How many per-axis noise σ a reading must lie from the origin for its direction to be
 /// the locus's rather than its noise's: for noise alone the distance exceeds `cσ` with
@@ -207,8 +212,7 @@ impl BinnedEllipseCalibrator {
             backlog: [Vector2::zeros(); MAX_UPDATE_PUSHES],
             backlog_len: 0,
             floor_sq: 0.0,
-            last_bin: None,
-            bin_run: 0,
+            counted: [0; MAX_BINS],
         }
     }
 
@@ -345,12 +349,13 @@ impl BinnedEllipseCalibrator {
             && self.filled_bins() >= self.config.min_filled_bins
         {
             self.since_update = 0;
+            self.counted = [0; MAX_BINS];
             self.start_update();
         }
     }
 
     /// Bins `p` if it has a direction about the origin; returns whether it counts towards
-    /// the next update (see [`COUNTED_PER_BIN_RUN`]).
+    /// the next update (see [`COUNTED_PER_BIN`]).
     fn bin(&mut self, p: &Vector2<f64>) -> bool {
         let Some(origin) = self.origin else {
             return false;
@@ -367,13 +372,21 @@ impl BinnedEllipseCalibrator {
         ) else {
             return false;
         };
-        if self.last_bin == Some(i) {
-            self.bin_run = self.bin_run.saturating_add(1);
+        let cap = (2 * self.config.update_interval)
+            .div_ceil(self.config.bins)
+            .max(COUNTED_PER_BIN);
+        let counted = &mut self.counted[i];
+        if (*counted as usize) < cap {
+            *counted += 1;
+            true
         } else {
-            self.last_bin = Some(i);
-            self.bin_run = 1;
+            false
         }
-        self.bin_run <= COUNTED_PER_BIN_RUN
+    }
+
+    /// The per-bin counts towards the next update, as saved (the first `n` bins).
+    pub(crate) fn counted_bins(&self) -> &[u32] {
+        &self.counted[..self.config.bins]
     }
 
     /// Starts a full-set update on a copy of the bins, with the refresh spread evenly over

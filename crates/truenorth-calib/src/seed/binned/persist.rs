@@ -57,10 +57,10 @@ pub struct BinnedEllipseCalibratorState {
     pub estimate: Option<Solution<CompassCalibration2d>>,
     update: Option<BinnedUpdateState>,
     backlog: Vec<Vector2<f64>>,
+    /// Per bin, the readings counted towards the next update since the last one started
+    /// (empty in a state saved before they were kept: all zero).
     #[serde(default)]
-    last_bin: Option<usize>,
-    #[serde(default)]
-    bin_run: u32,
+    counted: Vec<u32>,
 }
 
 fn finite2(v: &Vector2<f64>) -> bool {
@@ -121,8 +121,7 @@ impl Persistent for BinnedEllipseCalibrator {
                 pending: u.pending[..u.pending_len].to_vec(),
             }),
             backlog: self.backlog[..self.backlog_len].to_vec(),
-            last_bin: self.last_bin,
-            bin_run: self.bin_run,
+            counted: self.counted_bins().to_vec(),
         }
     }
 
@@ -140,8 +139,15 @@ impl Persistent for BinnedEllipseCalibrator {
         if c.origin.is_some() {
             c.floor_sq = super::calibrator::noise_floor_sq(&s.init);
         }
-        c.last_bin = s.last_bin.filter(|&i| i < n);
-        c.bin_run = s.bin_run;
+        match s.counted.len() {
+            0 => {}
+            len if len == n => c.counted[..n].copy_from_slice(&s.counted),
+            _ => {
+                return Err(Error::InvalidSnapshot {
+                    reason: "the binned ellipse must save a count for each of its bins",
+                });
+            }
+        }
         c.samples = s.samples;
         c.since_update = s.since_update;
         c.reference[..n].copy_from_slice(&s.reference);

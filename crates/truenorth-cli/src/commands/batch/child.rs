@@ -10,7 +10,7 @@ use std::time::{Duration, Instant};
 use super::journal::COMMAND_ERROR_CODE;
 use super::passthrough::Passthrough;
 use super::results::Status;
-use crate::io::{CliError, CliResult, write_atomically};
+use crate::io::{CliError, CliResult, ErrorKind, write_atomically};
 
 /// Set in a child's environment: the child then reports the rows it read on its last line
 /// of standard error, after [`STATS_PREFIX`].
@@ -18,6 +18,12 @@ pub const CHILD_ENV: &str = "TRUENORTH_BATCH_CHILD";
 
 /// What starts the line on which a child reports the rows it read.
 pub const STATS_PREFIX: &str = "truenorth-batch: rows read ";
+
+/// What starts the line on which a child that ended with an error reports its kind
+/// ([`ErrorKind::name`]: the data refused, or a failure), where the error carries one. A
+/// line of its own on standard error, which the batch reads and the user never sees, so that
+/// the exit codes and messages scripts rely on stay as they are.
+pub const KIND_PREFIX: &str = "truenorth-batch: error kind ";
 
 /// How often a running child is checked for its end and for an abort.
 const POLL: Duration = Duration::from_millis(2);
@@ -168,10 +174,15 @@ pub fn judge(status: Option<ExitStatus>, stderr: &str) -> Ended {
         .rev()
         .find_map(|l| l.strip_prefix(STATS_PREFIX))
         .and_then(|n| n.trim().parse().ok());
+    let kind = stderr
+        .lines()
+        .rev()
+        .find_map(|l| l.strip_prefix(KIND_PREFIX))
+        .and_then(ErrorKind::from_name);
     let said = stderr
         .lines()
         .rev()
-        .filter(|l| !l.starts_with(STATS_PREFIX))
+        .filter(|l| !l.starts_with(STATS_PREFIX) && !l.starts_with(KIND_PREFIX))
         .find(|l| !l.trim().is_empty())
         .unwrap_or("")
         .trim();
@@ -196,8 +207,14 @@ pub fn judge(status: Option<ExitStatus>, stderr: &str) -> Ended {
         },
         Some(COMMAND_ERROR_CODE) => {
             let message = said.strip_prefix("truenorth: ").unwrap_or(said).to_string();
+            // The kind the child reported; today's reading of the words only for a child
+            // that reported none.
+            let refused = match kind {
+                Some(kind) => kind == ErrorKind::Refusal,
+                None => is_refusal(&message),
+            };
             Ended {
-                status: if is_refusal(&message) {
+                status: if refused {
                     Status::Refused
                 } else {
                     Status::Failed
@@ -242,8 +259,9 @@ fn signal_message(_status: ExitStatus) -> String {
 }
 
 /// Whether a command's message is a verdict on the data rather than a file it could not
-/// read: the commands word a refusal as one they `refuse`/`cannot calibrate`, or with the
-/// option that would accept it anyway (`--accept-…`, "… anyway").
+/// read, for a child that reported no kind ([`KIND_PREFIX`]): the commands word a refusal as
+/// one they `refuse`/`cannot calibrate`, or with the option that would accept it anyway
+/// (`--accept-…`, "… anyway").
 pub fn is_refusal(message: &str) -> bool {
     let m = message.to_ascii_lowercase();
     ["refused", "cannot calibrate", "anyway", "--accept-"]
@@ -285,6 +303,28 @@ mod tests {
         );
         assert_eq!(panic.status, Status::Failed);
         assert!(panic.message.contains("exit code 101"), "{}", panic.message);
+        // A refusal worded with none of the words above is still a refusal when the child
+        // says so, and a failure that happens to contain them is still a failure.
+        let refused = judge(
+            Some(ExitStatus::from_raw(1 << 8)),
+            "truenorth-batch: rows read 9\ntruenorth-batch: error kind refusal\ntruenorth: a.csv: the turn covered only 90°, need at least 360°; drive a complete circle\n",
+        );
+        assert_eq!(refused.status, Status::Refused);
+        assert!(
+            refused.message.starts_with("a.csv: the turn"),
+            "{}",
+            refused.message
+        );
+        assert_eq!(refused.samples, Some(9));
+        let failed = judge(
+            Some(ExitStatus::from_raw(1 << 8)),
+            "truenorth-batch: rows read 0\ntruenorth-batch: error kind failure\ntruenorth: a.csv: cannot open: refused by the file system\n",
+        );
+        assert_eq!(failed.status, Status::Failed);
+        assert_eq!(
+            failed.message,
+            "a.csv: cannot open: refused by the file system"
+        );
         let killed = judge(Some(ExitStatus::from_raw(9)), "");
         assert_eq!((killed.status, killed.exit_code), (Status::Failed, None));
         assert_eq!(killed.message, "killed by signal 9");
