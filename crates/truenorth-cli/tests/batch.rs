@@ -614,3 +614,40 @@ proptest! {
         }
     }
 }
+
+/// Run as a batch's child, a command tells its parent that its error refused the data, in a
+/// line of the batch protocol (a corrupt file is no refusal); run by hand, it prints no such
+/// line.
+#[test]
+fn a_child_reports_the_kind_of_its_error() {
+    use truenorth_cli::commands::batch::child::{CHILD_ENV, KIND_PREFIX};
+    let dir = scratch("batch", "kind");
+    std::fs::write(dir.join("arc.csv"), arc()).unwrap();
+    std::fs::write(
+        dir.join("corrupt.csv"),
+        "t_s,mag_x,mag_y\n0,1,2\n0.1,abc,2\n",
+    )
+    .unwrap();
+    let out = dir.join("o.json");
+    let stderr = |input: &str, child: bool| {
+        let mut c = common::binary();
+        c.args(["calibrate", "--method", "ellipse", "--input"])
+            .arg(dir.join(input))
+            .arg("--output")
+            .arg(&out)
+            .env_remove(CHILD_ENV);
+        if child {
+            c.env(CHILD_ENV, "1");
+        }
+        let o = c.output().unwrap();
+        assert_eq!(o.status.code(), Some(1), "{input}");
+        String::from_utf8_lossy(&o.stderr).into_owned()
+    };
+    assert!(stderr("arc.csv", true).contains(&format!("{KIND_PREFIX}refusal")));
+    assert!(!stderr("corrupt.csv", true).contains(&format!("{KIND_PREFIX}refusal")));
+    for input in ["arc.csv", "corrupt.csv"] {
+        let by_hand = stderr(input, false);
+        assert!(!by_hand.contains(KIND_PREFIX), "{by_hand}");
+        assert_eq!(by_hand.lines().count(), 1, "{by_hand}");
+    }
+}

@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 use nalgebra::{SMatrix, SVector, Vector2, Vector3};
 use truenorth::calib::quality::{self, Cause, Grade, Verdict};
 use truenorth::calib::{MagAccelQuality, MagAccelSample, TurnQuality, TurnSample};
-use truenorth::core::{Calibrator, CompassQuality, Mag2Sample, Mag3Sample, Solution};
+use truenorth::core::{Calibrator, CompassQuality, Fixed, Mag2Sample, Mag3Sample, Solution};
 
 use super::field::Place;
 use super::mag_unit::{MagUnit, check_field};
@@ -206,7 +206,8 @@ pub fn run(args: &Args) -> CliResult {
             return Err(CliError::file(
                 &input,
                 format!("{problem} (write it anyway with --accept-field-mismatch)"),
-            ));
+            )
+            .refusal());
         }
     } else if let Some(w) = expected.and_then(|e| quality::field_mismatch(&fitted.quality, e)) {
         // An expected field given directly: a warning, as the numbers are the user's.
@@ -224,7 +225,8 @@ pub fn run(args: &Args) -> CliResult {
             return Err(CliError::file(
                 &input,
                 format!("{what}; refused (write it anyway with --accept-poor)"),
-            ));
+            )
+            .refusal());
         }
     }
     fitted.file.write(&args.output)?;
@@ -235,32 +237,33 @@ pub fn run(args: &Args) -> CliResult {
 /// The one line on stderr after a successful calibration.
 fn summary(file: &CalibrationFile, verdict: &Verdict) -> String {
     let q = file.quality.as_ref();
-    let num = |v: Option<f64>| v.map_or("unbounded".to_string(), |v| format!("{v:.2}"));
+    let num = |v: Option<f64>| v.map_or("unbounded".to_string(), |v| Fixed(v, 2).to_string());
     let cause = match verdict.cause {
         Cause::None => String::new(),
         c => format!(" (decided by the {c})"),
     };
     let mut s = format!(
-        "calibrate: method {}, {} points, verdict {}{cause}, field {:.6} (input unit), heading error bound {} deg (3 sigma + systematic), per-reading noise {} deg RMS",
+        "calibrate: method {}, {} points, verdict {}{cause}, field {} (input unit), heading error bound {} deg (3 sigma + systematic), per-reading noise {} deg RMS",
         file.method,
         q.map_or(0, |q| q.points),
         verdict.grade,
-        file.field,
+        Fixed(file.field, 6),
         num(q.and_then(|q| q.heading_error_bound_deg)),
         num(q.and_then(|q| q.heading_noise_rms_deg)),
     );
     if let Some(g) = &file.gyro {
         s += &format!(
-            ", gyro zero {:.4} deg/s, scale {:.5} ({} pairs X, {} Y)",
-            g.zero_rps.to_degrees(),
-            g.scale,
+            ", gyro zero {} deg/s, scale {} ({} pairs X, {} Y)",
+            Fixed(g.zero_rps.to_degrees(), 4),
+            Fixed(g.scale, 5),
             g.pairs[0],
             g.pairs[1]
         );
     }
     if let (Some(q), Some(d)) = (q, file.dip_deg) {
         s += &format!(
-            ", dip {d:.2} deg (spread {} deg), {} runs",
+            ", dip {} deg (spread {} deg), {} runs",
+            Fixed(d, 2),
             num(q.dip_spread_deg),
             q.runs.unwrap_or(0)
         );
@@ -308,7 +311,7 @@ where
     while let Some(row) = rows.next_row()? {
         let t_s = t_col.map_or(count as f64, |i| row[i]);
         cal.push(&sample(row, t_s))
-            .map_err(|e| CliError::row(&path, row.number, e.to_string()))?;
+            .map_err(|e| CliError::row(&path, row.number, e.to_string()).kind_of(&e))?;
         count += 1;
     }
     if count == 0 {
@@ -505,6 +508,7 @@ where
                 e
             ),
         )
+        .kind_of(&e)
     })?;
     if expected.is_some() && !args.method.reports_expected_field() {
         let q = *sol.quality.compass();
