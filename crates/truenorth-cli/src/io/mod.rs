@@ -32,6 +32,9 @@
 
 mod atomic_write;
 mod calibration_file;
+#[cfg(test)]
+mod chunk_boundaries;
+mod chunks;
 mod closest_name;
 mod columns;
 mod compass_physics;

@@ -186,9 +186,25 @@ impl Records {
     }
 
     /// Whether the current record is the file's last line and has no line break after it
-    /// (the next line would start right after it).
+    /// (the next line would start right after it). The parsers see this in their chunks.
+    #[cfg(test)]
     pub fn unterminated(&self) -> bool {
         self.next == self.end
+    }
+
+    /// Ends the line-by-line read: the source, the bytes read from it and not yet returned
+    /// as records (from the current record's line on when `again`, else from the line
+    /// after it), the number of lines before those bytes, and whether the source has ended.
+    pub fn into_rest(self, again: bool) -> (Box<dyn BufRead + Send>, Vec<u8>, usize, bool) {
+        let (from, lines) = if again {
+            (self.start, self.line_number.saturating_sub(1))
+        } else {
+            (self.next, self.line_number)
+        };
+        let mut buffer = self.buffer;
+        buffer.truncate(self.filled);
+        buffer.drain(..from);
+        (self.source, buffer, lines, self.eof)
     }
 
     /// The fields of the current record as text (invalid UTF-8 replaced), for a header.
