@@ -243,7 +243,6 @@ impl RowReader {
 impl ChunkParser for RowParser {
     fn parse_chunk(&self, chunk: &Chunk, block: &mut Block, spans: &mut Vec<(usize, usize)>) {
         let bytes = chunk.lines();
-        let n = self.columns.len();
         let mut number = chunk.line_before;
         let mut at = 0;
         while at < bytes.len() {
@@ -262,13 +261,12 @@ impl ChunkParser for RowParser {
             };
             split_fields(line, a, b, self.delimiter, spans);
             let start = block.values.len();
-            block.values.resize(start + n, 0.0);
             let row = self.parse_row(
                 number,
                 line,
                 spans,
                 unterminated,
-                &mut block.values[start..],
+                &mut block.values,
                 &mut block.last_increasing,
             );
             if let Err(e) = row {
@@ -302,17 +300,19 @@ impl ChunkParser for RowParser {
 }
 
 impl RowParser {
-    /// Converts and checks the record of row `number` (its fields at `spans` in `line`)
-    /// into `values`; `previous` is the increasing column's last number in the chunk.
+    /// Converts and checks the record of row `number` (its fields at `spans` in `line`),
+    /// appending its values to `values` (some of them on an error); `previous` is the
+    /// increasing column's last number in the chunk.
     fn parse_row(
         &self,
         number: usize,
         line: &[u8],
         spans: &[(usize, usize)],
         unterminated: bool,
-        values: &mut [f64],
+        values: &mut Vec<f64>,
         previous: &mut Option<f64>,
     ) -> CliResult {
+        let start = values.len();
         let fields = spans.len();
         if fields > self.width {
             return Err(CliError::row(
@@ -334,7 +334,7 @@ impl RowParser {
                 ),
             ));
         }
-        for (k, (c, required)) in self.columns.iter().enumerate() {
+        for (c, required) in &self.columns {
             let cell = spans
                 .get(c.index)
                 .map(|&(a, b)| &line[a..b])
@@ -366,10 +366,10 @@ impl RowParser {
                     format!("column `{}`: `{}` is not finite", c.header, shown(cell)),
                 ));
             }
-            values[k] = c.sign * v;
+            values.push(c.sign * v);
         }
         if let Some(k) = self.increasing {
-            let t = values[k];
+            let t = values[start + k];
             if let Some(prev) = *previous
                 && t.partial_cmp(&prev) != Some(std::cmp::Ordering::Greater)
             {
