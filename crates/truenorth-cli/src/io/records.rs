@@ -400,6 +400,23 @@ mod tests {
     }
 
     #[test]
+    fn lines_cut_by_the_end_of_the_buffer_are_read_whole() {
+        // More than one buffer of lines: the line cut by the end of the first read is moved
+        // to the front and completed by the next.
+        let text: String = (0..120_000).map(|k| format!("{k},{}\n", k * 7)).collect();
+        assert!(text.len() > BUFFER_BYTES);
+        let source = std::io::BufReader::new(std::io::Cursor::new(text));
+        let mut r = Records::new(Box::new(source), Delimiter::Byte(b','));
+        let mut k = 0usize;
+        while r.advance().unwrap() {
+            assert_eq!(r.line(), k + 1);
+            assert_eq!(r.text_fields(), vec![k.to_string(), (k * 7).to_string()]);
+            k += 1;
+        }
+        assert_eq!(k, 120_000);
+    }
+
+    #[test]
     fn numbers_and_shown_cells() {
         assert_eq!(parse_number(b"-1.5e3"), Some(-1500.0));
         assert_eq!(parse_number(b"+2"), Some(2.0));
