@@ -1,4 +1,4 @@
-//! Reading on every core: one thread reads the input (and decompresses it) and cuts it
+//! Reading on more than one core: one thread reads the input (and decompresses it) and cuts it
 //! into chunks of whole lines (see the `chunks` module), two workers split and parse the
 //! chunks into blocks of numbers, and the thread that uses the rows (a fit, a filter, a
 //! writer) takes the blocks in file order, so that parsing overlaps itself and the work
