@@ -146,10 +146,9 @@ impl AtomicOutput {
 
     /// Writes `bytes`.
     pub fn write_all(&mut self, bytes: &[u8]) -> CliResult {
-        let name = self.name.clone();
-        self.writer()
-            .write_all(bytes)
-            .map_err(|e| CliError::file(&name, format!("cannot write: {e}")))
+        // The name is borrowed only on an error: this runs once a row.
+        let written = self.writer().write_all(bytes);
+        written.map_err(|e| CliError::file(&self.name, format!("cannot write: {e}")))
     }
 
     /// Finishes the output. A replaced file is flushed, synced to disk and renamed over

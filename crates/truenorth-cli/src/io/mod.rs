@@ -10,8 +10,8 @@
 //!   column named twice is an error;
 //! * [`RowReader`]: the streaming read, one row at a time, the requested columns by name as
 //!   `f64` with the row number for messages, time order checked on the way; memory does not
-//!   grow with the file; the splitting and parsing run on a second thread a few blocks of
-//!   rows ahead, so that they overlap the command's own work;
+//!   grow with the file; the reading runs on a second thread and the splitting and parsing
+//!   on two more, a few blocks of rows ahead, so that they overlap the command's own work;
 //! * [`Table`]: the whole-table read built on it;
 //! * [`log_input`]: a PX4 ULog or ROS 2 MCAP input, found by its magic number, read as the
 //!   CSV the command takes (the topic options flatten into [`InputOptions`]).
@@ -32,6 +32,9 @@
 
 mod atomic_write;
 mod calibration_file;
+#[cfg(test)]
+mod chunk_boundaries;
+mod chunks;
 mod closest_name;
 mod columns;
 mod compass_physics;

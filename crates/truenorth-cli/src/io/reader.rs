@@ -13,10 +13,13 @@
 
 use std::path::{Path, PathBuf};
 
+use super::chunks::{Chunk, ChunkCutter};
 use super::columns::{ColumnSource, Delimiter, Header, InputOptions};
 use super::errln;
-use super::records::{RecordError, Records, parse_number, shown};
-use super::row_blocks::{RowBlocks, RowSource};
+use super::records::{
+    MAX_LINE_BYTES, RecordError, Records, parse_number, record_bounds, shown, split_fields,
+};
+use super::row_blocks::{BLOCK_ROWS, Block, ChunkParser, RowBlocks};
 use super::source::InputPath;
 use super::{CliError, CliResult};
 
@@ -72,14 +75,17 @@ impl std::ops::Index<usize> for Row {
 }
 
 /// A streaming reader of the requested numeric columns of a CSV (see the module
-/// documentation). It holds one row at a time; the file is split and parsed on a second
-/// thread, a few blocks of rows ahead (see the `row_blocks` module), with the same numbers
-/// and errors as a read on one thread.
+/// documentation). It holds one row at a time; the file is read on a second thread and
+/// parsed, in chunks, on two more, a few blocks of rows ahead (see the `row_blocks`
+/// module), with the same numbers and errors as a read on one thread.
 pub struct RowReader {
     path: PathBuf,
     names: Vec<String>,
     blocks: RowBlocks,
     row: Row,
+    /// Rows handed out and not yet added to the process's count (added when dropped: one
+    /// atomic addition a reader, not a row).
+    handed: u64,
 }
 
 impl std::fmt::Debug for RowReader {
@@ -91,20 +97,16 @@ impl std::fmt::Debug for RowReader {
     }
 }
 
-/// The parsing of the rows after the header: split, convert, check (run on the reader
-/// thread).
+/// The parsing of the rows after the header: split, convert, check (shared by the
+/// parsing threads, each on its own chunks of lines).
 struct RowParser {
     path: PathBuf,
-    records: Records,
+    delimiter: Delimiter,
     columns: Vec<(ColumnSource, bool)>,
     increasing: Option<usize>,
-    previous: Option<f64>,
     /// The header's field count: a row with more fields is refused, as is a last line
     /// without a line break that has fewer.
     width: usize,
-    /// With `--no-header`: the first record, read to count the columns, is still to be
-    /// returned.
-    pending: bool,
 }
 
 impl RowReader {
@@ -115,6 +117,19 @@ impl RowReader {
     /// A left-handed `--axes` (a mirror image of frd) is allowed, with a warning on stderr:
     /// it reverses every turn.
     pub fn open(input: &InputPath, opts: &InputOptions, spec: &ReadSpec<'_>) -> CliResult<Self> {
+        Self::open_chunked(input, opts, spec, BLOCK_ROWS, None)
+    }
+
+    /// [`RowReader::open`] with chunks of at most `chunk_lines` lines and `workers`
+    /// parsing threads (`None`: as many as the machine has cores, up to two), so that
+    /// tests can put chunk boundaries anywhere.
+    pub(crate) fn open_chunked(
+        input: &InputPath,
+        opts: &InputOptions,
+        spec: &ReadSpec<'_>,
+        chunk_lines: usize,
+        workers: Option<usize>,
+    ) -> CliResult<Self> {
         let path = input.display_path();
         let mut records = Records::new(input.open()?, Delimiter::Whitespace);
         let more = records
@@ -170,15 +185,19 @@ impl RowReader {
         let names = columns.iter().map(|(c, _)| c.name.clone()).collect();
         let parser = RowParser {
             path: path.clone(),
-            records,
+            delimiter,
             columns,
             increasing,
-            previous: None,
             width: header.names().len(),
-            pending: opts.no_header,
         };
-        let blocks = RowBlocks::spawn(parser, n)
-            .map_err(|e| CliError::file(&path, format!("cannot start the reader: {e}")))?;
+        // With `--no-header` the first record is data: the parsers read it again.
+        let (source, rest, lines, eof) = records.into_rest(opts.no_header);
+        let cutter = ChunkCutter::new(source, rest, lines, eof, chunk_lines);
+        let blocks = match workers {
+            None => RowBlocks::spawn(cutter, parser, n),
+            Some(w) => RowBlocks::spawn_with(cutter, std::sync::Arc::new(parser), n, w),
+        }
+        .map_err(|e| CliError::file(&path, format!("cannot start the reader: {e}")))?;
         Ok(Self {
             path,
             names,
@@ -187,6 +206,7 @@ impl RowReader {
                 number: header_row,
                 values: vec![0.0; n],
             },
+            handed: 0,
         })
     }
 
@@ -212,7 +232,7 @@ impl RowReader {
         match self.blocks.next_into(&mut self.row.values)? {
             Some(number) => {
                 self.row.number = number;
-                ROWS_READ.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                self.handed += 1;
                 Ok(Some(&self.row))
             }
             None => Ok(None),
@@ -220,16 +240,80 @@ impl RowReader {
     }
 }
 
-impl RowSource for RowParser {
-    fn parse_next(&mut self, values: &mut [f64]) -> CliResult<Option<usize>> {
-        if !std::mem::take(&mut self.pending) {
-            let more = self.records.advance().map_err(|e| self.record_error(&e))?;
-            if !more {
-                return Ok(None);
+impl ChunkParser for RowParser {
+    fn parse_chunk(&self, chunk: &Chunk, block: &mut Block, spans: &mut Vec<(usize, usize)>) {
+        let bytes = chunk.lines();
+        let mut number = chunk.line_before;
+        let mut at = 0;
+        while at < bytes.len() {
+            let (line, unterminated) = match memchr::memchr(b'\n', &bytes[at..]) {
+                Some(i) => (&bytes[at..at + i], false),
+                None => (&bytes[at..], true),
+            };
+            at += line.len() + 1;
+            number += 1;
+            if line.len() > MAX_LINE_BYTES {
+                block.end = Some(Err(self.record_error(number, &RecordError::TooLong)));
+                return;
             }
+            let Some((a, b)) = record_bounds(line) else {
+                continue;
+            };
+            split_fields(line, a, b, self.delimiter, spans);
+            let start = block.values.len();
+            let row = self.parse_row(
+                number,
+                line,
+                spans,
+                unterminated,
+                &mut block.values,
+                &mut block.last_increasing,
+            );
+            if let Err(e) = row {
+                block.values.truncate(start);
+                block.end = Some(Err(e));
+                return;
+            }
+            block.numbers.push(number);
         }
-        let number = self.records.line();
-        let fields = self.records.len();
+        block.end = chunk.end.as_ref().map(|end| match end {
+            Ok(()) => Ok(()),
+            Err((row, e)) => Err(self.record_error(*row, e)),
+        });
+    }
+
+    fn increasing(&self) -> Option<usize> {
+        self.increasing
+    }
+
+    fn not_after(&self, number: usize, t: f64, previous: f64) -> CliError {
+        let k = self.increasing.unwrap_or_default();
+        CliError::row(
+            &self.path,
+            number,
+            format!(
+                "{} = {t} does not come after the previous row's {previous}; sort by time and drop duplicates",
+                self.columns[k].0.name
+            ),
+        )
+    }
+}
+
+impl RowParser {
+    /// Converts and checks the record of row `number` (its fields at `spans` in `line`),
+    /// appending its values to `values` (some of them on an error); `previous` is the
+    /// increasing column's last number in the chunk.
+    fn parse_row(
+        &self,
+        number: usize,
+        line: &[u8],
+        spans: &[(usize, usize)],
+        unterminated: bool,
+        values: &mut Vec<f64>,
+        previous: &mut Option<f64>,
+    ) -> CliResult {
+        let start = values.len();
+        let fields = spans.len();
         if fields > self.width {
             return Err(CliError::row(
                 &self.path,
@@ -240,7 +324,7 @@ impl RowSource for RowParser {
                 ),
             ));
         }
-        if fields < self.width && self.records.unterminated() {
+        if fields < self.width && unterminated {
             return Err(CliError::row(
                 &self.path,
                 number,
@@ -250,17 +334,20 @@ impl RowSource for RowParser {
                 ),
             ));
         }
-        for (k, (c, required)) in self.columns.iter().enumerate() {
-            let cell = self.records.field(c.index).ok_or_else(|| {
-                CliError::row(
-                    &self.path,
-                    number,
-                    format!(
-                        "has {fields} fields, the header {}: no value for `{}`",
-                        self.width, c.name
-                    ),
-                )
-            })?;
+        for (c, required) in &self.columns {
+            let cell = spans
+                .get(c.index)
+                .map(|&(a, b)| &line[a..b])
+                .ok_or_else(|| {
+                    CliError::row(
+                        &self.path,
+                        number,
+                        format!(
+                            "has {fields} fields, the header {}: no value for `{}`",
+                            self.width, c.name
+                        ),
+                    )
+                })?;
             let v = if cell.is_empty() && !required {
                 f64::NAN
             } else {
@@ -279,27 +366,29 @@ impl RowSource for RowParser {
                     format!("column `{}`: `{}` is not finite", c.header, shown(cell)),
                 ));
             }
-            values[k] = c.sign * v;
+            values.push(c.sign * v);
         }
         if let Some(k) = self.increasing {
-            let t = values[k];
-            if let Some(prev) = self.previous
+            let t = values[start + k];
+            if let Some(prev) = *previous
                 && t.partial_cmp(&prev) != Some(std::cmp::Ordering::Greater)
             {
-                return Err(CliError::row(
-                    &self.path,
-                    number,
-                    format!(
-                        "{} = {t} does not come after the previous row's {prev}; sort by time and drop duplicates",
-                        self.columns[k].0.name
-                    ),
-                ));
+                return Err(self.not_after(number, t, prev));
             }
             if !t.is_nan() {
-                self.previous = Some(t);
+                *previous = Some(t);
             }
         }
-        Ok(Some(number))
+        Ok(())
+    }
+
+    /// A record that could not be read at row `number`, as the error naming its row.
+    fn record_error(&self, number: usize, e: &RecordError) -> CliError {
+        let what = match e {
+            RecordError::Io(_) => e.to_string(),
+            RecordError::TooLong => format!("malformed CSV: {e}"),
+        };
+        CliError::row(&self.path, number.max(1), what)
     }
 }
 
@@ -307,20 +396,15 @@ impl RowSource for RowParser {
 /// results table.
 static ROWS_READ: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
 
-/// How many rows the process's readers have handed to their commands so far.
-pub fn rows_read() -> u64 {
-    ROWS_READ.load(std::sync::atomic::Ordering::Relaxed)
+impl Drop for RowReader {
+    fn drop(&mut self) {
+        ROWS_READ.fetch_add(self.handed, std::sync::atomic::Ordering::Relaxed);
+    }
 }
 
-impl RowParser {
-    /// A record that could not be read, as the error naming its row.
-    fn record_error(&self, e: &RecordError) -> CliError {
-        let what = match e {
-            RecordError::Io(_) => e.to_string(),
-            RecordError::TooLong => format!("malformed CSV: {e}"),
-        };
-        CliError::row(&self.path, self.records.line().max(1), what)
-    }
+/// How many rows the process's readers (those dropped) have handed to their commands.
+pub fn rows_read() -> u64 {
+    ROWS_READ.load(std::sync::atomic::Ordering::Relaxed)
 }
 
 impl Iterator for RowReader {

@@ -13,6 +13,11 @@ use super::columns::Delimiter;
 /// hundred bytes), and small enough that a file with no line breaks fails at once.
 pub const MAX_LINE_BYTES: usize = 64 * 1024;
 
+/// The read buffer (1 MiB): lines are split where they lie in it, so that a row is never
+/// copied; large enough that refilling it (and moving the line cut at its end to the
+/// front) costs nothing beside parsing the rows in it. Holds at least one longest line.
+const BUFFER_BYTES: usize = 1 << 20;
+
 /// The UTF-8 byte-order mark a spreadsheet may put before the header.
 const BOM: &[u8] = b"\xef\xbb\xbf";
 
@@ -42,14 +47,24 @@ impl std::fmt::Display for RecordError {
 /// skipped (and counted, so that row numbers are the file's line numbers). A field may be
 /// enclosed in double quotes, which are dropped; a quoted field cannot span lines (sensor
 /// logs never need it).
+///
+/// The lines are split where they lie in one large read buffer; only the part of a line
+/// cut by the end of the buffer is moved, to the front, before the buffer is refilled.
 pub struct Records {
     source: Box<dyn BufRead + Send>,
     delimiter: Delimiter,
-    line: Vec<u8>,
+    buffer: Vec<u8>,
+    /// The bytes read: `buffer[..filled]`.
+    filled: usize,
+    /// The current line: `buffer[start..end]`, without its line break.
+    start: usize,
+    end: usize,
+    /// Where the next line starts.
+    next: usize,
+    /// Whether the source has ended.
+    eof: bool,
     spans: Vec<(usize, usize)>,
     line_number: usize,
-    /// Whether the current record's line ended without a line break (the file's last).
-    unterminated: bool,
 }
 
 impl Records {
@@ -58,10 +73,14 @@ impl Records {
         Self {
             source,
             delimiter,
-            line: Vec::with_capacity(256),
+            buffer: vec![0; BUFFER_BYTES],
+            filled: 0,
+            start: 0,
+            end: 0,
+            next: 0,
+            eof: false,
             spans: Vec::new(),
             line_number: 0,
-            unterminated: false,
         }
     }
 
@@ -69,84 +88,66 @@ impl Records {
     /// is the row that failed.
     pub fn advance(&mut self) -> Result<bool, RecordError> {
         loop {
-            self.line.clear();
-            let limit = MAX_LINE_BYTES as u64 + 1;
-            let n = (&mut self.source)
-                .take(limit)
-                .read_until(b'\n', &mut self.line)
-                .map_err(|e| {
-                    self.line_number += 1;
-                    RecordError::Io(e.to_string())
-                })?;
-            if n == 0 {
+            if !self.next_line()? {
                 return Ok(false);
             }
-            self.line_number += 1;
-            self.unterminated = self.line.last() != Some(&b'\n');
-            if self.unterminated && self.line.len() > MAX_LINE_BYTES {
-                return Err(RecordError::TooLong);
+            let line = &self.buffer[self.start..self.end];
+            if let Some((a, b)) = record_bounds(line) {
+                split_fields(line, a, b, self.delimiter, &mut self.spans);
+                return Ok(true);
             }
-            let (a, b) = self.content();
-            let text = &self.line[a..b];
-            if text.is_empty() || text[0] == b'#' {
-                continue;
-            }
-            self.split(a, b);
-            return Ok(true);
         }
     }
 
-    /// The current line without its byte-order mark, line break and surrounding blanks.
-    fn content(&self) -> (usize, usize) {
-        let line = &self.line[..];
-        let a = if line.starts_with(BOM) { BOM.len() } else { 0 };
-        trim(line, a, line.len())
+    /// Moves to the next line (a record or not), reading more of the source when the
+    /// buffer holds no whole line; `Ok(false)` at the end of the source.
+    fn next_line(&mut self) -> Result<bool, RecordError> {
+        loop {
+            let rest = &self.buffer[self.next..self.filled];
+            if let Some(i) = memchr::memchr(b'\n', rest) {
+                self.line_number += 1;
+                if i > MAX_LINE_BYTES {
+                    return Err(RecordError::TooLong);
+                }
+                (self.start, self.end) = (self.next, self.next + i);
+                self.next += i + 1;
+                return Ok(true);
+            }
+            if rest.len() > MAX_LINE_BYTES {
+                self.line_number += 1;
+                return Err(RecordError::TooLong);
+            }
+            if self.eof {
+                if rest.is_empty() {
+                    return Ok(false);
+                }
+                self.line_number += 1;
+                (self.start, self.end) = (self.next, self.filled);
+                self.next = self.filled;
+                return Ok(true);
+            }
+            self.refill().inspect_err(|_| self.line_number += 1)?;
+        }
     }
 
-    /// Finds the fields of `line[a..b]`.
-    fn split(&mut self, a: usize, b: usize) {
-        self.spans.clear();
-        let line = &self.line[..b];
-        match self.delimiter {
-            // Without a quote on the line (a sensor log's rows), every delimiter splits: one
-            // comparison a byte.
-            Delimiter::Byte(d) if !line[a..].contains(&b'"') => {
-                let mut start = a;
-                for (i, &c) in line.iter().enumerate().skip(a) {
-                    if c == d {
-                        self.spans.push(field_span(line, start, i));
-                        start = i + 1;
-                    }
+    /// Moves the unread bytes to the front and reads more after them (at least one byte,
+    /// or sets `eof`).
+    fn refill(&mut self) -> Result<(), RecordError> {
+        self.buffer.copy_within(self.next..self.filled, 0);
+        self.filled -= self.next;
+        (self.start, self.end, self.next) = (0, 0, 0);
+        loop {
+            match self.source.read(&mut self.buffer[self.filled..]) {
+                Ok(0) => {
+                    self.eof = true;
+                    return Ok(());
                 }
-                self.spans.push(field_span(line, start, b));
-            }
-            Delimiter::Byte(d) => {
-                let mut start = a;
-                let mut quoted = false;
-                for (i, &c) in line.iter().enumerate().skip(a) {
-                    if c == b'"' {
-                        quoted = !quoted;
-                    } else if c == d && !quoted {
-                        self.spans.push(field_span(line, start, i));
-                        start = i + 1;
-                    }
+                Ok(n) => {
+                    self.filled += n;
+                    return Ok(());
                 }
-                self.spans.push(field_span(line, start, b));
-            }
-            _ => {
-                let mut i = a;
-                while i < b {
-                    while i < b && is_blank(line[i]) {
-                        i += 1;
-                    }
-                    let s = i;
-                    while i < b && !is_blank(line[i]) {
-                        i += 1;
-                    }
-                    if i > s {
-                        self.spans.push((s, i));
-                    }
-                }
+                Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
+                Err(e) => return Err(RecordError::Io(e.to_string())),
             }
         }
     }
@@ -155,20 +156,23 @@ impl Records {
     /// the first line has shown which it is).
     pub fn resplit(&mut self, delimiter: Delimiter) {
         self.delimiter = delimiter;
-        let (a, b) = self.content();
-        self.split(a, b);
+        let line = &self.buffer[self.start..self.end];
+        let (a, b) = record_bounds(line).unwrap_or((0, 0));
+        split_fields(line, a, b, delimiter, &mut self.spans);
     }
 
     /// The current record's line as text (without byte-order mark, line break and
     /// surrounding blanks; invalid UTF-8 replaced).
     pub fn text(&self) -> String {
-        let (a, b) = self.content();
-        String::from_utf8_lossy(&self.line[a..b]).into_owned()
+        let line = &self.buffer[self.start..self.end];
+        let (a, b) = record_bounds(line).unwrap_or((0, 0));
+        String::from_utf8_lossy(&line[a..b]).into_owned()
     }
 
     /// Field `i` of the current record, as bytes.
     pub fn field(&self, i: usize) -> Option<&[u8]> {
-        self.spans.get(i).map(|&(a, b)| &self.line[a..b])
+        let line = &self.buffer[self.start..self.end];
+        self.spans.get(i).map(|&(a, b)| &line[a..b])
     }
 
     /// Number of fields of the current record.
@@ -181,9 +185,26 @@ impl Records {
         self.line_number
     }
 
-    /// Whether the current record is the file's last line and has no line break after it.
+    /// Whether the current record is the file's last line and has no line break after it
+    /// (the next line would start right after it). The parsers see this in their chunks.
+    #[cfg(test)]
     pub fn unterminated(&self) -> bool {
-        self.unterminated
+        self.next == self.end
+    }
+
+    /// Ends the line-by-line read: the source, the bytes read from it and not yet returned
+    /// as records (from the current record's line on when `again`, else from the line
+    /// after it), the number of lines before those bytes, and whether the source has ended.
+    pub fn into_rest(self, again: bool) -> (Box<dyn BufRead + Send>, Vec<u8>, usize, bool) {
+        let (from, lines) = if again {
+            (self.start, self.line_number.saturating_sub(1))
+        } else {
+            (self.next, self.line_number)
+        };
+        let mut buffer = self.buffer;
+        buffer.truncate(self.filled);
+        buffer.drain(..from);
+        (self.source, buffer, lines, self.eof)
     }
 
     /// The fields of the current record as text (invalid UTF-8 replaced), for a header.
@@ -192,6 +213,73 @@ impl Records {
             .map(|i| String::from_utf8_lossy(self.field(i).unwrap_or_default()).into_owned())
             .collect()
     }
+}
+
+/// The record in `line` (without its line break): the byte range left after a byte-order
+/// mark and surrounding blanks, or `None` for a blank or `#` comment line.
+pub fn record_bounds(line: &[u8]) -> Option<(usize, usize)> {
+    let a = if line.starts_with(BOM) { BOM.len() } else { 0 };
+    let (a, b) = trim(line, a, line.len());
+    (a < b && line[a] != b'#').then_some((a, b))
+}
+
+/// Finds the fields of the record `line[a..b]` into `spans` (cleared first).
+pub fn split_fields(
+    line: &[u8],
+    a: usize,
+    b: usize,
+    delimiter: Delimiter,
+    spans: &mut Vec<(usize, usize)>,
+) {
+    spans.clear();
+    let line = &line[..b];
+    match delimiter {
+        Delimiter::Byte(d) => {
+            // Without a quote on the line (a sensor log's rows), every delimiter splits: one
+            // pass, two comparisons a byte; a quote starts over with the quote-aware split.
+            let mut start = a;
+            for (i, &c) in line.iter().enumerate().skip(a) {
+                if c == d {
+                    spans.push(field_span(line, start, i));
+                    start = i + 1;
+                } else if c == b'"' {
+                    return split_quoted(line, a, d, spans);
+                }
+            }
+            spans.push(field_span(line, start, b));
+        }
+        _ => {
+            let mut i = a;
+            while i < b {
+                while i < b && is_blank(line[i]) {
+                    i += 1;
+                }
+                let s = i;
+                while i < b && !is_blank(line[i]) {
+                    i += 1;
+                }
+                if i > s {
+                    spans.push((s, i));
+                }
+            }
+        }
+    }
+}
+
+/// The fields of `line[a..]` split at `d` outside double quotes.
+fn split_quoted(line: &[u8], a: usize, d: u8, spans: &mut Vec<(usize, usize)>) {
+    spans.clear();
+    let mut start = a;
+    let mut quoted = false;
+    for (i, &c) in line.iter().enumerate().skip(a) {
+        if c == b'"' {
+            quoted = !quoted;
+        } else if c == d && !quoted {
+            spans.push(field_span(line, start, i));
+            start = i + 1;
+        }
+    }
+    spans.push(field_span(line, start, line.len()));
 }
 
 fn is_blank(c: u8) -> bool {
@@ -309,6 +397,23 @@ mod tests {
         let mut text = vec![b'1'; MAX_LINE_BYTES - 1];
         text.push(b'\n');
         assert_eq!(all(&text, Delimiter::Byte(b',')).unwrap().len(), 1);
+    }
+
+    #[test]
+    fn lines_cut_by_the_end_of_the_buffer_are_read_whole() {
+        // More than one buffer of lines: the line cut by the end of the first read is moved
+        // to the front and completed by the next.
+        let text: String = (0..120_000).map(|k| format!("{k},{}\n", k * 7)).collect();
+        assert!(text.len() > BUFFER_BYTES);
+        let source = std::io::BufReader::new(std::io::Cursor::new(text));
+        let mut r = Records::new(Box::new(source), Delimiter::Byte(b','));
+        let mut k = 0usize;
+        while r.advance().unwrap() {
+            assert_eq!(r.line(), k + 1);
+            assert_eq!(r.text_fields(), vec![k.to_string(), (k * 7).to_string()]);
+            k += 1;
+        }
+        assert_eq!(k, 120_000);
     }
 
     #[test]
