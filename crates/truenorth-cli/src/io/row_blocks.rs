@@ -134,18 +134,9 @@ impl RowBlocks {
             .spawn(move || {
                 let mut made = 0usize;
                 for k in 0.. {
-                    // A chunk given back, else a new one while fewer than `chunks` exist.
-                    let mut chunk = match returned.try_recv() {
-                        Ok(c) => c,
-                        Err(TryRecvError::Empty) if made < chunks => {
-                            made += 1;
-                            Chunk::default()
-                        }
-                        Err(_) => match returned.recv() {
-                            Ok(c) => c,
-                            // Every worker has gone: stop reading.
-                            Err(_) => return,
-                        },
+                    // Every worker has gone: stop reading.
+                    let Some(mut chunk) = reuse_or_make(&returned, &mut made, chunks) else {
+                        return;
                     };
                     if !cutter.next_into(&mut chunk) {
                         return;
@@ -244,18 +235,9 @@ fn work(
     let mut made = 0usize;
     let mut spans = Vec::new();
     while let Ok(chunk) = chunks.recv() {
-        // A block given back, else a new one while fewer than BLOCKS exist.
-        let mut block = match empty.try_recv() {
-            Ok(b) => b,
-            Err(TryRecvError::Empty) if made < BLOCKS => {
-                made += 1;
-                Block::default()
-            }
-            Err(_) => match empty.recv() {
-                Ok(b) => b,
-                // The consumer has gone.
-                Err(_) => return,
-            },
+        // The consumer has gone.
+        let Some(mut block) = reuse_or_make(empty, &mut made, BLOCKS) else {
+            return;
         };
         block.clear();
         parser.parse_chunk(&chunk, &mut block, &mut spans);
@@ -264,6 +246,20 @@ fn work(
         if full.send(block).is_err() || last {
             return;
         }
+    }
+}
+
+/// One buffer of a pool of at most `max` reused ones: one given back, else a new one while
+/// fewer than `max` exist (`made` counts them), else the next one given back; `None` once
+/// none can come back (the other end has gone).
+fn reuse_or_make<T: Default>(returned: &Receiver<T>, made: &mut usize, max: usize) -> Option<T> {
+    match returned.try_recv() {
+        Ok(x) => Some(x),
+        Err(TryRecvError::Empty) if *made < max => {
+            *made += 1;
+            Some(T::default())
+        }
+        Err(_) => returned.recv().ok(),
     }
 }
 
