@@ -9,7 +9,7 @@ use std::fmt::Write as _;
 use std::path::Path;
 use std::process::Output;
 
-use common::{binary, p};
+use common::{binary, command_args};
 
 /// The memory share the tests give the fit (bytes), so that a recording of a few ten
 /// thousand rows spills (see `io/reading_spill.rs`).
@@ -58,16 +58,13 @@ fn recording(dims: usize) -> String {
 /// Runs `calibrate` with TMPDIR at `tmp` and, when given, the memory share.
 fn calibrate(method: &str, input: &Path, output: &Path, tmp: &Path, share: Option<&str>) -> Output {
     let mut cmd = binary();
-    cmd.args([
+    cmd.args(command_args(
         "calibrate",
-        "--method",
-        method,
-        "--input",
-        p(input),
-        "--output",
-        p(output),
-        "--accept-poor",
-    ])
+        &["--method", method],
+        input,
+        output,
+        &["--accept-poor"],
+    ))
     .env("TMPDIR", tmp);
     if let Some(s) = share {
         cmd.env("TRUENORTH_TEST_SPILL_MEMORY_BYTES", s);

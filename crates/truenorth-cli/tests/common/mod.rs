@@ -106,7 +106,7 @@ pub fn p(path: &Path) -> &str {
 }
 
 /// `command leading… --input input --output output extra…`, as arguments.
-fn command_args<'a>(
+pub fn command_args<'a>(
     command: &'a str,
     leading: &[&'a str],
     input: &'a Path,
