@@ -16,9 +16,9 @@ use std::path::{Path, PathBuf};
 use super::chunks::{Chunk, ChunkCutter};
 use super::columns::{ColumnSource, Delimiter, Header, InputOptions};
 use super::errln;
-use super::records::{
-    MAX_LINE_BYTES, RecordError, Records, parse_number, record_bounds, shown, split_fields,
-};
+use super::number_parse::parse_number;
+use super::plain_rows::{MOST_FIELDS, PlainRows};
+use super::records::{MAX_LINE_BYTES, RecordError, Records, record_bounds, shown, split_fields};
 use super::row_blocks::{BLOCK_ROWS, Block, ChunkParser, RowBlocks};
 use super::source::InputPath;
 use super::{CliError, CliResult};
@@ -107,6 +107,8 @@ struct RowParser {
     /// The header's field count: a row with more fields is refused, as is a last line
     /// without a line break that has fewer.
     width: usize,
+    /// The one-pass reading of plain rows, where the delimiter allows it.
+    plain: Option<PlainRows>,
 }
 
 impl RowReader {
@@ -183,12 +185,18 @@ impl RowReader {
             .and_then(|n| columns.iter().position(|(c, _)| c.name == n));
         let n = columns.len();
         let names = columns.iter().map(|(c, _)| c.name.clone()).collect();
+        let width = header.names().len();
+        let plain = match delimiter {
+            Delimiter::Byte(d) => PlainRows::new(d, width, columns.iter().map(|(c, _)| c.index)),
+            _ => None,
+        };
         let parser = RowParser {
             path: path.clone(),
             delimiter,
             columns,
             increasing,
-            width: header.names().len(),
+            width,
+            plain,
         };
         // With `--no-header` the first record is data: the parsers read it again.
         let (source, rest, lines, eof) = records.into_rest(opts.no_header);
@@ -244,6 +252,7 @@ impl ChunkParser for RowParser {
     fn parse_chunk(&self, chunk: &Chunk, block: &mut Block, spans: &mut Vec<(usize, usize)>) {
         let bytes = chunk.lines();
         let mut number = chunk.line_before;
+        let mut cells = [0.0; MOST_FIELDS];
         let mut at = 0;
         while at < bytes.len() {
             let (line, unterminated) = match memchr::memchr(b'\n', &bytes[at..]) {
@@ -256,11 +265,30 @@ impl ChunkParser for RowParser {
                 block.end = Some(Err(self.record_error(number, &RecordError::TooLong)));
                 return;
             }
+            let start = block.values.len();
+            if let Some(plain) = &self.plain
+                && plain.read(line, &mut cells)
+            {
+                block
+                    .values
+                    .extend(self.columns.iter().map(|(c, _)| c.sign * cells[c.index]));
+                let row = self.check_increasing(
+                    number,
+                    &block.values[start..],
+                    &mut block.last_increasing,
+                );
+                if let Err(e) = row {
+                    block.values.truncate(start);
+                    block.end = Some(Err(e));
+                    return;
+                }
+                block.numbers.push(number);
+                continue;
+            }
             let Some((a, b)) = record_bounds(line) else {
                 continue;
             };
             split_fields(line, a, b, self.delimiter, spans);
-            let start = block.values.len();
             let row = self.parse_row(
                 number,
                 line,
@@ -368,8 +396,19 @@ impl RowParser {
             }
             values.push(c.sign * v);
         }
+        self.check_increasing(number, &values[start..], previous)
+    }
+
+    /// Checks that the increasing column of row `number` (its `values`) comes after
+    /// `previous`, the column's last number in the chunk, which it then becomes.
+    fn check_increasing(
+        &self,
+        number: usize,
+        values: &[f64],
+        previous: &mut Option<f64>,
+    ) -> CliResult {
         if let Some(k) = self.increasing {
-            let t = values[start + k];
+            let t = values[k];
             if let Some(prev) = *previous
                 && t.partial_cmp(&prev) != Some(std::cmp::Ordering::Greater)
             {

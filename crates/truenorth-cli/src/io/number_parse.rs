@@ -1,0 +1,149 @@
+//! Numbers read from the cells of a CSV, from their bytes.
+//!
+//! A sensor log's cells are short plain decimals (`-12.345`). Those take a fast path: the
+//! digits are gathered into one integer `m` and divided by `10^f`, `f` the number of
+//! fraction digits. When `m < 2^53` and `f ≤ 22` both operands are exact `f64`s, so the one
+//! correctly rounded division gives the correctly rounded value of the decimal (Clinger,
+//! "How to read floating point numbers accurately", PLDI 1990, the fast path), the same
+//! `f64` a full parser gives. Any other cell (an exponent, a `+`, more digits, `inf`, text)
+//! goes to `fast_float2`, which is correctly rounded too, so the result never depends on
+//! the path taken.
+
+/// `10^k` for `k ≤ 22`: every one exact in an `f64` (5^22 < 2^53).
+const POWERS_OF_TEN: [f64; 23] = [
+    1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15, 1e16,
+    1e17, 1e18, 1e19, 1e20, 1e21, 1e22,
+];
+
+/// The largest integer below which every integer is exact in an `f64`.
+const EXACT_INTEGERS: u64 = 1 << 53;
+
+/// Parses a numeric cell from its bytes (decimal point, optional exponent; `inf` and `nan`
+/// are read as such, for the caller to refuse).
+pub fn parse_number(cell: &[u8]) -> Option<f64> {
+    plain_decimal(cell).or_else(|| fast_float2::parse::<f64, _>(cell).ok())
+}
+
+/// The value of a cell of the form `-?[0-9]+(\.[0-9]+)?` whose digits fit the fast path,
+/// else `None` (which says nothing about whether the cell is a number).
+#[inline]
+fn plain_decimal(cell: &[u8]) -> Option<f64> {
+    plain_decimal_prefix(cell).and_then(|(v, used)| (used == cell.len()).then_some(v))
+}
+
+/// The value of the longest prefix of `bytes` of the form `-?[0-9]+(\.[0-9]+)?` and its
+/// length in bytes, if its digits fit the fast path (at most 19, an integer below 2^53);
+/// else `None`. What follows the prefix is for the caller to judge.
+#[inline]
+pub fn plain_decimal_prefix(bytes: &[u8]) -> Option<(f64, usize)> {
+    let negative = bytes.first() == Some(&b'-');
+    let mut i = usize::from(negative);
+    // Wrapping: more than 19 digits (which could overflow) are refused below.
+    let mut m: u64 = 0;
+    let whole_start = i;
+    while let Some(d) = bytes
+        .get(i)
+        .map(|c| c.wrapping_sub(b'0'))
+        .filter(|d| *d < 10)
+    {
+        m = m.wrapping_mul(10).wrapping_add(u64::from(d));
+        i += 1;
+    }
+    let whole = i - whole_start;
+    let mut fraction = 0;
+    if bytes.get(i) == Some(&b'.') {
+        let start = i + 1;
+        i = start;
+        while let Some(d) = bytes
+            .get(i)
+            .map(|c| c.wrapping_sub(b'0'))
+            .filter(|d| *d < 10)
+        {
+            m = m.wrapping_mul(10).wrapping_add(u64::from(d));
+            i += 1;
+        }
+        fraction = i - start;
+        if fraction == 0 {
+            return None;
+        }
+    }
+    if whole == 0 || whole + fraction > 19 || m >= EXACT_INTEGERS {
+        return None;
+    }
+    let magnitude = m as f64 / POWERS_OF_TEN[fraction];
+    Some((if negative { -magnitude } else { magnitude }, i))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    fn full(cell: &[u8]) -> Option<f64> {
+        fast_float2::parse::<f64, _>(cell).ok()
+    }
+
+    fn same(a: Option<f64>, b: Option<f64>) -> bool {
+        match (a, b) {
+            (Some(x), Some(y)) => x.to_bits() == y.to_bits() || (x.is_nan() && y.is_nan()),
+            (None, None) => true,
+            _ => false,
+        }
+    }
+
+    #[test]
+    fn numbers_plain_and_not() {
+        assert_eq!(parse_number(b"-1.5e3"), Some(-1500.0));
+        assert_eq!(parse_number(b"+2"), Some(2.0));
+        assert_eq!(parse_number(b"1,5"), None);
+        assert_eq!(parse_number(b""), None);
+        assert_eq!(parse_number(b"-"), None);
+        assert_eq!(parse_number(b"0.1"), Some(0.1));
+        assert_eq!(
+            parse_number(b"-0").map(f64::to_bits),
+            Some((-0.0f64).to_bits())
+        );
+        assert_eq!(
+            parse_number(b"9007199254740993"),
+            Some(9_007_199_254_740_992.0)
+        );
+        assert!(parse_number(b"inf").is_some_and(f64::is_infinite));
+        // The fast path takes these, the full parser the rest.
+        assert!(plain_decimal(b"-12.345").is_some());
+        assert!(plain_decimal(b"9007199254740993").is_none());
+        assert!(plain_decimal(b"1.").is_none() && plain_decimal(b".5").is_none());
+    }
+
+    proptest! {
+        /// Whatever the cell, the value (or its absence) is bit for bit the full parser's:
+        /// plain decimals of every length around the fast path's limits, and any text.
+        #[test]
+        fn the_fast_path_never_changes_a_value(
+            sign in prop::sample::select(vec!["", "-", "+"]),
+            whole in "[0-9]{0,22}",
+            point in prop::bool::ANY,
+            fraction in "[0-9]{0,25}",
+            tail in prop::sample::select(vec!["", "e3", "e-400", "x", ".", " "]),
+        ) {
+            let cell = format!("{sign}{whole}{}{fraction}{tail}", if point { "." } else { "" });
+            let b = cell.as_bytes();
+            prop_assert!(same(parse_number(b), full(b)), "{cell}");
+        }
+
+        #[test]
+        fn any_bytes_parse_as_the_full_parser_does(cell in prop::collection::vec(any::<u8>(), 0..30)) {
+            prop_assert!(same(parse_number(&cell), full(&cell)));
+        }
+
+        /// Every finite f64 written shortest, or with a few decimals, reads back as the
+        /// full parser reads it.
+        #[test]
+        fn written_doubles_read_back_alike(bits in any::<u64>(), decimals in 0usize..20) {
+            let v = f64::from_bits(bits);
+            prop_assume!(v.is_finite());
+            for text in [format!("{v}"), format!("{v:.decimals$}")] {
+                prop_assert!(same(parse_number(text.as_bytes()), full(text.as_bytes())), "{text}");
+            }
+        }
+    }
+}
