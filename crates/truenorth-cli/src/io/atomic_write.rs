@@ -11,7 +11,6 @@ use std::io::{BufWriter, ErrorKind, Write};
 use std::path::{Path, PathBuf};
 
 use super::console::end_on_closed_pipe;
-use super::number_format::Precision;
 use super::output_target::OutputTarget;
 use super::source::InputPath;
 use super::temporaries;
@@ -214,66 +213,6 @@ pub fn write_atomically(
     out.commit()
 }
 
-/// A CSV written row by row into an `AtomicOutput`: numbers in Rust's shortest form that
-/// reads back to the same `f64`.
-pub struct CsvOutput {
-    out: AtomicOutput,
-    line: String,
-}
-
-impl std::fmt::Debug for CsvOutput {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("CsvOutput")
-            .field("out", &self.out)
-            .finish_non_exhaustive()
-    }
-}
-
-impl CsvOutput {
-    /// Starts `path` (`-`: standard output) with its header row.
-    pub fn create(path: &Path, header: &[&str]) -> CliResult<Self> {
-        let mut out = AtomicOutput::create(path)?;
-        out.write_all((header.join(",") + "\n").as_bytes())?;
-        Ok(Self {
-            out,
-            line: String::new(),
-        })
-    }
-
-    /// Appends one row, the numbers written at `precision` (see [`Precision`]); a NaN is
-    /// written as an empty cell (no value, as an empty cell reads on input).
-    pub fn row(&mut self, values: &[f64], precision: Precision) -> CliResult {
-        self.line.clear();
-        for (k, &v) in values.iter().enumerate() {
-            if k > 0 {
-                self.line.push(',');
-            }
-            precision.write(&mut self.line, v);
-        }
-        self.line.push('\n');
-        self.out.write_all(self.line.as_bytes())
-    }
-
-    /// Finishes the file (see [`AtomicOutput::commit`]).
-    pub fn commit(self) -> CliResult {
-        self.out.commit()
-    }
-}
-
-/// Writes a CSV with a header row and rows of numbers, whole or not at all.
-pub fn write_csv(
-    path: &Path,
-    header: &[&str],
-    rows: impl IntoIterator<Item = Vec<f64>>,
-    precision: Precision,
-) -> CliResult {
-    let mut out = CsvOutput::create(path, header)?;
-    for r in rows {
-        out.row(&r, precision)?;
-    }
-    out.commit()
-}
-
 /// Refuses an output path that names one of the inputs (it would destroy the recording),
 /// before anything is read: the same path, the same file through a link, or the same file
 /// under another name (same device and inode). Standard input and output never clash, nor
@@ -328,6 +267,7 @@ fn same_file(a: &Path, b: &Path) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::io::{CsvOutput, Precision, write_csv};
 
     fn dir(tag: &str) -> tempfile::TempDir {
         crate::io::scratch::scratch_dir(&format!("atomic-{tag}"))

@@ -39,6 +39,7 @@ mod closest_name;
 mod columns;
 mod compass_physics;
 mod console;
+mod csv_output;
 mod direction_spans;
 mod error;
 mod gyro_axes;
@@ -65,7 +66,7 @@ mod vehicle_file;
 mod wheel_columns;
 mod yaw_rate_check;
 
-pub use atomic_write::{CsvOutput, check_distinct, write_atomically, write_csv};
+pub use atomic_write::{check_distinct, write_atomically};
 pub use calibration_file::{
     AccelPart, CALIBRATION_FORMAT, CALIBRATION_VERSION, CalibrationFile, CompassCalibration,
     GyroPart, QualityReport, finite, gyro_units, matrix_rows, units_block,
@@ -73,6 +74,7 @@ pub use calibration_file::{
 pub use columns::InputOptions;
 pub(crate) use console::{errln, out, outln};
 pub use console::{write_stderr, write_stdout};
+pub use csv_output::{CsvOutput, write_csv};
 pub use direction_spans::{Inertial, Reference, median, median_magnitude};
 pub use error::{CliError, CliResult, ErrorKind};
 pub use gyro_axes::{
