@@ -37,41 +37,39 @@ fn plain_decimal(cell: &[u8]) -> Option<f64> {
 #[inline]
 pub fn plain_decimal_prefix(bytes: &[u8]) -> Option<(f64, usize)> {
     let negative = bytes.first() == Some(&b'-');
-    let mut i = usize::from(negative);
-    // Wrapping: more than 19 digits (which could overflow) are refused below.
-    let mut m: u64 = 0;
-    let whole_start = i;
+    let start = usize::from(negative);
+    let (at, m) = digits(bytes, start, 0);
+    let whole = at - start;
+    let (at, m, fraction) = if bytes.get(at) == Some(&b'.') {
+        let (end, m) = digits(bytes, at + 1, m);
+        (end, m, end - at - 1)
+    } else {
+        (at, m, 0)
+    };
+    // A point needs a digit on each side; more than 19 digits may have wrapped `m`.
+    if whole == 0 || (at > start + whole && fraction == 0) || whole + fraction > 19 {
+        return None;
+    }
+    if m >= EXACT_INTEGERS {
+        return None;
+    }
+    let magnitude = m as f64 / POWERS_OF_TEN[fraction];
+    Some((if negative { -magnitude } else { magnitude }, at))
+}
+
+/// The run of ASCII digits at `bytes[at..]` appended to `m` (wrapping), and where the run
+/// ends.
+#[inline(always)]
+fn digits(bytes: &[u8], mut at: usize, mut m: u64) -> (usize, u64) {
     while let Some(d) = bytes
-        .get(i)
+        .get(at)
         .map(|c| c.wrapping_sub(b'0'))
         .filter(|d| *d < 10)
     {
         m = m.wrapping_mul(10).wrapping_add(u64::from(d));
-        i += 1;
+        at += 1;
     }
-    let whole = i - whole_start;
-    let mut fraction = 0;
-    if bytes.get(i) == Some(&b'.') {
-        let start = i + 1;
-        i = start;
-        while let Some(d) = bytes
-            .get(i)
-            .map(|c| c.wrapping_sub(b'0'))
-            .filter(|d| *d < 10)
-        {
-            m = m.wrapping_mul(10).wrapping_add(u64::from(d));
-            i += 1;
-        }
-        fraction = i - start;
-        if fraction == 0 {
-            return None;
-        }
-    }
-    if whole == 0 || whole + fraction > 19 || m >= EXACT_INTEGERS {
-        return None;
-    }
-    let magnitude = m as f64 / POWERS_OF_TEN[fraction];
-    Some((if negative { -magnitude } else { magnitude }, i))
+    (at, m)
 }
 
 #[cfg(test)]
@@ -112,6 +110,17 @@ mod tests {
         assert!(plain_decimal(b"-12.345").is_some());
         assert!(plain_decimal(b"9007199254740993").is_none());
         assert!(plain_decimal(b"1.").is_none() && plain_decimal(b".5").is_none());
+    }
+
+    #[test]
+    fn long_and_short_prefixes() {
+        assert_eq!(plain_decimal_prefix(b"-1234567890123456.125,"), None);
+        assert_eq!(
+            plain_decimal_prefix(b"-123456789012.125,7"),
+            Some((-123_456_789_012.125, 17))
+        );
+        assert_eq!(plain_decimal_prefix(b"12.5.3"), Some((12.5, 4)));
+        assert_eq!(plain_decimal_prefix(b"12.,"), None);
     }
 
     proptest! {

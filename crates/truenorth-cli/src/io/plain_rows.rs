@@ -12,6 +12,7 @@
 //! path of `parse_number`), and never an error.
 
 use super::number_parse::plain_decimal_prefix;
+use super::records::MAX_LINE_BYTES;
 
 /// The most fields a row may have to take the fast path (its cells are held on the stack).
 pub const MOST_FIELDS: usize = 64;
@@ -40,49 +41,48 @@ impl PlainRows {
         for k in read {
             *needed.get_mut(k)? = true;
         }
-        Some(Self { delimiter, needed })
+        // A row has at least one field, and one is needed.
+        needed.contains(&true).then_some(Self { delimiter, needed })
     }
 
-    /// Reads `line` (without its line break) if it is plain: the values of the needed
-    /// fields are written into `cells` at their field positions. `false` (with `cells`
-    /// partly written) when the row is not plain and must go to the general path.
+    /// Reads the row at the start of `text` (the rest of a chunk: the row, its line break
+    /// and what follows) if it is plain: the values of the needed fields are written into
+    /// `cells` at their field positions, and the row's length without its line break is
+    /// returned. `None` (with `cells` partly written) when the row is not plain and must go
+    /// to the general path.
     #[inline]
-    pub fn read(&self, line: &[u8], cells: &mut [f64; MOST_FIELDS]) -> bool {
-        let (Some(&first), Some(&last)) = (line.first(), line.last()) else {
-            return false;
-        };
-        // A comment, a byte-order mark (0xEF) or blanks to trim: the general path.
-        if first == b'#'
-            || first == 0xEF
-            || first.is_ascii_whitespace()
-            || last.is_ascii_whitespace()
-        {
-            return false;
+    pub fn read(&self, text: &[u8], cells: &mut [f64; MOST_FIELDS]) -> Option<usize> {
+        // A comment, a byte-order mark (0xEF), or blanks before the row (which may hide a
+        // comment): the general path. Other blanks change nothing here: an unused cell is
+        // not read, a needed one is digits to its end, and trimming never removes a
+        // delimiter (a delimiter is not a blank).
+        match text.first() {
+            Some(&c) if c == b'#' || c == 0xEF || c.is_ascii_whitespace() => return None,
+            _ => {}
         }
         let mut at = 0;
+        let last = self.needed.len() - 1;
         for (field, &needed) in self.needed.iter().enumerate() {
-            let rest = &line[at..];
-            let end = if needed {
-                let Some((v, used)) = plain_decimal_prefix(rest) else {
-                    return false;
-                };
+            let rest = &text[at..];
+            at += if needed {
+                let (v, used) = plain_decimal_prefix(rest)?;
                 cells[field] = v;
                 used
             } else {
                 // A quote could hide a delimiter: stop there, and the row goes to the
                 // general path below. A needed cell stops at a quote as at any byte
                 // that is not part of its number.
-                memchr::memchr2(self.delimiter, b'"', rest).unwrap_or(rest.len())
+                memchr::memchr3(self.delimiter, b'"', b'\n', rest).unwrap_or(rest.len())
             };
-            at += end;
-            let last_field = field + 1 == self.needed.len();
-            match line.get(at) {
-                None if last_field => return true,
-                Some(&c) if c == self.delimiter && !last_field => at += 1,
-                _ => return false,
+            match text.get(at) {
+                Some(&c) if c == self.delimiter && field < last => at += 1,
+                Some(b'\n') | None if field == last => {
+                    return (at <= MAX_LINE_BYTES).then_some(at);
+                }
+                _ => return None,
             }
         }
-        false
+        None
     }
 }
 
@@ -96,8 +96,15 @@ mod tests {
 
     fn read(p: &PlainRows, line: &str) -> Option<Vec<f64>> {
         let mut cells = [f64::NAN; MOST_FIELDS];
-        p.read(line.as_bytes(), &mut cells)
-            .then(|| cells[..p.needed.len()].to_vec())
+        let text = format!("{line}\n9,9,9\n");
+        let plain = p.read(text.as_bytes(), &mut cells);
+        // Terminated or not, a row reads alike.
+        let mut again = [f64::NAN; MOST_FIELDS];
+        assert_eq!(p.read(line.as_bytes(), &mut again), plain, "{line:?}");
+        plain.map(|len| {
+            assert_eq!(len, line.len());
+            cells[..p.needed.len()].to_vec()
+        })
     }
 
     #[test]
@@ -130,6 +137,7 @@ mod tests {
         assert!(PlainRows::new(b' ', 3, [0]).is_none());
         assert!(PlainRows::new(b',', 3, [3]).is_none());
         assert!(PlainRows::new(b',', MOST_FIELDS + 1, [0]).is_none());
+        assert!(PlainRows::new(b',', 3, []).is_none());
     }
 
     proptest! {
@@ -150,12 +158,16 @@ mod tests {
             bom in any::<bool>(),
         ) {
             let width = cells.len();
-            let read: Vec<usize> = (0..width).filter(|&k| needed[k]).collect();
+            let mut read: Vec<usize> = (0..width).filter(|&k| needed[k]).collect();
+            if read.is_empty() {
+                read.push(width - 1);
+            }
             let p = PlainRows::new(delimiter, width, read.iter().copied()).unwrap();
             let mut line = if bom { b"\xef\xbb\xbf".to_vec() } else { Vec::new() };
             line.extend_from_slice(cells.join(&(delimiter as char).to_string()).as_bytes());
             let mut got = [f64::NAN; MOST_FIELDS];
-            if p.read(&line, &mut got) {
+            if let Some(len) = p.read(&line, &mut got) {
+                prop_assert_eq!(len, line.len());
                 let (a, b) = record_bounds(&line).expect("a record");
                 let mut spans = Vec::new();
                 split_fields(&line, a, b, Delimiter::Byte(delimiter), &mut spans);

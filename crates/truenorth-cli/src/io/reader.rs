@@ -255,20 +255,12 @@ impl ChunkParser for RowParser {
         let mut cells = [0.0; MOST_FIELDS];
         let mut at = 0;
         while at < bytes.len() {
-            let (line, unterminated) = match memchr::memchr(b'\n', &bytes[at..]) {
-                Some(i) => (&bytes[at..at + i], false),
-                None => (&bytes[at..], true),
-            };
-            at += line.len() + 1;
             number += 1;
-            if line.len() > MAX_LINE_BYTES {
-                block.end = Some(Err(self.record_error(number, &RecordError::TooLong)));
-                return;
-            }
             let start = block.values.len();
             if let Some(plain) = &self.plain
-                && plain.read(line, &mut cells)
+                && let Some(len) = plain.read(&bytes[at..], &mut cells)
             {
+                at += len + 1;
                 block
                     .values
                     .extend(self.columns.iter().map(|(c, _)| c.sign * cells[c.index]));
@@ -284,6 +276,15 @@ impl ChunkParser for RowParser {
                 }
                 block.numbers.push(number);
                 continue;
+            }
+            let (line, unterminated) = match memchr::memchr(b'\n', &bytes[at..]) {
+                Some(i) => (&bytes[at..at + i], false),
+                None => (&bytes[at..], true),
+            };
+            at += line.len() + 1;
+            if line.len() > MAX_LINE_BYTES {
+                block.end = Some(Err(self.record_error(number, &RecordError::TooLong)));
+                return;
             }
             let Some((a, b)) = record_bounds(line) else {
                 continue;
