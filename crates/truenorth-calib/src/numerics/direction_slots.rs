@@ -39,15 +39,18 @@ impl DirectionSlots {
     }
 
     /// Keeps `p` in the slot of its direction about `centre` (skipped if not finite or at the
-    /// centre).
-    pub(crate) fn push(&mut self, p: &Vector2<f64>, centre: &Vector2<f64>) {
+    /// centre), and returns that direction, `atan2` of `p − centre`, radians (`None` when
+    /// skipped), for a caller that needs it too.
+    pub(crate) fn push(&mut self, p: &Vector2<f64>, centre: &Vector2<f64>) -> Option<f64> {
         let d = p - centre;
         if !(d.x.is_finite() && d.y.is_finite()) || (d.x == 0.0 && d.y == 0.0) {
-            return;
+            return None;
         }
-        let i = ((wrap_two_pi(d.y.atan2(d.x)) / TAU * SLOTS as f64) as usize).min(SLOTS - 1);
+        let direction = d.y.atan2(d.x);
+        let i = ((wrap_two_pi(direction) / TAU * SLOTS as f64) as usize).min(SLOTS - 1);
         self.points[i] = *p;
         self.filled[i] = true;
+        Some(direction)
     }
 
     /// The slots in order, `None` where empty (for saving).

@@ -138,6 +138,10 @@ pub struct MeritCircleCalibrator {
     /// of the kept readings, so the published estimate stays the previous refresh's until
     /// it completes).
     pub(crate) seed: Option<SeedJob>,
+    /// The direction of the last data point about the centre, radians, with the centre and
+    /// point it was computed for: it changes only when either does, so the new-data-point
+    /// test computes one `atan2` a push instead of two.
+    last_direction: Option<(Vector2<f64>, Vector2<f64>, f64)>,
 }
 
 impl Default for MeritCircleCalibrator {
@@ -180,6 +184,7 @@ impl MeritCircleCalibrator {
             estimate: None,
             refresh_due: false,
             seed: None,
+            last_direction: None,
         }
     }
 
@@ -203,8 +208,9 @@ impl MeritCircleCalibrator {
         &self.state
     }
 
-    /// Whether `p` counts as a new heading data point (see the module documentation).
-    fn heading_changed(&self, p: &Vector2<f64>) -> bool {
+    /// Whether `p` counts as a new heading data point (see the module documentation);
+    /// `direction` is `p`'s direction about the current centre when the caller has it.
+    fn heading_changed(&mut self, p: &Vector2<f64>, direction: Option<f64>) -> bool {
         let Some(last) = self.last_point else {
             return true;
         };
@@ -215,8 +221,25 @@ impl MeritCircleCalibrator {
         }
         match self.state.centre {
             Some(c) => {
-                let (a, b) = (p - c, last - c);
-                angle_diff(a.y.atan2(a.x), b.y.atan2(b.x)).abs() >= self.config.min_turn_rad
+                let a = direction.unwrap_or_else(|| {
+                    let a = p - c;
+                    a.y.atan2(a.x)
+                });
+                let b = match self.last_direction {
+                    // Bit for bit: a zero's sign can change an `atan2`.
+                    Some((centre, point, b))
+                        if same_bits(&centre, &c) && same_bits(&point, &last) =>
+                    {
+                        b
+                    }
+                    _ => {
+                        let d = last - c;
+                        let b = d.y.atan2(d.x);
+                        self.last_direction = Some((c, last, b));
+                        b
+                    }
+                };
+                angle_diff(a, b).abs() >= self.config.min_turn_rad
             }
             None => {
                 let spread = (self.hi - self.lo).max();
@@ -380,8 +403,10 @@ impl Calibrator for MeritCircleCalibrator {
         self.lo = self.lo.inf(&p);
         self.hi = self.hi.sup(&p);
         let slot_centre = self.state.centre.unwrap_or((self.lo + self.hi) * 0.5);
-        self.slots.push(&p, &slot_centre);
-        if self.samples <= self.config.warmup_samples || !self.heading_changed(&p) {
+        // About the centre, when there is one, as the new-data-point test wants it.
+        let direction = self.slots.push(&p, &slot_centre);
+        let direction = direction.filter(|_| self.state.centre.is_some());
+        if self.samples <= self.config.warmup_samples || !self.heading_changed(&p, direction) {
             return Ok(pushed);
         }
         // A new heading data point (step d).
@@ -442,4 +467,9 @@ impl OnlineCalibrator for MeritCircleCalibrator {
     fn estimate(&self) -> Option<Solution<CompassCalibration2d>> {
         self.estimate
     }
+}
+
+/// Whether `a` and `b` are the same bits (so any arithmetic on them gives the same result).
+fn same_bits(a: &Vector2<f64>, b: &Vector2<f64>) -> bool {
+    a.x.to_bits() == b.x.to_bits() && a.y.to_bits() == b.y.to_bits()
 }
