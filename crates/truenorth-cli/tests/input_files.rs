@@ -301,3 +301,28 @@ fn a_killed_run_leaves_the_old_output() {
         "the old output is untouched"
     );
 }
+
+/// Written to standard output, a run that stops at a bad row has written every row before
+/// it (the rows are formatted on a writer thread, which gets them all before the run ends),
+/// and the error names the row.
+#[test]
+fn standard_output_carries_every_row_before_an_error() {
+    let dir = common::scratch("input_files", "stdout_error");
+    let rows = common::turn_rows(10_000, 0.01, 25.0, [3.0, -2.0], 0.0);
+    let (_, cal) =
+        common::ellipse_calibration(&dir, &(common::TURN_HEADER.to_owned() + &rows), &[]);
+    let good = 9_000;
+    let mut text = common::TURN_HEADER.to_owned();
+    text.extend(rows.lines().take(good).map(|l| format!("{l}\n")));
+    text += "1e9,1,x\n";
+    let input = dir.join("bad.csv");
+    std::fs::write(&input, text).unwrap();
+    let out = common::heading(&cal, &input, Path::new("-"), &[]);
+    assert!(!out.status.success());
+    let err = String::from_utf8(out.stderr).unwrap();
+    assert!(err.contains(&format!("row {}", good + 2)), "{err}");
+    assert_eq!(
+        headings(&String::from_utf8(out.stdout).unwrap()).len(),
+        good
+    );
+}

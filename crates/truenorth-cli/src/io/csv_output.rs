@@ -174,10 +174,15 @@ impl CsvOutput {
 }
 
 impl Drop for CsvOutput {
-    /// An output dropped unfinished (an error on the way) waits for its writer, which then
-    /// drops the output and so removes its temporary before the run ends.
+    /// An output dropped unfinished (an error on the way) hands over its last rows and
+    /// waits for its writer, which then drops the output: a temporary is removed before the
+    /// run ends, and standard output, a device or a FIFO gets every row written before the
+    /// error, as a single-threaded writer flushing on drop would give it.
     fn drop(&mut self) {
         if self.writer.is_some() {
+            if !self.block.widths.is_empty() {
+                let _ = self.hand_over();
+            }
             let _ = self.stop();
         }
     }
