@@ -5,11 +5,15 @@
 pub(crate) mod calibration;
 pub(crate) mod calibrator;
 pub(crate) mod config;
+pub(crate) mod readings;
+#[cfg(test)]
+mod readings_tests;
 pub(crate) mod report;
 pub(crate) mod runs;
 pub(crate) mod solve;
 
 pub use calibration::{MagAccelCalibration, MagAccelSample};
-pub use calibrator::{MagAccelCalibrator, fit_mag_accel};
+pub use calibrator::{MagAccelCalibrator, fit_mag_accel, fit_mag_accel_readings};
 pub use config::{INITIAL_FIT_BOUND_DEG, MIN_MAG_ACCEL_READINGS, MagAccelConfig};
+pub use readings::{MagAccelReading, MagAccelStore, mag_accel_reading};
 pub use report::MagAccelQuality;

@@ -35,7 +35,12 @@ use core::ops::Range;
 
 use nalgebra::{Matrix3, Rotation3, SMatrix, SVector, Vector3};
 
+use truenorth_core::Result;
+
 use crate::fits::lm::NormalEquations;
+use crate::fits::mag_accel::readings::Sensor;
+use crate::fits::normalise::Normaliser;
+use crate::fits::readings::Readings;
 
 #[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
@@ -121,11 +126,58 @@ pub(crate) fn level_direction(
     Some(Vector3::new(e1.dot(p), e2.dot(p), u.dot(p)))
 }
 
-/// The readings, each sensor in its normaliser's coordinates.
-#[derive(Debug, Clone)]
-pub(crate) struct Data {
-    pub acc: Vec<Vector3<f64>>,
-    pub mag: Vec<Vector3<f64>>,
+/// The readings, each sensor in its normaliser's coordinates: normalised as they are
+/// replayed, so that the fit keeps no copy of them.
+pub(crate) struct Data<'a> {
+    pub readings: &'a dyn Readings<6>,
+    pub na: Normaliser<3>,
+    pub nm: Normaliser<3>,
+}
+
+impl Data<'_> {
+    /// How many readings there are.
+    pub fn len(&self) -> usize {
+        self.readings.len()
+    }
+
+    /// Calls `f` with every reading, in order: the accelerometer's and the magnetometer's,
+    /// normalised. An error replaying the readings is returned as it is.
+    pub fn replay(&self, mut f: impl FnMut(&Vector3<f64>, &Vector3<f64>)) -> Result<()> {
+        self.readings.replay(&mut |run| {
+            for r in run {
+                f(
+                    &self.na.apply(&Sensor::Acc.of(r)),
+                    &self.nm.apply(&Sensor::Mag.of(r)),
+                );
+            }
+        })
+    }
+
+    /// Calls `f` with the normalised readings `(accelerometer, magnetometer)` of each of
+    /// `runs` (index ranges, increasing and disjoint, as `mag_accel_runs` finds them), in
+    /// order, one run at a time: only the run at hand is kept.
+    pub fn replay_runs(
+        &self,
+        runs: &[Range<usize>],
+        mut f: impl FnMut(&[(Vector3<f64>, Vector3<f64>)]),
+    ) -> Result<()> {
+        let mut shots = Vec::new();
+        let (mut i, mut next) = (0usize, 0usize);
+        self.replay(|a, m| {
+            while runs.get(next).is_some_and(|r| r.end <= i) {
+                next += 1;
+            }
+            if let Some(run) = runs.get(next).filter(|r| r.contains(&i)) {
+                shots.push((*a, *m));
+                if i + 1 == run.end {
+                    f(&shots);
+                    shots.clear();
+                    next += 1;
+                }
+            }
+            i += 1;
+        })
+    }
 }
 
 /// Inverse standard deviations of the residual groups.
@@ -206,14 +258,21 @@ pub(crate) fn normal_equations(
     w: &Weights,
     r0: &Rotation3<f64>,
     theta: &SVector<f64, P>,
-) -> Option<(NormalEquations<P>, GroupSums)> {
+) -> Result<Option<(NormalEquations<P>, GroupSums)>> {
     let m = Model::of(theta, r0);
     let mut jtj = SMatrix::<f64, P, P>::zeros();
     let mut jtr = SVector::<f64, P>::zeros();
     let mut cost = 0.0;
     let mut sums = GroupSums::default();
-    for (a, mg) in data.acc.iter().zip(&data.mag) {
-        let [acc, mag, dip] = reading_rows(&m, a, mg)?;
+    let mut defined = true;
+    data.replay(|a, mg| {
+        if !defined {
+            return;
+        }
+        let Some([acc, mag, dip]) = reading_rows(&m, a, mg) else {
+            defined = false;
+            return;
+        };
         for ((row, r), weight, group) in [
             (acc, w.acc, &mut sums.acc),
             (mag, w.mag, &mut sums.mag),
@@ -223,6 +282,9 @@ pub(crate) fn normal_equations(
             group.0 += r * r;
             group.1 += 1;
         }
+    })?;
+    if !defined {
+        return Ok(None);
     }
     if runs.is_empty() {
         // No run: the pointing axis is x. A stiff prior keeps the normal equations regular.
@@ -232,10 +294,18 @@ pub(crate) fn normal_equations(
             add_row(&mut jtj, &mut jtr, &mut cost, &row, 1e4 * theta[k]);
         }
     }
-    for run in runs {
-        run_rows(
-            data, run, w, r0, theta, &mut jtj, &mut jtr, &mut cost, &mut sums,
-        )?;
+    if !runs.is_empty() {
+        data.replay_runs(runs, |shots| {
+            if defined {
+                defined = run_rows(
+                    shots, w, r0, theta, &mut jtj, &mut jtr, &mut cost, &mut sums,
+                )
+                .is_some();
+            }
+        })?;
+        if !defined {
+            return Ok(None);
+        }
     }
     for a in 0..P {
         for b in 0..a {
@@ -243,7 +313,7 @@ pub(crate) fn normal_equations(
         }
     }
     let ne = NormalEquations { cost, jtj, jtr };
-    (ne.cost.is_finite() && ne.jtj.iter().all(|x| x.is_finite())).then_some((ne, sums))
+    Ok((ne.cost.is_finite() && ne.jtj.iter().all(|x| x.is_finite())).then_some((ne, sums)))
 }
 
 /// The unweighted Jacobian rows and residuals of one reading `(a, mg)` under the model `m`:
@@ -302,25 +372,26 @@ fn reading_rows(
     Some([(acc, nu - 1.0), (mag, nv - 1.0), (dip, r)])
 }
 
-/// The level-frame direction of the pointing axis for shot `i` under `theta`.
+/// The level-frame direction of the pointing axis for the shot `(a, mg)` (normalised)
+/// under `theta`.
 fn shot_direction(
-    data: &Data,
-    i: usize,
+    a: &Vector3<f64>,
+    mg: &Vector3<f64>,
     r0: &Rotation3<f64>,
     theta: &SVector<f64, P>,
 ) -> Option<Vector3<f64>> {
     let m = Model::of(theta, r0);
-    let u = (m.b_a * (data.acc[i] - m.c_a)).try_normalize(1e-12)?;
-    let v = (m.b_m * (data.mag[i] - m.c_m)).try_normalize(1e-12)?;
+    let u = (m.b_a * (a - m.c_a)).try_normalize(1e-12)?;
+    let v = (m.b_m * (mg - m.c_m)).try_normalize(1e-12)?;
     level_direction(&u, &(m.rot * v), &m.p)
 }
 
-/// The rows `wᵢ − w̄` of one run, with Jacobians by forward differences (the TRIAD frame's
-/// derivatives are long to write out and a run is a few shots), centred like the residuals.
+/// The rows `wᵢ − w̄` of one run's `shots` (normalised accelerometer and magnetometer
+/// readings), with Jacobians by forward differences (the TRIAD frame's derivatives are long
+/// to write out and a run is a few shots), centred like the residuals.
 #[allow(clippy::too_many_arguments)]
 fn run_rows(
-    data: &Data,
-    run: &Range<usize>,
+    shots: &[(Vector3<f64>, Vector3<f64>)],
     w: &Weights,
     r0: &Rotation3<f64>,
     theta: &SVector<f64, P>,
@@ -329,19 +400,19 @@ fn run_rows(
     cost: &mut f64,
     sums: &mut GroupSums,
 ) -> Option<()> {
-    let n = run.len();
+    let n = shots.len();
     let mut dirs: Vec<Vector3<f64>> = Vec::with_capacity(n);
     let mut jac: Vec<SMatrix<f64, 3, P>> = Vec::with_capacity(n);
     // Step: the parameters are of order one in normalised coordinates; √ε balances
     // truncation and rounding of a forward difference.
     const H: f64 = 1.5e-8;
-    for i in run.clone() {
-        let d0 = shot_direction(data, i, r0, theta)?;
+    for (a, mg) in shots {
+        let d0 = shot_direction(a, mg, r0, theta)?;
         let mut j = SMatrix::<f64, 3, P>::zeros();
         for k in 0..P {
             let mut t = *theta;
             t[k] += H;
-            let dk = shot_direction(data, i, r0, &t)?;
+            let dk = shot_direction(a, mg, r0, &t)?;
             j.set_column(k, &((dk - d0) / H));
         }
         dirs.push(d0);
@@ -363,20 +434,20 @@ fn run_rows(
     Some(())
 }
 
-/// RMS of the run residuals.
+/// RMS of the run residuals. An error replaying the readings is returned as it is.
 pub(crate) fn aim_rms(
     data: &Data,
     runs: &[Range<usize>],
     r0: &Rotation3<f64>,
     theta: &SVector<f64, P>,
-) -> f64 {
+) -> Result<f64> {
     let w = Weights {
         acc: 0.0,
         mag: 0.0,
         dip: 0.0,
         aim: 1.0,
     };
-    normal_equations(data, runs, &w, r0, theta)
+    Ok(normal_equations(data, runs, &w, r0, theta)?
         .map(|(_, s)| (s.aim.0 / s.aim.1.max(1) as f64).sqrt())
-        .unwrap_or(1.0)
+        .unwrap_or(1.0))
 }
