@@ -61,8 +61,8 @@ use crate::fits::mag_accel::readings::{MagAccelReading, MagAccelStore, Sensor, S
 use crate::fits::mag_accel::report::{MagAccelQuality, assemble};
 use crate::fits::mag_accel::runs::{RunFinder, RunRule};
 use crate::fits::mag_accel::solve::{
-    BA, BM, CA, CM, Data, GroupSums, Model, P, S, Weights, aim_rms, level_direction,
-    normal_equations, unsym,
+    BA, BM, CA, CM, Data, GroupSums, LIMITS, Limits, Model, P, S, Weights, aim_rms,
+    level_direction, normal_equations, unsym,
 };
 use crate::fits::normalise::Normaliser;
 use crate::fits::readings::Readings;
@@ -188,14 +188,26 @@ pub fn fit_mag_accel(
 
 /// [`fit_mag_accel`] of readings replayed from wherever they are kept (see [`Readings`];
 /// each reading `[mag; acc]`, a [`MagAccelReading`]): the same result, bit for bit, as of
-/// the same samples in one slice. Every pass of the fit goes over them in order, so it keeps
-/// no copy of them: its memory is that of the longest stretch of shots aimed one way
-/// (step 4), not of the recording. An error replaying them is returned as it is.
+/// the same samples in one slice. Every pass of the fit goes over them in order and keeps
+/// no copy of them: at most a few megabytes of frames and shots for the runs of step 4 (a
+/// run, or a stretch of shots aimed one way, longer than that takes more passes), so its
+/// memory does not grow with the recording. An error replaying them is returned as it is.
 pub fn fit_mag_accel_readings<R: Readings<6> + ?Sized>(
     readings: &R,
     config: &MagAccelConfig,
 ) -> Result<Solution<MagAccelCalibration, MagAccelQuality>> {
-    fit(&Joint(readings), config)
+    fit(&Joint(readings), config, LIMITS)
+}
+
+/// [`fit_mag_accel_readings`] keeping at most `limits` of the readings at once (the
+/// result is the same whatever they are; small ones make more passes).
+#[cfg(test)]
+pub(crate) fn fit_mag_accel_within<R: Readings<6> + ?Sized>(
+    readings: &R,
+    config: &MagAccelConfig,
+    limits: Limits,
+) -> Result<Solution<MagAccelCalibration, MagAccelQuality>> {
+    fit(&Joint(readings), config, limits)
 }
 
 /// Readings of any kind, sized, so that the fit takes them as one type.
@@ -214,6 +226,7 @@ impl<R: Readings<6> + ?Sized> Readings<6> for Joint<'_, R> {
 fn fit(
     readings: &dyn Readings<6>,
     config: &MagAccelConfig,
+    limits: Limits,
 ) -> Result<Solution<MagAccelCalibration, MagAccelQuality>> {
     config.validate()?;
     check_readings(readings)?;
@@ -223,7 +236,7 @@ fn fit(
         mag_fit,
         data,
         mut theta,
-    } = start(readings, config)?;
+    } = start(readings, config, limits)?;
     // Step 2.
     let (r0, s0) = initial_alignment(&data, &theta)?;
     theta[S] = s0;
@@ -288,7 +301,11 @@ struct Start<'a> {
 
 /// Step 1: each sensor's ellipsoid, accepted up to [`INITIAL_FIT_BOUND_DEG`], as the start
 /// of the joint fit, in the normalised readings' units.
-fn start<'a>(readings: &'a dyn Readings<6>, config: &MagAccelConfig) -> Result<Start<'a>> {
+fn start<'a>(
+    readings: &'a dyn Readings<6>,
+    config: &MagAccelConfig,
+    limits: Limits,
+) -> Result<Start<'a>> {
     let start = EllipsoidConfig {
         limits: FitLimits {
             max_heading_error_bound_deg: INITIAL_FIT_BOUND_DEG,
@@ -326,7 +343,12 @@ fn start<'a>(readings: &'a dyn Readings<6>, config: &MagAccelConfig) -> Result<S
     Ok(Start {
         acc_fit,
         mag_fit,
-        data: Data { readings, na, nm },
+        data: Data {
+            readings,
+            na,
+            nm,
+            limits,
+        },
         theta,
     })
 }
@@ -365,9 +387,20 @@ fn aimed_runs(
             min_roll_rad: config.run_min_roll_deg.to_radians(),
             min_shots: config.run_min_shots,
         },
+        data.limits.stretch_frames,
     );
-    data.replay(|a, m| finder.push(level_frame(a, m, r0, theta)))?;
-    Ok(finder.finish())
+    loop {
+        let mut k = 0usize;
+        data.replay(|a, m| {
+            if finder.wants(k) {
+                finder.push(level_frame(a, m, r0, theta));
+            }
+            k += 1;
+        })?;
+        if !finder.end_pass() {
+            return Ok(finder.runs());
+        }
+    }
 }
 
 /// Step 5: the covariance, the calibration and its report, and the refusal on the heading

@@ -1,6 +1,7 @@
 //! Joint calibration of a magnetometer and an accelerometer mounted together: its
-//! configuration, the calibration it produces, the calibrator and its fit, the
-//! least-squares problem, the runs of shots aimed at one target, and the report.
+//! configuration, the calibration it produces, the readings it keeps, the calibrator and
+//! its fit, the least-squares problem, the runs of shots aimed at one target and their
+//! rows, and the report.
 
 pub(crate) mod calibration;
 pub(crate) mod calibrator;
@@ -9,6 +10,7 @@ pub(crate) mod readings;
 #[cfg(test)]
 mod readings_tests;
 pub(crate) mod report;
+pub(crate) mod run_rows;
 pub(crate) mod runs;
 pub(crate) mod solve;
 

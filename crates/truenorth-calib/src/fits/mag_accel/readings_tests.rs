@@ -5,6 +5,8 @@ use nalgebra::{Matrix3, Rotation3, Vector3};
 use proptest::prelude::*;
 use truenorth_core::Calibrator;
 
+use crate::fits::mag_accel::calibrator::fit_mag_accel_within;
+use crate::fits::mag_accel::solve::Limits;
 use crate::fits::mag_accel::{
     MagAccelCalibrator, MagAccelConfig, MagAccelSample, fit_mag_accel, fit_mag_accel_readings,
     mag_accel_reading,
@@ -17,10 +19,17 @@ fn wobble(k: usize, c: usize) -> f64 {
 }
 
 /// `n` readings of an instrument turned through attitudes whose pitch spans ±`pitch_rad`,
-/// then `rolled` shots aimed at one target and rolled about it, 45° apart: an
+/// then `still` readings held at one attitude and `rolled` shots aimed the same way and
+/// rolled about the pointing axis, 45° apart (with enough roll, one run): an
 /// accelerometer with bias, scale and cross-axis, a magnetometer with hard and soft iron
 /// turned 2° from it, both with noise of relative size `noise`.
-fn recording(n: usize, pitch_rad: f64, rolled: usize, noise: f64) -> Vec<MagAccelSample> {
+fn recording(
+    n: usize,
+    pitch_rad: f64,
+    still: usize,
+    rolled: usize,
+    noise: f64,
+) -> Vec<MagAccelSample> {
     let dip = 60f64.to_radians();
     let up = Vector3::new(0.0, 0.0, 9.81);
     let field = Vector3::new(dip.cos(), 0.0, -dip.sin()) * 50.0;
@@ -32,6 +41,7 @@ fn recording(n: usize, pitch_rad: f64, rolled: usize, noise: f64) -> Vec<MagAcce
             let k = k as f64;
             (2.4 * k, pitch_rad * (0.7 * k).sin(), 1.3 * k)
         })
+        .chain((0..still).map(|_| (0.5, 0.3, 0.0)))
         .chain((0..rolled).map(|j| (0.5, 0.3, 0.785 * j as f64)));
     attitudes
         .enumerate()
@@ -72,10 +82,11 @@ proptest! {
     /// so is a calibrator with its own store, `progress` included.
     #[test]
     fn the_joint_fit_through_runs_is_the_slice_fit(
-        n in 4usize..260, pitch in 0.0f64..1.4, rolled in prop_oneof![Just(0usize), 3usize..9],
-        noise in 0.0f64..0.02, runs in runs(),
+        n in 4usize..260, pitch in 0.0f64..1.4, still in 0usize..40,
+        rolled in prop_oneof![Just(0usize), 3usize..9], noise in 0.0f64..0.02, runs in runs(), run_shots_kept in 1usize..6,
+        frames_kept in 1usize..12,
     ) {
-        let samples = recording(n, pitch, rolled, noise);
+        let samples = recording(n, pitch, still, rolled, noise);
         let config = MagAccelConfig::default();
         let store = cut(&samples, runs);
         let want = format!("{:?}", fit_mag_accel(&samples, &config));
@@ -86,23 +97,28 @@ proptest! {
             cal.push(s).unwrap();
             plain.push(s).unwrap();
         }
-        prop_assert_eq!(format!("{:?}", cal.solve()), want);
+        prop_assert_eq!(format!("{:?}", cal.solve()), want.clone());
         prop_assert_eq!(format!("{:?}", cal.progress()), format!("{:?}", plain.progress()));
+        // And keeping only a few frames and shots at once, passing over them again.
+        let limits = Limits { run_shots: run_shots_kept, stretch_frames: frames_kept };
+        prop_assert_eq!(format!("{:?}", fit_mag_accel_within(&store, &config, limits)), want);
     }
 
-    /// A replay that fails, whichever pass it is, fails the fit with its error.
+    /// A replay that fails, whichever pass it is, fails the fit with its error (the
+    /// passes of long runs and stretches included).
     #[test]
     fn a_failed_replay_is_the_error(
-        n in 40usize..200, pitch in 0.3f64..1.4, rolled in prop_oneof![Just(0usize), 3usize..9],
-        at in 0.0f64..1.0, runs in runs(),
+        n in 40usize..200, pitch in 0.3f64..1.4, still in 0usize..40,
+        rolled in prop_oneof![Just(0usize), 3usize..9], at in 0.0f64..1.0, runs in runs(), kept in 1usize..8,
     ) {
-        let samples = recording(n, pitch, rolled, 0.005);
+        let samples = recording(n, pitch, still, rolled, 0.005);
         let config = MagAccelConfig::default();
+        let limits = Limits { run_shots: kept, stretch_frames: kept };
         let store = cut(&samples, runs);
-        let _ = fit_mag_accel_readings(&store, &config);
+        let _ = fit_mag_accel_within(&store, &config, limits);
         let passes = store.replays.get();
         let failing = Cut { fail_at: Some((at * passes as f64) as usize), ..cut(&samples, store.runs.clone()) };
-        prop_assert_eq!(fit_mag_accel_readings(&failing, &config), Err(FAILED));
+        prop_assert_eq!(fit_mag_accel_within(&failing, &config, limits), Err(FAILED));
     }
 }
 
@@ -110,9 +126,12 @@ proptest! {
 #[test]
 fn the_recordings_reach_runs_fits_and_refusals() {
     let config = MagAccelConfig::default();
-    let with_runs = fit_mag_accel(&recording(120, 1.2, 8, 0.002), &config).unwrap();
+    let with_runs = fit_mag_accel(&recording(120, 1.2, 0, 8, 0.002), &config).unwrap();
     assert!(with_runs.quality.runs > 0, "{:?}", with_runs.quality);
-    let without = fit_mag_accel(&recording(120, 1.2, 0, 0.002), &config).unwrap();
+    // A still stretch before the roll joins the run.
+    let long_run = fit_mag_accel(&recording(120, 1.2, 30, 8, 0.002), &config).unwrap();
+    assert!(long_run.quality.run_shots >= 38, "{:?}", long_run.quality);
+    let without = fit_mag_accel(&recording(120, 1.2, 30, 0, 0.002), &config).unwrap();
     assert_eq!(without.quality.runs, 0);
-    assert!(fit_mag_accel(&recording(120, 0.0, 0, 0.002), &config).is_err());
+    assert!(fit_mag_accel(&recording(120, 0.0, 0, 0, 0.002), &config).is_err());
 }

@@ -40,12 +40,14 @@ fn rotation_angle(a: &Matrix3<f64>, b: &Matrix3<f64>) -> f64 {
 ///
 /// A stretch that does not roll enough is searched again from its middle, for a run that
 /// starts later in it; so the finder keeps the frames from the middle of the stretch at
-/// hand on, and no others (memory of the order of the longest stretch within the
-/// tolerance, not of the recording).
+/// hand on, up to `cap` of them. A stretch longer than that loses its frames: the search
+/// then asks for the shots again from where it starts over ([`Self::end_pass`]), and the
+/// caller passes over them once more. The runs are those of every frame at hand at once.
 #[derive(Debug, Clone)]
 pub(crate) struct RunFinder {
     p: Vector3<f64>,
     rule: RunRule,
+    cap: usize,
     /// The frames from shot `base` on, as far as they have come.
     window: VecDeque<Option<Matrix3<f64>>>,
     base: usize,
@@ -53,6 +55,8 @@ pub(crate) struct RunFinder {
     start: usize,
     /// The scan of that stretch so far, once it has begun.
     scan: Option<Scan>,
+    /// Whether the frames from `start` on must be given again.
+    rewind: bool,
     runs: Vec<Range<usize>>,
 }
 
@@ -67,28 +71,54 @@ struct Scan {
 }
 
 impl RunFinder {
-    /// A finder of runs for the pointing axis `p`, before any shot.
-    pub fn new(p: Vector3<f64>, rule: RunRule) -> Self {
+    /// A finder of runs for the pointing axis `p` keeping up to `cap` frames (at least
+    /// one), before any shot.
+    pub fn new(p: Vector3<f64>, rule: RunRule, cap: usize) -> Self {
         Self {
             p,
             rule,
+            cap: cap.max(1),
             window: VecDeque::new(),
             base: 0,
             start: 0,
             scan: None,
+            rewind: false,
             runs: Vec::new(),
         }
     }
 
-    /// The next shot's frame.
-    pub fn push(&mut self, frame: Option<Matrix3<f64>>) {
-        self.window.push_back(frame);
-        self.advance(false);
+    /// Whether the finder takes the frame of shot `k` in this pass (the shots are given
+    /// in order; one it does not take need not have its frame computed).
+    pub fn wants(&self, k: usize) -> bool {
+        !self.rewind && k == self.base + self.window.len()
     }
 
-    /// The runs, once every shot has been pushed.
-    pub fn finish(mut self) -> Vec<Range<usize>> {
-        self.advance(true);
+    /// The frame of the next shot it wants (see [`Self::wants`]).
+    pub fn push(&mut self, frame: Option<Matrix3<f64>>) {
+        if !self.rewind {
+            self.window.push_back(frame);
+            self.advance(false);
+        }
+    }
+
+    /// Ends a pass over every shot: `true` when the finder wants another (the shots it
+    /// wants, [`Self::wants`], begin further back), `false` when it has found every run.
+    pub fn end_pass(&mut self) -> bool {
+        if !self.rewind {
+            self.advance(true);
+        }
+        if self.rewind {
+            self.rewind = false;
+            self.window.clear();
+            self.base = self.start;
+            true
+        } else {
+            false
+        }
+    }
+
+    /// The runs found.
+    pub fn runs(self) -> Vec<Range<usize>> {
         self.runs
     }
 
@@ -139,9 +169,13 @@ impl RunFinder {
             }
             if !ended && !at_end {
                 // The stretch goes on past the frames at hand. Whatever it turns out to be,
-                // the next start is at least halfway along it.
+                // the next start is at least halfway along it; past the cap the frames go,
+                // and the next start's are asked for again.
                 self.scan = Some(s);
                 self.forget_before(i + (s.next - i) / 2);
+                if self.window.len() > self.cap {
+                    self.forget_before(n);
+                }
                 return;
             }
             let j = s.next;
@@ -153,6 +187,10 @@ impl RunFinder {
                 self.start = i + ((j - i) / 2).max(1);
             }
             self.scan = None;
+            if self.start < self.base {
+                self.rewind = true;
+                return;
+            }
             self.forget_before(self.start);
         }
     }
@@ -164,17 +202,34 @@ mod tests {
     use nalgebra::Rotation3;
     use proptest::prelude::*;
 
-    /// The runs among `frames`, all at hand, by the finder.
+    /// The runs among `frames` by the finder keeping up to `cap` of them, given again
+    /// as often as it asks.
+    fn find_runs_within(
+        frames: &[Option<Matrix3<f64>>],
+        p: &Vector3<f64>,
+        rule: &RunRule,
+        cap: usize,
+    ) -> Vec<Range<usize>> {
+        let mut finder = RunFinder::new(*p, *rule, cap);
+        loop {
+            for (k, f) in frames.iter().enumerate() {
+                if finder.wants(k) {
+                    finder.push(*f);
+                }
+            }
+            if !finder.end_pass() {
+                return finder.runs();
+            }
+        }
+    }
+
+    /// The runs among `frames` by the finder, every frame kept.
     fn find_runs(
         frames: &[Option<Matrix3<f64>>],
         p: &Vector3<f64>,
         rule: &RunRule,
     ) -> Vec<Range<usize>> {
-        let mut finder = RunFinder::new(*p, *rule);
-        for f in frames {
-            finder.push(*f);
-        }
-        finder.finish()
+        find_runs_within(frames, p, rule, usize::MAX)
     }
 
     /// The runs among `frames` by the definition, every frame at hand: what the finder must
@@ -219,7 +274,7 @@ mod tests {
         #[test]
         fn the_finder_finds_the_runs_of_the_definition(
             steps in prop::collection::vec((0u8..6, 0.0f64..1.0, 1usize..40), 0..40),
-            min_shots in 3usize..6,
+            min_shots in 3usize..6, cap in 1usize..12,
         ) {
             let mut frames = Vec::new();
             let (mut yaw, mut pitch, mut roll) = (0.0f64, 0.0f64, 0.0f64);
@@ -237,10 +292,10 @@ mod tests {
                 }
             }
             let rule = RunRule { min_shots, ..RULE };
-            prop_assert_eq!(
-                find_runs(&frames, &Vector3::x(), &rule),
-                runs_by_definition(&frames, &Vector3::x(), &rule)
-            );
+            let want = runs_by_definition(&frames, &Vector3::x(), &rule);
+            prop_assert_eq!(find_runs(&frames, &Vector3::x(), &rule), want.clone());
+            // And keeping only a few frames, passing over the shots again when asked.
+            prop_assert_eq!(find_runs_within(&frames, &Vector3::x(), &rule, cap), want);
         }
     }
 

@@ -39,6 +39,7 @@ use truenorth_core::Result;
 
 use crate::fits::lm::NormalEquations;
 use crate::fits::mag_accel::readings::Sensor;
+use crate::fits::mag_accel::run_rows::{RunSums, all_run_rows};
 use crate::fits::normalise::Normaliser;
 use crate::fits::readings::Readings;
 
@@ -126,12 +127,31 @@ pub(crate) fn level_direction(
     Some(Vector3::new(e1.dot(p), e2.dot(p), u.dot(p)))
 }
 
+/// How much of the readings a pass of the joint fit keeps at once; past that, it passes
+/// over them again instead.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct Limits {
+    /// The most shots of a run kept for its rows (about 650 bytes each with their
+    /// Jacobians); a longer run takes two more passes.
+    pub run_shots: usize,
+    /// The most level frames the run search keeps (80 bytes each); a stretch of shots
+    /// aimed one way longer than twice that takes more passes.
+    pub stretch_frames: usize,
+}
+
+/// The limits of the fit: a few megabytes each.
+pub(crate) const LIMITS: Limits = Limits {
+    run_shots: 1 << 12,
+    stretch_frames: 1 << 16,
+};
+
 /// The readings, each sensor in its normaliser's coordinates: normalised as they are
 /// replayed, so that the fit keeps no copy of them.
 pub(crate) struct Data<'a> {
     pub readings: &'a dyn Readings<6>,
     pub na: Normaliser<3>,
     pub nm: Normaliser<3>,
+    pub limits: Limits,
 }
 
 impl Data<'_> {
@@ -150,6 +170,21 @@ impl Data<'_> {
                     &self.nm.apply(&Sensor::Mag.of(r)),
                 );
             }
+        })
+    }
+
+    /// Calls `f` with every reading of `range` (normalised), in order: a whole replay.
+    pub fn replay_range(
+        &self,
+        range: &Range<usize>,
+        mut f: impl FnMut(&Vector3<f64>, &Vector3<f64>),
+    ) -> Result<()> {
+        let mut i = 0usize;
+        self.replay(|a, m| {
+            if range.contains(&i) {
+                f(a, m);
+            }
+            i += 1;
         })
     }
 
@@ -200,7 +235,7 @@ pub(crate) struct GroupSums {
 
 /// A rank-one update of the normal equations by the row `j` with residual `r`, both
 /// already weighted.
-fn add_row(
+pub(crate) fn add_row(
     jtj: &mut SMatrix<f64, P, P>,
     jtr: &mut SVector<f64, P>,
     cost: &mut f64,
@@ -294,18 +329,14 @@ pub(crate) fn normal_equations(
             add_row(&mut jtj, &mut jtr, &mut cost, &row, 1e4 * theta[k]);
         }
     }
-    if !runs.is_empty() {
-        data.replay_runs(runs, |shots| {
-            if defined {
-                defined = run_rows(
-                    shots, w, r0, theta, &mut jtj, &mut jtr, &mut cost, &mut sums,
-                )
-                .is_some();
-            }
-        })?;
-        if !defined {
-            return Ok(None);
-        }
+    let mut out = RunSums {
+        jtj: &mut jtj,
+        jtr: &mut jtr,
+        cost: &mut cost,
+        sums: &mut sums,
+    };
+    if all_run_rows(data, runs, w, r0, theta, &mut out)?.is_none() {
+        return Ok(None);
     }
     for a in 0..P {
         for b in 0..a {
@@ -370,68 +401,6 @@ fn reading_rows(
     }
     dip[S] = -1.0;
     Some([(acc, nu - 1.0), (mag, nv - 1.0), (dip, r)])
-}
-
-/// The level-frame direction of the pointing axis for the shot `(a, mg)` (normalised)
-/// under `theta`.
-fn shot_direction(
-    a: &Vector3<f64>,
-    mg: &Vector3<f64>,
-    r0: &Rotation3<f64>,
-    theta: &SVector<f64, P>,
-) -> Option<Vector3<f64>> {
-    let m = Model::of(theta, r0);
-    let u = (m.b_a * (a - m.c_a)).try_normalize(1e-12)?;
-    let v = (m.b_m * (mg - m.c_m)).try_normalize(1e-12)?;
-    level_direction(&u, &(m.rot * v), &m.p)
-}
-
-/// The rows `wᵢ − w̄` of one run's `shots` (normalised accelerometer and magnetometer
-/// readings), with Jacobians by forward differences (the TRIAD frame's derivatives are long
-/// to write out and a run is a few shots), centred like the residuals.
-#[allow(clippy::too_many_arguments)]
-fn run_rows(
-    shots: &[(Vector3<f64>, Vector3<f64>)],
-    w: &Weights,
-    r0: &Rotation3<f64>,
-    theta: &SVector<f64, P>,
-    jtj: &mut SMatrix<f64, P, P>,
-    jtr: &mut SVector<f64, P>,
-    cost: &mut f64,
-    sums: &mut GroupSums,
-) -> Option<()> {
-    let n = shots.len();
-    let mut dirs: Vec<Vector3<f64>> = Vec::with_capacity(n);
-    let mut jac: Vec<SMatrix<f64, 3, P>> = Vec::with_capacity(n);
-    // Step: the parameters are of order one in normalised coordinates; √ε balances
-    // truncation and rounding of a forward difference.
-    const H: f64 = 1.5e-8;
-    for (a, mg) in shots {
-        let d0 = shot_direction(a, mg, r0, theta)?;
-        let mut j = SMatrix::<f64, 3, P>::zeros();
-        for k in 0..P {
-            let mut t = *theta;
-            t[k] += H;
-            let dk = shot_direction(a, mg, r0, &t)?;
-            j.set_column(k, &((dk - d0) / H));
-        }
-        dirs.push(d0);
-        jac.push(j);
-    }
-    let inv = 1.0 / n as f64;
-    let mean: Vector3<f64> = dirs.iter().sum::<Vector3<f64>>() * inv;
-    let mean_j: SMatrix<f64, 3, P> = jac.iter().sum::<SMatrix<f64, 3, P>>() * inv;
-    for (d, j) in dirs.iter().zip(&jac) {
-        let r = d - mean;
-        let jc = j - mean_j;
-        for c in 0..3 {
-            let row: SVector<f64, P> = jc.row(c).transpose();
-            add_row(jtj, jtr, cost, &(row * w.aim), r[c] * w.aim);
-            sums.aim.0 += r[c] * r[c];
-        }
-        sums.aim.1 += 3;
-    }
-    Some(())
 }
 
 /// RMS of the run residuals. An error replaying the readings is returned as it is.
