@@ -23,10 +23,11 @@ pub fn mag_accel_reading(sample: &MagAccelSample) -> MagAccelReading {
     MagAccelReading::from([m.x, m.y, m.z, a.x, a.y, a.z])
 }
 
-/// Readings converted to another shape go through a buffer of this many, a multiple of
-/// [`READINGS_RUN_MULTIPLE`] (so the runs handed on keep the blocks' boundaries) small
-/// enough for the stack (12 kB of six-wide readings).
-const CONVERTED_RUN: usize = 8 * READINGS_RUN_MULTIPLE;
+/// Readings converted to another shape go through a buffer of this many on the stack
+/// (3 kB of six-wide readings): a multiple of [`READINGS_RUN_MULTIPLE`], so that the runs
+/// handed on keep the blocks' boundaries, and long enough that handing on a run costs
+/// little beside the fit's work on its readings.
+const CONVERTED_RUN: usize = 2 * READINGS_RUN_MULTIPLE;
 
 /// Calls `run` with `convert` of every item of `items`, in runs of [`CONVERTED_RUN`] (the
 /// last shorter).
