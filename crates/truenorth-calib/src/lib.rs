@@ -93,7 +93,8 @@ pub use fits::ellipsoid::{
 };
 pub use fits::mag_accel::{
     INITIAL_FIT_BOUND_DEG, MIN_MAG_ACCEL_READINGS, MagAccelCalibration, MagAccelCalibrator,
-    MagAccelConfig, MagAccelQuality, MagAccelSample, fit_mag_accel,
+    MagAccelConfig, MagAccelQuality, MagAccelReading, MagAccelSample, MagAccelStore, fit_mag_accel,
+    fit_mag_accel_readings, mag_accel_reading,
 };
 pub use fits::readings::{READINGS_RUN_MULTIPLE, ReadingStore, Readings};
 pub use numerics::circumcentre::{Circumcircle, circumcircle};

@@ -1,4 +1,5 @@
-//! `truenorth calibrate --method ellipse|ellipsoid` on a recording longer than the memory
+//! `truenorth calibrate --method ellipse|ellipsoid|ellipsoid-accel` on a recording longer
+//! than the memory
 //! the fit keeps its readings in: the rest goes to a temporary file in TMPDIR, the output
 //! is the same to the byte, nothing is left in TMPDIR, and a TMPDIR that cannot take the
 //! file is one clear error line.
@@ -22,9 +23,13 @@ fn scratch(name: &str) -> common::ScratchDir {
     common::scratch("cli_calibrate_spill", name)
 }
 
-/// A level compass turning a few times round (2-D) or a sensor tumbled (3-D), with
+/// A level compass turning a few times round (2-D), a sensor tumbled (3-D) or a
+/// magnetometer and an accelerometer tumbled together (6: the two sensors' columns), with
 /// deterministic pseudo-noise.
 fn recording(dims: usize) -> String {
+    if dims == 6 {
+        return joint_recording();
+    }
     let mut csv = String::from(if dims == 2 {
         "mag_x,mag_y\n"
     } else {
@@ -51,6 +56,42 @@ fn recording(dims: usize) -> String {
             )
             .unwrap();
         }
+    }
+    csv
+}
+
+/// An instrument tumbled through every attitude (pitch within ±75°): its accelerometer
+/// (bias, scale, cross-axis) and its magnetometer (hard and soft iron, turned 2° from the
+/// accelerometer), m/s² and µT, with deterministic pseudo-noise.
+fn joint_recording() -> String {
+    let mut csv = String::from("acc_x,acc_y,acc_z,mag_x,mag_y,mag_z\n");
+    let (sd, cd) = 60f64.to_radians().sin_cos();
+    for k in 0..ROWS {
+        let t = k as f64 / ROWS as f64;
+        let noise = ((k as f64 * 12.9898).sin() * 43_758.545).fract() - 0.5;
+        let (sy, cy) = (std::f64::consts::TAU * 37.0 * t).sin_cos();
+        let (sp, cp) = (1.3 * (std::f64::consts::TAU * 23.0 * t).sin()).sin_cos();
+        let (sr, cr) = (std::f64::consts::TAU * 53.0 * t).sin_cos();
+        // Specific force (up) and the field (north, dipping 60°) in the body axes of an
+        // attitude (yaw, pitch, roll), z up.
+        let f = [-9.81 * sp, 9.81 * cp * sr, 9.81 * cp * cr];
+        let (hx, hz) = (50.0 * cd, -50.0 * sd);
+        let (ax, ay) = (cy * hx, -sy * hx);
+        let (bx, bz) = (cp * ax - sp * hz, sp * ax + cp * hz);
+        let h = [bx, cr * ay + sr * bz, -sr * ay + cr * bz];
+        let (s2, c2) = 0.035f64.sin_cos();
+        let m = [c2 * h[0] - s2 * h[1], s2 * h[0] + c2 * h[1], h[2]];
+        writeln!(
+            csv,
+            "{},{},{},{},{},{}",
+            0.2 + 1.02 * f[0] + 0.01 * f[1] + 0.01 * noise,
+            -0.1 + 0.98 * f[1] + 0.01 * f[0],
+            0.3 + 1.01 * f[2] - 0.01 * noise,
+            12.0 + 1.1 * m[0] + 0.05 * m[1] + 0.1 * noise,
+            -7.0 + 0.05 * m[0] + 0.93 * m[1],
+            4.0 + 1.04 * m[2] - 0.1 * noise,
+        )
+        .unwrap();
     }
     csv
 }
@@ -104,6 +145,11 @@ fn an_ellipse_fit_that_spills_writes_the_same_bytes_and_leaves_nothing() {
 #[test]
 fn an_ellipsoid_fit_that_spills_writes_the_same_bytes_and_leaves_nothing() {
     spilled_output_is_the_same("ellipsoid", 3);
+}
+
+#[test]
+fn an_ellipsoid_accel_fit_that_spills_writes_the_same_bytes_and_leaves_nothing() {
+    spilled_output_is_the_same("ellipsoid-accel", 6);
 }
 
 #[test]

@@ -31,6 +31,7 @@ pub(crate) struct Normaliser<const D: usize> {
 impl<const D: usize> Normaliser<D> {
     /// The normaliser of `points` (all finite, non-empty). Refuses points that are all equal
     /// and coordinates too large to square in `f64`.
+    #[cfg(test)]
     pub fn of(points: &[SVector<f64, D>]) -> Result<Self> {
         Self::of_finite(points, "point")
     }

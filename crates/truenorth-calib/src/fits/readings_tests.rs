@@ -16,15 +16,15 @@ use crate::fits::readings::{READINGS_RUN_MULTIPLE, ReadingStore, Readings};
 /// Readings replayed in runs of the given numbers of [`READINGS_RUN_MULTIPLE`] (cycled),
 /// failing on replay number `fail_at` (counting from 0) after its first run, if given.
 #[derive(Debug, Clone, Default)]
-struct Cut<const D: usize> {
-    points: Vec<SVector<f64, D>>,
-    runs: Vec<usize>,
-    fail_at: Option<usize>,
-    replays: Cell<usize>,
+pub(crate) struct Cut<const D: usize> {
+    pub points: Vec<SVector<f64, D>>,
+    pub runs: Vec<usize>,
+    pub fail_at: Option<usize>,
+    pub replays: Cell<usize>,
 }
 
 /// The error a failing [`Cut`] gives.
-const FAILED: Error = Error::Unsupported {
+pub(crate) const FAILED: Error = Error::Unsupported {
     reason: "test replay failure",
 };
 

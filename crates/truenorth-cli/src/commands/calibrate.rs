@@ -45,11 +45,11 @@ The input is read once, row by row, straight into the method: the online methods
 (online-ellipse, online-ellipsoid, binned-ellipse, merit-circle) and `turn` without
 `gyr_z` keep running state whose size does not depend on the file; the batch fits
 (ellipse, ellipsoid, ellipsoid-accel, turn with `gyr_z`) keep the one copy of the
-readings their fit needs (ellipse about 16 bytes per row, ellipsoid 24), nothing else.
-Ellipse and ellipsoid keep the first 32 MiB of it in memory and the rest in a temporary
-file in TMPDIR (default /tmp), removed from the directory as soon as it is made, so
-their memory stays bounded; point TMPDIR at a disk with room for a long recording (a
-full disk is an error saying so). A line longer than 64 KiB, or a file without line
+readings their fit needs (ellipse about 16 bytes per row, ellipsoid 24, ellipsoid-accel
+48), nothing else. Ellipse, ellipsoid and ellipsoid-accel keep the first 32 MiB of it in
+memory and the rest in a temporary file in TMPDIR (default /tmp), removed from the
+directory as soon as it is made, so their memory stays bounded; point TMPDIR at a disk
+with room for a long recording (a full disk is an error saying so). A line longer than 64 KiB, or a file without line
 breaks, is refused with its row.
 
 `turn` with a `gyr_z` column (yaw rate, rad/s, positive turning right; needs `t_s`)

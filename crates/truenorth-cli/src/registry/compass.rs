@@ -119,9 +119,9 @@ impl CalibrationMethod {
         self.build(expected_field, None)
     }
 
-    /// [`Self::calibrator`], with the batch ellipse and ellipsoid fits keeping their
-    /// readings in stores of `spill` (memory up to a share, the rest in a temporary file):
-    /// the same results in bounded memory.
+    /// [`Self::calibrator`], with the batch ellipse, ellipsoid and ellipsoid-accel fits
+    /// keeping their readings in stores of `spill` (memory up to a share, the rest in a
+    /// temporary file): the same results in bounded memory.
     pub fn calibrator_spilling(
         self,
         expected_field: Option<f64>,
@@ -172,10 +172,14 @@ impl CalibrationMethod {
                 },
             )?)),
             Self::EllipsoidAccel => {
-                C::MagAccel(Box::new(MagAccelCalibrator::new(MagAccelConfig {
+                let config = MagAccelConfig {
                     expected_field,
                     ..MagAccelConfig::default()
-                })?))
+                };
+                C::MagAccel(match spill {
+                    Some(s) => Box::new(MagAccelCalibrator::with_store(config, s.store::<6>())?),
+                    None => Box::new(MagAccelCalibrator::new(config)?),
+                })
             }
             Self::Turn => C::Turn {
                 compass: Box::new(TurnCompassCalibrator::default()),

@@ -117,7 +117,7 @@ impl<S: ReadingStore<3>> Calibrator for EllipsoidCalibrator<S> {
 /// The coverage of [`EllipsoidCalibrator::progress`]: the information share of the directions
 /// seen from the bounding-box centre, without a soft iron, judged at the mean distance from
 /// it (as `quality::mean_corrected_norm_3d` gives it for readings in one slice).
-fn raw_coverage<R: Readings<3> + ?Sized>(points: &R) -> Result<f64> {
+pub(crate) fn raw_coverage<R: Readings<3> + ?Sized>(points: &R) -> Result<f64> {
     let centre = bbox_centre(points)?;
     let raw = CompassCalibration3d {
         hard_iron: centre,

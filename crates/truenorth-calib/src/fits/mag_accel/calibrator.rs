@@ -50,41 +50,58 @@ use truenorth_core::{
 
 use crate::fits::ellipsoid::config::EllipsoidConfig;
 
-use crate::fits::ellipsoid::fit::fit_ellipsoid;
+use crate::fits::ellipsoid::calibrator::raw_coverage;
+use crate::fits::ellipsoid::fit::fit_ellipsoid_readings;
 use crate::fits::lm;
 use crate::fits::mag_accel::calibration::{MagAccelCalibration, MagAccelSample};
 use crate::fits::mag_accel::config::{
     INITIAL_FIT_BOUND_DEG, MIN_MAG_ACCEL_READINGS, MagAccelConfig,
 };
+use crate::fits::mag_accel::readings::{MagAccelReading, MagAccelStore, Sensor, SensorReadings};
 use crate::fits::mag_accel::report::{MagAccelQuality, assemble};
-use crate::fits::mag_accel::runs::{RunRule, find_runs};
+use crate::fits::mag_accel::runs::{RunFinder, RunRule};
 use crate::fits::mag_accel::solve::{
-    BA, BM, CA, CM, Data, GroupSums, Model, P, S, Weights, aim_rms, level_direction,
-    normal_equations, unsym,
+    BA, BM, CA, CM, Data, GroupSums, LIMITS, Limits, Model, P, S, Weights, aim_rms,
+    level_direction, normal_equations, unsym,
 };
 use crate::fits::normalise::Normaliser;
+use crate::fits::readings::Readings;
 use crate::quality::{self, FitLimits};
 
 #[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 
 /// Joint magnetometer + accelerometer calibrator (batch): stores every reading pushed and
-/// fits them all with [`fit_mag_accel`] on `solve`. [`Calibrator::progress`] runs the fit
-/// to decide `ready`.
-#[derive(Debug, Clone, Default)]
-pub struct MagAccelCalibrator {
-    samples: Vec<MagAccelSample>,
+/// fits them all with [`fit_mag_accel`] on `solve`.
+///
+/// The readings go to a [`MagAccelStore`]: a `Vec` of the samples by default
+/// ([`Self::new`]), or one of the caller's own ([`Self::with_store`]: any
+/// [`ReadingStore`](crate::ReadingStore) of six-wide readings, e.g. one that keeps most of
+/// a long recording on disk); the fit is the same, bit for bit, whichever store holds them.
+///
+/// [`Calibrator::progress`] runs the whole fit to decide `ready` (so that it agrees with
+/// `solve` exactly): it costs as much as `solve`. Call it now and then, not per sample.
+#[derive(Debug, Clone)]
+pub struct MagAccelCalibrator<S = Vec<MagAccelSample>> {
+    samples: S,
     config: MagAccelConfig,
 }
 
-impl MagAccelCalibrator {
-    /// A calibrator with the given configuration (validated).
-    pub fn new(config: MagAccelConfig) -> Result<Self> {
-        config.validate()?;
-        Ok(Self {
+/// The default configuration, samples in memory.
+impl Default for MagAccelCalibrator {
+    fn default() -> Self {
+        Self {
             samples: Vec::new(),
-            config,
-        })
+            config: MagAccelConfig::default(),
+        }
+    }
+}
+
+impl MagAccelCalibrator {
+    /// A calibrator with the given configuration (validated), keeping the samples in
+    /// memory.
+    pub fn new(config: MagAccelConfig) -> Result<Self> {
+        Self::with_store(config, Vec::new())
     }
 
     /// The readings stored so far.
@@ -93,7 +110,30 @@ impl MagAccelCalibrator {
     }
 }
 
-impl Calibrator for MagAccelCalibrator {
+impl<S: MagAccelStore> MagAccelCalibrator<S> {
+    /// A calibrator with the given configuration (validated) that keeps its readings in
+    /// `store` (emptied first).
+    pub fn with_store(config: MagAccelConfig, mut store: S) -> Result<Self> {
+        config.validate()?;
+        store.clear_samples();
+        Ok(Self {
+            samples: store,
+            config,
+        })
+    }
+
+    /// The store holding the readings.
+    pub fn store(&self) -> &S {
+        &self.samples
+    }
+
+    /// The configuration in use.
+    pub fn config(&self) -> &MagAccelConfig {
+        &self.config
+    }
+}
+
+impl<S: MagAccelStore> Calibrator for MagAccelCalibrator<S> {
     type Sample = MagAccelSample;
     type Params = MagAccelCalibration;
     type Quality = MagAccelQuality;
@@ -102,34 +142,31 @@ impl Calibrator for MagAccelCalibrator {
         check_finite("timestamp t_s", sample.t_s)?;
         check_finite3("magnetometer reading", &sample.mag)?;
         check_finite3("accelerometer reading", &sample.acc)?;
-        self.samples.push(*sample);
+        self.samples.push_sample(sample)?;
         Ok(Pushed::Accepted)
     }
 
     /// `ready` runs the fit; `coverage` is the magnetometer's information share before the
-    /// fit (see [`crate::EllipsoidCalibrator`]).
+    /// fit (see [`crate::EllipsoidCalibrator`]). A store that cannot replay its readings
+    /// reports no coverage and not ready.
     fn progress(&self) -> Progress {
-        let mags: Vec<Vector3<f64>> = self.samples.iter().map(|s| s.mag).collect();
-        let mut c = crate::EllipsoidCalibrator::new(self.config.ellipsoid).unwrap_or_default();
-        for (k, m) in mags.iter().enumerate() {
-            let _ = c.push(&truenorth_core::Mag3Sample {
-                t_s: k as f64,
-                mag: *m,
-            });
-        }
+        let mags = SensorReadings {
+            readings: &self.samples,
+            sensor: Sensor::Mag,
+        };
         Progress {
             samples: self.samples.len(),
-            coverage: c.progress().coverage,
+            coverage: raw_coverage(&mags).unwrap_or(0.0),
             ready: self.solve().is_ok(),
         }
     }
 
     fn solve(&self) -> Result<Solution<MagAccelCalibration, MagAccelQuality>> {
-        fit_mag_accel(&self.samples, &self.config)
+        fit_mag_accel_readings(&self.samples, &self.config)
     }
 
     fn reset(&mut self) {
-        self.samples.clear();
+        self.samples.clear_samples();
     }
 }
 
@@ -146,23 +183,64 @@ pub fn fit_mag_accel(
     samples: &[MagAccelSample],
     config: &MagAccelConfig,
 ) -> Result<Solution<MagAccelCalibration, MagAccelQuality>> {
+    fit_mag_accel_readings(samples, config)
+}
+
+/// [`fit_mag_accel`] of readings replayed from wherever they are kept (see [`Readings`];
+/// each reading `[mag; acc]`, a [`MagAccelReading`]): the same result, bit for bit, as of
+/// the same samples in one slice. Every pass of the fit goes over them in order and keeps
+/// no copy of them: at most a few megabytes of frames and shots for the runs of step 4 (a
+/// run, or a stretch of shots aimed one way, longer than that takes more passes), so its
+/// memory does not grow with the recording. An error replaying them is returned as it is.
+pub fn fit_mag_accel_readings<R: Readings<6> + ?Sized>(
+    readings: &R,
+    config: &MagAccelConfig,
+) -> Result<Solution<MagAccelCalibration, MagAccelQuality>> {
+    fit(&Joint(readings), config, LIMITS)
+}
+
+/// [`fit_mag_accel_readings`] keeping at most `limits` of the readings at once (the
+/// result is the same whatever they are; small ones make more passes).
+#[cfg(test)]
+pub(crate) fn fit_mag_accel_within<R: Readings<6> + ?Sized>(
+    readings: &R,
+    config: &MagAccelConfig,
+    limits: Limits,
+) -> Result<Solution<MagAccelCalibration, MagAccelQuality>> {
+    fit(&Joint(readings), config, limits)
+}
+
+/// Readings of any kind, sized, so that the fit takes them as one type.
+struct Joint<'a, R: ?Sized>(&'a R);
+
+impl<R: Readings<6> + ?Sized> Readings<6> for Joint<'_, R> {
+    fn len(&self) -> usize {
+        self.0.len()
+    }
+
+    fn replay(&self, run: &mut dyn FnMut(&[MagAccelReading])) -> Result<()> {
+        self.0.replay(run)
+    }
+}
+
+fn fit(
+    readings: &dyn Readings<6>,
+    config: &MagAccelConfig,
+    limits: Limits,
+) -> Result<Solution<MagAccelCalibration, MagAccelQuality>> {
     config.validate()?;
-    check_readings(samples)?;
-    let acc: Vec<Vector3<f64>> = samples.iter().map(|s| s.acc).collect();
-    let mag: Vec<Vector3<f64>> = samples.iter().map(|s| s.mag).collect();
+    check_readings(readings)?;
     // Step 1.
     let Start {
         acc_fit,
         mag_fit,
-        na,
-        nm,
         data,
         mut theta,
-    } = start(&acc, &mag, config)?;
+    } = start(readings, config, limits)?;
     // Step 2.
     let (r0, s0) = initial_alignment(&data, &theta)?;
     theta[S] = s0;
-    let mut w = initial_weights(&data, &r0, &theta, &acc_fit, &mag_fit);
+    let mut w = initial_weights(&data, &r0, &theta, &acc_fit, &mag_fit)?;
     // Step 3.
     let no_runs: Vec<Range<usize>> = Vec::new();
     theta = refine(&data, &no_runs, &mut w, &r0, theta, config)?;
@@ -170,27 +248,17 @@ pub fn fit_mag_accel(
     let (no_runs_theta, no_runs_w) = (theta, w);
     let mut runs = Vec::new();
     if config.find_runs {
-        runs = aimed_runs(&data, samples.len(), &r0, &theta, config);
+        runs = aimed_runs(&data, &r0, &theta, config)?;
         if !runs.is_empty() {
-            w.aim = 1.0 / aim_rms(&data, &runs, &r0, &theta).max(SIGMA_FLOOR);
+            w.aim = 1.0 / aim_rms(&data, &runs, &r0, &theta)?.max(SIGMA_FLOOR);
             theta = refine(&data, &runs, &mut w, &r0, theta, config)?;
         }
     }
     // Step 5.
     let report = |theta: &SVector<f64, P>, runs: &[Range<usize>], w: &Weights| {
-        finish(
-            samples,
-            &data,
-            (&na, &nm),
-            &r0,
-            theta,
-            runs,
-            w,
-            &mag,
-            config,
-        )
+        finish(&data, &r0, theta, runs, w, config)
     };
-    let with_runs = report(&theta, &runs, &w);
+    let with_runs = report(&theta, &runs, &w)?;
     if runs.is_empty() || with_runs.is_ok() {
         return with_runs;
     }
@@ -198,38 +266,46 @@ pub fn fit_mag_accel(
     // (a few consecutive readings rolling about the pointing axis) can leave the pointing
     // axis less certain than the calibration without them. Those readings still count as
     // readings; only the pointing axis falls back to the accelerometer's x.
-    report(&no_runs_theta, &[], &no_runs_w).or(with_runs)
+    report(&no_runs_theta, &[], &no_runs_w)?.or(with_runs)
 }
 
-/// Refuses too few readings and non-finite ones.
-fn check_readings(samples: &[MagAccelSample]) -> Result<()> {
-    if samples.len() < MIN_MAG_ACCEL_READINGS {
+/// Refuses too few readings and non-finite ones (the first, magnetometer before
+/// accelerometer).
+fn check_readings(readings: &dyn Readings<6>) -> Result<()> {
+    if readings.len() < MIN_MAG_ACCEL_READINGS {
         return Err(Error::TooFewPoints {
-            got: samples.len(),
+            got: readings.len(),
             need: MIN_MAG_ACCEL_READINGS,
         });
     }
-    for s in samples {
-        check_finite3("magnetometer reading", &s.mag)?;
-        check_finite3("accelerometer reading", &s.acc)?;
-    }
-    Ok(())
+    let mut first_bad = Ok(());
+    readings.replay(&mut |run| {
+        for r in run {
+            if first_bad.is_ok() {
+                first_bad = check_finite3("magnetometer reading", &Sensor::Mag.of(r))
+                    .and_then(|_| check_finite3("accelerometer reading", &Sensor::Acc.of(r)));
+            }
+        }
+    })?;
+    first_bad
 }
 
-/// Step 1's outcome: each sensor's own ellipsoid, the normalisers of the two sensors'
-/// readings, the normalised readings, and the joint parameters the ellipsoids give.
-struct Start {
+/// Step 1's outcome: each sensor's own ellipsoid, the readings normalised, and the joint
+/// parameters the ellipsoids give.
+struct Start<'a> {
     acc_fit: Solution<CompassCalibration3d>,
     mag_fit: Solution<CompassCalibration3d>,
-    na: Normaliser<3>,
-    nm: Normaliser<3>,
-    data: Data,
+    data: Data<'a>,
     theta: SVector<f64, P>,
 }
 
 /// Step 1: each sensor's ellipsoid, accepted up to [`INITIAL_FIT_BOUND_DEG`], as the start
 /// of the joint fit, in the normalised readings' units.
-fn start(acc: &[Vector3<f64>], mag: &[Vector3<f64>], config: &MagAccelConfig) -> Result<Start> {
+fn start<'a>(
+    readings: &'a dyn Readings<6>,
+    config: &MagAccelConfig,
+    limits: Limits,
+) -> Result<Start<'a>> {
     let start = EllipsoidConfig {
         limits: FitLimits {
             max_heading_error_bound_deg: INITIAL_FIT_BOUND_DEG,
@@ -237,14 +313,18 @@ fn start(acc: &[Vector3<f64>], mag: &[Vector3<f64>], config: &MagAccelConfig) ->
         },
         ..config.ellipsoid
     };
-    let acc_fit = fit_ellipsoid(acc, &start)?;
-    let mag_fit = fit_ellipsoid(mag, &start)?;
-    let na = Normaliser::of(acc)?;
-    let nm = Normaliser::of(mag)?;
-    let data = Data {
-        acc: acc.iter().map(|a| (a - na.centre) / na.scale).collect(),
-        mag: mag.iter().map(|m| (m - nm.centre) / nm.scale).collect(),
+    let acc = SensorReadings {
+        readings,
+        sensor: Sensor::Acc,
     };
+    let mag = SensorReadings {
+        readings,
+        sensor: Sensor::Mag,
+    };
+    let acc_fit = fit_ellipsoid_readings(&acc, &start)?;
+    let mag_fit = fit_ellipsoid_readings(&mag, &start)?;
+    let na = Normaliser::of_finite(&acc, "point")?;
+    let nm = Normaliser::of_finite(&mag, "point")?;
     let mut theta = SVector::<f64, P>::zeros();
     let put = |theta: &mut SVector<f64, P>,
                c0: usize,
@@ -263,9 +343,12 @@ fn start(acc: &[Vector3<f64>], mag: &[Vector3<f64>], config: &MagAccelConfig) ->
     Ok(Start {
         acc_fit,
         mag_fit,
-        na,
-        nm,
-        data,
+        data: Data {
+            readings,
+            na,
+            nm,
+            limits,
+        },
         theta,
     })
 }
@@ -278,69 +361,80 @@ fn initial_weights(
     theta: &SVector<f64, P>,
     acc_fit: &Solution<CompassCalibration3d>,
     mag_fit: &Solution<CompassCalibration3d>,
-) -> Weights {
+) -> Result<Weights> {
     let mut w = Weights {
         acc: 1.0 / acc_fit.quality.fit.residual_rms_rel.max(SIGMA_FLOOR),
         mag: 1.0 / mag_fit.quality.fit.residual_rms_rel.max(SIGMA_FLOOR),
         dip: 1.0,
         aim: 1.0,
     };
-    w.dip = 1.0 / dip_rms(data, r0, theta).max(SIGMA_FLOOR);
-    w
+    w.dip = 1.0 / dip_rms(data, r0, theta)?.max(SIGMA_FLOOR);
+    Ok(w)
 }
 
-/// Step 4: the runs of shots sharing a pointing direction among the `n` readings, from
-/// their level frames at the refined calibration.
+/// Step 4: the runs of shots sharing a pointing direction among the readings, from their
+/// level frames at the refined calibration.
 fn aimed_runs(
     data: &Data,
-    n: usize,
     r0: &Rotation3<f64>,
     theta: &SVector<f64, P>,
     config: &MagAccelConfig,
-) -> Vec<Range<usize>> {
-    let frames: Vec<Option<Matrix3<f64>>> =
-        (0..n).map(|i| level_frame(data, i, r0, theta)).collect();
-    find_runs(
-        &frames,
-        &Vector3::x(),
-        &RunRule {
+) -> Result<Vec<Range<usize>>> {
+    let mut finder = RunFinder::new(
+        Vector3::x(),
+        RunRule {
             tolerance_rad: config.run_tolerance_deg.to_radians(),
             min_roll_rad: config.run_min_roll_deg.to_radians(),
             min_shots: config.run_min_shots,
         },
-    )
+        data.limits.stretch_frames,
+    );
+    loop {
+        let mut k = 0usize;
+        data.replay(|a, m| {
+            if finder.wants(k) {
+                finder.push(level_frame(a, m, r0, theta));
+            }
+            k += 1;
+        })?;
+        if !finder.end_pass() {
+            return Ok(finder.runs());
+        }
+    }
 }
 
 /// Step 5: the covariance, the calibration and its report, and the refusal on the heading
-/// bound (widened to the Student-t quantile of σ's degrees of freedom).
-#[allow(clippy::too_many_arguments)]
+/// bound (widened to the Student-t quantile of σ's degrees of freedom). The outer error is
+/// one replaying the readings, the inner one the refusal.
 fn finish(
-    samples: &[MagAccelSample],
     data: &Data,
-    (na, nm): (&Normaliser<3>, &Normaliser<3>),
     r0: &Rotation3<f64>,
     theta: &SVector<f64, P>,
     runs: &[Range<usize>],
     w: &Weights,
-    mag: &[Vector3<f64>],
     config: &MagAccelConfig,
-) -> Result<Solution<MagAccelCalibration, MagAccelQuality>> {
-    let (ne, sums) = normal_equations(data, runs, w, r0, theta).ok_or(Error::Degenerate {
-        reason: "the joint fit left a reading at a sensor's centre; check the input",
-    })?;
-    let cov = ne.jtj.try_inverse().ok_or(Error::Degenerate {
-        reason: "the readings do not determine the joint calibration (singular information); add readings in other orientations",
-    })?;
-    let out = assemble(
-        samples, data, na, nm, r0, theta, runs, &sums, &cov, w, mag, config,
-    )?;
-    let dof = (3 * samples.len()) as f64 - (P - 2 * usize::from(runs.is_empty())) as f64;
-    quality::require_certain(
+) -> Result<Result<Solution<MagAccelCalibration, MagAccelQuality>>> {
+    let Some((ne, sums)) = normal_equations(data, runs, w, r0, theta)? else {
+        return Ok(Err(Error::Degenerate {
+            reason: "the joint fit left a reading at a sensor's centre; check the input",
+        }));
+    };
+    let Some(cov) = ne.jtj.try_inverse() else {
+        return Ok(Err(Error::Degenerate {
+            reason: "the readings do not determine the joint calibration (singular information); add readings in other orientations",
+        }));
+    };
+    let out = match assemble(data, r0, theta, runs, &sums, &cov, w, config)? {
+        Ok(out) => out,
+        Err(e) => return Ok(Err(e)),
+    };
+    let dof = (3 * data.len()) as f64 - (P - 2 * usize::from(runs.is_empty())) as f64;
+    Ok(quality::require_certain(
         &out.quality.mag,
         dof.max(1.0),
         config.max_heading_error_bound_deg,
-    )?;
-    Ok(out)
+    )
+    .map(|()| out))
 }
 
 /// The rotation taking the magnetometer's calibrated frame into the accelerometer's, and
@@ -349,12 +443,12 @@ fn initial_alignment(data: &Data, theta: &SVector<f64, P>) -> Result<(Rotation3<
     let m = Model::of(theta, &Rotation3::identity());
     // Σ zzᵀ for z = (vec(û v̂ᵀ), −1): the homogeneous least squares of ûᵀMv̂ − s = 0.
     let mut a = SMatrix::<f64, 10, 10>::zeros();
-    for (acc, mag) in data.acc.iter().zip(&data.mag) {
+    data.replay(|acc, mag| {
         let (Some(u), Some(v)) = (
             (m.b_a * (acc - m.c_a)).try_normalize(1e-12),
             (m.b_m * (mag - m.c_m)).try_normalize(1e-12),
         ) else {
-            continue;
+            return;
         };
         let mut z = SVector::<f64, 10>::zeros();
         for i in 0..3 {
@@ -364,7 +458,7 @@ fn initial_alignment(data: &Data, theta: &SVector<f64, P>) -> Result<(Rotation3<
         }
         z[9] = -1.0;
         a += z * z.transpose();
-    }
+    })?;
     let singular = Error::Degenerate {
         reason: "the readings do not determine the rotation between the magnetometer and the accelerometer; take readings in more orientations",
     };
@@ -397,28 +491,29 @@ fn initial_alignment(data: &Data, theta: &SVector<f64, P>) -> Result<(Rotation3<
 }
 
 /// RMS of the dip residuals `ûᵀRv̂ − s`.
-fn dip_rms(data: &Data, r0: &Rotation3<f64>, theta: &SVector<f64, P>) -> f64 {
+fn dip_rms(data: &Data, r0: &Rotation3<f64>, theta: &SVector<f64, P>) -> Result<f64> {
     let w = Weights {
         acc: 0.0,
         mag: 0.0,
         dip: 1.0,
         aim: 0.0,
     };
-    normal_equations(data, &[], &w, r0, theta)
+    Ok(normal_equations(data, &[], &w, r0, theta)?
         .map(|(_, s)| (s.dip.0 / s.dip.1.max(1) as f64).sqrt())
-        .unwrap_or(1.0)
+        .unwrap_or(1.0))
 }
 
-/// The level frame (rows: the level axes in the accelerometer's frame) of reading `i`.
+/// The level frame (rows: the level axes in the accelerometer's frame) of the reading
+/// `(a, mg)` (normalised).
 fn level_frame(
-    data: &Data,
-    i: usize,
+    a: &Vector3<f64>,
+    mg: &Vector3<f64>,
     r0: &Rotation3<f64>,
     theta: &SVector<f64, P>,
 ) -> Option<Matrix3<f64>> {
     let m = Model::of(theta, r0);
-    let u = (m.b_a * (data.acc[i] - m.c_a)).try_normalize(1e-12)?;
-    let v = (m.b_m * (data.mag[i] - m.c_m)).try_normalize(1e-12)?;
+    let u = (m.b_a * (a - m.c_a)).try_normalize(1e-12)?;
+    let v = (m.b_m * (mg - m.c_m)).try_normalize(1e-12)?;
     let rows: [Vector3<f64>; 3] = [Vector3::x(), Vector3::y(), Vector3::z()]
         .map(|e| level_direction(&u, &(m.rot * v), &e).unwrap_or_else(Vector3::zeros));
     let f = Matrix3::from_columns(&rows);
@@ -437,17 +532,18 @@ fn refine(
     config: &MagAccelConfig,
 ) -> Result<SVector<f64, P>> {
     for _ in 0..VARIANCE_ROUNDS {
-        let out = lm::minimise(
+        let weights = *w;
+        let out = lm::minimise_replayed(
             "joint magnetometer + accelerometer refinement",
             theta,
             config.max_iterations,
             // Three residuals per reading (accelerometer, magnetometer, dip), and one per
             // shot in a run.
-            3 * data.acc.len() + runs.iter().map(|r| r.len()).sum::<usize>(),
-            |t| normal_equations(data, runs, w, r0, t).map(|(ne, _)| ne),
-        )?;
+            3 * data.len() + runs.iter().map(|r| r.len()).sum::<usize>(),
+            |t| Ok(normal_equations(data, runs, &weights, r0, t)?.map(|(ne, _)| ne)),
+        )??;
         theta = out.params;
-        let Some((_, s)) = normal_equations(data, runs, w, r0, &theta) else {
+        let Some((_, s)) = normal_equations(data, runs, w, r0, &theta)? else {
             break;
         };
         *w = reweighted(&s, runs.is_empty());

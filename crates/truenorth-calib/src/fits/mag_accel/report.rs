@@ -12,8 +12,9 @@ use truenorth_core::{
     CompassQuality, Error, FitQuality, Result, STANDARD_GRAVITY_MPS2, Solution, Validate,
 };
 
-use crate::fits::mag_accel::calibration::{MagAccelCalibration, MagAccelSample};
+use crate::fits::mag_accel::calibration::MagAccelCalibration;
 use crate::fits::mag_accel::config::MagAccelConfig;
+use crate::fits::mag_accel::readings::{Sensor, SensorReadings};
 use crate::fits::mag_accel::solve::{
     BM, CA, CM, Data, GroupSums, Model, OMEGA, P, Weights, aim_rms, level_direction,
 };
@@ -158,37 +159,47 @@ fn reading_sensitivity(
         .sum()
 }
 
-/// The calibration in raw units and body axes, and its report.
+/// The calibration in raw units and body axes, and its report. The outer error is one
+/// replaying the readings, the inner one a refusal.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn assemble(
-    samples: &[MagAccelSample],
     data: &Data,
-    na: &Normaliser<3>,
-    nm: &Normaliser<3>,
     r0: &Rotation3<f64>,
     theta: &SVector<f64, P>,
     runs: &[Range<usize>],
     sums: &GroupSums,
     cov: &SMatrix<f64, P, P>,
     w: &Weights,
-    mag_raw: &[Vector3<f64>],
     config: &MagAccelConfig,
-) -> Result<Solution<MagAccelCalibration, MagAccelQuality>> {
+) -> Result<Result<Solution<MagAccelCalibration, MagAccelQuality>>> {
+    let (na, nm) = (&data.na, &data.nm);
     let md = Model::of(theta, r0);
-    let cal = raw_calibration(&md, na, nm)?;
+    let cal = match raw_calibration(&md, na, nm) {
+        Ok(cal) => cal,
+        Err(e) => return Ok(Err(e)),
+    };
     let rms = |(ss, n): (f64, usize)| (ss / n.max(1) as f64).sqrt();
     let (sigma_a, sigma_m) = (rms(sums.acc), rms(sums.mag));
     let (bound, noise) = heading_figures(theta, r0, cov, 1.0 / w.acc, 1.0 / w.mag);
     // The magnetometer's own geometry, for its coverage, condition and dilution.
-    let own = quality::assess_3d(mag_raw, &cal.mag, cal.field);
+    let mag_raw = SensorReadings {
+        readings: data.readings,
+        sensor: Sensor::Mag,
+    };
+    let own = quality::assess_3d_of(&mag_raw, &cal.mag, cal.field)?;
     let sigmas = ParameterSigmas::of(cov, &md, na, nm);
     let dip_spread =
         (rms(sums.dip) / md.s.clamp(-1.0, 1.0).acos().sin().abs().max(1e-9)).to_degrees();
     let run_shots: usize = runs.iter().map(|r| r.len()).sum();
+    let aim_rms_deg = if runs.is_empty() {
+        0.0
+    } else {
+        aim_rms(data, runs, r0, theta)?.to_degrees() * 3f64.sqrt()
+    };
     let quality = MagAccelQuality {
         mag: quality::with_expected_field(
             joint_compass_quality(
-                samples.len(),
+                data.len(),
                 &own,
                 sigma_m,
                 (bound, noise),
@@ -208,16 +219,12 @@ pub(crate) fn assemble(
         runs: runs.len(),
         run_shots,
         pointing_offset_deg: md.p.angle(&Vector3::x()).to_degrees(),
-        aim_rms_deg: if runs.is_empty() {
-            0.0
-        } else {
-            aim_rms(data, runs, r0, theta).to_degrees() * 3f64.sqrt()
-        },
+        aim_rms_deg,
     };
-    Ok(Solution {
+    Ok(Ok(Solution {
         params: cal,
         quality,
-    })
+    }))
 }
 
 /// The magnetometer's report of the joint fit: the points, coverage, condition and

@@ -35,7 +35,13 @@ use core::ops::Range;
 
 use nalgebra::{Matrix3, Rotation3, SMatrix, SVector, Vector3};
 
+use truenorth_core::Result;
+
 use crate::fits::lm::NormalEquations;
+use crate::fits::mag_accel::readings::Sensor;
+use crate::fits::mag_accel::run_rows::{RunSums, all_run_rows};
+use crate::fits::normalise::Normaliser;
+use crate::fits::readings::Readings;
 
 #[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
@@ -121,11 +127,92 @@ pub(crate) fn level_direction(
     Some(Vector3::new(e1.dot(p), e2.dot(p), u.dot(p)))
 }
 
-/// The readings, each sensor in its normaliser's coordinates.
-#[derive(Debug, Clone)]
-pub(crate) struct Data {
-    pub acc: Vec<Vector3<f64>>,
-    pub mag: Vec<Vector3<f64>>,
+/// How much of the readings a pass of the joint fit keeps at once; past that, it passes
+/// over them again instead.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct Limits {
+    /// The most shots of a run kept for its rows (about 650 bytes each with their
+    /// Jacobians); a longer run takes two more passes.
+    pub run_shots: usize,
+    /// The most level frames the run search keeps (80 bytes each); a stretch of shots
+    /// aimed one way longer than twice that takes more passes.
+    pub stretch_frames: usize,
+}
+
+/// The limits of the fit: a few megabytes each.
+pub(crate) const LIMITS: Limits = Limits {
+    run_shots: 1 << 12,
+    stretch_frames: 1 << 16,
+};
+
+/// The readings, each sensor in its normaliser's coordinates: normalised as they are
+/// replayed, so that the fit keeps no copy of them.
+pub(crate) struct Data<'a> {
+    pub readings: &'a dyn Readings<6>,
+    pub na: Normaliser<3>,
+    pub nm: Normaliser<3>,
+    pub limits: Limits,
+}
+
+impl Data<'_> {
+    /// How many readings there are.
+    pub fn len(&self) -> usize {
+        self.readings.len()
+    }
+
+    /// Calls `f` with every reading, in order: the accelerometer's and the magnetometer's,
+    /// normalised. An error replaying the readings is returned as it is.
+    pub fn replay(&self, mut f: impl FnMut(&Vector3<f64>, &Vector3<f64>)) -> Result<()> {
+        self.readings.replay(&mut |run| {
+            for r in run {
+                f(
+                    &self.na.apply(&Sensor::Acc.of(r)),
+                    &self.nm.apply(&Sensor::Mag.of(r)),
+                );
+            }
+        })
+    }
+
+    /// Calls `f` with every reading of `range` (normalised), in order: a whole replay.
+    pub fn replay_range(
+        &self,
+        range: &Range<usize>,
+        mut f: impl FnMut(&Vector3<f64>, &Vector3<f64>),
+    ) -> Result<()> {
+        let mut i = 0usize;
+        self.replay(|a, m| {
+            if range.contains(&i) {
+                f(a, m);
+            }
+            i += 1;
+        })
+    }
+
+    /// Calls `f` with the normalised readings `(accelerometer, magnetometer)` of each of
+    /// `runs` (index ranges, increasing and disjoint, as `mag_accel_runs` finds them), in
+    /// order, one run at a time: only the run at hand is kept.
+    pub fn replay_runs(
+        &self,
+        runs: &[Range<usize>],
+        mut f: impl FnMut(&[(Vector3<f64>, Vector3<f64>)]),
+    ) -> Result<()> {
+        let mut shots = Vec::new();
+        let (mut i, mut next) = (0usize, 0usize);
+        self.replay(|a, m| {
+            while runs.get(next).is_some_and(|r| r.end <= i) {
+                next += 1;
+            }
+            if let Some(run) = runs.get(next).filter(|r| r.contains(&i)) {
+                shots.push((*a, *m));
+                if i + 1 == run.end {
+                    f(&shots);
+                    shots.clear();
+                    next += 1;
+                }
+            }
+            i += 1;
+        })
+    }
 }
 
 /// Inverse standard deviations of the residual groups.
@@ -148,7 +235,7 @@ pub(crate) struct GroupSums {
 
 /// A rank-one update of the normal equations by the row `j` with residual `r`, both
 /// already weighted.
-fn add_row(
+pub(crate) fn add_row(
     jtj: &mut SMatrix<f64, P, P>,
     jtr: &mut SVector<f64, P>,
     cost: &mut f64,
@@ -206,14 +293,21 @@ pub(crate) fn normal_equations(
     w: &Weights,
     r0: &Rotation3<f64>,
     theta: &SVector<f64, P>,
-) -> Option<(NormalEquations<P>, GroupSums)> {
+) -> Result<Option<(NormalEquations<P>, GroupSums)>> {
     let m = Model::of(theta, r0);
     let mut jtj = SMatrix::<f64, P, P>::zeros();
     let mut jtr = SVector::<f64, P>::zeros();
     let mut cost = 0.0;
     let mut sums = GroupSums::default();
-    for (a, mg) in data.acc.iter().zip(&data.mag) {
-        let [acc, mag, dip] = reading_rows(&m, a, mg)?;
+    let mut defined = true;
+    data.replay(|a, mg| {
+        if !defined {
+            return;
+        }
+        let Some([acc, mag, dip]) = reading_rows(&m, a, mg) else {
+            defined = false;
+            return;
+        };
         for ((row, r), weight, group) in [
             (acc, w.acc, &mut sums.acc),
             (mag, w.mag, &mut sums.mag),
@@ -223,6 +317,9 @@ pub(crate) fn normal_equations(
             group.0 += r * r;
             group.1 += 1;
         }
+    })?;
+    if !defined {
+        return Ok(None);
     }
     if runs.is_empty() {
         // No run: the pointing axis is x. A stiff prior keeps the normal equations regular.
@@ -232,10 +329,14 @@ pub(crate) fn normal_equations(
             add_row(&mut jtj, &mut jtr, &mut cost, &row, 1e4 * theta[k]);
         }
     }
-    for run in runs {
-        run_rows(
-            data, run, w, r0, theta, &mut jtj, &mut jtr, &mut cost, &mut sums,
-        )?;
+    let mut out = RunSums {
+        jtj: &mut jtj,
+        jtr: &mut jtr,
+        cost: &mut cost,
+        sums: &mut sums,
+    };
+    if all_run_rows(data, runs, w, r0, theta, &mut out)?.is_none() {
+        return Ok(None);
     }
     for a in 0..P {
         for b in 0..a {
@@ -243,7 +344,7 @@ pub(crate) fn normal_equations(
         }
     }
     let ne = NormalEquations { cost, jtj, jtr };
-    (ne.cost.is_finite() && ne.jtj.iter().all(|x| x.is_finite())).then_some((ne, sums))
+    Ok((ne.cost.is_finite() && ne.jtj.iter().all(|x| x.is_finite())).then_some((ne, sums)))
 }
 
 /// The unweighted Jacobian rows and residuals of one reading `(a, mg)` under the model `m`:
@@ -302,81 +403,20 @@ fn reading_rows(
     Some([(acc, nu - 1.0), (mag, nv - 1.0), (dip, r)])
 }
 
-/// The level-frame direction of the pointing axis for shot `i` under `theta`.
-fn shot_direction(
-    data: &Data,
-    i: usize,
-    r0: &Rotation3<f64>,
-    theta: &SVector<f64, P>,
-) -> Option<Vector3<f64>> {
-    let m = Model::of(theta, r0);
-    let u = (m.b_a * (data.acc[i] - m.c_a)).try_normalize(1e-12)?;
-    let v = (m.b_m * (data.mag[i] - m.c_m)).try_normalize(1e-12)?;
-    level_direction(&u, &(m.rot * v), &m.p)
-}
-
-/// The rows `wᵢ − w̄` of one run, with Jacobians by forward differences (the TRIAD frame's
-/// derivatives are long to write out and a run is a few shots), centred like the residuals.
-#[allow(clippy::too_many_arguments)]
-fn run_rows(
-    data: &Data,
-    run: &Range<usize>,
-    w: &Weights,
-    r0: &Rotation3<f64>,
-    theta: &SVector<f64, P>,
-    jtj: &mut SMatrix<f64, P, P>,
-    jtr: &mut SVector<f64, P>,
-    cost: &mut f64,
-    sums: &mut GroupSums,
-) -> Option<()> {
-    let n = run.len();
-    let mut dirs: Vec<Vector3<f64>> = Vec::with_capacity(n);
-    let mut jac: Vec<SMatrix<f64, 3, P>> = Vec::with_capacity(n);
-    // Step: the parameters are of order one in normalised coordinates; √ε balances
-    // truncation and rounding of a forward difference.
-    const H: f64 = 1.5e-8;
-    for i in run.clone() {
-        let d0 = shot_direction(data, i, r0, theta)?;
-        let mut j = SMatrix::<f64, 3, P>::zeros();
-        for k in 0..P {
-            let mut t = *theta;
-            t[k] += H;
-            let dk = shot_direction(data, i, r0, &t)?;
-            j.set_column(k, &((dk - d0) / H));
-        }
-        dirs.push(d0);
-        jac.push(j);
-    }
-    let inv = 1.0 / n as f64;
-    let mean: Vector3<f64> = dirs.iter().sum::<Vector3<f64>>() * inv;
-    let mean_j: SMatrix<f64, 3, P> = jac.iter().sum::<SMatrix<f64, 3, P>>() * inv;
-    for (d, j) in dirs.iter().zip(&jac) {
-        let r = d - mean;
-        let jc = j - mean_j;
-        for c in 0..3 {
-            let row: SVector<f64, P> = jc.row(c).transpose();
-            add_row(jtj, jtr, cost, &(row * w.aim), r[c] * w.aim);
-            sums.aim.0 += r[c] * r[c];
-        }
-        sums.aim.1 += 3;
-    }
-    Some(())
-}
-
-/// RMS of the run residuals.
+/// RMS of the run residuals. An error replaying the readings is returned as it is.
 pub(crate) fn aim_rms(
     data: &Data,
     runs: &[Range<usize>],
     r0: &Rotation3<f64>,
     theta: &SVector<f64, P>,
-) -> f64 {
+) -> Result<f64> {
     let w = Weights {
         acc: 0.0,
         mag: 0.0,
         dip: 0.0,
         aim: 1.0,
     };
-    normal_equations(data, runs, &w, r0, theta)
+    Ok(normal_equations(data, runs, &w, r0, theta)?
         .map(|(_, s)| (s.aim.0 / s.aim.1.max(1) as f64).sqrt())
-        .unwrap_or(1.0)
+        .unwrap_or(1.0))
 }
