@@ -9,7 +9,8 @@
 #
 # For each size it writes a 2-D compass file (t_s,mag_x,mag_y: ten turns of a tilted
 # ellipse with noise), a 3-D one (t_s,mag_x,mag_y,mag_z: a tumble), an IMU file
-# (t_s,gyr_*,acc_*,mag_*) and a drive log (t_s,dist_l_m,dist_r_m,gyr_z), then prints one
+# (t_s,gyr_*,acc_*,mag_*), a tumbling IMU for the joint fit (t_s,acc_*,mag_*) and a
+# drive log (t_s,dist_l_m,dist_r_m,gyr_z), then prints one
 # table row per command: wall time (s), CPU time (user + system, s: the work done, which a
 # machine loaded by other jobs stretches less than the wall time) and peak resident memory
 # (MB), from /usr/bin/time -v.
@@ -34,6 +35,7 @@ gen() { # gen KIND ROWS FILE
         if (kind == "2d") print "t_s,mag_x,mag_y"
         else if (kind == "3d") print "t_s,mag_x,mag_y,mag_z"
         else if (kind == "imu") print "t_s,gyr_x,gyr_y,gyr_z,acc_x,acc_y,acc_z,mag_x,mag_y,mag_z"
+        else if (kind == "tumble") print "t_s,acc_x,acc_y,acc_z,mag_x,mag_y,mag_z"
         else print "t_s,dist_l_m,dist_r_m,gyr_z"
         for (k = 0; k < n; k++) {
             t = k * 0.01; a = 2 * pi * 10 * k / n
@@ -45,6 +47,18 @@ gen() { # gen KIND ROWS FILE
             } else if (kind == "imu") {
                 y = 0.05 * t
                 printf "%.2f,%.5f,%.5f,%.5f,%.4f,%.4f,%.4f,%.3f,%.3f,%.3f\n", t, 0.001 * (rand() - 0.5), 0.001 * (rand() - 0.5), 0.05, 0.01 * (rand() - 0.5), 0.01 * (rand() - 0.5), -9.81, 20 * cos(y), -20 * sin(y), 45
+            } else if (kind == "tumble") {
+                # Yaw 37 turns, pitch +-1.3 rad 23 times, roll 53 turns; the earth field
+                # (20, 0, 45) and gravity turned into the body (yaw, then pitch, then roll).
+                y = 2 * pi * 37 * k / n; p = 1.3 * sin(2 * pi * 23 * k / n); r = 2 * pi * 53 * k / n
+                for (s = 0; s < 2; s++) {
+                    vx = (s == 0) ? 20 : 0; vy = 0; vz = (s == 0) ? 45 : -9.81
+                    ax = cos(y) * vx + sin(y) * vy; ay = -sin(y) * vx + cos(y) * vy; vx = ax; vy = ay
+                    ax = cos(p) * vx - sin(p) * vz; az = sin(p) * vx + cos(p) * vz; vx = ax; vz = az
+                    ay = cos(r) * vy + sin(r) * vz; az = -sin(r) * vy + cos(r) * vz; vy = ay; vz = az
+                    if (s == 0) { mx = vx; my = vy; mz = vz } else { gx = vx; gy = vy; gz = vz }
+                }
+                printf "%.2f,%.4f,%.4f,%.4f,%.3f,%.3f,%.3f\n", t, 0.1 + 1.01 * gx + 0.02 * (rand() - 0.5), -0.05 + 0.99 * gy + 0.02 * (rand() - 0.5), 0.2 + gz + 0.02 * (rand() - 0.5), 15 + 1.1 * mx + 0.05 * my + rand() - 0.5, -8 + 0.05 * mx + 0.95 * my + 0.02 * mz + rand() - 0.5, 5 + 0.02 * my + mz + rand() - 0.5
             } else {
                 d = 10 * t
                 printf "%.2f,%.4f,%.4f,%.5f\n", t, d + 0.05 * t, d - 0.05 * t, 0.0645 + 0.001 * (rand() - 0.5)
@@ -75,7 +89,7 @@ echo "| command                            |      rows |  wall s |   cpu s |  pe
 echo "|------------------------------------|-----------|---------|---------|----------|-------"
 echo '{"track_m": 1.55, "odometer_wheels": "rear"}' > "$dir/vehicle.json"
 for n in "${sizes[@]}"; do
-    for kind in 2d 3d imu drive; do gen "$kind" "$n" "$dir/$kind.csv"; done
+    for kind in 2d 3d imu tumble drive; do gen "$kind" "$n" "$dir/$kind.csv"; done
     size=$(du -m "$dir/2d.csv" | cut -f1)
     for m in ellipse online-ellipse binned-ellipse merit-circle turn; do
         measure "calibrate $m" "$n" "$bin" calibrate --method "$m" --input "$dir/2d.csv" --output "$dir/cal-$m.json" --accept-poor
@@ -83,6 +97,7 @@ for n in "${sizes[@]}"; do
     for m in ellipsoid online-ellipsoid; do
         measure "calibrate $m (3-D)" "$n" "$bin" calibrate --method "$m" --input "$dir/3d.csv" --output "$dir/cal-$m.json" --accept-poor
     done
+    measure "calibrate ellipsoid-accel (tumble)" "$n" "$bin" calibrate --method ellipsoid-accel --input "$dir/tumble.csv" --output "$dir/cal-accel.json" --accept-poor
     measure "heading" "$n" "$bin" heading --calibration "$dir/cal-ellipse.json" --input "$dir/2d.csv" --output "$dir/heading.csv"
     if [ -n "${TRUENORTH_BEFORE:-}" ]; then
         measure "before: calibrate ellipse" "$n" "$TRUENORTH_BEFORE" calibrate --method ellipse --input "$dir/2d.csv" --output "$dir/cal-before.json" --accept-poor
