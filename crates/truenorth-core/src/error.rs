@@ -307,6 +307,14 @@ pub enum Error {
         /// What is missing and what to use instead.
         reason: &'static str,
     },
+    /// The store that keeps a batch fit's readings (one that holds them outside memory, in a
+    /// file) could not keep them or give them back: a failure beneath the calibrator, not a
+    /// fault of the data.
+    #[error("the readings could not be kept or read back: {reason}")]
+    ReadingsUnavailable {
+        /// Where the readings were kept and what to do.
+        reason: &'static str,
+    },
 }
 
 #[cfg(test)]

@@ -45,7 +45,7 @@ impl Error {
             // The input or the request: values that are no numbers, time that does not
             // advance, parameters outside their range, units the data contradict, a date
             // outside the model, a saved state of another version or layout, a request the
-            // sensor or method cannot meet.
+            // sensor or method cannot meet; or the readings' store failing beneath the fit.
             Error::NonFinite { .. }
             | Error::NonIncreasingTime { .. }
             | Error::InvalidDt { .. }
@@ -54,7 +54,8 @@ impl Error {
             | Error::DateOutOfRange { .. }
             | Error::SnapshotVersion { .. }
             | Error::InvalidSnapshot { .. }
-            | Error::Unsupported { .. } => false,
+            | Error::Unsupported { .. }
+            | Error::ReadingsUnavailable { .. } => false,
         }
     }
 }
@@ -93,6 +94,7 @@ mod tests {
                 max: 1.0,
             },
             Error::Unsupported { reason: "r" },
+            Error::ReadingsUnavailable { reason: "r" },
             Error::SnapshotVersion {
                 found: 1,
                 expected: 2,

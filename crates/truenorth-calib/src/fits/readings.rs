@@ -43,7 +43,8 @@ pub trait Readings<const D: usize> {
     ///
     /// # Errors
     /// Whatever stopped the replay (readings kept in memory never fail; a store on disk
-    /// fails when it cannot read them back). A replay that failed may have called `run`
+    /// fails when it cannot read them back, with
+    /// [`Error::ReadingsUnavailable`](truenorth_core::Error::ReadingsUnavailable)). A replay that failed may have called `run`
     /// with only part of the readings; a fit that sees the error returns it.
     fn replay(&self, run: &mut dyn FnMut(&[SVector<f64, D>])) -> Result<()>;
 }
@@ -80,8 +81,9 @@ pub trait ReadingStore<const D: usize>: Readings<D> {
     /// Adds a reading after the others.
     ///
     /// # Errors
-    /// When the reading cannot be stored (memory or disk full); the store then holds the
-    /// readings before it.
+    /// When the reading cannot be stored (a disk full:
+    /// [`Error::ReadingsUnavailable`](truenorth_core::Error::ReadingsUnavailable)); the
+    /// store then holds the readings before it.
     fn push(&mut self, reading: SVector<f64, D>) -> Result<()>;
 
     /// Forgets every reading.

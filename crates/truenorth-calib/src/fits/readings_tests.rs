@@ -24,7 +24,7 @@ pub(crate) struct Cut<const D: usize> {
 }
 
 /// The error a failing [`Cut`] gives.
-pub(crate) const FAILED: Error = Error::Unsupported {
+pub(crate) const FAILED: Error = Error::ReadingsUnavailable {
     reason: "test replay failure",
 };
 

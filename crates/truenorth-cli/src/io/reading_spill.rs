@@ -14,8 +14,8 @@
 //! A write or a read that fails (a full disk, an unwritable directory) is one error line
 //! naming the directory and saying to point `TMPDIR` at a disk with room: the store keeps
 //! the first such failure in the [`ReadingSpill`] it came from, for the command to report
-//! in place of the library's error (the library's [`truenorth::core::Error`] has no variant for an I/O
-//! failure; the store hands it [`truenorth::core::Error::Unsupported`] to stop the fit).
+//! in place of the library's error, which the store hands the fit to stop it
+//! ([`truenorth::core::Error::ReadingsUnavailable`]) and which cannot carry the I/O error's text.
 
 use std::cell::RefCell;
 use std::fs::{File, OpenOptions};
@@ -43,8 +43,8 @@ const CHUNK_READINGS: usize = 1 << 15;
 
 /// The reason the store gives the library when the disk fails it (the command reports the
 /// failure kept in [`ReadingSpill`] instead).
-const STOPPED: Error = Error::Unsupported {
-    reason: "the readings kept in a temporary file could not be written or read back; set TMPDIR to a directory on a disk with room",
+const STOPPED: Error = Error::ReadingsUnavailable {
+    reason: "they were kept in a temporary file; set TMPDIR to a directory on a disk with room",
 };
 
 /// Where the stores of one command spill, how much they keep in memory, and the first
