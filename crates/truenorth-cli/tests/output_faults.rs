@@ -10,7 +10,7 @@ use std::io::{BufRead as _, BufReader, Read as _};
 use std::os::unix::fs::FileTypeExt as _;
 use std::os::unix::process::ExitStatusExt as _;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
+use std::process::{Command, ExitStatus, Stdio};
 use std::time::{Duration, Instant};
 
 use common::{TURN_HEADER, ok, p, truenorth};
@@ -72,9 +72,20 @@ fn spawn(args: &[&str]) -> std::process::Child {
         .args(args)
         .stdin(Stdio::null())
         .stdout(Stdio::piped())
-        .stderr(Stdio::null())
+        // Piped, to show a failed run's message (one line: it never fills the pipe).
+        .stderr(Stdio::piped())
         .spawn()
         .unwrap()
+}
+
+/// The number of the signal `kill -NAME` sends (the same on every Unix).
+fn signal_number(name: &str) -> i32 {
+    match name {
+        "INT" => 2,
+        "KILL" => 9,
+        "TERM" => 15,
+        _ => unreachable!("a signal these tests send: {name}"),
+    }
 }
 
 /// The `.NAME.tmp-PID` temporaries in `dir`.
@@ -106,6 +117,9 @@ struct KillOutcomes {
     sent_mid_write: usize,
     /// Kills sent at a random time before the writing began.
     sent_early: usize,
+    /// Runs that ended (and were reaped) while the test waited for their temporary to
+    /// grow, before their signal could be sent: these must have succeeded.
+    ended_before_the_signal: usize,
     stopped_by_the_signal: usize,
     finished_first: usize,
     previous_output_kept: usize,
@@ -113,19 +127,30 @@ struct KillOutcomes {
     temporaries_left: usize,
 }
 
-/// Waits until `temp` holds at least `bytes` (true), or the run ended first (false).
-fn wait_for_size(temp: &Path, bytes: u64, child: &mut std::process::Child) -> bool {
+/// How waiting for a temporary to grow ended.
+enum Waited {
+    /// The temporary holds the bytes asked for.
+    Reached,
+    /// The run ended first, with this status: it is reaped, and its process id may
+    /// already be another process's, so no signal may be sent to it.
+    Ended(ExitStatus),
+    /// Neither within a minute.
+    TimedOut,
+}
+
+/// Waits until `temp` holds at least `bytes`, or the run ends first.
+fn wait_for_size(temp: &Path, bytes: u64, child: &mut std::process::Child) -> Waited {
     let deadline = Instant::now() + Duration::from_secs(60);
     while Instant::now() < deadline {
         if std::fs::metadata(temp).is_ok_and(|m| m.len() >= bytes) {
-            return true;
+            return Waited::Reached;
         }
-        if child.try_wait().unwrap().is_some() {
-            return false;
+        if let Some(status) = child.try_wait().unwrap() {
+            return Waited::Ended(status);
         }
         std::thread::sleep(Duration::from_micros(500));
     }
-    false
+    Waited::TimedOut
 }
 
 /// Runs `heading` `kills` times, each time on the input whose output is not there yet, and stops each run with `signal`:
@@ -160,6 +185,7 @@ fn kill_repeatedly(name: &str, signal: &str, kills: usize, seed: u64) -> KillOut
         let mut child = spawn(&heading_args(&s, input, out));
         let temp = dir.join(format!(".out.csv.tmp-{}", child.id()));
         let share = delays.next_fraction();
+        let mut ended_first = None;
         if share < 0.2 {
             std::thread::sleep(start_up.mul_f64(share * 5.0));
             found.sent_early += 1;
@@ -168,29 +194,58 @@ fn kill_repeatedly(name: &str, signal: &str, kills: usize, seed: u64) -> KillOut
             // and renamed, or just after.
             let whole = complete[input].len() as f64;
             let bytes = (whole * ((share - 0.2) / 0.7).min(1.0)) as u64;
-            if wait_for_size(&temp, bytes.max(1), &mut child) {
-                found.sent_mid_write += 1;
+            match wait_for_size(&temp, bytes.max(1), &mut child) {
+                Waited::Reached => found.sent_mid_write += 1,
+                Waited::Ended(status) => ended_first = Some(status),
+                Waited::TimedOut => {}
             }
         }
-        if signal == "KILL" {
-            let _ = child.kill();
-        } else {
-            let sent = Command::new("kill")
-                .args([format!("-{signal}"), child.id().to_string()])
-                .status()
-                .unwrap();
-            assert!(sent.success());
-        }
-        let status = child.wait().unwrap();
-        found.kills += 1;
-        match status.signal() {
-            Some(_) => found.stopped_by_the_signal += 1,
+        let status = match ended_first {
+            Some(status) => {
+                found.ended_before_the_signal += 1;
+                status
+            }
             None => {
-                assert!(status.success(), "run {k}: {status}");
-                found.finished_first += 1;
+                if signal == "KILL" {
+                    let _ = child.kill();
+                } else {
+                    // The run is not reaped yet (a zombie at worst), so its id is still its own.
+                    let sent = Command::new("kill")
+                        .args([format!("-{signal}"), child.id().to_string()])
+                        .status()
+                        .unwrap();
+                    assert!(sent.success(), "run {k}: kill -{signal} failed: {sent}");
+                }
+                child.wait().unwrap()
             }
+        };
+        let mut stderr = String::new();
+        if let Some(mut pipe) = child.stderr.take() {
+            let _ = pipe.read_to_string(&mut stderr);
         }
+        found.kills += 1;
         let now = std::fs::read(&output).unwrap();
+        // The two endings the contract allows: stopped by the signal sent (it arrived before
+        // the handler was installed and the default action ended the run, or the handler
+        // removed the temporary and raised it again), or success (the run ended before its
+        // signal was sent, or renamed its output into place and ended before the handler
+        // acted: either way the output is the new one). An exit status is a failure of the
+        // run itself, shown with its message.
+        if status.signal() == Some(signal_number(signal)) {
+            found.stopped_by_the_signal += 1;
+        } else if status.success() {
+            assert!(
+                now == complete[input],
+                "run {k} (SIG{signal}): a successful run left {} bytes, not its complete output ({})",
+                now.len(),
+                complete[input].len()
+            );
+            found.finished_first += 1;
+        } else {
+            panic!(
+                "run {k} (SIG{signal}): ended with {status}, neither stopped by the signal nor successful; its stderr: {stderr:?}"
+            );
+        }
         if now == complete[input] {
             found.new_output_complete += 1;
         } else {
@@ -205,7 +260,7 @@ fn kill_repeatedly(name: &str, signal: &str, kills: usize, seed: u64) -> KillOut
         }
         let left = temporaries(&dir);
         if signal != "KILL" {
-            assert!(left.is_empty(), "run {k}: SIGTERM left {left:?}");
+            assert!(left.is_empty(), "run {k}: SIG{signal} left {left:?}");
         }
         assert!(
             left.len() <= 1,

@@ -96,14 +96,7 @@ impl AtomicOutput {
                 let temp = temporaries::name_for(&target)
                     .ok_or_else(|| CliError::file(path, "not a file name"))?;
                 temporaries::remove_stale(&target);
-                temporaries::register(&temp);
-                let file = match File::create(&temp) {
-                    Ok(f) => f,
-                    Err(e) => {
-                        temporaries::discard(&temp);
-                        return Err(cannot_create(e));
-                    }
-                };
+                let file = temporaries::create(&temp).map_err(cannot_create)?;
                 // The replacement keeps the permissions of the file it replaces.
                 if let Ok(m) = std::fs::metadata(&target) {
                     let _ = file.set_permissions(m.permissions());

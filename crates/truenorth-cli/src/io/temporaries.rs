@@ -11,6 +11,7 @@
 //!   concurrent run).
 
 use std::ffi::OsString;
+use std::fs::File;
 use std::path::{Path, PathBuf};
 use std::sync::{Mutex, MutexGuard, Once};
 
@@ -35,11 +36,17 @@ pub(super) fn name_for(target: &Path) -> Option<PathBuf> {
     Some(target.with_file_name(tmp))
 }
 
-/// Records `temp` as live (before it is created, so that a signal in between still finds
-/// it) and makes sure the signals remove it.
-pub(super) fn register(temp: &Path) {
+/// Creates `temp` (truncating it) and records it as live, both under the list's lock, and
+/// makes sure the signals remove it: a signal handled at the same moment either comes
+/// first, and then holds the lock until the process ends so the file is never made, or
+/// finds it made and listed. (Listed first and created outside the lock, a file made just
+/// after the signal emptied the list would outlive the process.)
+pub(super) fn create(temp: &Path) -> std::io::Result<File> {
     install_handler();
-    live().push(temp.to_path_buf());
+    let mut list = live();
+    let file = File::create(temp)?;
+    list.push(temp.to_path_buf());
+    Ok(file)
 }
 
 /// Removes `temp` from the disk and from the live list.
