@@ -62,8 +62,10 @@ impl Precision {
             return;
         }
         match self.digits {
-            // Whole numbers (flags, counts, whole seconds) as integers: `1`, not `1.0`.
-            None if v.trunc() == v && v.abs() < 1e15 => {
+            // Whole numbers (flags, counts, whole seconds) as integers: `1`, not `1.0`. Below
+            // 1e15 the cast truncates exactly, so comparing it with `v` is `v.trunc() == v`
+            // without the call to the maths library.
+            None if v.abs() < 1e15 && (v as i64) as f64 == v => {
                 let sign = if v.is_sign_negative() { "-" } else { "" };
                 let _ = write!(out, "{sign}{}", v.abs() as u64);
             }
@@ -363,6 +365,20 @@ mod tests {
     /// `d` in 0..=21 as an exact power of ten.
     fn ten_to(d: u32) -> f64 {
         format!("1e{d}").parse().unwrap()
+    }
+
+    proptest! {
+        /// The whole-number test of the shortest form is `trunc` below 1e15, for any bits.
+        #[test]
+        fn whole_numbers_are_told_by_the_cast_as_by_trunc(bits in any::<u64>(), small in -1e16f64..1e16) {
+            for v in [f64::from_bits(bits), small, small.round()] {
+                prop_assume!(v.is_finite());
+                prop_assert_eq!(
+                    v.abs() < 1e15 && (v as i64) as f64 == v,
+                    v.trunc() == v && v.abs() < 1e15
+                );
+            }
+        }
     }
 
     proptest! {
