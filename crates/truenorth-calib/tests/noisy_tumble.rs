@@ -98,7 +98,10 @@ fn check(seed: u64) {
     let half = fit_ellipsoid(&every_other, &EllipsoidConfig::default()).unwrap();
     let ratio = half.quality.heading_error_3sigma_deg / q.heading_error_3sigma_deg;
     assert!((ratio / 2f64.sqrt() - 1.0).abs() < 0.05, "{ratio}");
-    assert!(q.heading_error_bound_deg() < 0.5, "{q:?}");
+    // The noise averages out of the parameters: the 3σ part, which was the whole bound
+    // before the fit reported the noise's second-order bias (which does not average out)
+    // as its systematic part; `tests/bias_bound.rs` holds that part.
+    assert!(q.heading_error_3sigma_deg < 0.5, "{q:?}");
     // And it holds: the error the calibration itself leaves (see `rms_direction_error_deg`).
     let worst = rms_direction_error_deg(&sol.params, &m);
     assert!(worst <= q.heading_error_bound_deg(), "{worst} > {q:?}");

@@ -59,7 +59,7 @@ impl RowBlock {
 /// its temporary) and the first write error.
 type Written = (AtomicOutput, CliResult);
 
-/// A CSV written row by row into an [`AtomicOutput`]: numbers in the shortest form that
+/// A CSV written row by row into an `AtomicOutput`: numbers in the shortest form that
 /// reads back as the same `f64`, or rounded (see [`Precision`]).
 pub struct CsvOutput {
     name: PathBuf,
@@ -164,7 +164,7 @@ impl CsvOutput {
         }
     }
 
-    /// Finishes the file (see [`AtomicOutput::commit`]).
+    /// Finishes the file (see `AtomicOutput::commit`).
     pub fn commit(mut self) -> CliResult {
         if !self.block.widths.is_empty() {
             self.hand_over()?;

@@ -43,7 +43,7 @@ use crate::fits::lm::{self, NormalAccumulator, NormalEquations};
 use crate::fits::normalise::Normaliser;
 use crate::fits::readings::{Readings, bbox_centre, replay_points};
 use crate::numerics::blocks::{BLOCK, replay_blocks};
-use crate::numerics::linalg::sym_sqrt3;
+use crate::numerics::linalg::{sym_eigen3, sym_sqrt3};
 use crate::quality::{self, CompassUncertainty};
 
 use crate::fits::ellipsoid::config::EllipsoidConfig;
@@ -223,7 +223,12 @@ fn fit_unchecked<R: Readings<3> + ?Sized>(
             reason: "the fitted ellipsoid is not finite; check the input scale",
         });
     }
-    let q = quality::assess_3d_of(points, &cal, field)?;
+    let mut q = quality::assess_3d_of(points, &cal, field)?;
+    // The noise's second-order bias, which no number of readings removes, bounded as for the
+    // direct fit (each plane section is an ellipse; see the batch ellipse's
+    // `refinement_could_matter`); the refinement removes part of it (`tests/bias_bound.rs`).
+    q.heading_error_systematic_deg =
+        bias_bound_rad(points, &cal, q.heading_noise_rms_deg.to_radians())?.to_degrees();
     quality::require_determined(
         &q.uncertainty,
         3,
@@ -253,6 +258,40 @@ fn fit_unchecked<R: Readings<3> + ?Sized>(
         params: cal,
         quality: q,
     })
+}
+
+/// The bound `4σ²(κ + h₁ + h₂)` radians on the field-direction error that the noise's
+/// second-order bias leaves, for the calibration `cal` of `points` with per-reading noise
+/// `sigma` (relative): `κ` the anisotropy of the soft iron's square, `h₁` the length of the
+/// mean calibrated direction and `h₂` the distance of their second moment from `I/3` over
+/// `√(2/3)` (each 0 for an even tumble, 1 for readings all in one direction).
+fn bias_bound_rad<R: Readings<3> + ?Sized>(
+    points: &R,
+    cal: &CompassCalibration3d,
+    sigma: f64,
+) -> Result<f64> {
+    let (mut first, mut second, mut n) = (Vector3::zeros(), Matrix3::zeros(), 0usize);
+    replay_points(points, |p| {
+        let u = cal.correct(p);
+        let norm = u.norm();
+        if norm > 0.0 && norm.is_finite() {
+            let u = u / norm;
+            first += u;
+            second += u * u.transpose();
+            n += 1;
+        }
+    })?;
+    if n == 0 {
+        return Ok(f64::INFINITY);
+    }
+    let h1 = first.norm() / n as f64;
+    let h2 = (second / n as f64 - Matrix3::identity() / 3.0).norm() / (2.0f64 / 3.0).sqrt();
+    let kappa = sym_eigen3(&(cal.soft_iron * cal.soft_iron.transpose())).map_or(1.0, |(l, _)| {
+        ((l.max() - l.min()) / (l.max() + l.min())).abs()
+    });
+    Ok(crate::online::conic::direct_fit_bias_rad(
+        sigma, kappa, h1, h2,
+    ))
 }
 
 /// Why [`refine`] gave no ellipsoid: the refinement failed (the direct fit then stands), or
