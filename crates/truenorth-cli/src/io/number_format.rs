@@ -257,15 +257,7 @@ fn write_rounded_reference(out: &mut String, v: f64, digits: usize) {
         return;
     }
     let decimals = usize::try_from(digits as i32 - 1 - exp).unwrap_or(0);
-    let start = out.len();
-    let _ = write!(out, "{v:.decimals$}");
-    if decimals > 0 {
-        let kept = out[start..]
-            .trim_end_matches('0')
-            .trim_end_matches('.')
-            .len();
-        out.truncate(start + kept);
-    }
+    write_fixed_std(out, v, decimals);
 }
 
 #[cfg(test)]

@@ -257,47 +257,37 @@ impl ChunkParser for RowParser {
         while at < bytes.len() {
             number += 1;
             let start = block.values.len();
-            if let Some(plain) = &self.plain
+            let row = if let Some(plain) = &self.plain
                 && let Some(len) = plain.read(&bytes[at..], &mut cells)
             {
                 at += len + 1;
                 block
                     .values
                     .extend(self.columns.iter().map(|(c, _)| c.sign * cells[c.index]));
-                let row = self.check_increasing(
-                    number,
-                    &block.values[start..],
-                    &mut block.last_increasing,
-                );
-                if let Err(e) = row {
-                    block.values.truncate(start);
-                    block.end = Some(Err(e));
+                self.check_increasing(number, &block.values[start..], &mut block.last_increasing)
+            } else {
+                let (line, unterminated) = match memchr::memchr(b'\n', &bytes[at..]) {
+                    Some(i) => (&bytes[at..at + i], false),
+                    None => (&bytes[at..], true),
+                };
+                at += line.len() + 1;
+                if line.len() > MAX_LINE_BYTES {
+                    block.end = Some(Err(self.record_error(number, &RecordError::TooLong)));
                     return;
                 }
-                block.numbers.push(number);
-                continue;
-            }
-            let (line, unterminated) = match memchr::memchr(b'\n', &bytes[at..]) {
-                Some(i) => (&bytes[at..at + i], false),
-                None => (&bytes[at..], true),
+                let Some((a, b)) = record_bounds(line) else {
+                    continue;
+                };
+                split_fields(line, a, b, self.delimiter, spans);
+                self.parse_row(
+                    number,
+                    line,
+                    spans,
+                    unterminated,
+                    &mut block.values,
+                    &mut block.last_increasing,
+                )
             };
-            at += line.len() + 1;
-            if line.len() > MAX_LINE_BYTES {
-                block.end = Some(Err(self.record_error(number, &RecordError::TooLong)));
-                return;
-            }
-            let Some((a, b)) = record_bounds(line) else {
-                continue;
-            };
-            split_fields(line, a, b, self.delimiter, spans);
-            let row = self.parse_row(
-                number,
-                line,
-                spans,
-                unterminated,
-                &mut block.values,
-                &mut block.last_increasing,
-            );
             if let Err(e) = row {
                 block.values.truncate(start);
                 block.end = Some(Err(e));
