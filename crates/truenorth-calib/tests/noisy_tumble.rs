@@ -111,9 +111,10 @@ fn check(seed: u64) {
     // The old test, dilution times residual against the 10° bound, refused it.
     let old_deg = (g * q.fit.residual_rms_rel).to_degrees();
     println!(
-        "19,743 readings at {:.1} % noise: dilution {g:.2}, bound {:.3}° (3σ), RMS direction error {worst:.3}°, noise {:.2}° per reading; the dilution times the residual reads {old_deg:.1}°",
+        "19,743 readings at {:.1} % noise: dilution {g:.2}, bound {:.3}° (3σ) + {:.3}° (bias), RMS direction error {worst:.3}°, noise {:.2}° per reading; the dilution times the residual reads {old_deg:.1}°",
         100.0 * sigma,
         q.heading_error_3sigma_deg,
+        q.heading_error_systematic_deg,
         q.heading_noise_rms_deg
     );
     assert!(old_deg > 10.0, "{old_deg}");
