@@ -169,23 +169,6 @@ pub(crate) fn bound_deg(sigma: f64, worst: Option<f64>) -> f64 {
     }
 }
 
-/// A bound on the heading (3-D: field-direction) error, radians, that the second-order bias
-/// of the direct (algebraic) fit leaves, which no number of readings removes:
-/// `4σ²(κ + h₁ + h₂)`, with `σ` the per-reading noise (relative), `κ = (λ₁ − λ₂)/(λ₁ + λ₂)`
-/// the anisotropy of `B²` (largest and smallest eigenvalues), and `h₁`, `h₂` the first and
-/// second harmonics of the calibrated directions (1 each for readings all in one direction,
-/// 0 for an even spread). The derivation is that of the batch ellipse's
-/// `refinement_could_matter`: isotropic sensor noise is anisotropic in the calibrated frame,
-/// the algebraic fit of such points is an ellipse of axis ratio `1 + 4(σ₁² − σ₂²)`, a
-/// two-cycle heading error of amplitude `4σ²κ`, and an uneven spread adds its harmonics
-/// with the same factor. In 3-D each plane section is such an ellipse; the bound is held
-/// against the error actually left by `tests/noisy_tumble.rs` (0.53° at 6 % noise, where the
-/// 3σ part alone is 0.31°).
-pub(crate) fn direct_fit_bias_rad(sigma: f64, kappa: f64, h1: f64, h2: f64) -> f64 {
-    let b = 4.0 * sigma * sigma * (kappa + h1 + h2);
-    if b.is_finite() { b } else { f64::INFINITY }
-}
-
 /// The quality report of a refresh, the direct fit's bias bound (radians) as its
 /// systematic part.
 pub(crate) fn report(

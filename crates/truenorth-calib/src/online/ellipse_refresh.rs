@@ -25,9 +25,10 @@ use crate::online::conic_sums::{ConicSums, LAYOUT_2D, MONOMIALS_2D, Retained, in
 use crate::quality::{self, COVERAGE_BINS, Coverage, GAP_BINS, turns, turns_in};
 
 use crate::online::conic::{
-    ConicRefresh, RefreshBase, bound_deg, direct_fit_bias_rad, noise_factor, refuse_fit, report,
+    ConicRefresh, RefreshBase, bound_deg, noise_factor, refuse_fit, report,
 };
 use crate::online::ellipse_config::OnlineEllipseConfig;
+use crate::quality::direct_fit_bias_rad;
 
 #[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
@@ -142,7 +143,7 @@ pub(crate) struct Refresh {
     /// once) and its slots, for the dilution.
     support_l_inv: Option<SMatrix<f64, PARAMS, PARAMS>>,
     support_cells: usize,
-    /// The direct fit's bias bound, radians (see `crate::online::conic::direct_fit_bias_rad`).
+    /// The direct fit's bias bound, radians (see `crate::quality::direct_fit_bias_rad`).
     bias_rad: f64,
     /// The geometric refinement of the retained readings (normalised coordinates), its
     /// readings, and the arc they cover about it.

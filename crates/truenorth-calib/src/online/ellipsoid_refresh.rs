@@ -100,7 +100,7 @@ pub(crate) struct Refresh {
     sigma: f64,
     l_inv: Option<SMatrix<f64, PARAMS, PARAMS>>,
     worst: f64,
-    /// The direct fit's bias bound, radians (see `crate::online::conic::direct_fit_bias_rad`).
+    /// The direct fit's bias bound, radians (see `crate::quality::direct_fit_bias_rad`).
     bias_rad: f64,
     /// The support's information matrix (upper triangle, row by row) while it is summed,
     /// then its inverse factor, its cells, and the worst of `trace(G A⁻¹ Gᵀ)` over the

@@ -391,7 +391,7 @@ fn refinement_could_matter(m: &Moments2, e: &Ellipse, a: &Assessment2d) -> bool 
         return true;
     };
     let kappa = ((l[0] - l[1]) / (l[0] + l[1])).abs();
-    let bias = 4.0 * sigma * sigma * (kappa + h1 + h2);
+    let bias = quality::direct_fit_bias_rad(sigma, kappa, h1, h2);
     let step = (bias * bias + 0.5 * kappa * kappa * s * s).sqrt();
     !(step <= SKIPPED_STEP_SHARE_OF_BOUND * BOUND_SIGMAS * s)
 }
@@ -405,7 +405,7 @@ fn bias_bound_rad(m: &Moments2, n: usize, e: &Ellipse, a: &Assessment2d) -> f64 
     match sym_eigen2(&(e.unit_map * e.unit_map)) {
         Some((l, _)) => {
             let kappa = ((l[0] - l[1]) / (l[0] + l[1])).abs();
-            crate::online::conic::direct_fit_bias_rad(sigma, kappa, h1, h2)
+            quality::direct_fit_bias_rad(sigma, kappa, h1, h2)
         }
         None => f64::INFINITY,
     }

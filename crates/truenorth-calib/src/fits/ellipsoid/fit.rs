@@ -289,9 +289,7 @@ fn bias_bound_rad<R: Readings<3> + ?Sized>(
     let kappa = sym_eigen3(&(cal.soft_iron * cal.soft_iron.transpose())).map_or(1.0, |(l, _)| {
         ((l.max() - l.min()) / (l.max() + l.min())).abs()
     });
-    Ok(crate::online::conic::direct_fit_bias_rad(
-        sigma, kappa, h1, h2,
-    ))
+    Ok(quality::direct_fit_bias_rad(sigma, kappa, h1, h2))
 }
 
 /// Why [`refine`] gave no ellipsoid: the refinement failed (the direct fit then stands), or

@@ -12,10 +12,11 @@ use crate::fits::ellipsoid::direct::{
     Ellipsoid, constrained_quadric, quadric_to_ellipsoid, reduce, second_moments,
 };
 use crate::numerics::linalg::sym_eigen3;
-use crate::online::conic::{direct_fit_bias_rad, noise_factor};
+use crate::online::conic::noise_factor;
 use crate::online::conic_sums::LAYOUT_3D;
 use crate::online::ellipsoid_config::OnlineEllipsoidConfig;
 use crate::quality;
+use crate::quality::direct_fit_bias_rad;
 
 #[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
