@@ -28,6 +28,19 @@ use crate::quality::{self, BOUND_SIGMAS};
 #[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 
+/// The inverse of the share of the readings the sums weigh that a refresh waits for, at
+/// least, after the last one started.
+///
+/// A refresh costs as much as thousands of pushes. `n` readings in the sums and `n/64` new
+/// ones shift the sums by about a 64th of their weight, so the estimate the next refresh
+/// would publish differs from the last by about a 64th of the difference between the new
+/// readings' own calibration and the current one: nothing for a calibration that holds, and
+/// a change of calibration shows within a 64th of the memory, as forgetting caps the
+/// memory at a half-life. Without this the refreshes cost the same per push however long
+/// the recording (at the default interval, most of what a push costs on average), while
+/// what each refresh can change shrinks as `1/n`.
+const REFRESH_SHARE: u64 = 64;
+
 /// The parameters of an online calibrator's configuration that its bookkeeping needs.
 pub(crate) trait OnlineConfig: Copy + Debug + PartialEq + Validate {
     /// Fewest readings a solution is accepted from (and when the first refresh starts).
@@ -311,7 +324,7 @@ where
         }
         if self.pending.is_none() && now >= self.next_refresh {
             self.pending = Some(self.start());
-            self.next_refresh = now + u64::from(self.config.refresh_interval_samples());
+            self.next_refresh = now + self.refresh_spacing(now);
         }
         let done = match &mut self.pending {
             Some(r) => r.step(&self.config, self.lifetime),
@@ -324,6 +337,14 @@ where
             return Ok(Pushed::NewEstimate);
         }
         Ok(Pushed::Accepted)
+    }
+
+    /// Readings from the start of one refresh, at `now` readings, to the start of the next:
+    /// the configured interval, or [`REFRESH_SHARE`] of the readings the sums weigh when
+    /// that is longer (all of them; forgetting, those of the last half-life).
+    fn refresh_spacing(&self, now: u64) -> u64 {
+        let weighed = now.min(self.lifetime / 4);
+        u64::from(self.config.refresh_interval_samples()).max(weighed / REFRESH_SHARE)
     }
 
     /// See [`truenorth_core::Calibrator::progress`] on the calibrators.

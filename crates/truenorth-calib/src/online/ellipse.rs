@@ -6,8 +6,8 @@
 //! Per reading, [`OnlineEllipseCalibrator::push`] adds the 15 monomials of degree ≤ 4 to
 //! the sums (one product each) and may keep the reading as its direction slot's
 //! representative for coverage: O(1), no allocation. Every
-//! [`OnlineEllipseConfig::refresh_interval_samples`] readings a refresh of the estimate
-//! starts on a copy of the sums and runs one short stage per push (normalise; direct fit;
+//! [`OnlineEllipseConfig::refresh_interval_samples`] readings (or a 64th of the readings
+//! the sums weigh, if that is more) a refresh of the estimate starts on a copy of the sums and runs one short stage per push (normalise; direct fit;
 //! coverage; residual, information matrix and the condition of the headings seen;
 //! heading-error bound and refusals; the `online_ellipse_refresh` module), so that no push
 //! pays for a whole solve. A refresh publishes only what [`Calibrator::solve`] would
@@ -259,5 +259,41 @@ mod tests {
         }
         assert_eq!(at_start.map(|r| r.ok()), Some(cal.estimate()));
         assert!(cal.estimate().is_some());
+    }
+
+    /// Refresh starts over `n` readings of a steady turn, with the given half-life.
+    fn refreshes(n: usize, half_life: Option<f64>) -> usize {
+        let config = OnlineEllipseConfig {
+            forgetting_half_life_samples: half_life,
+            ..Default::default()
+        };
+        let mut cal = OnlineEllipseCalibrator::new(config).unwrap();
+        let mut started = 0;
+        for s in turn(n, 360.0 * n as f64 / 720.0) {
+            cal.push(&s).unwrap();
+            // The push that starts a refresh runs its first stage.
+            started += usize::from(cal.refresh_stage() == Some(1));
+        }
+        started
+    }
+
+    /// Refreshes thin out as the readings in the sums grow: one per 32 readings up to
+    /// 2,048, then one per 64th of the readings, about 64·ln(n/2048) more. Forgetting caps
+    /// the memory, and so the spacing, at a half-life: with a half-life under 64 × 32
+    /// readings they stay one per 32 readings.
+    #[test]
+    fn refreshes_thin_out_with_the_readings_the_sums_weigh() {
+        let n = 200_000;
+        let logarithmic = 64.0 + 64.0 * (n as f64 / 2048.0).ln();
+        let got = refreshes(n, None) as f64;
+        assert!(
+            (got - logarithmic).abs() <= 0.05 * logarithmic,
+            "{got} refreshes, expected about {logarithmic}"
+        );
+        let forgetting = refreshes(n, Some(1_000.0));
+        assert!(
+            forgetting.abs_diff(n / 32) <= 2,
+            "{forgetting} refreshes with forgetting, expected one per 32 readings"
+        );
     }
 }

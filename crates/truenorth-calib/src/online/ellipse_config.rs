@@ -21,8 +21,10 @@ pub struct OnlineEllipseConfig {
     /// beyond the parameters the noise, and so the heading-error bound, is estimated from
     /// so few residuals that a chance fit of a short arc can pass every other check.
     pub min_samples: u32,
-    /// Readings between the starts of two refreshes of the estimate, 1..=10⁶ (32). A
-    /// refresh runs over the next five pushes, one stage each.
+    /// Readings between the starts of two refreshes of the estimate, 1..=10⁶ (32), or a
+    /// 64th of the readings the sums weigh if that is more (from 2,048 readings on; see
+    /// the `conic` module). A refresh runs over the next five pushes, one stage
+    /// each.
     pub refresh_interval_samples: u32,
     /// Half-life of a reading's weight, in readings, 20..=10⁹ (`None`: never forget). With
     /// forgetting the calibration follows a slowly changing hard or soft iron; readings

@@ -5,7 +5,8 @@
 //!
 //! It works as the two-axis [`crate::OnlineEllipseCalibrator`] does (see that module for
 //! the approximations the sums imply): O(1) per push, and a refresh every
-//! [`OnlineEllipsoidConfig::refresh_interval_samples`] readings split into short stages, one
+//! [`OnlineEllipsoidConfig::refresh_interval_samples`] readings (or a 64th of the readings
+//! the sums weigh, if that is more) split into short stages, one
 //! per push — here more of them, since the 3-D algebra is larger (the heading-error bound
 //! alone visits 256 directions, 32 per stage). Coverage is the share of the equal-area
 //! direction cells of [`crate::quality`] holding a retained reading, at most one per cell.

@@ -24,8 +24,10 @@ pub struct OnlineEllipsoidConfig {
     /// beyond the parameters the noise, and so the heading-error bound, is estimated from
     /// so few residuals that a chance fit of a short arc can pass every other check.
     pub min_samples: u32,
-    /// Readings between the starts of two refreshes of the estimate, 1..=10⁶ (64). A
-    /// refresh runs over the next 20 pushes, one stage each.
+    /// Readings between the starts of two refreshes of the estimate, 1..=10⁶ (64), or a
+    /// 64th of the readings the sums weigh if that is more (from 4,096 readings on; see
+    /// the `conic` module). A refresh runs over the next 20 pushes, one stage
+    /// each.
     pub refresh_interval_samples: u32,
     /// Half-life of a reading's weight, in readings, 50..=10⁹ (`None`: never forget).
     /// Readings older than four half-lives no longer count towards coverage.
