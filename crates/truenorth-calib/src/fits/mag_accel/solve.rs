@@ -37,11 +37,12 @@ use nalgebra::{Matrix3, Rotation3, SMatrix, SVector, Vector3};
 
 use truenorth_core::Result;
 
-use crate::fits::lm::NormalEquations;
+use crate::fits::lm::{NormalAccumulator, NormalEquations};
 use crate::fits::mag_accel::readings::Sensor;
 use crate::fits::mag_accel::run_rows::{RunSums, all_run_rows};
 use crate::fits::normalise::Normaliser;
 use crate::fits::readings::Readings;
+use crate::numerics::blocks::{BLOCK, sum_block};
 
 #[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
@@ -295,32 +296,25 @@ pub(crate) fn normal_equations(
     theta: &SVector<f64, P>,
 ) -> Result<Option<(NormalEquations<P>, GroupSums)>> {
     let m = Model::of(theta, r0);
-    let mut jtj = SMatrix::<f64, P, P>::zeros();
-    let mut jtr = SVector::<f64, P>::zeros();
-    let mut cost = 0.0;
-    let mut sums = GroupSums::default();
+    let mut groups = ReadingGroups::new();
     let mut defined = true;
     data.replay(|a, mg| {
         if !defined {
             return;
         }
-        let Some([acc, mag, dip]) = reading_rows(&m, a, mg) else {
+        let Some(rows) = reading_rows(&m, a, mg) else {
             defined = false;
             return;
         };
-        for ((row, r), weight, group) in [
-            (acc, w.acc, &mut sums.acc),
-            (mag, w.mag, &mut sums.mag),
-            (dip, w.dip, &mut sums.dip),
-        ] {
-            add_row(&mut jtj, &mut jtr, &mut cost, &(row * weight), r * weight);
-            group.0 += r * r;
-            group.1 += 1;
-        }
+        groups.add(&rows, w);
     })?;
     if !defined {
         return Ok(None);
     }
+    let Some((NormalEquations { cost, jtj, jtr }, sums)) = groups.finish() else {
+        return Ok(None);
+    };
+    let (mut jtj, mut jtr, mut cost, mut sums) = (jtj, jtr, cost, sums);
     if runs.is_empty() {
         // No run: the pointing axis is x. A stiff prior keeps the normal equations regular.
         for k in [PT, PT + 1] {
@@ -345,6 +339,115 @@ pub(crate) fn normal_equations(
     }
     let ne = NormalEquations { cost, jtj, jtr };
     Ok((ne.cost.is_finite() && ne.jtj.iter().all(|x| x.is_finite())).then_some((ne, sums)))
+}
+
+/// The reading rows' normal equations, gathered a [`BLOCK`] of readings at a time (see the
+/// `blocks` module), each group with only the parameters its rows touch: the
+/// accelerometer's `(c_a, B_a)`, the magnetometer's `(c_m, B_m)`, the dip's everything but
+/// the pointing axis. A dense rank-one update per row would spend most of its time adding
+/// zeros, one scalar at a time.
+struct ReadingGroups {
+    acc: NormalAccumulator<SENSOR, { SENSOR + 1 }>,
+    mag: NormalAccumulator<SENSOR, { SENSOR + 1 }>,
+    dip: NormalAccumulator<PT, { PT + 1 }>,
+    /// The unweighted squared residuals of the block, per group.
+    squares: [[f64; BLOCK]; 3],
+    /// The group sums of the blocks added so far.
+    sums: GroupSums,
+    /// Readings in the block being filled.
+    filled: usize,
+}
+
+/// Parameters of one sensor's ellipsoid: its centre (3) and symmetric matrix (6).
+const SENSOR: usize = 9;
+
+impl ReadingGroups {
+    fn new() -> Self {
+        Self {
+            acc: NormalAccumulator::new(),
+            mag: NormalAccumulator::new(),
+            dip: NormalAccumulator::new(),
+            squares: [[0.0; BLOCK]; 3],
+            sums: GroupSums::default(),
+            filled: 0,
+        }
+    }
+
+    /// Adds one reading's rows (from [`reading_rows`]), weighted by `w`.
+    fn add(&mut self, [acc, mag, dip]: &[(SVector<f64, P>, f64); 3], w: &Weights) {
+        let i = self.filled;
+        for (cols, (row, r), first, weight) in [
+            (&mut self.acc.cols[..], acc, CA, w.acc),
+            (&mut self.mag.cols[..], mag, CM, w.mag),
+            (&mut self.dip.cols[..], dip, 0, w.dip),
+        ] {
+            let n = cols.len() - 1;
+            for (k, col) in cols[..n].iter_mut().enumerate() {
+                col[i] = row[first + k] * weight;
+            }
+            cols[n][i] = r * weight;
+        }
+        for (g, (_, r)) in [acc, mag, dip].into_iter().enumerate() {
+            self.squares[g][i] = r * r;
+        }
+        self.filled += 1;
+        if self.filled == BLOCK {
+            self.add_block();
+        }
+    }
+
+    /// Adds the block filled so far (rows past `filled` zeroed: they add nothing).
+    fn add_block(&mut self) {
+        let i = self.filled;
+        for col in self
+            .acc
+            .cols
+            .iter_mut()
+            .chain(self.mag.cols.iter_mut())
+            .chain(self.dip.cols.iter_mut())
+            .chain(self.squares.iter_mut())
+        {
+            col[i..].fill(0.0);
+        }
+        self.acc.add_block();
+        self.mag.add_block();
+        self.dip.add_block();
+        for (group, squares) in [&mut self.sums.acc, &mut self.sums.mag, &mut self.sums.dip]
+            .into_iter()
+            .zip(&self.squares)
+        {
+            group.0 += sum_block(squares);
+            group.1 += i;
+        }
+        self.filled = 0;
+    }
+
+    /// The normal equations in every parameter (upper triangle and diagonal; the caller
+    /// mirrors them) and the group sums; `None` if anything overflowed.
+    fn finish(mut self) -> Option<(NormalEquations<P>, GroupSums)> {
+        if self.filled > 0 {
+            self.add_block();
+        }
+        let mut jtj = SMatrix::<f64, P, P>::zeros();
+        let mut jtr = SVector::<f64, P>::zeros();
+        let mut cost = 0.0;
+        let acc = self.acc.finish()?;
+        let mag = self.mag.finish()?;
+        let dip = self.dip.finish()?;
+        let mut place = |first: usize, ne_jtj: &[f64], ne_jtr: &[f64], n: usize, c: f64| {
+            for a in 0..n {
+                for b in a..n {
+                    jtj[(first + a, first + b)] += ne_jtj[a + b * n];
+                }
+                jtr[first + a] += ne_jtr[a];
+            }
+            cost += c;
+        };
+        place(CA, acc.jtj.as_slice(), acc.jtr.as_slice(), SENSOR, acc.cost);
+        place(CM, mag.jtj.as_slice(), mag.jtr.as_slice(), SENSOR, mag.cost);
+        place(0, dip.jtj.as_slice(), dip.jtr.as_slice(), PT, dip.cost);
+        Some((NormalEquations { cost, jtj, jtr }, self.sums))
+    }
 }
 
 /// The unweighted Jacobian rows and residuals of one reading `(a, mg)` under the model `m`:
