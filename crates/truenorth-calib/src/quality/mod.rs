@@ -71,8 +71,8 @@ pub use limits::FitLimits;
 pub(crate) use pass_2d::ReportSums;
 pub use report::{Assessment2d, assess_2d, assess_3d, quality_2d};
 pub(crate) use report::{
-    Moments2, SupportFigures, assess_2d_from_moments, assess_3d_of, direction_harmonics,
-    support_dilution_3d,
+    Moments2, SupportFigures, assess_2d_from_moments, assess_3d_of, assess_3d_with_harmonics_of,
+    direction_harmonics, support_dilution_3d,
 };
 pub(crate) use sphere_cells::sphere_cell;
 pub use sphere_cells::{

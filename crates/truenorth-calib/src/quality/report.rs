@@ -444,11 +444,24 @@ pub(crate) fn assess_3d_of<R: Readings<3> + ?Sized>(
     cal: &CompassCalibration3d,
     field: f64,
 ) -> Result<CompassQuality> {
+    assess_3d_with_harmonics_of(points, cal, field).map(|(q, _)| q)
+}
+
+/// [`assess_3d_of`] and, from the same pass, the first and second harmonics `(h₁, h₂)` of
+/// the calibrated directions `u` (the length of their mean; the distance of their second
+/// moment from `I/3` over `√(2/3)`; each 0 for an even tumble, 1 for readings all in one
+/// direction), `None` without a usable reading.
+pub(crate) fn assess_3d_with_harmonics_of<R: Readings<3> + ?Sized>(
+    points: &R,
+    cal: &CompassCalibration3d,
+    field: f64,
+) -> Result<(CompassQuality, Option<(f64, f64)>)> {
     let mut in_cell = [0u32; SPHERE_CELLS];
     replay_blocks(points, |p, len| count_cells(&mut in_cell, p, len, cal))?;
     let mut sums = Sums3d::new(cell_weights(&in_cell), field);
     replay_blocks(points, |p, len| sums.add_block(p, len, cal))?;
-    Ok(sums.report(field))
+    let harmonics = sums.direction_harmonics();
+    Ok((sums.report(field), harmonics))
 }
 
 /// The sums of [`assess_3d`]'s second pass, a block of readings at a time: of the squared
@@ -462,6 +475,8 @@ struct Sums3d {
     support_sums: [f64; MONOMIALS_3D],
     ss: f64,
     n: usize,
+    /// Sums of the columns: of `u` (0–2) and of its products `u_a u_b` (3–8).
+    moments: [f64; 9],
     // The block's columns, kept between blocks (every entry is written for each block).
     cols: [[f64; BLOCK]; 9],
     weighted: [[f64; BLOCK]; 9],
@@ -478,6 +493,7 @@ impl Sums3d {
             support_sums: [0.0; MONOMIALS_3D],
             ss: 0.0,
             n: 0,
+            moments: [0.0; 9],
             cols: [[0.0; BLOCK]; 9],
             weighted: [[0.0; BLOCK]; 9],
             r2: [0.0; BLOCK],
@@ -506,8 +522,26 @@ impl Sums3d {
             *sk += dot_block(&cols[a], &cols[c]);
             *wk += dot_block(&weighted[a], &cols[c]);
         }
+        for (m, col) in self.moments.iter_mut().zip(cols.iter()) {
+            *m += sum_block(col);
+        }
         self.ss += sum_block(r2);
         self.n += sum_block(&b.kept) as usize;
+    }
+
+    /// See [`assess_3d_with_harmonics_of`].
+    fn direction_harmonics(&self) -> Option<(f64, f64)> {
+        if self.n == 0 {
+            return None;
+        }
+        let inv = 1.0 / self.n as f64;
+        let [x, y, z, xx, xy, xz, yy, yz, zz] = self.moments.map(|m| m * inv);
+        let h1 = (x * x + y * y + z * z).sqrt();
+        let third = 1.0 / 3.0;
+        let (dx, dy, dz) = (xx - third, yy - third, zz - third);
+        let h2 = (dx * dx + dy * dy + dz * dz + 2.0 * (xy * xy + xz * xz + yz * yz)).sqrt()
+            / (2.0f64 / 3.0).sqrt();
+        Some((h1, h2))
     }
 
     /// The report from the sums.

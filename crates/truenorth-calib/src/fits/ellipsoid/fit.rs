@@ -41,7 +41,7 @@ use truenorth_core::{Error, Result, Solution, Validate};
 
 use crate::fits::lm::{self, NormalAccumulator, NormalEquations};
 use crate::fits::normalise::Normaliser;
-use crate::fits::readings::{Readings, bbox_centre, replay_points};
+use crate::fits::readings::{Readings, replay_points};
 use crate::numerics::blocks::{BLOCK, replay_blocks};
 use crate::numerics::linalg::{sym_eigen3, sym_sqrt3};
 use crate::quality::{self, CompassUncertainty};
@@ -174,9 +174,18 @@ fn fit_unchecked<R: Readings<3> + ?Sized>(
     points: &R,
     config: &EllipsoidConfig,
 ) -> Result<Solution<CompassCalibration3d>> {
-    let mut all_finite = true;
+    // Whether every reading is finite, and the centre of their bounding box, in one pass.
+    let (mut all_finite, mut lo, mut hi) = (
+        true,
+        Vector3::repeat(f64::INFINITY),
+        -Vector3::repeat(f64::INFINITY),
+    );
     if points.len() >= MIN_POINTS_3D {
-        replay_points(points, |p| all_finite &= p.iter().all(|x| x.is_finite()))?;
+        replay_points(points, |p| {
+            all_finite &= p.iter().all(|x| x.is_finite());
+            lo = lo.inf(p);
+            hi = hi.sup(p);
+        })?;
     }
     if points.len() >= MIN_POINTS_3D && all_finite {
         // Before fitting, seen from the bounding-box centre (the centre of any complete
@@ -185,9 +194,8 @@ fn fit_unchecked<R: Readings<3> + ?Sized>(
         // directions are distorted by the soft iron and by a centre a few shots place
         // roughly, which can raise the dilution a few times: the bound is taken
         // PRE_FIT_SLACK times looser here, and exactly after the fit.
-        let centre = bbox_centre(points)?;
         let raw = CompassCalibration3d {
-            hard_iron: centre,
+            hard_iron: (lo + hi) * 0.5,
             soft_iron: Matrix3::identity(),
         };
         // Only the dilution is judged here; the fit's own figures come after it.
@@ -223,12 +231,12 @@ fn fit_unchecked<R: Readings<3> + ?Sized>(
             reason: "the fitted ellipsoid is not finite; check the input scale",
         });
     }
-    let mut q = quality::assess_3d_of(points, &cal, field)?;
+    let (mut q, harmonics) = quality::assess_3d_with_harmonics_of(points, &cal, field)?;
     // The noise's second-order bias, which no number of readings removes, bounded as for the
     // direct fit (each plane section is an ellipse; see the batch ellipse's
     // `refinement_could_matter`); the refinement removes part of it (`tests/bias_bound.rs`).
     q.heading_error_systematic_deg =
-        bias_bound_rad(points, &cal, q.heading_noise_rms_deg.to_radians())?.to_degrees();
+        bias_bound_rad(harmonics, &cal, q.heading_noise_rms_deg.to_radians()).to_degrees();
     quality::require_determined(
         &q.uncertainty,
         3,
@@ -261,35 +269,18 @@ fn fit_unchecked<R: Readings<3> + ?Sized>(
 }
 
 /// The bound `4σ²(κ + h₁ + h₂)` radians on the field-direction error that the noise's
-/// second-order bias leaves, for the calibration `cal` of `points` with per-reading noise
-/// `sigma` (relative): `κ` the anisotropy of the soft iron's square, `h₁` the length of the
-/// mean calibrated direction and `h₂` the distance of their second moment from `I/3` over
-/// `√(2/3)` (each 0 for an even tumble, 1 for readings all in one direction).
-fn bias_bound_rad<R: Readings<3> + ?Sized>(
-    points: &R,
-    cal: &CompassCalibration3d,
-    sigma: f64,
-) -> Result<f64> {
-    let (mut first, mut second, mut n) = (Vector3::zeros(), Matrix3::zeros(), 0usize);
-    replay_points(points, |p| {
-        let u = cal.correct(p);
-        let norm = u.norm();
-        if norm > 0.0 && norm.is_finite() {
-            let u = u / norm;
-            first += u;
-            second += u * u.transpose();
-            n += 1;
-        }
-    })?;
-    if n == 0 {
-        return Ok(f64::INFINITY);
-    }
-    let h1 = first.norm() / n as f64;
-    let h2 = (second / n as f64 - Matrix3::identity() / 3.0).norm() / (2.0f64 / 3.0).sqrt();
+/// second-order bias leaves, for the calibration `cal` with per-reading noise `sigma`
+/// (relative) and the harmonics `(h₁, h₂)` of its calibrated directions (see
+/// [`quality::assess_3d_with_harmonics_of`]; `∞` without them): `κ` the anisotropy of the
+/// soft iron's square.
+fn bias_bound_rad(harmonics: Option<(f64, f64)>, cal: &CompassCalibration3d, sigma: f64) -> f64 {
+    let Some((h1, h2)) = harmonics else {
+        return f64::INFINITY;
+    };
     let kappa = sym_eigen3(&(cal.soft_iron * cal.soft_iron.transpose())).map_or(1.0, |(l, _)| {
         ((l.max() - l.min()) / (l.max() + l.min())).abs()
     });
-    Ok(quality::direct_fit_bias_rad(sigma, kappa, h1, h2))
+    quality::direct_fit_bias_rad(sigma, kappa, h1, h2)
 }
 
 /// Why [`refine`] gave no ellipsoid: the refinement failed (the direct fit then stands), or
