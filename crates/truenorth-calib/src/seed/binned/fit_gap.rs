@@ -20,9 +20,6 @@ use crate::fits::ellipse::fit_ellipse_direct;
 use crate::numerics::linalg::sym_eigen2;
 use crate::quality::{Assessment2d, direct_fit_bias_rad};
 
-#[cfg(not(feature = "std"))]
-use truenorth_core::Float as _;
-
 /// The largest heading difference between `cal` and the direct least-squares ellipse fit of
 /// `points`, over `points`, and that fit's second-order bias bound for a per-reading noise
 /// of `sigma_rad`, radians: `(difference, bias)`. Both `∞` when the fit fails (the readings
