@@ -281,3 +281,21 @@ fn a_dense_noisy_turn_keeps_readings_at_their_own_directions() {
     );
     assert!(n >= 16, "{n} bins hold a single reading");
 }
+
+/// A state saved before the bins' counts of the interval before were kept restores (all
+/// zero: every bin is fresh) and calibrates on.
+#[test]
+fn a_state_without_the_counts_of_the_interval_before_restores() {
+    use truenorth_core::Persistent;
+    let mut m = reference();
+    let mut c = BinnedEllipseCalibrator::default();
+    drive(&mut c, &mut m, 0.0, 200.0);
+    let mut saved = serde_json::to_value(c.snapshot()).unwrap();
+    let fields = saved["state"].as_object_mut().unwrap();
+    assert!(fields.remove("counted_before").is_some());
+    let state = serde_json::from_value(saved).unwrap();
+    let mut on = BinnedEllipseCalibrator::restore(state).unwrap();
+    assert!(on.counted_before.iter().all(|&k| k == 0));
+    drive(&mut on, &mut m, 200.0, 250.0);
+    assert!(on.solve().is_ok());
+}
