@@ -86,9 +86,9 @@ fn off_centre_rad(d: &Vector2<f64>, i: usize, n: usize) -> f64 {
 /// which grows with the readings per bin; on an ellipse the radius there is the radius of
 /// another direction, and as every bin lags the same way the fitted ellipse turns against
 /// the true one. (At 5 % noise and 200 readings per degree the kept readings lagged by
-/// 2.0–2.8 noise σ — the binned tests' `a_dense_noisy_turn_keeps_readings_at_their_own_directions`
-/// — and the heading error reached 7°, where the same readings binned in random order left
-/// 2.4°.) So a bin keeps the reading nearest its centre direction: near the centre the noise
+/// 2.0–2.8 noise σ, see the calibrator's test
+/// `a_dense_noisy_turn_keeps_readings_at_their_own_directions`, and the heading error
+/// reached 7°, where the same readings binned in random order left 2.4°.) So a bin keeps the reading nearest its centre direction: near the centre the noise
 /// that put a reading there is as likely either way, so the kept reading's true direction
 /// is its own on average, at any density. To follow a changed locus (claim 15) the first
 /// reading of a fresh bin replaces the stored one whatever its direction: the update

@@ -155,13 +155,14 @@ pub struct BinnedEllipseCalibrator {
 /// and so what the set lost to them, grow with the sampling rate (a recording of 2 000
 /// readings per degree ran 5 600 updates per turn and kept 15 of 64 bins). Readings past
 /// the first 16 of a bin (the 11 a bin takes at the 2 readings per degree the patent's turn
-/// gives, with room) may still replace its reading but bring no update closer, so the updates come
-/// per angle turned, not per reading, at any rate. The cap is per bin and update, not per
-/// run of readings in a row: near a bin's edge noise moves a dense recording's readings
-/// back and forth between two bins hundreds of times as the turn crosses it, and a cap per
-/// run counted every crossing (one turn of the `io_speed` ellipse at 500 readings per
-/// degree ran 318 updates, kept 27 of 64 bins and was refused for 185° of turning; see
-/// `tests/denser_data.rs`). Never below what lets half the bins start an update.
+/// gives, with room) may still replace its reading but bring no update closer, so the
+/// updates come per angle turned, not per reading, at any rate. The cap is per bin and
+/// update, not per run of readings in a row: near a bin's edge noise moves a dense
+/// recording's readings back and forth between two bins hundreds of times as the turn
+/// crosses it, and a cap per run counted every crossing (one turn of the `io_speed`
+/// ellipse at 500 readings per degree ran 318 updates, kept 27 of 64 bins and was refused
+/// for 185° of turning; see `tests/denser_data.rs`). Never below what lets half the bins
+/// start an update.
 const COUNTED_PER_BIN: usize = 16;
 
 /// How many per-axis noise σ a reading must lie from the origin for its direction to be
