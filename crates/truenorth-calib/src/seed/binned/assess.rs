@@ -3,7 +3,8 @@
 //! the locus's own turning, residual), on any set of bins. It reads only what stays fixed
 //! while an update is in progress (the configuration, the restart reference and the
 //! sample count), so an update can be assessed over a few pushes (the quality report in
-//! the bounded steps of [`SeedJob`]) and applied in the next.
+//! the bounded steps of [`SeedJob`], then its completion by the least-squares fit of the
+//! same readings, `fit_gap`) and applied in the next.
 
 use nalgebra::Vector2;
 use truenorth_compass::{CompassCalibration2d, EllipsePhasors};
@@ -12,6 +13,7 @@ use truenorth_core::{Error, Result, Solution};
 use crate::quality::{Assessment2d, locus_turning_rad, require_arc, require_certain};
 use crate::seed::binned::bins::{BinState, Bins, MAX_BINS, filled};
 use crate::seed::binned::config::BinnedEllipseConfig;
+use crate::seed::binned::fit_gap::complete_bound;
 use crate::seed::binned::refresh::RefreshJob;
 use crate::seed::seed_quality::{SeedJob, seed_assessment};
 
@@ -128,11 +130,15 @@ impl Assessor<'_> {
         turned_deg: f64,
     ) -> Result<Solution<CompassCalibration2d>> {
         let job = self.seed_job(bins, params);
-        let a = seed_assessment(
+        let a = complete_bound(
+            seed_assessment(
+                job.points(),
+                job.calibration(),
+                job.field(),
+                job.samples_used(),
+            ),
             job.points(),
             job.calibration(),
-            job.field(),
-            job.samples_used(),
         );
         self.judge(&a, job.calibration(), turned_deg, job.points().len())
     }

@@ -4,8 +4,13 @@
 //!    readings.
 //! 2. **Bins by direction** (claim 4): the direction of a reading about the current origin
 //!    picks one of `N` bins, which stores the reading (claim 1). With
-//!    [`BinnedEllipseConfig::bin_memory`] = 1 (the default, as in the seed) a new reading
-//!    replaces the stored one; a larger memory keeps a running mean of the last few.
+//!    [`BinnedEllipseConfig::bin_memory`] = 1 (the default, as in the seed) a bin holds one
+//!    reading: the first it takes after a full-set update interval without any, then any
+//!    that lies nearer its centre direction. (Keeping simply the newest kept, in a dense
+//!    noisy turn, the last reading that noise threw back across the bin's edge: the bins
+//!    lagged the turn by an extreme of the noise and turned the fitted ellipse, up to 7° of
+//!    heading at 5 % noise and 200 readings per degree; see `tests/binned_bound.rs`.) A
+//!    larger memory keeps a running mean of the last few.
 //! 3. **Interpolation** (claims 1–2): once more than
 //!    [`BinnedEllipseConfig::min_filled_bins`] bins hold readings, every empty bin gets a value
 //!    by linear interpolation between its nearest filled neighbours. What is interpolated is
@@ -55,7 +60,8 @@
 //! `min(update_interval, 96)` pushes (the `binned_refresh` module); the pushes between do
 //! no update work at all. The finished refresh is then assessed over a few pushes (the
 //! restart check and the locus's turning; the quality report in bounded steps, one per push,
-//! and the other acceptance tests) and applied at the next, which swaps in its bins, origin and estimate together
+//! its completion by the least-squares fit of the same readings, and the other acceptance
+//! tests) and applied at the next, which swaps in its bins, origin and estimate together
 //! (so the published estimate is always one update's) and bins the readings that arrived
 //! meanwhile about the new origin, exactly as if the update had been done at once when it
 //! started; at most 16 of them in that push and as many in each of the next (readings
@@ -136,6 +142,10 @@ pub struct BinnedEllipseCalibrator {
     /// How many readings of each bin counted towards the next update since the last one
     /// started (see [`COUNTED_PER_BIN`]).
     pub(crate) counted: [u32; MAX_BINS],
+    /// `counted` of the interval before, taken when the last update started: a bin that
+    /// took readings in neither keeps its reading only while a new one lies nearer its
+    /// centre (see `bins::store_reading`).
+    pub(crate) counted_before: [u32; MAX_BINS],
 }
 
 /// Most readings of one bin that count towards the next update
@@ -145,13 +155,14 @@ pub struct BinnedEllipseCalibrator {
 /// and so what the set lost to them, grow with the sampling rate (a recording of 2 000
 /// readings per degree ran 5 600 updates per turn and kept 15 of 64 bins). Readings past
 /// the first 16 of a bin (the 11 a bin takes at the 2 readings per degree the patent's turn
-/// gives, with room) only renew its value and bring no update closer, so the updates come
-/// per angle turned, not per reading, at any rate. The cap is per bin and update, not per
-/// run of readings in a row: near a bin's edge noise moves a dense recording's readings
-/// back and forth between two bins hundreds of times as the turn crosses it, and a cap per
-/// run counted every crossing (one turn of the `io_speed` ellipse at 500 readings per
-/// degree ran 318 updates, kept 27 of 64 bins and was refused for 185° of turning; see
-/// `tests/denser_data.rs`). Never below what lets half the bins start an update.
+/// gives, with room) may still replace its reading but bring no update closer, so the
+/// updates come per angle turned, not per reading, at any rate. The cap is per bin and
+/// update, not per run of readings in a row: near a bin's edge noise moves a dense
+/// recording's readings back and forth between two bins hundreds of times as the turn
+/// crosses it, and a cap per run counted every crossing (one turn of the `io_speed`
+/// ellipse at 500 readings per degree ran 318 updates, kept 27 of 64 bins and was refused
+/// for 185° of turning; see `tests/denser_data.rs`). Never below what lets half the bins
+/// start an update.
 const COUNTED_PER_BIN: usize = 16;
 
 /// How many per-axis noise σ a reading must lie from the origin for its direction to be
@@ -213,6 +224,7 @@ impl BinnedEllipseCalibrator {
             backlog_len: 0,
             floor_sq: 0.0,
             counted: [0; MAX_BINS],
+            counted_before: [0; MAX_BINS],
         }
     }
 
@@ -349,6 +361,7 @@ impl BinnedEllipseCalibrator {
             && self.filled_bins() >= self.config.min_filled_bins
         {
             self.since_update = 0;
+            self.counted_before = self.counted;
             self.counted = [0; MAX_BINS];
             self.start_update();
         }
@@ -369,6 +382,7 @@ impl BinnedEllipseCalibrator {
             &origin,
             p,
             self.config.bin_memory,
+            |i| self.counted[i] == 0 && self.counted_before[i] == 0,
         ) else {
             return false;
         };
@@ -387,6 +401,11 @@ impl BinnedEllipseCalibrator {
     /// The per-bin counts towards the next update, as saved (the first `n` bins).
     pub(crate) fn counted_bins(&self) -> &[u32] {
         &self.counted[..self.config.bins]
+    }
+
+    /// The per-bin counts of the interval before, as saved (the first `n` bins).
+    pub(crate) fn counted_before_bins(&self) -> &[u32] {
+        &self.counted_before[..self.config.bins]
     }
 
     /// Starts a full-set update on a copy of the bins, with the refresh spread evenly over

@@ -18,8 +18,9 @@ use crate::seed::binned::calibrator::{
     BinnedEllipseCalibrator, BinnedEllipseConfig, MAX_INIT_SAMPLES,
 };
 use crate::seed::binned::refresh::RefreshJob;
-use crate::seed::binned::update::{MAX_UPDATE_PUSHES, REFRESH_STRIDE, Update, UpdatePhase};
-use crate::seed::seed_quality::SeedJob;
+use crate::seed::binned::update::{
+    ASSESS_PUSHES, MAX_UPDATE_PUSHES, REFRESH_STRIDE, Update, UpdatePhase,
+};
 
 /// A full-set update in progress, as saved (opaque).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -61,6 +62,11 @@ pub struct BinnedEllipseCalibratorState {
     /// (empty in a state saved before they were kept: all zero).
     #[serde(default)]
     counted: Vec<u32>,
+    /// The same counts of the interval before the last update started (empty in a state
+    /// saved before they were kept: all zero, so that the next reading of each bin replaces
+    /// its stored one, as every reading did then).
+    #[serde(default)]
+    counted_before: Vec<u32>,
 }
 
 fn finite2(v: &Vector2<f64>) -> bool {
@@ -122,6 +128,7 @@ impl Persistent for BinnedEllipseCalibrator {
             }),
             backlog: self.backlog[..self.backlog_len].to_vec(),
             counted: self.counted_bins().to_vec(),
+            counted_before: self.counted_before_bins().to_vec(),
         }
     }
 
@@ -139,13 +146,18 @@ impl Persistent for BinnedEllipseCalibrator {
         if c.origin.is_some() {
             c.floor_sq = super::calibrator::noise_floor_sq(&s.init);
         }
-        match s.counted.len() {
-            0 => {}
-            len if len == n => c.counted[..n].copy_from_slice(&s.counted),
-            _ => {
-                return Err(Error::InvalidSnapshot {
-                    reason: "the binned ellipse must save a count for each of its bins",
-                });
+        for (saved, into) in [
+            (&s.counted, &mut c.counted),
+            (&s.counted_before, &mut c.counted_before),
+        ] {
+            match saved.len() {
+                0 => {}
+                len if len == n => into[..n].copy_from_slice(saved),
+                _ => {
+                    return Err(Error::InvalidSnapshot {
+                        reason: "the binned ellipse must save a count for each of its bins",
+                    });
+                }
             }
         }
         c.samples = s.samples;
@@ -265,7 +277,7 @@ fn replay_update(
     }
     // Precheck, the steps of the assessment, then the application: a saved update is
     // at most that many assessment pushes past its refresh.
-    let mut left = 2 + SeedJob::STEPS;
+    let mut left = ASSESS_PUSHES;
     while update.phase != u.phase
         || (u.phase == UpdatePhase::Assess && update.assess_steps < u.assess_steps)
     {

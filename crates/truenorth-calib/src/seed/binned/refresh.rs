@@ -422,7 +422,7 @@ mod tests {
         let mut bins = [EMPTY; MAX_BINS];
         for &(a, r) in points {
             let p = origin + Vector2::new(a.cos(), a.sin()) * r;
-            let _ = bin_reading(&mut bins, n, origin, &p, 1);
+            let _ = bin_reading(&mut bins, n, origin, &p, 1, |_| true);
         }
         bins
     }

@@ -4,7 +4,7 @@ use super::*;
 use truenorth_compass::{
     Disturbance, DisturbanceShape, HeadingTruth, MagnetometerModel2d, soft_iron_from_axes,
 };
-use truenorth_core::{SensorModel, SplitMix64, angle_diff};
+use truenorth_core::{NoiseSource, SensorModel, SplitMix64, angle_diff};
 
 const H: f64 = 20.0;
 
@@ -232,4 +232,70 @@ fn config_is_validated() {
     for cfg in bad {
         assert!(BinnedEllipseCalibrator::new(cfg).is_err(), "{cfg:?}");
     }
+}
+
+/// What a dense noisy turn leaves in the bins is a reading taken at the direction it shows:
+/// on 1.5 turns at 200 readings per degree with noise 5 % of the field, the readings the
+/// bins keep lag their true headings by a fraction of the noise σ on average (0.07 σ here,
+/// up to 0.7 σ over other draws), where keeping the last reading of each bin kept the last
+/// noise excursion back across the edge the turn crossed (2.0 σ here, 2.5–2.8 σ over other
+/// draws: see `bins::store_reading`).
+#[test]
+fn a_dense_noisy_turn_keeps_readings_at_their_own_directions() {
+    let sigma = 0.05;
+    let (hard, w) = (Vector2::new(0.4, -0.3), soft_iron_from_axes(1.8, 1.0, 0.7));
+    let w_inv = w.try_inverse().unwrap();
+    let mut rng = SplitMix64::new(3);
+    let per_deg = 200.0;
+    let readings: Vec<(f64, Vector2<f64>)> = (0..(540.0 * per_deg) as usize)
+        .map(|k| {
+            let psi = (k as f64 / per_deg).to_radians();
+            let noise = Vector2::new(rng.normal(sigma), rng.normal(sigma));
+            (psi, hard + w * Vector2::new(psi.cos(), psi.sin()) + noise)
+        })
+        .collect();
+    let mut c = BinnedEllipseCalibrator::default();
+    for (k, (_, p)) in readings.iter().enumerate() {
+        c.push(&Mag2Sample {
+            t_s: k as f64 * 0.01,
+            mag: *p,
+        })
+        .unwrap();
+    }
+    let (mut sum, mut n) = (0.0, 0usize);
+    for b in c.bins[..64]
+        .iter()
+        .filter(|b| b.state == BinState::Measured)
+    {
+        // Bins that merged two readings hold neither.
+        if let Some((psi, p)) = readings.iter().find(|(_, p)| *p == b.value) {
+            let d = w_inv * (p - hard);
+            sum += angle_diff(*psi, d.y.atan2(d.x)) / sigma;
+            n += 1;
+        }
+    }
+    let mean_lag = sum / n as f64;
+    assert!(
+        mean_lag.abs() < 1.25,
+        "the kept readings lag by {mean_lag:.2} σ"
+    );
+    assert!(n >= 16, "{n} bins hold a single reading");
+}
+
+/// A state saved before the bins' counts of the interval before were kept restores (all
+/// zero: every bin is fresh) and calibrates on.
+#[test]
+fn a_state_without_the_counts_of_the_interval_before_restores() {
+    use truenorth_core::Persistent;
+    let mut m = reference();
+    let mut c = BinnedEllipseCalibrator::default();
+    drive(&mut c, &mut m, 0.0, 200.0);
+    let mut saved = serde_json::to_value(c.snapshot()).unwrap();
+    let fields = saved["state"].as_object_mut().unwrap();
+    assert!(fields.remove("counted_before").is_some());
+    let state = serde_json::from_value(saved).unwrap();
+    let mut on = BinnedEllipseCalibrator::restore(state).unwrap();
+    assert!(on.counted_before.iter().all(|&k| k == 0));
+    drive(&mut on, &mut m, 200.0, 250.0);
+    assert!(on.solve().is_ok());
 }

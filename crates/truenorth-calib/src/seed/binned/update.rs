@@ -6,9 +6,11 @@
 use nalgebra::Vector2;
 use serde::{Deserialize, Serialize};
 
+use crate::quality::Assessment2d;
 use crate::seed::binned::assess::{Assessor, Precheck, Verdict};
 use crate::seed::binned::bins::Bins;
 use crate::seed::binned::config::BinnedEllipseConfig;
+use crate::seed::binned::fit_gap::complete_bound;
 use crate::seed::binned::refresh::RefreshJob;
 use crate::seed::seed_quality::SeedJob;
 
@@ -17,9 +19,14 @@ use crate::seed::seed_quality::SeedJob;
 pub const MAX_UPDATE_PUSHES: usize = 128;
 
 /// Most pushes the refresh of a full-set update is spread over; its assessment and its
-/// application take `2 + SeedJob::STEPS` pushes after it, so at most
-/// `REFRESH_PUSHES + 2 + SeedJob::STEPS` readings wait.
+/// application take `ASSESS_PUSHES` pushes after it, so at most
+/// `REFRESH_PUSHES + ASSESS_PUSHES` readings wait.
 pub(crate) const REFRESH_PUSHES: usize = 96;
+
+/// Pushes from the end of a refresh to the application of its update: the precheck, the
+/// [`SeedJob::STEPS`] of the report, its completion by the least-squares fit of the same
+/// readings (`fit_gap`), and the application.
+pub(crate) const ASSESS_PUSHES: usize = 3 + SeedJob::STEPS;
 
 /// Most waiting readings binned per push once an update is applied (the rest wait for the
 /// next pushes; at most `MAX_UPDATE_PUSHES` wait, so they are all binned within
@@ -39,7 +46,8 @@ pub enum UpdatePhase {
     /// turning.
     Precheck,
     /// The next pushes complete the assessment: the quality report, one bounded step per
-    /// push, then the acceptance tests.
+    /// push, its completion by the least-squares fit of the same readings, then the
+    /// acceptance tests.
     Assess,
     /// The result is assessed; the next push applies it and bins the readings that waited.
     Apply,
@@ -62,6 +70,8 @@ pub(crate) struct Update {
     pub verdict: Option<Verdict>,
     /// The quality report in progress (phase `Assess`), and the pushes of that phase so far.
     pub seed: Option<SeedJob>,
+    /// The finished report of `seed`, before its completion by `fit_gap` (the next push).
+    pub report: Option<Assessment2d>,
     pub assess_steps: usize,
     pub pending: [Vector2<f64>; MAX_UPDATE_PUSHES],
     pub pending_len: usize,
@@ -95,6 +105,7 @@ impl Update {
             precheck: None,
             verdict: None,
             seed: None,
+            report: None,
             assess_steps: 0,
             pending: [Vector2::zeros(); MAX_UPDATE_PUSHES],
             pending_len: 0,
@@ -121,13 +132,19 @@ impl Update {
                         let seed = self
                             .seed
                             .get_or_insert_with(|| assessor.seed_job(bins, &params));
-                        if let Some(a) = seed.step() {
-                            let estimate = assessor
-                                .judge(&a, seed.calibration(), turned_deg, seed.points().len())
-                                .ok();
-                            self.verdict = Some(Verdict::Accept(params, estimate));
-                            self.seed = None;
-                            self.phase = UpdatePhase::Apply;
+                        // The report's steps, then its completion (one more push), then
+                        // the verdict.
+                        match self.report.take() {
+                            None => self.report = seed.step(),
+                            Some(a) => {
+                                let a = complete_bound(a, seed.points(), seed.calibration());
+                                let estimate = assessor
+                                    .judge(&a, seed.calibration(), turned_deg, seed.points().len())
+                                    .ok();
+                                self.verdict = Some(Verdict::Accept(params, estimate));
+                                self.seed = None;
+                                self.phase = UpdatePhase::Apply;
+                            }
                         }
                     }
                     other => {
