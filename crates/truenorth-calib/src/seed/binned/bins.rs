@@ -5,7 +5,7 @@ use core::f64::consts::TAU;
 
 use nalgebra::Vector2;
 use serde::{Deserialize, Serialize};
-use truenorth_core::{angle_diff, wrap_two_pi};
+use truenorth_core::wrap_two_pi;
 
 #[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
@@ -58,6 +58,7 @@ pub(crate) fn bin_index(d: &Vector2<f64>, n: usize) -> Option<usize> {
 /// direction.
 pub(crate) fn bin_reading(
     bins: &mut Bins,
+    centres: &BinCentres,
     n: usize,
     origin: &Vector2<f64>,
     p: &Vector2<f64>,
@@ -66,17 +67,32 @@ pub(crate) fn bin_reading(
 ) -> Option<usize> {
     let i = bin_index(&(p - origin), n)?;
     let fresh = fresh(i);
-    store_reading(&mut bins[i], i, n, origin, p, memory, fresh);
+    store_reading(&mut bins[i], &centres[i], origin, p, memory, fresh);
     Some(i)
 }
 
-/// Angle between the direction of `d` and the centre direction of bin `i` of `n`, radians.
-fn off_centre_rad(d: &Vector2<f64>, i: usize, n: usize) -> f64 {
-    let centre = (i as f64 + 0.5) * TAU / n as f64;
-    angle_diff(d.y.atan2(d.x), centre).abs()
+/// The unit centre direction of each of `n` bins (the first `n` entries).
+pub(crate) type BinCentres = [Vector2<f64>; MAX_BINS];
+
+/// The [`BinCentres`] of `n` bins.
+pub(crate) fn bin_centres(n: usize) -> BinCentres {
+    let mut c = [Vector2::zeros(); MAX_BINS];
+    for (i, c) in c.iter_mut().enumerate().take(n) {
+        let (sin, cos) = ((i as f64 + 0.5) * TAU / n as f64).sin_cos();
+        *c = Vector2::new(cos, sin);
+    }
+    c
 }
 
-/// Stores reading `p` in bin `b` (bin `i` of `n` about `origin`); `fresh` says whether the
+/// Whether direction `d` lies nearer the bin centre direction `c` (a unit vector) than `e`
+/// does, both in that bin. Within a bin, at most π/8 from its centre (N ≥ 8), the nearer
+/// direction has the smaller sine of its angle from the centre, `|c × d|/|d|`; compared
+/// cross-multiplied, that takes no trigonometry per reading.
+fn nearer_centre(d: &Vector2<f64>, e: &Vector2<f64>, c: &Vector2<f64>) -> bool {
+    c.perp(d).abs() * e.norm() < c.perp(e).abs() * d.norm()
+}
+
+/// Stores reading `p` in bin `b` (of centre direction `centre` about `origin`); `fresh` says whether the
 /// bin took no reading in the current full-set update interval nor in the one before.
 ///
 /// With `memory` = 1 the bin holds one reading (claim 1), and which one matters: a bin
@@ -88,17 +104,17 @@ fn off_centre_rad(d: &Vector2<f64>, i: usize, n: usize) -> f64 {
 /// the true one. (At 5 % noise and 200 readings per degree the kept readings lagged by
 /// 2.0–2.8 noise σ, see the calibrator's test
 /// `a_dense_noisy_turn_keeps_readings_at_their_own_directions`, and the heading error
-/// reached 7°, where the same readings binned in random order left 2.4°.) So a bin keeps the reading nearest its centre direction: near the centre the noise
-/// that put a reading there is as likely either way, so the kept reading's true direction
-/// is its own on average, at any density. To follow a changed locus (claim 15) the first
+/// reached 7°, where the same readings binned in random order left 2.4°.) So a bin keeps
+/// the reading nearest its centre direction: near the centre the noise that put a reading
+/// there is as likely either way, so the kept reading's true direction is its own on
+/// average, at any density. To follow a changed locus (claim 15) the first
 /// reading of a fresh bin replaces the stored one whatever its direction: the update
 /// intervals are counted in readings, a clock the noise does not set, and a bin must have
 /// gone a whole interval without readings — the turn is away, not passing — so that the
 /// last excursions back across its edge after the turn has left do not count as a new visit.
 fn store_reading(
     b: &mut Bin,
-    i: usize,
-    n: usize,
+    centre: &Vector2<f64>,
     origin: &Vector2<f64>,
     p: &Vector2<f64>,
     memory: u32,
@@ -114,8 +130,7 @@ fn store_reading(
     }
     b.count = b.count.saturating_add(1);
     if memory <= 1 {
-        if fresh || off_centre_rad(&(p - origin), i, n) < off_centre_rad(&(b.value - origin), i, n)
-        {
+        if fresh || nearer_centre(&(p - origin), &(b.value - origin), centre) {
             b.value = *p;
         }
         return;

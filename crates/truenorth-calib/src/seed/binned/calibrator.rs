@@ -85,7 +85,9 @@ use truenorth_core::{
 };
 
 use crate::seed::binned::assess::{Assessor, Verdict};
-use crate::seed::binned::bins::{Bin, BinState, Bins, EMPTY, MAX_BINS, bin_reading, filled};
+use crate::seed::binned::bins::{
+    Bin, BinCentres, BinState, Bins, EMPTY, MAX_BINS, bin_centres, bin_reading, filled,
+};
 pub use crate::seed::binned::config::{BinnedEllipseConfig, MAX_INIT_SAMPLES};
 use crate::seed::binned::refresh::RefreshJob;
 
@@ -146,6 +148,8 @@ pub struct BinnedEllipseCalibrator {
     /// took readings in neither keeps its reading only while a new one lies nearer its
     /// centre (see `bins::store_reading`).
     pub(crate) counted_before: [u32; MAX_BINS],
+    /// The bins' centre directions (from the configuration).
+    centres: BinCentres,
 }
 
 /// Most readings of one bin that count towards the next update
@@ -225,6 +229,7 @@ impl BinnedEllipseCalibrator {
             floor_sq: 0.0,
             counted: [0; MAX_BINS],
             counted_before: [0; MAX_BINS],
+            centres: bin_centres(config.bins),
         }
     }
 
@@ -378,6 +383,7 @@ impl BinnedEllipseCalibrator {
         }
         let Some(i) = bin_reading(
             &mut self.bins,
+            &self.centres,
             self.config.bins,
             &origin,
             p,

@@ -365,7 +365,7 @@ fn interpolate(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::seed::binned::bins::{bin_reading, rebin};
+    use crate::seed::binned::bins::{bin_centres, bin_reading, rebin};
     use crate::seed::binned::params::ellipse_parameters;
     use proptest::prelude::*;
 
@@ -420,9 +420,10 @@ mod tests {
 
     fn bins_of(points: &[(f64, f64)], n: usize, origin: &Vector2<f64>) -> Bins {
         let mut bins = [EMPTY; MAX_BINS];
+        let centres = bin_centres(n);
         for &(a, r) in points {
             let p = origin + Vector2::new(a.cos(), a.sin()) * r;
-            let _ = bin_reading(&mut bins, n, origin, &p, 1, |_| true);
+            let _ = bin_reading(&mut bins, &centres, n, origin, &p, 1, |_| true);
         }
         bins
     }
