@@ -5,6 +5,7 @@
 
 pub mod binned;
 pub mod extrema;
+pub(crate) mod fit_gap;
 pub mod merit_circle;
 pub(crate) mod seed_quality;
 pub mod speed_coefficient;

@@ -13,8 +13,8 @@ use truenorth_core::{Error, Result, Solution};
 use crate::quality::{Assessment2d, locus_turning_rad, require_arc, require_certain};
 use crate::seed::binned::bins::{BinState, Bins, MAX_BINS, filled};
 use crate::seed::binned::config::BinnedEllipseConfig;
-use crate::seed::binned::fit_gap::complete_bound;
 use crate::seed::binned::refresh::RefreshJob;
+use crate::seed::fit_gap::complete_bound;
 use crate::seed::seed_quality::{SeedJob, seed_assessment};
 
 #[cfg(not(feature = "std"))]

@@ -5,7 +5,6 @@ pub(crate) mod assess;
 pub(crate) mod bins;
 pub(crate) mod calibrator;
 pub(crate) mod config;
-pub(crate) mod fit_gap;
 pub(crate) mod params;
 pub(crate) mod persist;
 pub(crate) mod refresh;

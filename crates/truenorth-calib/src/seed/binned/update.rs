@@ -10,8 +10,8 @@ use crate::quality::Assessment2d;
 use crate::seed::binned::assess::{Assessor, Precheck, Verdict};
 use crate::seed::binned::bins::Bins;
 use crate::seed::binned::config::BinnedEllipseConfig;
-use crate::seed::binned::fit_gap::complete_bound;
 use crate::seed::binned::refresh::RefreshJob;
+use crate::seed::fit_gap::complete_bound;
 use crate::seed::seed_quality::SeedJob;
 
 /// Most readings kept while a full-set update is in progress (they are binned when it

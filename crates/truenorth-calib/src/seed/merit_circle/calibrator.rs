@@ -37,8 +37,11 @@
 //!    weighting by geometry, de-weighted where the centre disagrees with the scatter seen so
 //!    far. The first centre has `m = 1`.
 //!
-//! The method fits a circle: it removes hard iron but not soft iron. The quality report
-//! gives the two-cycle heading error that leaves as `heading_error_systematic_deg`.
+//! The method fits a circle: it removes hard iron but not soft iron. The quality report's
+//! `heading_error_systematic_deg` is the larger of the two-cycle heading error that leaves
+//! and the heading difference from a least-squares ellipse fit of the kept readings, plus
+//! that fit's second-order bias (the `fit_gap` module; computed with the last step of the
+//! report).
 //!
 //! ## Online estimate, readiness and persistence
 //! At every new heading data point the calibrator runs its own `solve` and keeps the result
@@ -64,6 +67,7 @@ use truenorth_core::{
 use crate::numerics::circumcentre::{BEST_AMPLIFICATION_SQ, Circumcircle, circumcircle};
 use crate::numerics::direction_slots::{DirectionSlots, SLOTS};
 use crate::quality::{Coverage, coverage, mean_corrected_norm_2d, require_arc};
+use crate::seed::fit_gap::complete_bound;
 use crate::seed::seed_quality::{SeedJob, seed_assessment};
 
 use crate::seed::merit_circle::config::MeritCircleConfig;
@@ -367,6 +371,8 @@ impl Calibrator for MeritCircleCalibrator {
         // state the refresh started from.
         let refreshed = if let Some(job) = self.seed.as_mut() {
             let done = job.step().map(|a| {
+                // Bounded, as the job: one direct fit of at most 72 kept readings.
+                let a = complete_bound(a, job.points(), job.calibration());
                 Some(Solution {
                     params: *job.calibration(),
                     quality: a.quality,
@@ -450,7 +456,11 @@ impl Calibrator for MeritCircleCalibrator {
 
     fn solve(&self) -> Result<Solution<CompassCalibration2d>> {
         let (cal, field, buf, n, _) = self.accepted()?;
-        let a = seed_assessment(&buf[..n], &cal, field, self.samples);
+        let a = complete_bound(
+            seed_assessment(&buf[..n], &cal, field, self.samples),
+            &buf[..n],
+            &cal,
+        );
         Ok(Solution {
             params: cal,
             quality: a.quality,

@@ -1,16 +1,21 @@
-//! The binned ellipse's share of its heading-error bound that the shared report cannot see.
+//! The share of a seed calibration's heading-error bound that the shared report cannot see.
 //!
 //! The shared report ([`crate::quality::assess_2d`]) bounds the heading error that noise
-//! leaves in a *least-squares* fit of the binned readings: its 3σ part is the spread of such
-//! a fit. The binned ellipse does not fit by least squares: it interpolates the full set
-//! at the bin centres and takes the parameters from the R²-weighted sums of EP 0634001
-//! (claims 7–9), which weigh the noise of single readings differently and can land further
-//! from the truth than the fit the report describes (on noisy turns of elongated ellipses,
-//! twice as far), with radial residuals no larger. So the bound is completed by the triangle
-//! inequality: the error of the binned estimate is at most the error of the direct
-//! least-squares fit of the same readings — its 3σ part and its second-order bias
-//! `4σ²(κ + h₁ + h₂)` ([`crate::quality::direct_fit_bias_rad`]) — plus the largest heading
-//! difference between the two calibrations.
+//! leaves in a *least-squares* fit of the kept readings: its 3σ part is the spread of such
+//! a fit. The seed methods do not fit by least squares. The binned ellipse interpolates the
+//! full set at the bin centres and takes the parameters from the R²-weighted sums of
+//! EP 0634001 (claims 7–9), which weigh the noise of single readings differently and can
+//! land further from the truth than the fit the report describes (on noisy turns of
+//! elongated ellipses, twice as far), with radial residuals no larger. The merit circle
+//! (US 5,297,063) fits a circle, so a soft iron is an error of its model that its report's
+//! two-cycle term measures only to first order, and the centre it finds from triples of
+//! data points can land further from the truth than a least-squares fit of the same
+//! readings (without any soft iron, 9 of 270 noisy turns exceeded its bound without this
+//! part, by up to a third; `tests/seed_bound.rs`). So the bound is
+//! completed by the triangle inequality: the error of the seed estimate is at most the error
+//! of the direct least-squares ellipse fit of the same readings — its 3σ part and its
+//! second-order bias `4σ²(κ + h₁ + h₂)` ([`crate::quality::direct_fit_bias_rad`]) — plus
+//! the largest heading difference between the two calibrations.
 
 use nalgebra::Vector2;
 use truenorth_compass::CompassCalibration2d;
@@ -61,7 +66,7 @@ pub(crate) fn fit_gap_rad(
     }
 }
 
-/// The report `a` of `cal` on the binned `points` with the bound completed (see the module
+/// The report `a` of `cal` on its kept `points` with the bound completed (see the module
 /// documentation): the systematic part becomes the larger of the two-cycle amplitude the
 /// shared report found and the heading difference from the least-squares fit, plus that
 /// fit's bias bound.
