@@ -5,7 +5,7 @@
 //! ignores (and the next line starts on a line of its own).
 
 use std::collections::HashMap;
-use std::fs::{File, OpenOptions};
+use std::fs::{File, OpenOptions, TryLockError};
 use std::io::{Read as _, Seek as _, SeekFrom, Write as _};
 use std::path::{Path, PathBuf};
 
@@ -93,6 +93,22 @@ impl Journal {
             .create(true)
             .open(&path)
             .map_err(err)?;
+        // One batch per folder: a second would interleave its journal lines with the first's,
+        // write the same outputs twice and leave whichever results table ends last. The
+        // lock goes with the process, however it ends. A file system without locks (some
+        // network ones) runs unlocked, as before.
+        match file.try_lock() {
+            Ok(()) => {}
+            Err(TryLockError::WouldBlock) => {
+                return Err(CliError::file(
+                    &path,
+                    "another `truenorth batch` is writing into this folder: wait for it to \
+                     end, or give this one another --out",
+                ));
+            }
+            Err(TryLockError::Error(e)) if e.kind() == std::io::ErrorKind::Unsupported => {}
+            Err(TryLockError::Error(e)) => return Err(err(e)),
+        }
         let mut bytes = Vec::new();
         file.read_to_end(&mut bytes).map_err(err)?;
         let mut last = HashMap::new();
@@ -154,6 +170,22 @@ mod tests {
             },
             pid: Some(1),
         }
+    }
+
+    #[test]
+    fn a_second_batch_on_one_folder_is_refused_while_the_first_runs() {
+        let d = std::env::temp_dir().join(format!("truenorth-journal-lock-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&d);
+        std::fs::create_dir_all(&d).unwrap();
+        let first = Journal::open(&d).unwrap();
+        let second = Journal::open(&d).unwrap_err().to_string();
+        assert!(second.contains("another `truenorth batch`"), "{second}");
+        drop(first);
+        assert!(
+            Journal::open(&d).is_ok(),
+            "the lock ends with the first batch"
+        );
+        let _ = std::fs::remove_dir_all(&d);
     }
 
     #[test]

@@ -55,7 +55,8 @@ Resuming: a journal in --out (.truenorth-batch-journal.jsonl) gets one synced li
 finished file, keyed by the output name, the SHA-256 of the input's bytes and the command \
 line. A rerun skips a file whose bytes and command are unchanged and whose run settled it \
 (ok, refused, or failed with the command's own message; a crash or a signal is retried; \
---retry-failed retries every failure), and reruns a changed one.
+--retry-failed retries every failure), and reruns a changed one. One batch at a time per \
+--out: the journal is locked while a batch runs, and a second is refused (exit 1).
 
 Stopping: Ctrl-C or SIGTERM stops handing out files and lets the running ones finish; a \
 second one stops them too (SIGTERM, so each removes its unfinished output). The journal \
@@ -131,8 +132,9 @@ pub fn run(args: &Args) -> CliResult<u8> {
     let plan = plan(&jobs, &command, &args.out, &results_path)?;
     let exe = std::env::current_exe()
         .map_err(|e| CliError::msg(format!("batch: cannot find its own executable: {e}")))?;
-    sweep::remove_stale_temporaries(&args.out);
+    // Locked first, so that a batch refused for another's folder touches nothing in it.
     let mut journal = Journal::open(&args.out)?;
+    sweep::remove_stale_temporaries(&args.out);
     let known = journal.known().clone();
     let workers = args
         .jobs
