@@ -340,7 +340,7 @@ where
     }
 
     /// Readings from the start of one refresh, at `now` readings, to the start of the next:
-    /// the configured interval, or [`REFRESH_SHARE`] of the readings the sums weigh when
+    /// the configured interval, or 1/[`REFRESH_SHARE`] of the readings the sums weigh when
     /// that is longer (all of them; forgetting, those of the last half-life).
     fn refresh_spacing(&self, now: u64) -> u64 {
         let weighed = now.min(self.lifetime / 4);
