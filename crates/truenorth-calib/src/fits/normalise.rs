@@ -38,7 +38,7 @@ impl<const D: usize> Normaliser<D> {
 
     /// The normaliser of `points` (non-empty), refusing with [`Error::NonFinite`] naming
     /// `what` the first non-finite coordinate, exactly as checking every point with
-    /// `check_finite` before [`Self::of`] would. The check rides on the centroid's sum, which
+    /// `check_finite` before `Self::of` (its tests' form) would. The check rides on the centroid's sum, which
     /// is finite when every point is: only a non-finite sum needs the points looked at one
     /// by one (they are then either not all finite, or so large that the sum overflowed).
     /// An error replaying `points` is returned as it is.

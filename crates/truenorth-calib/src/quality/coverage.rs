@@ -57,7 +57,7 @@ impl AngleBins {
         self.mark_bin(fine_bin_xy(d.y, d.x));
     }
 
-    /// Marks the direction `t` (a share of a full turn in [0, 1), from [`turns`]).
+    /// Marks the direction `t` (a share of a full turn in [0, 1), from [`turns`](crate::quality::direction_bins::turns)).
     #[inline]
     pub(super) fn mark(&mut self, t: f64) {
         self.mark_bin(fine_bin(t));

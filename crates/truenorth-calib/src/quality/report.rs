@@ -314,7 +314,7 @@ fn cell_weights(in_cell: &[u32; SPHERE_CELLS]) -> [f64; SPHERE_CELLS] {
 }
 
 /// The dilution of the support of the directions of `points` under `cal` alone (see the
-/// `support` module), as [`assess_3d`] reports it in [`CompassUncertainty::dilution`], without the
+/// `support` module), as [`assess_3d`] reports it in [`CompassUncertainty::dilution`](truenorth_core::CompassUncertainty::dilution), without the
 /// sums of every reading, the residuals and the bound: what a check of the geometry before
 /// a fit needs. Allocates nothing.
 /// An error replaying `points` is returned as it is.

@@ -33,7 +33,7 @@ pub(crate) fn two_cycle_amplitude(
     two_cycle_fit(points, cal, field).0
 }
 
-/// The two-cycle amplitude (see [`two_cycle_amplitude`]) and the residual standard
+/// The two-cycle amplitude (see `two_cycle_amplitude`, its tests' form) and the residual standard
 /// deviation left by the fit of `1, cos 2u, sin 2u` (relative to the field; `None` when
 /// fewer than 4 usable points or a singular fit).
 fn two_cycle_fit(

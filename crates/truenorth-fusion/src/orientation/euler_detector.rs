@@ -10,11 +10,11 @@
 //! 4. **Tentative yaw** from the magnetometer levelled with the static pitch and roll
 //!    ([`truenorth_compass::tilt_compensated_heading`]); with two magnetometers, `M_z` is
 //!    reconstructed from the start-up field ([`truenorth_compass::MzReconstruction`]).
-//! 5. **Correction definer** ([`CorrectionDefinerConfig`]): modes (1)–(7).
+//! 5. **Correction definer** ([`CorrectionDefinerConfig`](super::CorrectionDefinerConfig)): modes (1)–(7).
 //! 6. **Correction** `angle = SA − k·E`, `E = SA − static`, `k = dt/τ`, per axis and only
 //!    where the static angle was judged accurate.
 //! 7. **Coefficient table** ([`coefficient_table`]).
-//! 8. **Gyro conditioning** ([`GyroConditioning`]) and 9. the **oscillation remover**, from
+//! 8. **Gyro conditioning** ([`GyroConditioning`](super::GyroConditioning)) and 9. the **oscillation remover**, from
 //!    `truenorth-gyro`.
 //! 10. The **yaw + pitch variant** ([`EulerVariant::YawPitch`]).
 //!

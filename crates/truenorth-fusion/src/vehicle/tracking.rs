@@ -95,7 +95,7 @@ pub(super) struct GyroTrack {
 pub(super) struct Motion {
     /// Time the wheels have stood still, s.
     pub still_s: f64,
-    /// Stood still for [`VehicleConfig::standstill_s`].
+    /// Stood still for [`VehicleConfig::standstill_s`](super::VehicleConfig::standstill_s).
     pub at_rest: bool,
     /// The heading at the last wheel reading (for the mid-step heading of the track).
     pub psi_at_wheels_rad: f64,

@@ -13,8 +13,8 @@ use crate::quality::MIN_ARC_DEG;
 /// more leaves a residual to judge it by.
 pub const MIN_POINTS_2D: usize = 6;
 
-/// The fewest readings [`fit_ellipse`] accepts a calibration from: five for the ellipse and
-/// five residuals to judge it by (the direct fit alone, [`fit_ellipse_direct`], needs
+/// The fewest readings [`fit_ellipse`](crate::fit_ellipse) accepts a calibration from: five for the ellipse and
+/// five residuals to judge it by (the direct fit alone, [`fit_ellipse_direct`](crate::fit_ellipse_direct), needs
 /// [`MIN_POINTS_2D`]).
 pub(crate) const MIN_POINTS_JUDGED_2D: usize = 10;
 

@@ -7,7 +7,7 @@
 //! 1. Refuse too few points and degenerate sets (all equal, collinear).
 //! 2. Normalise: centroid to the origin, RMS radius 1 (see the `normalise` module), so the
 //!    fit is equivariant under rotation, translation and scaling of the input.
-//! 3. Direct fit ([`fit_ellipse_direct`]): minimise the algebraic distance
+//! 3. Direct fit ([`fit_ellipse_direct`](crate::fit_ellipse_direct)): minimise the algebraic distance
 //!    `Σ (a x² + b xy + c y² + d x + e y + f)²` subject to `4ac − b² = 1`.
 //! 4. Refuse when the data are not an ellipse: the best conic without the ellipse
 //!    constraint is a hyperbola or parabola, or the ellipse is flatter than
@@ -340,7 +340,7 @@ fn fit_unchecked<R: Readings<2> + ?Sized>(
 }
 
 /// Largest heading shift of the geometric refinement, as a share of the direct fit's own
-/// heading-error bound ([`CompassQuality::heading_error_3sigma_deg`]), for which the
+/// heading-error bound ([`CompassQuality::heading_error_3sigma_deg`](truenorth_core::CompassQuality::heading_error_3sigma_deg)), for which the
 /// refinement is skipped: a quarter of the bound changes no heading by a statistically
 /// meaningful amount.
 const SKIPPED_STEP_SHARE_OF_BOUND: f64 = 0.25;

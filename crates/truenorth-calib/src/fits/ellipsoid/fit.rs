@@ -8,7 +8,7 @@
 //!    [`crate::quality::require_determined`], checked loosely about the bounding-box centre
 //!    before the fit, and exactly about the fitted calibration after).
 //! 2. Normalise (centroid, RMS radius; see the `normalise` module) for equivariance.
-//! 3. Direct fit ([`fit_ellipsoid_direct`]): minimise the algebraic distance of the quadric
+//! 3. Direct fit ([`fit_ellipsoid_direct`](crate::fit_ellipsoid_direct)): minimise the algebraic distance of the quadric
 //!    `ax² + by² + cz² + 2fyz + 2gxz + 2hxy + 2px + 2qy + 2rz + d` subject to
 //!    `4J − I² = 1` (Li & Griffiths 2004, eq. 5, with their `k = 4`), where
 //!    `I = a + b + c` and `J = ab + bc + ca − f² − g² − h²`. The constraint makes the
@@ -79,7 +79,7 @@ pub(crate) fn radial_normal_equations(
     radial_normal_equations_of(points, norm, p).unwrap_or(None)
 }
 
-/// [`radial_normal_equations`] of readings replayed (see [`Readings`]); an error replaying
+/// `radial_normal_equations` (a test's reference) of readings replayed (see [`Readings`]); an error replaying
 /// them is the `Err`.
 fn radial_normal_equations_of<R: Readings<3> + ?Sized>(
     points: &R,

@@ -151,7 +151,7 @@ pub(crate) fn rebin(bins: &mut Bins, n: usize, new_origin: &Vector2<f64>) {
     }
 }
 
-/// One old bin's share of [`rebin`]: moves `b` (if it holds a reading) into `bins`.
+/// One old bin's share of `rebin` (the tests' reference): moves `b` (if it holds a reading) into `bins`.
 pub(crate) fn rebin_one(bins: &mut Bins, n: usize, b: &Bin, new_origin: &Vector2<f64>) {
     if b.state == BinState::Empty {
         return;

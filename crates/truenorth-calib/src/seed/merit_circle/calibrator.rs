@@ -20,7 +20,7 @@
 //! For the new circumcentre `c` (from the triple), with `ĉ` the current estimate:
 //!
 //! 1. **Geometry** — `γ`, the triple's noise amplification (see
-//!    [`circumcircle`](crate::circumcircle)): the centre's per-axis error per unit of point
+//!    [`crate::circumcircle`]): the centre's per-axis error per unit of point
 //!    noise. `w_geom = (2/3)/γ²`, which is 1 for the best possible triple (equilateral) and
 //!    falls to 0 as the points close up or line up. Triples with `γ >`
 //!    [`MeritCircleConfig::max_amplification`] are not used at all.
@@ -52,7 +52,7 @@
 //! the previous one until the last step, and equals `solve` of the state the refresh
 //! started from bit for bit). `progress().ready` runs the acceptance tests of `solve`
 //! (centres, field, arc) on the same data, so the two always agree. The whole learned state,
-//! configuration included, is saved and restored through [`Persistent`].
+//! configuration included, is saved and restored through [`Persistent`](truenorth_core::Persistent).
 
 extern crate alloc;
 
