@@ -311,10 +311,17 @@ pub(crate) fn normal_equations(
     if !defined {
         return Ok(None);
     }
-    let Some((NormalEquations { cost, jtj, jtr }, sums)) = groups.finish() else {
+    let Some((
+        NormalEquations {
+            mut cost,
+            mut jtj,
+            mut jtr,
+        },
+        mut sums,
+    )) = groups.finish()
+    else {
         return Ok(None);
     };
-    let (mut jtj, mut jtr, mut cost, mut sums) = (jtj, jtr, cost, sums);
     if runs.is_empty() {
         // No run: the pointing axis is x. A stiff prior keeps the normal equations regular.
         for k in [PT, PT + 1] {
