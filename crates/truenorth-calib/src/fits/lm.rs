@@ -79,6 +79,15 @@ impl<const P: usize, const K: usize> NormalAccumulator<P, K> {
         }
     }
 
+    /// Adds the sums of `later`, the accumulator of the residuals that follow these.
+    pub fn merge(&mut self, later: &Self) {
+        for a in 0..K {
+            for b in a..K {
+                self.sums[a][b] += later.sums[a][b];
+            }
+        }
+    }
+
     /// The normal equations, or `None` if anything overflowed.
     pub fn finish(&self) -> Option<NormalEquations<P>> {
         let mut jtj = SMatrix::<f64, P, P>::zeros();

@@ -10,4 +10,4 @@ pub mod mag_accel;
 pub(crate) mod normalise;
 pub mod readings;
 #[cfg(test)]
-mod readings_tests;
+pub(crate) mod readings_tests;

@@ -17,6 +17,7 @@ use nalgebra::SVector;
 use truenorth_core::{Error, Result, check_finite};
 
 use crate::fits::readings::{Readings, replay_points};
+use crate::numerics::segments::{RunFold, fold};
 
 #[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
@@ -109,24 +110,35 @@ impl<const D: usize> Normaliser<D> {
 /// the result differs by rounding error only (Higham 2002, *Accuracy and Stability of
 /// Numerical Algorithms*, §4.2). The partial sums carry over from one run of the replay to
 /// the next, whose lengths are multiples of four (see [`Readings::replay`]), so a point goes
-/// to the same partial sum however the readings are cut into runs.
+/// to the same partial sum however the readings are cut into runs; segment by segment (see
+/// `fold`), whose partial sums merge lane by lane.
 #[inline]
 fn lane_sum<const D: usize, const E: usize, R: Readings<D> + ?Sized>(
     points: &R,
-    f: impl Fn(&SVector<f64, D>) -> SVector<f64, E>,
+    f: impl Fn(&SVector<f64, D>) -> SVector<f64, E> + Sync,
 ) -> Result<SVector<f64, E>> {
-    let mut s = [SVector::<f64, E>::zeros(); 4];
-    points.replay(&mut |run| {
-        let mut chunks = run.chunks_exact(4);
-        for c in &mut chunks {
-            for (sl, p) in s.iter_mut().zip(c) {
-                *sl += f(p);
-            }
-        }
-        for (sl, p) in s.iter_mut().zip(chunks.remainder()) {
-            *sl += f(p);
-        }
-    })?;
+    let s = fold(
+        points,
+        &RunFold {
+            start: || [SVector::<f64, E>::zeros(); 4],
+            add: |s: &mut [SVector<f64, E>; 4], run: &[SVector<f64, D>]| {
+                let mut chunks = run.chunks_exact(4);
+                for c in &mut chunks {
+                    for (sl, p) in s.iter_mut().zip(c) {
+                        *sl += f(p);
+                    }
+                }
+                for (sl, p) in s.iter_mut().zip(chunks.remainder()) {
+                    *sl += f(p);
+                }
+            },
+            merge: |s: &mut [SVector<f64, E>; 4], later: [SVector<f64, E>; 4]| {
+                for (a, b) in s.iter_mut().zip(later) {
+                    *a += b;
+                }
+            },
+        },
+    )?;
     Ok((s[0] + s[2]) + (s[1] + s[3]))
 }
 

@@ -47,6 +47,46 @@ pub trait Readings<const D: usize> {
     /// [`Error::ReadingsUnavailable`](truenorth_core::Error::ReadingsUnavailable)). A replay that failed may have called `run`
     /// with only part of the readings; a fit that sees the error returns it.
     fn replay(&self, run: &mut dyn FnMut(&[SVector<f64, D>])) -> Result<()>;
+
+    /// Calls `run` with the readings `start..end`, in order, in consecutive runs as
+    /// [`Self::replay`] does (every run but the last a multiple of
+    /// [`READINGS_RUN_MULTIPLE`] long). `start` is a multiple of [`READINGS_RUN_MULTIPLE`]
+    /// and `end` at most [`Self::len`]; an empty range calls nothing.
+    ///
+    /// The default replays every reading and hands on those in the range; a store that
+    /// can seek overrides it.
+    ///
+    /// # Errors
+    /// As [`Self::replay`].
+    fn replay_range(
+        &self,
+        start: usize,
+        end: usize,
+        run: &mut dyn FnMut(&[SVector<f64, D>]),
+    ) -> Result<()> {
+        let mut at = 0usize;
+        self.replay(&mut |r| {
+            let (lo, hi) = (start.max(at), end.min(at + r.len()));
+            if lo < hi {
+                run(&r[lo - at..hi - at]);
+            }
+            at += r.len();
+        })
+    }
+
+    /// The readings as one slice, when they are kept in one: the fits then cut it among
+    /// threads without a replay. `None` (the default) otherwise.
+    fn in_memory(&self) -> Option<&[SVector<f64, D>]> {
+        None
+    }
+
+    /// The readings as readings that several threads may replay ranges of at once
+    /// ([`Self::replay_range`]), when the store allows it. `None` (the default) keeps every
+    /// pass of a fit on one thread; the result is the same either way (see the
+    /// `numerics::segments` module).
+    fn shared(&self) -> Option<&(dyn Readings<D> + Sync)> {
+        None
+    }
 }
 
 impl<const D: usize> Readings<D> for [SVector<f64, D>] {
@@ -60,6 +100,23 @@ impl<const D: usize> Readings<D> for [SVector<f64, D>] {
         }
         Ok(())
     }
+
+    fn replay_range(
+        &self,
+        start: usize,
+        end: usize,
+        run: &mut dyn FnMut(&[SVector<f64, D>]),
+    ) -> Result<()> {
+        let end = end.min(<[SVector<f64, D>]>::len(self));
+        if start < end {
+            run(&self[start..end]);
+        }
+        Ok(())
+    }
+
+    fn in_memory(&self) -> Option<&[SVector<f64, D>]> {
+        Some(self)
+    }
 }
 
 impl<const D: usize> Readings<D> for Vec<SVector<f64, D>> {
@@ -69,6 +126,19 @@ impl<const D: usize> Readings<D> for Vec<SVector<f64, D>> {
 
     fn replay(&self, run: &mut dyn FnMut(&[SVector<f64, D>])) -> Result<()> {
         self.as_slice().replay(run)
+    }
+
+    fn replay_range(
+        &self,
+        start: usize,
+        end: usize,
+        run: &mut dyn FnMut(&[SVector<f64, D>]),
+    ) -> Result<()> {
+        self.as_slice().replay_range(start, end, run)
+    }
+
+    fn in_memory(&self) -> Option<&[SVector<f64, D>]> {
+        Some(self.as_slice())
     }
 }
 

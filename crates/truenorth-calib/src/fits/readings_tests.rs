@@ -1,7 +1,7 @@
 //! The fits through readings cut into runs give the fits of one slice, bit for bit; a
 //! replay that fails fails the fit with its own error.
 
-use core::cell::Cell;
+use core::sync::atomic::{AtomicUsize, Ordering};
 
 use nalgebra::{Matrix2, Matrix3, SVector, Vector2, Vector3};
 use proptest::prelude::*;
@@ -15,12 +15,23 @@ use crate::fits::readings::{READINGS_RUN_MULTIPLE, ReadingStore, Readings};
 
 /// Readings replayed in runs of the given numbers of [`READINGS_RUN_MULTIPLE`] (cycled),
 /// failing on replay number `fail_at` (counting from 0) after its first run, if given.
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Default)]
 pub(crate) struct Cut<const D: usize> {
     pub points: Vec<SVector<f64, D>>,
     pub runs: Vec<usize>,
     pub fail_at: Option<usize>,
-    pub replays: Cell<usize>,
+    pub replays: AtomicUsize,
+}
+
+impl<const D: usize> Clone for Cut<D> {
+    fn clone(&self) -> Self {
+        Self {
+            points: self.points.clone(),
+            runs: self.runs.clone(),
+            fail_at: self.fail_at,
+            replays: AtomicUsize::new(self.replays.load(Ordering::Relaxed)),
+        }
+    }
 }
 
 /// The error a failing [`Cut`] gives.
@@ -34,8 +45,7 @@ impl<const D: usize> Readings<D> for Cut<D> {
     }
 
     fn replay(&self, run: &mut dyn FnMut(&[SVector<f64, D>])) -> Result<()> {
-        let k = self.replays.get();
-        self.replays.set(k + 1);
+        let k = self.replays.fetch_add(1, Ordering::Relaxed);
         let mut rest = self.points.as_slice();
         for &blocks in self.runs.iter().cycle() {
             if rest.is_empty() {
@@ -155,7 +165,7 @@ proptest! {
         let cut = Cut { points: points.clone(), runs: runs.clone(), ..Cut::default() };
         let config = EllipseConfig::default();
         let _ = fit_ellipse_readings(&cut, &config);
-        let passes = cut.replays.get();
+        let passes = cut.replays.load(Ordering::Relaxed);
         let failing = Cut { points, runs, fail_at: Some(fail_at), ..Cut::default() };
         let got = fit_ellipse_readings(&failing, &config);
         if fail_at < passes {
@@ -166,7 +176,7 @@ proptest! {
         let cut = Cut { points: points.clone(), runs: vec![1, 2], ..Cut::default() };
         let config = EllipsoidConfig::default();
         let _ = fit_ellipsoid_readings(&cut, &config);
-        let passes = cut.replays.get();
+        let passes = cut.replays.load(Ordering::Relaxed);
         let failing = Cut { points, runs: vec![1, 2], fail_at: Some(fail_at), ..Cut::default() };
         let got = fit_ellipsoid_readings(&failing, &config);
         if fail_at < passes {

@@ -1,8 +1,9 @@
 //! Shared mathematics of the calibrators: small dense linear algebra, blocked sums over
-//! the readings, the circle through three points, and a bounded sample of readings spread
+//! the readings and their segments (folded on several threads), the circle through three points, and a bounded sample of readings spread
 //! by direction.
 
 pub(crate) mod blocks;
 pub mod circumcentre;
 pub(crate) mod direction_slots;
 pub(crate) mod linalg;
+pub(crate) mod segments;

@@ -9,7 +9,8 @@ use truenorth_compass::CompassCalibration2d;
 use super::direction_bins::{bin_if_clear, coarse_fixed, fine_bin, fine_bin_exact, fine_bin_xy};
 use super::support::{GAP_BINS, Support2d};
 use crate::fits::readings::{Readings, replay_points};
-use crate::numerics::blocks::{BLOCK, blocks, replay_blocks};
+use crate::numerics::blocks::{BLOCK, blocks};
+use crate::numerics::segments::{BlockFold, fold};
 use truenorth_core::Result;
 
 /// Number of heading bins used for coverage (10° each).
@@ -45,6 +46,13 @@ impl AngleBins {
     pub(super) fn new() -> Self {
         Self {
             fine: [false; GAP_BINS],
+        }
+    }
+
+    /// Adds the directions marked in `later`.
+    pub(super) fn merge(&mut self, later: &Self) {
+        for (a, b) in self.fine.iter_mut().zip(&later.fine) {
+            *a |= *b;
         }
     }
 
@@ -144,10 +152,16 @@ pub(crate) fn calibrated_directions_2d<R: Readings<2> + ?Sized>(
     readings: &R,
     cal: &CompassCalibration2d,
 ) -> Result<(Coverage, Support2d)> {
-    let mut bins = AngleBins::new();
-    replay_blocks(readings, |p, len| {
-        mark_calibrated_block(&mut bins, p, len, cal)
-    })?;
+    let bins = fold(
+        readings,
+        &BlockFold {
+            start: AngleBins::new,
+            add: |bins: &mut AngleBins, p: &[[f64; BLOCK]; 2], len| {
+                mark_calibrated_block(bins, p, len, cal);
+            },
+            merge: |bins: &mut AngleBins, later| bins.merge(&later),
+        },
+    )?;
     Ok((bins.coverage(), bins.support()))
 }
 

@@ -18,6 +18,7 @@ use super::uncertainty::bound_and_uncertainty;
 use crate::fits::readings::Readings;
 use crate::numerics::blocks::{BLOCK, blocks, dot_block, replay_blocks, sum_block};
 use crate::numerics::linalg::{condition_from_eigenvalues, sym_eigen5, sym_eigen9};
+use crate::numerics::segments::{BlockFold, add_sums, fold};
 use crate::quality::SPHERE_CELLS;
 use truenorth_core::Result;
 
@@ -301,6 +302,28 @@ fn count_cells(
     }
 }
 
+/// The kept readings of `points` in each equal-area cell under `cal` ([`count_cells`]),
+/// segment by segment (see `fold`).
+fn cell_counts<R: Readings<3> + ?Sized>(
+    points: &R,
+    cal: &CompassCalibration3d,
+) -> Result<[u32; SPHERE_CELLS]> {
+    fold(
+        points,
+        &BlockFold {
+            start: || [0u32; SPHERE_CELLS],
+            add: |in_cell: &mut [u32; SPHERE_CELLS], p: &[[f64; BLOCK]; 3], len| {
+                count_cells(in_cell, p, len, cal);
+            },
+            merge: |in_cell: &mut [u32; SPHERE_CELLS], later: [u32; SPHERE_CELLS]| {
+                for (a, b) in in_cell.iter_mut().zip(later) {
+                    *a += b;
+                }
+            },
+        },
+    )
+}
+
 /// One over the number of kept readings in each equal-area cell (0 for an empty cell), from
 /// the counts of [`count_cells`]: the weights of the support.
 fn cell_weights(in_cell: &[u32; SPHERE_CELLS]) -> [f64; SPHERE_CELLS] {
@@ -322,8 +345,7 @@ pub(crate) fn support_dilution_3d<R: Readings<3> + ?Sized>(
     points: &R,
     cal: &CompassCalibration3d,
 ) -> Result<f64> {
-    let mut in_cell = [0u32; SPHERE_CELLS];
-    replay_blocks(points, |p, len| count_cells(&mut in_cell, p, len, cal))?;
+    let in_cell = cell_counts(points, cal)?;
     let weight = cell_weights(&in_cell);
     let mut sums = [0.0; MONOMIALS_3D];
     let plan = monomial_plan_3d();
@@ -456,10 +478,16 @@ pub(crate) fn assess_3d_with_harmonics_of<R: Readings<3> + ?Sized>(
     cal: &CompassCalibration3d,
     field: f64,
 ) -> Result<(CompassQuality, Option<(f64, f64)>)> {
-    let mut in_cell = [0u32; SPHERE_CELLS];
-    replay_blocks(points, |p, len| count_cells(&mut in_cell, p, len, cal))?;
-    let mut sums = Sums3d::new(cell_weights(&in_cell), field);
-    replay_blocks(points, |p, len| sums.add_block(p, len, cal))?;
+    let in_cell = cell_counts(points, cal)?;
+    let weight = cell_weights(&in_cell);
+    let sums = fold(
+        points,
+        &BlockFold {
+            start: || Sums3d::new(weight, field),
+            add: |sums: &mut Sums3d, p: &[[f64; BLOCK]; 3], len| sums.add_block(p, len, cal),
+            merge: |sums: &mut Sums3d, later| sums.merge(&later),
+        },
+    )?;
     let harmonics = sums.direction_harmonics();
     Ok((sums.report(field), harmonics))
 }
@@ -498,6 +526,16 @@ impl Sums3d {
             weighted: [[0.0; BLOCK]; 9],
             r2: [0.0; BLOCK],
         }
+    }
+
+    /// Adds the sums of `later`, the sums of the readings that follow these (with the same
+    /// weights and field).
+    fn merge(&mut self, later: &Self) {
+        add_sums(&mut self.sums, later.sums);
+        add_sums(&mut self.support_sums, later.support_sums);
+        add_sums(&mut self.moments, later.moments);
+        self.ss += later.ss;
+        self.n += later.n;
     }
 
     /// Adds a block (see `crate::numerics::blocks::BLOCK`): first every point's direction,

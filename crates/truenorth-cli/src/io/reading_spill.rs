@@ -17,12 +17,11 @@
 //! in place of the library's error, which the store hands the fit to stop it
 //! ([`truenorth::core::Error::ReadingsUnavailable`]) and which cannot carry the I/O error's text.
 
-use std::cell::RefCell;
 use std::fs::{File, OpenOptions};
 use std::io::{self, Write};
 use std::path::PathBuf;
-use std::rc::Rc;
 use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::{Arc, Mutex, PoisonError};
 
 use nalgebra::SVector;
 use truenorth::calib::{READINGS_RUN_MULTIPLE, ReadingStore, Readings};
@@ -53,7 +52,7 @@ const STOPPED: Error = Error::ReadingsUnavailable {
 pub struct ReadingSpill {
     dir: PathBuf,
     memory_bytes: usize,
-    failure: Rc<RefCell<Option<String>>>,
+    failure: Arc<Mutex<Option<String>>>,
 }
 
 impl ReadingSpill {
@@ -72,7 +71,7 @@ impl ReadingSpill {
         Self {
             dir,
             memory_bytes,
-            failure: Rc::new(RefCell::new(None)),
+            failure: Arc::new(Mutex::new(None)),
         }
     }
 
@@ -87,20 +86,24 @@ impl ReadingSpill {
             file: None,
             on_disk: 0,
             pending: Vec::new(),
-            bytes: RefCell::new(Vec::new()),
-            chunk: RefCell::new(Vec::new()),
+            bytes: Vec::new(),
+            read_buffers: Mutex::new(Vec::new()),
         }
     }
 
     /// The first failure of a store, as the command's error line (taken: a second call
     /// gives `None`).
     pub fn take_failure(&self) -> Option<CliError> {
-        self.failure.borrow_mut().take().map(CliError::msg)
+        self.failure
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner)
+            .take()
+            .map(CliError::msg)
     }
 
     /// Keeps the first failure, `doing` what on which error.
     fn fail(&self, doing: &str, e: &io::Error) -> Error {
-        let mut failure = self.failure.borrow_mut();
+        let mut failure = self.failure.lock().unwrap_or_else(PoisonError::into_inner);
         if failure.is_none() {
             *failure = Some(format!(
                 "cannot {doing} the readings kept for the fit in a temporary file in {}: {e}; set TMPDIR to a directory on a disk with room",
@@ -126,11 +129,16 @@ pub struct SpillStore<const D: usize> {
     on_disk: usize,
     /// Readings after the memory share not yet written (less than a chunk).
     pending: Vec<SVector<f64, D>>,
-    /// The bytes of one chunk, written or read.
-    bytes: RefCell<Vec<u8>>,
-    /// One chunk read back.
-    chunk: RefCell<Vec<SVector<f64, D>>>,
+    /// The bytes of the chunk being written.
+    bytes: Vec<u8>,
+    /// Buffers to read chunks back through, kept between replays (a fresh chunk-sized
+    /// buffer would be fresh pages from the system for every range every pass); one per
+    /// replay running at once.
+    read_buffers: Mutex<Vec<ReadBuffers<D>>>,
 }
+
+/// The bytes of a chunk read back, and the chunk's readings.
+type ReadBuffers<const D: usize> = (Vec<u8>, Vec<SVector<f64, D>>);
 
 impl<const D: usize> SpillStore<D> {
     /// Whether the readings went beyond memory.
@@ -144,28 +152,33 @@ impl<const D: usize> SpillStore<D> {
             Some(f) => f,
             None => self.file.insert(anonymous_file(&self.spill.dir)?),
         };
-        let mut bytes = self.bytes.borrow_mut();
-        bytes.clear();
+        self.bytes.clear();
         for p in &self.pending {
             for x in p.iter() {
-                bytes.extend_from_slice(&x.to_le_bytes());
+                self.bytes.extend_from_slice(&x.to_le_bytes());
             }
         }
-        file.write_all(&bytes)?;
+        file.write_all(&self.bytes)?;
         self.on_disk += self.pending.len();
         self.pending.clear();
         Ok(())
     }
 
-    /// Reads back chunk `k` of the file into `chunk`.
-    fn read_chunk(&self, k: usize, chunk: &mut Vec<SVector<f64, D>>) -> io::Result<()> {
+    /// Reads back the readings `from..to` of the file (within one chunk) into `chunk`,
+    /// through `bytes`.
+    fn read_back(
+        &self,
+        from: usize,
+        to: usize,
+        bytes: &mut Vec<u8>,
+        chunk: &mut Vec<SVector<f64, D>>,
+    ) -> io::Result<()> {
         let Some(file) = &self.file else {
             return Err(io::Error::other("the temporary file is missing"));
         };
         let per_reading = D * size_of::<f64>();
-        let mut bytes = self.bytes.borrow_mut();
-        bytes.resize(CHUNK_READINGS * per_reading, 0);
-        read_exact_at(file, &mut bytes, (k * CHUNK_READINGS * per_reading) as u64)?;
+        bytes.resize((to - from) * per_reading, 0);
+        read_exact_at(file, bytes, (from * per_reading) as u64)?;
         chunk.clear();
         for r in bytes.chunks_exact(per_reading) {
             chunk.push(SVector::from_fn(|d, _| {
@@ -184,19 +197,58 @@ impl<const D: usize> Readings<D> for SpillStore<D> {
     }
 
     fn replay(&self, run: &mut dyn FnMut(&[SVector<f64, D>])) -> Result<()> {
-        if !self.memory.is_empty() {
-            run(&self.memory);
+        self.replay_range(0, Readings::len(self), run)
+    }
+
+    /// The readings `start..end` from memory, the file and the pending chunk, in runs cut
+    /// where those meet and at the file's chunks, each but the last a multiple of
+    /// [`READINGS_RUN_MULTIPLE`] (`start`, the memory share and the chunks are). Each call
+    /// reads through buffers of its own, so threads may replay ranges at once.
+    fn replay_range(
+        &self,
+        start: usize,
+        end: usize,
+        run: &mut dyn FnMut(&[SVector<f64, D>]),
+    ) -> Result<()> {
+        let end = end.min(Readings::len(self));
+        let (memory, disk_end) = (self.memory.len(), self.memory.len() + self.on_disk);
+        if start < end.min(memory) {
+            run(&self.memory[start..end.min(memory)]);
         }
-        let mut chunk = self.chunk.borrow_mut();
-        for k in 0..self.on_disk / CHUNK_READINGS {
-            self.read_chunk(k, &mut chunk)
-                .map_err(|e| self.spill.fail("read back", &e))?;
-            run(&chunk);
+        let (mut at, to) = (start.max(memory), end.min(disk_end));
+        if at < to {
+            let mut pool = self
+                .read_buffers
+                .lock()
+                .unwrap_or_else(PoisonError::into_inner);
+            let (mut bytes, mut chunk) = pool.pop().unwrap_or_default();
+            drop(pool);
+            while at < to {
+                // Up to the end of the chunk `at` is in, or of the range.
+                let from = at - memory;
+                let next = (from / CHUNK_READINGS + 1) * CHUNK_READINGS;
+                let upto = (to - memory).min(next);
+                let read = self.read_back(from, upto, &mut bytes, &mut chunk);
+                if let Err(e) = read {
+                    return Err(self.spill.fail("read back", &e));
+                }
+                run(&chunk);
+                at = memory + upto;
+            }
+            self.read_buffers
+                .lock()
+                .unwrap_or_else(PoisonError::into_inner)
+                .push((bytes, chunk));
         }
-        if !self.pending.is_empty() {
-            run(&self.pending);
+        let at = start.max(disk_end);
+        if at < end {
+            run(&self.pending[at - disk_end..end - disk_end]);
         }
         Ok(())
+    }
+
+    fn shared(&self) -> Option<&(dyn Readings<D> + Sync)> {
+        Some(self)
     }
 }
 
@@ -229,6 +281,10 @@ impl<const D: usize> ReadingStore<D> for SpillStore<D> {
         // A new file for the next readings; this one goes with its handle.
         self.file = None;
         self.on_disk = 0;
+        self.read_buffers
+            .get_mut()
+            .unwrap_or_else(PoisonError::into_inner)
+            .clear();
     }
 }
 
@@ -297,6 +353,40 @@ mod tests {
 
     proptest! {
         #![proptest_config(ProptestConfig::with_cases(32))]
+
+        /// Any range of readings comes back, in order, in runs that are multiples of the
+        /// run length but the last, whether it starts or ends in memory, in the file or in
+        /// the pending chunk; and the store offers itself to threads.
+        #[test]
+        fn replays_any_range(
+            n in 0usize..100_000,
+            memory in prop_oneof![0usize..2_000, 0usize..200_000],
+            start in 0usize..4_000,
+            len in 0usize..100_000,
+        ) {
+            let spill = ReadingSpill::new(std::env::temp_dir(), memory);
+            let mut store = spill.store::<2>();
+            for k in 0..n {
+                store.push(SVector::<f64, 2>::new(k as f64, -(k as f64))).unwrap();
+            }
+            prop_assert!(store.shared().is_some());
+            let start = (start * READINGS_RUN_MULTIPLE).min(n - n % READINGS_RUN_MULTIPLE);
+            let end = (start + len).min(n);
+            let mut next = start;
+            let mut last_short = false;
+            store
+                .replay_range(start, end, &mut |run| {
+                    assert!(!last_short, "a short run before the last");
+                    assert!(!run.is_empty(), "an empty run");
+                    last_short = run.len() % READINGS_RUN_MULTIPLE != 0;
+                    for p in run {
+                        assert_eq!(p.x, next as f64);
+                        next += 1;
+                    }
+                })
+                .unwrap();
+            prop_assert_eq!(next, end.max(start));
+        }
 
         /// Every reading comes back, in order, in runs that are multiples of the run
         /// length but the last, whatever the memory share.

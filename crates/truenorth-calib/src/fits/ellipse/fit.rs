@@ -51,8 +51,9 @@ use truenorth_core::{Error, Result, Solution, Validate};
 use crate::fits::lm::{self, NormalAccumulator, NormalEquations};
 use crate::fits::normalise::Normaliser;
 use crate::fits::readings::{Readings, replay_points};
-use crate::numerics::blocks::{BLOCK, replay_blocks};
+use crate::numerics::blocks::BLOCK;
 use crate::numerics::linalg::{sym_eigen2, sym_sqrt2};
+use crate::numerics::segments::{BlockFold, fold};
 use crate::quality::{self, Assessment2d, BOUND_SIGMAS, Moments2};
 
 use crate::fits::ellipse::config::EllipseConfig;
@@ -99,10 +100,9 @@ fn sampson_normal_equations_of<R: Readings<2> + ?Sized>(
     let (a11, a12, a22) = (a[(0, 0)], a[(0, 1)], a[(1, 1)]);
     let (mx, my) = (norm.centre.x, norm.centre.y);
     let inv = 1.0 / norm.scale;
-    let mut acc = NormalAccumulator::<5, 6>::new();
     // A block of points at a time (see `BLOCK`): first every point's gradient row and
-    // residual, then the sums.
-    replay_blocks(points, |[qx, qy], len| {
+    // residual, then the sums; segment by segment (see `fold`).
+    let add = |acc: &mut NormalAccumulator<5, 6>, [qx, qy]: &[[f64; BLOCK]; 2], len: usize| {
         let [j0, j1, j2, j3, j4, res] = &mut acc.cols;
         for i in 0..BLOCK {
             let vx = (qx[i] - mx) * inv - cx;
@@ -128,7 +128,15 @@ fn sampson_normal_equations_of<R: Readings<2> + ?Sized>(
             res[i] = if keep { r } else { 0.0 };
         }
         acc.add_block();
-    })?;
+    };
+    let acc = fold(
+        points,
+        &BlockFold {
+            start: NormalAccumulator::<5, 6>::new,
+            add,
+            merge: |acc: &mut NormalAccumulator<5, 6>, later| acc.merge(&later),
+        },
+    )?;
     Ok(acc
         .finish()
         .and_then(|ne| ne.reparametrised(&square_jacobian(&b))))

@@ -9,8 +9,9 @@ use truenorth_core::{Error, Result};
 
 use crate::fits::normalise::Normaliser;
 use crate::fits::readings::Readings;
-use crate::numerics::blocks::{BLOCK, dot_block, replay_blocks};
+use crate::numerics::blocks::{BLOCK, dot_block};
 use crate::numerics::linalg::{constrained_min6, sym_eigen3, sym_eigen6, sym_sqrt3};
+use crate::numerics::segments::{BlockFold, add_sums, fold};
 
 use crate::fits::ellipsoid::config::MIN_POINTS_3D;
 #[cfg(not(feature = "std"))]
@@ -136,11 +137,12 @@ pub(crate) fn moments<R: Readings<3> + ?Sized>(
     // at a time (see `BLOCK`), and multiply the factors in afterwards (exactly: they are
     // powers of 2).
     let (exps, pairs) = moment_pairs();
-    let mut sums = [0.0; 35];
     let inv = 1.0 / norm.scale;
     let c = norm.centre;
-    let mut t = [[0.0; BLOCK]; 10];
-    replay_blocks(points, |[x, y, z], len| {
+    // Segment by segment (see `fold`); each accumulator carries its block of monomials.
+    let add = |(sums, t): &mut ([f64; 35], [[f64; BLOCK]; 10]),
+               [x, y, z]: &[[f64; BLOCK]; 3],
+               len: usize| {
         for i in 0..BLOCK {
             // Rows past the end of the data are zeros, which add nothing.
             let live = i < len;
@@ -166,7 +168,17 @@ pub(crate) fn moments<R: Readings<3> + ?Sized>(
         for (sk, &(a, b)) in sums.iter_mut().zip(&pairs) {
             *sk += dot_block(&t[a], &t[b]);
         }
-    })?;
+    };
+    let (sums, _) = fold(
+        points,
+        &BlockFold {
+            start: || ([0.0; 35], [[0.0; BLOCK]; 10]),
+            add,
+            merge: |(sums, _): &mut ([f64; 35], [[f64; BLOCK]; 10]), (later, _)| {
+                add_sums(sums, later);
+            },
+        },
+    )?;
     let mut s = SMatrix::<f64, 10, 10>::zeros();
     for a in 0..TERMS.len() {
         for b in a..TERMS.len() {

@@ -42,8 +42,9 @@ use truenorth_core::{Error, Result, Solution, Validate};
 use crate::fits::lm::{self, NormalAccumulator, NormalEquations};
 use crate::fits::normalise::Normaliser;
 use crate::fits::readings::{Readings, replay_points};
-use crate::numerics::blocks::{BLOCK, replay_blocks};
+use crate::numerics::blocks::BLOCK;
 use crate::numerics::linalg::{sym_eigen3, sym_sqrt3};
+use crate::numerics::segments::{BlockFold, fold};
 use crate::quality::{self, CompassUncertainty};
 
 use crate::fits::ellipsoid::config::EllipsoidConfig;
@@ -92,10 +93,9 @@ fn radial_normal_equations_of<R: Readings<3> + ?Sized>(
     let a = (a + a.transpose()) * 0.5;
     let mu = norm.centre;
     let inv = 1.0 / norm.scale;
-    let mut acc = NormalAccumulator::<9, 10>::new();
     // A block of points at a time (see `BLOCK`): first every point's gradient row and
-    // residual, then the sums.
-    replay_blocks(points, |[qx, qy, qz], len| {
+    // residual, then the sums; segment by segment (see `fold`).
+    let add = |acc: &mut NormalAccumulator<9, 10>, [qx, qy, qz]: &[[f64; BLOCK]; 3], len: usize| {
         let cols = &mut acc.cols;
         for i in 0..BLOCK {
             let v = [
@@ -124,7 +124,15 @@ fn radial_normal_equations_of<R: Readings<3> + ?Sized>(
             cols[9][i] = if keep { rho - 1.0 } else { 0.0 };
         }
         acc.add_block();
-    })?;
+    };
+    let acc = fold(
+        points,
+        &BlockFold {
+            start: NormalAccumulator::<9, 10>::new,
+            add,
+            merge: |acc: &mut NormalAccumulator<9, 10>, later| acc.merge(&later),
+        },
+    )?;
     Ok(acc
         .finish()
         .and_then(|ne| ne.reparametrised(&square_jacobian(&b))))

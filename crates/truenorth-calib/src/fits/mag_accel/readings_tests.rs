@@ -116,7 +116,7 @@ proptest! {
         let limits = Limits { run_shots: kept, stretch_frames: kept };
         let store = cut(&samples, runs);
         let _ = fit_mag_accel_within(&store, &config, limits);
-        let passes = store.replays.get();
+        let passes = store.replays.load(core::sync::atomic::Ordering::Relaxed);
         let failing = Cut { fail_at: Some((at * passes as f64) as usize), ..cut(&samples, store.runs.clone()) };
         prop_assert_eq!(fit_mag_accel_within(&failing, &config, limits), Err(FAILED));
     }
