@@ -394,7 +394,8 @@ proptest! {
             let refused = matches!(
                 r,
                 Err(Error::InsufficientCoverage { .. } | Error::IncompleteTurn { .. }
-                    | Error::TooFewPoints { .. } | Error::Degenerate { .. } | Error::NotAnEllipse { .. })
+                    | Error::TooFewPoints { .. } | Error::TooFewBins { .. } | Error::Degenerate { .. }
+                    | Error::NotAnEllipse { .. })
             );
             prop_assert!(refused, "method {} accepted a {}° arc: {:?}", i, span, r);
         }

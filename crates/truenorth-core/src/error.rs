@@ -114,6 +114,19 @@ pub enum Error {
         /// Samples required.
         need: usize,
     },
+    /// The readings fill too few of a binned calibrator's direction bins: a count of the
+    /// headings seen, not of the readings, so more readings at the same headings do not help.
+    #[error(
+        "the readings fill only {filled} of the {bins} direction bins, need at least {need}; turn through more headings (a full circle is best) before solving"
+    )]
+    TooFewBins {
+        /// Direction bins holding a reading.
+        filled: usize,
+        /// Direction bins required.
+        need: usize,
+        /// Direction bins in all (each covers `360° / bins` of direction).
+        bins: usize,
+    },
     /// The samples cover too little of a turn to determine a calibration.
     #[error(
         "the samples cover only {}° of heading{}, need at least {}°; turn further (a full circle is best) before solving",
@@ -462,6 +475,15 @@ mod tests {
         assert_eq!(
             e.to_string(),
             "the samples cover only 187° of heading, need at least 200°; turn further (a full circle is best) before solving"
+        );
+        let e = Error::TooFewBins {
+            filled: 15,
+            need: 16,
+            bins: 64,
+        };
+        assert_eq!(
+            e.to_string(),
+            "the readings fill only 15 of the 64 direction bins, need at least 16; turn through more headings (a full circle is best) before solving"
         );
         let e = Error::TooNoisyForOrientations {
             noise_rel: 0.012,

@@ -25,12 +25,13 @@ impl Error {
     /// ```
     pub fn is_refusal(&self) -> bool {
         match self {
-            // The data: too few, too little of a turn or of the sphere, orientations or
-            // noise that leave the calibration undetermined or uncertain, geometry that
-            // determines nothing, a gap longer than a method bridges, a locus that is no
-            // ellipse, a fit the data do not let converge, a result asked for before the
-            // data it needs.
+            // The data: too few, too few headings, too little of a turn or of the sphere,
+            // orientations or noise that leave the calibration undetermined or uncertain,
+            // geometry that determines nothing, a gap longer than a method bridges, a locus
+            // that is no ellipse, a fit the data do not let converge, a result asked for
+            // before the data it needs.
             Error::TooFewPoints { .. }
+            | Error::TooFewBins { .. }
             | Error::InsufficientCoverage { .. }
             | Error::InsufficientSphereCoverage { .. }
             | Error::IncompleteTurn { .. }
@@ -68,6 +69,11 @@ mod tests {
     fn the_data_are_refused_and_bad_input_fails() {
         let refusals = [
             Error::TooFewPoints { got: 3, need: 10 },
+            Error::TooFewBins {
+                filled: 15,
+                need: 16,
+                bins: 64,
+            },
             Error::InsufficientCoverage {
                 covered_deg: 90.0,
                 noise_deg: 0.0,

@@ -28,7 +28,7 @@ use crate::online::conic::{
     ConicRefresh, RefreshBase, bound_deg, noise_factor, refuse_fit, report,
 };
 use crate::online::ellipse_config::OnlineEllipseConfig;
-use crate::quality::direct_fit_bias_rad;
+use crate::quality::{anisotropy_2d, direct_fit_bias_rad};
 
 #[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
@@ -379,8 +379,7 @@ impl Refresh {
         let c = su.column(5);
         let h1 = c[3].hypot(c[4]) / c[5];
         let h2 = (c[0] - c[2]).hypot(2.0 * c[1]) / c[5];
-        let kappa = sym_eigen2(&(e.unit_map * e.unit_map))
-            .map_or(1.0, |(l, _)| ((l[0] - l[1]) / (l[0] + l[1])).abs());
+        let kappa = anisotropy_2d(&(e.unit_map * e.unit_map)).unwrap_or(1.0);
         self.bias_rad = direct_fit_bias_rad(self.sigma, kappa, h1, h2);
     }
 

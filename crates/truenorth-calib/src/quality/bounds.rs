@@ -47,7 +47,9 @@
 
 use core::f64::consts::TAU;
 
-use nalgebra::{SMatrix, SVector, Vector3};
+use nalgebra::{Matrix2, Matrix3, SMatrix, SVector, Vector3};
+
+use crate::numerics::linalg::{sym_eigen2, sym_eigen3};
 
 #[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
@@ -369,7 +371,8 @@ fn t_factor(dof: f64) -> f64 {
 /// A bound on the heading (3-D: field-direction) error, radians, that the second-order bias
 /// of the direct (algebraic) fit leaves, which no number of readings removes:
 /// `4σ²(κ + h₁ + h₂)`, with `σ` the per-reading noise (relative), `κ = (λ₁ − λ₂)/(λ₁ + λ₂)`
-/// the anisotropy of `B²` (largest and smallest eigenvalues), and `h₁`, `h₂` the first and
+/// the anisotropy of `B²` (largest and smallest eigenvalues: [`anisotropy_2d`],
+/// [`anisotropy_3d`]), and `h₁`, `h₂` the first and
 /// second harmonics of the calibrated directions (1 each for readings all in one direction,
 /// 0 for an even spread). The derivation is at the batch ellipse's
 /// `refinement_could_matter`: isotropic sensor noise is anisotropic in the calibrated frame,
@@ -381,4 +384,26 @@ fn t_factor(dof: f64) -> f64 {
 pub(crate) fn direct_fit_bias_rad(sigma: f64, kappa: f64, h1: f64, h2: f64) -> f64 {
     let b = 4.0 * sigma * sigma * (kappa + h1 + h2);
     if b.is_finite() { b } else { f64::INFINITY }
+}
+
+/// The anisotropy `κ = |λ₁ − λ₂| / (λ₁ + λ₂)` of the symmetric 2-D matrix `b_sq`, the square
+/// `B²` of the map `B` that takes the fitted ellipse to the unit circle (`λ₁`, `λ₂` its
+/// largest and smallest eigenvalues): 0 for a circle, towards 1 as the ellipse flattens (`B²` has the squared axis ratio as
+/// the ratio of its eigenvalues). It is the `κ` of [`direct_fit_bias_rad`], whose
+/// derivation is at the batch ellipse's `refinement_could_matter`. `None` where the
+/// eigenvalues cannot be computed (a non-finite entry); a caller that must still bound
+/// can take `κ = 1`, which no positive `B²` exceeds.
+pub(crate) fn anisotropy_2d(b_sq: &Matrix2<f64>) -> Option<f64> {
+    sym_eigen2(b_sq).map(|(l, _)| ((l[0] - l[1]) / (l[0] + l[1])).abs())
+}
+
+/// The anisotropy `κ = |λ₁ − λ₃| / (λ₁ + λ₃)` of the symmetric 3-D matrix `b_sq` (`B²`, or
+/// `W Wᵀ` for a soft-iron matrix `W`), from its largest and smallest eigenvalues: as
+/// [`anisotropy_2d`], for the ellipse in which the plane of those two axes cuts the
+/// ellipsoid, the most anisotropic of its sections.
+pub(crate) fn anisotropy_3d(b_sq: &Matrix3<f64>) -> Option<f64> {
+    sym_eigen3(b_sq).map(|(l, _)| {
+        let (hi, lo) = (l.max(), l.min());
+        ((hi - lo) / (hi + lo)).abs()
+    })
 }

@@ -59,7 +59,9 @@ mod tests;
 
 pub use arc::{ARC_END_NOISE_SIGMAS, MIN_ARC_DEG, locus_turning_rad, require_arc};
 pub use bounds::BOUND_SIGMAS;
-pub(crate) use bounds::{direct_fit_bias_rad, regressor_2d, regressor_3d};
+pub(crate) use bounds::{
+    anisotropy_2d, anisotropy_3d, direct_fit_bias_rad, regressor_2d, regressor_3d,
+};
 pub use coverage::{COVERAGE_BINS, Coverage, calibrated_coverage_2d, coverage};
 pub(crate) use coverage::{calibrated_directions_2d, coverage_of};
 pub(crate) use direction_bins::{turns, turns_in};

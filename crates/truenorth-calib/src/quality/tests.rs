@@ -121,6 +121,24 @@ fn bound_3d_matches_solving_with_the_information_matrix() {
 }
 
 /// The information matrices built from monomial sums equal `Σ φφᵀ` summed directly.
+/// κ of `B²` is 0 for a circle, `(q² − 1)/(q² + 1)` for an axis ratio `q` (whatever the
+/// axes' orientation), and unavailable for a non-finite matrix; in 3-D it takes the
+/// outermost axes and ignores the middle one.
+#[test]
+fn anisotropy_reads_the_axis_ratio() {
+    use nalgebra::{Matrix2, Matrix3, Rotation2};
+    assert_eq!(anisotropy_2d(&Matrix2::identity()), Some(0.0));
+    let r = Rotation2::new(0.7).into_inner();
+    let b = r * Matrix2::new(2.0, 0.0, 0.0, 1.0) * r.transpose();
+    let kappa = anisotropy_2d(&(b * b)).unwrap();
+    assert!((kappa - 3.0 / 5.0).abs() < 1e-12, "{kappa}");
+    assert_eq!(anisotropy_2d(&Matrix2::new(f64::NAN, 0.0, 0.0, 1.0)), None);
+    let b_sq = Matrix3::from_diagonal(&Vector3::new(4.0, 9.0, 1.0));
+    assert!((anisotropy_3d(&b_sq).unwrap() - 0.8).abs() < 1e-12);
+    assert_eq!(anisotropy_3d(&Matrix3::identity()), Some(0.0));
+    assert_eq!(anisotropy_3d(&(Matrix3::identity() * f64::INFINITY)), None);
+}
+
 #[test]
 fn information_from_monomials_matches_outer_products() {
     let mut rng = SplitMix64::new(11);

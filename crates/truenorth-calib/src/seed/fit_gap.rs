@@ -22,8 +22,7 @@ use truenorth_compass::CompassCalibration2d;
 use truenorth_core::angle_diff;
 
 use crate::fits::ellipse::fit_ellipse_direct;
-use crate::numerics::linalg::sym_eigen2;
-use crate::quality::{Assessment2d, direct_fit_bias_rad};
+use crate::quality::{Assessment2d, anisotropy_2d, direct_fit_bias_rad};
 
 /// The largest heading difference between `cal` and the direct least-squares ellipse fit of
 /// `points`, over `points`, and that fit's second-order bias bound for a per-reading noise
@@ -54,8 +53,7 @@ pub(crate) fn fit_gap_rad(
         s2 += Vector2::new(u.x * u.x - u.y * u.y, 2.0 * u.x * u.y);
         k += 1;
     }
-    let kappa =
-        sym_eigen2(&(e.unit_map * e.unit_map)).map(|(l, _)| ((l[0] - l[1]) / (l[0] + l[1])).abs());
+    let kappa = anisotropy_2d(&(e.unit_map * e.unit_map));
     match (k, kappa) {
         (0, _) | (_, None) => (f64::INFINITY, f64::INFINITY),
         (k, Some(kappa)) => {

@@ -89,10 +89,11 @@ fitted field that is not a plausible Earth field in that unit (or, with --lat/--
 than 15 % from the World Magnetic Model's) is refused with the unit the data are
 probably in, unless `--accept-field-mismatch`. On success one summary line goes to
 stderr. Exit status 1 with one line on stderr when the file is bad or the data cannot
-support a calibration (too few points, too little of the circle, orientations that do
-not determine it whatever their count, too few readings for their noise, readings too
-noisy for their orientations, not an ellipse, or with `turn` and `gyr_z` a gap between
-rows longer than 1 s, across which the rate cannot be integrated).
+support a calibration (too few points, too few headings (`binned-ellipse`: direction
+bins filled), too little of the circle, orientations that do not determine it whatever
+their count, too few readings for their noise, readings too noisy for their
+orientations, not an ellipse, or with `turn` and `gyr_z` a gap between rows longer than
+1 s, across which the rate cannot be integrated).
 
 Example: a logger's file with columns `time;mx;my;mz;ax;ay;az`, sensor axes x forward,
 y left, z up, field in µT, recorded in London:

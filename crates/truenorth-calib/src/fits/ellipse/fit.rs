@@ -52,7 +52,7 @@ use crate::fits::lm::{self, NormalAccumulator, NormalEquations};
 use crate::fits::normalise::Normaliser;
 use crate::fits::readings::{Readings, replay_points};
 use crate::numerics::blocks::BLOCK;
-use crate::numerics::linalg::{sym_eigen2, sym_sqrt2};
+use crate::numerics::linalg::sym_sqrt2;
 use crate::numerics::segments::{BlockFold, fold};
 use crate::quality::{self, Assessment2d, BOUND_SIGMAS, Moments2};
 
@@ -395,10 +395,9 @@ fn refinement_could_matter(m: &Moments2, e: &Ellipse, a: &Assessment2d) -> bool 
     let (h1, h2) = quality::direction_harmonics(m, q.fit.points, &e.centre, &e.unit_map);
     let sigma = q.heading_noise_rms_deg.to_radians();
     let s = (q.heading_error_3sigma_deg / BOUND_SIGMAS).to_radians();
-    let Some((l, _)) = sym_eigen2(&(e.unit_map * e.unit_map)) else {
+    let Some(kappa) = quality::anisotropy_2d(&(e.unit_map * e.unit_map)) else {
         return true;
     };
-    let kappa = ((l[0] - l[1]) / (l[0] + l[1])).abs();
     let bias = quality::direct_fit_bias_rad(sigma, kappa, h1, h2);
     let step = (bias * bias + 0.5 * kappa * kappa * s * s).sqrt();
     !(step <= SKIPPED_STEP_SHARE_OF_BOUND * BOUND_SIGMAS * s)
@@ -410,13 +409,9 @@ fn refinement_could_matter(m: &Moments2, e: &Ellipse, a: &Assessment2d) -> bool 
 fn bias_bound_rad(m: &Moments2, n: usize, e: &Ellipse, a: &Assessment2d) -> f64 {
     let (h1, h2) = quality::direction_harmonics(m, n, &e.centre, &e.unit_map);
     let sigma = a.quality.heading_noise_rms_deg.to_radians();
-    match sym_eigen2(&(e.unit_map * e.unit_map)) {
-        Some((l, _)) => {
-            let kappa = ((l[0] - l[1]) / (l[0] + l[1])).abs();
-            quality::direct_fit_bias_rad(sigma, kappa, h1, h2)
-        }
-        None => f64::INFINITY,
-    }
+    quality::anisotropy_2d(&(e.unit_map * e.unit_map)).map_or(f64::INFINITY, |kappa| {
+        quality::direct_fit_bias_rad(sigma, kappa, h1, h2)
+    })
 }
 
 /// The part of [`refinement_could_matter`] that needs no report: whether the refinement runs

@@ -43,7 +43,7 @@ use crate::fits::lm::{self, NormalAccumulator, NormalEquations};
 use crate::fits::normalise::Normaliser;
 use crate::fits::readings::{Readings, replay_points};
 use crate::numerics::blocks::BLOCK;
-use crate::numerics::linalg::{sym_eigen3, sym_sqrt3};
+use crate::numerics::linalg::sym_sqrt3;
 use crate::numerics::segments::{BlockFold, fold};
 use crate::quality::{self, CompassUncertainty};
 
@@ -285,9 +285,7 @@ fn bias_bound_rad(harmonics: Option<(f64, f64)>, cal: &CompassCalibration3d, sig
     let Some((h1, h2)) = harmonics else {
         return f64::INFINITY;
     };
-    let kappa = sym_eigen3(&(cal.soft_iron * cal.soft_iron.transpose())).map_or(1.0, |(l, _)| {
-        ((l.max() - l.min()) / (l.max() + l.min())).abs()
-    });
+    let kappa = quality::anisotropy_3d(&(cal.soft_iron * cal.soft_iron.transpose())).unwrap_or(1.0);
     quality::direct_fit_bias_rad(sigma, kappa, h1, h2)
 }
 

@@ -16,7 +16,7 @@ use crate::online::conic::noise_factor;
 use crate::online::conic_sums::LAYOUT_3D;
 use crate::online::ellipsoid_config::OnlineEllipsoidConfig;
 use crate::quality;
-use crate::quality::direct_fit_bias_rad;
+use crate::quality::{anisotropy_3d, direct_fit_bias_rad};
 
 #[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
@@ -173,10 +173,7 @@ impl Refresh {
         ) / n
             - Matrix3::identity() / 3.0;
         let h2 = m.norm() / (2.0f64 / 3.0).sqrt();
-        let kappa = sym_eigen3(&(e.unit_map * e.unit_map)).map_or(1.0, |(l, _)| {
-            let (hi, lo) = (l.max(), l.min());
-            ((hi - lo) / (hi + lo)).abs()
-        });
+        let kappa = anisotropy_3d(&(e.unit_map * e.unit_map)).unwrap_or(1.0);
         self.bias_rad = direct_fit_bias_rad(self.sigma, kappa, h1, h2);
     }
 }

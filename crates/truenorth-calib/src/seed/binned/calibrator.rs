@@ -530,6 +530,9 @@ impl BinnedEllipseCalibrator {
     /// Solve on this (scratch) calibrator: complete any update, run a full one, accept.
     fn solve_in_place(&mut self) -> Result<Solution<CompassCalibration2d>> {
         self.finish_update();
+        // Before the first origin every reading since the (re)start waits in `init`: a
+        // count of readings. After it the bins count headings, however many readings
+        // each holds.
         if self.origin.is_none() {
             return Err(Error::TooFewPoints {
                 got: self.samples,
@@ -538,9 +541,10 @@ impl BinnedEllipseCalibrator {
         }
         let filled = self.filled_bins();
         if filled < self.config.min_filled_bins {
-            return Err(Error::TooFewPoints {
-                got: filled,
+            return Err(Error::TooFewBins {
+                filled,
                 need: self.config.min_filled_bins,
+                bins: self.config.bins,
             });
         }
         let params = self.refresh()?;

@@ -16,7 +16,7 @@ use nalgebra::Vector2;
 use truenorth_compass::EllipsePhasors;
 use truenorth_core::{Error, Result, angle_diff};
 
-use crate::seed::binned::bins::{BinState, Bins, EMPTY, MAX_BINS, filled, rebin_one};
+use crate::seed::binned::bins::{BinState, Bins, EMPTY, MAX_BINS, rebin_one};
 use crate::seed::binned::params::{EVALUATIONS, ParamSearch};
 
 #[cfg(not(feature = "std"))]
@@ -76,6 +76,17 @@ pub(crate) struct RefreshJob {
     stage: Stage,
     /// The outcome, once [`Self::advance`] returned `true`.
     pub result: Option<Result<EllipsePhasors>>,
+}
+
+/// The refusal of bins of which only `directions` (fewer than two) hold a reading off the
+/// origin: a reading at the origin has no direction, and interpolating the full set needs
+/// two, so at least two bins (and the calibrator's `min_filled`) are needed.
+fn too_few_bins(directions: usize, n: usize, min_filled: usize) -> Error {
+    Error::TooFewBins {
+        filled: directions,
+        need: min_filled.max(2),
+        bins: n,
+    }
 }
 
 impl RefreshJob {
@@ -259,10 +270,7 @@ impl RefreshJob {
     /// the iteration, and the final pass would see the same bins about the same origin, so
     /// either way the refresh ends here.
     fn no_full_set(&mut self) -> Stage {
-        self.result = Some(Err(Error::TooFewPoints {
-            got: filled(&self.bins, self.n),
-            need: self.min_filled,
-        }));
+        self.result = Some(Err(too_few_bins(self.k, self.n, self.min_filled)));
         Stage::Done
     }
 
@@ -380,16 +388,17 @@ mod tests {
         let full_set = |bins: &Bins, origin: &Vector2<f64>| {
             let mut job = RefreshJob::start(bins, n, origin, 0, 0);
             job.polar();
-            (job.k >= 2).then(|| {
-                let mut out = [Vector2::zeros(); MAX_BINS];
-                for (i, o) in out[..n].iter_mut().enumerate() {
-                    *o = job.full_set_bin(i);
-                }
-                out
-            })
+            if job.k < 2 {
+                return Err(too_few_bins(job.k, n, 0));
+            }
+            let mut out = [Vector2::zeros(); MAX_BINS];
+            for (i, o) in out[..n].iter_mut().enumerate() {
+                *o = job.full_set_bin(i);
+            }
+            Ok(out)
         };
         for _ in 0..iterations {
-            let Some(full) = full_set(bins, origin) else {
+            let Ok(full) = full_set(bins, origin) else {
                 break;
             };
             let mean = full[..n].iter().sum::<Vector2<f64>>() / n as f64;
@@ -399,7 +408,7 @@ mod tests {
             rebin(bins, n, &mean);
             *origin = mean;
         }
-        let full = full_set(bins, origin).ok_or(Error::TooFewPoints { got: 0, need: 0 })?;
+        let full = full_set(bins, origin)?;
         ellipse_parameters(&full[..n], origin)
     }
 
@@ -492,7 +501,7 @@ mod tests {
             prop_assert_eq!(&job.bins[..n], &ref_bins[..n]);
             match (job.result.unwrap(), expect) {
                 (Ok(a), Ok(b)) => prop_assert_eq!(a, b),
-                (Err(_), Err(_)) => {}
+                (Err(a), Err(b)) => prop_assert_eq!(a, b),
                 (a, b) => prop_assert!(false, "{:?} vs {:?}", a, b),
             }
         }

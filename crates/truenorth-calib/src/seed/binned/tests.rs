@@ -299,3 +299,41 @@ fn a_state_without_the_counts_of_the_interval_before_restores() {
     drive(&mut on, &mut m, 200.0, 250.0);
     assert!(on.solve().is_ok());
 }
+
+/// Before the first origin a refusal counts readings; after it, direction bins. A half turn
+/// of 5400 readings fills fewer bins than solving needs: the refusal says so with the
+/// count of bins, and asks for more headings rather than more readings.
+#[test]
+fn a_dense_half_turn_is_refused_for_its_bins_not_its_readings() {
+    let mut m = reference();
+    let mut c = BinnedEllipseCalibrator::default();
+    let mut rng = SplitMix64::new(7);
+    let per_deg = 30.0;
+    let readings = (180.0 * per_deg) as usize;
+    for i in 0..readings {
+        if i == 5 {
+            assert_eq!(
+                c.solve().map(|_| ()),
+                Err(Error::TooFewPoints { got: 5, need: 8 })
+            );
+        }
+        let truth = HeadingTruth {
+            heading_rad: (i as f64 / per_deg).to_radians(),
+            horizontal_field: H,
+        };
+        c.push(&Mag2Sample {
+            t_s: i as f64 * 0.01,
+            mag: m.sample(&truth, 0.01, &mut rng).unwrap(),
+        })
+        .unwrap();
+    }
+    let e = c.solve().map(|_| ()).unwrap_err();
+    let Error::TooFewBins { filled, need, bins } = e else {
+        panic!("{e:?}");
+    };
+    assert_eq!((need, bins), (16, 64));
+    assert!(filled < need, "{e}");
+    let text = e.to_string();
+    assert!(!text.contains("too few points"), "{text}");
+    assert!(text.contains("turn through more headings"), "{text}");
+}
