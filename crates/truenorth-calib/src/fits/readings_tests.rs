@@ -198,3 +198,40 @@ fn slices_and_vecs_replay_in_one_run() {
         .unwrap();
     assert_eq!(none, 0);
 }
+
+/// Readings in one slice, three segments long, are folded on every core (see the
+/// `numerics::segments` module); the same readings replayed in runs are folded on one
+/// thread. (Three: with two, the merge is one addition, which rounds the same in either
+/// order.) The fits agree to the bit. (On a machine with one core both take one thread;
+/// the segments' own tests hold the thread count at 2, 3 and 7.)
+#[test]
+fn fits_on_several_threads_are_the_fits_on_one() {
+    let n = 2 * crate::numerics::segments::SEGMENT + 3_000;
+    let points = arc_2d(n, 400.0, 2.0, 0.1);
+    let config = EllipseConfig::default();
+    let cut = Cut {
+        points: points.clone(),
+        runs: vec![3, 1],
+        ..Cut::default()
+    };
+    let on_threads = format!("{:?}", fit_ellipse(&points, &config));
+    assert!(on_threads.starts_with("Ok"), "{on_threads}");
+    assert_eq!(
+        format!("{:?}", fit_ellipse_readings(&cut, &config)),
+        on_threads
+    );
+
+    let points = cap_3d(n, 180.0, 2.0);
+    let config = EllipsoidConfig::default();
+    let cut = Cut {
+        points: points.clone(),
+        runs: vec![5, 2],
+        ..Cut::default()
+    };
+    let on_threads = format!("{:?}", fit_ellipsoid(&points, &config));
+    assert!(on_threads.starts_with("Ok"), "{on_threads}");
+    assert_eq!(
+        format!("{:?}", fit_ellipsoid_readings(&cut, &config)),
+        on_threads
+    );
+}

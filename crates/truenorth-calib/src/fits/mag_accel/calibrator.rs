@@ -150,10 +150,7 @@ impl<S: MagAccelStore> Calibrator for MagAccelCalibrator<S> {
     /// fit (see [`crate::EllipsoidCalibrator`]). A store that cannot replay its readings
     /// reports no coverage and not ready.
     fn progress(&self) -> Progress {
-        let mags = SensorReadings {
-            readings: &self.samples,
-            sensor: Sensor::Mag,
-        };
+        let mags = SensorReadings::new(&self.samples, Sensor::Mag);
         Progress {
             samples: self.samples.len(),
             coverage: raw_coverage(&mags).unwrap_or(0.0),
@@ -220,6 +217,23 @@ impl<R: Readings<6> + ?Sized> Readings<6> for Joint<'_, R> {
 
     fn replay(&self, run: &mut dyn FnMut(&[MagAccelReading])) -> Result<()> {
         self.0.replay(run)
+    }
+
+    fn replay_range(
+        &self,
+        start: usize,
+        end: usize,
+        run: &mut dyn FnMut(&[MagAccelReading]),
+    ) -> Result<()> {
+        self.0.replay_range(start, end, run)
+    }
+
+    fn in_memory(&self) -> Option<&[MagAccelReading]> {
+        self.0.in_memory()
+    }
+
+    fn shared(&self) -> Option<&(dyn Readings<6> + Sync)> {
+        self.0.shared()
     }
 }
 
@@ -313,14 +327,8 @@ fn start<'a>(
         },
         ..config.ellipsoid
     };
-    let acc = SensorReadings {
-        readings,
-        sensor: Sensor::Acc,
-    };
-    let mag = SensorReadings {
-        readings,
-        sensor: Sensor::Mag,
-    };
+    let acc = SensorReadings::new(readings, Sensor::Acc);
+    let mag = SensorReadings::new(readings, Sensor::Mag);
     let acc_fit = fit_ellipsoid_readings(&acc, &start)?;
     let mag_fit = fit_ellipsoid_readings(&mag, &start)?;
     let na = Normaliser::of_finite(&acc, "point")?;

@@ -8,8 +8,8 @@ use truenorth_core::Calibrator;
 use crate::fits::mag_accel::calibrator::fit_mag_accel_within;
 use crate::fits::mag_accel::solve::Limits;
 use crate::fits::mag_accel::{
-    MagAccelCalibrator, MagAccelConfig, MagAccelSample, fit_mag_accel, fit_mag_accel_readings,
-    mag_accel_reading,
+    MagAccelCalibrator, MagAccelConfig, MagAccelReading, MagAccelSample, fit_mag_accel,
+    fit_mag_accel_readings, mag_accel_reading,
 };
 use crate::fits::readings_tests::{Cut, FAILED};
 
@@ -134,4 +134,26 @@ fn the_recordings_reach_runs_fits_and_refusals() {
     let without = fit_mag_accel(&recording(120, 1.2, 30, 0, 0.002), &config).unwrap();
     assert_eq!(without.quality.runs, 0);
     assert!(fit_mag_accel(&recording(120, 0.0, 0, 0, 0.002), &config).is_err());
+}
+
+/// The joint fit of readings in one slice three segments long, folded on every core, is
+/// the fit of the same samples converted as they are replayed, folded on one thread, to
+/// the bit (see `fits_on_several_threads_are_the_fits_on_one` for the 2-D and 3-D fits).
+#[test]
+fn the_joint_fit_on_several_threads_is_the_fit_on_one() {
+    let samples = recording(
+        2 * crate::numerics::segments::SEGMENT + 2_000,
+        1.2,
+        0,
+        8,
+        0.002,
+    );
+    let config = MagAccelConfig::default();
+    let readings: Vec<MagAccelReading> = samples.iter().map(mag_accel_reading).collect();
+    let on_threads = format!("{:?}", fit_mag_accel_readings(&readings, &config));
+    assert!(on_threads.starts_with("Ok"), "{on_threads}");
+    assert_eq!(
+        format!("{:?}", fit_mag_accel(&samples, &config)),
+        on_threads
+    );
 }

@@ -182,10 +182,7 @@ pub(crate) fn assemble(
     let (sigma_a, sigma_m) = (rms(sums.acc), rms(sums.mag));
     let (bound, noise) = heading_figures(theta, r0, cov, 1.0 / w.acc, 1.0 / w.mag);
     // The magnetometer's own geometry, for its coverage, condition and dilution.
-    let mag_raw = SensorReadings {
-        readings: data.readings,
-        sensor: Sensor::Mag,
-    };
+    let mag_raw = SensorReadings::new(data.readings, Sensor::Mag);
     let own = quality::assess_3d_of(&mag_raw, &cal.mag, cal.field)?;
     let sigmas = ParameterSigmas::of(cov, &md, na, nm);
     let dip_spread =

@@ -38,11 +38,12 @@ use nalgebra::{Matrix3, Rotation3, SMatrix, SVector, Vector3};
 use truenorth_core::Result;
 
 use crate::fits::lm::{NormalAccumulator, NormalEquations};
-use crate::fits::mag_accel::readings::Sensor;
+use crate::fits::mag_accel::readings::{MagAccelReading, Sensor};
 use crate::fits::mag_accel::run_rows::{RunSums, all_run_rows};
 use crate::fits::normalise::Normaliser;
 use crate::fits::readings::Readings;
 use crate::numerics::blocks::{BLOCK, sum_block};
+use crate::numerics::segments::{self, RunFold};
 
 #[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
@@ -174,6 +175,36 @@ impl Data<'_> {
         })
     }
 
+    /// Folds every reading (normalised, accelerometer then magnetometer) with `add`, a
+    /// segment at a time, merging the segments' accumulators in order with `merge` (see
+    /// the `numerics::segments` module): on several threads where the store allows it,
+    /// with the same result on any number. An error replaying the readings is returned as
+    /// it is.
+    pub fn fold<A: Send>(
+        &self,
+        start: impl Fn() -> A + Sync,
+        add: impl Fn(&mut A, &Vector3<f64>, &Vector3<f64>) + Sync,
+        merge: impl Fn(&mut A, A) + Sync,
+    ) -> Result<A> {
+        let (na, nm) = (&self.na, &self.nm);
+        segments::fold(
+            self.readings,
+            &RunFold {
+                start,
+                add: |acc: &mut A, run: &[MagAccelReading]| {
+                    for r in run {
+                        add(
+                            acc,
+                            &na.apply(&Sensor::Acc.of(r)),
+                            &nm.apply(&Sensor::Mag.of(r)),
+                        );
+                    }
+                },
+                merge,
+            },
+        )
+    }
+
     /// Calls `f` with every reading of `range` (normalised), in order: a whole replay.
     pub fn replay_range(
         &self,
@@ -296,18 +327,22 @@ pub(crate) fn normal_equations(
     theta: &SVector<f64, P>,
 ) -> Result<Option<(NormalEquations<P>, GroupSums)>> {
     let m = Model::of(theta, r0);
-    let mut groups = ReadingGroups::new();
-    let mut defined = true;
-    data.replay(|a, mg| {
-        if !defined {
-            return;
-        }
-        let Some(rows) = reading_rows(&m, a, mg) else {
-            defined = false;
-            return;
-        };
-        groups.add(&rows, w);
-    })?;
+    let (groups, defined) = data.fold(
+        || (ReadingGroups::new(), true),
+        |(groups, defined): &mut (ReadingGroups, bool), a, mg| {
+            if !*defined {
+                return;
+            }
+            match reading_rows(&m, a, mg) {
+                Some(rows) => groups.add(&rows, w),
+                None => *defined = false,
+            }
+        },
+        |(groups, defined), (later, later_defined)| {
+            *defined &= later_defined;
+            groups.merge(later);
+        },
+    )?;
     if !defined {
         return Ok(None);
     }
@@ -427,6 +462,27 @@ impl ReadingGroups {
             group.1 += i;
         }
         self.filled = 0;
+    }
+
+    /// Adds the sums of `later`, the groups of the readings that follow these (its block
+    /// in progress first: the blocks of a segment are its own).
+    fn merge(&mut self, mut later: Self) {
+        for g in [&mut *self, &mut later] {
+            if g.filled > 0 {
+                g.add_block();
+            }
+        }
+        self.acc.merge(&later.acc);
+        self.mag.merge(&later.mag);
+        self.dip.merge(&later.dip);
+        for (group, more) in [
+            (&mut self.sums.acc, later.sums.acc),
+            (&mut self.sums.mag, later.sums.mag),
+            (&mut self.sums.dip, later.sums.dip),
+        ] {
+            group.0 += more.0;
+            group.1 += more.1;
+        }
     }
 
     /// The normal equations in every parameter (upper triangle and diagonal; the caller
