@@ -198,10 +198,11 @@ fn merge_into<const D: usize, F: Fold<D>>(f: &F, total: &mut Option<F::Acc>, nex
 #[cfg(feature = "std")]
 mod threads {
     use std::sync::atomic::{AtomicUsize, Ordering};
+    use std::sync::{Mutex, PoisonError};
     use std::vec::Vec;
 
     use nalgebra::SVector;
-    use truenorth_core::Result;
+    use truenorth_core::{Error, Result};
 
     use super::{Fold, SEGMENT, merge_into};
     use crate::fits::readings::Readings;
@@ -220,9 +221,23 @@ mod threads {
         }
     }
 
+    /// The segments folded so far and not yet merged, and the merge of those before them.
+    struct Merged<A> {
+        /// The merge of segments `0..next`.
+        total: Option<A>,
+        /// The segment to merge next.
+        next: usize,
+        /// Segments folded ahead of one not yet done: as many as the other threads fold
+        /// meanwhile, about one each when segments take alike.
+        waiting: Vec<(usize, A)>,
+        /// The error of the first segment whose replay failed.
+        failed: Option<(usize, Error)>,
+    }
+
     /// [`super::fold`] of `readings` on `threads` threads (the caller's among them): each
-    /// takes the next segment not yet taken, folds it into a fresh accumulator, and keeps
-    /// it with its index; the caller then merges them in index order.
+    /// takes the next segment not yet taken and folds it into a fresh accumulator, which
+    /// is merged into the total as soon as every segment before it is: the merges go in
+    /// index order, and few accumulators wait (not one per segment).
     pub(super) fn fold<const D: usize, R, F>(readings: &R, threads: usize, f: &F) -> Result<F::Acc>
     where
         R: Readings<D> + Sync + ?Sized,
@@ -231,8 +246,13 @@ mod threads {
         let n = readings.len();
         let segments = n.div_ceil(SEGMENT);
         let next = AtomicUsize::new(0);
+        let merged = Mutex::new(Merged {
+            total: None,
+            next: 0,
+            waiting: Vec::with_capacity(threads),
+            failed: None,
+        });
         let work = || {
-            let mut done: Vec<(usize, Result<F::Acc>)> = Vec::new();
             loop {
                 let k = next.fetch_add(1, Ordering::Relaxed);
                 if k >= segments {
@@ -244,36 +264,40 @@ mod threads {
                     readings.replay_range(k * SEGMENT, end, &mut |run: &[SVector<f64, D>]| {
                         f.add(&mut acc, run);
                     });
-                let failed = r.is_err();
-                done.push((k, r.map(|()| acc)));
-                if failed {
+                let mut m = merged.lock().unwrap_or_else(PoisonError::into_inner);
+                if let Err(e) = r {
                     // The pass fails anyway; the other threads stop at their next segment.
                     next.store(segments, Ordering::Relaxed);
+                    if m.failed.as_ref().is_none_or(|(j, _)| k < *j) {
+                        m.failed = Some((k, e));
+                    }
                     break;
                 }
-            }
-            done
-        };
-        let mut parts = std::thread::scope(|s| {
-            let helpers: Vec<_> = (1..threads).map(|_| s.spawn(work)).collect();
-            let mut parts = work();
-            for h in helpers {
-                match h.join() {
-                    Ok(p) => parts.extend(p),
-                    // A panic in a fold is a fault of the fold itself: it goes on as it
-                    // would have on one thread.
-                    Err(e) => std::panic::resume_unwind(e),
+                m.waiting.push((k, acc));
+                while let Some(i) = m.waiting.iter().position(|(j, _)| *j == m.next) {
+                    let (_, part) = m.waiting.swap_remove(i);
+                    merge_into(f, &mut m.total, part);
+                    m.next += 1;
                 }
             }
-            parts
+        };
+        std::thread::scope(|s| {
+            let helpers: Vec<_> = (1..threads).map(|_| s.spawn(work)).collect();
+            work();
+            for h in helpers {
+                if let Err(e) = h.join() {
+                    // A panic in a fold is a fault of the fold itself: it goes on as it
+                    // would have on one thread.
+                    std::panic::resume_unwind(e);
+                }
+            }
         });
-        parts.sort_unstable_by_key(|(k, _)| *k);
-        let mut total: Option<F::Acc> = None;
-        for (_, part) in parts {
-            merge_into(f, &mut total, part?);
+        let m = merged.into_inner().unwrap_or_else(PoisonError::into_inner);
+        if let Some((_, e)) = m.failed {
+            return Err(e);
         }
-        // Every segment was folded (no part failed), so there was at least one.
-        Ok(total.unwrap_or_else(|| f.start()))
+        // Every segment was folded and merged (none failed), so there was at least one.
+        Ok(m.total.unwrap_or_else(|| f.start()))
     }
 }
 
