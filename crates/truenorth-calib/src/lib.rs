@@ -17,6 +17,10 @@
 //! constant dip, and the pointing axis from runs of shots aimed at one target). The
 //! [`quality`] module holds the report every calibrator shares: what the readings determine
 //! (not how much of the sphere they fill), the predicted uncertainty and a verdict.
+//! Their passes over the readings cut them into segments of 65,536, folded on every core
+//! (with `std`) and merged in order: the result is the same, to the bit, on any number of
+//! threads, and for readings kept anywhere ([`Readings`]: in memory, or a store that
+//! replays ranges of them, as the CLI's spill to disk does).
 //!
 //! The seed calibrators learn online, sample by sample, without allocating:
 //! [`MeritCircleCalibrator`] (US 5,297,063: circumcentres of reading triples, merged by a
