@@ -57,7 +57,9 @@ use crate::fits::mag_accel::calibration::{MagAccelCalibration, MagAccelSample};
 use crate::fits::mag_accel::config::{
     INITIAL_FIT_BOUND_DEG, MIN_MAG_ACCEL_READINGS, MagAccelConfig,
 };
-use crate::fits::mag_accel::readings::{MagAccelReading, MagAccelStore, Sensor, SensorReadings};
+use crate::fits::mag_accel::readings::{
+    MagAccelReading, MagAccelStore, SampleSlice, Sensor, SensorReadings,
+};
 use crate::fits::mag_accel::report::{MagAccelQuality, assemble};
 use crate::fits::mag_accel::runs::{RunFinder, RunRule};
 use crate::fits::mag_accel::solve::{
@@ -180,7 +182,7 @@ pub fn fit_mag_accel(
     samples: &[MagAccelSample],
     config: &MagAccelConfig,
 ) -> Result<Solution<MagAccelCalibration, MagAccelQuality>> {
-    fit_mag_accel_readings(samples, config)
+    fit_mag_accel_readings(&SampleSlice(samples), config)
 }
 
 /// [`fit_mag_accel`] of readings replayed from wherever they are kept (see [`Readings`];

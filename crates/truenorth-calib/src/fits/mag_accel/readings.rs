@@ -55,6 +55,19 @@ impl Readings<6> for [MagAccelSample] {
         replay_converted(self, mag_accel_reading, run);
         Ok(())
     }
+
+    fn replay_range(
+        &self,
+        start: usize,
+        end: usize,
+        run: &mut dyn FnMut(&[MagAccelReading]),
+    ) -> Result<()> {
+        let end = end.min(<[MagAccelSample]>::len(self));
+        if start < end {
+            replay_converted(&self[start..end], mag_accel_reading, run);
+        }
+        Ok(())
+    }
 }
 
 impl Readings<6> for Vec<MagAccelSample> {
@@ -64,6 +77,46 @@ impl Readings<6> for Vec<MagAccelSample> {
 
     fn replay(&self, run: &mut dyn FnMut(&[MagAccelReading])) -> Result<()> {
         self.as_slice().replay(run)
+    }
+
+    fn replay_range(
+        &self,
+        start: usize,
+        end: usize,
+        run: &mut dyn FnMut(&[MagAccelReading]),
+    ) -> Result<()> {
+        self.as_slice().replay_range(start, end, run)
+    }
+
+    fn shared(&self) -> Option<&(dyn Readings<6> + Sync)> {
+        Some(self)
+    }
+}
+
+/// Samples in one slice as readings that threads may replay ranges of at once (a slice
+/// itself is unsized, so it cannot be handed on as [`Readings::shared`]).
+pub(crate) struct SampleSlice<'a>(pub &'a [MagAccelSample]);
+
+impl Readings<6> for SampleSlice<'_> {
+    fn len(&self) -> usize {
+        self.0.len()
+    }
+
+    fn replay(&self, run: &mut dyn FnMut(&[MagAccelReading])) -> Result<()> {
+        self.0.replay(run)
+    }
+
+    fn replay_range(
+        &self,
+        start: usize,
+        end: usize,
+        run: &mut dyn FnMut(&[MagAccelReading]),
+    ) -> Result<()> {
+        self.0.replay_range(start, end, run)
+    }
+
+    fn shared(&self) -> Option<&(dyn Readings<6> + Sync)> {
+        Some(self)
     }
 }
 

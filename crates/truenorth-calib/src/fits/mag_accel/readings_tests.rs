@@ -136,9 +136,10 @@ fn the_recordings_reach_runs_fits_and_refusals() {
     assert!(fit_mag_accel(&recording(120, 0.0, 0, 0, 0.002), &config).is_err());
 }
 
-/// The joint fit of readings in one slice three segments long, folded on every core, is
-/// the fit of the same samples converted as they are replayed, folded on one thread, to
-/// the bit (see `fits_on_several_threads_are_the_fits_on_one` for the 2-D and 3-D fits).
+/// The joint fit of readings three segments long, folded on every core (readings in one
+/// slice, samples in one slice, the default calibrator's samples), is the fit of the same
+/// readings replayed in runs, folded on one thread, to the bit (see
+/// `fits_on_several_threads_are_the_fits_on_one` for the 2-D and 3-D fits).
 #[test]
 fn the_joint_fit_on_several_threads_is_the_fit_on_one() {
     let samples = recording(
@@ -149,11 +150,20 @@ fn the_joint_fit_on_several_threads_is_the_fit_on_one() {
         0.002,
     );
     let config = MagAccelConfig::default();
-    let readings: Vec<MagAccelReading> = samples.iter().map(mag_accel_reading).collect();
-    let on_threads = format!("{:?}", fit_mag_accel_readings(&readings, &config));
-    assert!(on_threads.starts_with("Ok"), "{on_threads}");
-    assert_eq!(
-        format!("{:?}", fit_mag_accel(&samples, &config)),
-        on_threads
+    let on_one = format!(
+        "{:?}",
+        fit_mag_accel_readings(&cut(&samples, vec![3, 1]), &config)
     );
+    assert!(on_one.starts_with("Ok"), "{on_one}");
+    let readings: Vec<MagAccelReading> = samples.iter().map(mag_accel_reading).collect();
+    assert_eq!(
+        format!("{:?}", fit_mag_accel_readings(&readings, &config)),
+        on_one
+    );
+    assert_eq!(format!("{:?}", fit_mag_accel(&samples, &config)), on_one);
+    let mut cal = MagAccelCalibrator::new(config).unwrap();
+    for s in &samples {
+        cal.push(s).unwrap();
+    }
+    assert_eq!(format!("{:?}", cal.solve()), on_one);
 }
