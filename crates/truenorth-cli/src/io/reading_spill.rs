@@ -37,7 +37,7 @@ pub const SPILL_MEMORY_BYTES: usize = 32 << 20;
 pub const SPILL_MEMORY_ENV: &str = "TRUENORTH_TEST_SPILL_MEMORY_BYTES";
 
 /// Readings per chunk of the file: written a chunk at a time and read back a chunk at a
-/// time into one buffer (a multiple of [`READINGS_RUN_MULTIPLE`]).
+/// time into a buffer of each replay (a multiple of [`READINGS_RUN_MULTIPLE`]).
 const CHUNK_READINGS: usize = 1 << 15;
 
 /// The reason the store gives the library when the disk fails it (the command reports the
@@ -86,7 +86,6 @@ impl ReadingSpill {
             file: None,
             on_disk: 0,
             pending: Vec::new(),
-            bytes: Vec::new(),
             read_buffers: Mutex::new(Vec::new()),
         }
     }
@@ -129,16 +128,11 @@ pub struct SpillStore<const D: usize> {
     on_disk: usize,
     /// Readings after the memory share not yet written (less than a chunk).
     pending: Vec<SVector<f64, D>>,
-    /// The bytes of the chunk being written.
-    bytes: Vec<u8>,
-    /// Buffers to read chunks back through, kept between replays (a fresh chunk-sized
+    /// Buffers to read chunks back into, kept between replays (a fresh chunk-sized
     /// buffer would be fresh pages from the system for every range every pass); one per
     /// replay running at once.
-    read_buffers: Mutex<Vec<ReadBuffers<D>>>,
+    read_buffers: Mutex<Vec<Vec<SVector<f64, D>>>>,
 }
-
-/// The bytes of a chunk read back, and the chunk's readings.
-type ReadBuffers<const D: usize> = (Vec<u8>, Vec<SVector<f64, D>>);
 
 impl<const D: usize> SpillStore<D> {
     /// Whether the readings went beyond memory.
@@ -152,42 +146,27 @@ impl<const D: usize> SpillStore<D> {
             Some(f) => f,
             None => self.file.insert(anonymous_file(&self.spill.dir)?),
         };
-        self.bytes.clear();
-        for p in &self.pending {
-            for x in p.iter() {
-                self.bytes.extend_from_slice(&x.to_le_bytes());
-            }
-        }
-        file.write_all(&self.bytes)?;
+        // The readings' own bytes: the same process reads them back.
+        file.write_all(bytemuck::cast_slice(&self.pending))?;
         self.on_disk += self.pending.len();
         self.pending.clear();
         Ok(())
     }
 
-    /// Reads back the readings `from..to` of the file (within one chunk) into `chunk`,
-    /// through `bytes`.
+    /// Reads back the readings `from..to` of the file into `chunk`.
     fn read_back(
         &self,
         from: usize,
         to: usize,
-        bytes: &mut Vec<u8>,
         chunk: &mut Vec<SVector<f64, D>>,
     ) -> io::Result<()> {
         let Some(file) = &self.file else {
             return Err(io::Error::other("the temporary file is missing"));
         };
-        let per_reading = D * size_of::<f64>();
-        bytes.resize((to - from) * per_reading, 0);
-        read_exact_at(file, bytes, (from * per_reading) as u64)?;
         chunk.clear();
-        for r in bytes.chunks_exact(per_reading) {
-            chunk.push(SVector::from_fn(|d, _| {
-                let mut x = [0; 8];
-                x.copy_from_slice(&r[8 * d..8 * d + 8]);
-                f64::from_le_bytes(x)
-            }));
-        }
-        Ok(())
+        chunk.resize(to - from, SVector::zeros());
+        let offset = (from * size_of::<SVector<f64, D>>()) as u64;
+        read_exact_at(file, bytemuck::cast_slice_mut(chunk), offset)
     }
 }
 
@@ -221,14 +200,14 @@ impl<const D: usize> Readings<D> for SpillStore<D> {
                 .read_buffers
                 .lock()
                 .unwrap_or_else(PoisonError::into_inner);
-            let (mut bytes, mut chunk) = pool.pop().unwrap_or_default();
+            let mut chunk = pool.pop().unwrap_or_default();
             drop(pool);
             while at < to {
                 // Up to the end of the chunk `at` is in, or of the range.
                 let from = at - memory;
                 let next = (from / CHUNK_READINGS + 1) * CHUNK_READINGS;
                 let upto = (to - memory).min(next);
-                let read = self.read_back(from, upto, &mut bytes, &mut chunk);
+                let read = self.read_back(from, upto, &mut chunk);
                 if let Err(e) = read {
                     return Err(self.spill.fail("read back", &e));
                 }
@@ -238,7 +217,7 @@ impl<const D: usize> Readings<D> for SpillStore<D> {
             self.read_buffers
                 .lock()
                 .unwrap_or_else(PoisonError::into_inner)
-                .push((bytes, chunk));
+                .push(chunk);
         }
         let at = start.max(disk_end);
         if at < end {
