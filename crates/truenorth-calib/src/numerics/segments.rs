@@ -50,42 +50,6 @@ pub(crate) trait Fold<const D: usize>: Sync {
     fn merge(&self, acc: &mut Self::Acc, later: Self::Acc);
 }
 
-/// A [`Fold`] a block of readings at a time (see [`BLOCK`]): `add` is given the
-/// coordinates of a block as arrays and how many of its rows are readings (the rest are
-/// zeros).
-pub(crate) struct BlockFold<S, A, M> {
-    /// The fresh accumulator.
-    pub start: S,
-    /// Adds one block.
-    pub add: A,
-    /// Merges the next segment's accumulator.
-    pub merge: M,
-}
-
-impl<const D: usize, T: Send, S, A, M> Fold<D> for BlockFold<S, A, M>
-where
-    S: Fn() -> T + Sync,
-    A: Fn(&mut T, &[[f64; BLOCK]; D], usize) + Sync,
-    M: Fn(&mut T, T) + Sync,
-{
-    type Acc = T;
-
-    fn start(&self) -> T {
-        (self.start)()
-    }
-
-    #[inline]
-    fn add(&self, acc: &mut T, run: &[SVector<f64, D>]) {
-        for (q, len) in blocks(run) {
-            (self.add)(acc, &q, len);
-        }
-    }
-
-    fn merge(&self, acc: &mut T, later: T) {
-        (self.merge)(acc, later);
-    }
-}
-
 /// A [`Fold`] a run of consecutive readings at a time.
 pub(crate) struct RunFold<S, A, M> {
     /// The fresh accumulator.
@@ -115,6 +79,19 @@ where
 
     fn merge(&self, acc: &mut T, later: T) {
         (self.merge)(acc, later);
+    }
+}
+
+/// The `add` of a [`RunFold`] that takes a block of readings at a time (see [`BLOCK`]):
+/// `add_block` is given the coordinates of a block as arrays and how many of its rows are
+/// readings (the rest are zeros).
+pub(crate) fn by_blocks<const D: usize, T>(
+    add_block: impl Fn(&mut T, &[[f64; BLOCK]; D], usize) + Sync,
+) -> impl Fn(&mut T, &[SVector<f64, D>]) + Sync {
+    move |acc, run| {
+        for (q, len) in blocks(run) {
+            add_block(acc, &q, len);
+        }
     }
 }
 

@@ -10,7 +10,7 @@ use super::direction_bins::{bin_if_clear, coarse_fixed, fine_bin, fine_bin_exact
 use super::support::{GAP_BINS, Support2d};
 use crate::fits::readings::{Readings, replay_points};
 use crate::numerics::blocks::{BLOCK, blocks};
-use crate::numerics::segments::{BlockFold, fold};
+use crate::numerics::segments::{RunFold, by_blocks, fold};
 use truenorth_core::Result;
 
 /// Number of heading bins used for coverage (10° each).
@@ -154,11 +154,11 @@ pub(crate) fn calibrated_directions_2d<R: Readings<2> + ?Sized>(
 ) -> Result<(Coverage, Support2d)> {
     let bins = fold(
         readings,
-        &BlockFold {
+        &RunFold {
             start: AngleBins::new,
-            add: |bins: &mut AngleBins, p: &[[f64; BLOCK]; 2], len| {
+            add: by_blocks(|bins: &mut AngleBins, p: &[[f64; BLOCK]; 2], len| {
                 mark_calibrated_block(bins, p, len, cal);
-            },
+            }),
             merge: |bins: &mut AngleBins, later| bins.merge(&later),
         },
     )?;

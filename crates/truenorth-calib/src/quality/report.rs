@@ -18,7 +18,7 @@ use super::uncertainty::bound_and_uncertainty;
 use crate::fits::readings::Readings;
 use crate::numerics::blocks::{BLOCK, blocks, dot_block, replay_blocks, sum_block};
 use crate::numerics::linalg::{condition_from_eigenvalues, sym_eigen5, sym_eigen9};
-use crate::numerics::segments::{BlockFold, add_sums, fold};
+use crate::numerics::segments::{RunFold, add_sums, by_blocks, fold};
 use crate::quality::SPHERE_CELLS;
 use truenorth_core::Result;
 
@@ -310,11 +310,13 @@ fn cell_counts<R: Readings<3> + ?Sized>(
 ) -> Result<[u32; SPHERE_CELLS]> {
     fold(
         points,
-        &BlockFold {
+        &RunFold {
             start: || [0u32; SPHERE_CELLS],
-            add: |in_cell: &mut [u32; SPHERE_CELLS], p: &[[f64; BLOCK]; 3], len| {
-                count_cells(in_cell, p, len, cal);
-            },
+            add: by_blocks(
+                |in_cell: &mut [u32; SPHERE_CELLS], p: &[[f64; BLOCK]; 3], len| {
+                    count_cells(in_cell, p, len, cal);
+                },
+            ),
             merge: |in_cell: &mut [u32; SPHERE_CELLS], later: [u32; SPHERE_CELLS]| {
                 for (a, b) in in_cell.iter_mut().zip(later) {
                     *a += b;
@@ -482,9 +484,11 @@ pub(crate) fn assess_3d_with_harmonics_of<R: Readings<3> + ?Sized>(
     let weight = cell_weights(&in_cell);
     let sums = fold(
         points,
-        &BlockFold {
+        &RunFold {
             start: || Sums3d::new(weight, field),
-            add: |sums: &mut Sums3d, p: &[[f64; BLOCK]; 3], len| sums.add_block(p, len, cal),
+            add: by_blocks(|sums: &mut Sums3d, p: &[[f64; BLOCK]; 3], len| {
+                sums.add_block(p, len, cal);
+            }),
             merge: |sums: &mut Sums3d, later| sums.merge(&later),
         },
     )?;

@@ -53,7 +53,7 @@ use crate::fits::normalise::Normaliser;
 use crate::fits::readings::{Readings, replay_points};
 use crate::numerics::blocks::BLOCK;
 use crate::numerics::linalg::sym_sqrt2;
-use crate::numerics::segments::{BlockFold, fold};
+use crate::numerics::segments::{RunFold, by_blocks, fold};
 use crate::quality::{self, Assessment2d, BOUND_SIGMAS, Moments2};
 
 use crate::fits::ellipse::config::EllipseConfig;
@@ -131,9 +131,9 @@ fn sampson_normal_equations_of<R: Readings<2> + ?Sized>(
     };
     let acc = fold(
         points,
-        &BlockFold {
+        &RunFold {
             start: NormalAccumulator::<5, 6>::new,
-            add,
+            add: by_blocks(add),
             merge: |acc: &mut NormalAccumulator<5, 6>, later| acc.merge(&later),
         },
     )?;

@@ -11,7 +11,7 @@ use crate::fits::normalise::Normaliser;
 use crate::fits::readings::Readings;
 use crate::numerics::blocks::{BLOCK, dot_block};
 use crate::numerics::linalg::{constrained_min6, sym_eigen3, sym_eigen6, sym_sqrt3};
-use crate::numerics::segments::{BlockFold, add_sums, fold};
+use crate::numerics::segments::{RunFold, add_sums, by_blocks, fold};
 
 use crate::fits::ellipsoid::config::MIN_POINTS_3D;
 #[cfg(not(feature = "std"))]
@@ -171,9 +171,9 @@ pub(crate) fn moments<R: Readings<3> + ?Sized>(
     };
     let (sums, _) = fold(
         points,
-        &BlockFold {
+        &RunFold {
             start: || ([0.0; 35], [[0.0; BLOCK]; 10]),
-            add,
+            add: by_blocks(add),
             merge: |(sums, _): &mut ([f64; 35], [[f64; BLOCK]; 10]), (later, _)| {
                 add_sums(sums, later);
             },

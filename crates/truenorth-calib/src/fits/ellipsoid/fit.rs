@@ -44,7 +44,7 @@ use crate::fits::normalise::Normaliser;
 use crate::fits::readings::{Readings, replay_points};
 use crate::numerics::blocks::BLOCK;
 use crate::numerics::linalg::sym_sqrt3;
-use crate::numerics::segments::{BlockFold, fold};
+use crate::numerics::segments::{RunFold, by_blocks, fold};
 use crate::quality::{self, CompassUncertainty};
 
 use crate::fits::ellipsoid::config::EllipsoidConfig;
@@ -127,9 +127,9 @@ fn radial_normal_equations_of<R: Readings<3> + ?Sized>(
     };
     let acc = fold(
         points,
-        &BlockFold {
+        &RunFold {
             start: NormalAccumulator::<9, 10>::new,
-            add,
+            add: by_blocks(add),
             merge: |acc: &mut NormalAccumulator<9, 10>, later| acc.merge(&later),
         },
     )?;

@@ -184,49 +184,30 @@ impl Sensor {
 /// order (for the fits and reports of one sensor: its ellipsoid, its normaliser, its
 /// coverage).
 pub(crate) struct SensorReadings<'a, R: ?Sized> {
-    readings: &'a R,
-    sensor: Sensor,
+    view: SensorView<'a, R>,
     /// The same view of the joint readings as threads may replay them, when they may.
-    shared: Option<SharedSensorReadings<'a>>,
+    shared: Option<SensorView<'a, dyn Readings<6> + Sync + 'a>>,
 }
 
 impl<'a, R: Readings<6> + ?Sized> SensorReadings<'a, R> {
     /// `sensor`'s readings among `readings`.
     pub fn new(readings: &'a R, sensor: Sensor) -> Self {
         Self {
-            readings,
-            sensor,
+            view: SensorView { readings, sensor },
             shared: readings
                 .shared()
-                .map(|readings| SharedSensorReadings { readings, sensor }),
+                .map(|readings| SensorView { readings, sensor }),
         }
     }
 }
 
-/// [`SensorReadings`] of joint readings that several threads may replay at once.
-struct SharedSensorReadings<'a> {
-    readings: &'a (dyn Readings<6> + Sync),
-    sensor: Sensor,
-}
-
-/// A sensor's readings among the joint runs of a replay, as runs of their own: a run of
-/// the joint readings is a multiple of READINGS_RUN_MULTIPLE but perhaps the last, and so
-/// is every piece of CONVERTED_RUN it is cut into but its last, so the runs handed on keep
-/// the rule.
-fn sensor_runs<'r>(
-    sensor: Sensor,
-    run: &'r mut dyn FnMut(&[Vector3<f64>]),
-) -> impl FnMut(&[MagAccelReading]) + 'r {
-    move |joint| replay_converted(joint, |r| sensor.of(r), run)
-}
-
 impl<R: Readings<6> + ?Sized> Readings<3> for SensorReadings<'_, R> {
     fn len(&self) -> usize {
-        self.readings.len()
+        self.view.len()
     }
 
     fn replay(&self, run: &mut dyn FnMut(&[Vector3<f64>])) -> Result<()> {
-        self.readings.replay(&mut sensor_runs(self.sensor, run))
+        self.view.replay(run)
     }
 
     fn replay_range(
@@ -235,22 +216,31 @@ impl<R: Readings<6> + ?Sized> Readings<3> for SensorReadings<'_, R> {
         end: usize,
         run: &mut dyn FnMut(&[Vector3<f64>]),
     ) -> Result<()> {
-        self.readings
-            .replay_range(start, end, &mut sensor_runs(self.sensor, run))
+        self.view.replay_range(start, end, run)
     }
 
     fn shared(&self) -> Option<&(dyn Readings<3> + Sync)> {
-        self.shared.as_ref().map(|s| s as &(dyn Readings<3> + Sync))
+        self.shared.as_ref().map(|v| v as &(dyn Readings<3> + Sync))
     }
 }
 
-impl Readings<3> for SharedSensorReadings<'_> {
+/// A sensor's three values of each joint reading. A run of the joint readings is a
+/// multiple of READINGS_RUN_MULTIPLE but perhaps the last, and so is every piece of
+/// CONVERTED_RUN it is cut into but its last: the runs handed on keep the rule.
+struct SensorView<'a, R: ?Sized> {
+    readings: &'a R,
+    sensor: Sensor,
+}
+
+impl<R: Readings<6> + ?Sized> Readings<3> for SensorView<'_, R> {
     fn len(&self) -> usize {
         self.readings.len()
     }
 
     fn replay(&self, run: &mut dyn FnMut(&[Vector3<f64>])) -> Result<()> {
-        self.readings.replay(&mut sensor_runs(self.sensor, run))
+        let sensor = self.sensor;
+        self.readings
+            .replay(&mut |joint| replay_converted(joint, |r| sensor.of(r), run))
     }
 
     fn replay_range(
@@ -259,7 +249,9 @@ impl Readings<3> for SharedSensorReadings<'_> {
         end: usize,
         run: &mut dyn FnMut(&[Vector3<f64>]),
     ) -> Result<()> {
-        self.readings
-            .replay_range(start, end, &mut sensor_runs(self.sensor, run))
+        let sensor = self.sensor;
+        self.readings.replay_range(start, end, &mut |joint| {
+            replay_converted(joint, |r| sensor.of(r), run);
+        })
     }
 }
