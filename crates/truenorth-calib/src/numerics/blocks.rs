@@ -1,9 +1,6 @@
 //! Sums over the readings a block at a time, in the shape the compiler vectorises.
 
 use nalgebra::SVector;
-use truenorth_core::Result;
-
-use crate::fits::readings::Readings;
 
 /// How many points the hot loops over the data (the refinement passes, the moments of the
 /// 3-D direct fit, the quality reports) process at a time.
@@ -61,19 +58,5 @@ pub(crate) fn blocks<const D: usize>(
             }
         }
         (q, chunk.len())
-    })
-}
-
-/// [`blocks`] over every run of `readings`, in order: the same blocks as over the readings
-/// in one slice, as every run but the last is a multiple of [`BLOCK`] long.
-#[inline(always)]
-pub(crate) fn replay_blocks<const D: usize, R: Readings<D> + ?Sized>(
-    readings: &R,
-    mut f: impl FnMut(&[[f64; BLOCK]; D], usize),
-) -> Result<()> {
-    readings.replay(&mut |run| {
-        for (q, len) in blocks(run) {
-            f(&q, len);
-        }
     })
 }

@@ -16,7 +16,7 @@ use super::sphere_cells::sphere_cell;
 use super::support::{Support2d, Support3d, support_dilution};
 use super::uncertainty::bound_and_uncertainty;
 use crate::fits::readings::Readings;
-use crate::numerics::blocks::{BLOCK, blocks, dot_block, replay_blocks, sum_block};
+use crate::numerics::blocks::{BLOCK, blocks, dot_block, sum_block};
 use crate::numerics::linalg::{condition_from_eigenvalues, sym_eigen5, sym_eigen9};
 use crate::numerics::segments::{RunFold, add_sums, by_blocks, fold};
 use crate::quality::SPHERE_CELLS;
@@ -349,16 +349,25 @@ pub(crate) fn support_dilution_3d<R: Readings<3> + ?Sized>(
 ) -> Result<f64> {
     let in_cell = cell_counts(points, cal)?;
     let weight = cell_weights(&in_cell);
-    let mut sums = [0.0; MONOMIALS_3D];
     let plan = monomial_plan_3d();
-    let mut cols = [[0.0; BLOCK]; 9];
-    let mut weighted = [[0.0; BLOCK]; 9];
-    replay_blocks(points, |p, len| {
-        CalibratedBlock::of(p, len, cal).monomials(&weight, &mut cols, &mut weighted);
-        for (wk, &(a, c)) in sums.iter_mut().zip(&plan) {
-            *wk += dot_block(&weighted[a], &cols[c]);
-        }
-    })?;
+    // Each segment's accumulator carries its block's columns (every entry is written for
+    // each block).
+    type Acc = ([f64; MONOMIALS_3D], [[f64; BLOCK]; 9], [[f64; BLOCK]; 9]);
+    let (sums, _, _) = fold(
+        points,
+        &RunFold {
+            start: || ([0.0; MONOMIALS_3D], [[0.0; BLOCK]; 9], [[0.0; BLOCK]; 9]),
+            add: by_blocks(
+                |(sums, cols, weighted): &mut Acc, p: &[[f64; BLOCK]; 3], len| {
+                    CalibratedBlock::of(p, len, cal).monomials(&weight, cols, weighted);
+                    for (wk, &(a, c)) in sums.iter_mut().zip(&plan) {
+                        *wk += dot_block(&weighted[a], &cols[c]);
+                    }
+                },
+            ),
+            merge: |(sums, _, _): &mut Acc, (later, _, _): Acc| add_sums(sums, later),
+        },
+    )?;
     let cells = weight.iter().filter(|&&x| x > 0.0).count();
     let support = Support3d { sums, cells };
     Ok(support_dilution(&support.information(), cells, worst_3d))

@@ -41,7 +41,7 @@ use truenorth_core::{Error, Result, Solution, Validate};
 
 use crate::fits::lm::{self, NormalAccumulator, NormalEquations};
 use crate::fits::normalise::Normaliser;
-use crate::fits::readings::{Readings, replay_points};
+use crate::fits::readings::Readings;
 use crate::numerics::blocks::BLOCK;
 use crate::numerics::linalg::sym_sqrt3;
 use crate::numerics::segments::{RunFold, by_blocks, fold};
@@ -183,18 +183,38 @@ fn fit_unchecked<R: Readings<3> + ?Sized>(
     config: &EllipsoidConfig,
 ) -> Result<Solution<CompassCalibration3d>> {
     // Whether every reading is finite, and the centre of their bounding box, in one pass.
-    let (mut all_finite, mut lo, mut hi) = (
-        true,
-        Vector3::repeat(f64::INFINITY),
-        -Vector3::repeat(f64::INFINITY),
-    );
-    if points.len() >= MIN_POINTS_3D {
-        replay_points(points, |p| {
-            all_finite &= p.iter().all(|x| x.is_finite());
-            lo = lo.inf(p);
-            hi = hi.sup(p);
-        })?;
-    }
+    // Segment by segment (see `fold`): a conjunction, a minimum and a maximum merge
+    // exactly.
+    type Acc = (bool, Vector3<f64>, Vector3<f64>);
+    let start = || {
+        (
+            true,
+            Vector3::repeat(f64::INFINITY),
+            -Vector3::repeat(f64::INFINITY),
+        )
+    };
+    let (all_finite, lo, hi) = if points.len() >= MIN_POINTS_3D {
+        fold(
+            points,
+            &RunFold {
+                start,
+                add: |(all_finite, lo, hi): &mut Acc, run: &[Vector3<f64>]| {
+                    for p in run {
+                        *all_finite &= p.iter().all(|x| x.is_finite());
+                        *lo = lo.inf(p);
+                        *hi = hi.sup(p);
+                    }
+                },
+                merge: |(all_finite, lo, hi): &mut Acc, (f, l, h): Acc| {
+                    *all_finite &= f;
+                    *lo = lo.inf(&l);
+                    *hi = hi.sup(&h);
+                },
+            },
+        )?
+    } else {
+        start()
+    };
     if points.len() >= MIN_POINTS_3D && all_finite {
         // Before fitting, seen from the bounding-box centre (the centre of any complete
         // ellipsoid) without a soft iron, so that a single-axis turn or a small patch of
