@@ -81,7 +81,7 @@ pub(crate) fn sector(y: f64, x: f64, n: usize) -> usize {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::quality::turns;
+    use crate::quality::direction_bins::tests::worst_coarse_error_rad;
     use crate::seed::binned::MAX_BINS;
     use proptest::prelude::*;
 
@@ -123,14 +123,7 @@ mod tests {
     /// bins, on a finer grid.
     #[test]
     fn margin_covers_the_coarse_error_three_times() {
-        let mut worst: f64 = 0.0;
-        for k in 0..1_000_000 {
-            let a = TAU * k as f64 / 1_000_000.0;
-            let (y, x) = a.sin_cos();
-            let mut d = (coarse_turns(y, x) - turns(y, x)).abs();
-            d = d.min(1.0 - d);
-            worst = worst.max(d * TAU);
-        }
+        let worst = worst_coarse_error_rad(1_000_000);
         assert!(worst < 1.2e-5, "{worst}");
         assert!(NEAR_BOUNDARY_RAD > 3.0 * worst, "{worst}");
     }
