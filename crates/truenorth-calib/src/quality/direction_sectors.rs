@@ -53,14 +53,16 @@ pub(crate) fn sector_of_angle(angle_rad: f64, n: usize) -> usize {
 #[inline(always)]
 fn sector_if_clear(y: f64, x: f64, n: usize) -> Option<usize> {
     let sectors = n as f64;
-    // In [0, n]: `coarse_turns` is in [0, 1]. Truncation is the floor of a non-negative
-    // value, and subtracting the integer part of a double below 2⁵³ is exact.
+    // In [0, n]: `coarse_turns` is in [0, 1]. Truncation is its floor; it goes through `u32`
+    // because x86-64 converts between doubles and `u64` in a dozen instructions or more
+    // each way and `u32` in one or two. Past 2³² it saturates, `inside` is then 1 or more
+    // and `atan2` decides. Subtracting the integer part of a double is exact.
     let u = coarse_turns(y, x) * sectors;
-    let k = u as usize;
-    let inside = u - k as f64;
+    let k = u as u32;
+    let inside = u - f64::from(k);
     let margin = NEAR_BOUNDARY_TURNS * sectors;
     // A clear `u` is below n − margin, so `k` < n; `min` only proves it.
-    (inside > margin && inside < 1.0 - margin).then_some(k.min(n.saturating_sub(1)))
+    (inside > margin && inside < 1.0 - margin).then_some((k as usize).min(n.saturating_sub(1)))
 }
 
 /// The sector by `atan2`, kept out of line: it is the rare path.
