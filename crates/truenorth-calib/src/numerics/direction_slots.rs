@@ -3,10 +3,9 @@
 
 extern crate alloc;
 
-use core::f64::consts::TAU;
-
 use nalgebra::Vector2;
-use truenorth_core::wrap_two_pi;
+
+use crate::quality::{sector, sector_of_angle};
 
 #[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
@@ -39,18 +38,32 @@ impl DirectionSlots {
     }
 
     /// Keeps `p` in the slot of its direction about `centre` (skipped if not finite or at the
-    /// centre), and returns that direction, `atan2` of `p − centre`, radians (`None` when
-    /// skipped), for a caller that needs it too.
-    pub(crate) fn push(&mut self, p: &Vector2<f64>, centre: &Vector2<f64>) -> Option<f64> {
-        let d = p - centre;
-        if !(d.x.is_finite() && d.y.is_finite()) || (d.x == 0.0 && d.y == 0.0) {
-            return None;
+    /// centre). The slot is that of `atan2` of `p − centre`, found mostly without it
+    /// ([`sector`]).
+    pub(crate) fn push(&mut self, p: &Vector2<f64>, centre: &Vector2<f64>) {
+        if let Some(d) = direction_about(p, centre) {
+            self.keep(sector(d.y, d.x, SLOTS), p);
         }
+    }
+
+    /// [`Self::push`], for a caller that needs the direction too: returns it, `atan2` of
+    /// `p − centre`, radians (`None` when skipped), and takes the slot from it (the same
+    /// slot as [`Self::push`]'s).
+    pub(crate) fn push_with_direction(
+        &mut self,
+        p: &Vector2<f64>,
+        centre: &Vector2<f64>,
+    ) -> Option<f64> {
+        let d = direction_about(p, centre)?;
         let direction = d.y.atan2(d.x);
-        let i = ((wrap_two_pi(direction) / TAU * SLOTS as f64) as usize).min(SLOTS - 1);
+        self.keep(sector_of_angle(direction, SLOTS), p);
+        Some(direction)
+    }
+
+    /// Stores `p` in slot `i`.
+    fn keep(&mut self, i: usize, p: &Vector2<f64>) {
         self.points[i] = *p;
         self.filled[i] = true;
-        Some(direction)
     }
 
     /// The slots in order, `None` where empty (for saving).
@@ -95,4 +108,10 @@ impl DirectionSlots {
         }
         n
     }
+}
+
+/// `p − centre`, or `None` if it is not finite or zero (no direction).
+fn direction_about(p: &Vector2<f64>, centre: &Vector2<f64>) -> Option<Vector2<f64>> {
+    let d = p - centre;
+    ((d.x.is_finite() && d.y.is_finite()) && (d.x != 0.0 || d.y != 0.0)).then_some(d)
 }

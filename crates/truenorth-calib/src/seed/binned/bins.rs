@@ -5,7 +5,8 @@ use core::f64::consts::TAU;
 
 use nalgebra::Vector2;
 use serde::{Deserialize, Serialize};
-use truenorth_core::wrap_two_pi;
+
+use crate::quality::sector;
 
 #[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
@@ -42,12 +43,13 @@ pub(crate) const EMPTY: Bin = Bin {
 /// The bins of a calibrator (the first `n` are in use).
 pub(crate) type Bins = [Bin; MAX_BINS];
 
-/// The bin of direction `d` among `n`, or `None` for a zero or non-finite `d`.
+/// The bin of direction `d` among `n`, or `None` for a zero or non-finite `d`: the sector
+/// of `atan2(d)` in [0, 2π), bit for bit, found mostly without it ([`sector`]).
 pub(crate) fn bin_index(d: &Vector2<f64>, n: usize) -> Option<usize> {
     if !(d.x.is_finite() && d.y.is_finite()) || (d.x == 0.0 && d.y == 0.0) {
         return None;
     }
-    Some(((wrap_two_pi(d.y.atan2(d.x)) / TAU * n as f64) as usize).min(n - 1))
+    Some(sector(d.y, d.x, n))
 }
 
 /// Puts reading `p` in its bin about `origin` (claims 1, 3, 4): it replaces what a bin

@@ -410,7 +410,7 @@ impl Calibrator for MeritCircleCalibrator {
         self.hi = self.hi.sup(&p);
         let slot_centre = self.state.centre.unwrap_or((self.lo + self.hi) * 0.5);
         // About the centre, when there is one, as the new-data-point test wants it.
-        let direction = self.slots.push(&p, &slot_centre);
+        let direction = self.slots.push_with_direction(&p, &slot_centre);
         let direction = direction.filter(|_| self.state.centre.is_some());
         if self.samples <= self.config.warmup_samples || !self.heading_changed(&p, direction) {
             return Ok(pushed);

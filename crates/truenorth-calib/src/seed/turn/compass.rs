@@ -108,7 +108,7 @@ impl Calibrator for TurnCompassCalibrator {
         self.clock.dt_s(sample.t_s)?;
         self.extrema.push(&sample.mag, sample.t_s)?;
         let c = self.extrema.provisional_centre();
-        let _ = self.slots.push(&sample.mag, &c);
+        self.slots.push(&sample.mag, &c);
         Ok(Pushed::Accepted)
     }
 

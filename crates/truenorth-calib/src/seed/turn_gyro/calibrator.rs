@@ -537,7 +537,7 @@ impl Calibrator for TurnCalibrator {
         }
         self.extrema.push(&sample.mag, self.at)?;
         let c = self.extrema.provisional_centre();
-        let _ = self.slots.push(&sample.mag, &c);
+        self.slots.push(&sample.mag, &c);
         if self.zero.is_none()
             && self.extrema.x().confirmed_count() + self.extrema.y().confirmed_count() > 0
         {
