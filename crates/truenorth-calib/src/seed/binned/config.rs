@@ -13,7 +13,7 @@ pub const MAX_INIT_SAMPLES: usize = 64;
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct BinnedEllipseConfig {
-    /// Number of direction bins N, even, 8..=[`MAX_BINS`] (64).
+    /// Number of direction bins N, even, 8..=[`MAX_BINS`] (128; 64 by default).
     pub bins: usize,
     /// Readings averaged for the initial origin, 1..=[`MAX_INIT_SAMPLES`] (8).
     pub init_samples: usize,
