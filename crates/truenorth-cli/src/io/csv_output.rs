@@ -1,11 +1,11 @@
-//! CSVs of numbers written row by row, the text made and written on a thread of its own.
+//! CSVs of numbers written row by row, the text made and written on threads of their own.
 //!
 //! Writing the shortest text of every number is much of a streaming command's work (a
-//! `heading` run spends about half of its main thread's time on it): the command hands
-//! its rows over in blocks, and a writer thread formats them and writes them into the
-//! [`AtomicOutput`], while the command computes the next rows. The bytes are those one
-//! thread would write, in the same order. The hand-over is bounded (a few blocks), so
-//! memory does not grow with the file.
+//! `heading` run spends about half of its time on it): the command hands its rows over in
+//! blocks, [`FORMATTERS`] threads take turns to format them, and a writer thread writes
+//! their text into the [`AtomicOutput`] in the order of the blocks, while the command
+//! computes the next rows. The bytes are those one thread would write, in the same order.
+//! The hand-over is bounded (a few blocks), so memory does not grow with the file.
 
 use std::path::{Path, PathBuf};
 use std::sync::mpsc::{Receiver, SyncSender};
@@ -15,13 +15,18 @@ use super::atomic_write::AtomicOutput;
 use super::number_format::Precision;
 use super::{CliError, CliResult};
 
-/// Rows handed to the writer at a time: large enough that the hand-over costs nothing
+/// Rows handed to a formatter at a time: large enough that the hand-over costs nothing
 /// beside the formatting, small enough that a block's values stay in the cache.
 const BLOCK_ROWS: usize = 4096;
 
-/// Blocks handed over and not yet written, at most: the command runs ahead of the writer
-/// by this much and no more.
+/// Blocks handed to each formatter and not yet formatted, at most: the command runs ahead
+/// of the output by this much and no more.
 const BLOCKS_AHEAD: usize = 2;
+
+/// Threads that format blocks, taking turns: formatting is the slowest stage of a
+/// streaming command (a `heading` run's one formatter took 44 % of its CPU time, more than
+/// the command itself, on `scripts/io_speed.sh`'s 10⁷-row file), and two share it.
+const FORMATTERS: usize = 2;
 
 /// Rows on their way to the writer.
 #[derive(Debug, Default)]
@@ -59,14 +64,23 @@ impl RowBlock {
 /// its temporary) and the first write error.
 type Written = (AtomicOutput, CliResult);
 
+/// A formatted block on its way to the writer: its text, and the block, to hand back for
+/// reuse.
+type Formatted = (String, RowBlock);
+
 /// A CSV written row by row into an `AtomicOutput`: numbers in the shortest form that
 /// reads back as the same `f64`, or rounded (see [`Precision`]).
 pub struct CsvOutput {
     name: PathBuf,
     block: RowBlock,
-    to_writer: Option<SyncSender<RowBlock>>,
+    /// To each formatter; block `k` goes to formatter `k % FORMATTERS`. Empty once the
+    /// hand-over has ended.
+    to_formatters: Vec<SyncSender<RowBlock>>,
+    /// Blocks handed over so far.
+    handed: usize,
     /// Blocks the writer is done with, for reuse.
     written: Receiver<RowBlock>,
+    formatters: Vec<JoinHandle<()>>,
     writer: Option<JoinHandle<Written>>,
 }
 
@@ -84,29 +98,61 @@ impl CsvOutput {
         let mut out = AtomicOutput::create(path)?;
         out.write_all((header.join(",") + "\n").as_bytes())?;
         let name = out.name().to_path_buf();
-        let (to_writer, blocks) = std::sync::mpsc::sync_channel::<RowBlock>(BLOCKS_AHEAD);
+        let cannot =
+            |e: std::io::Error| CliError::file(path, format!("cannot start the writer: {e}"));
         let (give_back, written) = std::sync::mpsc::sync_channel::<RowBlock>(BLOCKS_AHEAD + 1);
+        let mut to_formatters = Vec::with_capacity(FORMATTERS);
+        let mut from_formatters = Vec::with_capacity(FORMATTERS);
+        let mut formatters = Vec::with_capacity(FORMATTERS);
+        for _ in 0..FORMATTERS {
+            let (to_formatter, blocks) = std::sync::mpsc::sync_channel::<RowBlock>(BLOCKS_AHEAD);
+            let (to_writer, texts) = std::sync::mpsc::sync_channel::<Formatted>(1);
+            let (text_back, spare_texts) = std::sync::mpsc::sync_channel::<String>(2);
+            let formatter = std::thread::Builder::new()
+                .name("truenorth-format".into())
+                .spawn(move || {
+                    for block in blocks {
+                        let mut text = spare_texts.try_recv().unwrap_or_default();
+                        text.clear();
+                        block.write_into(&mut text);
+                        if to_writer.send((text, block)).is_err() {
+                            // The writer stopped on an error, which it reports.
+                            return;
+                        }
+                    }
+                })
+                .map_err(cannot)?;
+            to_formatters.push(to_formatter);
+            from_formatters.push((texts, text_back));
+            formatters.push(formatter);
+        }
         let writer = std::thread::Builder::new()
             .name("truenorth-write".into())
             .spawn(move || {
-                let mut text = String::new();
-                for block in blocks {
-                    text.clear();
-                    block.write_into(&mut text);
+                // The blocks' texts in the order the blocks were handed over: block `k` from
+                // formatter `k % FORMATTERS`, until that one has no more (then no later block
+                // exists either).
+                for (texts, text_back) in from_formatters.iter().cycle() {
+                    let Ok((text, block)) = texts.recv() else {
+                        break;
+                    };
                     if let Err(e) = out.write_all(text.as_bytes()) {
                         return (out, Err(e));
                     }
-                    // A full return channel only means the block is not reused.
+                    // A full return channel only means the buffer or block is not reused.
+                    let _ = text_back.try_send(text);
                     let _ = give_back.try_send(block);
                 }
                 (out, Ok(()))
             })
-            .map_err(|e| CliError::file(path, format!("cannot start the writer: {e}")))?;
+            .map_err(cannot)?;
         Ok(Self {
             name,
             block: RowBlock::default(),
-            to_writer: Some(to_writer),
+            to_formatters,
+            handed: 0,
             written,
+            formatters,
             writer: Some(writer),
         })
     }
@@ -126,41 +172,53 @@ impl CsvOutput {
         Ok(())
     }
 
-    /// Hands the rows so far to the writer, and starts a new block (a reused one when the
-    /// writer has given one back).
+    /// Hands the rows so far to the next formatter, and starts a new block (a reused one
+    /// when the writer has given one back).
     fn hand_over(&mut self) -> CliResult {
         let mut next = self.written.try_recv().unwrap_or_default();
         next.clear();
         next.precision = self.block.precision;
         let full = std::mem::replace(&mut self.block, next);
-        let sent = match &self.to_writer {
-            Some(to_writer) => to_writer.send(full).is_ok(),
+        let sent = match self.to_formatters.get(self.handed % FORMATTERS) {
+            Some(to_formatter) => to_formatter.send(full).is_ok(),
             None => false,
         };
+        self.handed += 1;
         if sent {
             Ok(())
         } else {
-            // The writer stopped on an error: that error is the one to report.
+            // The writer stopped on an error (and the formatters with it): that error is
+            // the one to report.
             self.stop().map(drop)
         }
     }
 
-    /// Ends the hand-over and waits for the writer: the output, or the first error.
+    /// Ends the hand-over and waits for the formatters and the writer: the output, or the
+    /// first error.
     fn stop(&mut self) -> CliResult<AtomicOutput> {
-        self.to_writer = None;
+        self.to_formatters.clear();
         let Some(writer) = self.writer.take() else {
             return Err(CliError::file(
                 &self.name,
                 "the output was already finished",
             ));
         };
-        match writer.join() {
-            Ok((out, Ok(()))) => Ok(out),
-            Ok((_, Err(e))) => Err(e),
-            Err(_) => Err(CliError::file(
+        let stopped = || {
+            CliError::file(
                 &self.name,
                 "the writer thread stopped unexpectedly; the output was not finished",
-            )),
+            )
+        };
+        let mut formatted = Ok(());
+        for formatter in self.formatters.drain(..) {
+            if formatter.join().is_err() {
+                formatted = Err(stopped());
+            }
+        }
+        match writer.join() {
+            Ok((out, Ok(()))) => formatted.map(|()| out),
+            Ok((_, Err(e))) => Err(e),
+            Err(_) => Err(stopped()),
         }
     }
 
@@ -175,9 +233,10 @@ impl CsvOutput {
 
 impl Drop for CsvOutput {
     /// An output dropped unfinished (an error on the way) hands over its last rows and
-    /// waits for its writer, which then drops the output: a temporary is removed before the
-    /// run ends, and standard output, a device or a FIFO gets every row written before the
-    /// error, as a single-threaded writer flushing on drop would give it.
+    /// waits for its threads, after which the writer drops the output: a temporary is
+    /// removed before the run ends, and standard output, a device or a FIFO gets every row
+    /// written before the error, as a single-threaded writer flushing on drop would give
+    /// it.
     fn drop(&mut self) {
         if self.writer.is_some() {
             if !self.block.widths.is_empty() {
