@@ -14,14 +14,17 @@ use super::console::end_on_closed_pipe;
 use super::output_target::OutputTarget;
 use super::source::InputPath;
 use super::temporaries;
+use super::write_behind::WriteBehind;
 use super::{CliError, CliResult};
 
 /// The bytes' destination: standard output or an open file (a temporary, or a device or
 /// FIFO written directly). Its reader closing the pipe ends the run quietly (see
-/// [`console`](super::console)).
+/// [`console`](super::console)). A temporary is synced behind its writes (see
+/// [`write_behind`](super::write_behind)).
 enum Dest {
     Stdout(std::io::Stdout),
     File(File),
+    Temporary(WriteBehind),
 }
 
 impl Write for Dest {
@@ -29,6 +32,7 @@ impl Write for Dest {
         let written = match self {
             Self::Stdout(s) => s.write(bytes),
             Self::File(f) => f.write(bytes),
+            Self::Temporary(f) => f.write(bytes),
         };
         match written {
             Err(e) if e.kind() == ErrorKind::BrokenPipe => end_on_closed_pipe(),
@@ -40,6 +44,7 @@ impl Write for Dest {
         let flushed = match self {
             Self::Stdout(s) => s.flush(),
             Self::File(f) => f.flush(),
+            Self::Temporary(f) => f.flush(),
         };
         match flushed {
             Err(e) if e.kind() == ErrorKind::BrokenPipe => end_on_closed_pipe(),
@@ -101,7 +106,11 @@ impl AtomicOutput {
                 if let Ok(m) = std::fs::metadata(&target) {
                     let _ = file.set_permissions(m.permissions());
                 }
-                (Dest::File(file), Some((temp, target)), path.to_path_buf())
+                (
+                    Dest::Temporary(WriteBehind::new(file)),
+                    Some((temp, target)),
+                    path.to_path_buf(),
+                )
             }
         };
         let writer = BufWriter::with_capacity(1 << 16, dest);
@@ -161,6 +170,7 @@ impl AtomicOutput {
         };
         // From here on the temporary is this function's to remove on failure.
         let synced = match dest {
+            Dest::Temporary(f) => f.finish().and_then(|f| f.sync_all()),
             Dest::File(f) => f.sync_all(),
             Dest::Stdout(_) => Ok(()),
         };

@@ -64,6 +64,7 @@ mod temporaries;
 mod unit_check;
 mod vehicle_file;
 mod wheel_columns;
+mod write_behind;
 mod yaw_rate_check;
 
 pub use atomic_write::{check_distinct, write_atomically};
