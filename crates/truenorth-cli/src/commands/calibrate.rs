@@ -22,7 +22,7 @@ use crate::io::log_input;
 use crate::io::reading_spill::ReadingSpill;
 use crate::io::{
     AccelPart, CALIBRATION_FORMAT, CALIBRATION_VERSION, CalibrationFile, CliError, CliResult,
-    GyroPart, InputOptions, InputPath, QualityReport, ReadSpec, Row, RowReader, check_distinct,
+    GyroPart, InputOptions, InputPath, QualityReport, ReadSpec, RowReader, RowRef, check_distinct,
     finite, gyro_units, matrix_rows, units_block,
 };
 use crate::registry::{
@@ -301,7 +301,7 @@ fn at(rows: &RowReader, name: &str) -> usize {
 fn push_rows<C>(
     rows: &mut RowReader,
     cal: &mut C,
-    mut sample: impl FnMut(&Row, f64) -> C::Sample,
+    mut sample: impl FnMut(&RowRef<'_>, f64) -> C::Sample,
 ) -> CliResult
 where
     C: Calibrator + ?Sized,
@@ -309,11 +309,13 @@ where
     let t_col = rows.index("t_s");
     let path = rows.path().to_path_buf();
     let mut count = 0usize;
-    while let Some(row) = rows.next_row()? {
-        let t_s = t_col.map_or(count as f64, |i| row[i]);
-        cal.push(&sample(row, t_s))
-            .map_err(|e| CliError::row(&path, row.number, e.to_string()).kind_of(&e))?;
-        count += 1;
+    while let Some(block) = rows.next_rows()? {
+        for row in block {
+            let t_s = t_col.map_or(count as f64, |i| row[i]);
+            cal.push(&sample(&row, t_s))
+                .map_err(|e| CliError::row(&path, row.number, e.to_string()).kind_of(&e))?;
+            count += 1;
+        }
     }
     if count == 0 {
         return Err(CliError::row(&path, 2, "no data rows after the header"));
@@ -392,7 +394,7 @@ fn calibrate_turn(
 }
 
 /// Three columns of a row as a vector.
-fn vector(r: &Row, [x, y, z]: [usize; 3]) -> Vector3<f64> {
+fn vector(r: &RowRef<'_>, [x, y, z]: [usize; 3]) -> Vector3<f64> {
     Vector3::new(r[x], r[y], r[z])
 }
 

@@ -14,7 +14,7 @@ use super::field::Place;
 use crate::io::errln;
 use crate::io::log_input::{self, AxleTrack};
 use crate::io::{
-    CliError, CliResult, GyroUnit, InputOptions, OutputOptions, ReadSpec, Row, RowReader,
+    CliError, CliResult, GyroUnit, InputOptions, OutputOptions, ReadSpec, RowReader, RowRef,
     VehicleFile, WheelColumns, check_distinct, read_learned, write_learned,
 };
 use crate::registry::{VehicleMethod, VehicleRun};
@@ -366,7 +366,7 @@ struct Columns {
 impl Columns {
     /// The sample a row carries: each sensor whose cells are filled (wheel speeds
     /// integrated into distances on the way).
-    fn sample(&mut self, row: &Row, path: &Path) -> CliResult<VehicleSample> {
+    fn sample(&mut self, row: &RowRef<'_>, path: &Path) -> CliResult<VehicleSample> {
         let v = &row.values;
         let mut sample = VehicleSample::at(v[self.t]);
         if let Some(w) = self.wheels.as_mut()
@@ -399,15 +399,17 @@ fn estimate(
 ) -> CliResult<usize> {
     let path = rows.path().to_path_buf();
     let mut samples = 0usize;
-    while let Some(row) = rows.next_row()? {
-        let sample = columns.sample(row, &path)?;
-        method
-            .push(&sample, &mut |e, filter| writer.write(e, filter))
-            .map_err(|e| CliError::row(&path, row.number, e.to_string()).kind_of(&e))?;
-        if let Some(e) = writer.error.take() {
-            return Err(e);
+    while let Some(block) = rows.next_rows()? {
+        for row in block {
+            let sample = columns.sample(&row, &path)?;
+            method
+                .push(&sample, &mut |e, filter| writer.write(e, filter))
+                .map_err(|e| CliError::row(&path, row.number, e.to_string()).kind_of(&e))?;
+            if let Some(e) = writer.error.take() {
+                return Err(e);
+            }
+            samples += 1;
         }
-        samples += 1;
     }
     method
         .finish(&mut |e, filter| writer.write(e, filter))

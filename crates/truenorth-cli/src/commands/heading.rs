@@ -12,7 +12,7 @@ use crate::io::errln;
 use crate::io::log_input;
 use crate::io::{
     CalibrationFile, CliError, CliResult, CompassCalibration, CsvOutput, InputOptions,
-    OutputOptions, Precision, ReadSpec, Row, RowReader, check_distinct,
+    OutputOptions, Precision, ReadSpec, RowReader, RowRef, check_distinct,
 };
 
 /// The long help of the command (after the options).
@@ -95,20 +95,22 @@ pub fn run(args: &Args) -> CliResult {
     let mut out = CsvOutput::create(&args.output, &header)?;
     let mut count = 0usize;
     let path = rows.path().to_path_buf();
-    while let Some(row) = rows.next_row()? {
-        let (magnetic, tilt) = cols.heading(&cal, row, &path)?;
-        let rad = match declination {
-            Some(d) => magnetic.to_true(d).rad(),
-            None => magnetic.rad(),
-        };
-        write_row(
-            &mut out,
-            args.output_options.precision,
-            row[cols.t],
-            rad,
-            tilt,
-        )?;
-        count += 1;
+    while let Some(block) = rows.next_rows()? {
+        for row in block {
+            let (magnetic, tilt) = cols.heading(&cal, &row, &path)?;
+            let rad = match declination {
+                Some(d) => magnetic.to_true(d).rad(),
+                None => magnetic.rad(),
+            };
+            write_row(
+                &mut out,
+                args.output_options.precision,
+                row[cols.t],
+                rad,
+                tilt,
+            )?;
+            count += 1;
+        }
     }
     if count == 0 {
         return Err(CliError::row(&path, 2, "no data rows after the header"));
@@ -181,7 +183,7 @@ impl Columns {
     fn heading(
         &self,
         cal: &CompassCalibration,
-        row: &Row,
+        row: &RowRef<'_>,
         path: &Path,
     ) -> CliResult<(MagneticHeading, Option<Tilt>)> {
         let (x, y) = (self.x, self.y);

@@ -84,7 +84,7 @@ pub use gyro_axes::{
 pub use inertial_units::{AccUnit, GyroUnit};
 pub use learned_file::{read_learned, write_learned};
 pub use number_format::{OutputOptions, Precision};
-pub use reader::{ReadSpec, Row, RowReader, rows_read};
+pub use reader::{ReadSpec, Row, RowReader, RowRef, rows_read};
 pub use source::InputPath;
 pub use table::Table;
 pub use unit_check::{

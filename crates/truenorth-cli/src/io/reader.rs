@@ -74,6 +74,24 @@ impl std::ops::Index<usize> for Row {
     }
 }
 
+/// A data row seen where it lies in the reader's current block (see
+/// [`RowReader::next_rows`]): a [`Row`] without the copy.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RowRef<'a> {
+    /// The 1-based line of the file it was read from.
+    pub number: usize,
+    /// The values, in the reader's column order.
+    pub values: &'a [f64],
+}
+
+impl std::ops::Index<usize> for RowRef<'_> {
+    type Output = f64;
+
+    fn index(&self, i: usize) -> &f64 {
+        &self.values[i]
+    }
+}
+
 /// A streaming reader of the requested numeric columns of a CSV (see the module
 /// documentation). It holds one row at a time; the file is read on a second thread and
 /// parsed, in chunks, on two more, a few blocks of rows ahead (see the `row_blocks`
@@ -245,6 +263,20 @@ impl RowReader {
             }
             None => Ok(None),
         }
+    }
+
+    /// The next rows at once, in file order, or `None` at the end of the file: for a loop
+    /// over every row, which then pays no call and no copy a row (the rows are where the
+    /// reader parsed them). Rows handed out one way are not handed out the other.
+    pub fn next_rows(&mut self) -> CliResult<Option<impl Iterator<Item = RowRef<'_>>>> {
+        let width = self.row.values.len();
+        Ok(self.blocks.next_rows()?.map(|(numbers, values)| {
+            self.handed += numbers.len() as u64;
+            numbers
+                .iter()
+                .zip(values.chunks_exact(width.max(1)))
+                .map(|(&number, values)| RowRef { number, values })
+        }))
     }
 }
 

@@ -165,18 +165,50 @@ impl RowBlocks {
     /// Copies the next row's values into `values` and returns its row number; `None` at the
     /// end of the input, the first error in file order where it happened.
     pub fn next_into(&mut self, values: &mut [f64]) -> CliResult<Option<usize>> {
+        if !self.fill()? {
+            return Ok(None);
+        }
+        let Some((_, block)) = &self.current else {
+            return Ok(None);
+        };
+        let k = self.next;
+        self.next += 1;
+        let n = self.columns;
+        values.copy_from_slice(&block.values[k * n..(k + 1) * n]);
+        Ok(Some(block.numbers[k]))
+    }
+
+    /// The rows not yet handed out of the current block, or else of the next one, all at
+    /// once: their row numbers and their values, row after row (`None` at the end of the
+    /// input, the first error in file order where it happened). For a loop over every row,
+    /// which then pays no call and no copy a row.
+    pub fn next_rows(&mut self) -> CliResult<Option<(&[usize], &[f64])>> {
+        if !self.fill()? {
+            return Ok(None);
+        }
+        let Some((_, block)) = &self.current else {
+            return Ok(None);
+        };
+        let k = self.next;
+        self.next = block.numbers.len();
+        Ok(Some((
+            &block.numbers[k..],
+            &block.values[k * self.columns..],
+        )))
+    }
+
+    /// Makes the current block one with rows not yet handed out, taking the next blocks in
+    /// file order as needed; `false` at the end of the input, the first error in file order
+    /// where it happened.
+    fn fill(&mut self) -> CliResult<bool> {
         loop {
             if let Some((_, block)) = &mut self.current {
                 if self.next < block.numbers.len() {
-                    let k = self.next;
-                    self.next += 1;
-                    let n = self.columns;
-                    values.copy_from_slice(&block.values[k * n..(k + 1) * n]);
-                    return Ok(Some(block.numbers[k]));
+                    return Ok(true);
                 }
                 if let Some(end) = block.end.take() {
                     self.done = true;
-                    return end.map(|()| None);
+                    return end.map(|()| false);
                 }
                 // Emptied: back to its worker (which may have stopped; then it is dropped).
                 if let Some((w, b)) = self.current.take() {
@@ -184,7 +216,7 @@ impl RowBlocks {
                 }
             }
             if self.done {
-                return Ok(None);
+                return Ok(false);
             }
             let w = self.chunk % self.full.len();
             match self.full[w].recv() {
@@ -304,10 +336,33 @@ mod tests {
         RowBlocks::spawn_with(cutter, Arc::new(Counting { fail }), 2, workers).unwrap()
     }
 
-    fn drain(mut blocks: RowBlocks) -> (Vec<usize>, CliResult) {
+    /// Every row of `blocks`, and how they ended: one row at a time, or, `by_rows`, taking
+    /// a row and then the rest of its block by turns (so both ways, and their mix, are held).
+    fn drain(mut blocks: RowBlocks, by_rows: bool) -> (Vec<usize>, CliResult) {
         let mut v = [0.0; 2];
         let mut seen = Vec::new();
+        let mut take_rest = false;
         loop {
+            if by_rows && take_rest {
+                match blocks.next_rows() {
+                    Ok(Some((numbers, values))) => {
+                        assert!(!numbers.is_empty());
+                        assert_eq!(values.len(), 2 * numbers.len());
+                        for (&n, v) in numbers.iter().zip(values.chunks_exact(2)) {
+                            assert_eq!(v, [n as f64, -(n as f64)]);
+                            seen.push(n);
+                        }
+                    }
+                    Ok(None) => {
+                        assert!(matches!(blocks.next_rows(), Ok(None)));
+                        return (seen, Ok(()));
+                    }
+                    Err(e) => return (seen, Err(e)),
+                }
+                take_rest = false;
+                continue;
+            }
+            take_rest = true;
             match blocks.next_into(&mut v) {
                 Ok(Some(n)) => {
                     assert_eq!(v, [n as f64, -(n as f64)]);
@@ -325,7 +380,7 @@ mod tests {
 
     #[test]
     fn every_row_in_order_then_the_end_or_the_error() {
-        for workers in [1, 2, 3] {
+        for (workers, by_rows) in [(1, false), (2, false), (3, false), (1, true), (2, true)] {
             for n in [
                 0,
                 1,
@@ -333,12 +388,15 @@ mod tests {
                 BLOCK_ROWS,
                 3 * BLOCKS * BLOCK_ROWS + 5,
             ] {
-                let (seen, end) = drain(counting(n, None, BLOCK_ROWS, workers));
+                let (seen, end) = drain(counting(n, None, BLOCK_ROWS, workers), by_rows);
                 assert_eq!(seen, (1..=n).collect::<Vec<_>>());
                 assert!(end.is_ok());
             }
             let fail = 2 * BLOCK_ROWS + 7;
-            let (seen, end) = drain(counting(10 * BLOCK_ROWS, Some(fail), BLOCK_ROWS, workers));
+            let (seen, end) = drain(
+                counting(10 * BLOCK_ROWS, Some(fail), BLOCK_ROWS, workers),
+                by_rows,
+            );
             assert_eq!(seen.len(), fail - 1);
             assert!(
                 end.unwrap_err()
@@ -347,7 +405,7 @@ mod tests {
             );
             // Chunks of one line: the error in the first row of a chunk, after every row
             // before it.
-            let (seen, end) = drain(counting(50, Some(17), 1, workers));
+            let (seen, end) = drain(counting(50, Some(17), 1, workers), by_rows);
             assert_eq!(seen, (1..17).collect::<Vec<_>>());
             assert!(end.unwrap_err().to_string().contains("bad row 17"));
         }
@@ -386,7 +444,7 @@ mod tests {
                 Box::new(std::io::Cursor::new(b"x\n".repeat(100)));
             let cutter = ChunkCutter::new(text, Vec::new(), 0, false, 1);
             let blocks = RowBlocks::spawn_with(cutter, Arc::new(Panicking), 2, workers).unwrap();
-            let (seen, end) = drain(blocks);
+            let (seen, end) = drain(blocks, workers == 2);
             assert_eq!(seen, (1..=5).collect::<Vec<_>>());
             assert!(
                 end.unwrap_err()
