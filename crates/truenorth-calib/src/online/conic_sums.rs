@@ -370,10 +370,18 @@ impl<T: Real, const D: usize, const M: usize> ConicSums<T, D, M> {
             });
         }
         let m = layout.monomials(&q);
-        for (s, mj) in self.sums.iter_mut().zip(m) {
-            *s = *s * decay + mj;
+        if decay == T::one() {
+            // Without forgetting: `s · 1 + m` is `s + m`, exactly, without the products.
+            for (s, mj) in self.sums.iter_mut().zip(m) {
+                *s = *s + mj;
+            }
+            self.sum_w2 = self.sum_w2 + T::one();
+        } else {
+            for (s, mj) in self.sums.iter_mut().zip(m) {
+                *s = *s * decay + mj;
+            }
+            self.sum_w2 = self.sum_w2 * decay * decay + T::one();
         }
-        self.sum_w2 = self.sum_w2 * decay * decay + T::one();
         self.count += 1;
         Ok(())
     }
