@@ -313,14 +313,16 @@ where
         }
         R::add(&mut self.sums, mag, self.decay)?;
         let now = self.sums.count;
-        // Before the first refresh there is no calibration to sort by: the first readings
-        // take the slots in order, and the first refresh sorts them.
-        let slot = match &self.map_in {
-            Some(m) => R::slot(m, mag),
-            None => Some((now - 1) as usize),
-        };
-        if let Some(k) = slot {
-            self.slots.offer(k, mag, now, self.lifetime);
+        if !self.slots.refuses_all(self.lifetime) {
+            // Before the first refresh there is no calibration to sort by: the first
+            // readings take the slots in order, and the first refresh sorts them.
+            let slot = match &self.map_in {
+                Some(m) => R::slot(m, mag),
+                None => Some((now - 1) as usize),
+            };
+            if let Some(k) = slot {
+                self.slots.offer(k, mag, now, self.lifetime);
+            }
         }
         if self.pending.is_none() && now >= self.next_refresh {
             self.pending = Some(self.start());

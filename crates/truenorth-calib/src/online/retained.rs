@@ -24,6 +24,9 @@ pub(crate) struct Retained<T: Real, const D: usize, const N: usize> {
     pub reading: [SVector<T, D>; N],
     /// Its sample number (1 for the first reading accepted); 0 for an empty slot.
     pub stamp: [u64; N],
+    /// Number of empty slots (stamp 0), kept with the stamps so that a full set is known
+    /// without a scan (see [`Retained::refuses_all`]).
+    vacant: usize,
 }
 
 impl<T: Real, const D: usize, const N: usize> Retained<T, D, N> {
@@ -32,7 +35,19 @@ impl<T: Real, const D: usize, const N: usize> Retained<T, D, N> {
         Self {
             reading: [SVector::zeros(); N],
             stamp: [0; N],
+            vacant: N,
         }
+    }
+
+    /// Whether [`Retained::offer`] keeps nothing until the slots change otherwise, whatever
+    /// the slot: every slot holds a reading and none expires (`lifetime` unlimited, no
+    /// forgetting). A caller can then skip finding a reading's slot, most of what keeping
+    /// the readings costs per sample.
+    #[inline]
+    pub fn refuses_all(&self, lifetime: u64) -> bool {
+        // With `lifetime` u64::MAX a stored reading is live at every later sample:
+        // `now - stamp < u64::MAX` as `stamp ≥ 1`.
+        self.vacant == 0 && lifetime == u64::MAX
     }
 
     /// Whether slot `j` holds a reading younger than `lifetime` samples at sample `now`.
@@ -46,6 +61,7 @@ impl<T: Real, const D: usize, const N: usize> Retained<T, D, N> {
     #[inline]
     pub fn offer(&mut self, slot: usize, p: &SVector<T, D>, stamp: u64, lifetime: u64) {
         if slot < N && !self.is_live(slot, stamp, lifetime) {
+            self.vacant -= usize::from(self.stamp[slot] == 0);
             self.reading[slot] = *p;
             self.stamp[slot] = stamp;
         }
@@ -67,6 +83,7 @@ impl<T: Real, const D: usize, const N: usize> Retained<T, D, N> {
             if let Some(k) = key(&self.reading[j]).filter(|&k| k < N)
                 && (out.stamp[k] == 0 || out.stamp[k] > self.stamp[j])
             {
+                out.vacant -= usize::from(out.stamp[k] == 0);
                 out.reading[k] = self.reading[j];
                 out.stamp[k] = self.stamp[j];
             }
@@ -86,6 +103,7 @@ impl<T: Real, const D: usize, const N: usize> Retained<T, D, N> {
         Retained {
             reading: self.reading.map(|p| p.map(T::to_f64)),
             stamp: self.stamp,
+            vacant: self.vacant,
         }
     }
 
@@ -120,6 +138,7 @@ impl<T: Real, const D: usize, const N: usize> Retained<T, D, N> {
             out.reading[j] = SVector::from_fn(|i, _| T::of(s.readings[j * D + i]));
             out.stamp[j] = s.stamps[j];
         }
+        out.vacant = out.stamp.iter().filter(|&&t| t == 0).count();
         Ok(out)
     }
 }
