@@ -324,7 +324,21 @@ where
                 self.slots.offer(k, mag, now, self.lifetime);
             }
         }
-        if self.pending.is_none() && now >= self.next_refresh {
+        if self.pending.is_none() && now < self.next_refresh {
+            return Ok(Pushed::Accepted);
+        }
+        Ok(self.advance_refresh(now))
+    }
+
+    /// Starts a refresh if none is running, runs its next stage, and publishes it once
+    /// done; at `now` readings.
+    ///
+    /// Out of line: a refresh holds kilobytes, and inlined into [`OnlineCore::push`] it
+    /// gave every push a frame of that size (stack probes, every register saved) for work
+    /// that most pushes skip.
+    #[inline(never)]
+    fn advance_refresh(&mut self, now: u64) -> Pushed {
+        if self.pending.is_none() {
             self.pending = Some(self.start());
             self.next_refresh = now + self.refresh_spacing(now);
         }
@@ -336,9 +350,9 @@ where
             && let Some(r) = self.pending.take()
             && self.publish(r)
         {
-            return Ok(Pushed::NewEstimate);
+            return Pushed::NewEstimate;
         }
-        Ok(Pushed::Accepted)
+        Pushed::Accepted
     }
 
     /// Readings from the start of one refresh, at `now` readings, to the start of the next:
