@@ -359,9 +359,11 @@ impl<T: Real, const D: usize, const M: usize> ConicSums<T, D, M> {
             };
         }
         let q = (p - self.origin) / self.scale;
-        let far = q.amax();
         let limit = max_relative_coordinate::<T>();
-        if !(far <= limit) {
+        // Each coordinate against the limit (one vector comparison), the largest only for
+        // the refusal.
+        if !q.iter().all(|x| x.abs() <= limit) {
+            let far = q.amax();
             return Err(Error::OutOfRange {
                 what: "magnetometer reading, relative to the first reading and in its unit",
                 value: far.to_f64(),
