@@ -152,3 +152,53 @@ pub struct RetainedSnapshot {
     /// Sample number of each slot's reading, 0 for an empty slot.
     pub stamps: Vec<u64>,
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::Vector2;
+
+    type Slots = Retained<f64, 2, 8>;
+
+    fn empty(r: &Slots) -> usize {
+        r.stamp.iter().filter(|&&s| s == 0).count()
+    }
+
+    /// The count of empty slots follows every change of the stamps, and once every slot is
+    /// taken without forgetting, every offer is refused, as `refuses_all` lets a caller
+    /// assume.
+    #[test]
+    fn vacant_slots_are_counted_through_offers_rekeys_and_restores() {
+        let mut r = Slots::new();
+        let mut now = 0;
+        // Slot 9 is out of range, slot 3 offered twice.
+        for k in [3, 3, 5, 0, 9, 7, 1, 2, 4] {
+            now += 1;
+            r.offer(k, &Vector2::new(now as f64, 0.0), now, u64::MAX);
+            assert_eq!(r.vacant, empty(&r));
+            assert!(!r.refuses_all(u64::MAX));
+        }
+        now += 1;
+        r.offer(6, &Vector2::new(now as f64, 0.0), now, u64::MAX);
+        assert_eq!(r.vacant, 0);
+        assert!(r.refuses_all(u64::MAX));
+        // With forgetting a reading may expire: nothing is refused for sure.
+        assert!(!r.refuses_all(1_000));
+        let before = r;
+        for k in 0..8 {
+            r.offer(k, &Vector2::new(-1.0, 0.0), now + 1, u64::MAX);
+        }
+        assert_eq!(r, before);
+        // An expired reading is replaced: the slot stays taken.
+        r.offer(3, &Vector2::new(-1.0, 0.0), now + 100, 10);
+        assert_eq!((r.stamp[3], r.vacant), (now + 100, 0));
+        // Re-sorted into the first four slots, of which two readings meet in one: the
+        // other half of the slots is empty.
+        r.rekey(|p| Some(p.x.abs() as usize % 4), now + 100, u64::MAX);
+        assert_eq!(r.vacant, empty(&r));
+        assert_eq!(r.vacant, 4);
+        let back = Slots::restore(&r.snapshot(), now + 100).unwrap();
+        assert_eq!(back.vacant, empty(&back));
+        assert_eq!(back, r);
+    }
+}
