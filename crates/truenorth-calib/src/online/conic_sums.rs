@@ -360,8 +360,9 @@ impl<T: Real, const D: usize, const M: usize> ConicSums<T, D, M> {
         }
         let q = (p - self.origin) / self.scale;
         let limit = max_relative_coordinate::<T>();
-        // Each coordinate against the limit (one vector comparison), the largest only for
-        // the refusal.
+        // Each coordinate against the limit, the largest found only for the refusal. The
+        // same test as `amax() <= limit`: `q` is never NaN (a finite reading, a finite
+        // origin, a positive finite scale), and an infinite coordinate fails both.
         if !q.iter().all(|x| x.abs() <= limit) {
             let far = q.amax();
             return Err(Error::OutOfRange {
