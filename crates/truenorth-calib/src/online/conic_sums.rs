@@ -376,9 +376,9 @@ impl<T: Real, const D: usize, const M: usize> ConicSums<T, D, M> {
         if decay == T::one() {
             // Without forgetting: `s · 1 + m` is `s + m`, exactly, without the products.
             for (s, mj) in self.sums.iter_mut().zip(m) {
-                *s = *s + mj;
+                *s += mj;
             }
-            self.sum_w2 = self.sum_w2 + T::one();
+            self.sum_w2 += T::one();
         } else {
             for (s, mj) in self.sums.iter_mut().zip(m) {
                 *s = *s * decay + mj;

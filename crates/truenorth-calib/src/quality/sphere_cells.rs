@@ -70,7 +70,7 @@ pub(crate) fn sphere_cell_of(h: &Vector3<f64>) -> Option<u32> {
         return None;
     }
     let z2 = h.z * h.z;
-    let mut near = !(ss >= SMALLEST) || (h.z < 0.0 && z2 <= MARGIN * ss);
+    let mut near = ss < SMALLEST || (h.z < 0.0 && z2 <= MARGIN * ss);
     let mut from_equator = 0;
     for e in EDGES_SQ {
         let d = z2 - e * ss;
