@@ -188,10 +188,10 @@ impl ConicRefresh<3, MONOMIALS_3D, SPHERE_CELLS> for Refresh {
 
     /// The calibrated reading in `T`, its cell found in `f64` (the cell's band and sector
     /// are comparisons on the direction, exact in either type up to the reading's own
-    /// rounding).
+    /// rounding); the cell of [`cell`], by comparisons (see [`quality::sphere_cell_of`]).
     #[inline]
     fn slot<T: Real>(cal: &CompassCalibration3dIn<T>, p: &Vector3<T>) -> Option<usize> {
-        cell(&cal.correct(p).map(T::to_f64))
+        quality::sphere_cell_of(&cal.correct(p).map(T::to_f64)).map(|c| c as usize)
     }
 
     fn coverage(slots: &Slots, now: u64, lifetime: u64, cal: &CompassCalibration3d) -> f64 {

@@ -24,6 +24,9 @@ pub(crate) struct Retained<T: Real, const D: usize, const N: usize> {
     pub reading: [SVector<T, D>; N],
     /// Its sample number (1 for the first reading accepted); 0 for an empty slot.
     pub stamp: [u64; N],
+    /// Number of empty slots (stamp 0), kept with the stamps so that a full set is known
+    /// without a scan (see [`Retained::refuses_all`]).
+    vacant: usize,
 }
 
 impl<T: Real, const D: usize, const N: usize> Retained<T, D, N> {
@@ -32,7 +35,19 @@ impl<T: Real, const D: usize, const N: usize> Retained<T, D, N> {
         Self {
             reading: [SVector::zeros(); N],
             stamp: [0; N],
+            vacant: N,
         }
+    }
+
+    /// Whether [`Retained::offer`] keeps nothing until the slots change otherwise, whatever
+    /// the slot: every slot holds a reading and none expires (`lifetime` unlimited, no
+    /// forgetting). A caller can then skip finding a reading's slot, most of what keeping
+    /// the readings costs per sample.
+    #[inline]
+    pub fn refuses_all(&self, lifetime: u64) -> bool {
+        // With `lifetime` u64::MAX a stored reading is live at every later sample:
+        // `now - stamp < u64::MAX` as `stamp ≥ 1`.
+        self.vacant == 0 && lifetime == u64::MAX
     }
 
     /// Whether slot `j` holds a reading younger than `lifetime` samples at sample `now`.
@@ -46,6 +61,7 @@ impl<T: Real, const D: usize, const N: usize> Retained<T, D, N> {
     #[inline]
     pub fn offer(&mut self, slot: usize, p: &SVector<T, D>, stamp: u64, lifetime: u64) {
         if slot < N && !self.is_live(slot, stamp, lifetime) {
+            self.vacant -= usize::from(self.stamp[slot] == 0);
             self.reading[slot] = *p;
             self.stamp[slot] = stamp;
         }
@@ -67,6 +83,7 @@ impl<T: Real, const D: usize, const N: usize> Retained<T, D, N> {
             if let Some(k) = key(&self.reading[j]).filter(|&k| k < N)
                 && (out.stamp[k] == 0 || out.stamp[k] > self.stamp[j])
             {
+                out.vacant -= usize::from(out.stamp[k] == 0);
                 out.reading[k] = self.reading[j];
                 out.stamp[k] = self.stamp[j];
             }
@@ -86,6 +103,7 @@ impl<T: Real, const D: usize, const N: usize> Retained<T, D, N> {
         Retained {
             reading: self.reading.map(|p| p.map(T::to_f64)),
             stamp: self.stamp,
+            vacant: self.vacant,
         }
     }
 
@@ -120,6 +138,7 @@ impl<T: Real, const D: usize, const N: usize> Retained<T, D, N> {
             out.reading[j] = SVector::from_fn(|i, _| T::of(s.readings[j * D + i]));
             out.stamp[j] = s.stamps[j];
         }
+        out.vacant = out.stamp.iter().filter(|&&t| t == 0).count();
         Ok(out)
     }
 }
@@ -132,4 +151,54 @@ pub struct RetainedSnapshot {
     pub readings: Vec<f64>,
     /// Sample number of each slot's reading, 0 for an empty slot.
     pub stamps: Vec<u64>,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::Vector2;
+
+    type Slots = Retained<f64, 2, 8>;
+
+    fn empty(r: &Slots) -> usize {
+        r.stamp.iter().filter(|&&s| s == 0).count()
+    }
+
+    /// The count of empty slots follows every change of the stamps, and once every slot is
+    /// taken without forgetting, every offer is refused, as `refuses_all` lets a caller
+    /// assume.
+    #[test]
+    fn vacant_slots_are_counted_through_offers_rekeys_and_restores() {
+        let mut r = Slots::new();
+        let mut now = 0;
+        // Slot 9 is out of range, slot 3 offered twice.
+        for k in [3, 3, 5, 0, 9, 7, 1, 2, 4] {
+            now += 1;
+            r.offer(k, &Vector2::new(now as f64, 0.0), now, u64::MAX);
+            assert_eq!(r.vacant, empty(&r));
+            assert!(!r.refuses_all(u64::MAX));
+        }
+        now += 1;
+        r.offer(6, &Vector2::new(now as f64, 0.0), now, u64::MAX);
+        assert_eq!(r.vacant, 0);
+        assert!(r.refuses_all(u64::MAX));
+        // With forgetting a reading may expire: nothing is refused for sure.
+        assert!(!r.refuses_all(1_000));
+        let before = r;
+        for k in 0..8 {
+            r.offer(k, &Vector2::new(-1.0, 0.0), now + 1, u64::MAX);
+        }
+        assert_eq!(r, before);
+        // An expired reading is replaced: the slot stays taken.
+        r.offer(3, &Vector2::new(-1.0, 0.0), now + 100, 10);
+        assert_eq!((r.stamp[3], r.vacant), (now + 100, 0));
+        // Re-sorted into the first four slots, of which two readings meet in one: the
+        // other half of the slots is empty.
+        r.rekey(|p| Some(p.x.abs() as usize % 4), now + 100, u64::MAX);
+        assert_eq!(r.vacant, empty(&r));
+        assert_eq!(r.vacant, 4);
+        let back = Slots::restore(&r.snapshot(), now + 100).unwrap();
+        assert_eq!(back.vacant, empty(&back));
+        assert_eq!(back, r);
+    }
 }

@@ -79,11 +79,11 @@ pub(crate) use report::{
     Moments2, SupportFigures, assess_2d_from_moments, assess_3d_of, assess_3d_with_harmonics_of,
     direction_harmonics, support_dilution_3d,
 };
-pub(crate) use sphere_cells::sphere_cell;
 pub use sphere_cells::{
     MIN_SPHERE_COVERAGE, SPHERE_BANDS, SPHERE_CELLS, SPHERE_SECTORS, require_sphere_coverage,
     sphere_coverage,
 };
+pub(crate) use sphere_cells::{sphere_cell, sphere_cell_of};
 pub(crate) use support::GAP_BINS;
 pub use truenorth_core::compass_quality::{
     DILUTION_EVEN_CIRCLE, DILUTION_EVEN_SPHERE, MODEL_ERROR_REL,

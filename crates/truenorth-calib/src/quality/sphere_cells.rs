@@ -42,6 +42,53 @@ pub(crate) fn sphere_cell(x: f64, y: f64, z: f64, n: f64) -> u32 {
     b * SPHERE_SECTORS as u32 + sector_16(y, x)
 }
 
+/// The cell of `h` as [`sphere_cell`] gives it with `n = |h|`, for one vector at a time:
+/// `None` where `|h|` is zero or not finite.
+///
+/// The band is found without the square root and the division of `z/|h|`, which were most
+/// of the time of an online 3-D push (the longest chain of dependent operations in it):
+/// `|z|/|h|` is placed against the band edges ¼, ½ and ¾ by comparing `z²` with their
+/// squares times `|h|²`, and the sign of `z` picks the hemisphere. Where that is not
+/// certain — `z²` within 10⁻⁹·|h|² of an edge's, a negative `z` within 3·10⁻⁵·|h| of the
+/// equator (where `z/|h| + 1` may round to 1, the upper band), or `|h|²` so small that its
+/// terms may have lost precision — the cell is computed as [`sphere_cell`] does. Away from
+/// those, the comparisons' rounding (a few units in 10¹⁶ of `|h|²`) cannot change a sign,
+/// and the roundings of `z/|h|` (a few in 10¹⁶) cannot move it across an edge, so the
+/// cell is the same for every `h` (and the tests compare both near every edge).
+#[inline(always)]
+pub(crate) fn sphere_cell_of(h: &Vector3<f64>) -> Option<u32> {
+    /// Squares of the band edges in `|z|/|h|`, from the equator.
+    const EDGES_SQ: [f64; 3] = [1.0 / 16.0, 0.25, 9.0 / 16.0];
+    /// Relative distance from an edge, in `z²/|h|²`, below which the band is computed.
+    const MARGIN: f64 = 1e-9;
+    /// Smallest `|h|²` compared: its terms stay normal numbers or negligible.
+    const SMALLEST: f64 = 1e-250;
+    const _: () = assert!(SPHERE_BANDS == 8);
+    // `|h| > 0` and finite exactly when `|h|²` is, as `|h|` is its square root.
+    let ss = h.norm_squared();
+    if !(ss > 0.0 && ss.is_finite()) {
+        return None;
+    }
+    let z2 = h.z * h.z;
+    let mut near = ss < SMALLEST || (h.z < 0.0 && z2 <= MARGIN * ss);
+    let mut from_equator = 0;
+    for e in EDGES_SQ {
+        let d = z2 - e * ss;
+        near |= d.abs() <= MARGIN * ss;
+        from_equator += u32::from(d > 0.0);
+    }
+    if near {
+        return Some(sphere_cell(h.x, h.y, h.z, ss.sqrt()));
+    }
+    // −0 goes up, as `−0/|h| + 1 = 1`.
+    let band = if h.z >= 0.0 {
+        4 + from_equator
+    } else {
+        3 - from_equator
+    };
+    Some(band * SPHERE_SECTORS as u32 + sector_16(h.y, h.x))
+}
+
 /// The sixteenth of a turn, counted counter-clockwise from +x, that `(x, y)` points into,
 /// in `0..16` (a direction on a boundary goes to either side).
 ///
@@ -142,8 +189,82 @@ mod tests {
     use super::*;
     use proptest::prelude::*;
 
+    /// [`sphere_cell`] with the norm, as the online ellipsoid sorted its readings.
+    fn exact(h: &Vector3<f64>) -> Option<u32> {
+        let n = h.norm();
+        (n > 0.0 && n.is_finite()).then(|| sphere_cell(h.x, h.y, h.z, n))
+    }
+
+    /// `z` moved by `k` units in the last place.
+    fn ulps(z: f64, k: i64) -> f64 {
+        if z == 0.0 {
+            return f64::from_bits(k.unsigned_abs()) * (k.signum() as f64);
+        }
+        f64::from_bits((z.to_bits() as i64 + k * z.signum() as i64) as u64)
+    }
+
+    /// The cell without the square root and the division is the cell, at and around every
+    /// band edge (within a few hundred units in the last place of `z`, on both sides), at
+    /// the equator and the poles, at tiny and huge norms, and for zero and non-finite
+    /// vectors.
+    #[test]
+    fn cell_by_comparisons_is_the_cell_near_every_edge() {
+        let mut checked = 0;
+        let mut rng = 0x2545_f491_4f6c_dd1du64;
+        let mut uniform = move || {
+            rng ^= rng << 13;
+            rng ^= rng >> 7;
+            rng ^= rng << 17;
+            (rng >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for scale in [1e-200, 1e-155, 1e-3, 1.0, 47.6, 1e150, 1e200] {
+            for _ in 0..200 {
+                let phi = uniform() * core::f64::consts::TAU;
+                let rho = scale * (0.1 + uniform());
+                let (x, y) = (rho * phi.cos(), rho * phi.sin());
+                // z with z/|h| at each band edge, the equator and the poles' neighbourhood.
+                for w in [-0.75f64, -0.5, -0.25, 0.0, 0.25, 0.5, 0.75, 0.999_999] {
+                    let z0 = w * rho / (1.0 - w * w).sqrt();
+                    for k in (-300..=300).step_by(7).chain(-3..=3) {
+                        let h = Vector3::new(x, y, ulps(z0, k));
+                        assert_eq!(sphere_cell_of(&h), exact(&h), "{h:?}");
+                        checked += 1;
+                    }
+                }
+                let h = Vector3::new(x, y, scale * (2.0 * uniform() - 1.0));
+                assert_eq!(sphere_cell_of(&h), exact(&h), "{h:?}");
+            }
+        }
+        for h in [
+            Vector3::zeros(),
+            Vector3::new(0.0, 0.0, -0.0),
+            Vector3::new(1.0, 0.0, -0.0),
+            Vector3::new(0.0, 0.0, -5e-324),
+            Vector3::new(1e-320, 0.0, -1e-320),
+            Vector3::new(0.0, 0.0, 1.0),
+            Vector3::new(0.0, 0.0, -1.0),
+            Vector3::new(1e300, 1e300, 1e300),
+            Vector3::new(f64::NAN, 0.0, 1.0),
+            Vector3::new(0.0, f64::INFINITY, 1.0),
+        ] {
+            assert_eq!(sphere_cell_of(&h), exact(&h), "{h:?}");
+        }
+        assert!(checked > 1_000_000);
+    }
+
     proptest! {
         #![proptest_config(ProptestConfig::with_cases(20_000))]
+
+        /// The cell by comparisons is the cell for any vector.
+        #[test]
+        fn cell_by_comparisons_is_the_cell(
+            x in -1e3f64..1e3,
+            y in -1e3f64..1e3,
+            z in -1e3f64..1e3,
+        ) {
+            let h = Vector3::new(x, y, z);
+            prop_assert_eq!(sphere_cell_of(&h), exact(&h));
+        }
 
         /// The sector of a direction by comparisons is the sixteenth of a turn `atan2`
         /// places it in, wherever the angle is not within rounding of a boundary.
