@@ -40,6 +40,7 @@ impl DirectionSlots {
     /// Keeps `p` in the slot of its direction about `centre` (skipped if not finite or at the
     /// centre). The slot is that of `atan2` of `p − centre`, found mostly without it
     /// ([`sector`]).
+    #[inline]
     pub(crate) fn push(&mut self, p: &Vector2<f64>, centre: &Vector2<f64>) {
         if let Some(d) = direction_about(p, centre) {
             self.keep(sector(d.y, d.x, SLOTS), p);
