@@ -5,7 +5,7 @@ extern crate alloc;
 
 use nalgebra::Vector2;
 
-use crate::quality::{sector, sector_of_angle};
+use crate::quality::sector;
 
 #[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
@@ -40,25 +40,11 @@ impl DirectionSlots {
     /// Keeps `p` in the slot of its direction about `centre` (skipped if not finite or at the
     /// centre). The slot is that of `atan2` of `p − centre`, found mostly without it
     /// ([`sector`]).
-    #[inline]
+    #[inline(always)]
     pub(crate) fn push(&mut self, p: &Vector2<f64>, centre: &Vector2<f64>) {
         if let Some(d) = direction_about(p, centre) {
             self.keep(sector(d.y, d.x, SLOTS), p);
         }
-    }
-
-    /// [`Self::push`], for a caller that needs the direction too: returns it, `atan2` of
-    /// `p − centre`, radians (`None` when skipped), and takes the slot from it (the same
-    /// slot as [`Self::push`]'s).
-    pub(crate) fn push_with_direction(
-        &mut self,
-        p: &Vector2<f64>,
-        centre: &Vector2<f64>,
-    ) -> Option<f64> {
-        let d = direction_about(p, centre)?;
-        let direction = d.y.atan2(d.x);
-        self.keep(sector_of_angle(direction, SLOTS), p);
-        Some(direction)
     }
 
     /// Stores `p` in slot `i`.

@@ -40,10 +40,9 @@ const NEAR_BOUNDARY_TURNS: f64 = NEAR_BOUNDARY_RAD / TAU;
 
 /// The sector among `n` (≥ 1) of the angle `angle_rad` (finite, any turn):
 /// `⌊wrap(angle)/2π · n⌋`, capped at `n − 1` for the product that rounds up to `n`. This is
-/// the rule [`sector`] reproduces; callers that have the angle anyway take the sector
-/// from it here.
+/// the rule [`sector`] reproduces.
 #[inline]
-pub(crate) fn sector_of_angle(angle_rad: f64, n: usize) -> usize {
+fn sector_of_angle(angle_rad: f64, n: usize) -> usize {
     ((wrap_two_pi(angle_rad) / TAU * n as f64) as usize).min(n.saturating_sub(1))
 }
 

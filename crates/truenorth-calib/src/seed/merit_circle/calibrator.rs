@@ -66,6 +66,7 @@ use truenorth_core::{
 
 use crate::numerics::circumcentre::{BEST_AMPLIFICATION_SQ, Circumcircle, circumcircle};
 use crate::numerics::direction_slots::{DirectionSlots, SLOTS};
+use crate::numerics::reading::read_by_coordinate;
 use crate::quality::{Coverage, coverage, mean_corrected_norm_2d, require_arc};
 use crate::seed::fit_gap::complete_bound;
 use crate::seed::seed_quality::{SeedJob, seed_assessment};
@@ -212,9 +213,8 @@ impl MeritCircleCalibrator {
         &self.state
     }
 
-    /// Whether `p` counts as a new heading data point (see the module documentation);
-    /// `direction` is `p`'s direction about the current centre when the caller has it.
-    fn heading_changed(&mut self, p: &Vector2<f64>, direction: Option<f64>) -> bool {
+    /// Whether `p` counts as a new heading data point (see the module documentation).
+    fn heading_changed(&mut self, p: &Vector2<f64>) -> bool {
         let Some(last) = self.last_point else {
             return true;
         };
@@ -225,10 +225,8 @@ impl MeritCircleCalibrator {
         }
         match self.state.centre {
             Some(c) => {
-                let a = direction.unwrap_or_else(|| {
-                    let a = p - c;
-                    a.y.atan2(a.x)
-                });
+                let a = p - c;
+                let a = a.y.atan2(a.x);
                 let b = match self.last_direction {
                     // Bit for bit: a zero's sign can change an `atan2`.
                     Some((centre, point, b))
@@ -362,7 +360,7 @@ impl Calibrator for MeritCircleCalibrator {
     /// [`Pushed::NewEstimate`] on the push after a heading data point, when the estimate
     /// refreshed from the state that data point left has changed.
     fn push(&mut self, sample: &Mag2Sample) -> Result<Pushed> {
-        let p = sample.mag;
+        let p = read_by_coordinate(&sample.mag);
         check_finite("timestamp t_s", sample.t_s)?;
         check_finite2("magnetometer reading", &p)?;
         let mut pushed = Pushed::Accepted;
@@ -409,10 +407,8 @@ impl Calibrator for MeritCircleCalibrator {
         self.lo = self.lo.inf(&p);
         self.hi = self.hi.sup(&p);
         let slot_centre = self.state.centre.unwrap_or((self.lo + self.hi) * 0.5);
-        // About the centre, when there is one, as the new-data-point test wants it.
-        let direction = self.slots.push_with_direction(&p, &slot_centre);
-        let direction = direction.filter(|_| self.state.centre.is_some());
-        if self.samples <= self.config.warmup_samples || !self.heading_changed(&p, direction) {
+        self.slots.push(&p, &slot_centre);
+        if self.samples <= self.config.warmup_samples || !self.heading_changed(&p) {
             return Ok(pushed);
         }
         // A new heading data point (step d).
