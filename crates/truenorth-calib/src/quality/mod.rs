@@ -67,7 +67,7 @@ pub(crate) use bounds::{
 pub use coverage::{COVERAGE_BINS, Coverage, calibrated_coverage_2d, coverage};
 pub(crate) use coverage::{calibrated_directions_2d, coverage_of};
 pub(crate) use direction_bins::{turns, turns_in};
-pub(crate) use direction_sectors::sector;
+pub(crate) use direction_sectors::{SectorHint, sector};
 pub use field::{
     FIELD_RATIO_TOLERANCE, FieldMismatch, field_mismatch, mean_corrected_norm_2d,
     mean_corrected_norm_3d, with_expected_field,

@@ -6,7 +6,7 @@ use core::f64::consts::TAU;
 use nalgebra::Vector2;
 use serde::{Deserialize, Serialize};
 
-use crate::quality::sector;
+use crate::quality::{SectorHint, sector};
 
 #[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
@@ -53,12 +53,22 @@ pub(crate) fn bin_index(d: &Vector2<f64>, n: usize) -> Option<usize> {
     Some(sector(d.y, d.x, n))
 }
 
+/// [`bin_index`] through `hint`, the bin of the direction before (see [`SectorHint`]): the
+/// same bin.
+#[inline(always)]
+fn hinted_bin_index(d: &Vector2<f64>, n: usize, hint: &mut SectorHint) -> Option<usize> {
+    if !(d.x.is_finite() && d.y.is_finite()) || (d.x == 0.0 && d.y == 0.0) {
+        return None;
+    }
+    Some(hint.sector(d.y, d.x, n))
+}
+
 /// Puts reading `p` in its bin about `origin` (claims 1, 3, 4): it replaces what a bin
 /// that holds no measurement has; otherwise, with `memory` > 1, it enters the running mean
 /// of the last `memory` readings, and with `memory` = 1 the bin keeps one reading (see
 /// [`store_reading`]; `fresh` says, given the bin, whether it took no reading in the
-/// current update interval nor in the one before). Returns the bin, if the reading has a
-/// direction. Inlined into the calibrator's push, where the reading and the origin stay
+/// current update interval nor in the one before). The bin is found through `hint`, the
+/// bin of the reading before. Returns the bin, if the reading has a direction. Inlined into the calibrator's push, where the reading and the origin stay
 /// in registers: passed through memory, each was stored in halves and loaded back whole,
 /// which stalls (see [`crate::numerics::reading`]).
 #[inline(always)]
@@ -70,8 +80,9 @@ pub(crate) fn bin_reading(
     p: &Vector2<f64>,
     memory: u32,
     fresh: impl FnOnce(usize) -> bool,
+    hint: &mut SectorHint,
 ) -> Option<usize> {
-    let i = bin_index(&(p - origin), n)?;
+    let i = hinted_bin_index(&(p - origin), n, hint)?;
     let fresh = fresh(i);
     store_reading(&mut bins[i], &centres[i], origin, p, memory, fresh);
     Some(i)

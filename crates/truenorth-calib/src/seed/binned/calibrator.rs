@@ -85,6 +85,7 @@ use truenorth_core::{
 };
 
 use crate::numerics::reading::read_by_coordinate;
+use crate::quality::SectorHint;
 use crate::seed::binned::assess::{Assessor, Verdict};
 use crate::seed::binned::bins::{
     Bin, BinCentres, BinState, Bins, EMPTY, MAX_BINS, bin_centres, bin_reading, filled,
@@ -154,6 +155,8 @@ pub struct BinnedEllipseCalibrator {
     /// Most readings of one bin that count towards the next update (from the
     /// configuration, see [`counted_cap`]).
     counted_cap: usize,
+    /// The bin of the last reading binned, which the next one is almost always in.
+    hint: SectorHint,
 }
 
 /// Most readings of one bin that count towards the next update
@@ -244,6 +247,7 @@ impl BinnedEllipseCalibrator {
             counted_before: [0; MAX_BINS],
             centres: bin_centres(config.bins),
             counted_cap: counted_cap(&config),
+            hint: SectorHint::new(),
         }
     }
 
@@ -412,6 +416,7 @@ impl BinnedEllipseCalibrator {
             &p,
             self.config.bin_memory,
             |i| self.counted[i] == 0 && self.counted_before[i] == 0,
+            &mut self.hint,
         ) else {
             return false;
         };
