@@ -61,13 +61,15 @@ use serde::{Deserialize, Serialize};
 use truenorth_compass::CompassCalibration2d;
 use truenorth_core::{
     Calibrator, CompassQuality, Error, Mag2Sample, OnlineCalibrator, Progress, Pushed, Result,
-    Solution, Validate, angle_diff, check_finite, check_finite2,
+    Solution, Validate, check_finite, check_finite2,
 };
 
 use crate::numerics::circumcentre::{BEST_AMPLIFICATION_SQ, Circumcircle, circumcircle};
 use crate::numerics::direction_slots::{DirectionSlots, SLOTS};
 use crate::numerics::reading::read_by_coordinate;
-use crate::quality::{Coverage, coverage, mean_corrected_norm_2d, require_arc};
+use crate::quality::{
+    Coverage, Direction, coverage, mean_corrected_norm_2d, require_arc, turned_at_least,
+};
 use crate::seed::fit_gap::complete_bound;
 use crate::seed::seed_quality::{SeedJob, seed_assessment};
 
@@ -143,10 +145,10 @@ pub struct MeritCircleCalibrator {
     /// of the kept readings, so the published estimate stays the previous refresh's until
     /// it completes).
     pub(crate) seed: Option<SeedJob>,
-    /// The direction of the last data point about the centre, radians, with the centre and
-    /// point it was computed for: it changes only when either does, so the new-data-point
-    /// test computes one `atan2` a push instead of two.
-    last_direction: Option<(Vector2<f64>, Vector2<f64>, f64)>,
+    /// The direction of the last data point about the centre, with the centre and point it
+    /// was computed for: it changes only when either does, so the new-data-point test
+    /// takes it once, not per push.
+    last_direction: Option<(Vector2<f64>, Vector2<f64>, Direction)>,
 }
 
 impl Default for MeritCircleCalibrator {
@@ -225,8 +227,6 @@ impl MeritCircleCalibrator {
         }
         match self.state.centre {
             Some(c) => {
-                let a = p - c;
-                let a = a.y.atan2(a.x);
                 let b = match self.last_direction {
                     // Bit for bit: a zero's sign can change an `atan2`.
                     Some((centre, point, b))
@@ -235,13 +235,14 @@ impl MeritCircleCalibrator {
                         b
                     }
                     _ => {
-                        let d = last - c;
-                        let b = d.y.atan2(d.x);
+                        let b = Direction::of(&(last - c));
                         self.last_direction = Some((c, last, b));
                         b
                     }
                 };
-                angle_diff(a, b).abs() >= self.config.min_turn_rad
+                // `|angle_diff(atan2(p − c), atan2(last − c))| ≥ min_turn_rad`, mostly
+                // without the `atan2`.
+                turned_at_least(&(p - c), &b, self.config.min_turn_rad)
             }
             None => {
                 let spread = (self.hi - self.lo).max();
