@@ -56,7 +56,7 @@ pub(crate) fn bin_index(d: &Vector2<f64>, n: usize) -> Option<usize> {
 /// [`bin_index`] through `hint`, the bin of the direction before (see [`SectorHint`]): the
 /// same bin.
 #[inline(always)]
-fn hinted_bin_index(d: &Vector2<f64>, n: usize, hint: &mut SectorHint) -> Option<usize> {
+pub(crate) fn hinted_bin_index(d: &Vector2<f64>, n: usize, hint: &mut SectorHint) -> Option<usize> {
     if !(d.x.is_finite() && d.y.is_finite()) || (d.x == 0.0 && d.y == 0.0) {
         return None;
     }
@@ -67,22 +67,24 @@ fn hinted_bin_index(d: &Vector2<f64>, n: usize, hint: &mut SectorHint) -> Option
 /// that holds no measurement has; otherwise, with `memory` > 1, it enters the running mean
 /// of the last `memory` readings, and with `memory` = 1 the bin keeps one reading (see
 /// [`store_reading`]; `fresh` says, given the bin, whether it took no reading in the
-/// current update interval nor in the one before). The bin is found through `hint`, the
-/// bin of the reading before. Returns the bin, if the reading has a direction. Inlined into the calibrator's push, where the reading and the origin stay
-/// in registers: passed through memory, each was stored in halves and loaded back whole,
+/// current update interval nor in the one before). `index` gives the bin of a direction
+/// ([`bin_index`], or [`hinted_bin_index`] for a stream of readings). Returns the bin, if
+/// the reading has a direction.
+///
+/// Inlined into the calibrator's push, where the reading and the origin stay in
+/// registers: passed through memory, each was stored in halves and loaded back whole,
 /// which stalls (see [`crate::numerics::reading`]).
 #[inline(always)]
 pub(crate) fn bin_reading(
     bins: &mut Bins,
     centres: &BinCentres,
-    n: usize,
     origin: &Vector2<f64>,
     p: &Vector2<f64>,
     memory: u32,
+    index: impl FnOnce(&Vector2<f64>) -> Option<usize>,
     fresh: impl FnOnce(usize) -> bool,
-    hint: &mut SectorHint,
 ) -> Option<usize> {
-    let i = hinted_bin_index(&(p - origin), n, hint)?;
+    let i = index(&(p - origin))?;
     let fresh = fresh(i);
     store_reading(&mut bins[i], &centres[i], origin, p, memory, fresh);
     Some(i)

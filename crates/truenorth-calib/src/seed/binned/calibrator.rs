@@ -89,6 +89,7 @@ use crate::quality::SectorHint;
 use crate::seed::binned::assess::{Assessor, Verdict};
 use crate::seed::binned::bins::{
     Bin, BinCentres, BinState, Bins, EMPTY, MAX_BINS, bin_centres, bin_reading, filled,
+    hinted_bin_index,
 };
 pub use crate::seed::binned::config::{BinnedEllipseConfig, MAX_INIT_SAMPLES};
 use crate::seed::binned::refresh::RefreshJob;
@@ -408,15 +409,16 @@ impl BinnedEllipseCalibrator {
         if (p - origin).norm_squared() <= self.floor_sq {
             return false;
         }
+        let n = self.config.bins;
         let Some(i) = bin_reading(
             &mut self.bins,
             &self.centres,
-            self.config.bins,
             &origin,
             &p,
             self.config.bin_memory,
+            #[inline(always)]
+            |d| hinted_bin_index(d, n, &mut self.hint),
             |i| self.counted[i] == 0 && self.counted_before[i] == 0,
-            &mut self.hint,
         ) else {
             return false;
         };

@@ -373,8 +373,7 @@ fn interpolate(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::quality::SectorHint;
-    use crate::seed::binned::bins::{bin_centres, bin_reading, rebin};
+    use crate::seed::binned::bins::{bin_centres, bin_index, bin_reading, rebin};
     use crate::seed::binned::params::ellipse_parameters;
     use proptest::prelude::*;
 
@@ -436,12 +435,11 @@ mod tests {
             let _ = bin_reading(
                 &mut bins,
                 &centres,
-                n,
                 origin,
                 &p,
                 1,
+                |d| bin_index(d, n),
                 |_| true,
-                &mut SectorHint::new(),
             );
         }
         bins
