@@ -5,7 +5,7 @@ extern crate alloc;
 
 use nalgebra::Vector2;
 
-use crate::quality::{sector, sector_of_angle};
+use crate::quality::SectorHint;
 
 #[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
@@ -23,6 +23,8 @@ pub(crate) const SLOTS: usize = 72;
 pub(crate) struct DirectionSlots {
     points: [Vector2<f64>; SLOTS],
     filled: [bool; SLOTS],
+    /// The slot of the last reading, which the next one is almost always in.
+    hint: SectorHint,
 }
 
 impl DirectionSlots {
@@ -30,6 +32,7 @@ impl DirectionSlots {
         Self {
             points: [Vector2::zeros(); SLOTS],
             filled: [false; SLOTS],
+            hint: SectorHint::new(),
         }
     }
 
@@ -39,25 +42,13 @@ impl DirectionSlots {
 
     /// Keeps `p` in the slot of its direction about `centre` (skipped if not finite or at the
     /// centre). The slot is that of `atan2` of `p − centre`, found mostly without it
-    /// ([`sector`]).
+    /// ([`SectorHint`]).
+    #[inline(always)]
     pub(crate) fn push(&mut self, p: &Vector2<f64>, centre: &Vector2<f64>) {
         if let Some(d) = direction_about(p, centre) {
-            self.keep(sector(d.y, d.x, SLOTS), p);
+            let i = self.hint.sector(d.y, d.x, SLOTS);
+            self.keep(i, p);
         }
-    }
-
-    /// [`Self::push`], for a caller that needs the direction too: returns it, `atan2` of
-    /// `p − centre`, radians (`None` when skipped), and takes the slot from it (the same
-    /// slot as [`Self::push`]'s).
-    pub(crate) fn push_with_direction(
-        &mut self,
-        p: &Vector2<f64>,
-        centre: &Vector2<f64>,
-    ) -> Option<f64> {
-        let d = direction_about(p, centre)?;
-        let direction = d.y.atan2(d.x);
-        self.keep(sector_of_angle(direction, SLOTS), p);
-        Some(direction)
     }
 
     /// Stores `p` in slot `i`.

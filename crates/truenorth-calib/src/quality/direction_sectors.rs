@@ -40,10 +40,9 @@ const NEAR_BOUNDARY_TURNS: f64 = NEAR_BOUNDARY_RAD / TAU;
 
 /// The sector among `n` (≥ 1) of the angle `angle_rad` (finite, any turn):
 /// `⌊wrap(angle)/2π · n⌋`, capped at `n − 1` for the product that rounds up to `n`. This is
-/// the rule [`sector`] reproduces; callers that have the angle anyway take the sector
-/// from it here.
+/// the rule [`sector`] reproduces.
 #[inline]
-pub(crate) fn sector_of_angle(angle_rad: f64, n: usize) -> usize {
+fn sector_of_angle(angle_rad: f64, n: usize) -> usize {
     ((wrap_two_pi(angle_rad) / TAU * n as f64) as usize).min(n.saturating_sub(1))
 }
 
@@ -78,6 +77,114 @@ fn sector_exact(y: f64, x: f64, n: usize) -> usize {
 #[inline]
 pub(crate) fn sector(y: f64, x: f64, n: usize) -> usize {
     sector_if_clear(y, x, n).unwrap_or_else(|| sector_exact(y, x, n))
+}
+
+/// How far (radians) inside the remembered sector of a [`SectorHint`] a direction must
+/// lie, by its cross products with the sector's boundary directions, to take that sector
+/// without [`sector`].
+///
+/// The cross product of a boundary direction `b` (unit, `b.x·y − b.y·x`) with `(x, y)` is
+/// `|d| sin(θ − θ_b)`. As computed it is off by the error of `b` (its angle `2πk/n` rounded,
+/// a few ulps of 2π, and its sine and cosine rounded, under 4·10⁻¹⁵ together) and the
+/// rounding of two products and a difference, so by under 4·10⁻¹⁵ · (|x| + |y|) (products
+/// that underflow add at most 3·2⁻¹⁰⁷⁵, nothing beside the least `|x| + |y|` admitted).
+/// As `|d| ≤ |x| + |y|`, a cross product above `HINT_MARGIN_RAD · (|x| + |y|)` puts θ past
+/// the boundary by more than `HINT_MARGIN_RAD − 4·10⁻¹⁵` rad (`asin v ≥ v`); past both
+/// boundaries of a sector narrower than π (n ≥ 3) it lies inside, farther from both than
+/// the 10⁻¹⁴ rad within which [`NEAR_BOUNDARY_RAD`] shows `atan2` and the exact rule can
+/// move a direction to another sector: `sector_of_angle(atan2)` gives the remembered one.
+/// Ten thousand times that, still a negligible share of any sector.
+const HINT_MARGIN_RAD: f64 = 1.0e-10;
+
+/// Least and greatest `|x| + |y|` a [`SectorHint`] decides: clear of subnormal products and
+/// of overflow in the sums.
+const HINT_SCALE: (f64, f64) = (1.0e-280, 1.0e280);
+
+/// Most sectors a [`SectorHint`] keeps the boundary directions of (the binned ellipse's
+/// most bins); more are placed by [`sector`] alone.
+const HINT_MAX_SECTORS: usize = 128;
+
+/// The sector of the last direction of a stream of directions, and the boundary
+/// directions of all `n` sectors, so that the next direction, which in a dense recording
+/// is almost always in the same sector or the next one, is placed by cross products with
+/// them instead of the arctangent of [`sector`]: exactly the same sector (see
+/// [`HINT_MARGIN_RAD`]), found faster.
+///
+/// A cache: it never changes a result, so every two hints compare equal (a calibrator's
+/// equality is that of what it has learned).
+#[derive(Debug, Clone)]
+pub(crate) struct SectorHint {
+    /// The sector count the boundary directions are for; 0 before any.
+    n: usize,
+    /// The remembered sector (below `n`).
+    k: usize,
+    /// `(cos, sin)` of `2πj/n` for `j` in `0..=n`.
+    boundaries: [(f64, f64); HINT_MAX_SECTORS + 1],
+}
+
+impl PartialEq for SectorHint {
+    fn eq(&self, _: &Self) -> bool {
+        true
+    }
+}
+
+impl SectorHint {
+    /// No sector remembered.
+    pub(crate) const fn new() -> Self {
+        Self {
+            n: 0,
+            k: 0,
+            boundaries: [(0.0, 0.0); HINT_MAX_SECTORS + 1],
+        }
+    }
+
+    /// [`sector`] of `(x, y)` among `n`, bit for bit; remembers it for the next call.
+    #[inline(always)]
+    pub(crate) fn sector(&mut self, y: f64, x: f64, n: usize) -> usize {
+        if self.n == n && self.inside(self.k, y, x) {
+            self.k
+        } else {
+            self.place(y, x, n)
+        }
+    }
+
+    /// Whether `(x, y)` lies inside sector `k` (below `self.n`) by [`HINT_MARGIN_RAD`].
+    #[inline(always)]
+    fn inside(&self, k: usize, y: f64, x: f64) -> bool {
+        let (lo, hi) = (self.boundaries[k], self.boundaries[k + 1]);
+        let scale = x.abs() + y.abs();
+        let margin = HINT_MARGIN_RAD * scale;
+        let past_lo = lo.0 * y - lo.1 * x;
+        let before_hi = hi.1 * x - hi.0 * y;
+        (past_lo > margin) & (before_hi > margin) & (scale > HINT_SCALE.0) & (scale < HINT_SCALE.1)
+    }
+
+    /// The sector when it is not the remembered one: one of its neighbours, by their
+    /// boundary directions, or else by [`sector`]; remembered (for 3 to
+    /// [`HINT_MAX_SECTORS`] sectors, which are narrower than π and whose boundary
+    /// directions it keeps, taken here when `n` changes).
+    #[inline(never)]
+    fn place(&mut self, y: f64, x: f64, n: usize) -> usize {
+        if !(3..=HINT_MAX_SECTORS).contains(&n) {
+            return sector(y, x, n);
+        }
+        if self.n != n {
+            for (j, b) in self.boundaries[..=n].iter_mut().enumerate() {
+                let (sin, cos) = (TAU * j as f64 / n as f64).sin_cos();
+                *b = (cos, sin);
+            }
+            self.n = n;
+        } else {
+            for k in [(self.k + 1) % n, (self.k + n - 1) % n] {
+                if self.inside(k, y, x) {
+                    self.k = k;
+                    return k;
+                }
+            }
+        }
+        self.k = sector(y, x, n);
+        self.k
+    }
 }
 
 #[cfg(test)]
@@ -184,6 +291,96 @@ mod tests {
         assert!(exact > 0 && exact < total / 400, "{exact} of {total}");
     }
 
+    /// A hint that remembers sector `k` of `n` (placed by a direction at its middle).
+    fn hint_at(k: usize, n: usize) -> SectorHint {
+        let mut hint = SectorHint::new();
+        let (y, x) = (TAU * (k as f64 + 0.5) / n as f64).sin_cos();
+        assert_eq!(hint.sector(y, x, n), k);
+        hint
+    }
+
+    /// The hinted sector on and beside every boundary of every count, as in
+    /// `matches_atan2_on_and_beside_every_boundary`, with the hint fresh or remembering
+    /// either sector of the boundary, the one past either, or the opposite one: every path
+    /// (the remembered sector, a neighbour, the full rule) meets the boundaries.
+    #[test]
+    fn the_hint_matches_atan2_on_and_beside_every_boundary() {
+        for n in COUNTS {
+            for k in 0..n {
+                let (sin, cos) = (TAU * k as f64 / n as f64).sin_cos();
+                let remembered = [
+                    k,
+                    (k + 1) % n,
+                    (k + n - 1) % n,
+                    (k + 2 * n - 2) % n,
+                    (k + n / 2) % n,
+                ];
+                for r in [1e-300, 3e-7, 1.0, 7e5, 1e300] {
+                    for ux in -3..=3 {
+                        for uy in -3..=3 {
+                            let (y, x) = (nudge(r * sin, uy), nudge(r * cos, ux));
+                            let want = reference(y, x, n);
+                            assert_eq!(
+                                SectorHint::new().sector(y, x, n),
+                                want,
+                                "({x:e}, {y:e}), n = {n}"
+                            );
+                            for at in remembered {
+                                let mut hint = hint_at(at, n);
+                                assert_eq!(
+                                    hint.sector(y, x, n),
+                                    want,
+                                    "({x:e}, {y:e}), n = {n}, k = {k}, remembered {at}"
+                                );
+                                // Remembered now: the same again.
+                                assert_eq!(hint.sector(y, x, n), want);
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    /// A hint kept for one count and then asked about another takes the other's
+    /// boundaries.
+    #[test]
+    fn the_hint_follows_a_change_of_count() {
+        let mut hint = hint_at(3, 64);
+        for (n, a) in [
+            (72, 1.0),
+            (8, 2.5),
+            (64, 4.0),
+            (2, 1.0),
+            (200, 6.0),
+            (64, 4.0),
+        ] {
+            let (y, x) = f64::sin_cos(a);
+            assert_eq!(hint.sector(y, x, n), reference(y, x, n), "n = {n}");
+        }
+    }
+
+    /// On a dense turn (with noise across the sector boundaries) the remembered sector or
+    /// a neighbour places almost every direction, so the hint saves the arctangent.
+    #[test]
+    fn the_hint_places_a_dense_turn_by_cross_products() {
+        let n = 72;
+        let mut hint = SectorHint::new();
+        let (mut full, total) = (0, 100_000);
+        for i in 0..total {
+            let noise = 0.01 * ((i as f64 * 7.3).sin());
+            let (y, x) = (TAU * i as f64 / total as f64 + noise).sin_cos();
+            let (before_n, before_k) = (hint.n, hint.k);
+            let near = before_n == n
+                && [before_k, (before_k + 1) % n, (before_k + n - 1) % n]
+                    .iter()
+                    .any(|&k| hint.inside(k, y, x));
+            full += usize::from(!near);
+            assert_eq!(hint.sector(y, x, n), reference(y, x, n));
+        }
+        assert!(full < 10, "{full} of {total} by the full rule");
+    }
+
     /// A magnitude 10^e, e in [−300, 300], with either sign.
     fn magnitude() -> impl Strategy<Value = f64> {
         (-300.0f64..300.0, any::<bool>()).prop_map(|(e, neg)| {
@@ -206,6 +403,25 @@ mod tests {
         fn matches_atan2_at_any_scale(a in 0.0f64..TAU, r in magnitude()) {
             let (sin, cos) = a.sin_cos();
             check_all_counts(r * sin, r * cos)?;
+        }
+
+        /// A stream of directions a small random step apart (at one random scale), each
+        /// hinted by the one before, for a random count.
+        #[test]
+        fn the_hint_matches_atan2_along_a_random_walk(
+            n in 1usize..=MAX_BINS,
+            start in 0.0f64..TAU,
+            steps in proptest::collection::vec(-0.2f64..0.2, 1..200),
+            r in magnitude(),
+        ) {
+            let mut hint = SectorHint::new();
+            let mut a = start;
+            for step in steps {
+                a += step;
+                let (sin, cos) = a.sin_cos();
+                let (y, x) = (r * sin, r * cos);
+                prop_assert_eq!(hint.sector(y, x, n), reference(y, x, n), "({:e}, {:e}), n = {}", x, y, n);
+            }
         }
 
         /// Directions near a boundary of every count, within a few margins of it: where a

@@ -10,7 +10,8 @@
 //! The parts live in submodules: coverage (heading bins), sphere_cells (the sphere's direction
 //! cells), arc (the locus's turning and the shortest arc accepted), direction_bins (the fast
 //! direction of a reading and its bin), direction_sectors (the sector of a direction among n
-//! equal ones, as `atan2` places it, found mostly without it), bounds (information matrices and heading-error bounds),
+//! equal ones, as `atan2` places it, found mostly without it), direction_turn (whether a direction
+//! turned a given angle from another, as `atan2` decides it, found mostly without it), bounds (information matrices and heading-error bounds),
 //! uncertainty (what the readings determine: the dilution of the information matrix, the predicted
 //! parameter σ, and the determination test that replaces a share of direction cells), pass_2d (the
 //! one pass over 2-D readings the report is built from), report (assembly of the
@@ -48,6 +49,7 @@ mod bounds;
 mod coverage;
 mod direction_bins;
 mod direction_sectors;
+mod direction_turn;
 mod field;
 mod limits;
 mod pass_2d;
@@ -67,7 +69,8 @@ pub(crate) use bounds::{
 pub use coverage::{COVERAGE_BINS, Coverage, calibrated_coverage_2d, coverage};
 pub(crate) use coverage::{calibrated_directions_2d, coverage_of};
 pub(crate) use direction_bins::{turns, turns_in};
-pub(crate) use direction_sectors::{sector, sector_of_angle};
+pub(crate) use direction_sectors::{SectorHint, sector};
+pub(crate) use direction_turn::{Direction, turned_at_least};
 pub use field::{
     FIELD_RATIO_TOLERANCE, FieldMismatch, field_mismatch, mean_corrected_norm_2d,
     mean_corrected_norm_3d, with_expected_field,

@@ -186,24 +186,34 @@ impl<T: Copy> ExtremumTracker<T> {
 
     /// The hysteresis now in force.
     pub fn hysteresis(&self) -> f64 {
-        let mean_step = if self.samples > 1 {
-            self.abs_step_sum / (self.samples - 1) as f64
-        } else {
-            0.0
-        };
-        let range = if self.samples > 0 {
-            self.max - self.min
-        } else {
-            0.0
-        };
-        (self.config.swing_fraction * range).max(self.config.noise_multiple * mean_step)
+        hysteresis_of(
+            &self.config,
+            self.samples,
+            self.abs_step_sum,
+            self.min,
+            self.max,
+        )
     }
 
     /// Feeds the value of sample `index` (indices must increase) with the caller's tag.
     /// Non-finite values are ignored (the caller validates and reports them).
     pub fn push(&mut self, index: usize, value: f64, tag: T) {
+        self.push_range(index, value, tag);
+    }
+
+    /// [`Self::push`], returning the range after it ([`Self::range`]) from the values just
+    /// computed: a caller that needs it would otherwise load it back as one pair from the
+    /// two halves just stored, which the processor cannot forward from the stores.
+    ///
+    /// The candidate is updated where it lies (a whole new phase, built and copied back
+    /// on every sample, stalled the copy on the store of its parts), and the hysteresis,
+    /// a division, is computed only when a comparison needs it: while the signal moves on
+    /// past the candidate it does not. Inlined into the calibrators' push, which then read
+    /// the range just updated from registers, not back from memory.
+    #[inline(always)]
+    pub(crate) fn push_range(&mut self, index: usize, value: f64, tag: T) -> (f64, f64) {
         if !value.is_finite() {
-            return;
+            return (self.min, self.max);
         }
         if self.samples > 0 {
             self.abs_step_sum += (value - self.last).abs();
@@ -212,20 +222,49 @@ impl<T: Copy> ExtremumTracker<T> {
         self.last = value;
         self.min = self.min.min(value);
         self.max = self.max.max(value);
-        let h = self.hysteresis();
-        let here = |kind| Extremum {
+        let here = move |kind| Extremum {
             kind,
             value,
             index,
             tag,
         };
+        let (config, samples, abs_step_sum, min, max) = (
+            self.config,
+            self.samples,
+            self.abs_step_sum,
+            self.min,
+            self.max,
+        );
+        let h = || hysteresis_of(&config, samples, abs_step_sum, min, max);
+        match &mut self.phase {
+            Some(Phase::Rising(cand)) => {
+                if value > cand.value {
+                    *cand = here(ExtremumKind::Max);
+                } else if value <= cand.value - h() {
+                    let confirmed = *cand;
+                    self.phase = Some(Phase::Falling(here(ExtremumKind::Min)));
+                    self.confirm(confirmed);
+                }
+            }
+            Some(Phase::Falling(cand)) => {
+                if value < cand.value {
+                    *cand = here(ExtremumKind::Min);
+                } else if value >= cand.value + h() {
+                    let confirmed = *cand;
+                    self.phase = Some(Phase::Rising(here(ExtremumKind::Max)));
+                    self.confirm(confirmed);
+                }
+            }
+            _ => self.push_at_start(value, h(), here),
+        }
+        (min, max)
+    }
+
+    /// [`Self::push`] before a direction is known (no phase, or [`Phase::Start`]): the
+    /// first samples only, kept out of the loop.
+    #[inline(never)]
+    fn push_at_start(&mut self, value: f64, h: f64, here: impl Fn(ExtremumKind) -> Extremum<T>) {
         let next = match self.phase {
-            None => Phase::Start {
-                hi: here(ExtremumKind::Max),
-                lo: here(ExtremumKind::Min),
-                lo_before_hi: value,
-                hi_before_lo: value,
-            },
             Some(Phase::Start {
                 mut hi,
                 mut lo,
@@ -258,26 +297,12 @@ impl<T: Copy> ExtremumTracker<T> {
                     }
                 }
             }
-            Some(Phase::Rising(cand)) => {
-                if value > cand.value {
-                    Phase::Rising(here(ExtremumKind::Max))
-                } else if value <= cand.value - h {
-                    self.confirm(cand);
-                    Phase::Falling(here(ExtremumKind::Min))
-                } else {
-                    Phase::Rising(cand)
-                }
-            }
-            Some(Phase::Falling(cand)) => {
-                if value < cand.value {
-                    Phase::Falling(here(ExtremumKind::Min))
-                } else if value >= cand.value + h {
-                    self.confirm(cand);
-                    Phase::Rising(here(ExtremumKind::Max))
-                } else {
-                    Phase::Falling(cand)
-                }
-            }
+            _ => Phase::Start {
+                hi: here(ExtremumKind::Max),
+                lo: here(ExtremumKind::Min),
+                lo_before_hi: value,
+                hi_before_lo: value,
+            },
         };
         self.phase = Some(next);
     }
@@ -341,6 +366,24 @@ impl<T: Copy> ExtremumTracker<T> {
             }
         })
     }
+}
+
+/// The hysteresis of a tracker with these running values (see the module documentation):
+/// `max(swing_fraction · range, noise_multiple · mean |Δx|)`.
+fn hysteresis_of(
+    config: &ExtremaConfig,
+    samples: usize,
+    abs_step_sum: f64,
+    min: f64,
+    max: f64,
+) -> f64 {
+    let mean_step = if samples > 1 {
+        abs_step_sum / (samples - 1) as f64
+    } else {
+        0.0
+    };
+    let range = if samples > 0 { max - min } else { 0.0 };
+    (config.swing_fraction * range).max(config.noise_multiple * mean_step)
 }
 
 /// The saved state of an [`ExtremumTracker`]: everything it has learned, with its

@@ -6,7 +6,7 @@ use core::f64::consts::TAU;
 use nalgebra::Vector2;
 use serde::{Deserialize, Serialize};
 
-use crate::quality::sector;
+use crate::quality::{SectorHint, sector};
 
 #[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
@@ -45,6 +45,7 @@ pub(crate) type Bins = [Bin; MAX_BINS];
 
 /// The bin of direction `d` among `n`, or `None` for a zero or non-finite `d`: the sector
 /// of `atan2(d)` in [0, 2π), bit for bit, found mostly without it ([`sector`]).
+#[inline]
 pub(crate) fn bin_index(d: &Vector2<f64>, n: usize) -> Option<usize> {
     if !(d.x.is_finite() && d.y.is_finite()) || (d.x == 0.0 && d.y == 0.0) {
         return None;
@@ -52,22 +53,38 @@ pub(crate) fn bin_index(d: &Vector2<f64>, n: usize) -> Option<usize> {
     Some(sector(d.y, d.x, n))
 }
 
+/// [`bin_index`] through `hint`, the bin of the direction before (see [`SectorHint`]): the
+/// same bin.
+#[inline(always)]
+pub(crate) fn hinted_bin_index(d: &Vector2<f64>, n: usize, hint: &mut SectorHint) -> Option<usize> {
+    if !(d.x.is_finite() && d.y.is_finite()) || (d.x == 0.0 && d.y == 0.0) {
+        return None;
+    }
+    Some(hint.sector(d.y, d.x, n))
+}
+
 /// Puts reading `p` in its bin about `origin` (claims 1, 3, 4): it replaces what a bin
 /// that holds no measurement has; otherwise, with `memory` > 1, it enters the running mean
 /// of the last `memory` readings, and with `memory` = 1 the bin keeps one reading (see
 /// [`store_reading`]; `fresh` says, given the bin, whether it took no reading in the
-/// current update interval nor in the one before). Returns the bin, if the reading has a
-/// direction.
+/// current update interval nor in the one before). `index` gives the bin of a direction
+/// ([`bin_index`], or [`hinted_bin_index`] for a stream of readings). Returns the bin, if
+/// the reading has a direction.
+///
+/// Inlined into the calibrator's push, where the reading and the origin stay in
+/// registers: passed through memory, each was stored in halves and loaded back whole,
+/// which stalls (see [`crate::numerics::reading`]).
+#[inline(always)]
 pub(crate) fn bin_reading(
     bins: &mut Bins,
     centres: &BinCentres,
-    n: usize,
     origin: &Vector2<f64>,
     p: &Vector2<f64>,
     memory: u32,
+    index: impl FnOnce(&Vector2<f64>) -> Option<usize>,
     fresh: impl FnOnce(usize) -> bool,
 ) -> Option<usize> {
-    let i = bin_index(&(p - origin), n)?;
+    let i = index(&(p - origin))?;
     let fresh = fresh(i);
     store_reading(&mut bins[i], &centres[i], origin, p, memory, fresh);
     Some(i)
@@ -90,6 +107,7 @@ pub(crate) fn bin_centres(n: usize) -> BinCentres {
 /// does, both in that bin. Within a bin, at most π/8 from its centre (N ≥ 8), the nearer
 /// direction has the smaller sine of its angle from the centre, `|c × d|/|d|`; compared
 /// cross-multiplied, that takes no trigonometry per reading.
+#[inline(always)]
 fn nearer_centre(d: &Vector2<f64>, e: &Vector2<f64>, c: &Vector2<f64>) -> bool {
     c.perp(d).abs() * e.norm() < c.perp(e).abs() * d.norm()
 }
@@ -114,6 +132,7 @@ fn nearer_centre(d: &Vector2<f64>, e: &Vector2<f64>, c: &Vector2<f64>) -> bool {
 /// intervals are counted in readings, a clock the noise does not set, and a bin must have
 /// gone a whole interval without readings — the turn is away, not passing — so that the
 /// last excursions back across its edge after the turn has left do not count as a new visit.
+#[inline(always)]
 fn store_reading(
     b: &mut Bin,
     centre: &Vector2<f64>,

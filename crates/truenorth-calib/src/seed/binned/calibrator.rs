@@ -84,9 +84,12 @@ use truenorth_core::{
     Solution, Validate, check_finite, check_finite2,
 };
 
+use crate::numerics::reading::read_by_coordinate;
+use crate::quality::SectorHint;
 use crate::seed::binned::assess::{Assessor, Verdict};
 use crate::seed::binned::bins::{
     Bin, BinCentres, BinState, Bins, EMPTY, MAX_BINS, bin_centres, bin_reading, filled,
+    hinted_bin_index,
 };
 pub use crate::seed::binned::config::{BinnedEllipseConfig, MAX_INIT_SAMPLES};
 use crate::seed::binned::refresh::RefreshJob;
@@ -150,6 +153,11 @@ pub struct BinnedEllipseCalibrator {
     pub(crate) counted_before: [u32; MAX_BINS],
     /// The bins' centre directions (from the configuration).
     centres: BinCentres,
+    /// Most readings of one bin that count towards the next update (from the
+    /// configuration, see [`counted_cap`]).
+    counted_cap: usize,
+    /// The bin of the last reading binned, which the next one is almost always in.
+    hint: SectorHint,
 }
 
 /// Most readings of one bin that count towards the next update
@@ -168,6 +176,15 @@ pub struct BinnedEllipseCalibrator {
 /// for 185° of turning; see `tests/denser_data.rs`). Never below what lets half the bins
 /// start an update.
 const COUNTED_PER_BIN: usize = 16;
+
+/// Most readings of one bin that count towards the next update: the bin's share of two
+/// update intervals, and never fewer than [`COUNTED_PER_BIN`]. Taken once from the
+/// configuration, not per reading (an integer division).
+fn counted_cap(config: &BinnedEllipseConfig) -> usize {
+    (2 * config.update_interval)
+        .div_ceil(config.bins)
+        .max(COUNTED_PER_BIN)
+}
 
 /// How many per-axis noise σ a reading must lie from the origin for its direction to be
 /// the locus's rather than its noise's: for noise alone the distance exceeds `cσ` with
@@ -230,6 +247,8 @@ impl BinnedEllipseCalibrator {
             counted: [0; MAX_BINS],
             counted_before: [0; MAX_BINS],
             centres: bin_centres(config.bins),
+            counted_cap: counted_cap(&config),
+            hint: SectorHint::new(),
         }
     }
 
@@ -340,23 +359,13 @@ impl BinnedEllipseCalibrator {
         scratch.refresh().ok()
     }
 
-    /// The push logic proper, for a finite reading (no update in progress).
-    fn ingest(&mut self, p: &Vector2<f64>) {
+    /// The push logic proper, for a finite reading (no update in progress). Inlined, with
+    /// the binning, into push: one function keeps the reading and the bin in registers.
+    #[inline(always)]
+    fn ingest(&mut self, p: Vector2<f64>) {
         self.samples += 1;
         if self.origin.is_none() {
-            // Claim 6: average the first readings for the initial origin, then bin them.
-            self.init[self.init_count] = *p;
-            self.init_count += 1;
-            if self.init_count >= self.config.init_samples {
-                let k = self.init_count;
-                let init = self.init;
-                let o = init[..k].iter().sum::<Vector2<f64>>() / k as f64;
-                self.origin = Some(o);
-                self.floor_sq = noise_floor_sq(&init[..k]);
-                for q in &init[..k] {
-                    self.bin(q);
-                }
-            }
+            self.ingest_initial(&p);
             return;
         }
         if self.bin(p) {
@@ -372,31 +381,49 @@ impl BinnedEllipseCalibrator {
         }
     }
 
+    /// Claim 6: averages the first readings for the initial origin, then bins them (the
+    /// first readings only, kept out of line).
+    #[inline(never)]
+    fn ingest_initial(&mut self, p: &Vector2<f64>) {
+        self.init[self.init_count] = *p;
+        self.init_count += 1;
+        if self.init_count >= self.config.init_samples {
+            let k = self.init_count;
+            let init = self.init;
+            let o = init[..k].iter().sum::<Vector2<f64>>() / k as f64;
+            self.origin = Some(o);
+            self.floor_sq = noise_floor_sq(&init[..k]);
+            for &q in &init[..k] {
+                self.bin(q);
+            }
+        }
+    }
+
     /// Bins `p` if it has a direction about the origin; returns whether it counts towards
     /// the next update (see [`COUNTED_PER_BIN`]).
-    fn bin(&mut self, p: &Vector2<f64>) -> bool {
+    #[inline(always)]
+    fn bin(&mut self, p: Vector2<f64>) -> bool {
         let Some(origin) = self.origin else {
             return false;
         };
         if (p - origin).norm_squared() <= self.floor_sq {
             return false;
         }
+        let n = self.config.bins;
         let Some(i) = bin_reading(
             &mut self.bins,
             &self.centres,
-            self.config.bins,
             &origin,
-            p,
+            &p,
             self.config.bin_memory,
+            #[inline(always)]
+            |d| hinted_bin_index(d, n, &mut self.hint),
             |i| self.counted[i] == 0 && self.counted_before[i] == 0,
         ) else {
             return false;
         };
-        let cap = (2 * self.config.update_interval)
-            .div_ceil(self.config.bins)
-            .max(COUNTED_PER_BIN);
         let counted = &mut self.counted[i];
-        if (*counted as usize) < cap {
+        if (*counted as usize) < self.counted_cap {
             *counted += 1;
             true
         } else {
@@ -416,7 +443,9 @@ impl BinnedEllipseCalibrator {
 
     /// Starts a full-set update on a copy of the bins, with the refresh spread evenly over
     /// the working pushes (every `stride`-th) among the first
-    /// `min(update_interval, REFRESH_PUSHES)`.
+    /// `min(update_interval, REFRESH_PUSHES)`. Out of line: it copies the bins, and the
+    /// push that inlined it reserved the stack for them on every reading.
+    #[inline(never)]
     fn start_update(&mut self) {
         let Some(origin) = self.origin else { return };
         let n = self.config.bins;
@@ -475,6 +504,7 @@ impl BinnedEllipseCalibrator {
     /// count plus the backlog is below it none can, and once it reaches it only the latest
     /// reading can, and all are binned in that push — exactly when the update would start
     /// if nothing had waited.
+    #[inline(never)]
     fn drain(&mut self, spread: bool) {
         let len = self.backlog_len;
         if len == 0 {
@@ -484,7 +514,7 @@ impl BinnedEllipseCalibrator {
         let k = if all { len } else { len.min(DRAIN_PER_PUSH) };
         for i in 0..k {
             let p = self.backlog[i];
-            self.ingest(&p);
+            self.ingest(p);
         }
         self.backlog.copy_within(k..len, 0);
         // Unused entries stay zero, so equal states compare equal.
@@ -497,6 +527,50 @@ impl BinnedEllipseCalibrator {
         self.drain(false);
         if let Some(u) = self.update.take() {
             self.complete_update(u, false);
+        }
+    }
+
+    /// The update work of a push while a full-set update is in progress: one slice of the
+    /// refresh (on working pushes), or the assessment, or the application — never two of
+    /// them. Kept out of line: the update and its copy of the bins are large, and a push
+    /// that inlined them reserved (and probed) their stack space on every reading.
+    #[inline(never)]
+    fn advance_update(&mut self) -> Pushed {
+        let Some(u) = self.update.as_mut() else {
+            return Pushed::Accepted;
+        };
+        // The phase at the start of this push decides its work: one slice of the refresh
+        // (on working pushes), or the assessment, or the application — never two of them.
+        let phase = u.phase;
+        u.step_refresh();
+        let full = u.pending_len >= MAX_UPDATE_PUSHES;
+        match phase {
+            _ if full => {}
+            UpdatePhase::Refresh => return Pushed::Accepted,
+            UpdatePhase::Precheck | UpdatePhase::Assess => {
+                let assessor = Assessor {
+                    config: &self.config,
+                    reference: &self.reference,
+                    phasors: self.phasors.as_ref(),
+                    samples: self.samples,
+                };
+                if let Some(u) = self.update.as_mut() {
+                    u.advance_assessment(&assessor);
+                }
+                return Pushed::Accepted;
+            }
+            UpdatePhase::Apply => {}
+        }
+        let Some(u) = self.update.take() else {
+            return Pushed::Accepted;
+        };
+        // The refresh ends within `REFRESH_PUSHES` and a few more pushes complete it, well
+        // within the pending buffer; completing at once when it is full is a safeguard that
+        // does not change the result.
+        if self.complete_update(u, !full) {
+            Pushed::NewEstimate
+        } else {
+            Pushed::Accepted
         }
     }
 
@@ -588,7 +662,7 @@ impl Calibrator for BinnedEllipseCalibrator {
     /// most one slice, the assessment or the application of a full-set update (see the
     /// module documentation).
     fn push(&mut self, sample: &Mag2Sample) -> Result<Pushed> {
-        let p = sample.mag;
+        let p = read_by_coordinate(&sample.mag);
         check_finite("timestamp t_s", sample.t_s)?;
         check_finite2("magnetometer reading", &p)?;
         if let Some(u) = self.update.as_mut() {
@@ -601,44 +675,12 @@ impl Calibrator for BinnedEllipseCalibrator {
             self.backlog_len += 1;
             self.drain(true);
         } else {
-            self.ingest(&p);
+            self.ingest(p);
         }
-        let Some(u) = self.update.as_mut() else {
+        if self.update.is_none() {
             return Ok(Pushed::Accepted);
-        };
-        // The phase at the start of this push decides its work: one slice of the refresh
-        // (on working pushes), or the assessment, or the application — never two of them.
-        let phase = u.phase;
-        u.step_refresh();
-        let full = u.pending_len >= MAX_UPDATE_PUSHES;
-        match phase {
-            _ if full => {}
-            UpdatePhase::Refresh => return Ok(Pushed::Accepted),
-            UpdatePhase::Precheck | UpdatePhase::Assess => {
-                let assessor = Assessor {
-                    config: &self.config,
-                    reference: &self.reference,
-                    phasors: self.phasors.as_ref(),
-                    samples: self.samples,
-                };
-                if let Some(u) = self.update.as_mut() {
-                    u.advance_assessment(&assessor);
-                }
-                return Ok(Pushed::Accepted);
-            }
-            UpdatePhase::Apply => {}
         }
-        let Some(u) = self.update.take() else {
-            return Ok(Pushed::Accepted);
-        };
-        // The refresh ends within `REFRESH_PUSHES` and a few more pushes complete it, well
-        // within the pending buffer; completing at once when it is full is a safeguard that
-        // does not change the result.
-        if self.complete_update(u, !full) {
-            Ok(Pushed::NewEstimate)
-        } else {
-            Ok(Pushed::Accepted)
-        }
+        Ok(self.advance_update())
     }
 
     /// Runs the same path as [`Calibrator::solve`] on a copy (so `ready` agrees with it

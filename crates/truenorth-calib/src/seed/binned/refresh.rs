@@ -373,7 +373,7 @@ fn interpolate(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::seed::binned::bins::{bin_centres, bin_reading, rebin};
+    use crate::seed::binned::bins::{bin_centres, bin_index, bin_reading, rebin};
     use crate::seed::binned::params::ellipse_parameters;
     use proptest::prelude::*;
 
@@ -432,7 +432,15 @@ mod tests {
         let centres = bin_centres(n);
         for &(a, r) in points {
             let p = origin + Vector2::new(a.cos(), a.sin()) * r;
-            let _ = bin_reading(&mut bins, &centres, n, origin, &p, 1, |_| true);
+            let _ = bin_reading(
+                &mut bins,
+                &centres,
+                origin,
+                &p,
+                1,
+                |d| bin_index(d, n),
+                |_| true,
+            );
         }
         bins
     }

@@ -61,12 +61,15 @@ use serde::{Deserialize, Serialize};
 use truenorth_compass::CompassCalibration2d;
 use truenorth_core::{
     Calibrator, CompassQuality, Error, Mag2Sample, OnlineCalibrator, Progress, Pushed, Result,
-    Solution, Validate, angle_diff, check_finite, check_finite2,
+    Solution, Validate, check_finite, check_finite2,
 };
 
 use crate::numerics::circumcentre::{BEST_AMPLIFICATION_SQ, Circumcircle, circumcircle};
 use crate::numerics::direction_slots::{DirectionSlots, SLOTS};
-use crate::quality::{Coverage, coverage, mean_corrected_norm_2d, require_arc};
+use crate::numerics::reading::read_by_coordinate;
+use crate::quality::{
+    Coverage, Direction, coverage, mean_corrected_norm_2d, require_arc, turned_at_least,
+};
 use crate::seed::fit_gap::complete_bound;
 use crate::seed::seed_quality::{SeedJob, seed_assessment};
 
@@ -142,10 +145,10 @@ pub struct MeritCircleCalibrator {
     /// of the kept readings, so the published estimate stays the previous refresh's until
     /// it completes).
     pub(crate) seed: Option<SeedJob>,
-    /// The direction of the last data point about the centre, radians, with the centre and
-    /// point it was computed for: it changes only when either does, so the new-data-point
-    /// test computes one `atan2` a push instead of two.
-    last_direction: Option<(Vector2<f64>, Vector2<f64>, f64)>,
+    /// The direction of the last data point about the centre, with the centre and point it
+    /// was computed for: it changes only when either does, so the new-data-point test
+    /// takes it once, not per push.
+    last_direction: Option<(Vector2<f64>, Vector2<f64>, Direction)>,
 }
 
 impl Default for MeritCircleCalibrator {
@@ -212,9 +215,8 @@ impl MeritCircleCalibrator {
         &self.state
     }
 
-    /// Whether `p` counts as a new heading data point (see the module documentation);
-    /// `direction` is `p`'s direction about the current centre when the caller has it.
-    fn heading_changed(&mut self, p: &Vector2<f64>, direction: Option<f64>) -> bool {
+    /// Whether `p` counts as a new heading data point (see the module documentation).
+    fn heading_changed(&mut self, p: &Vector2<f64>) -> bool {
         let Some(last) = self.last_point else {
             return true;
         };
@@ -225,10 +227,6 @@ impl MeritCircleCalibrator {
         }
         match self.state.centre {
             Some(c) => {
-                let a = direction.unwrap_or_else(|| {
-                    let a = p - c;
-                    a.y.atan2(a.x)
-                });
                 let b = match self.last_direction {
                     // Bit for bit: a zero's sign can change an `atan2`.
                     Some((centre, point, b))
@@ -237,13 +235,14 @@ impl MeritCircleCalibrator {
                         b
                     }
                     _ => {
-                        let d = last - c;
-                        let b = d.y.atan2(d.x);
+                        let b = Direction::of(&(last - c));
                         self.last_direction = Some((c, last, b));
                         b
                     }
                 };
-                angle_diff(a, b).abs() >= self.config.min_turn_rad
+                // `|angle_diff(atan2(p − c), atan2(last − c))| ≥ min_turn_rad`, mostly
+                // without the `atan2`.
+                turned_at_least(&(p - c), &b, self.config.min_turn_rad)
             }
             None => {
                 let spread = (self.hi - self.lo).max();
@@ -362,7 +361,7 @@ impl Calibrator for MeritCircleCalibrator {
     /// [`Pushed::NewEstimate`] on the push after a heading data point, when the estimate
     /// refreshed from the state that data point left has changed.
     fn push(&mut self, sample: &Mag2Sample) -> Result<Pushed> {
-        let p = sample.mag;
+        let p = read_by_coordinate(&sample.mag);
         check_finite("timestamp t_s", sample.t_s)?;
         check_finite2("magnetometer reading", &p)?;
         let mut pushed = Pushed::Accepted;
@@ -409,10 +408,8 @@ impl Calibrator for MeritCircleCalibrator {
         self.lo = self.lo.inf(&p);
         self.hi = self.hi.sup(&p);
         let slot_centre = self.state.centre.unwrap_or((self.lo + self.hi) * 0.5);
-        // About the centre, when there is one, as the new-data-point test wants it.
-        let direction = self.slots.push_with_direction(&p, &slot_centre);
-        let direction = direction.filter(|_| self.state.centre.is_some());
-        if self.samples <= self.config.warmup_samples || !self.heading_changed(&p, direction) {
+        self.slots.push(&p, &slot_centre);
+        if self.samples <= self.config.warmup_samples || !self.heading_changed(&p) {
             return Ok(pushed);
         }
         // A new heading data point (step d).

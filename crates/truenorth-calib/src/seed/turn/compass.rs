@@ -106,8 +106,7 @@ impl Calibrator for TurnCompassCalibrator {
     fn push(&mut self, sample: &Mag2Sample) -> Result<Pushed> {
         check_finite2("magnetometer reading", &sample.mag)?;
         self.clock.dt_s(sample.t_s)?;
-        self.extrema.push(&sample.mag, sample.t_s)?;
-        let c = self.extrema.provisional_centre();
+        let c = self.extrema.push_centred(&sample.mag, sample.t_s)?;
         self.slots.push(&sample.mag, &c);
         Ok(Pushed::Accepted)
     }

@@ -143,17 +143,32 @@ impl<T: Copy> TurnExtrema<T> {
     /// Feeds one finite reading with its tag; returns its sample index.
     /// Non-finite readings are refused with a typed error and not counted.
     pub fn push(&mut self, point: &Vector2<f64>, tag: T) -> Result<usize> {
-        check_finite2("magnetometer reading", point)?;
         let i = self.samples;
-        let t = TurnTag { point: *point, tag };
-        self.x.push(i, point.x, t);
-        self.y.push(i, point.y, t);
-        if self.first.is_none() {
-            self.first = Some(*point);
-        }
-        self.last = Some(*point);
-        self.samples += 1;
+        self.push_centred(point, tag)?;
         Ok(i)
+    }
+
+    /// [`Self::push`], returning the provisional centre after it
+    /// ([`Self::provisional_centre`]) from the ranges just updated, which stay in registers
+    /// (loaded back as pairs from the halves just stored, they stall the processor). The
+    /// reading is taken coordinate by coordinate for the same reason: a caller that stored
+    /// them one by one cannot forward them to a load of the pair.
+    #[inline(always)]
+    pub(crate) fn push_centred(&mut self, point: &Vector2<f64>, tag: T) -> Result<Vector2<f64>> {
+        let (x, y) = (point.x, point.y);
+        check_finite2("magnetometer reading", &Vector2::new(x, y))?;
+        let point = Vector2::new(x, y);
+        let i = self.samples;
+        let t = TurnTag { point, tag };
+        let (x0, x1) = self.x.push_range(i, x, t);
+        let (y0, y1) = self.y.push_range(i, y, t);
+        if self.first.is_none() {
+            self.first = Some(point);
+        }
+        self.last = Some(point);
+        self.samples += 1;
+        // As `provisional_centre` with at least one sample.
+        Ok(Vector2::new(0.5 * (x0 + x1), 0.5 * (y0 + y1)))
     }
 
     /// Samples accepted.

@@ -535,8 +535,7 @@ impl Calibrator for TurnCalibrator {
             self.ring_len = (self.ring_len + 1).min(RING);
             self.last_kept_integral = self.at.integral;
         }
-        self.extrema.push(&sample.mag, self.at)?;
-        let c = self.extrema.provisional_centre();
+        let c = self.extrema.push_centred(&sample.mag, self.at)?;
         self.slots.push(&sample.mag, &c);
         if self.zero.is_none()
             && self.extrema.x().confirmed_count() + self.extrema.y().confirmed_count() > 0
