@@ -1,6 +1,6 @@
-//! Reading a caller's 2-D sample coordinate by coordinate.
+//! Reading a caller's sample coordinate by coordinate.
 
-use nalgebra::Vector2;
+use nalgebra::{Vector2, Vector3};
 
 /// The vector `v`, read one coordinate at a time.
 ///
@@ -15,4 +15,15 @@ use nalgebra::Vector2;
 #[inline(always)]
 pub(crate) fn read_by_coordinate(v: &Vector2<f64>) -> Vector2<f64> {
     Vector2::new(core::hint::black_box(v.x), core::hint::black_box(v.y))
+}
+
+/// [`read_by_coordinate`] for a 3-D reading: three separate stores, which a 16-byte load
+/// of the first two would span in the same way.
+#[inline(always)]
+pub(crate) fn read_by_coordinate3(v: &Vector3<f64>) -> Vector3<f64> {
+    Vector3::new(
+        core::hint::black_box(v.x),
+        core::hint::black_box(v.y),
+        core::hint::black_box(v.z),
+    )
 }

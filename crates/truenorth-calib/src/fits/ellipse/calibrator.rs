@@ -19,6 +19,7 @@ use crate::fits::ellipse::config::EllipseConfig;
 use crate::fits::ellipse::fit::fit_ellipse;
 use crate::fits::ellipse::fit::fit_ellipse_readings;
 use crate::fits::readings::{ReadingStore, bbox_centre};
+use crate::numerics::reading::read_by_coordinate;
 /// Least-squares ellipse calibrator (batch): stores every reading pushed and fits them all
 /// with [`fit_ellipse`] on `solve`.
 ///
@@ -108,8 +109,9 @@ impl<S: ReadingStore<2>> Calibrator for EllipseCalibrator<S> {
 
     fn push(&mut self, sample: &Mag2Sample) -> Result<Pushed> {
         check_finite("timestamp t_s", sample.t_s)?;
-        check_finite2("magnetometer reading", &sample.mag)?;
-        self.points.push(sample.mag)?;
+        let mag = read_by_coordinate(&sample.mag);
+        check_finite2("magnetometer reading", &mag)?;
+        self.points.push(mag)?;
         Ok(Pushed::Accepted)
     }
 

@@ -19,6 +19,7 @@ use crate::fits::ellipsoid::config::EllipsoidConfig;
 use crate::fits::ellipsoid::fit::fit_ellipsoid;
 use crate::fits::ellipsoid::fit::fit_ellipsoid_readings;
 use crate::fits::readings::{ReadingStore, Readings, bbox_centre, replay_points};
+use crate::numerics::reading::read_by_coordinate3;
 /// Least-squares ellipsoid calibrator (batch): stores every reading pushed and fits them
 /// all with [`fit_ellipsoid`] on `solve`.
 ///
@@ -87,8 +88,9 @@ impl<S: ReadingStore<3>> Calibrator for EllipsoidCalibrator<S> {
 
     fn push(&mut self, sample: &Mag3Sample) -> Result<Pushed> {
         check_finite("timestamp t_s", sample.t_s)?;
-        check_finite3("magnetometer reading", &sample.mag)?;
-        self.points.push(sample.mag)?;
+        let mag = read_by_coordinate3(&sample.mag);
+        check_finite3("magnetometer reading", &mag)?;
+        self.points.push(mag)?;
         Ok(Pushed::Accepted)
     }
 
