@@ -11,4 +11,5 @@ pub(crate) mod ellipse_refresh;
 pub mod ellipsoid;
 pub(crate) mod ellipsoid_config;
 pub(crate) mod ellipsoid_refresh;
+pub(crate) mod monomial_layout;
 pub(crate) mod retained;
