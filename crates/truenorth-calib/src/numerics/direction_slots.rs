@@ -7,9 +7,6 @@ use nalgebra::Vector2;
 
 use crate::quality::SectorHint;
 
-#[cfg(not(feature = "std"))]
-use truenorth_core::Float as _;
-
 /// Number of direction slots (5° each).
 pub(crate) const SLOTS: usize = 72;
 

@@ -336,11 +336,8 @@ pub(crate) fn sigma_kappa(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::online::monomial_layout::design2;
     use nalgebra::Vector2;
-
-    fn design2(q: &Vector2<f64>) -> SVector<f64, 6> {
-        SVector::from([q.x * q.x, q.x * q.y, q.y * q.y, q.x, q.y, 1.0])
-    }
 
     #[test]
     fn scatter_from_sums_matches_outer_products() {

@@ -261,14 +261,16 @@ pub(crate) const LAYOUT_2D: Layout<2, 6, MONOMIALS_2D> = Layout::new(TERMS_2D);
 /// The 3-D layout.
 pub(crate) const LAYOUT_3D: Layout<3, 10, MONOMIALS_3D> = Layout::new(TERMS_3D);
 
+/// The 2-D design vector of `q`, written out, for the tests of the layout and the sums.
+#[cfg(test)]
+pub(crate) fn design2(q: &nalgebra::Vector2<f64>) -> SVector<f64, 6> {
+    SVector::from([q.x * q.x, q.x * q.y, q.y * q.y, q.x, q.y, 1.0])
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use nalgebra::{Matrix2, Vector2, Vector3};
-
-    fn design2(q: &Vector2<f64>) -> SVector<f64, 6> {
-        SVector::from([q.x * q.x, q.x * q.y, q.y * q.y, q.x, q.y, 1.0])
-    }
 
     #[test]
     fn layouts_have_every_monomial_once() {

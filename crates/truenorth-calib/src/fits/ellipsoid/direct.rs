@@ -12,6 +12,8 @@ use crate::fits::readings::Readings;
 use crate::numerics::blocks::{BLOCK, dot_block};
 use crate::numerics::linalg::{constrained_min6, sym_eigen3, sym_eigen6, sym_sqrt3};
 use crate::numerics::segments::{RunFold, add_sums, by_blocks, fold};
+// The quadric's terms `(x², y², z², 2yz, 2xz, 2xy, 2x, 2y, 2z, 1)`, the online fit's too.
+use crate::online::monomial_layout::TERMS_3D as TERMS;
 
 use crate::fits::ellipsoid::config::MIN_POINTS_3D;
 #[cfg(not(feature = "std"))]
@@ -84,21 +86,6 @@ pub(crate) fn direct_normalised<R: Readings<3> + ?Sized>(
     let e = quadric_to_ellipsoid(&solve_direct(&s)?, max_axis_ratio)?;
     Ok((norm, e))
 }
-
-/// The terms of the quadric `(x², y², z², 2yz, 2xz, 2xy, 2x, 2y, 2z, 1)`: each is a constant
-/// factor times a monomial of degree ≤ 2, given by its exponents of `(x, y, z)`.
-const TERMS: [(f64, [u8; 3]); 10] = [
-    (1.0, [2, 0, 0]),
-    (1.0, [0, 2, 0]),
-    (1.0, [0, 0, 2]),
-    (2.0, [0, 1, 1]),
-    (2.0, [1, 0, 1]),
-    (2.0, [1, 1, 0]),
-    (2.0, [1, 0, 0]),
-    (2.0, [0, 1, 0]),
-    (2.0, [0, 0, 1]),
-    (1.0, [0, 0, 0]),
-];
 
 /// The exponents of `(x, y, z)` in the product of the monomials of terms `a` and `b`.
 fn product_exponents(a: usize, b: usize) -> [u8; 3] {

@@ -75,8 +75,6 @@ use crate::seed::seed_quality::{SeedJob, seed_assessment};
 
 use crate::seed::merit_circle::config::MeritCircleConfig;
 use crate::seed::merit_circle::config::RING;
-#[cfg(not(feature = "std"))]
-use truenorth_core::Float as _;
 
 /// Where the merit-circle estimate stands.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
