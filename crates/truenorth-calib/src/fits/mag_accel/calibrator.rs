@@ -353,12 +353,7 @@ fn start<'a>(
     Ok(Start {
         acc_fit,
         mag_fit,
-        data: Data {
-            readings,
-            na,
-            nm,
-            limits,
-        },
+        data: Data::new(readings, na, nm, limits),
         theta,
     })
 }

@@ -13,6 +13,8 @@ pub(crate) mod report;
 pub(crate) mod run_rows;
 pub(crate) mod runs;
 pub(crate) mod solve;
+#[cfg(test)]
+mod solve_tests;
 
 pub use calibration::{MagAccelCalibration, MagAccelSample};
 pub use calibrator::{MagAccelCalibrator, fit_mag_accel, fit_mag_accel_readings};

@@ -31,6 +31,7 @@
 extern crate alloc;
 
 use alloc::vec::Vec;
+use core::cell::RefCell;
 use core::ops::Range;
 
 use nalgebra::{Matrix3, Rotation3, SMatrix, SVector, Vector3};
@@ -154,9 +155,27 @@ pub(crate) struct Data<'a> {
     pub na: Normaliser<3>,
     pub nm: Normaliser<3>,
     pub limits: Limits,
+    /// The readings' normals at the last point asked for (see [`ReadingNormals`]).
+    pub last: RefCell<Option<ReadingNormals>>,
 }
 
-impl Data<'_> {
+impl<'a> Data<'a> {
+    /// The readings in the normalisers' coordinates, nothing remembered yet.
+    pub fn new(
+        readings: &'a dyn Readings<6>,
+        na: Normaliser<3>,
+        nm: Normaliser<3>,
+        limits: Limits,
+    ) -> Self {
+        Self {
+            readings,
+            na,
+            nm,
+            limits,
+            last: RefCell::new(None),
+        }
+    }
+
     /// How many readings there are.
     pub fn len(&self) -> usize {
         self.readings.len()
@@ -326,37 +345,17 @@ pub(crate) fn normal_equations(
     r0: &Rotation3<f64>,
     theta: &SVector<f64, P>,
 ) -> Result<Option<(NormalEquations<P>, GroupSums)>> {
-    let m = Model::of(theta, r0);
-    let (groups, defined) = data.fold(
-        || (ReadingGroups::new(), true),
-        |(groups, defined): &mut (ReadingGroups, bool), a, mg| {
-            if !*defined {
-                return;
-            }
-            match reading_rows(&m, a, mg) {
-                Some(rows) => groups.add(&rows, w),
-                None => *defined = false,
-            }
-        },
-        |(groups, defined), (later, later_defined)| {
-            *defined &= later_defined;
-            groups.merge(later);
-        },
-    )?;
-    if !defined {
+    let Some(normals) = reading_normals(data, r0, theta)? else {
         return Ok(None);
-    }
-    let Some((
+    };
+    let (
         NormalEquations {
             mut cost,
             mut jtj,
             mut jtr,
         },
         mut sums,
-    )) = groups.finish()
-    else {
-        return Ok(None);
-    };
+    ) = normals.weighted(w);
     if runs.is_empty() {
         // No run: the pointing axis is x. A stiff prior keeps the normal equations regular.
         for k in [PT, PT + 1] {
@@ -381,6 +380,106 @@ pub(crate) fn normal_equations(
     }
     let ne = NormalEquations { cost, jtj, jtr };
     Ok((ne.cost.is_finite() && ne.jtj.iter().all(|x| x.is_finite())).then_some((ne, sums)))
+}
+
+/// The reading rows' normal equations at `theta`, each group's unweighted, from the pass
+/// over the readings or, when the last pass was at the same point, from it: a round of the
+/// variance components reweights at the point the previous round ended, and the report at
+/// the point the last round ended, so weighting after the sums instead of in them spares
+/// those passes (the weights scale each group's sums by `w²`).
+fn reading_normals(
+    data: &Data,
+    r0: &Rotation3<f64>,
+    theta: &SVector<f64, P>,
+) -> Result<Option<ReadingNormals>> {
+    if let Some(last) = data.last.borrow().as_ref()
+        && last.theta == *theta
+        && last.r0 == *r0
+    {
+        return Ok(Some(*last));
+    }
+    let m = Model::of(theta, r0);
+    let (groups, defined) = data.fold(
+        || (ReadingGroups::new(), true),
+        |(groups, defined): &mut (ReadingGroups, bool), a, mg| {
+            if !*defined {
+                return;
+            }
+            match reading_rows(&m, a, mg) {
+                Some(rows) => groups.add(&rows),
+                None => *defined = false,
+            }
+        },
+        |(groups, defined), (later, later_defined)| {
+            *defined &= later_defined;
+            groups.merge(later);
+        },
+    )?;
+    let normals = if defined {
+        groups.finish(*theta, *r0)
+    } else {
+        None
+    };
+    *data.last.borrow_mut() = normals;
+    Ok(normals)
+}
+
+/// The unweighted normal equations of the reading rows at one point, per group, and the
+/// group sums.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct ReadingNormals {
+    theta: SVector<f64, P>,
+    r0: Rotation3<f64>,
+    acc: NormalEquations<SENSOR>,
+    mag: NormalEquations<SENSOR>,
+    dip: NormalEquations<PT>,
+    sums: GroupSums,
+}
+
+impl ReadingNormals {
+    /// The normal equations of the rows weighted by `w`, in every parameter (upper triangle
+    /// and diagonal; the caller mirrors them), and the group sums.
+    fn weighted(&self, w: &Weights) -> (NormalEquations<P>, GroupSums) {
+        let mut jtj = SMatrix::<f64, P, P>::zeros();
+        let mut jtr = SVector::<f64, P>::zeros();
+        let mut cost = 0.0;
+        let mut place = |first: usize, ne_jtj: &[f64], ne_jtr: &[f64], n: usize, c: f64, w: f64| {
+            let w2 = w * w;
+            for a in 0..n {
+                for b in a..n {
+                    jtj[(first + a, first + b)] += w2 * ne_jtj[a + b * n];
+                }
+                jtr[first + a] += w2 * ne_jtr[a];
+            }
+            cost += w2 * c;
+        };
+        let (acc, mag, dip) = (&self.acc, &self.mag, &self.dip);
+        place(
+            CA,
+            acc.jtj.as_slice(),
+            acc.jtr.as_slice(),
+            SENSOR,
+            acc.cost,
+            w.acc,
+        );
+        place(
+            CM,
+            mag.jtj.as_slice(),
+            mag.jtr.as_slice(),
+            SENSOR,
+            mag.cost,
+            w.mag,
+        );
+        place(
+            0,
+            dip.jtj.as_slice(),
+            dip.jtr.as_slice(),
+            PT,
+            dip.cost,
+            w.dip,
+        );
+        (NormalEquations { cost, jtj, jtr }, self.sums)
+    }
 }
 
 /// The reading rows' normal equations, gathered a [`BLOCK`] of readings at a time (see the
@@ -415,19 +514,19 @@ impl ReadingGroups {
         }
     }
 
-    /// Adds one reading's rows (from [`reading_rows`]), weighted by `w`.
-    fn add(&mut self, [acc, mag, dip]: &[(SVector<f64, P>, f64); 3], w: &Weights) {
+    /// Adds one reading's rows (from [`reading_rows`]), unweighted.
+    fn add(&mut self, [acc, mag, dip]: &[(SVector<f64, P>, f64); 3]) {
         let i = self.filled;
-        for (cols, (row, r), first, weight) in [
-            (&mut self.acc.cols[..], acc, CA, w.acc),
-            (&mut self.mag.cols[..], mag, CM, w.mag),
-            (&mut self.dip.cols[..], dip, 0, w.dip),
+        for (cols, (row, r), first) in [
+            (&mut self.acc.cols[..], acc, CA),
+            (&mut self.mag.cols[..], mag, CM),
+            (&mut self.dip.cols[..], dip, 0),
         ] {
             let n = cols.len() - 1;
             for (k, col) in cols[..n].iter_mut().enumerate() {
-                col[i] = row[first + k] * weight;
+                col[i] = row[first + k];
             }
-            cols[n][i] = r * weight;
+            cols[n][i] = *r;
         }
         for (g, (_, r)) in [acc, mag, dip].into_iter().enumerate() {
             self.squares[g][i] = r * r;
@@ -485,38 +584,27 @@ impl ReadingGroups {
         }
     }
 
-    /// The normal equations in every parameter (upper triangle and diagonal; the caller
-    /// mirrors them) and the group sums; `None` if anything overflowed.
-    fn finish(mut self) -> Option<(NormalEquations<P>, GroupSums)> {
+    /// The groups' normal equations at `theta` (with `r0`) and the group sums; `None` if
+    /// anything overflowed.
+    fn finish(mut self, theta: SVector<f64, P>, r0: Rotation3<f64>) -> Option<ReadingNormals> {
         if self.filled > 0 {
             self.add_block();
         }
-        let mut jtj = SMatrix::<f64, P, P>::zeros();
-        let mut jtr = SVector::<f64, P>::zeros();
-        let mut cost = 0.0;
-        let acc = self.acc.finish()?;
-        let mag = self.mag.finish()?;
-        let dip = self.dip.finish()?;
-        let mut place = |first: usize, ne_jtj: &[f64], ne_jtr: &[f64], n: usize, c: f64| {
-            for a in 0..n {
-                for b in a..n {
-                    jtj[(first + a, first + b)] += ne_jtj[a + b * n];
-                }
-                jtr[first + a] += ne_jtr[a];
-            }
-            cost += c;
-        };
-        place(CA, acc.jtj.as_slice(), acc.jtr.as_slice(), SENSOR, acc.cost);
-        place(CM, mag.jtj.as_slice(), mag.jtr.as_slice(), SENSOR, mag.cost);
-        place(0, dip.jtj.as_slice(), dip.jtr.as_slice(), PT, dip.cost);
-        Some((NormalEquations { cost, jtj, jtr }, self.sums))
+        Some(ReadingNormals {
+            theta,
+            r0,
+            acc: self.acc.finish()?,
+            mag: self.mag.finish()?,
+            dip: self.dip.finish()?,
+            sums: self.sums,
+        })
     }
 }
 
 /// The unweighted Jacobian rows and residuals of one reading `(a, mg)` under the model `m`:
 /// the accelerometer's `|u| − 1`, the magnetometer's `|v| − 1` and the dip's `ûᵀ R v̂ − s`;
 /// `None` for a reading at a sensor's centre.
-fn reading_rows(
+pub(crate) fn reading_rows(
     m: &Model,
     a: &Vector3<f64>,
     mg: &Vector3<f64>,
