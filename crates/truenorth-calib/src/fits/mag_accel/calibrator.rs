@@ -394,11 +394,12 @@ fn aimed_runs(
         },
         data.limits.stretch_frames,
     );
+    let model = Model::of(theta, r0);
     loop {
         let mut k = 0usize;
         data.replay(|a, m| {
             if finder.wants(k) {
-                finder.push(level_frame(a, m, r0, theta));
+                finder.push(level_frame(a, m, &model));
             }
             k += 1;
         })?;
@@ -509,14 +510,8 @@ fn dip_rms(data: &Data, r0: &Rotation3<f64>, theta: &SVector<f64, P>) -> Result<
 }
 
 /// The level frame (rows: the level axes in the accelerometer's frame) of the reading
-/// `(a, mg)` (normalised).
-fn level_frame(
-    a: &Vector3<f64>,
-    mg: &Vector3<f64>,
-    r0: &Rotation3<f64>,
-    theta: &SVector<f64, P>,
-) -> Option<Matrix3<f64>> {
-    let m = Model::of(theta, r0);
+/// `(a, mg)` (normalised) under the model `m`.
+fn level_frame(a: &Vector3<f64>, mg: &Vector3<f64>, m: &Model) -> Option<Matrix3<f64>> {
     let u = (m.b_a * (a - m.c_a)).try_normalize(1e-12)?;
     let v = (m.b_m * (mg - m.c_m)).try_normalize(1e-12)?;
     let rows: [Vector3<f64>; 3] = [Vector3::x(), Vector3::y(), Vector3::z()]
