@@ -100,6 +100,11 @@ fn malformed_files_get_one_line_naming_the_row() {
             vec!["row 2", "not finite"],
         ),
         (
+            "huge",
+            b"t_s,mag_x,mag_y\n0,1,2\n0.1,1e308,2\n".to_vec(),
+            vec!["row 3", "`1e308` is beyond ±2^53"],
+        ),
+        (
             "decimal_comma",
             b"t_s,mag_x,mag_y\n0,1.5,2\n1,1,5,2\n".to_vec(),
             vec!["row 3", "has 4 fields, the header 3", "decimal comma"],

@@ -18,6 +18,31 @@ const POWERS_OF_TEN: [f64; 23] = [
 /// The largest integer below which every integer is exact in an `f64`.
 const EXACT_INTEGERS: u64 = 1 << 53;
 
+/// The largest magnitude a cell may hold: 2^53. No sensor reads more in any unit its column
+/// allows (the Earth's field is 6.5e10 in femtotesla, a 32-bit converter's full scale 2.1e9
+/// counts), and past it an `f64` no longer holds every integer, so a time or a count would
+/// be rounded: a larger number is a wrong column or unit, or a corrupt cell. The fast path
+/// never gives one (its integer is below 2^53), so only the general path's cells need the
+/// check.
+pub const MOST_MAGNITUDE: f64 = EXACT_INTEGERS as f64;
+
+/// What is wrong with `v`, the value of a cell, if anything: not finite (a NaN only where a
+/// value is `required`: elsewhere it is no reading), or beyond [`MOST_MAGNITUDE`].
+#[inline]
+pub fn value_problem(v: f64, required: bool) -> Option<&'static str> {
+    if v.abs() <= MOST_MAGNITUDE {
+        None
+    } else if v.is_nan() {
+        required.then_some("is not finite")
+    } else if v.is_infinite() {
+        Some("is not finite")
+    } else {
+        Some(
+            "is beyond ±2^53 (9.0e15), more than any sensor reads in any unit (the Earth's field is 6.5e10 femtotesla, a 32-bit converter's full scale 2.1e9 counts); check the column and its unit",
+        )
+    }
+}
+
 /// Parses a numeric cell from its bytes (decimal point, optional exponent; `inf` and `nan`
 /// are read as such, for the caller to refuse).
 pub fn parse_number(cell: &[u8]) -> Option<f64> {
@@ -137,6 +162,26 @@ mod tests {
             let cell = format!("{sign}{whole}{}{fraction}{tail}", if point { "." } else { "" });
             let b = cell.as_bytes();
             prop_assert!(same(parse_number(b), full(b)), "{cell}");
+            // The fast path never gives a value the bound would refuse: the reader checks
+            // only the general path's.
+            if let Some((v, _)) = plain_decimal_prefix(b) {
+                prop_assert!(value_problem(v, true).is_none(), "{cell}: {v}");
+            }
+        }
+
+        /// A finite value is refused exactly when it is beyond 2^53; an infinite one
+        /// always; a NaN only where a value is required.
+        #[test]
+        fn value_problems_are_the_bound_and_finiteness(bits in any::<u64>(), required in any::<bool>()) {
+            let v = f64::from_bits(bits);
+            let problem = value_problem(v, required);
+            if v.is_nan() {
+                prop_assert_eq!(problem.is_some(), required);
+            } else if v.is_infinite() {
+                prop_assert!(problem.is_some_and(|p| p.contains("not finite")));
+            } else {
+                prop_assert_eq!(problem.is_some(), v.abs() > 9_007_199_254_740_992.0, "{}", v);
+            }
         }
 
         #[test]

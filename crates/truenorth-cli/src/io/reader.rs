@@ -16,7 +16,7 @@ use std::path::{Path, PathBuf};
 use super::chunks::{Chunk, ChunkCutter};
 use super::columns::{ColumnSource, Delimiter, Header, InputOptions};
 use super::errln;
-use super::number_parse::parse_number;
+use super::number_parse::{parse_number, value_problem};
 use super::plain_rows::{MOST_FIELDS, PlainRows};
 use super::records::{MAX_LINE_BYTES, RecordError, Records, record_bounds, shown, split_fields};
 use super::row_blocks::{BLOCK_ROWS, Block, ChunkParser, RowBlocks};
@@ -26,9 +26,11 @@ use super::{CliError, CliResult};
 /// The columns a command reads.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct ReadSpec<'a> {
-    /// Columns that must be present; each cell must be a finite number.
+    /// Columns that must be present; each cell must be a finite number within ±2^53
+    /// (`number_parse::MOST_MAGNITUDE`).
     pub required: &'a [&'a str],
-    /// Columns read when present; an empty cell reads as NaN.
+    /// Columns read when present; an empty cell (or `nan`) reads as NaN, any other within
+    /// ±2^53 as for a required column.
     pub optional: &'a [&'a str],
     /// A column (required or optional) whose values must increase strictly, e.g. `t_s`.
     pub increasing: Option<&'a str>,
@@ -410,11 +412,11 @@ impl RowParser {
                     )
                 })?
             };
-            if *required && !v.is_finite() {
+            if let Some(problem) = value_problem(v, *required) {
                 return Err(CliError::row(
                     &self.path,
                     number,
-                    format!("column `{}`: `{}` is not finite", c.header, shown(cell)),
+                    format!("column `{}`: `{}` {problem}", c.header, shown(cell)),
                 ));
             }
             values.push(c.sign * v);
@@ -553,6 +555,21 @@ mod tests {
         );
         let e = read_all("t_s,mag_x\n0,inf\n", &o, &spec).unwrap_err();
         assert!(e.message.contains("not finite"), "{e}");
+        // A finite number no sensor reads, in a required or an optional column.
+        let e = read_all("t_s,mag_x\n0,1e308\n", &o, &spec).unwrap_err();
+        assert!(
+            e.row == Some(2) && e.message.contains("beyond ±2^53"),
+            "{e}"
+        );
+        let e = read_all("t_s,mag_x,mag_z\n0,1,-9007199254740994\n", &o, &spec).unwrap_err();
+        assert!(
+            e.row == Some(2) && e.message.contains("beyond ±2^53"),
+            "{e}"
+        );
+        let e = read_all("t_s,mag_x,mag_z\n0,1,-inf\n", &o, &spec).unwrap_err();
+        assert!(e.row == Some(2) && e.message.contains("not finite"), "{e}");
+        // The largest magnitude held, and an optional column's NaN (no reading), are read.
+        assert!(read_all("t_s,mag_x,mag_z\n0,9007199254740992,nan\n", &o, &spec).is_ok());
         let e = read_all("t_s,mag_x\n0\n", &o, &spec).unwrap_err();
         assert!(e.message.contains("no value for `mag_x`"), "{e}");
         let e = read_all("t_s,mag_y\n0,1\n", &o, &spec).unwrap_err();
