@@ -440,46 +440,34 @@ impl ReadingNormals {
     /// The normal equations of the rows weighted by `w`, in every parameter (upper triangle
     /// and diagonal; the caller mirrors them), and the group sums.
     fn weighted(&self, w: &Weights) -> (NormalEquations<P>, GroupSums) {
-        let mut jtj = SMatrix::<f64, P, P>::zeros();
-        let mut jtr = SVector::<f64, P>::zeros();
-        let mut cost = 0.0;
-        let mut place = |first: usize, ne_jtj: &[f64], ne_jtr: &[f64], n: usize, c: f64, w: f64| {
-            let w2 = w * w;
-            for a in 0..n {
-                for b in a..n {
-                    jtj[(first + a, first + b)] += w2 * ne_jtj[a + b * n];
-                }
-                jtr[first + a] += w2 * ne_jtr[a];
-            }
-            cost += w2 * c;
+        let mut all = NormalEquations {
+            cost: 0.0,
+            jtj: SMatrix::<f64, P, P>::zeros(),
+            jtr: SVector::<f64, P>::zeros(),
         };
-        let (acc, mag, dip) = (&self.acc, &self.mag, &self.dip);
-        place(
-            CA,
-            acc.jtj.as_slice(),
-            acc.jtr.as_slice(),
-            SENSOR,
-            acc.cost,
-            w.acc,
-        );
-        place(
-            CM,
-            mag.jtj.as_slice(),
-            mag.jtr.as_slice(),
-            SENSOR,
-            mag.cost,
-            w.mag,
-        );
-        place(
-            0,
-            dip.jtj.as_slice(),
-            dip.jtr.as_slice(),
-            PT,
-            dip.cost,
-            w.dip,
-        );
-        (NormalEquations { cost, jtj, jtr }, self.sums)
+        place(&mut all, CA, &self.acc, w.acc);
+        place(&mut all, CM, &self.mag, w.mag);
+        place(&mut all, 0, &self.dip, w.dip);
+        (all, self.sums)
     }
+}
+
+/// Adds the normal equations `group` of the parameters from `first` on, weighted by `w`
+/// (each row's, so the sums' by `w²`), to `all` (upper triangle and diagonal).
+fn place<const N: usize>(
+    all: &mut NormalEquations<P>,
+    first: usize,
+    group: &NormalEquations<N>,
+    w: f64,
+) {
+    let w2 = w * w;
+    for a in 0..N {
+        for b in a..N {
+            all.jtj[(first + a, first + b)] += w2 * group.jtj[(a, b)];
+        }
+        all.jtr[first + a] += w2 * group.jtr[a];
+    }
+    all.cost += w2 * group.cost;
 }
 
 /// The reading rows' normal equations, gathered a [`BLOCK`] of readings at a time (see the
