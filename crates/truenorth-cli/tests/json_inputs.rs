@@ -102,6 +102,12 @@ fn calibration_files_are_versioned_strict_and_physical() {
         &cal,
         &["not a truenorth calibration file"],
     );
+    // Cut short, as by a full disk or a copy interrupted.
+    refused(
+        with(&GOOD_CAL[..GOOD_CAL.len() / 2]),
+        &cal,
+        &["not a truenorth calibration file", "EOF while parsing"],
+    );
 }
 
 /// A drive log with a compass, and the vehicle file for it.
@@ -151,6 +157,22 @@ fn vehicle_files_are_versioned_strict_and_physical() {
         ),
         &vehicle,
         &["`pitman_ratio` is 3"],
+    );
+    refused(
+        with(r#"{"track_m": 1.55, "odometer_wheels": "re"#),
+        &vehicle,
+        &["not a vehicle file", "EOF while parsing"],
+    );
+    refused(
+        with(r#"{"track_m": NaN, "odometer_wheels": "rear"}"#),
+        &vehicle,
+        &["not a vehicle file"],
+    );
+    std::fs::write(&vehicle, [0u8, 0xff, 0xfe, 7, 0x80]).unwrap();
+    refused(
+        drive(&dir, &log, &vehicle, &[]),
+        &vehicle,
+        &["did not contain valid UTF-8"],
     );
 }
 
@@ -228,6 +250,23 @@ fn learned_state_files_are_versioned_strict_and_physical() {
         *s = serde_json::json!([f[0], f[1], f[2] * 0.01, f[3] * 0.01]);
     });
     refused(with(&flat), &input, &["condition number"]);
+    let text = written.to_string();
+    std::fs::write(&input, &text[..text.len() / 2]).unwrap();
+    refused(
+        drive(&dir, &log, &vehicle, &["--calibration-in", p(&input)]),
+        &input,
+        &["EOF while parsing"],
+    );
+    std::fs::write(
+        &input,
+        text.replacen("\"hard_iron\":[", "\"hard_iron\":[NaN,", 1),
+    )
+    .unwrap();
+    refused(
+        drive(&dir, &log, &vehicle, &["--calibration-in", p(&input)]),
+        &input,
+        &["not a drive calibration", "expected value"],
+    );
 }
 
 #[test]
