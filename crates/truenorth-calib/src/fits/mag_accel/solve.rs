@@ -156,7 +156,7 @@ pub(crate) struct Data<'a> {
     pub nm: Normaliser<3>,
     pub limits: Limits,
     /// The readings' normals at the last point asked for (see [`ReadingNormals`]).
-    pub last: RefCell<Option<ReadingNormals>>,
+    last: RefCell<Option<ReadingNormals>>,
 }
 
 impl<'a> Data<'a> {
@@ -427,7 +427,7 @@ fn reading_normals(
 /// The unweighted normal equations of the reading rows at one point, per group, and the
 /// group sums.
 #[derive(Debug, Clone, Copy)]
-pub(crate) struct ReadingNormals {
+struct ReadingNormals {
     theta: SVector<f64, P>,
     r0: Rotation3<f64>,
     acc: NormalEquations<SENSOR>,
