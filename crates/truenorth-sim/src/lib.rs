@@ -59,7 +59,7 @@ pub use streams::{
     ImuSensorParams, VehicleSensorParams, imu_streams, rotated_soft_iron, vehicle_accel_stream,
     vehicle_streams, vehicle_streams_disturbed,
 };
-pub use vehicle::{MAX_SAMPLES, VehicleTruth, simulate};
+pub use vehicle::{MAX_SAMPLES, VehicleTruth, simulate, simulate_at};
 pub use vehicle_kind::{RangeVehicle, Slip, SlipProcess, VehicleKind};
 
 /// The code blocks of the crate's README, compiled and run as doctests.

@@ -112,6 +112,11 @@ impl RouteBuilder {
         self.speed_mps
     }
 
+    /// The duration of the route so far, s.
+    pub fn duration_s(&self) -> f64 {
+        self.route.duration_s()
+    }
+
     fn moving(&self) -> Result<f64> {
         if self.speed_mps > 0.0 {
             Ok(self.speed_mps)

@@ -1,7 +1,7 @@
 //! Rear-axle kinematic vehicle: integrates a [`Route`] into ground truth at a fixed rate.
 
 use serde::{Deserialize, Serialize};
-use truenorth_core::{Error, Result, check_range, wrap_pi};
+use truenorth_core::{Error, Result, check_finite, check_range, wrap_pi};
 
 use crate::route::Route;
 
@@ -60,51 +60,110 @@ pub fn simulate(route: &Route, heading0_rad: f64, rate_hz: f64) -> Result<Vec<Ve
     // Whole steps strictly before the end, then the end itself.
     let whole = (steps * (1.0 - 1e-12)).floor() as usize;
     let mut out = Vec::with_capacity(whole + 2);
-    let mut s = VehicleTruth {
-        heading_rad: wrap_pi(heading0_rad),
-        heading_unwrapped_rad: heading0_rad,
-        speed_mps: route.start_speed_mps,
-        ..VehicleTruth::default()
-    };
-    let mut planned_v = route.start_speed_mps;
-    let mut cmd_idx = 0;
-    let mut cmd_end = route.commands.first().map_or(0.0, |c| c.duration_s);
-    let mut turning = set_command(&mut s, route, cmd_idx);
-    out.push(s);
+    let mut vehicle = Integrator::new(route, heading0_rad);
+    out.push(vehicle.s);
     let times = (1..=whole)
         .map(|k| k as f64 * dt)
         .chain(core::iter::once(total));
     for t1 in times {
-        if t1 <= s.t_s {
-            continue;
+        if t1 > vehicle.s.t_s {
+            out.push(vehicle.advance_to(t1));
         }
-        // Integrate the step piecewise across command boundaries.
+    }
+    Ok(out)
+}
+
+/// Integrates `route` from heading `heading0_rad` and returns the truth at each of `times_s`
+/// (seconds from the route's start, finite, non-negative and strictly increasing): the truth
+/// at instants a sensor's own clock chooses, as exact as [`simulate`]'s. Past the route's
+/// end the vehicle keeps its last speed in a straight line.
+pub fn simulate_at(route: &Route, heading0_rad: f64, times_s: &[f64]) -> Result<Vec<VehicleTruth>> {
+    check_finite("heading0_rad", heading0_rad)?;
+    check_range("number of instants", times_s.len() as f64, 0.0, MAX_SAMPLES)?;
+    let mut vehicle = Integrator::new(route, heading0_rad);
+    let mut out = Vec::with_capacity(times_s.len());
+    for &t1 in times_s {
+        check_range("instant (s from the route's start)", t1, 0.0, f64::MAX)?;
+        if let Some(prev) = out.last().map(|p: &VehicleTruth| p.t_s)
+            && t1 <= prev
+        {
+            return Err(Error::NonIncreasingTime {
+                t_s: t1,
+                prev_s: prev,
+            });
+        }
+        out.push(if t1 > vehicle.s.t_s {
+            vehicle.advance_to(t1)
+        } else {
+            vehicle.s
+        });
+    }
+    Ok(out)
+}
+
+/// The vehicle on its way along a route: the state, and where in the route it is.
+struct Integrator<'a> {
+    route: &'a Route,
+    s: VehicleTruth,
+    planned_v: f64,
+    cmd_idx: usize,
+    cmd_end: f64,
+    turning: Turning,
+}
+
+impl<'a> Integrator<'a> {
+    /// At the route's start (t = 0), heading `heading0_rad`.
+    fn new(route: &'a Route, heading0_rad: f64) -> Self {
+        let mut s = VehicleTruth {
+            heading_rad: wrap_pi(heading0_rad),
+            heading_unwrapped_rad: heading0_rad,
+            speed_mps: route.start_speed_mps,
+            ..VehicleTruth::default()
+        };
+        let turning = set_command(&mut s, route, 0);
+        Self {
+            route,
+            s,
+            planned_v: route.start_speed_mps,
+            cmd_idx: 0,
+            cmd_end: route.commands.first().map_or(0.0, |c| c.duration_s),
+            turning,
+        }
+    }
+
+    /// Integrates to `t1` (later than the current time), piecewise across command
+    /// boundaries, and returns the state there.
+    fn advance_to(&mut self, t1: f64) -> VehicleTruth {
+        let route = self.route;
+        let s = &mut self.s;
         let mut t = s.t_s;
         while t < t1 - 1e-12 {
-            while cmd_idx < route.commands.len() && t >= cmd_end - 1e-12 {
+            while self.cmd_idx < route.commands.len() && t >= self.cmd_end - 1e-12 {
                 // Snap to the planned speed at the boundary so rounding cannot leave a
                 // "stopped" vehicle creeping at 1e-16 m/s.
-                if let Some(c) = route.commands.get(cmd_idx) {
-                    planned_v = (planned_v + c.accel_mps2 * c.duration_s).max(0.0);
-                    s.speed_mps = planned_v;
+                if let Some(c) = route.commands.get(self.cmd_idx) {
+                    self.planned_v = (self.planned_v + c.accel_mps2 * c.duration_s).max(0.0);
+                    s.speed_mps = self.planned_v;
                 }
-                cmd_idx += 1;
-                cmd_end += route.commands.get(cmd_idx).map_or(0.0, |c| c.duration_s);
-                turning = set_command(&mut s, route, cmd_idx);
+                self.cmd_idx += 1;
+                self.cmd_end += route
+                    .commands
+                    .get(self.cmd_idx)
+                    .map_or(0.0, |c| c.duration_s);
+                self.turning = set_command(s, route, self.cmd_idx);
             }
-            let h = if cmd_idx < route.commands.len() {
-                (t1.min(cmd_end)) - t
+            let h = if self.cmd_idx < route.commands.len() {
+                (t1.min(self.cmd_end)) - t
             } else {
                 t1 - t
             };
-            advance(&mut s, h, turning);
+            advance(s, h, self.turning);
             t += h;
         }
         s.t_s = t1;
-        s.yaw_rate_rps = s.speed_mps * s.curvature_per_m + turning.pivot_rps;
-        out.push(s);
+        s.yaw_rate_rps = s.speed_mps * s.curvature_per_m + self.turning.pivot_rps;
+        *s
     }
-    Ok(out)
 }
 
 /// How the curvature and the heading change within a command besides the path.

@@ -5,7 +5,9 @@ use std::f64::consts::PI;
 use nalgebra::UnitQuaternion;
 use proptest::prelude::*;
 use truenorth_core::angle_diff;
-use truenorth_sim::{HandheldParams, RouteBuilder, handheld_motion, scenario, simulate};
+use truenorth_sim::{
+    HandheldParams, RouteBuilder, handheld_motion, scenario, simulate, simulate_at,
+};
 
 #[test]
 fn quarter_right_turn_ends_at_radius_radius() {
@@ -174,4 +176,50 @@ proptest! {
             prop_assert!((w[1].yaw_rate_rps - w[0].yaw_rate_rps).abs() <= max_jump);
         }
     }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(24))]
+
+    /// The truth at instants of a sensor's own clock is the truth of the fixed-rate
+    /// integration: bit for bit at the same instants, and to rounding at any subset of them
+    /// (the steps between differ, the arcs do not).
+    #[test]
+    fn truth_at_any_instants_is_the_fixed_rate_truth(
+        rate in 5.0f64..80.0, keep in proptest::collection::vec(any::<bool>(), 64), heading in -3.0f64..3.0,
+    ) {
+        let route = scenario::city_blocks(2, 60.0).unwrap();
+        let grid = simulate(&route, heading, rate).unwrap();
+        let times: Vec<f64> = grid.iter().map(|s| s.t_s).collect();
+        prop_assert_eq!(&simulate_at(&route, heading, &times).unwrap(), &grid);
+        let picked: Vec<&truenorth_sim::VehicleTruth> = grid
+            .iter()
+            .enumerate()
+            .filter(|(k, _)| keep[k % keep.len()])
+            .map(|(_, s)| s)
+            .collect();
+        let at: Vec<f64> = picked.iter().map(|s| s.t_s).collect();
+        let sparse = simulate_at(&route, heading, &at).unwrap();
+        for (a, b) in sparse.iter().zip(picked) {
+            prop_assert!((a.north_m - b.north_m).abs() < 1e-6 && (a.east_m - b.east_m).abs() < 1e-6);
+            prop_assert!((a.heading_unwrapped_rad - b.heading_unwrapped_rad).abs() < 1e-9);
+            prop_assert!((a.distance_m - b.distance_m).abs() < 1e-9);
+            prop_assert_eq!(a.t_s, b.t_s);
+        }
+    }
+}
+
+#[test]
+fn instants_out_of_order_or_not_finite_are_typed_errors() {
+    let route = scenario::parking().unwrap();
+    assert!(simulate_at(&route, 0.0, &[1.0, 1.0]).is_err());
+    assert!(simulate_at(&route, 0.0, &[2.0, 1.0]).is_err());
+    assert!(simulate_at(&route, 0.0, &[f64::NAN]).is_err());
+    assert!(simulate_at(&route, 0.0, &[-1.0]).is_err());
+    assert!(simulate_at(&route, f64::INFINITY, &[1.0]).is_err());
+    assert_eq!(simulate_at(&route, 0.0, &[]).unwrap(), vec![]);
+    // Past the end the vehicle keeps going straight at its last speed (here at rest).
+    let end = route.duration_s();
+    let after = simulate_at(&route, 0.0, &[end, end + 10.0]).unwrap();
+    assert_eq!(after[0].north_m, after[1].north_m);
 }
