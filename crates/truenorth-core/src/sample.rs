@@ -221,7 +221,10 @@ pub struct WheelReading {
 /// What a land vehicle's navigation sensors report at one instant (the `drive` CSV row).
 ///
 /// Every reading is optional: sensors arrive at their own rates, so a row may carry the
-/// wheels, the gyro, the compass or any subset of them.
+/// wheels, the gyro, the compass or any subset of them. A vehicle whose odometer gives one
+/// distance for the whole vehicle (a car's CAN vehicle speed integrated, a single odometer)
+/// carries it as [`VehicleSample::dist_m`]: a distance with no left and right, which says
+/// nothing about turning.
 ///
 /// ```
 /// use nalgebra::Vector2;
@@ -229,9 +232,11 @@ pub struct WheelReading {
 ///
 /// let s = VehicleSample::at(1.5).with_wheels(10.2, 10.1).with_gyro(0.01);
 /// assert_eq!(s.wheels.unwrap().dist_l_m, 10.2);
-/// assert!(s.mag.is_none());
+/// assert!(s.mag.is_none() && s.dist_m.is_none());
 /// let m = VehicleSample::at(1.6).with_mag(Vector2::new(20.0, -3.0));
 /// assert!(m.wheels.is_none() && m.gyr_z_rps.is_none());
+/// let car = VehicleSample::at(1.7).with_distance(12.5).with_gyro(0.02);
+/// assert_eq!(car.dist_m, Some(12.5));
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct VehicleSample {
@@ -243,6 +248,11 @@ pub struct VehicleSample {
     pub gyr_z_rps: Option<f64>,
     /// Raw, uncalibrated horizontal magnetometer reading, if the row carries one.
     pub mag: Option<Vector2<f64>>,
+    /// Cumulative distance of the vehicle as one odometer reports it (no left and right:
+    /// a vehicle speed integrated), metres, if the row carries one. It gives the distance
+    /// travelled and nothing about the heading; a row with wheels too is read by its wheels.
+    #[serde(default)]
+    pub dist_m: Option<f64>,
 }
 
 impl VehicleSample {
@@ -253,6 +263,7 @@ impl VehicleSample {
             wheels: None,
             gyr_z_rps: None,
             mag: None,
+            dist_m: None,
         }
     }
 
@@ -271,6 +282,12 @@ impl VehicleSample {
     /// The row with a raw horizontal magnetometer reading (any unit).
     pub const fn with_mag(mut self, mag: Vector2<f64>) -> Self {
         self.mag = Some(mag);
+        self
+    }
+
+    /// The row with the vehicle's cumulative distance from a single odometer, metres.
+    pub const fn with_distance(mut self, dist_m: f64) -> Self {
+        self.dist_m = Some(dist_m);
         self
     }
 }
@@ -294,6 +311,9 @@ impl Validate for VehicleSample {
         if let Some(m) = self.mag {
             check_finite("mag_x", m.x)?;
             check_finite("mag_y", m.y)?;
+        }
+        if let Some(d) = self.dist_m {
+            check_finite("dist_m", d)?;
         }
         Ok(())
     }
