@@ -210,34 +210,76 @@ fn sensor_errors(v: &RangeVehicle, rng: &mut SplitMix64) -> VehicleSensorParams 
     let (mean, diff) = if car { (0.005, 0.005) } else { (0.02, 0.01) };
     let mean = between(rng, -mean, mean);
     let diff = between(rng, -diff, diff);
+    let gyro = GyroAxisParams {
+        bias_rps: either_sign(rng) * between(rng, 0.05, 5.0).to_radians(),
+        bias_walk_rps_per_sqrt_s: between(rng, 0.002, 0.01).to_radians(),
+        scale_error_pos: common + between(rng, -0.01, 0.01),
+        scale_error_neg: common + between(rng, -0.01, 0.01),
+        noise_density_rps_per_sqrt_hz: between(rng, 0.005, 0.05).to_radians(),
+        ..GyroAxisParams::PERFECT
+    };
+    let odometer = OdometerParams {
+        wheels: v.wheels,
+        scale_error_l: mean + 0.5 * diff,
+        scale_error_r: mean - 0.5 * diff,
+        speed_coeff_s2_per_m2: if car { between(rng, 0.0, 3e-4) } else { 0.0 },
+        dist_per_pulse_m: Some(if car {
+            between(rng, 0.01, 0.04)
+        } else {
+            between(rng, 1e-4, 2e-3)
+        }),
+    };
+    let compass = CompassRanges::RANGE.draw(field, rng);
     VehicleSensorParams {
-        gyro: GyroAxisParams {
-            bias_rps: either_sign(rng) * between(rng, 0.05, 5.0).to_radians(),
-            bias_walk_rps_per_sqrt_s: between(rng, 0.002, 0.01).to_radians(),
-            scale_error_pos: common + between(rng, -0.01, 0.01),
-            scale_error_neg: common + between(rng, -0.01, 0.01),
-            noise_density_rps_per_sqrt_hz: between(rng, 0.005, 0.05).to_radians(),
-            ..GyroAxisParams::PERFECT
-        },
+        gyro,
         gyro_temp_c: 25.0,
-        odometer: OdometerParams {
-            wheels: v.wheels,
-            scale_error_l: mean + 0.5 * diff,
-            scale_error_r: mean - 0.5 * diff,
-            speed_coeff_s2_per_m2: if car { between(rng, 0.0, 3e-4) } else { 0.0 },
-            dist_per_pulse_m: Some(if car {
-                between(rng, 0.01, 0.04)
-            } else {
-                between(rng, 1e-4, 2e-3)
-            }),
-        },
-        compass_hard_iron: {
-            let (s, c) = (2.0 * PI * rng.uniform()).sin_cos();
-            Vector2::new(c, s) * field * between(rng, 0.1, 0.8)
-        },
-        compass_soft_iron: soft_iron(rng, 1.0, 1.5),
-        compass_noise: field * between(rng, 0.005, 0.03),
+        odometer,
+        compass_hard_iron: compass.hard_iron,
+        compass_soft_iron: compass.soft_iron,
+        compass_noise: compass.noise,
         horizontal_field: field,
+    }
+}
+
+/// The ranges a compass installation's errors are drawn from.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct CompassRanges {
+    /// Hard iron, times the horizontal field, in any direction.
+    pub hard_iron: (f64, f64),
+    /// Soft iron ratio, major axis at any angle.
+    pub soft_iron: (f64, f64),
+    /// Noise per axis, times the horizontal field.
+    pub noise: (f64, f64),
+}
+
+/// One compass installation's errors.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct CompassDraw {
+    pub hard_iron: Vector2<f64>,
+    pub soft_iron: nalgebra::Matrix2<f64>,
+    pub noise: f64,
+}
+
+impl CompassRanges {
+    /// The ranges of the module documentation.
+    pub const RANGE: Self = Self {
+        hard_iron: (0.1, 0.8),
+        soft_iron: (1.0, 1.5),
+        noise: (0.005, 0.03),
+    };
+
+    /// An installation on a horizontal field of `field` µT.
+    pub fn draw(&self, field: f64, rng: &mut SplitMix64) -> CompassDraw {
+        let hard_iron = {
+            let (s, c) = (2.0 * PI * rng.uniform()).sin_cos();
+            Vector2::new(c, s) * field * between(rng, self.hard_iron.0, self.hard_iron.1)
+        };
+        let soft_iron = soft_iron(rng, self.soft_iron.0, self.soft_iron.1);
+        CompassDraw {
+            hard_iron,
+            soft_iron,
+            noise: field * between(rng, self.noise.0, self.noise.1),
+        }
     }
 }
 
@@ -338,10 +380,7 @@ impl Streams {
     ) -> Result<(Vec<VehicleTruth>, Vec<VehicleSample>)> {
         let mut truth = Vec::new();
         let mut rows = Vec::new();
-        let peak = match self.geometry {
-            WheelGeometry::Front(g) => 0.98 * g.peak_curvature_per_m(),
-            WheelGeometry::Rear { .. } => f64::INFINITY,
-        };
+        let peak = peak_curvature(&self.geometry);
         for (k, s) in grid.iter().enumerate() {
             if let Some(p) = k.checked_sub(1).and_then(|j| grid.get(j)) {
                 self.roll_wheels(p, s, peak, rng)?;
@@ -395,25 +434,46 @@ impl Streams {
         rng: &mut SplitMix64,
     ) -> Result<()> {
         let dt = s.t_s - p.t_s;
-        let ds = s.distance_m - p.distance_m;
         let a_lat = s.speed_mps * s.yaw_rate_rps;
         let factor = self.slip.step(dt, a_lat, rng);
-        let dpsi = angle_diff(s.heading_rad, p.heading_rad) * factor;
-        let motion = if ds > 0.0 {
-            WheelMotion {
-                ds_m: ds,
-                curvature_per_m: (dpsi / ds).clamp(-peak_curvature, peak_curvature),
-                speed_mps: ds / dt,
-                pivot_rad: 0.0,
-            }
-        } else {
-            WheelMotion {
-                pivot_rad: dpsi,
-                ..WheelMotion::default()
-            }
-        };
+        let motion = wheel_motion(p, s, factor, peak_curvature);
         self.odometer.sample(&motion, dt, rng)?;
         Ok(())
+    }
+}
+
+/// The largest curvature the wheels of `geometry` are driven at: just short of the peak an
+/// Ackermann front axle can report, unlimited for an unsteered axle.
+pub(crate) fn peak_curvature(geometry: &WheelGeometry) -> f64 {
+    match geometry {
+        WheelGeometry::Front(g) => 0.98 * g.peak_curvature_per_m(),
+        WheelGeometry::Rear { .. } => f64::INFINITY,
+    }
+}
+
+/// What the wheels roll from `p` to `s` when they see `factor` times the vehicle's turn (a
+/// turn in place when the vehicle does not move), the curvature limited to
+/// `peak_curvature`.
+pub(crate) fn wheel_motion(
+    p: &VehicleTruth,
+    s: &VehicleTruth,
+    factor: f64,
+    peak_curvature: f64,
+) -> WheelMotion {
+    let ds = s.distance_m - p.distance_m;
+    let dpsi = angle_diff(s.heading_rad, p.heading_rad) * factor;
+    if ds > 0.0 {
+        WheelMotion {
+            ds_m: ds,
+            curvature_per_m: (dpsi / ds).clamp(-peak_curvature, peak_curvature),
+            speed_mps: ds / (s.t_s - p.t_s),
+            pivot_rad: 0.0,
+        }
+    } else {
+        WheelMotion {
+            pivot_rad: dpsi,
+            ..WheelMotion::default()
+        }
     }
 }
 

@@ -12,11 +12,11 @@ use crate::route::{Route, RouteBuilder};
 use crate::vehicle_kind::RangeVehicle;
 
 /// Comfortable longitudinal acceleration of a car, m/s².
-const CAR_ACCEL_MPS2: f64 = 1.5;
+pub(crate) const CAR_ACCEL_MPS2: f64 = 1.5;
 /// Longitudinal acceleration of a robot, m/s².
-const ROBOT_ACCEL_MPS2: f64 = 0.5;
+pub(crate) const ROBOT_ACCEL_MPS2: f64 = 0.5;
 /// Time the steering takes to wind in or out, s.
-const EASE_S: f64 = 1.5;
+pub(crate) const EASE_S: f64 = 1.5;
 /// Largest lateral acceleration a car is driven at in a tight turn, m/s².
 const TIGHT_LATERAL_MPS2: f64 = 2.5;
 
@@ -97,9 +97,9 @@ pub(crate) fn range_route(
     }
     while driven < length_m {
         let (next, d) = if car {
-            car_segment(v, rng, b)?
+            car_segment(v, rng, b, true)?
         } else {
-            robot_segment(v, rng, b)?
+            robot_segment(v, rng, b, true)?
         };
         b = next;
         driven += d;
@@ -107,12 +107,13 @@ pub(crate) fn range_route(
     Ok(b.change_speed(0.0, accel)?.stop(5.0)?.build())
 }
 
-/// One stretch of road: a city corner down to full lock, a suburban bend, a roundabout, a
-/// ramp or a highway.
-fn car_segment(
+/// One stretch of road: a city corner down to full lock (with a stop at the lights half the
+/// time if `stops`), a suburban bend, a roundabout, a ramp or a highway.
+pub(crate) fn car_segment(
     v: &RangeVehicle,
     rng: &mut SplitMix64,
     b: RouteBuilder,
+    stops: bool,
 ) -> Result<(RouteBuilder, f64)> {
     let a = CAR_ACCEL_MPS2;
     Ok(match (rng.uniform() * 6.0) as u32 {
@@ -125,7 +126,7 @@ fn car_segment(
                 .straight(block)?
                 .change_speed(corner_speed, a)?
                 .eased_turn(either_sign(rng) * PI / 2.0, radius, EASE_S)?;
-            if rng.uniform() < 0.5 {
+            if stops && rng.uniform() < 0.5 {
                 b = b.change_speed(0.0, a)?.stop(between(rng, 2.0, 30.0))?;
             }
             (b, block + radius * PI / 2.0)
@@ -184,22 +185,23 @@ fn car_segment(
     })
 }
 
-/// One piece of a robot's work: a straight run, a turn in place, an arc, with stops.
-fn robot_segment(
+/// One piece of a robot's work: a straight run (with a stop at its end if `stops`), a turn
+/// in place, an arc.
+pub(crate) fn robot_segment(
     v: &RangeVehicle,
     rng: &mut SplitMix64,
     b: RouteBuilder,
+    stops: bool,
 ) -> Result<(RouteBuilder, f64)> {
     let a = ROBOT_ACCEL_MPS2;
     let speed = between(rng, v.speed_range_mps.0, v.speed_range_mps.1);
     Ok(match (rng.uniform() * 4.0) as u32 {
         0 => {
             let run = between(rng, 3.0, 30.0);
-            let b = b
-                .change_speed(speed, a)?
-                .straight(run)?
-                .change_speed(0.0, a)?
-                .stop(between(rng, 0.5, 5.0))?;
+            let mut b = b.change_speed(speed, a)?.straight(run)?;
+            if stops {
+                b = b.change_speed(0.0, a)?.stop(between(rng, 0.5, 5.0))?;
+            }
             (b, run)
         }
         1 => {

@@ -74,6 +74,9 @@ impl Route {
 #[derive(Debug, Clone)]
 pub struct RouteBuilder {
     speed_mps: f64,
+    /// The duration of the commands so far, s (kept as they are added, so that asking
+    /// for it costs nothing however long the route).
+    duration_s: f64,
     route: Route,
 }
 
@@ -88,6 +91,7 @@ impl RouteBuilder {
     pub fn new() -> Self {
         Self {
             speed_mps: 0.0,
+            duration_s: 0.0,
             route: Route {
                 start_speed_mps: 0.0,
                 commands: Vec::new(),
@@ -100,6 +104,7 @@ impl RouteBuilder {
         check_positive("speed_mps", speed_mps)?;
         Ok(Self {
             speed_mps,
+            duration_s: 0.0,
             route: Route {
                 start_speed_mps: speed_mps,
                 commands: Vec::new(),
@@ -114,7 +119,12 @@ impl RouteBuilder {
 
     /// The duration of the route so far, s.
     pub fn duration_s(&self) -> f64 {
-        self.route.duration_s()
+        self.duration_s
+    }
+
+    fn push(&mut self, command: Command) {
+        self.duration_s += command.duration_s;
+        self.route.commands.push(command);
     }
 
     fn moving(&self) -> Result<f64> {
@@ -132,7 +142,7 @@ impl RouteBuilder {
     pub fn straight(mut self, distance_m: f64) -> Result<Self> {
         check_positive("distance_m", distance_m)?;
         let v = self.moving()?;
-        self.route.commands.push(Command {
+        self.push(Command {
             duration_s: distance_m / v,
             accel_mps2: 0.0,
             curvature_per_m: 0.0,
@@ -148,7 +158,7 @@ impl RouteBuilder {
         check_positive("radius_m", radius_m)?;
         check_positive("|angle_rad|", angle_rad.abs())?;
         let v = self.moving()?;
-        self.route.commands.push(Command {
+        self.push(Command {
             duration_s: angle_rad.abs() * radius_m / v,
             accel_mps2: 0.0,
             curvature_per_m: angle_rad.signum() / radius_m,
@@ -171,7 +181,7 @@ impl RouteBuilder {
         // Each easing turns through k·v·T/2; together they may take at most the whole angle.
         let ease = ease_s.min(angle_rad.abs() * radius_m / v);
         let held = (angle_rad.abs() - ease * v / radius_m) * radius_m / v;
-        self.route.commands.push(Command {
+        self.push(Command {
             duration_s: ease,
             accel_mps2: 0.0,
             curvature_per_m: 0.0,
@@ -179,7 +189,7 @@ impl RouteBuilder {
             pivot_rate_rps: 0.0,
         });
         if held > 0.0 {
-            self.route.commands.push(Command {
+            self.push(Command {
                 duration_s: held,
                 accel_mps2: 0.0,
                 curvature_per_m: k,
@@ -187,7 +197,7 @@ impl RouteBuilder {
                 pivot_rate_rps: 0.0,
             });
         }
-        self.route.commands.push(Command {
+        self.push(Command {
             duration_s: ease,
             accel_mps2: 0.0,
             curvature_per_m: k,
@@ -210,7 +220,7 @@ impl RouteBuilder {
         check_positive("accel_mps2", accel_mps2.abs())?;
         let dv = to_mps - self.speed_mps;
         if dv != 0.0 {
-            self.route.commands.push(Command {
+            self.push(Command {
                 duration_s: dv.abs() / accel_mps2.abs(),
                 accel_mps2: dv.signum() * accel_mps2.abs(),
                 curvature_per_m: 0.0,
@@ -233,7 +243,7 @@ impl RouteBuilder {
                 hint: "call change_speed(0.0, ..) before pivot",
             });
         }
-        self.route.commands.push(Command {
+        self.push(Command {
             duration_s: angle_rad.abs() / rate_rps,
             accel_mps2: 0.0,
             curvature_per_m: 0.0,
@@ -252,7 +262,7 @@ impl RouteBuilder {
                 hint: "call change_speed(0.0, ..) before stop",
             });
         }
-        self.route.commands.push(Command {
+        self.push(Command {
             duration_s,
             accel_mps2: 0.0,
             curvature_per_m: 0.0,
