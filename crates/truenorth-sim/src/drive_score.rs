@@ -3,7 +3,8 @@
 
 use truenorth_core::{Error, NavEstimate, Result, angle_diff};
 
-use crate::{RangeDrive, SimulatedDrive, VehicleTruth};
+use crate::drive::active_at;
+use crate::{LogDrive, RangeDrive, SimulatedDrive, VehicleTruth};
 
 /// The figures by which a drive's estimates are judged.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -39,13 +40,41 @@ impl SimulatedDrive {
 impl RangeDrive {
     /// Scores `estimates`, one per row of the drive, in order.
     pub fn score(&self, estimates: &[NavEstimate]) -> Result<DriveScore> {
-        DriveScore::of(
+        rows_score(
+            self.mean_wheel_scale(),
             &self.truth,
             estimates,
-            |t| self.disturbed_at(t),
-            self.mean_wheel_scale(),
+            &self.disturbances,
         )
     }
+}
+
+impl LogDrive {
+    /// Scores `estimates`, one per row of the drive, in order.
+    pub fn score(&self, estimates: &[NavEstimate]) -> Result<DriveScore> {
+        rows_score(
+            self.mean_wheel_scale(),
+            &self.truth,
+            estimates,
+            &self.disturbances,
+        )
+    }
+}
+
+/// [`DriveScore::of`] for a drive with `disturbances` and the odometer's mean scale
+/// `wheel_scale`.
+fn rows_score(
+    wheel_scale: f64,
+    truth: &[VehicleTruth],
+    estimates: &[NavEstimate],
+    disturbances: &[truenorth_compass::Disturbance],
+) -> Result<DriveScore> {
+    DriveScore::of(
+        truth,
+        estimates,
+        |t| active_at(disturbances, t),
+        wheel_scale,
+    )
 }
 
 impl DriveScore {

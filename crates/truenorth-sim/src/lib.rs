@@ -7,7 +7,12 @@
 //! for orientation filters; [`protocol_shots`] gives the few-shot calibration protocols of a
 //! hand-held pointing instrument ([`FewShotInstrument`]). [`vehicle_streams`] and [`imu_streams`] run the truth through the
 //! sensor crates' forward models (gyro, odometer, compass, accelerometer) with errors from
-//! [`VehicleSensorParams`] / [`ImuSensorParams`]. Everything is deterministic for a given seed.
+//! [`VehicleSensorParams`] / [`ImuSensorParams`]. [`LogDrive`] gives drives as real logs come
+//! ([`log_drive`]): in motion from the first row, each sensor on rows of its own with its
+//! latency, wheel data filtered and quantised by its controller, the sensor sets real
+//! vehicles carry (a CAN vehicle speed and yaw rate, two or four wheel speeds, a gyro and a
+//! compass without wheels, ...), as a `DRIVE.csv` if wanted. Everything is deterministic for
+//! a given seed.
 //! Gyro samples are the instantaneous rate at their timestamp (the convention of
 //! [`truenorth_core::GyroSample`]), so a trapezoid integrator tracks the heading to second
 //! order in the sample interval.
@@ -36,6 +41,7 @@ mod drive;
 mod drive_score;
 mod few_shot;
 mod handheld;
+pub mod log_drive;
 mod range_drive;
 mod range_route;
 mod route;
@@ -53,6 +59,12 @@ pub use few_shot::{
     FewShotInstrument, Shot, pointing_ned, protocol_shots, random_attitude, rolled_run,
 };
 pub use handheld::{HandheldParams, MotionTruth, handheld_motion};
+pub use log_drive::{
+    Clock, CompassConfig, Habit, LogDrive, LogDriveConfig, LogErrors, LogRow, Measured,
+    MotionConfig, Odometry, OdometryReading, Rests, RobotConfig, RouteShape, RowLayout, SensorSet,
+    SensorTiming, SkidGround, SkidSteerConfig, Span, TimingConfig, WheelConfig, YawRateConfig,
+    YawRateErrors, drive_csv, vehicle_samples,
+};
 pub use range_drive::{Fitted, RangeDrive, RangeSpec, SensorRates};
 pub use route::{Command, Route, RouteBuilder};
 pub use streams::{
