@@ -11,8 +11,8 @@
 //! ([`log_drive`]): in motion from the first row, each sensor on rows of its own with its
 //! latency, wheel data filtered and quantised by its controller, the sensor sets real
 //! vehicles carry (a CAN vehicle speed and yaw rate, two or four wheel speeds, a gyro and a
-//! compass without wheels, ...), as a `DRIVE.csv` if wanted. Everything is deterministic for
-//! a given seed.
+//! compass without wheels, ...) and a GNSS receiver's fixes, as a `DRIVE.csv` if wanted.
+//! Everything is deterministic for a given seed.
 //! Gyro samples are the instantaneous rate at their timestamp (the convention of
 //! [`truenorth_core::GyroSample`]), so a trapezoid integrator tracks the heading to second
 //! order in the sample interval.
@@ -41,6 +41,7 @@ mod drive;
 mod drive_score;
 mod few_shot;
 mod handheld;
+mod local_plane;
 pub mod log_drive;
 mod range_drive;
 mod range_route;
@@ -59,11 +60,13 @@ pub use few_shot::{
     FewShotInstrument, Shot, pointing_ned, protocol_shots, random_attitude, rolled_run,
 };
 pub use handheld::{HandheldParams, MotionTruth, handheld_motion};
+pub use local_plane::LocalTangentPlane;
 pub use log_drive::{
-    Clock, CompassConfig, Habit, LogDrive, LogDriveConfig, LogErrors, LogRow, Measured,
-    MotionConfig, Odometry, OdometryReading, Rests, RobotConfig, RouteShape, RowLayout, SensorSet,
-    SensorTiming, SkidGround, SkidSteerConfig, Span, TimingConfig, WheelConfig, YawRateConfig,
-    YawRateErrors, drive_csv, vehicle_samples,
+    Canyons, Clock, CompassConfig, Episodes, FixCondition, GnssConfig, GnssErrors, GnssFix,
+    GnssTruth, Habit, Jump, LateFixes, LogDrive, LogDriveConfig, LogErrors, LogRow, Measured,
+    MotionConfig, Odometry, OdometryReading, Origin, Rests, RobotConfig, RouteShape, RowLayout,
+    SensorSet, SensorTiming, SkidGround, SkidSteerConfig, Span, TimingConfig, WheelConfig,
+    YawRateConfig, YawRateErrors, drive_csv, vehicle_samples,
 };
 pub use range_drive::{Fitted, RangeDrive, RangeSpec, SensorRates};
 pub use route::{Command, Route, RouteBuilder};

@@ -515,6 +515,7 @@ fn the_csv_reads_back_to_the_rows() {
             mag: cells[4]
                 .zip(cells[5])
                 .map(|(x, y)| nalgebra::Vector2::new(x, y)),
+            gnss: None,
         };
         assert_eq!(&back, row);
     }
@@ -566,6 +567,8 @@ fn each_habit_can_be_left_out() {
             Habit::YawScale => assert_eq!(e.yaw_rate.gain(true), e.yaw_rate.tilt_rad.cos()),
             Habit::Tilt => assert_eq!(e.yaw_rate.tilt_rad, 0.0),
             Habit::VaryingTrack => assert_eq!(d.ground.as_ref().unwrap().patches.len(), 1),
+            // The GNSS habits, measured in the GNSS tests.
+            _ => assert!(d.gnss.is_none()),
         }
     }
     // Without their own clocks and latency, the sensors share every row, as a simulator

@@ -3,8 +3,8 @@
 
 use proptest::prelude::*;
 use truenorth_sim::{
-    LogDrive, LogDriveConfig, OdometryReading, RouteShape, SensorSet, Span, VehicleKind,
-    simulate_at,
+    Episodes, GnssConfig, LogDrive, LogDriveConfig, OdometryReading, Origin, RouteShape, SensorSet,
+    Span, VehicleKind, simulate_at,
 };
 
 /// A short drive of `kind` carrying `sensors`.
@@ -21,7 +21,7 @@ fn kind() -> impl Strategy<Value = VehicleKind> {
 type Setter = fn(&mut LogDriveConfig, f64);
 
 /// Every numeric field a user may set, one at a time.
-const SETTERS: [Setter; 24] = [
+const SETTERS: [Setter; 30] = [
     |c, x| c.motion.length_m = x.min(400.0),
     |c, x| {
         c.motion.shape = RouteShape::Circling {
@@ -64,6 +64,44 @@ const SETTERS: [Setter; 24] = [
     |c, x| c.compass.field_ut = Span::fixed(x),
     |c, x| c.skid_steer.ground_factor = Span::new(1.0, x),
     |c, x| c.robot.track_m = Some(Span::fixed(x)),
+    |c, x| {
+        c.gnss = Some(GnssConfig {
+            sigma_m: Span::new(0.0, x),
+            ..GnssConfig::for_car()
+        })
+    },
+    |c, x| {
+        c.gnss = Some(GnssConfig {
+            tau_s: Span::fixed(x),
+            ..GnssConfig::for_car()
+        })
+    },
+    |c, x| {
+        c.gnss = Some(GnssConfig {
+            origin: Origin {
+                lat_deg: x,
+                ..Origin::BERLIN
+            },
+            ..GnssConfig::for_car()
+        })
+    },
+    |c, x| {
+        c.gnss = Some(GnssConfig {
+            outages: Some(Episodes {
+                first_after_s: 0.0,
+                mean_gap_s: x,
+                duration_s: Span::new(1.0, 5.0),
+            }),
+            ..GnssConfig::for_car()
+        })
+    },
+    |c, x| {
+        c.gnss = Some(GnssConfig {
+            lever_forward_m: Span::fixed(x),
+            ..GnssConfig::for_robot()
+        })
+    },
+    |c, x| c.compass.declination_deg = Some(x),
 ];
 
 fn value() -> impl Strategy<Value = f64> {

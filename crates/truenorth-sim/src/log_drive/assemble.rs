@@ -3,6 +3,7 @@
 
 use truenorth_core::{NoiseSource, SplitMix64};
 
+use super::gnss_receiver::GnssTruth;
 use super::row::{LogRow, Measured};
 use super::streams::Slot;
 use super::timing::{RowLayout, Timed, TimingConfig, log_clock, rounded};
@@ -54,6 +55,13 @@ pub(crate) fn assemble(
             Slot::Compass(c) => {
                 row.mag = Some(c);
                 m.compass_s = at;
+            }
+            Slot::Gnss(fix, truth) => {
+                row.gnss = Some(fix);
+                m.gnss = Some(GnssTruth {
+                    epoch_s: start + truth.epoch_s,
+                    ..truth
+                });
             }
         }
     }

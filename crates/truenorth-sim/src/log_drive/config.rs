@@ -2,8 +2,9 @@
 //! how its readings are timed, and the ranges every error is drawn from.
 
 use serde::{Deserialize, Serialize};
-use truenorth_core::{Result, Validate};
+use truenorth_core::{Result, Validate, check_range};
 
+use super::gnss_config::GnssConfig;
 use super::motion::{MotionConfig, Rests, RouteShape};
 use super::sensor_set::SensorSet;
 use super::skid_ground::SkidSteerConfig;
@@ -30,6 +31,10 @@ pub struct CompassConfig {
     /// Magnetic disturbances on the way (true): short strong ones and long slow ones that
     /// turn the field, as [`crate::DriveSpec`] describes them.
     pub disturbances: bool,
+    /// The declination, degrees east (−180–180): the compass sees the true heading less
+    /// it. `None` (the default): the World Magnetic Model's at the GNSS origin when the
+    /// drive has a GNSS receiver, 0 otherwise.
+    pub declination_deg: Option<f64>,
 }
 
 impl Default for CompassConfig {
@@ -41,6 +46,7 @@ impl Default for CompassConfig {
             soft_iron_ratio: Span::new(r.soft_iron.0, r.soft_iron.1),
             noise: Span::new(r.noise.0, r.noise.1),
             disturbances: true,
+            declination_deg: None,
         }
     }
 }
@@ -53,6 +59,9 @@ impl CompassConfig {
         self.soft_iron_ratio
             .check("compass soft_iron_ratio", 1.0, 5.0)?;
         self.noise.check("compass noise", 0.0, 0.5)?;
+        if let Some(d) = self.declination_deg {
+            check_range("compass declination_deg", d, -180.0, 180.0)?;
+        }
         Ok(())
     }
 
@@ -68,6 +77,7 @@ impl CompassConfig {
 /// A habit of real logs, which [`LogDriveConfig::without`] leaves out so that an ensemble
 /// can be run with and without each one.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[non_exhaustive]
 pub enum Habit {
     /// Starting and ending in motion. Without: a standstill of 3–12 s first and a stop at
     /// the end.
@@ -94,11 +104,23 @@ pub enum Habit {
     /// A skid-steer's effective track changing with the ground and the turn. Without: one
     /// track factor for the whole drive.
     VaryingTrack,
+    /// GNSS outages. Without: none.
+    GnssOutages,
+    /// Urban canyons: larger errors and multipath jumps. Without: none.
+    GnssCanyons,
+    /// Frozen fixes. Without: none.
+    GnssFrozen,
+    /// Fixes seconds late. Without: none (the receiver's usual latency stays).
+    GnssLate,
+    /// A time-correlated GNSS error. Without: white (a correlation time of 10 ms).
+    GnssCorrelation,
+    /// The antenna's lever arm. Without: the antenna over the rear-axle centre.
+    LeverArm,
 }
 
 impl Habit {
     /// Every habit.
-    pub const ALL: [Self; 10] = [
+    pub const ALL: [Self; 16] = [
         Self::InMotion,
         Self::RareRests,
         Self::OwnClocks,
@@ -109,6 +131,12 @@ impl Habit {
         Self::YawScale,
         Self::Tilt,
         Self::VaryingTrack,
+        Self::GnssOutages,
+        Self::GnssCanyons,
+        Self::GnssFrozen,
+        Self::GnssLate,
+        Self::GnssCorrelation,
+        Self::LeverArm,
     ];
 }
 
@@ -163,6 +191,9 @@ pub struct LogDriveConfig {
     pub skid_steer: SkidSteerConfig,
     /// A robot's geometry and speed, where fixed (robots only).
     pub robot: RobotConfig,
+    /// A GNSS receiver (`None`, the default: none; [`GnssConfig::for_car`] and
+    /// [`GnssConfig::for_robot`] give one).
+    pub gnss: Option<GnssConfig>,
 }
 
 impl Default for LogDriveConfig {
@@ -205,6 +236,20 @@ impl LogDriveConfig {
             compass: CompassConfig::default(),
             skid_steer: SkidSteerConfig::default(),
             robot: RobotConfig::default(),
+            gnss: None,
+        }
+    }
+
+    /// The same configuration with the GNSS receiver of its kind ([`GnssConfig::for_car`]
+    /// or [`GnssConfig::for_robot`]).
+    pub fn with_gnss(self) -> Self {
+        Self {
+            gnss: Some(if self.kind.is_car() {
+                GnssConfig::for_car()
+            } else {
+                GnssConfig::for_robot()
+            }),
+            ..self
         }
     }
 
@@ -246,10 +291,17 @@ impl LogDriveConfig {
                     s.latency_s = Span::fixed(0.0);
                     s.jitter_s = 0.0;
                 }
+                if let Some(g) = &mut self.gnss {
+                    g.timing.latency_s = Span::fixed(0.0);
+                    g.timing.jitter_s = 0.0;
+                }
             }
             Habit::Drops => {
                 for s in [&mut t.gyro, &mut t.odometry, &mut t.compass] {
                     s.drop_probability = Span::fixed(0.0);
+                }
+                if let Some(g) = &mut self.gnss {
+                    g.timing.drop_probability = Span::fixed(0.0);
                 }
             }
             Habit::WheelLag => self.wheels.lag_s = Span::fixed(0.0),
@@ -270,6 +322,27 @@ impl LogDriveConfig {
                 s.tight_turn_gain = Span::fixed(0.0);
                 s.per_g = Span::fixed(0.0);
                 s.wander = 0.0;
+            }
+            Habit::GnssOutages | Habit::GnssCanyons | Habit::GnssFrozen | Habit::GnssLate => {
+                if let Some(g) = &mut self.gnss {
+                    match habit {
+                        Habit::GnssOutages => g.outages = None,
+                        Habit::GnssCanyons => g.canyons = None,
+                        Habit::GnssFrozen => g.frozen = None,
+                        _ => g.late = None,
+                    }
+                }
+            }
+            Habit::GnssCorrelation => {
+                if let Some(g) = &mut self.gnss {
+                    g.tau_s = Span::fixed(0.01);
+                }
+            }
+            Habit::LeverArm => {
+                if let Some(g) = &mut self.gnss {
+                    g.lever_forward_m = Span::fixed(0.0);
+                    g.lever_right_m = Span::fixed(0.0);
+                }
             }
         }
         self
@@ -302,6 +375,10 @@ impl Validate for LogDriveConfig {
         self.yaw_rate.check()?;
         self.compass.check()?;
         self.skid_steer.check()?;
-        self.robot.check()
+        self.robot.check()?;
+        if let Some(g) = &self.gnss {
+            g.check()?;
+        }
+        Ok(())
     }
 }

@@ -28,10 +28,16 @@
 //! from the first row, rests, circling), [`timing`] (own rates, latency, jitter, lost
 //! readings, stamps), [`wheel_controller`] (lag and quanta of wheel data), [`skid_ground`]
 //! (a skid-steer's effective track), [`yaw_sensor`] (bias, scale, tilt and quantum of a
-//! yaw-rate sensor). [`Habit`] and [`LogDriveConfig::without`] leave one out at a time.
+//! yaw-rate sensor), [`gnss_config`] (a GNSS receiver: time-correlated errors, a reported σ,
+//! speed and course, outages, multipath jumps, frozen and late fixes, the lever arm; fixes as
+//! WGS84 latitude and longitude in the [`LocalTangentPlane`] at its origin, where the compass
+//! sees the World Magnetic Model's declination). [`Habit`] and [`LogDriveConfig::without`]
+//! leave one out at a time.
 
 mod assemble;
 mod config;
+pub mod gnss_config;
+mod gnss_receiver;
 pub mod motion;
 mod row;
 mod sensor_set;
@@ -43,6 +49,8 @@ pub mod wheel_controller;
 pub mod yaw_sensor;
 
 pub use config::{CompassConfig, Habit, LogDriveConfig, RobotConfig};
+pub use gnss_config::{Canyons, Episodes, GnssConfig, LateFixes, Origin};
+pub use gnss_receiver::{FixCondition, GnssErrors, GnssFix, GnssTruth, Jump};
 pub use motion::{MotionConfig, Rests, RouteShape};
 pub use row::{LogRow, Measured, OdometryReading, drive_csv, vehicle_samples};
 pub use sensor_set::{Odometry, SensorSet};
@@ -60,12 +68,15 @@ use truenorth_compass::Disturbance;
 use truenorth_core::{NoiseSource, Result, SplitMix64, Validate, VehicleSample, check_range};
 use truenorth_odometer::{AckermannParams, OdometerParams, OdometerWheels};
 
+use crate::LocalTangentPlane;
 use crate::drive::{active_at, random_disturbances};
 use crate::route::Route;
 use crate::vehicle::{MAX_SAMPLES, VehicleTruth, simulate_at};
 use crate::vehicle_kind::{RangeVehicle, VehicleKind};
 use assemble::assemble;
+use gnss_receiver::gnss_stream;
 use streams::{Track, compass_stream, gyro_stream, odometry_stream};
+use truenorth_geomag::field_at_deg;
 
 /// The true errors of one drive's sensors and clocks.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -91,6 +102,8 @@ pub struct LogErrors {
     pub compass_soft_iron: Matrix2<f64>,
     /// Compass noise per axis, µT.
     pub compass_noise_ut: f64,
+    /// The declination the compass sees, rad east (magnetic = true − declination).
+    pub declination_rad: f64,
     /// The gyro's clock.
     pub gyro_clock: Clock,
     /// The odometry's clock.
@@ -126,6 +139,11 @@ pub struct LogDrive {
     pub ground: Option<SkidGround>,
     /// The magnetic disturbances, s on the log's clock.
     pub disturbances: Vec<Disturbance>,
+    /// The GNSS receiver's errors (times s after the truth starts), if there is one.
+    pub gnss: Option<GnssErrors>,
+    /// The tangent plane the truth's north and east are in, at the GNSS origin, if there
+    /// is a receiver.
+    pub plane: Option<LocalTangentPlane>,
 }
 
 impl LogDrive {
@@ -139,6 +157,7 @@ impl LogDrive {
         // Each sensor draws its noise and its arrivals from a stream of its own, so that a
         // sensor's rows do not change with the other sensors fitted.
         let (mut gyro_rng, mut wheel_rng, mut compass_rng) = (stream(), stream(), stream());
+        let mut gnss_rng = stream();
 
         let (vehicle, front_axle) = draw_vehicle(config.kind, &config.robot, &mut motion_rng);
         let route = config.motion.route(&vehicle, &mut motion_rng)?;
@@ -150,6 +169,7 @@ impl LogDrive {
             &config.timing.compass.rate_hz,
         ]
         .iter()
+        .chain(config.gnss.as_ref().map(|g| &g.timing.rate_hz).as_ref())
         .fold(config.wheels.loop_hz, |m, r| m.max(r.hi));
         check_range(
             "readings of the drive (duration × fastest rate)",
@@ -158,13 +178,26 @@ impl LogDrive {
             MAX_SAMPLES,
         )?;
 
-        let errors = draw_errors(
+        let plane = config
+            .gnss
+            .map(|g| LocalTangentPlane::new(g.origin.lat_deg, g.origin.lon_deg, g.origin.height_m))
+            .transpose()?;
+        let declination_deg = match (config.compass.declination_deg, config.gnss) {
+            (Some(d), _) => d,
+            (None, Some(g)) => {
+                let o = g.origin;
+                field_at_deg(o.lat_deg, o.lon_deg, o.height_m / 1e3, g.year)?.declination_deg()
+            }
+            (None, None) => 0.0,
+        };
+        let mut errors = draw_errors(
             &config,
             &vehicle,
             front_axle,
             &mut error_rng,
             &mut clock_rng,
         );
+        errors.declination_rad = declination_deg.to_radians();
         let disturbances = if config.sensors.compass && config.compass.disturbances {
             random_disturbances(&mut error_rng, duration_s, errors.field_ut)
         } else {
@@ -195,6 +228,12 @@ impl LogDrive {
                 &mut compass_rng,
             )?);
         }
+        let mut gnss = None;
+        if let (Some(g), Some(plane)) = (&config.gnss, &plane) {
+            let e = GnssErrors::draw(g, duration_s, &mut gnss_rng);
+            streams.push(gnss_stream(&track, g, &e, plane, &mut gnss_rng)?);
+            gnss = Some(e);
+        }
         let (route_times, rows, measured) =
             assemble(streams, &config.timing, &mut clock_rng, duration_s);
         let mut truth = simulate_at(&route, heading0_rad, &route_times)?;
@@ -220,6 +259,8 @@ impl LogDrive {
             errors,
             ground,
             disturbances,
+            gnss,
+            plane,
         })
     }
 
@@ -350,6 +391,7 @@ fn draw_errors(
         compass_hard_iron: compass.hard_iron,
         compass_soft_iron: compass.soft_iron,
         compass_noise_ut: compass.noise,
+        declination_rad: 0.0,
         gyro_clock,
         odometry_clock,
         compass_clock,

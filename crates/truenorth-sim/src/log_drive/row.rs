@@ -8,6 +8,7 @@ use nalgebra::Vector2;
 use serde::{Deserialize, Serialize};
 use truenorth_core::VehicleSample;
 
+use super::gnss_receiver::{GnssFix, GnssTruth};
 use crate::VehicleKind;
 
 /// What the odometry gave on a row.
@@ -64,6 +65,8 @@ pub struct LogRow {
     pub gyr_z_rps: Option<f64>,
     /// The raw horizontal magnetometer reading, µT, if the row carries one.
     pub mag: Option<Vector2<f64>>,
+    /// A GNSS fix, if the row carries one.
+    pub gnss: Option<GnssFix>,
 }
 
 impl LogRow {
@@ -74,6 +77,7 @@ impl LogRow {
             odometry: None,
             gyr_z_rps: None,
             mag: None,
+            gnss: None,
         }
     }
 }
@@ -88,18 +92,21 @@ pub struct Measured {
     pub gyro_s: Option<f64>,
     /// The compass.
     pub compass_s: Option<f64>,
+    /// The truth behind the GNSS fix.
+    pub gnss: Option<GnssTruth>,
     /// By how much the wheels saw the vehicle's turn at the odometry's loop step: a
     /// skid-steer's effective over its physical track (times the wander), `1 +` the tyre
     /// slip of a car.
     pub turn_factor: Option<f64>,
 }
 
-/// `rows` as a `DRIVE.csv`: a header of the columns any row carries, then one line per row
-/// with an empty cell where the row carries no reading; numbers in the shortest form that
-/// reads back to the same `f64`.
+/// `rows` as a `DRIVE.csv`: a header of the columns any row carries (`t_s`, the odometry's,
+/// `gyr_z`, `mag_x,mag_y`, then `lat_deg,lon_deg,gnss_sigma_m,gnss_speed_mps,gnss_course_deg`
+/// as the fixes carry them), then one line per row with an empty cell where the row carries
+/// no reading; numbers in the shortest form that reads back to the same `f64`.
 pub fn drive_csv(rows: &[LogRow]) -> String {
     let mut odometry: &[&str] = &[];
-    let (mut gyro, mut mag) = (false, false);
+    let (mut gyro, mut mag, mut fix, mut sigma, mut velocity) = (false, false, false, false, false);
     for r in rows {
         if let Some(o) = r.odometry
             && o.columns().len() > odometry.len()
@@ -108,6 +115,11 @@ pub fn drive_csv(rows: &[LogRow]) -> String {
         }
         gyro |= r.gyr_z_rps.is_some();
         mag |= r.mag.is_some();
+        if let Some(g) = r.gnss {
+            fix = true;
+            sigma |= g.sigma_m.is_some();
+            velocity |= g.speed_mps.is_some() || g.course_deg.is_some();
+        }
     }
     let mut header = vec!["t_s"];
     header.extend_from_slice(odometry);
@@ -116,6 +128,15 @@ pub fn drive_csv(rows: &[LogRow]) -> String {
     }
     if mag {
         header.extend(["mag_x", "mag_y"]);
+    }
+    if fix {
+        header.extend(["lat_deg", "lon_deg"]);
+    }
+    if sigma {
+        header.push("gnss_sigma_m");
+    }
+    if velocity {
+        header.extend(["gnss_speed_mps", "gnss_course_deg"]);
     }
     let mut out = header.join(",");
     out.push('\n');
@@ -131,6 +152,17 @@ pub fn drive_csv(rows: &[LogRow]) -> String {
         if mag {
             cell(&mut out, r.mag.map(|m| m.x));
             cell(&mut out, r.mag.map(|m| m.y));
+        }
+        if fix {
+            cell(&mut out, r.gnss.map(|g| g.lat_deg));
+            cell(&mut out, r.gnss.map(|g| g.lon_deg));
+        }
+        if sigma {
+            cell(&mut out, r.gnss.and_then(|g| g.sigma_m));
+        }
+        if velocity {
+            cell(&mut out, r.gnss.and_then(|g| g.speed_mps));
+            cell(&mut out, r.gnss.and_then(|g| g.course_deg));
         }
         out.push('\n');
     }
@@ -150,7 +182,8 @@ fn cell(out: &mut String, value: Option<f64>) {
 /// four the odometer axle's pair on a car (the front wheels of a front-wheel car, else the
 /// rear) and each side's mean on a robot; a vehicle speed integrated the same way, and a
 /// single distance as it is, into [`VehicleSample::dist_m`] (a distance with no left and
-/// right, which says nothing about turning); the gyro and the compass as they are.
+/// right, which says nothing about turning); the gyro and the compass as they are. The core's
+/// sample has no GNSS fix: read [`LogRow::gnss`].
 pub fn vehicle_samples(rows: &[LogRow], kind: VehicleKind) -> Vec<VehicleSample> {
     let mut pair = Integral::<2>::default();
     let mut single = Integral::<1>::default();

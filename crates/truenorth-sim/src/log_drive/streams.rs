@@ -6,6 +6,7 @@ use truenorth_compass::{Disturbance, HeadingTruth, MagnetometerModel2d};
 use truenorth_core::{NoiseSource, Result, SensorModel, SplitMix64};
 use truenorth_gyro::{GyroAxisModel, RateTruth};
 
+use super::gnss_receiver::{GnssFix, GnssTruth};
 use super::row::OdometryReading;
 use super::sensor_set::Odometry;
 use super::skid_ground::{SkidGround, SkidProcess};
@@ -26,6 +27,8 @@ pub(crate) enum Slot {
     Gyro(f64),
     /// A compass reading, µT.
     Compass(Vector2<f64>),
+    /// A GNSS fix and the truth behind it.
+    Gnss(GnssFix, GnssTruth),
 }
 
 /// The route, where it starts, and how the log stamps: what every stream reads.
@@ -37,14 +40,14 @@ pub(crate) struct Track<'a> {
 }
 
 impl Track<'_> {
-    fn at(&self, times: &[f64]) -> Result<Vec<VehicleTruth>> {
+    pub(crate) fn at(&self, times: &[f64]) -> Result<Vec<VehicleTruth>> {
         simulate_at(self.route, self.heading0_rad, times)
     }
 
     /// Stamps the readings (the instant each measured, the instant its sensor sent it,
     /// the reading) as `clock` delivers them: late by its latency and jitter, rounded to
     /// the log's resolution and strictly increasing, the lost ones dropped.
-    fn stamped(
+    pub(crate) fn stamped(
         &self,
         clock: &Clock,
         measured: Vec<(f64, f64, Slot)>,
@@ -123,7 +126,8 @@ pub(crate) fn compass_stream(
     let mut out = Vec::with_capacity(truth.len());
     for s in &truth {
         let heading = HeadingTruth {
-            heading_rad: s.heading_rad,
+            // The compass sees the magnetic heading: the true one less the declination.
+            heading_rad: s.heading_rad - e.declination_rad,
             horizontal_field: e.field_ut,
         };
         let m = model.sample(&heading, s.t_s - prev, rng)?;
