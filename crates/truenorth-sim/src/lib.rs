@@ -65,8 +65,8 @@ pub use log_drive::{
     Canyons, Clock, CompassConfig, Episodes, FixCondition, GnssConfig, GnssErrors, GnssFix,
     GnssTruth, Habit, Jump, LateFixes, LogDrive, LogDriveConfig, LogErrors, LogRow, Measured,
     MotionConfig, Odometry, OdometryReading, Origin, Rests, RobotConfig, RouteShape, RowLayout,
-    SensorSet, SensorTiming, SkidGround, SkidSteerConfig, Span, TimingConfig, WheelConfig,
-    YawRateConfig, YawRateErrors, drive_csv, vehicle_samples,
+    SensorSet, SensorTiming, SkidGround, SkidSteerConfig, Span, TiltConfig, TiltErrors,
+    TimingConfig, WheelConfig, YawRateConfig, YawRateErrors, drive_csv, vehicle_samples,
 };
 pub use range_drive::{Fitted, RangeDrive, RangeSpec, SensorRates};
 pub use route::{Command, Route, RouteBuilder};

@@ -4,7 +4,7 @@
 use proptest::prelude::*;
 use truenorth_sim::{
     Episodes, GnssConfig, LogDrive, LogDriveConfig, OdometryReading, Origin, RouteShape, SensorSet,
-    Span, VehicleKind, simulate_at,
+    Span, TiltConfig, VehicleKind, simulate_at,
 };
 
 /// A short drive of `kind` carrying `sensors`.
@@ -21,7 +21,7 @@ fn kind() -> impl Strategy<Value = VehicleKind> {
 type Setter = fn(&mut LogDriveConfig, f64);
 
 /// Every numeric field a user may set, one at a time.
-const SETTERS: [Setter; 30] = [
+const SETTERS: [Setter; 32] = [
     |c, x| c.motion.length_m = x.min(400.0),
     |c, x| {
         c.motion.shape = RouteShape::Circling {
@@ -102,6 +102,18 @@ const SETTERS: [Setter; 30] = [
         })
     },
     |c, x| c.compass.declination_deg = Some(x),
+    |c, x| {
+        c.tilt = Some(TiltConfig {
+            dip_deg: Span::fixed(x),
+            ..TiltConfig::for_car()
+        })
+    },
+    |c, x| {
+        c.tilt = Some(TiltConfig {
+            grade_length_m: Span::fixed(x),
+            ..TiltConfig::for_robot()
+        })
+    },
 ];
 
 fn value() -> impl Strategy<Value = f64> {

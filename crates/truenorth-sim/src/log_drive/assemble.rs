@@ -52,9 +52,10 @@ pub(crate) fn assemble(
                 row.gyr_z_rps = Some(g);
                 m.gyro_s = at;
             }
-            Slot::Compass(c) => {
+            Slot::Compass(c, tilt) => {
                 row.mag = Some(c);
                 m.compass_s = at;
+                m.compass_tilt_rad = tilt;
             }
             Slot::Gnss(fix, truth) => {
                 row.gnss = Some(fix);

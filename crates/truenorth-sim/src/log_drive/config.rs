@@ -4,6 +4,7 @@
 use serde::{Deserialize, Serialize};
 use truenorth_core::{Result, Validate, check_range};
 
+use super::body_tilt::TiltConfig;
 use super::gnss_config::GnssConfig;
 use super::motion::{MotionConfig, Rests, RouteShape};
 use super::sensor_set::SensorSet;
@@ -116,11 +117,13 @@ pub enum Habit {
     GnssCorrelation,
     /// The antenna's lever arm. Without: the antenna over the rear-axle centre.
     LeverArm,
+    /// The body's roll and pitch under a level-assumed compass. Without: a level compass.
+    CompassTilt,
 }
 
 impl Habit {
     /// Every habit.
-    pub const ALL: [Self; 16] = [
+    pub const ALL: [Self; 17] = [
         Self::InMotion,
         Self::RareRests,
         Self::OwnClocks,
@@ -137,6 +140,7 @@ impl Habit {
         Self::GnssLate,
         Self::GnssCorrelation,
         Self::LeverArm,
+        Self::CompassTilt,
     ];
 }
 
@@ -194,6 +198,9 @@ pub struct LogDriveConfig {
     /// A GNSS receiver (`None`, the default: none; [`GnssConfig::for_car`] and
     /// [`GnssConfig::for_robot`] give one).
     pub gnss: Option<GnssConfig>,
+    /// How the body tilts under the compass ([`TiltConfig::for_car`] or
+    /// [`TiltConfig::for_robot`]; `None`: a level compass).
+    pub tilt: Option<TiltConfig>,
 }
 
 impl Default for LogDriveConfig {
@@ -237,6 +244,11 @@ impl LogDriveConfig {
             skid_steer: SkidSteerConfig::default(),
             robot: RobotConfig::default(),
             gnss: None,
+            tilt: Some(if car {
+                TiltConfig::for_car()
+            } else {
+                TiltConfig::for_robot()
+            }),
         }
     }
 
@@ -338,6 +350,7 @@ impl LogDriveConfig {
                     g.tau_s = Span::fixed(0.01);
                 }
             }
+            Habit::CompassTilt => self.tilt = None,
             Habit::LeverArm => {
                 if let Some(g) = &mut self.gnss {
                     g.lever_forward_m = Span::fixed(0.0);
@@ -378,6 +391,9 @@ impl Validate for LogDriveConfig {
         self.robot.check()?;
         if let Some(g) = &self.gnss {
             g.check()?;
+        }
+        if let Some(t) = &self.tilt {
+            t.check()?;
         }
         Ok(())
     }

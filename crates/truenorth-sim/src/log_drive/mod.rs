@@ -31,10 +31,12 @@
 //! yaw-rate sensor), [`gnss_config`] (a GNSS receiver: time-correlated errors, a reported σ,
 //! speed and course, outages, multipath jumps, frozen and late fixes, the lever arm; fixes as
 //! WGS84 latitude and longitude in the [`LocalTangentPlane`] at its origin, where the compass
-//! sees the World Magnetic Model's declination). [`Habit`] and [`LogDriveConfig::without`]
-//! leave one out at a time.
+//! sees the World Magnetic Model's declination), [`body_tilt`] (the body's roll in turns,
+//! pitch on grades and camber under a level-assumed compass, in the field with its vertical
+//! part). [`Habit`] and [`LogDriveConfig::without`] leave one out at a time.
 
 mod assemble;
+pub mod body_tilt;
 mod config;
 pub mod gnss_config;
 mod gnss_receiver;
@@ -48,6 +50,7 @@ pub mod timing;
 pub mod wheel_controller;
 pub mod yaw_sensor;
 
+pub use body_tilt::{TiltConfig, TiltErrors};
 pub use config::{CompassConfig, Habit, LogDriveConfig, RobotConfig};
 pub use gnss_config::{Canyons, Episodes, GnssConfig, LateFixes, Origin};
 pub use gnss_receiver::{FixCondition, GnssErrors, GnssFix, GnssTruth, Jump};
@@ -104,6 +107,10 @@ pub struct LogErrors {
     pub compass_noise_ut: f64,
     /// The declination the compass sees, rad east (magnetic = true − declination).
     pub declination_rad: f64,
+    /// The field's dip, rad (with a level compass it does not matter).
+    pub dip_rad: f64,
+    /// How the body tilts under the compass (`None`: it stays level).
+    pub tilt: Option<TiltErrors>,
     /// The gyro's clock.
     pub gyro_clock: Clock,
     /// The odometry's clock.
@@ -203,6 +210,16 @@ impl LogDrive {
         } else {
             Vec::new()
         };
+        if let Some(t) = &config.tilt {
+            errors.tilt = Some(TiltErrors::draw(t, &mut error_rng));
+            errors.dip_rad = match &config.gnss {
+                Some(g) => {
+                    let o = g.origin;
+                    field_at_deg(o.lat_deg, o.lon_deg, o.height_m / 1e3, g.year)?.inclination_rad
+                }
+                None => body_tilt::drawn_dip_rad(t, errors.field_ut, &mut error_rng),
+            };
+        }
         let track = Track {
             route: &route,
             heading0_rad,
@@ -392,6 +409,8 @@ fn draw_errors(
         compass_soft_iron: compass.soft_iron,
         compass_noise_ut: compass.noise,
         declination_rad: 0.0,
+        dip_rad: 0.0,
+        tilt: None,
         gyro_clock,
         odometry_clock,
         compass_clock,

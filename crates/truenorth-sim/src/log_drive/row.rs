@@ -94,6 +94,9 @@ pub struct Measured {
     pub compass_s: Option<f64>,
     /// The truth behind the GNSS fix.
     pub gnss: Option<GnssTruth>,
+    /// The body's roll (right side down) and pitch (nose up) under the compass, rad, when
+    /// it tilts.
+    pub compass_tilt_rad: Option<[f64; 2]>,
     /// By how much the wheels saw the vehicle's turn at the odometry's loop step: a
     /// skid-steer's effective over its physical track (times the wander), `1 +` the tyre
     /// slip of a car.

@@ -1,11 +1,14 @@
 //! Each sensor's readings from the truth at its own instants, stamped as its clock
 //! delivers them.
 
-use nalgebra::Vector2;
-use truenorth_compass::{Disturbance, HeadingTruth, MagnetometerModel2d};
+use nalgebra::{Matrix3, Vector2, Vector3};
+use truenorth_compass::{
+    AttitudeTruth, Disturbance, HeadingTruth, MagnetometerModel2d, MagnetometerModel3d,
+};
 use truenorth_core::{NoiseSource, Result, SensorModel, SplitMix64};
 use truenorth_gyro::{GyroAxisModel, RateTruth};
 
+use super::body_tilt::TiltProcess;
 use super::gnss_receiver::{GnssFix, GnssTruth};
 use super::row::OdometryReading;
 use super::sensor_set::Odometry;
@@ -25,8 +28,8 @@ pub(crate) enum Slot {
     Odometry(OdometryReading, f64),
     /// A yaw rate, rad/s.
     Gyro(f64),
-    /// A compass reading, µT.
-    Compass(Vector2<f64>),
+    /// A compass reading, µT, and the body's roll and pitch under it, rad.
+    Compass(Vector2<f64>, Option<[f64; 2]>),
     /// A GNSS fix and the truth behind it.
     Gnss(GnssFix, GnssTruth),
 }
@@ -104,7 +107,9 @@ pub(crate) fn gyro_stream(
     Ok(track.stamped(clock, out, rng))
 }
 
-/// The compass's readings through the magnetometer's forward model, with the disturbances.
+/// The compass's readings through the magnetometer's forward model, with the disturbances:
+/// a level compass, or a two-axis compass on the tilting body (the three-axis model's `x`
+/// and `y`, in the field with its vertical part), each with the truth's roll and pitch.
 pub(crate) fn compass_stream(
     track: &Track,
     e: &LogErrors,
@@ -113,28 +118,88 @@ pub(crate) fn compass_stream(
 ) -> Result<Vec<Timed<Slot>>> {
     let clock = &e.compass_clock;
     let truth = track.at(&clock.instants(track.duration_s))?;
-    let mut model =
-        MagnetometerModel2d::new(e.compass_hard_iron, e.compass_soft_iron, e.compass_noise_ut)?;
-    for d in disturbances {
-        model = model.with_disturbance(*d)?;
-    }
+    let mut compass = Compass::new(e, disturbances, rng)?;
     let period = 1.0 / clock.rate_hz;
-    if let Some(first) = truth.first() {
-        model.set_time_s(first.t_s - period);
-    }
     let mut prev = truth.first().map_or(0.0, |s| s.t_s - period);
+    compass.set_time_s(prev);
     let mut out = Vec::with_capacity(truth.len());
     for s in &truth {
-        let heading = HeadingTruth {
-            // The compass sees the magnetic heading: the true one less the declination.
-            heading_rad: s.heading_rad - e.declination_rad,
-            horizontal_field: e.field_ut,
-        };
-        let m = model.sample(&heading, s.t_s - prev, rng)?;
-        out.push((s.t_s, s.t_s, Slot::Compass(m)));
+        let (m, tilt) = compass.sample(s, s.t_s - prev, e, rng)?;
+        out.push((s.t_s, s.t_s, Slot::Compass(m, tilt)));
         prev = s.t_s;
     }
     Ok(track.stamped(clock, out, rng))
+}
+
+/// A compass level in the vehicle, or on its tilting body.
+enum Compass {
+    Level(MagnetometerModel2d),
+    Tilted(MagnetometerModel3d, TiltProcess, Vector3<f64>),
+}
+
+impl Compass {
+    fn new(e: &LogErrors, disturbances: &[Disturbance], rng: &mut SplitMix64) -> Result<Self> {
+        let (h, s) = (e.compass_hard_iron, e.compass_soft_iron);
+        Ok(match e.tilt {
+            None => {
+                let mut m = MagnetometerModel2d::new(h, s, e.compass_noise_ut)?;
+                for d in disturbances {
+                    m = m.with_disturbance(*d)?;
+                }
+                Self::Level(m)
+            }
+            Some(body) => {
+                let soft = Matrix3::new(s.m11, s.m12, 0.0, s.m21, s.m22, 0.0, 0.0, 0.0, 1.0);
+                let mut m = MagnetometerModel3d::new(h.push(0.0), soft, e.compass_noise_ut)?;
+                for d in disturbances {
+                    m = m.with_disturbance(*d)?;
+                }
+                // The field in the frame of true north: magnetic north lies the declination
+                // east of it.
+                let (sin, cos) = e.declination_rad.sin_cos();
+                let f = e.field_ut;
+                let field = Vector3::new(f * cos, f * sin, f * e.dip_rad.tan());
+                Self::Tilted(m, TiltProcess::new(body, rng), field)
+            }
+        })
+    }
+
+    fn set_time_s(&mut self, t_s: f64) {
+        match self {
+            Self::Level(m) => m.set_time_s(t_s),
+            Self::Tilted(m, ..) => m.set_time_s(t_s),
+        }
+    }
+
+    /// The reading at `s`, `dt_s` after the previous, and the body's roll and pitch.
+    fn sample(
+        &mut self,
+        s: &VehicleTruth,
+        dt_s: f64,
+        e: &LogErrors,
+        rng: &mut SplitMix64,
+    ) -> Result<(Vector2<f64>, Option<[f64; 2]>)> {
+        match self {
+            Self::Level(m) => {
+                let heading = HeadingTruth {
+                    // The compass sees the magnetic heading: the true one less the
+                    // declination.
+                    heading_rad: s.heading_rad - e.declination_rad,
+                    horizontal_field: e.field_ut,
+                };
+                Ok((m.sample(&heading, dt_s, rng)?, None))
+            }
+            Self::Tilted(m, tilt, field) => {
+                let attitude = tilt.attitude(s, rng);
+                let truth = AttitudeTruth {
+                    attitude,
+                    field_ned: *field,
+                };
+                let reading = m.sample(&truth, dt_s, rng)?;
+                Ok((reading.xy(), Some([attitude.roll_rad, attitude.pitch_rad])))
+            }
+        }
+    }
 }
 
 /// The odometry's readings: the controller run at its loop rate over the whole drive, and
