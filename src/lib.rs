@@ -16,9 +16,12 @@
 //! | [`accel`] | `truenorth-accel` | accelerometer model, static tilt |
 //! | [`calib`] | `truenorth-calib` | calibrators with quality reports |
 //! | [`fusion`] | `truenorth-fusion` | orientation and vehicle heading estimators |
+//! | [`checks`] | `truenorth-checks` | a recording against its physics: units, axes, yaw against wheels (`std`) |
 //!
-//! The [`pipeline`] module wires them: a self-calibrating compass, or any vehicle or
-//! orientation estimator, with true north from the World Magnetic Model, in a few lines.
+//! On top of them, what the `truenorth` command and the Python package stand on: a [`Place`]
+//! and [`TrueNorth`], the one place where a magnetic heading, a track or an attitude turns
+//! onto true north, and [`CompassCalibration`], any stored compass calibration and the
+//! heading it gives a raw reading.
 //!
 //! ```
 //! use truenorth::prelude::*;
@@ -28,13 +31,20 @@
 //! ```
 #![cfg_attr(not(feature = "std"), no_std)]
 
-pub mod pipeline;
+mod heading;
+mod place;
+
+pub use heading::CompassCalibration;
+pub use place::{Place, TrueNorth};
 
 // Inlined so that `cargo doc -p truenorth` documents every crate's types under the facade.
 #[doc(inline)]
 pub use truenorth_accel as accel;
 #[doc(inline)]
 pub use truenorth_calib as calib;
+#[doc(inline)]
+#[cfg(feature = "std")]
+pub use truenorth_checks as checks;
 #[doc(inline)]
 pub use truenorth_compass as compass;
 #[doc(inline)]
@@ -58,7 +68,7 @@ pub use truenorth_core::{Error, Result};
 /// The types and functions most programs need, in one import. The error type is not in it
 /// (it would hide `std::error::Error`): it is [`crate::Error`].
 pub mod prelude {
-    pub use crate::pipeline::{CompassPipeline, NavPipeline, OrientationPipeline, Place};
+    pub use crate::{CompassCalibration, Place, TrueNorth};
     pub use truenorth_compass::{CompassCalibration2d, CompassCalibration3d};
     pub use truenorth_core::{
         AbsoluteHeadingSource, AttitudeEstimate, Axes, Calibration, Calibrator, CompassQuality,

@@ -1,4 +1,4 @@
-//! Every estimator's per-sample entry point: the orientation methods (through the pipeline
+//! Every estimator's per-sample entry point: the orientation methods (through the registry
 //! the commands use, and the single-precision quaternion filter directly) and the vehicle
 //! methods, on readings that the bytes move, break and reorder.
 
@@ -86,7 +86,7 @@ pub fn orientation(data: &[u8]) {
     };
     match method {
         Some(method) => {
-            let Ok(mut p) = method.pipeline(use_mag, timing) else {
+            let Ok(mut p) = method.estimator(use_mag, timing) else {
                 return;
             };
             for _ in 0..MAX_SAMPLES {
@@ -95,7 +95,7 @@ pub fn orientation(data: &[u8]) {
                 }
                 let s = next(&mut b);
                 if let Ok(r) = p.update(&s) {
-                    check_attitude(&r.estimate.attitude, "orientation pipeline", &s);
+                    check_attitude(&r.attitude, "orientation method", &s);
                 }
             }
         }

@@ -4,14 +4,12 @@
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
-use truenorth::accel::static_tilt;
-use truenorth::core::{MagneticHeading, Tilt};
+use truenorth::core::MagneticHeading;
 use truenorth::fusion::vehicle::VehicleCalibration;
 use truenorth::fusion::{SensorPriors, VehicleConfig, VehicleEstimator};
 use truenorth::nalgebra::{Vector2, Vector3};
 use truenorth_cli::io::{
-    CalibrationFile, CompassCalibration, InputOptions, InputPath, ReadSpec, RowReader, Table,
-    VehicleFile,
+    CalibrationFile, InputOptions, InputPath, ReadSpec, RowReader, Table, VehicleFile,
 };
 use truenorth_cli::registry::{VehicleMethod, VehicleRun};
 
@@ -116,21 +114,7 @@ pub fn calibration_json(data: &[u8]) {
     while !b.is_empty() {
         let mag = Vector3::new(b.f64(50.0), b.f64(50.0), b.f64(50.0));
         let acc = (b.byte() & 1 != 0).then(|| Vector3::new(b.f64(10.0), b.f64(10.0), b.f64(10.0)));
-        let _: Option<MagneticHeading> = match (&cal, acc) {
-            (CompassCalibration::TwoD(c), _) => {
-                Some(c.magnetic_heading(&Vector2::new(mag.x, mag.y)))
-            }
-            (CompassCalibration::ThreeD(c), Some(a)) => {
-                static_tilt(&a).ok().map(|t| c.magnetic_heading(&mag, &t))
-            }
-            (CompassCalibration::ThreeD(c), None) => {
-                Some(c.magnetic_heading(&mag, &Tilt::default()))
-            }
-            (CompassCalibration::Joint(c), Some(a)) => c.attitude(&mag, &a).ok().map(|(h, _)| h),
-            (CompassCalibration::Joint(c), None) => Some(MagneticHeading::new(
-                truenorth::compass::tilt_compensated_heading(&c.field_body(&mag), &Tilt::default()),
-            )),
-        };
+        let _: Option<MagneticHeading> = cal.heading(&mag, acc.as_ref()).ok().map(|(h, _)| h);
     }
 }
 

@@ -4,7 +4,7 @@
 //! WO 00/36376, a quaternion orientation filter, and vehicle heading and dead reckoning.
 //!
 //! Every estimator here implements one of the two traits of `truenorth-core`, so tests,
-//! benches, the CLI and the facade's pipelines take any of them:
+//! benches and the CLI take any of them:
 //! [`truenorth_core::OrientationEstimator`] (IMU samples → [`AttitudeEstimate`]: 9-D and 6-D
 //! attitude, gyro bias, rest and disturbance flags, σ) and
 //! [`truenorth_core::HeadingEstimator`] (vehicle samples → [`NavEstimate`]: position,

@@ -4,11 +4,11 @@
 use numpy::{PyArray1, PyArray2, PyReadonlyArray2};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use truenorth::accel::static_tilt;
+use truenorth::CompassCalibration;
 use truenorth::calib::{MagAccelCalibration, MagAccelQuality};
-use truenorth::compass::{CompassCalibration2d, CompassCalibration3d, tilt_compensated_heading};
-use truenorth::core::{CompassQuality, MagneticHeading, Tilt, rad_to_deg};
-use truenorth::nalgebra::{Matrix3, Vector2, Vector3};
+use truenorth::compass::{CompassCalibration2d, CompassCalibration3d};
+use truenorth::core::{CompassQuality, rad_to_deg};
+use truenorth::nalgebra::{Matrix3, Vector3};
 
 use crate::convert::{array1, array2, row_err, rows, same_rows, to_py};
 use crate::quality::{Quality, Verdict};
@@ -68,32 +68,14 @@ impl Calibration {
         }
     }
 
-    /// The heading of one row and its tilt when the accelerometer gives it.
-    fn heading_row(
-        &self,
-        mag: &[f64],
-        acc: Option<Vector3<f64>>,
-    ) -> truenorth::Result<(MagneticHeading, Option<Tilt>)> {
-        let mag3 = || Vector3::new(mag[0], mag[1], mag.get(2).copied().unwrap_or(f64::NAN));
-        Ok(match (&self.params, acc) {
-            (Params::TwoD(c), _) => (c.magnetic_heading(&Vector2::new(mag[0], mag[1])), None),
-            (Params::ThreeD(c), Some(a)) => {
-                let tilt = static_tilt(&a)?;
-                (c.magnetic_heading(&mag3(), &tilt), Some(tilt))
-            }
-            (Params::ThreeD(c), None) => (c.magnetic_heading(&mag3(), &Tilt::default()), None),
-            (Params::Joint(j), Some(a)) => {
-                let (h, tilt) = j.0.attitude(&mag3(), &a)?;
-                (h, Some(tilt))
-            }
-            (Params::Joint(j), None) => (
-                MagneticHeading::new(tilt_compensated_heading(
-                    &j.0.field_body(&mag3()),
-                    &Tilt::default(),
-                )),
-                None,
-            ),
-        })
+    /// The calibration as the library's [`CompassCalibration`], whose heading the
+    /// `truenorth heading` command gives.
+    fn compass(&self) -> CompassCalibration {
+        match &self.params {
+            Params::TwoD(c) => CompassCalibration::TwoD(*c),
+            Params::ThreeD(c) => CompassCalibration::ThreeD(*c),
+            Params::Joint(j) => CompassCalibration::Joint(j.0),
+        }
     }
 }
 
@@ -160,13 +142,16 @@ impl Calibration {
             }
             None => None,
         };
+        let compass = self.compass();
         let mut out = Vec::with_capacity(m.nrows());
         for (k, row) in m.rows().into_iter().enumerate() {
-            let r: Vec<f64> = row.iter().copied().collect();
+            let mag3 = Vector3::new(row[0], row[1], row.get(2).copied().unwrap_or(f64::NAN));
             let acc3 = a
                 .as_ref()
                 .map(|a| Vector3::new(a[(k, 0)], a[(k, 1)], a[(k, 2)]));
-            let (h, _) = self.heading_row(&r, acc3).map_err(|e| row_err(k, e))?;
+            let (h, _) = compass
+                .heading(&mag3, acc3.as_ref())
+                .map_err(|e| row_err(k, e))?;
             out.push(rad_to_deg(h.rad()));
         }
         Ok(array1(py, out))

@@ -7,7 +7,8 @@
 //! y right, z down; gyro rad/s, specific force m/s², magnetometer any unit); loops over
 //! arrays run in Rust without the GIL; the library's errors are raised as
 //! `truenorth.TruenorthError`, a `ValueError`, with the library's message. `read_log` reads
-//! PX4 ULog and ROS 2 MCAP files into arrays of the same frames and units.
+//! PX4 ULog and ROS 2 MCAP files into arrays of the same frames and units; `check_imu` checks
+//! a recording's declared units and the gyro's axes against its physics.
 //!
 //! The bindings wrap the library's public types only (the registry's method names, the
 //! traits' samples and estimates), so this crate holds conversions and no method of its own.
@@ -29,6 +30,7 @@
 mod broad;
 mod calibration;
 mod calibrators;
+mod checks;
 mod convert;
 mod geomag;
 mod logs;
@@ -59,5 +61,6 @@ fn _truenorth(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(geomag::field, m)?)?;
     m.add_function(wrap_pyfunction!(broad::broad_rmse, m)?)?;
     m.add_function(wrap_pyfunction!(logs::read_log, m)?)?;
+    m.add_function(wrap_pyfunction!(checks::check_imu, m)?)?;
     Ok(())
 }

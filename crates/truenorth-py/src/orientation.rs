@@ -1,6 +1,7 @@
 //! The orientation estimators (quaternion filter, Euler detector): one sample at a time,
 //! or whole arrays with the loop in Rust, giving what `truenorth orientation` writes.
 
+use numpy::ndarray::{ArrayView1, ArrayView2};
 use numpy::{PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -79,8 +80,41 @@ impl Attitude {
     }
 }
 
+/// The arrays of an IMU recording, checked: `gyr`, `acc` and `mag` (if given) N×3, as many
+/// rows as `t_s`.
+pub(crate) fn imu_arrays<'a>(
+    t_s: &'a PyReadonlyArray1<'_, f64>,
+    gyr: &'a PyReadonlyArray2<'_, f64>,
+    acc: &'a PyReadonlyArray2<'_, f64>,
+    mag: Option<&'a PyReadonlyArray2<'_, f64>>,
+) -> PyResult<ImuArrays<'a>> {
+    let t = t_s.as_array();
+    let g = rows(gyr, "gyr", &[3])?;
+    let a = rows(acc, "acc", &[3])?;
+    let n = t.len();
+    same_rows("gyr", g.nrows(), n)?;
+    same_rows("acc", a.nrows(), n)?;
+    let m = match mag {
+        Some(m) => {
+            let m = rows(m, "mag", &[3])?;
+            same_rows("mag", m.nrows(), n)?;
+            Some(m)
+        }
+        None => None,
+    };
+    Ok((t, g, a, m))
+}
+
+/// `t_s`, `gyr`, `acc` and `mag` of an IMU recording as checked views.
+pub(crate) type ImuArrays<'a> = (
+    ArrayView1<'a, f64>,
+    ArrayView2<'a, f64>,
+    ArrayView2<'a, f64>,
+    Option<ArrayView2<'a, f64>>,
+);
+
 /// An IMU sample from one row; a magnetometer row of three NaN is no reading.
-fn imu_sample(t_s: f64, g: [f64; 3], a: [f64; 3], m: Option<[f64; 3]>) -> ImuSample {
+pub(crate) fn imu_sample(t_s: f64, g: [f64; 3], a: [f64; 3], m: Option<[f64; 3]>) -> ImuSample {
     ImuSample {
         t_s,
         gyr_rps: Axes::xyz(Vector3::from(g)),
@@ -199,20 +233,8 @@ impl OrientationEstimator {
         frame: &str,
     ) -> PyResult<Bound<'py, PyDict>> {
         let to_frame = frame_rotation(frame)?;
-        let t = t_s.as_array();
-        let g = rows(&gyr, "gyr", &[3])?;
-        let a = rows(&acc, "acc", &[3])?;
+        let (t, g, a, m) = imu_arrays(&t_s, &gyr, &acc, mag.as_ref())?;
         let n = t.len();
-        same_rows("gyr", g.nrows(), n)?;
-        same_rows("acc", a.nrows(), n)?;
-        let m = match &mag {
-            Some(m) => {
-                let m = rows(m, "mag", &[3])?;
-                same_rows("mag", m.nrows(), n)?;
-                Some(m)
-            }
-            None => None,
-        };
         let inner = &mut self.inner;
         let cols = py.detach(|| {
             let mut cols = Columns::with_capacity(n);

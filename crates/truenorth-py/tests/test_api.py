@@ -155,3 +155,38 @@ def test_ellipsoid_accel_reports_its_joint_figures(data):
     assert h.shape == (100,)
     with pytest.raises(tn.TruenorthError, match="needs `acc`"):
         tn.calibrate("ellipsoid-accel", rows[:, 3:6])
+
+
+def rolling(rate_rps=0.8, seconds=20.0, hz=100.0):
+    """A body turning at a constant rate about an axis off the vertical: its gyro, its
+    specific force and the Earth's field in its axes."""
+    n = int(seconds * hz)
+    t = np.arange(n) / hz
+    axis = np.array([0.6, 0.3, 0.74])
+    axis /= np.linalg.norm(axis)
+    w = rate_rps * axis
+    up, field = np.array([0.0, 0.0, -9.80665]), np.array([18.0, 1.5, 45.0])
+    acc, mag = np.empty((n, 3)), np.empty((n, 3))
+    for k in range(n):
+        # Body axes seen from the start: rotate the world vectors back by the turn so far.
+        a = -rate_rps * t[k]
+        c, s = math.cos(a), math.sin(a)
+        kx = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
+        r = np.eye(3) + s * kx + (1 - c) * kx @ kx
+        acc[k], mag[k] = r @ up, r @ field
+    return t, np.tile(w, (n, 1)), acc, mag
+
+
+def test_check_imu_names_the_unit_and_the_axes_that_read_the_data_right():
+    t, gyr, acc, mag = rolling()
+    assert tn.check_imu(t, gyr, acc, mag) == []
+    found = tn.check_imu(t, np.degrees(gyr), acc, mag)
+    assert found[0]["kind"] == "units" and found[0]["fix"] == {"gyro_unit": "deg/s"}
+    assert tn.check_imu(t, np.degrees(gyr), acc, mag, gyro_unit="deg/s") == []
+    found = tn.check_imu(t, gyr, acc / 9.80665, mag)
+    assert found[0]["fix"] == {"acc_unit": "g"}
+    swapped = gyr[:, [1, 0, 2]]
+    found = tn.check_imu(t, swapped, acc, mag)
+    assert found[0]["kind"] == "axes" and found[0]["fix"] == {"gyro_axes": "x=y,y=x,z=z"}
+    with pytest.raises(tn.TruenorthError, match="gyro_unit"):
+        tn.check_imu(t, gyr, acc, gyro_unit="rpm")

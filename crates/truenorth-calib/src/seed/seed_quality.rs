@@ -15,11 +15,22 @@
 
 use nalgebra::{Matrix3, Vector2, Vector3};
 use truenorth_compass::CompassCalibration2d;
+use truenorth_core::Solution;
 
-use crate::quality::{Assessment2d, ReportSums, SupportFigures, assess_2d};
+use crate::quality::{self, Assessment2d, ReportSums, SupportFigures, assess_2d};
 
 #[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
+
+/// `solution` with its fitted field reported against `expected` (input unit), as the
+/// least-squares fits report theirs: the seed methods take the expected field in their
+/// configurations too.
+pub(crate) fn with_expected_field<P>(solution: Solution<P>, expected: Option<f64>) -> Solution<P> {
+    Solution {
+        quality: quality::with_expected_field(solution.quality, expected),
+        ..solution
+    }
+}
 
 /// Amplitude of the two-cycle component of `|cal(p)|/field − 1` over the heading of
 /// `cal(p)`: the peak heading error (radians) an unmodelled symmetric soft iron leaves.

@@ -10,20 +10,22 @@
 
 use std::path::{Path, PathBuf};
 
-use nalgebra::{SMatrix, SVector, Vector2, Vector3};
+use nalgebra::{SMatrix, SVector};
+use truenorth::calib::MagAccelQuality;
 use truenorth::calib::quality::{self, Cause, Grade, Verdict};
-use truenorth::calib::{MagAccelQuality, MagAccelSample, TurnQuality, TurnSample};
-use truenorth::core::{Calibrator, CompassQuality, Fixed, Mag2Sample, Mag3Sample, Solution};
+use truenorth::checks::{MagUnit, check_field};
+use truenorth::core::{Calibrator, CompassQuality, Fixed, Mag2Sample, Solution};
 
-use super::field::Place;
-use super::mag_unit::{MagUnit, check_field};
+use super::field::PlaceArgs;
+use crate::io::checking::say;
 use crate::io::errln;
-use crate::io::log_input;
-use crate::io::reading_spill::ReadingSpill;
+use crate::io::reading::kinds::{Mag2, Mag3, MagAccel as MagAccelRows, Turn};
+use crate::io::reading::{SampleKind, Samples};
+use crate::io::spill::ReadingSpill;
 use crate::io::{
     AccelPart, CALIBRATION_FORMAT, CALIBRATION_VERSION, CalibrationFile, CliError, CliResult,
-    GyroPart, InputOptions, InputPath, QualityReport, ReadSpec, RowReader, RowRef, check_distinct,
-    finite, gyro_units, matrix_rows, units_block,
+    GyroPart, Input, InputOptions, InputPath, QualityReport, check_distinct, finite, gyro_units,
+    matrix_rows, units_block,
 };
 use crate::registry::{
     CalibrationMethod, CompassCalibrator, MagAccel, Planar, Spatial, TurnWithGyro,
@@ -126,7 +128,7 @@ pub struct Args {
     pub mag_unit: Option<MagUnit>,
     /// Where and when the recording was made (for the expected field).
     #[command(flatten)]
-    pub place: Place,
+    pub place: PlaceArgs,
     /// Write a `poor` calibration anyway (with a warning) instead of refusing it.
     #[arg(long)]
     pub accept_poor: bool,
@@ -185,12 +187,10 @@ pub fn run(args: &Args) -> CliResult {
         .calibrator_spilling(expected, &spill)
         .map_err(library)?
     {
-        CompassCalibrator::Planar(cal) => calibrate_2d(args, cal, expected),
-        CompassCalibrator::Spatial(cal) => calibrate_3d(args, cal, expected),
+        CompassCalibrator::Planar(cal) => calibrate_2d(args, cal),
+        CompassCalibrator::Spatial(cal) => calibrate_3d(args, cal),
         CompassCalibrator::MagAccel(cal) => calibrate_joint(args, cal),
-        CompassCalibrator::Turn { compass, with_gyro } => {
-            calibrate_turn(args, compass, with_gyro, expected)
-        }
+        CompassCalibrator::Turn { compass, with_gyro } => calibrate_turn(args, compass, with_gyro),
     };
     let fitted = fitted.map_err(|e| spill.take_failure().unwrap_or(e))?;
     let input = InputPath::new(&args.input).display_path();
@@ -200,7 +200,9 @@ pub fn run(args: &Args) -> CliResult {
         args.mag_unit,
         expected.filter(|_| args.place.is_given()),
         args.method.dimensions(),
-    ) {
+    )
+    .map(|f| say(&f, &args.input_options))
+    {
         if args.accept_field_mismatch {
             warn(&problem);
         } else {
@@ -277,71 +279,40 @@ fn library(e: truenorth::core::Error) -> CliError {
     CliError::from(e)
 }
 
-/// Opens the input for the `columns`, with `optional` ones (`t_s`, strictly increasing,
-/// among them) read where present.
-fn open_input(args: &Args, columns: &[&str], optional: &[&str]) -> CliResult<RowReader> {
-    let spec = ReadSpec::new(columns).optional(optional).increasing("t_s");
+/// Opens the input for the samples of `kind` (`t_s` read where present, strictly
+/// increasing).
+fn open_input<K: SampleKind>(args: &Args, kind: K) -> CliResult<Samples<K>> {
     let csv_only = [(
         "--mag-unit",
         args.mag_unit.is_some_and(|u| u != MagUnit::MicroTesla),
     )];
-    let input = log_input::source(&args.input, &args.input_options, &spec, &csv_only)?;
-    RowReader::open(&input, &args.input_options, &spec)
+    Input::new(&args.input, &args.input_options)
+        .csv_only(&csv_only)
+        .samples(kind)
 }
 
-/// The position of a column the reader was asked for (required, so present).
-fn at(rows: &RowReader, name: &str) -> usize {
-    rows.index(name).unwrap_or(0)
-}
-
-/// Reads the input once, row by row, pushing the sample `sample` makes of each row and its
-/// time into `cal` (a rejected sample names its row). Without `t_s` the rows are taken as
-/// one second apart. Nothing is kept here: a batch method keeps its own one copy of the
+/// Reads the input once, row by row, pushing each sample into `cal` (a rejected sample
+/// names its row). Nothing is kept here: a batch method keeps its own one copy of the
 /// readings it fits, an online one its running state.
-fn push_rows<C>(
-    rows: &mut RowReader,
-    cal: &mut C,
-    mut sample: impl FnMut(&RowRef<'_>, f64) -> C::Sample,
-) -> CliResult
+fn push_rows<K, C>(samples: &mut Samples<K>, cal: &mut C) -> CliResult
 where
+    K: SampleKind<Sample = C::Sample>,
     C: Calibrator + ?Sized,
 {
-    let t_col = rows.index("t_s");
-    let path = rows.path().to_path_buf();
-    let mut count = 0usize;
-    while let Some(block) = rows.next_rows()? {
-        for row in block {
-            let t_s = t_col.map_or(count as f64, |i| row[i]);
-            cal.push(&sample(&row, t_s))
-                .map_err(|e| CliError::row(&path, row.number, e.to_string()).kind_of(&e))?;
-            count += 1;
-        }
-    }
-    if count == 0 {
-        return Err(CliError::row(&path, 2, "no data rows after the header"));
-    }
+    let path = samples.path().to_path_buf();
+    samples.for_each(|row, sample| {
+        cal.push(&sample)
+            .map_err(|e| CliError::row(&path, row, e.to_string()).kind_of(&e))?;
+        Ok(())
+    })?;
     Ok(())
 }
 
 /// Feeds every row to a 2-D calibrator, solves, and builds the output file.
-fn calibrate_2d(args: &Args, cal: Box<Planar>, expected: Option<f64>) -> CliResult<Fitted> {
-    let mut rows = open_input(args, &["mag_x", "mag_y"], &["t_s"])?;
-    solve_2d(args, &mut rows, cal, expected)
-}
-
-/// [`calibrate_2d`] on an input already opened.
-fn solve_2d(
-    args: &Args,
-    rows: &mut RowReader,
-    mut cal: Box<Planar>,
-    expected: Option<f64>,
-) -> CliResult<Fitted> {
-    let (x, y) = (at(rows, "mag_x"), at(rows, "mag_y"));
-    push_rows(rows, &mut *cal, |r, t_s| Mag2Sample {
-        t_s,
-        mag: Vector2::new(r[x], r[y]),
-    })?;
-    let sol = solve(args, rows.path(), &mut *cal, expected)?;
+fn calibrate_2d(args: &Args, mut cal: Box<Planar>) -> CliResult<Fitted> {
+    let mut samples = open_input(args, Mag2::default())?;
+    push_rows(&mut samples, &mut *cal)?;
+    let sol = solve(args, samples.path(), &mut *cal)?;
     Ok(fitted(
         args,
         &sol.params.hard_iron,
@@ -356,27 +327,32 @@ fn solve_2d(
 /// compass half alone ([`TurnCompassCalibrator`](truenorth::calib::TurnCompassCalibrator)).
 fn calibrate_turn(
     args: &Args,
-    compass: Box<Planar>,
+    mut compass: Box<Planar>,
     mut with_gyro: Box<TurnWithGyro>,
-    expected: Option<f64>,
 ) -> CliResult<Fitted> {
-    let mut rows = open_input(args, &["mag_x", "mag_y"], &["t_s", "gyr_z"])?;
-    let Some(g) = rows.index("gyr_z") else {
-        return solve_2d(args, &mut rows, compass, expected);
-    };
-    if rows.index("t_s").is_none() {
-        return Err(CliError::file(
-            rows.path(),
-            "`gyr_z` needs a `t_s` column: the gyro's rate is integrated over time (or drop `gyr_z` to calibrate the compass alone)",
+    let mut samples = open_input(args, Turn::default())?;
+    if !samples.kind().has_gyro() {
+        let path = samples.path().to_path_buf();
+        samples.for_each(|row, s| {
+            let sample = Mag2Sample {
+                t_s: s.t_s,
+                mag: s.mag,
+            };
+            compass
+                .push(&sample)
+                .map_err(|e| CliError::row(&path, row, e.to_string()).kind_of(&e))?;
+            Ok(())
+        })?;
+        let sol = solve(args, &path, &mut *compass)?;
+        return Ok(fitted(
+            args,
+            &sol.params.hard_iron,
+            &sol.params.soft_iron,
+            sol.quality,
         ));
     }
-    let (x, y) = (at(&rows, "mag_x"), at(&rows, "mag_y"));
-    push_rows(&mut rows, &mut *with_gyro, |r, t_s| TurnSample {
-        t_s,
-        gyr_z_rps: r[g],
-        mag: Vector2::new(r[x], r[y]),
-    })?;
-    let sol = solve(args, rows.path(), &mut *with_gyro, expected)?;
+    push_rows(&mut samples, &mut *with_gyro)?;
+    let sol = solve(args, samples.path(), &mut *with_gyro)?;
     let (c, q) = (sol.params, sol.quality);
     let mut f = fitted(args, &c.compass.hard_iron, &c.compass.soft_iron, q.compass);
     f.file.units.extend(gyro_units());
@@ -393,20 +369,11 @@ fn calibrate_turn(
     Ok(f)
 }
 
-/// Three columns of a row as a vector.
-fn vector(r: &RowRef<'_>, [x, y, z]: [usize; 3]) -> Vector3<f64> {
-    Vector3::new(r[x], r[y], r[z])
-}
-
 /// Feeds every row to a 3-D calibrator, solves, and builds the output file.
-fn calibrate_3d(args: &Args, mut cal: Box<Spatial>, expected: Option<f64>) -> CliResult<Fitted> {
-    let mut rows = open_input(args, &MAG3, &["t_s"])?;
-    let m = MAG3.map(|n| at(&rows, n));
-    push_rows(&mut rows, &mut *cal, |r, t_s| Mag3Sample {
-        t_s,
-        mag: vector(r, m),
-    })?;
-    let sol = solve(args, rows.path(), &mut *cal, expected)?;
+fn calibrate_3d(args: &Args, mut cal: Box<Spatial>) -> CliResult<Fitted> {
+    let mut samples = open_input(args, Mag3::default())?;
+    push_rows(&mut samples, &mut *cal)?;
+    let sol = solve(args, samples.path(), &mut *cal)?;
     Ok(fitted(
         args,
         &sol.params.hard_iron,
@@ -415,20 +382,11 @@ fn calibrate_3d(args: &Args, mut cal: Box<Spatial>, expected: Option<f64>) -> Cl
     ))
 }
 
-const MAG3: [&str; 3] = ["mag_x", "mag_y", "mag_z"];
-const ACC3: [&str; 3] = ["acc_x", "acc_y", "acc_z"];
-
-/// The joint magnetometer + accelerometer calibration (the expected field is in its
-/// configuration).
+/// The joint magnetometer + accelerometer calibration.
 fn calibrate_joint(args: &Args, mut cal: Box<MagAccel>) -> CliResult<Fitted> {
-    let mut rows = open_input(args, &[MAG3, ACC3].concat(), &["t_s"])?;
-    let (m, a) = (MAG3.map(|n| at(&rows, n)), ACC3.map(|n| at(&rows, n)));
-    push_rows(&mut rows, &mut *cal, |r, t_s| MagAccelSample {
-        t_s,
-        mag: vector(r, m),
-        acc: vector(r, a),
-    })?;
-    let sol = solve(args, rows.path(), &mut *cal, None)?;
+    let mut samples = open_input(args, MagAccelRows::default())?;
+    push_rows(&mut samples, &mut *cal)?;
+    let sol = solve(args, samples.path(), &mut *cal)?;
     let (c, q) = (sol.params, sol.quality);
     let mut f = fitted(args, &c.mag.hard_iron, &c.mag.soft_iron, q.mag);
     f.file.units = units_block(true);
@@ -458,51 +416,12 @@ fn joint_report(r: &mut QualityReport, q: &MagAccelQuality) {
     r.aim_rms_deg = finite(q.aim_rms_deg);
 }
 
-/// The quality report of any calibrator: its compass report inside.
-trait HasCompassQuality {
-    fn compass(&self) -> &CompassQuality;
-    fn compass_mut(&mut self) -> &mut CompassQuality;
-}
-
-impl HasCompassQuality for CompassQuality {
-    fn compass(&self) -> &CompassQuality {
-        self
-    }
-    fn compass_mut(&mut self) -> &mut CompassQuality {
-        self
-    }
-}
-
-impl HasCompassQuality for TurnQuality {
-    fn compass(&self) -> &CompassQuality {
-        &self.compass
-    }
-    fn compass_mut(&mut self) -> &mut CompassQuality {
-        &mut self.compass
-    }
-}
-
-impl HasCompassQuality for MagAccelQuality {
-    fn compass(&self) -> &CompassQuality {
-        &self.mag
-    }
-    fn compass_mut(&mut self) -> &mut CompassQuality {
-        &mut self.mag
-    }
-}
-
 /// Solves a calibrator fed with every row; a refusal names the file and the reason.
-fn solve<C>(
-    args: &Args,
-    path: &Path,
-    cal: &mut C,
-    expected: Option<f64>,
-) -> CliResult<Solution<C::Params, C::Quality>>
+fn solve<C>(args: &Args, path: &Path, cal: &mut C) -> CliResult<Solution<C::Params, C::Quality>>
 where
     C: Calibrator + ?Sized,
-    C::Quality: HasCompassQuality,
 {
-    let mut sol = cal.solve().map_err(|e| {
+    cal.solve().map_err(|e| {
         CliError::file(
             path,
             format!(
@@ -512,12 +431,7 @@ where
             ),
         )
         .kind_of(&e)
-    })?;
-    if expected.is_some() && !args.method.reports_expected_field() {
-        let q = *sol.quality.compass();
-        *sol.quality.compass_mut() = quality::with_expected_field(q, expected);
-    }
-    Ok(sol)
+    })
 }
 
 /// The output file of a magnetometer calibration and its report.

@@ -4,18 +4,20 @@
 
 use std::path::{Path, PathBuf};
 
-use nalgebra::Vector2;
-use truenorth::core::{Fixed, NavEstimate, VehicleSample, rad_to_deg};
+use truenorth::checks::GyroUnit;
+use truenorth::core::{Fixed, NavEstimate, rad_to_deg};
 use truenorth::fusion::vehicle::VehicleCalibration;
 use truenorth::fusion::{SensorPriors, VehicleConfig, VehicleEstimator};
 use truenorth::odometer::OdometerWheels;
 
-use super::field::Place;
+use super::field::PlaceArgs;
 use crate::io::errln;
-use crate::io::log_input::{self, AxleTrack};
+use crate::io::reading::Samples;
+use crate::io::reading::kinds::Vehicle;
+use crate::io::reading::logs::AxleTrack;
 use crate::io::{
-    CliError, CliResult, GyroUnit, InputOptions, OutputOptions, ReadSpec, RowReader, RowRef,
-    VehicleFile, WheelColumns, check_distinct, read_learned, write_learned,
+    CliError, CliResult, Input, InputOptions, OutputOptions, VehicleFile, check_distinct,
+    read_learned, write_learned,
 };
 use crate::registry::{VehicleMethod, VehicleRun};
 
@@ -132,7 +134,7 @@ pub struct Args {
     pub accept_axes: bool,
     /// Where and when the drive was made, for true heading.
     #[command(flatten)]
-    pub place: Place,
+    pub place: PlaceArgs,
     /// How to read the input.
     #[command(flatten)]
     pub input_options: InputOptions,
@@ -141,58 +143,32 @@ pub struct Args {
     pub output_options: OutputOptions,
 }
 
-/// The optional columns of a drive log.
-const OPTIONAL: [&str; 7] = [
-    "dist_l_m",
-    "dist_r_m",
-    "speed_l_mps",
-    "speed_r_mps",
-    "gyr_z",
-    "mag_x",
-    "mag_y",
-];
-
 /// Runs the subcommand: check the arguments, read the vehicle, build the method, run it
 /// over the log row by row, then save what it learned and summarise.
 pub fn run(args: &Args) -> CliResult {
     check_arguments(args)?;
-    let spec = ReadSpec::new(&["t_s"])
-        .optional(&OPTIONAL)
-        .increasing("t_s");
     let csv_only = [("--gyro-unit", args.gyro_unit != GyroUnit::default())];
-    let input =
-        log_input::drive_source(&args.input, &args.input_options, &spec, &csv_only, || {
-            axle(args)
-        })?;
-    let mut rows = RowReader::open(&input, &args.input_options, &spec)?;
-    let wheel_columns = wheel_columns(&rows)?;
+    let mut samples = Input::new(&args.input, &args.input_options)
+        .csv_only(&csv_only)
+        .axle(|| axle(args))
+        .samples(Vehicle::new(args.gyro_unit))?;
     let vehicle = VehicleFile::read(&args.vehicle)?;
     let wheels = vehicle.wheels(&args.vehicle)?;
-    let declination = if args.place.is_given() {
-        Some(args.place.field()?.declination())
-    } else {
-        None
-    };
-    let speeds = matches!(wheel_columns, Some(WheelColumns::Speeds { .. }));
+    let true_north = args.place.true_north()?;
+    let speeds = samples.kind().speeds();
     let mut method = build_method(args, &vehicle, wheels, speeds)?;
-    let mut columns = Columns {
-        t: rows.index("t_s").unwrap_or(0),
-        wheels: wheel_columns,
-        gyr: rows.index("gyr_z"),
-        to_rps: args.gyro_unit.to_rad_per_s(),
-        mag: mag_columns(&rows)?,
-        check: Diagnosis::new(vehicle.track_m, wheels.can_pivot(), speeds),
-    };
+    samples.kind().check_compass(samples.path())?;
+    let mut check = Diagnosis::new(vehicle.track_m, wheels.can_pivot(), speeds);
     let mut writer = Writer::create(
         &args.output,
         &args.extra,
-        declination,
+        true_north,
         args.output_options.precision,
     )?;
     let context = diagnosis_context(args, speeds);
-    let samples = estimate(&mut rows, &mut columns, method.as_mut(), &mut writer)
-        .map_err(|e| columns.check.check(&context).err().unwrap_or(e))?;
-    columns.check.check(&context)?;
+    let samples = estimate(&mut samples, &mut check, method.as_mut(), &mut writer)
+        .map_err(|e| check.check(&context).err().unwrap_or(e))?;
+    check.check(&context)?;
     let learned = method.calibration();
     if let (Some(out), Some(learned)) = (&args.calibration_out, &learned) {
         write_learned(out, learned)?;
@@ -238,47 +214,6 @@ fn check_arguments(args: &Args) -> CliResult {
         ));
     }
     Ok(())
-}
-
-/// The wheel columns of the log (distances before speeds); an error if the log has neither
-/// wheels nor a gyro.
-fn wheel_columns(rows: &RowReader) -> CliResult<Option<WheelColumns>> {
-    let ix = |n: &str| rows.index(n);
-    let wheels = match (
-        ix("dist_l_m"),
-        ix("dist_r_m"),
-        ix("speed_l_mps"),
-        ix("speed_r_mps"),
-    ) {
-        (Some(l), Some(r), _, _) => Some(WheelColumns::Distances([l, r])),
-        (_, _, Some(l), Some(r)) => Some(WheelColumns::Speeds {
-            columns: [l, r],
-            last: None,
-            dist: [0.0; 2],
-        }),
-        _ => None,
-    };
-    if wheels.is_none() && ix("gyr_z").is_none() {
-        return Err(CliError::row(
-            rows.path(),
-            1,
-            "needs a heading sensor: the wheels (`dist_l_m,dist_r_m` cumulative distances or `speed_l_mps,speed_r_mps` wheel speeds) or a gyro (`gyr_z`, rad/s)",
-        ));
-    }
-    Ok(wheels)
-}
-
-/// The compass columns: both or neither.
-fn mag_columns(rows: &RowReader) -> CliResult<Option<[usize; 2]>> {
-    match (rows.index("mag_x"), rows.index("mag_y")) {
-        (Some(x), Some(y)) => Ok(Some([x, y])),
-        (None, None) => Ok(None),
-        _ => Err(CliError::row(
-            rows.path(),
-            1,
-            "has one of mag_x, mag_y but not both; give both (any unit, uncalibrated) or neither",
-        )),
-    }
 }
 
 /// The method the arguments ask for, through the registry. The fused estimator starts from
@@ -351,76 +286,29 @@ fn diagnosis_context(args: &Args, speeds: bool) -> Context<'_> {
     }
 }
 
-/// Where each sensor is in a row, and the check of the gyro against the wheels that the
-/// rows feed.
-struct Columns {
-    t: usize,
-    wheels: Option<WheelColumns>,
-    gyr: Option<usize>,
-    /// The declared gyro unit's factor to rad/s.
-    to_rps: f64,
-    mag: Option<[usize; 2]>,
-    check: Diagnosis,
-}
-
-impl Columns {
-    /// The sample a row carries: each sensor whose cells are filled (wheel speeds
-    /// integrated into distances on the way).
-    fn sample(&mut self, row: &RowRef<'_>, path: &Path) -> CliResult<VehicleSample> {
-        let v = &row.values;
-        let mut sample = VehicleSample::at(v[self.t]);
-        if let Some(w) = self.wheels.as_mut()
-            && let Some([l, r]) = w
-                .cumulative(v[self.t], v)
-                .map_err(|m| CliError::row(path, row.number, m))?
-        {
-            sample = sample.with_wheels(l, r);
-        }
-        if let Some(g) = self.gyr.map(|g| v[g]).filter(|g| g.is_finite()) {
-            sample = sample.with_gyro(g * self.to_rps);
-        }
-        if let Some([x, y]) = self
-            .mag
-            .filter(|[x, y]| v[*x].is_finite() && v[*y].is_finite())
-        {
-            sample = sample.with_mag(Vector2::new(v[x], v[y]));
-        }
-        self.check.push(&sample, row.number);
-        Ok(sample)
-    }
-}
-
-/// Runs `method` over every row, each final estimate to `writer`; the number of rows.
+/// Runs `method` over every sample, each to the diagnosis `check` first and each final
+/// estimate to `writer`; the number of samples.
 fn estimate(
-    rows: &mut RowReader,
-    columns: &mut Columns,
+    samples: &mut Samples<Vehicle>,
+    check: &mut Diagnosis,
     method: &mut dyn VehicleRun,
     writer: &mut Writer,
 ) -> CliResult<usize> {
-    let path = rows.path().to_path_buf();
-    let mut samples = 0usize;
-    while let Some(block) = rows.next_rows()? {
-        for row in block {
-            let sample = columns.sample(&row, &path)?;
-            method
-                .push(&sample, &mut |e, filter| writer.write(e, filter))
-                .map_err(|e| CliError::row(&path, row.number, e.to_string()).kind_of(&e))?;
-            if let Some(e) = writer.error.take() {
-                return Err(e);
-            }
-            samples += 1;
-        }
-    }
+    let path = samples.path().to_path_buf();
+    let count = samples.for_each(|row, sample| {
+        check.push(&sample, row);
+        method
+            .push(&sample, &mut |e, filter| writer.write(e, filter))
+            .map_err(|e| CliError::row(&path, row, e.to_string()).kind_of(&e))?;
+        writer.error.take().map_or(Ok(()), Err)
+    })?;
     method
         .finish(&mut |e, filter| writer.write(e, filter))
         .map_err(|e| CliError::file(&path, e.to_string()).kind_of(&e))?;
     if let Some(e) = writer.error.take() {
         return Err(e);
     }
-    if samples == 0 {
-        return Err(CliError::file(&path, "has no data rows"));
-    }
-    Ok(samples)
+    Ok(count)
 }
 
 /// One line on stderr: what was done and what was learned.

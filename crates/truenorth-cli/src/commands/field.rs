@@ -12,6 +12,7 @@ use truenorth::geomag::{
     EXTRAPOLATION_LIMIT_YEARS, Extrapolation, MagneticField, WorldMagneticModel,
     decimal_year_from_date, decimal_year_from_unix_seconds,
 };
+use truenorth::{Place, TrueNorth};
 
 use crate::io::{CliError, CliResult};
 use crate::io::{errln, outln};
@@ -35,13 +36,14 @@ one-line warning goes to stderr."
 pub struct Args {
     /// The place and date.
     #[command(flatten)]
-    pub place: Place,
+    pub place: PlaceArgs,
 }
 
-/// Where and when to evaluate the World Magnetic Model; shared by every command that can
-/// turn magnetic into true heading.
+/// Where and when to evaluate the World Magnetic Model, as given on the command line (the
+/// library's [`Place`] once read); shared by every command that can turn magnetic into true
+/// heading.
 #[derive(Debug, Clone, Default, clap::Args)]
-pub struct Place {
+pub struct PlaceArgs {
     /// Geodetic latitude (WGS84), degrees north, -90 to 90.
     #[arg(long, value_name = "DEG", allow_negative_numbers = true)]
     pub lat: Option<String>,
@@ -69,7 +71,7 @@ pub fn run(args: &Args) -> CliResult {
     Ok(())
 }
 
-impl Place {
+impl PlaceArgs {
     /// Whether a place was given at all (`--lat` or `--lon`).
     pub fn is_given(&self) -> bool {
         self.lat.is_some() || self.lon.is_some()
@@ -90,6 +92,14 @@ impl Place {
             errln!("truenorth: warning: {w}");
         }
         Ok(field)
+    }
+
+    /// True north at the place given, `None` without one (its warnings go to stderr).
+    pub fn true_north(&self) -> CliResult<Option<TrueNorth>> {
+        if !self.is_given() {
+            return Ok(None);
+        }
+        Ok(Some(TrueNorth::from(self.field()?.declination())))
     }
 }
 
@@ -115,7 +125,7 @@ fn weak_horizontal_field(f: &MagneticField) -> Option<String> {
 pub const ALTITUDE_RANGE_KM: (f64, f64) = (-1.0, 850.0);
 
 /// The field for the parsed arguments at decimal year `year`.
-fn evaluate(args: &Place, year: f64) -> CliResult<MagneticField> {
+fn evaluate(args: &PlaceArgs, year: f64) -> CliResult<MagneticField> {
     let lat = parse_number("--lat", required("--lat", &args.lat)?)?;
     let lon = parse_number("--lon", required("--lon", &args.lon)?)?;
     if !((-180.0..360.0).contains(&lon)) {
@@ -138,9 +148,14 @@ fn evaluate(args: &Place, year: f64) -> CliResult<MagneticField> {
     } else {
         Extrapolation::Refuse
     };
-    WorldMagneticModel::WMM2025
-        .with_extrapolation(policy)
-        .field_at_deg(lat, lon, alt_km, year)
+    let place = Place {
+        lat_deg: lat,
+        lon_deg: lon,
+        height_m: alt_km * 1000.0,
+        year,
+    };
+    place
+        .field_in(&WorldMagneticModel::WMM2025.with_extrapolation(policy))
         .map_err(|e| match e {
             Error::DateOutOfRange { .. } if !args.allow_extrapolation => {
                 CliError::msg(format!("{e} (with --allow-extrapolation)"))
@@ -224,18 +239,18 @@ fn today_decimal_year() -> CliResult<f64> {
 mod tests {
     use super::*;
 
-    fn args(lat: &str, lon: &str) -> Place {
-        Place {
+    fn args(lat: &str, lon: &str) -> PlaceArgs {
+        PlaceArgs {
             lat: Some(lat.into()),
             lon: Some(lon.into()),
-            ..Place::default()
+            ..PlaceArgs::default()
         }
     }
 
     /// A row of the official WMM2025 test values: 2025.0, 100 km, 80° S 240° E.
     #[test]
     fn reproduces_a_test_value_row() {
-        let a = Place {
+        let a = PlaceArgs {
             alt_km: Some("100".into()),
             ..args("-80", "240")
         };
@@ -257,7 +272,7 @@ mod tests {
             s
         };
         assert!(
-            one_line(evaluate(&Place::default(), 2026.0).unwrap_err())
+            one_line(evaluate(&PlaceArgs::default(), 2026.0).unwrap_err())
                 .contains("--lat is required")
         );
         assert!(
@@ -295,13 +310,13 @@ mod tests {
     /// extrapolation limit says so, not "opt in" again.
     #[test]
     fn heights_and_far_dates_are_named() {
-        let deep = Place {
+        let deep = PlaceArgs {
             alt_km: Some("-1000".into()),
             ..args("10", "0")
         };
         let e = evaluate(&deep, 2026.0).unwrap_err().to_string();
         assert!(e.contains("--alt-km") && e.contains("-1 to 850 km"), "{e}");
-        let far = Place {
+        let far = PlaceArgs {
             allow_extrapolation: true,
             ..args("10", "0")
         };
@@ -315,7 +330,7 @@ mod tests {
 
     #[test]
     fn extrapolation_is_an_explicit_opt_in() {
-        let a = Place {
+        let a = PlaceArgs {
             allow_extrapolation: true,
             ..args("10", "0")
         };

@@ -1,18 +1,17 @@
 //! `truenorth heading`: apply a compass calibration to a recording and write the heading,
 //! tilt-compensated when the recording has the accelerometer and the calibration is 3-D.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
-use nalgebra::{Vector2, Vector3};
-use truenorth::accel::static_tilt;
-use truenorth::core::{Declination, MagneticHeading, Tilt, rad_to_deg};
+use truenorth::core::{Tilt, rad_to_deg};
+use truenorth::{CompassCalibration, TrueNorth};
 
-use super::field::Place;
+use super::field::PlaceArgs;
 use crate::io::errln;
-use crate::io::log_input;
+use crate::io::reading::kinds::Compass;
 use crate::io::{
-    CalibrationFile, CliError, CliResult, CompassCalibration, CsvOutput, InputOptions,
-    OutputOptions, Precision, ReadSpec, RowReader, RowRef, check_distinct,
+    CalibrationFile, CliError, CliResult, CsvOutput, Input, InputOptions, OutputOptions, Precision,
+    check_distinct,
 };
 
 /// The long help of the command (after the options).
@@ -54,7 +53,7 @@ pub struct Args {
     pub output: PathBuf,
     /// Where and when the recording was made, for true heading.
     #[command(flatten)]
-    pub place: Place,
+    pub place: PlaceArgs,
     /// How to read the input.
     #[command(flatten)]
     pub input_options: InputOptions,
@@ -63,10 +62,10 @@ pub struct Args {
     pub output_options: OutputOptions,
 }
 
-/// The declination that turns magnetic into true heading, if a place was given.
-fn declination(args: &Args) -> CliResult<Option<Declination>> {
+/// True north, if a place was given.
+fn true_north(args: &Args) -> CliResult<Option<TrueNorth>> {
     if args.place.is_given() {
-        Ok(Some(args.place.field()?.declination()))
+        args.place.true_north()
     } else if args.place.date.is_some() || args.place.alt_km.is_some() {
         Err(CliError::msg(
             "heading: --date and --alt-km need --lat and --lon (the declination depends on the place)",
@@ -76,52 +75,43 @@ fn declination(args: &Args) -> CliResult<Option<Declination>> {
     }
 }
 
-const ACC: [&str; 3] = ["acc_x", "acc_y", "acc_z"];
-
 /// Runs the subcommand.
 pub fn run(args: &Args) -> CliResult {
     check_inputs(args)?;
     let (_, cal) = CalibrationFile::read(&args.calibration)?;
-    let declination = declination(args)?;
-    let (needed, optional) = columns_read(&cal);
-    let spec = ReadSpec::new(needed).optional(optional).increasing("t_s");
-    let input = log_input::source(&args.input, &args.input_options, &spec, &[])?;
-    let mut rows = RowReader::open(&input, &args.input_options, &spec)?;
-    let cols = Columns::locate(&rows)?;
+    let true_north = true_north(args)?;
+    let mut samples =
+        Input::new(&args.input, &args.input_options).samples(Compass::new(cal.dimensions()))?;
+    let acc = samples.kind().has_acc();
     let mut header = vec!["t_s", "heading_deg"];
-    if cols.acc.is_some() {
+    if acc {
         header.extend(["pitch_deg", "roll_deg"]);
     }
     let mut out = CsvOutput::create(&args.output, &header)?;
-    let mut count = 0usize;
-    let path = rows.path().to_path_buf();
-    while let Some(block) = rows.next_rows()? {
-        for row in block {
-            let (magnetic, tilt) = cols.heading(&cal, &row, &path)?;
-            let rad = match declination {
-                Some(d) => magnetic.to_true(d).rad(),
-                None => magnetic.rad(),
-            };
-            write_row(
-                &mut out,
-                args.output_options.precision,
-                row[cols.t],
-                rad,
-                tilt,
-            )?;
-            count += 1;
-        }
-    }
-    if count == 0 {
-        return Err(CliError::row(&path, 2, "no data rows after the header"));
-    }
+    let path = samples.path().to_path_buf();
+    let count = samples.for_each(|row, reading| {
+        let (magnetic, tilt) = cal
+            .heading(&reading.mag, reading.acc.as_ref())
+            .map_err(|e| CliError::row(&path, row, e.to_string()).kind_of(&e))?;
+        let rad = match true_north {
+            Some(north) => north.heading(magnetic).rad(),
+            None => magnetic.rad(),
+        };
+        write_row(
+            &mut out,
+            args.output_options.precision,
+            reading.t_s,
+            rad,
+            tilt,
+        )
+    })?;
     out.commit()?;
-    let north = if declination.is_some() {
+    let north = if true_north.is_some() {
         "true"
     } else {
         "magnetic"
     };
-    let how = tilt_summary(&cal, cols.acc.is_some());
+    let how = tilt_summary(&cal, acc);
     errln!("truenorth: heading: {count} rows, {north} north, {how}");
     Ok(())
 }
@@ -135,89 +125,6 @@ fn check_inputs(args: &Args) -> CliResult {
         ));
     }
     Ok(())
-}
-
-/// The columns a calibration needs, and those it reads if present.
-fn columns_read(cal: &CompassCalibration) -> (&'static [&'static str], &'static [&'static str]) {
-    match cal {
-        CompassCalibration::TwoD(_) => (&["t_s", "mag_x", "mag_y"], &[]),
-        _ => (&["t_s", "mag_x", "mag_y", "mag_z"], &ACC),
-    }
-}
-
-/// Where the columns are in a row.
-struct Columns {
-    t: usize,
-    x: usize,
-    y: usize,
-    z: Option<usize>,
-    acc: Option<[usize; 3]>,
-}
-
-impl Columns {
-    /// Finds the columns; refuses an input with some of the accelerometer's but not all.
-    fn locate(rows: &RowReader) -> CliResult<Self> {
-        let ix = |n: &str| rows.index(n).unwrap_or(0);
-        let acc = match ACC.map(|n| rows.index(n)) {
-            [Some(a), Some(b), Some(c)] => Some([a, b, c]),
-            [None, None, None] => None,
-            _ => {
-                return Err(CliError::row(
-                    rows.path(),
-                    1,
-                    "the input has some of acc_x, acc_y, acc_z but not all three; give all three for tilt compensation, or none to assume a level sensor",
-                ));
-            }
-        };
-        Ok(Self {
-            t: ix("t_s"),
-            x: ix("mag_x"),
-            y: ix("mag_y"),
-            z: rows.index("mag_z"),
-            acc,
-        })
-    }
-
-    /// The magnetic heading of one row under `cal`, and the tilt when the accelerometer
-    /// gives it; a row the calibration cannot use is an error naming it.
-    fn heading(
-        &self,
-        cal: &CompassCalibration,
-        row: &RowRef<'_>,
-        path: &Path,
-    ) -> CliResult<(MagneticHeading, Option<Tilt>)> {
-        let (x, y) = (self.x, self.y);
-        let mag3 = || Vector3::new(row[x], row[y], self.z.map_or(f64::NAN, |z| row[z]));
-        let acc3 = self
-            .acc
-            .map(|[a, b, c]| Vector3::new(row[a], row[b], row[c]));
-        let bad =
-            |e: truenorth::core::Error| CliError::row(path, row.number, e.to_string()).kind_of(&e);
-        Ok(match (cal, acc3) {
-            (CompassCalibration::TwoD(c), _) => {
-                (c.magnetic_heading(&Vector2::new(row[x], row[y])), None)
-            }
-            (CompassCalibration::ThreeD(c), Some(a)) => {
-                let tilt = static_tilt(&a).map_err(bad)?;
-                (c.magnetic_heading(&mag3(), &tilt), Some(tilt))
-            }
-            // Level: zero pitch and roll, i.e. the corrected x and y.
-            (CompassCalibration::ThreeD(c), None) => {
-                (c.magnetic_heading(&mag3(), &Tilt::default()), None)
-            }
-            (CompassCalibration::Joint(c), Some(a)) => {
-                let (h, tilt) = c.attitude(&mag3(), &a).map_err(bad)?;
-                (h, Some(tilt))
-            }
-            (CompassCalibration::Joint(c), None) => {
-                let level = truenorth::compass::tilt_compensated_heading(
-                    &c.field_body(&mag3()),
-                    &Tilt::default(),
-                );
-                (MagneticHeading::new(level), None)
-            }
-        })
-    }
 }
 
 /// One output row: time, heading (`rad`, written in degrees) and the tilt if any.

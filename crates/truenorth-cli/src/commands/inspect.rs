@@ -6,7 +6,8 @@ use std::path::PathBuf;
 
 use crate::inspect::report::JsonReport;
 use crate::inspect::{COLUMNS, Recording, analyse};
-use crate::io::{CliError, CliResult, InputOptions, InputPath, ReadSpec, log_input};
+use crate::io::reading::logs::summary;
+use crate::io::{CliError, CliResult, Input, InputOptions, ReadSpec};
 use crate::io::{out, outln};
 
 /// Arguments of `truenorth inspect`.
@@ -41,12 +42,9 @@ pub struct Args {
 /// Runs the subcommand: read the columns, analyse them, print the report.
 pub fn run(args: &Args) -> CliResult {
     let spec = ReadSpec::new(&["t_s"]).optional(&COLUMNS);
-    let log = log_input::open(&args.file, &args.input_options, &spec, &[], None)?;
-    let input = log
-        .as_ref()
-        .map_or_else(|| InputPath::new(&args.file), |l| l.csv.clone());
-    let recording = Recording::read(&input, &args.input_options)?;
-    let name = input.display_path().display().to_string();
+    let (rows, log) = Input::new(&args.file, &args.input_options).rows(&spec)?;
+    let name = rows.path().display().to_string();
+    let recording = Recording::read(rows)?;
     let report = analyse(&name, &recording, &args.input_options);
     let failed =
         |e: serde_json::Error| CliError::msg(format!("inspect: cannot write the report: {e}"));
@@ -66,7 +64,7 @@ pub fn run(args: &Args) -> CliResult {
             Some(log) => {
                 let text = serde_json::to_string_pretty(&json).map_err(failed)?;
                 let summary =
-                    serde_json::to_string_pretty(&log_input::summary_json(log)).map_err(failed)?;
+                    serde_json::to_string_pretty(&summary::summary_json(log)).map_err(failed)?;
                 format!(
                     "{},\n  \"log\": {}\n}}",
                     text.trim_end().trim_end_matches('}').trim_end(),
@@ -77,7 +75,7 @@ pub fn run(args: &Args) -> CliResult {
         };
         outln!("{text}")?;
     } else {
-        for line in log.iter().flat_map(log_input::summary) {
+        for line in log.iter().flat_map(summary::summary) {
             outln!("{line}")?;
         }
         let table = report.to_table();

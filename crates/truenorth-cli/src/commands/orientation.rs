@@ -3,18 +3,21 @@
 
 use std::path::PathBuf;
 
-use nalgebra::{UnitQuaternion, Vector3};
+use nalgebra::UnitQuaternion;
+use truenorth::checks::{
+    AccUnit, GyroUnit, Inertial, MagUnit, Reference, check_field, check_inertial, fit_gyro_axes,
+    median, median_magnitude,
+};
 use truenorth::core::{
-    AttitudeEstimate, Axes, EulerZyx, Fixed, ImuSample, Precise, ned_to_enu, rad_to_deg,
+    AttitudeEstimate, EulerZyx, Fixed, ImuSample, Precise, ned_to_enu, rad_to_deg,
 };
 
-use super::mag_unit::{MagUnit, check_field};
+use crate::io::checking::{refusals, refuse_or_warn, say};
 use crate::io::errln;
-use crate::io::log_input;
+use crate::io::reading::Samples;
+use crate::io::reading::kinds::Imu;
 use crate::io::{
-    AccUnit, CliError, CliResult, CsvOutput, GyroUnit, Inertial, InputOptions, OutputOptions,
-    ReadSpec, Reference, RowReader, check_distinct, check_inertial, fit_gyro_axes, median,
-    median_magnitude, refuse_or_warn,
+    CliError, CliResult, CsvOutput, Input, InputOptions, OutputOptions, check_distinct,
 };
 use crate::plot::{Band, Envelope, Line, write_timeseries};
 use crate::registry::{Orientation, OrientationMethod, Timing};
@@ -183,7 +186,7 @@ pub fn run(args: &Args) -> CliResult {
     }
     let mut method = args
         .method
-        .pipeline(!args.no_mag, args.gyro_timing)
+        .estimator(!args.no_mag, args.gyro_timing)
         .map_err(CliError::from)?;
     let mut header: Vec<&str> = HEADER.to_vec();
     if args.status {
@@ -192,11 +195,11 @@ pub fn run(args: &Args) -> CliResult {
     // Whether the method reports σ is known from its first estimate; the header waits for it.
     let mut run = Estimation::new(args);
     for sample in &first {
-        run.step(&mut method, sample, &header)?;
+        run.step(&mut *method, sample, &header)?;
     }
     drop(first);
     while let Some(sample) = samples.next_sample()? {
-        run.step(&mut method, &sample, &header)?;
+        run.step(&mut *method, &sample, &header)?;
     }
     run.finish(args)
 }
@@ -205,7 +208,8 @@ pub fn run(args: &Args) -> CliResult {
 /// gyro axes contradict the other sensors' (or, with `--accept-units` / `--accept-axes`, says
 /// so on stderr and goes on).
 fn check_units(args: &Args, samples: &[ImuSample]) -> CliResult {
-    let findings = check_inertial(samples, args.gyro_unit, args.acc_unit, &args.input_options);
+    let findings = check_inertial(samples, args.gyro_unit, args.acc_unit);
+    let findings = refusals(&findings, &args.input_options);
     refuse_or_warn(&findings, &args.input, args.accept_units, args.accept_axes)?;
     let mut norms: Vec<f64> = samples
         .iter()
@@ -215,7 +219,9 @@ fn check_units(args: &Args, samples: &[ImuSample]) -> CliResult {
         .collect();
     // The raw magnitude includes any hard iron; the Earth-field range is wide enough that
     // only a wrong unit (a factor of 100 or more) falls outside it.
-    let problem = median(&mut norms).and_then(|f| check_field(f, args.mag_unit, None, 3));
+    let problem = median(&mut norms)
+        .and_then(|f| check_field(f, args.mag_unit, None, 3))
+        .map(|f| say(&f, &args.input_options));
     match problem {
         Some(p) if args.accept_units => {
             errln!("warning: {}: magnetometer: {p}", args.input.display());
@@ -246,9 +252,6 @@ fn check_evidence(args: &Args, first: &[ImuSample]) {
 
 /// The recording as IMU samples, one row at a time.
 fn read_samples(args: &Args) -> CliResult<ImuRows> {
-    let spec = ReadSpec::new(&["t_s", "gyr_x", "gyr_y", "gyr_z", "acc_x", "acc_y", "acc_z"])
-        .optional(&["mag_x", "mag_y", "mag_z"])
-        .increasing("t_s");
     let csv_only = [
         ("--gyro-unit", args.gyro_unit != GyroUnit::default()),
         ("--acc-unit", args.acc_unit != AccUnit::default()),
@@ -257,69 +260,29 @@ fn read_samples(args: &Args) -> CliResult<ImuRows> {
             args.mag_unit.is_some_and(|u| u != MagUnit::MicroTesla),
         ),
     ];
-    let input = log_input::source(&args.input, &args.input_options, &spec, &csv_only)?;
-    let rows = RowReader::open(&input, &args.input_options, &spec)?;
-    ImuRows::new(args, rows)
+    let kind = Imu::new(args.gyro_unit, args.acc_unit, !args.no_mag);
+    let samples = Input::new(&args.input, &args.input_options)
+        .csv_only(&csv_only)
+        .samples(kind)?;
+    Ok(ImuRows {
+        samples,
+        peeked: None,
+    })
 }
 
-/// The rows of a recording as IMU samples; a row whose three magnetometer cells are empty
-/// has no magnetometer reading, and with `--no-mag` none has.
+/// The samples of a recording, with one looked at ahead.
 struct ImuRows {
-    rows: RowReader,
-    t: usize,
-    gyr: [usize; 3],
-    acc: [usize; 3],
-    mag: Option<[usize; 3]>,
-    to_rps: f64,
-    to_mps2: f64,
+    samples: Samples<Imu>,
     peeked: Option<ImuSample>,
 }
 
 impl ImuRows {
-    fn new(args: &Args, rows: RowReader) -> CliResult<Self> {
-        let col = |n: &str| {
-            rows.index(n)
-                .ok_or_else(|| CliError::file(rows.path(), format!("missing column `{n}`")))
-        };
-        let mag = match (
-            rows.index("mag_x"),
-            rows.index("mag_y"),
-            rows.index("mag_z"),
-        ) {
-            (Some(x), Some(y), Some(z)) if !args.no_mag => Some([x, y, z]),
-            _ => None,
-        };
-        Ok(Self {
-            t: col("t_s")?,
-            gyr: [col("gyr_x")?, col("gyr_y")?, col("gyr_z")?],
-            acc: [col("acc_x")?, col("acc_y")?, col("acc_z")?],
-            mag,
-            to_rps: args.gyro_unit.to_rad_per_s(),
-            to_mps2: args.acc_unit.to_mps2(),
-            peeked: None,
-            rows,
-        })
-    }
-
     /// The next sample, `None` at the end.
     fn next_sample(&mut self) -> CliResult<Option<ImuSample>> {
         if let Some(s) = self.peeked.take() {
             return Ok(Some(s));
         }
-        let Some(r) = self.rows.next_row()? else {
-            return Ok(None);
-        };
-        let v = |[x, y, z]: [usize; 3]| Vector3::new(r[x], r[y], r[z]);
-        Ok(Some(ImuSample {
-            t_s: r[self.t],
-            gyr_rps: Axes::xyz(v(self.gyr) * self.to_rps),
-            acc_mps2: Axes::xyz(v(self.acc) * self.to_mps2),
-            mag: match self.mag {
-                Some([x, y, z]) if r[x].is_nan() && r[y].is_nan() && r[z].is_nan() => Axes::NONE,
-                Some(m) => Axes::xyz(v(m)),
-                None => Axes::NONE,
-            },
-        }))
+        Ok(self.samples.next_sample()?.map(|(_, s)| s))
     }
 
     /// The next sample, left to be returned by [`ImuRows::next_sample`].
@@ -339,13 +302,6 @@ impl ImuRows {
                 Some(s) => first.push(s),
                 None => break,
             }
-        }
-        if first.is_empty() {
-            return Err(CliError::row(
-                self.rows.path(),
-                2,
-                "no data rows after the header",
-            ));
         }
         Ok(first)
     }
@@ -399,8 +355,7 @@ impl Estimation {
         // Row k + 2: the data rows counted after the header.
         let est = method
             .update(sample)
-            .map_err(|e| CliError::row(&self.input, k + 2, e.to_string()).kind_of(&e))?
-            .estimate;
+            .map_err(|e| CliError::row(&self.input, k + 2, e.to_string()).kind_of(&e))?;
         if est.status.gap {
             let since = self.previous_t.map_or(0.0, |p| sample.t_s - p);
             if self.gaps.len() < GAPS_LISTED {

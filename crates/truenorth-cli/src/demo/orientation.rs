@@ -75,8 +75,8 @@ pub(super) fn orientation_section(seed: u64, out: &Path) -> CliResult {
     let err = |e: truenorth::core::Error| CliError::msg(e.to_string());
     // The simulator's gyro reads the instantaneous rate at each sample.
     let run_method = |method: OrientationMethod, use_mag: bool| -> Result<Run> {
-        let mut m = method.pipeline(use_mag, Timing::Instantaneous)?;
-        run(|s| Ok(m.update(s)?.estimate), !use_mag, seed, 30.0)
+        let mut m = method.estimator(use_mag, Timing::Instantaneous)?;
+        run(|s| m.update(s), !use_mag, seed, 30.0)
     };
     let q9 = run_method(OrientationMethod::Quaternion, true).map_err(err)?;
     let q6 = run_method(OrientationMethod::Quaternion, false).map_err(err)?;

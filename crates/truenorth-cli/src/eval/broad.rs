@@ -12,12 +12,11 @@ use std::path::{Path, PathBuf};
 
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 use serde::Serialize;
+use truenorth::checks::{AccUnit, GyroUnit};
 use truenorth::core::ImuSample;
 use truenorth::fusion::orientation::{BroadRmse, broad_rmse};
 
-use crate::io::{
-    AccUnit, CliError, CliResult, GyroUnit, InputOptions, InputPath, ReadSpec, RowReader,
-};
+use crate::io::{CliError, CliResult, InputOptions, InputPath, ReadSpec, RowReader};
 use crate::io::{errln, outln, write_stderr};
 use crate::registry::{OrientationMethod, Timing};
 use truenorth::core::ned_to_enu;
@@ -153,7 +152,7 @@ fn evaluate_trial(args: &Args, path: &Path, name: String) -> CliResult<TrialResu
     let trial = read_trial(path, args)?;
     let mut method = args
         .method
-        .pipeline(!args.no_mag, args.gyro_timing)
+        .estimator(!args.no_mag, args.gyro_timing)
         .map_err(|e| CliError::msg(e.to_string()))?;
     let to_enu = ned_to_enu();
     let mut q = Vec::with_capacity(trial.samples.len());
@@ -161,7 +160,7 @@ fn evaluate_trial(args: &Args, path: &Path, name: String) -> CliResult<TrialResu
         let r = method
             .update(s)
             .map_err(|e| CliError::row(path, k + 2, e.to_string()))?;
-        q.push(to_enu * r.estimate.attitude);
+        q.push(to_enu * r.attitude);
     }
     let rmse = broad_rmse(&q, &trial.reference, &trial.movement)
         .ok_or_else(|| CliError::file(path, "no scored sample (movement phase empty)"))?;

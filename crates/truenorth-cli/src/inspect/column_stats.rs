@@ -55,7 +55,7 @@ impl ColumnStats {
             .filter(|(dt, _)| dt.is_finite() && *dt > 0.0)
             .collect();
         let mut dts: Vec<f64> = steps.iter().map(|s| s.0).collect();
-        let median_dt = crate::io::median(&mut dts);
+        let median_dt = truenorth::checks::median(&mut dts);
         Self {
             name: name.to_string(),
             readings: finite.len(),

@@ -15,7 +15,9 @@ pub mod wheels;
 
 use nalgebra::Vector3;
 
-use crate::io::{CliResult, Inertial, InputOptions, InputPath, ReadSpec, Table};
+use truenorth::checks::Inertial;
+
+use crate::io::{CliResult, InputOptions, RowReader, Table};
 use report::Report;
 
 /// Every column `inspect` looks for (body axes, after `--axes` and `--column`).
@@ -46,10 +48,10 @@ pub struct Recording {
 }
 
 impl Recording {
-    /// Reads `input` under `opts`: `t_s` and whichever of [`COLUMNS`] it has.
-    pub fn read(input: &InputPath, opts: &InputOptions) -> CliResult<Self> {
-        let spec = ReadSpec::new(&["t_s"]).optional(&COLUMNS);
-        let table = Table::read_with(input, opts, &spec)?;
+    /// Reads every row of `rows` (opened for `t_s` and [`COLUMNS`]): `t_s` and whichever
+    /// of [`COLUMNS`] it has.
+    pub fn read(rows: RowReader) -> CliResult<Self> {
+        let table = Table::read(rows)?;
         table.require_rows()?;
         Ok(Self {
             t_s: table.req("t_s")?.to_vec(),

@@ -3,7 +3,7 @@
 
 use std::fmt::Write as _;
 
-use crate::io::shell_word;
+use crate::io::checking::shell_word;
 use truenorth::core::Fixed;
 
 use serde::Serialize;

@@ -1,15 +1,18 @@
 //! Each sensor's likely unit and the gyro's axes, judged from the physics the readings must
 //! obey rather than from their headers: an accelerometer at rest reads one gravity, a
 //! magnetometer the Earth's 25–65 µT, and a gyro turns gravity's and the magnetic field's
-//! directions in the body as they are seen to turn (the shared checks of `crate::io`).
+//! directions in the body as they are seen to turn (the checks of `truenorth::checks`).
 
 use serde::Serialize;
 
-use super::Recording;
-use crate::io::{
-    AxisFit, GyroUnit, Inertial, InputOptions, Reference, SignedPermutation, acc_unit_name,
-    fit_gyro_axes, fix_columns, gyro_unit_name, likely_acc_unit, median_magnitude,
+use truenorth::checks::{
+    AccUnit, AxisFit, GyroUnit, Inertial, Reference, SignedPermutation, axes_are_wrong,
+    fit_gyro_axes, likely_acc_unit, median, median_magnitude,
 };
+
+use super::Recording;
+use crate::io::InputOptions;
+use crate::io::checking::fix_columns;
 
 /// The accelerometer.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -103,7 +106,7 @@ pub fn acc(rec: &Recording, rows: &[Inertial]) -> Option<AccReport> {
     let median = median_magnitude(rows, Reference::Gravity);
     Some(AccReport {
         median_magnitude: median,
-        likely_unit: median.and_then(likely_acc_unit).map(acc_unit_name),
+        likely_unit: median.and_then(likely_acc_unit).map(AccUnit::name),
         up_axis: median.and_then(|m| up_axis(rows, m)),
     })
 }
@@ -146,7 +149,7 @@ pub fn gyro(rec: &Recording, rows: &[Inertial], opts: &InputOptions) -> Option<G
     };
     let unit_margin = other.1.best_deg / chosen.1.best_deg.max(1e-9);
     Some(GyroReport {
-        likely_unit: (unit_margin >= UNIT_MARGIN).then(|| gyro_unit_name(chosen.0)),
+        likely_unit: (unit_margin >= UNIT_MARGIN).then(|| chosen.0.name()),
         unit_margin: Some(unit_margin),
         rad_per_unit: Some(chosen.1.rad_per_unit),
         axes: Some(axes(&chosen.1, opts)),
@@ -155,7 +158,7 @@ pub fn gyro(rec: &Recording, rows: &[Inertial], opts: &InputOptions) -> Option<G
 
 /// The axes part of the gyro's report.
 fn axes(fit: &AxisFit, opts: &InputOptions) -> AxesReport {
-    let wrong = crate::io::axes_are_wrong(fit);
+    let wrong = axes_are_wrong(fit);
     let as_read = fit.best == SignedPermutation::IDENTITY;
     let informative = fit.is_informative();
     AxesReport {
@@ -188,7 +191,7 @@ pub fn mag(rec: &Recording) -> Option<MagReport> {
         .map(|k| (x[k] * x[k] + y[k] * y[k] + z[k] * z[k]).sqrt())
         .filter(|n| n.is_finite() && *n > 0.0)
         .collect();
-    let median = crate::io::median(&mut norms);
+    let median = median(&mut norms);
     let distance = |(_, k): &(&str, f64), m: f64| (m * k / 45.0).ln().abs();
     let likely = median.and_then(|m| {
         MAG_UNITS

@@ -3,10 +3,13 @@
 //! sign right (the shared check `drive` refuses by, with a track of one metre).
 
 use serde::Serialize;
+use truenorth::checks::{GyroUnit, SignedPermutation, YawRateCheck};
 use truenorth::core::VehicleSample;
 
 use super::Recording;
-use crate::io::{GyroUnit, InputOptions, SignedPermutation, WheelColumns, YawRateCheck, fix_pair};
+use crate::io::InputOptions;
+use crate::io::checking::fix_pair;
+use crate::io::reading::wheels::WheelColumns;
 
 /// The odometer wheels.
 #[derive(Debug, Clone, PartialEq, Serialize)]

@@ -1,16 +1,16 @@
 //! Compass calibration methods by name.
 
 use truenorth::calib::{
-    BinnedEllipseCalibrator, EllipseCalibrator, EllipseConfig, EllipsoidCalibrator,
-    EllipsoidConfig, MagAccelCalibration, MagAccelCalibrator, MagAccelConfig, MagAccelQuality,
-    MagAccelSample, MeritCircleCalibrator, OnlineEllipseCalibrator, OnlineEllipseConfig,
-    OnlineEllipsoidCalibrator, OnlineEllipsoidConfig, TurnCalibration, TurnCalibrator,
-    TurnCompassCalibrator, TurnConfig, TurnQuality, TurnSample,
+    BinnedEllipseCalibrator, BinnedEllipseConfig, EllipseCalibrator, EllipseConfig,
+    EllipsoidCalibrator, EllipsoidConfig, MagAccelCalibration, MagAccelCalibrator, MagAccelConfig,
+    MagAccelQuality, MagAccelSample, MeritCircleCalibrator, MeritCircleConfig,
+    OnlineEllipseCalibrator, OnlineEllipseConfig, OnlineEllipsoidCalibrator, OnlineEllipsoidConfig,
+    TurnCalibration, TurnCalibrator, TurnCompassCalibrator, TurnConfig, TurnQuality, TurnSample,
 };
 use truenorth::compass::{CompassCalibration2d, CompassCalibration3d};
 use truenorth::core::{Calibrator, CompassQuality, Mag2Sample, Mag3Sample, Result};
 
-use crate::io::reading_spill::ReadingSpill;
+use crate::io::spill::ReadingSpill;
 
 /// A calibrator of two-axis magnetometer readings.
 pub type Planar =
@@ -105,16 +105,9 @@ impl CalibrationMethod {
         }
     }
 
-    /// Whether the method's calibrator reports the fitted field against an expected one
-    /// itself (its configuration takes `expected_field`); the seed methods' do not.
-    pub fn reports_expected_field(self) -> bool {
-        !matches!(self, Self::BinnedEllipse | Self::MeritCircle | Self::Turn)
-    }
-
     /// The method's calibrator in its default configuration, with `expected_field` (input
-    /// unit) for the methods whose configuration takes one (the least-squares and online
-    /// fits report the fitted field against it; `ellipsoid-accel` also uses it in the fit).
-    /// The seed methods take none: see [`Self::reports_expected_field`].
+    /// unit): every method reports the fitted field against it; `ellipsoid-accel` also
+    /// uses it in the fit.
     pub fn calibrator(self, expected_field: Option<f64>) -> Result<CompassCalibrator> {
         self.build(expected_field, None)
     }
@@ -153,8 +146,18 @@ impl CalibrationMethod {
                     ..OnlineEllipseConfig::default()
                 },
             )?)),
-            Self::BinnedEllipse => C::Planar(Box::new(BinnedEllipseCalibrator::default())),
-            Self::MeritCircle => C::Planar(Box::new(MeritCircleCalibrator::default())),
+            Self::BinnedEllipse => C::Planar(Box::new(BinnedEllipseCalibrator::new(
+                BinnedEllipseConfig {
+                    expected_field,
+                    ..BinnedEllipseConfig::default()
+                },
+            )?)),
+            Self::MeritCircle => {
+                C::Planar(Box::new(MeritCircleCalibrator::new(MeritCircleConfig {
+                    expected_field,
+                    ..MeritCircleConfig::default()
+                })?))
+            }
             Self::Ellipsoid => {
                 let config = EllipsoidConfig {
                     expected_field,
@@ -181,10 +184,16 @@ impl CalibrationMethod {
                     None => Box::new(MagAccelCalibrator::new(config)?),
                 })
             }
-            Self::Turn => C::Turn {
-                compass: Box::new(TurnCompassCalibrator::default()),
-                with_gyro: Box::new(TurnCalibrator::new(TurnConfig::default())?),
-            },
+            Self::Turn => {
+                let config = TurnConfig {
+                    expected_field,
+                    ..TurnConfig::default()
+                };
+                C::Turn {
+                    compass: Box::new(TurnCompassCalibrator::new(config)?),
+                    with_gyro: Box::new(TurnCalibrator::new(config)?),
+                }
+            }
         })
     }
 }

@@ -4,12 +4,9 @@
 //!
 //! * [`CalibrationMethod`] → [`CompassCalibrator`]: a `Calibrator` of the samples the
 //!   method learns from (two-axis, three-axis, magnetometer with accelerometer, one turn);
-//! * [`OrientationMethod`] → the facade's [`OrientationPipeline`] around a
-//!   `dyn OrientationEstimator`;
+//! * [`OrientationMethod`] → a `dyn OrientationEstimator`;
 //! * [`VehicleMethod`] → a `dyn` [`VehicleRun`]: a `HeadingEstimator`, or the fused
 //!   estimator with its two-pass start.
-//!
-//! [`OrientationPipeline`]: truenorth::pipeline::OrientationPipeline
 
 mod compass;
 mod orientation;

@@ -4,10 +4,9 @@ use truenorth::core::{OrientationEstimator, Result};
 use truenorth::fusion::{
     EulerDetector, EulerDetectorConfig, GyroTiming, QuaternionFilter, QuaternionFilterConfig,
 };
-use truenorth::pipeline::OrientationPipeline;
 
-/// An orientation method ready to run: the facade's pipeline around the estimator.
-pub type Orientation = OrientationPipeline<dyn OrientationEstimator>;
+/// An orientation method ready to run.
+pub type Orientation = dyn OrientationEstimator;
 
 /// Orientation methods.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -33,24 +32,20 @@ pub enum Timing {
 impl OrientationMethod {
     /// The method with the magnetometer used or not and the gyro timing (the quaternion
     /// filter's; the Euler detector integrates Euler rates its own way), on magnetic north.
-    pub fn pipeline(self, use_mag: bool, timing: Timing) -> Result<Box<Orientation>> {
+    pub fn estimator(self, use_mag: bool, timing: Timing) -> Result<Box<Orientation>> {
         Ok(match self {
-            Self::Quaternion => Box::new(OrientationPipeline::new(QuaternionFilter::new(
-                QuaternionFilterConfig {
-                    use_mag,
-                    gyro_timing: match timing {
-                        Timing::IntervalMean => GyroTiming::IntervalMean,
-                        Timing::Instantaneous => GyroTiming::Instantaneous,
-                    },
-                    ..Default::default()
+            Self::Quaternion => Box::new(QuaternionFilter::new(QuaternionFilterConfig {
+                use_mag,
+                gyro_timing: match timing {
+                    Timing::IntervalMean => GyroTiming::IntervalMean,
+                    Timing::Instantaneous => GyroTiming::Instantaneous,
                 },
-            )?)),
-            Self::EulerDetector => Box::new(OrientationPipeline::new(EulerDetector::new(
-                EulerDetectorConfig {
-                    use_mag,
-                    ..Default::default()
-                },
-            )?)),
+                ..Default::default()
+            })?),
+            Self::EulerDetector => Box::new(EulerDetector::new(EulerDetectorConfig {
+                use_mag,
+                ..Default::default()
+            })?),
         })
     }
 }

@@ -22,6 +22,7 @@ from ._truenorth import (
     Verdict,
     broad_rmse,
     calibrate,
+    check_imu,
     field,
     read_log,
 )
@@ -42,6 +43,7 @@ __all__ = [
     "Verdict",
     "broad_rmse",
     "calibrate",
+    "check_imu",
     "field",
     "read_log",
 ]

@@ -266,3 +266,24 @@ def read_log(
 ) -> Log:
     """A PX4 ULog or ROS 2 MCAP log as arrays per stream (seconds, FRD body axes, rad/s,
     m/s^2, uT), as the `truenorth` command reads it; `mag_topic="none"`: no magnetometer."""
+
+class Finding(TypedDict):
+    """What contradicts a recording's declared units or the gyro's axes."""
+
+    kind: Literal["units", "axes"]
+    seen: str
+    fix: dict[str, Any]
+    row: Optional[int]
+
+def check_imu(
+    t_s: FloatArray,
+    gyr: FloatArray,
+    acc: FloatArray,
+    mag: Optional[FloatArray] = None,
+    gyro_unit: Literal["rad/s", "deg/s"] = "rad/s",
+    acc_unit: Literal["m/s2", "g", "mg"] = "m/s2",
+) -> list[Finding]:
+    """The gyro's and accelerometer's units and the gyro's axes checked against the physics
+    (one gravity at rest; gravity's and the field's directions turning as the gyro says): the
+    checks `truenorth orientation` refuses by. Empty when nothing contradicts them; `fix`
+    holds `gyro_unit`, `acc_unit` or `gyro_axes` (`x=-y,y=x,z=z`)."""

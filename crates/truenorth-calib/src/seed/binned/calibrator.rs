@@ -93,6 +93,7 @@ use crate::seed::binned::bins::{
 };
 pub use crate::seed::binned::config::{BinnedEllipseConfig, MAX_INIT_SAMPLES};
 use crate::seed::binned::refresh::RefreshJob;
+use crate::seed::seed_quality::with_expected_field;
 
 use core::f64::consts::TAU;
 
@@ -565,7 +566,10 @@ impl Calibrator for BinnedEllipseCalibrator {
     /// Completes any update in progress and runs a full one, on a copy: the calibrator is
     /// unchanged.
     fn solve(&self) -> Result<Solution<CompassCalibration2d>> {
-        self.clone().solve_in_place()
+        let expected = self.config.expected_field;
+        self.clone()
+            .solve_in_place()
+            .map(|s| with_expected_field(s, expected))
     }
 
     fn reset(&mut self) {
@@ -577,6 +581,7 @@ impl OnlineCalibrator for BinnedEllipseCalibrator {
     /// The solution of the last completed full-set update that passed the acceptance tests.
     fn estimate(&self) -> Option<Solution<CompassCalibration2d>> {
         self.estimate
+            .map(|s| with_expected_field(s, self.config.expected_field))
     }
 }
 

@@ -56,6 +56,9 @@ pub struct BinnedEllipseConfig {
     /// least-squares fits'): a noisy arc can spread its binned readings over more headings
     /// than it turned through, and this refuses what its arc tests let through.
     pub max_heading_error_bound_deg: f64,
+    /// The expected horizontal field, input unit (e.g. from the World Magnetic Model), > 0,
+    /// reported as [`CompassQuality::field_ratio_to_expected`](truenorth_core::CompassQuality::field_ratio_to_expected) (`None`).
+    pub expected_field: Option<f64>,
 }
 
 impl Default for BinnedEllipseConfig {
@@ -73,6 +76,7 @@ impl Default for BinnedEllipseConfig {
             min_arc_deg: MIN_ARC_DEG,
             max_residual_rel: 0.1,
             max_heading_error_bound_deg: 10.0,
+            expected_field: None,
         }
     }
 }
@@ -146,6 +150,9 @@ impl Validate for BinnedEllipseConfig {
             "binned ellipse max_heading_error_bound_deg",
             self.max_heading_error_bound_deg,
         )?;
+        if let Some(f) = self.expected_field {
+            check_positive("binned ellipse expected_field", f)?;
+        }
         Ok(())
     }
 }

@@ -71,7 +71,7 @@ use crate::quality::{
     Coverage, Direction, coverage, mean_corrected_norm_2d, require_arc, turned_at_least,
 };
 use crate::seed::fit_gap::complete_bound;
-use crate::seed::seed_quality::{SeedJob, seed_assessment};
+use crate::seed::seed_quality::{SeedJob, seed_assessment, with_expected_field};
 
 use crate::seed::merit_circle::config::MeritCircleConfig;
 use crate::seed::merit_circle::config::RING;
@@ -456,10 +456,11 @@ impl Calibrator for MeritCircleCalibrator {
             &buf[..n],
             &cal,
         );
-        Ok(Solution {
+        let solution = Solution {
             params: cal,
             quality: a.quality,
-        })
+        };
+        Ok(with_expected_field(solution, self.config.expected_field))
     }
 
     fn reset(&mut self) {
@@ -471,6 +472,7 @@ impl OnlineCalibrator for MeritCircleCalibrator {
     /// The solve of the latest heading data point (`None` before one succeeded).
     fn estimate(&self) -> Option<Solution<CompassCalibration2d>> {
         self.estimate
+            .map(|s| with_expected_field(s, self.config.expected_field))
     }
 }
 

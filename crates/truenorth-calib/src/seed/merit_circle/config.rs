@@ -5,7 +5,7 @@ extern crate alloc;
 use core::f64::consts::PI;
 
 use serde::{Deserialize, Serialize};
-use truenorth_core::{Result, Validate, check_range};
+use truenorth_core::{Result, Validate, check_positive, check_range};
 
 use crate::quality::MIN_ARC_DEG;
 
@@ -33,6 +33,9 @@ pub struct MeritCircleConfig {
     pub min_centres: usize,
     /// Shortest arc of headings accepted, degrees ([`MERIT_CIRCLE_MIN_ARC_DEG`]).
     pub min_arc_deg: f64,
+    /// The expected horizontal field, input unit (e.g. from the World Magnetic Model), > 0,
+    /// reported as [`CompassQuality::field_ratio_to_expected`](truenorth_core::CompassQuality::field_ratio_to_expected) (`None`).
+    pub expected_field: Option<f64>,
 }
 
 /// The merit circle's default shortest arc, degrees: 40° more than the workspace's
@@ -52,6 +55,7 @@ impl Default for MeritCircleConfig {
             weight_memory: 200.0,
             min_centres: 3,
             min_arc_deg: MERIT_CIRCLE_MIN_ARC_DEG,
+            expected_field: None,
         }
     }
 }
@@ -85,6 +89,9 @@ impl Validate for MeritCircleConfig {
             1e9,
         )?;
         check_range("merit circle min_arc_deg", self.min_arc_deg, 0.0, 360.0)?;
+        if let Some(f) = self.expected_field {
+            check_positive("merit circle expected_field", f)?;
+        }
         Ok(())
     }
 }

@@ -16,7 +16,7 @@ use truenorth_core::{
 
 use crate::numerics::direction_slots::{DirectionSlots, SLOTS};
 use crate::quality::{calibrated_coverage_2d, require_arc};
-use crate::seed::seed_quality::seed_assessment;
+use crate::seed::seed_quality::{seed_assessment, with_expected_field};
 
 use super::config::TurnConfig;
 use super::turn_extrema::{TurnEllipse, TurnExtrema, TurnExtremaState};
@@ -140,10 +140,11 @@ impl Calibrator for TurnCompassCalibrator {
             fit.field(),
             self.extrema.samples(),
         );
-        Ok(Solution {
+        let solution = Solution {
             params: fit.calibration(),
             quality: a.quality,
-        })
+        };
+        Ok(with_expected_field(solution, self.config.expected_field))
     }
 
     fn reset(&mut self) {

@@ -21,6 +21,9 @@ pub struct TurnConfig {
     /// longer one is refused with [`Error::TimeGap`](truenorth_core::Error::TimeGap). The
     /// compass half reads no time.
     pub max_gap_s: f64,
+    /// The expected horizontal field, input unit (e.g. from the World Magnetic Model), > 0,
+    /// reported as [`CompassQuality::field_ratio_to_expected`](truenorth_core::CompassQuality::field_ratio_to_expected) (`None`).
+    pub expected_field: Option<f64>,
 }
 
 /// The default [`TurnConfig::max_gap_s`]: 1 s. The trapezoid rule is exact across a step
@@ -36,6 +39,9 @@ impl Validate for TurnConfig {
         self.extrema.validate()?;
         check_range("turn min_arc_deg", self.min_arc_deg, 0.0, 360.0)?;
         check_positive("turn max_gap_s", self.max_gap_s)?;
+        if let Some(f) = self.expected_field {
+            check_positive("turn expected_field", f)?;
+        }
         Ok(())
     }
 }
@@ -46,6 +52,7 @@ impl Default for TurnConfig {
             extrema: ExtremaConfig::default(),
             min_arc_deg: MIN_ARC_DEG,
             max_gap_s: DEFAULT_MAX_GAP_S,
+            expected_field: None,
         }
     }
 }

@@ -13,7 +13,7 @@ use truenorth_core::{
 use truenorth_gyro::{GyroCalibration, YawIncrement};
 
 use crate::numerics::direction_slots::DirectionSlots;
-use crate::quality::{calibrated_coverage_2d, require_arc};
+use crate::quality::{self, calibrated_coverage_2d, require_arc};
 use crate::seed::extrema::ExtremumKind;
 use crate::seed::seed_quality::seed_assessment;
 use crate::seed::turn::{TurnConfig, TurnEllipse, TurnExtrema};
@@ -559,7 +559,8 @@ impl Calibrator for TurnCalibrator {
     }
 
     fn solve(&self) -> Result<Solution<TurnCalibration, TurnQuality>> {
-        let (_, params, quality) = self.accepted()?;
+        let (_, params, mut quality) = self.accepted()?;
+        quality.compass = quality::with_expected_field(quality.compass, self.config.expected_field);
         Ok(Solution { params, quality })
     }
 

@@ -9,11 +9,11 @@
 use std::f64::consts::PI;
 use std::path::PathBuf;
 
+use truenorth::checks::{FindingKind, GyroUnit, Turns, YawRateCheck};
 use truenorth::core::VehicleSample;
 
-use crate::io::{
-    CliResult, Finding, FindingKind, GyroUnit, InputOptions, Turns, YawRateCheck, refuse_or_warn,
-};
+use crate::io::checking::{Refusal, refusals, refuse_or_warn};
+use crate::io::{CliResult, InputOptions};
 
 /// Driving with one wheel's distance falling while the other's rises, m, before a car's
 /// wheel is called negated: a car's wheels never turn opposite ways (only a pivoting
@@ -189,7 +189,7 @@ impl Diagnosis {
 
     /// Everything found, the most telling first: a negated wheel spoils every other
     /// comparison, so it comes alone.
-    pub fn findings(&self, context: &Context) -> Vec<Finding> {
+    pub fn findings(&self, context: &Context) -> Vec<Refusal> {
         let [left, right] = context.wheel_names();
         if let Some((row, falling)) = self.negated {
             let (name, other) = if falling == 0 {
@@ -197,7 +197,7 @@ impl Diagnosis {
             } else {
                 (&right, &left)
             };
-            return vec![Finding {
+            return vec![Refusal {
                 kind: FindingKind::Axes,
                 message: format!(
                     "{name} falls while {other} rises over {OPPOSED_M:.0} m of driving: a car's wheels never turn opposite ways, so {name} has its sign flipped: pass --column {}",
@@ -206,7 +206,7 @@ impl Diagnosis {
                 row: Some(row),
             }];
         }
-        let mut findings = self.yaw.findings(context.gyro_unit, context.options);
+        let mut findings = refusals(&self.yaw.findings(context.gyro_unit), context.options);
         let opposite = self.yaw.agreeing_ratio().is_some_and(|(r, _)| r < 0.0);
         if opposite && let Some(sign) = findings.iter_mut().find(|f| f.kind == FindingKind::Axes) {
             let swap = format!(
@@ -232,9 +232,9 @@ impl Diagnosis {
             }
         }
         let wheels = format!("{left}, {right}");
+        let vehicle = context.vehicle.display().to_string();
         let scale = if self.yaw.agreeing_ratio().is_some() {
-            self.yaw
-                .wheel_scale_finding(&wheels, self.speeds, &context.vehicle)
+            self.yaw.wheel_scale_finding(&wheels, self.speeds, &vehicle)
         } else {
             // Windows chosen by the gyro carry its bias (a raw gyro's few °/s turn every
             // straight second), so only a ratio near a thousand's, which no bias makes,
@@ -242,10 +242,10 @@ impl Diagnosis {
             self.compass
                 .wheels_per_gyro(self.yaw.track_m())
                 .filter(|t| t.r2 >= MIN_KM_R2 && (t.ratio.abs() / 1e-3).ln().abs() < 3f64.ln())
-                .and_then(|t| t.wheel_scale_finding(&wheels, self.speeds, &context.vehicle))
+                .and_then(|t| t.wheel_scale_finding(&wheels, self.speeds, &vehicle))
         };
         if findings.iter().all(|f| f.kind != FindingKind::Units) {
-            findings.extend(scale);
+            findings.extend(scale.map(|f| Refusal::of(&f, context.options)));
         }
         findings
     }

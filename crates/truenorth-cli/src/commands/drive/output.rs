@@ -3,7 +3,8 @@
 
 use std::path::Path;
 
-use truenorth::core::{Declination, MagneticHeading, NavEstimate, rad_to_deg, wrap_two_pi};
+use truenorth::TrueNorth;
+use truenorth::core::{MagneticHeading, NavEstimate, rad_to_deg, wrap_two_pi};
 use truenorth::fusion::vehicle::NavFilter;
 
 use crate::io::{CliError, CliResult, CsvOutput, Precision};
@@ -26,7 +27,7 @@ pub enum Extra {
 pub(super) struct Writer {
     pub(super) out: CsvOutput,
     pub(super) extra: Vec<Extra>,
-    pub(super) declination: Option<Declination>,
+    pub(super) true_north: Option<TrueNorth>,
     pub(super) rows: usize,
     /// Rows where a sensor resumed after a gap.
     pub(super) gaps: usize,
@@ -38,17 +39,17 @@ pub(super) struct Writer {
 
 impl Writer {
     /// Creates the output `output` with the contract's columns and the `extra` groups;
-    /// headings turned to true north by `declination` when given.
+    /// headings and the track turned onto true north when `true_north` is given.
     pub(super) fn create(
         output: &Path,
         extra: &[Extra],
-        declination: Option<Declination>,
+        true_north: Option<TrueNorth>,
         precision: Precision,
     ) -> CliResult<Self> {
         Ok(Self {
             out: CsvOutput::create(output, &Self::header(extra))?,
             extra: extra.to_vec(),
-            declination,
+            true_north,
             rows: 0,
             gaps: 0,
             error: None,
@@ -111,11 +112,10 @@ impl Writer {
     /// The contract's columns: `t_s,north_m,east_m,heading_deg`.
     fn position_and_heading(&self, e: &NavEstimate) -> Vec<f64> {
         let (mut n, mut east, mut heading) = (e.north_m, e.east_m, e.heading.rad());
-        if let Some(d) = self.declination {
+        if let Some(north) = self.true_north {
             // True north: the heading and the whole track turn by the declination.
-            heading = MagneticHeading::new(heading).to_true(d).rad();
-            let (s, c) = d.0.sin_cos();
-            (n, east) = (c * n - s * east, s * n + c * east);
+            heading = north.heading(MagneticHeading::new(heading)).rad();
+            (n, east) = north.north_east(n, east);
         }
         if !e.status.position_known {
             // No wheels: no position, written as empty cells.
