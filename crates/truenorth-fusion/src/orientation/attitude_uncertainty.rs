@@ -14,7 +14,9 @@
 //!   Systems*, 2nd ed., 2013, §4.4.6 and §14.2.7): white noise adds `N² dt` to the variance of
 //!   the angle error `e`; a bias error `β` (a random constant plus a random walk) adds to it
 //!   through the pair `(e, β)`, whose 2 × 2 covariance is propagated exactly. Each applied
-//!   correction multiplies `e` by `1 − k`; in motion the filter's bias estimate integrates
+//!   correction multiplies `e` by `1 − k` (for inclination, whose low-pass sets the
+//!   dynamics, `k = dt/τ_i` with `τ_i = √2 τ_acc`, the first-order loop with the
+//!   Butterworth low-pass's lag behind a steady drift); in motion the filter's bias estimate integrates
 //!   the corrections (`β ← β − (k/τ_b) e`), which is credited only with the in-phase part
 //!   of a first-order loop's response to a bias that turns with the body at `|ω|`,
 //!   `1/(1 + (|ω| τ)²)`: a fast-turning body shows its bias to the corrections only
@@ -31,13 +33,13 @@
 //!   MPU-9250 register map, register 26: 2.9 ms at its widest bandwidth, 5.9 ms at 41 Hz),
 //!   so the attitude stands for a slightly earlier instant: an error `|R ω| δ` per axis.
 //! - **What the corrections trust**: the accelerometer's bias (`b/g` of tilt, a constant
-//!   passed fully) and white noise (through the two low-passes in cascade, variance
-//!   `N_a²/(2 g² (τ_lp + τ_acc))`); for heading, the magnetometer's residual calibration
+//!   passed fully) and white noise (through the Butterworth low-pass, whose noise bandwidth
+//!   is `1/(2√2 τ_acc)`: variance `N_a²/(2√2 g² τ_acc)`); for heading, the magnetometer's residual calibration
 //!   error (a constant), its white noise (`σ_h² k/2`: a first-order low-pass of white
 //!   noise) and the inclination error about north, which the dip turns into a heading error
 //!   `e_x tan(dip)` (the east component of `e × m`). Of that, the parts that persist (the
 //!   biases' and the scale error's) pass the heading loop whole; the accelerations' varies
-//!   with the inclination loop's time constant and passes by `τ_acc/(τ_acc + τ_mag)`, the
+//!   with the inclination loop's time constant `τ_i` and passes by `τ_i/(τ_i + τ_mag)`, the
 //!   variance a first-order low-pass leaves of a first-order Gauss–Markov process (Gelb,
 //!   *Applied Optimal Estimation*, 1974, §3.8). Such a variance `C` enters as
 //!   `P ← (1 − k)² P + (1 − (1 − k)²) C`, so it is reached with the correction's own time
@@ -47,8 +49,8 @@
 //!   - *accelerations*: the body's accelerations show in the inclination corrections; their
 //!     recent sum `ε ← (1 − k) ε + correction` is what the accelerometer has moved the
 //!     attitude by within the loop's time constant, and the envelope of its square is added
-//!     per axis (rising with it at once, decaying over the loop's natural period
-//!     `2π √(τ_lp τ_acc)`). A *sustained* horizontal acceleration (a vehicle's turn) looks exactly like a
+//!     per axis (rising with it at once, decaying over the low-pass's natural period
+//!     `2π τ_acc`). A *sustained* horizontal acceleration (a vehicle's turn) looks exactly like a
 //!     tilt and is not seen: like the filter itself, σ assumes that the body's
 //!     accelerations average out over a few seconds.
 //!   - *magnetic disturbances*: the field's norm and dip departures from the learned
@@ -65,6 +67,8 @@
 //!
 //! Without a magnetometer the heading is relative to the start and its σ is the drift
 //! since the start. Everything is a few scalars per axis, cheap enough for every sample.
+
+use core::f64::consts::SQRT_2;
 
 use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
@@ -246,10 +250,10 @@ pub struct AttitudeUncertainty<T: Real = f64> {
     /// Reference-frame rate and its norm at the last step.
     rate_ned: Vector3<T>,
     rate_rps: T,
-    /// The inclination correction's constants for the last (gain, time constant, low-pass):
-    /// variance target and the envelope's gain, recomputed only when those change; `None`
-    /// before the first inclination correction.
-    accel_constants: Option<([T; 3], T, T)>,
+    /// The inclination correction's constants for the last (interval, time constant): the
+    /// loop's gain and time constant, the variance target and the envelope's gain,
+    /// recomputed only when those change; `None` before the first inclination correction.
+    accel_constants: Option<([T; 2], [T; 4])>,
 }
 
 /// Inclination σ assumed before the first correction, rad: the tilt the first reading
@@ -337,36 +341,40 @@ impl<T: Real> AttitudeUncertainty<T> {
         self.heading.bias += mix * (mean - self.heading.bias);
     }
 
-    /// The inclination correction of this step: gain `k`, the correction applied about
-    /// x and y (rad), and the bias estimate's `1/τ_b` (0 when it does not learn: at rest or
-    /// in the start-up).
+    /// The inclination correction of this step of `dt_s`: the correction applied about x
+    /// and y (rad), the low-pass's time constant `tau_s` and the bias estimate's `1/τ_b` (0
+    /// when it does not learn: at rest or in the start-up). The error follows the low-pass
+    /// as it would a first-order loop with the same lag behind a steady drift, `√2 τ`.
     #[inline]
     pub(crate) fn accel_corrected(
         &mut self,
-        k: T,
+        dt_s: T,
         correction: (T, T),
         tau_s: T,
         inv_tau_bias: T,
-        lowpass_s: T,
     ) {
-        if self.accel_constants.map(|c| c.0) != Some([k, tau_s, lowpass_s]) {
+        if self.accel_constants.map(|c| c.0) != Some([dt_s, tau_s]) {
             let cfg = &self.config;
             let g = T::of(STANDARD_GRAVITY_MPS2);
             let bias = T::of(cfg.accel_bias_mps2) / g;
             let white = T::of(cfg.accel_noise_mps2_per_sqrt_hz) / g;
-            let target = bias * bias + white * white / (T::of(2.0) * (lowpass_s + tau_s));
+            // White noise through the Butterworth low-pass: its noise bandwidth is
+            // 1/(2√2 τ) (∫|H|² df).
+            let target = bias * bias + white * white / (T::of(2.0 * SQRT_2) * tau_s);
+            let loop_tau = T::of(SQRT_2) * tau_s;
+            let k = (dt_s / loop_tau).min(T::one());
             // The envelope of the square (below) follows a rise at once (the error an
             // acceleration causes builds as fast as the corrections it causes) and decays
-            // over the loop's natural period 2π √(τ_lp τ_acc) (11 s by default), so that it
-            // holds through the swings of an acceleration slow enough to pass the loop.
-            let period = T::of(core::f64::consts::TAU) * (lowpass_s * tau_s).sqrt();
-            let k_env = (k * tau_s / period).min(T::one());
-            self.accel_constants = Some(([k, tau_s, lowpass_s], target, k_env));
+            // over the low-pass's natural period 2π τ (13 s by default), so that it holds
+            // through the swings of an acceleration slow enough to pass the low-pass.
+            let period = T::of(core::f64::consts::TAU) * tau_s;
+            let k_env = (dt_s / period).min(T::one());
+            self.accel_constants = Some(([dt_s, tau_s], [k, loop_tau, target, k_env]));
         }
-        let Some((_, target, k_env)) = self.accel_constants else {
+        let Some((_, [k, loop_tau, target, k_env])) = self.accel_constants else {
             return;
         };
-        let c = self.bias_credit(k, tau_s, inv_tau_bias);
+        let c = self.bias_credit(k, loop_tau, inv_tau_bias);
         self.inclination.correct(k, c, target);
         self.turned_inclination *= T::one() - k;
         let a = T::one() - k;
@@ -422,9 +430,7 @@ impl<T: Real> AttitudeUncertainty<T> {
         // whole; the accelerations' varies with the inclination loop's time constant and
         // passes by τ_acc/(τ_acc + τ_mag).
         let passed = match self.accel_constants {
-            Some(([_, tau_acc_s, _], ..)) if tau_acc_s > T::zero() => {
-                tau_acc_s / (tau_acc_s + tau_s)
-            }
+            Some((_, [_, loop_tau, ..])) if loop_tau > T::zero() => loop_tau / (loop_tau + tau_s),
             _ => T::one(),
         };
         let acceleration = self.accel_moved_sq[0];
@@ -507,8 +513,8 @@ impl<T: Real> AttitudeUncertainty<T> {
         ] {
             check_finite_in("uncertainty field term", v)?;
         }
-        if let Some((key, target, k_env)) = self.accel_constants {
-            for v in key.iter().chain(&[target, k_env]) {
+        if let Some((key, constants)) = self.accel_constants {
+            for v in key.iter().chain(&constants) {
                 check_finite_in("uncertainty inclination constant", *v)?;
             }
         }

@@ -1,7 +1,10 @@
 //! The [`crate::QuaternionFilter`]'s per-sample gains, derived from its parameters and the
 //! sample interval (kept apart from the parameters and the state, as VQF's coefficients).
 
-use truenorth_core::{Real, STANDARD_GRAVITY_MPS2};
+use truenorth_core::Real;
+
+#[cfg(not(feature = "std"))]
+use truenorth_core::Float as _;
 
 use super::quaternion_config::QuaternionFilterConfig;
 
@@ -11,10 +14,9 @@ use super::quaternion_config::QuaternionFilterConfig;
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct Coefficients<T> {
     pub(crate) dt_s: T,
-    /// Low-pass gain of the reference-frame specific force.
-    pub(crate) acc_lowpass: T,
-    /// Inclination gain per m/s² of horizontal specific force.
-    pub(crate) acc: T,
+    /// The inclination low-pass's transition over one interval (see [`butterworth_step`]):
+    /// `[φ₁₁, φ₁₂, φ₂₁, φ₂₂]`.
+    pub(crate) acc_lowpass: [T; 4],
     /// Heading gains in motion and at rest.
     pub(crate) mag: T,
     pub(crate) mag_rest: T,
@@ -39,13 +41,74 @@ impl<T: Real> Coefficients<T> {
     /// [`STARTUP_TAU_S`].
     pub(crate) fn new(cfg: &QuaternionFilterConfig, dt_s: T, startup: bool) -> Self {
         let gain = |tau: f64| (dt_s / effective_tau(T::of(tau), startup)).min(T::one());
+        let tau_acc_s = effective_tau(T::of(cfg.tau_acc_s), startup).to_f64();
         Self {
             dt_s,
-            acc_lowpass: gain(cfg.acc_lowpass_s),
-            acc: gain(cfg.tau_acc_s) / T::of(STANDARD_GRAVITY_MPS2),
+            acc_lowpass: butterworth_step(tau_acc_s, dt_s.to_f64()).map(T::of),
             mag: gain(cfg.tau_mag_s),
             mag_rest: gain(cfg.tau_mag_rest_s),
             bias_rest: gain(cfg.bias_tau_rest_s),
         }
+    }
+}
+
+/// The exact (zero-order-hold) transition over `dt_s` of the second-order Butterworth
+/// low-pass with time constant `tau_s`, `τ² ÿ + √2 τ ẏ + y = u`, as the matrix
+/// `Φ = exp(A dt)` of the state `(y − u, ẏ)` for an input held over the step:
+/// `y' = u + φ₁₁ (y − u) + φ₁₂ ẏ`, `ẏ' = φ₂₁ (y − u) + φ₂₂ ẏ`. With `ω = 1/τ` the poles
+/// are `−ω/√2 ± i ω/√2`, so `Φ = e^{−σ dt} (cos(σ dt) I + sin(σ dt)/σ (A + σ I))` with
+/// `σ = ω/√2` (the matrix exponential of a 2 × 2 matrix with complex poles). Exact for any
+/// step, so a long interval (a slow accelerometer, the start-up's short time constant)
+/// cannot make it unstable; computed only when the interval changes.
+pub(crate) fn butterworth_step(tau_s: f64, dt_s: f64) -> [f64; 4] {
+    let w = 1.0 / tau_s;
+    let sigma = w * core::f64::consts::FRAC_1_SQRT_2;
+    let x = sigma * dt_s;
+    let decay = (-x).exp();
+    let (sin, cos) = (x.sin(), x.cos());
+    [
+        decay * (cos + sin),
+        decay * sin / sigma,
+        -decay * w * w * sin / sigma,
+        decay * (cos - sin),
+    ]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    proptest! {
+        /// The transition over one step equals that over many smaller ones (it is exact),
+        /// and a constant input is the fixed point at any step.
+        #[test]
+        fn the_lowpass_step_is_exact(tau in 0.05f64..20.0, dt in 1e-4f64..2.0, n in 2usize..50) {
+            let one = butterworth_step(tau, dt);
+            let small = butterworth_step(tau, dt / n as f64);
+            let (mut y, mut v) = (1.0, 0.3);
+            for _ in 0..n {
+                (y, v) = (small[0] * y + small[1] * v, small[2] * y + small[3] * v);
+            }
+            let (y1, v1) = (one[0] + one[1] * 0.3, one[2] + one[3] * 0.3);
+            prop_assert!((y - y1).abs() < 1e-9 * (1.0 + y1.abs()), "{y} {y1}");
+            prop_assert!((v - v1).abs() < 1e-9 * (1.0 + v1.abs()), "{v} {v1}");
+        }
+    }
+
+    #[test]
+    fn the_lowpass_is_a_butterworth() {
+        // A sine at the cut-off ω = 1/τ passes with gain 1/√2 after the transient.
+        let (tau, dt) = (2.0, 0.001);
+        let phi = butterworth_step(tau, dt);
+        let (mut y, mut v, mut peak) = (0.0f64, 0.0, 0.0f64);
+        for k in 0..200_000 {
+            let u = (k as f64 * dt / tau).sin();
+            (y, v) = (u + phi[0] * (y - u) + phi[1] * v, phi[2] * (y - u) + phi[3] * v);
+            if k > 100_000 {
+                peak = peak.max(y.abs());
+            }
+        }
+        assert!((peak - core::f64::consts::FRAC_1_SQRT_2).abs() < 2e-3, "{peak}");
     }
 }

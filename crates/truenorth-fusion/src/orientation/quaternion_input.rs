@@ -143,6 +143,7 @@ impl<T: Real> QuaternionFilter<T> {
         }
         s.undo_heading = (T::one(), T::zero());
         s.acc_lowpass_ned_mps2 = None;
+        s.acc_lowpass_rate_ned_mps3 = Vector3::zeros();
         s.last_gyr_rps = Some(gyr);
         s.since_mag_s = T::zero();
         s.since_start_s = T::zero();

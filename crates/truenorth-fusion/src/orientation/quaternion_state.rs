@@ -49,6 +49,9 @@ pub struct QuaternionFilterState<T: Real = f64> {
     pub gyro_bias_rps: Vector3<T>,
     /// The low-passed specific force in NED, m/s²; `None` before the first reading.
     pub acc_lowpass_ned_mps2: Option<Vector3<T>>,
+    /// The rate of change of the low-passed specific force (the low-pass's second state),
+    /// m/s³.
+    pub acc_lowpass_rate_ned_mps3: Vector3<T>,
     /// Time spent at rest since the start, s (counted up to `bias_known_after_rest_s`):
     /// how well the bias is known.
     pub rest_s: T,
@@ -88,6 +91,7 @@ impl<T: Real> QuaternionFilterState<T> {
             undo_heading: (T::one(), T::zero()),
             gyro_bias_rps: Vector3::zeros(),
             acc_lowpass_ned_mps2: None,
+            acc_lowpass_rate_ned_mps3: Vector3::zeros(),
             rest_s: T::zero(),
             bias_inv_tau_motion_per_s: T::of(1.0 / config.bias_tau_unknown_s),
             last_gyr_rps: None,
@@ -128,9 +132,13 @@ impl<T: Real> Validate for QuaternionFilterState<T> {
                 reason: "the gyro bias exceeds max_bias_rps",
             });
         }
-        for v in [self.acc_lowpass_ned_mps2, self.last_gyr_rps]
-            .iter()
-            .flatten()
+        for v in [
+            self.acc_lowpass_ned_mps2,
+            Some(self.acc_lowpass_rate_ned_mps3),
+            self.last_gyr_rps,
+        ]
+        .iter()
+        .flatten()
         {
             check_finite3_in("saved vector", v)?;
         }
