@@ -26,9 +26,15 @@
 //!   the three reference axes mix (a body axis that was horizontal becomes vertical).
 //! - **Gyro scale and axis errors** `S` (relative, `s` per element): the error rate `R S ω`
 //!   accumulates coherently while the body keeps turning the same way and cancels when it
-//!   turns back, so it is `s |ψ|` with `ψ` the reference-frame rotation of the last
-//!   correction time constant, `ψ ← (1 − k) ψ + R ω dt` (exact for scale errors and a
-//!   rotation about one body axis).
+//!   turns back. While a sensor corrects the axis, the drift it causes shows in the
+//!   corrections (a loop's error behind a steady drift is the drift over its time
+//!   constant, which is what its corrections add up to over that time), and is counted
+//!   there (below: what the sensors say). Only heading goes without correction (the field
+//!   rejected, or absent): then it is `s |ψ|` with `ψ` the reference-frame rotation since
+//!   the field was last trusted, `ψ ← ψ + R ω dt`, decaying as `ψ ← (1 − k) ψ` with the
+//!   corrections once the field returns (exact for scale errors and a rotation about one
+//!   body axis). Counting the prior `s |ψ|` while the corrections show the drift counted
+//!   it twice: on BROAD's 20 trials the inclination σ was 4 times its RMS error.
 //! - **Latency**: a gyro's digital low-pass delays it by a few milliseconds (InvenSense
 //!   MPU-9250 register map, register 26: 2.9 ms at its widest bandwidth, 5.9 ms at 41 Hz),
 //!   so the attitude stands for a slightly earlier instant: an error `|R ω| δ` per axis.
@@ -46,11 +52,12 @@
 //!   constant and kept while corrections are suspended.
 //! - **What the sensors say the model cannot explain** (covariance matching on the
 //!   corrections, Mehra, *Approaches to adaptive filtering*, IEEE TAC 17(5), 1972):
-//!   - *accelerations*: the body's accelerations show in the inclination corrections; their
-//!     recent sum `ε ← (1 − k) ε + correction` is what the accelerometer has moved the
-//!     attitude by within the loop's time constant, and the envelope of its square is added
-//!     per axis (rising with it at once, decaying over the low-pass's natural period
-//!     `2π τ_acc`). A *sustained* horizontal acceleration (a vehicle's turn) looks exactly like a
+//!   - *accelerations and drift*: the body's accelerations and the gyro's drift show in
+//!     the inclination corrections; their recent sum `ε ← (1 − k) ε + correction` is what
+//!     the accelerometer has moved the attitude by within the loop's time constant, and the
+//!     envelope of its square is added per axis (rising with it at once, decaying over the
+//!     low-pass's natural period `2π τ_acc`). Likewise the trusted heading corrections'
+//!     recent sum, its envelope decaying with the heading loop's time constant. A *sustained* horizontal acceleration (a vehicle's turn) looks exactly like a
 //!     tilt and is not seen: like the filter itself, σ assumes that the body's
 //!     accelerations average out over a few seconds.
 //!   - *magnetic disturbances*: the field's norm and dip departures from the learned
@@ -236,13 +243,18 @@ pub struct AttitudeUncertainty<T: Real = f64> {
     config: AttitudeUncertaintyConfig,
     inclination: AxisVariance<T>,
     heading: AxisVariance<T>,
-    /// Reference-frame rotation within the inclination and heading loops' time constants.
-    turned_inclination: Vector3<T>,
+    /// Reference-frame rotation since the field was last trusted, decaying with the
+    /// heading loop's time constant once it is again.
     turned_heading: Vector3<T>,
+    /// The last field reading corrected heading with trust (the turn since it is seen).
+    heading_trusted: bool,
     /// Recent sum of the inclination corrections about x and y, and the envelope of its
     /// square per axis.
     accel_moved: [T; 2],
     accel_moved_sq: [T; 2],
+    /// Recent sum of the trusted heading corrections, and the envelope of its square.
+    mag_moved: T,
+    mag_moved_sq: T,
     /// Low-passed relative norm and dip departures of the field, and `1/(2 cos² dip)`.
     norm_departure: T,
     dip_departure: T,
@@ -286,10 +298,12 @@ impl<T: Real> AttitudeUncertainty<T> {
                 bias,
             ),
             heading: AxisVariance::new(heading, bias),
-            turned_inclination: Vector3::zeros(),
             turned_heading: Vector3::zeros(),
+            heading_trusted: false,
             accel_moved: [T::zero(); 2],
             accel_moved_sq: [T::zero(); 2],
+            mag_moved: T::zero(),
+            mag_moved_sq: T::zero(),
             norm_departure: T::zero(),
             dip_departure: T::zero(),
             half_inv_cos2_dip: T::of(0.5),
@@ -331,8 +345,9 @@ impl<T: Real> AttitudeUncertainty<T> {
         self.rate_ned = r * omega_rps;
         self.rate_rps = rate_rps;
         let step = self.rate_ned * dt_s;
-        self.turned_inclination += step;
-        self.turned_heading += step;
+        if !self.heading_trusted {
+            self.turned_heading += step;
+        }
         // The body's turn mixes the reference axes' bias uncertainties (two inclination
         // axes and one heading axis), by the fraction of a radian turned.
         let mix = (rate_rps * dt_s).min(T::one());
@@ -376,7 +391,6 @@ impl<T: Real> AttitudeUncertainty<T> {
         };
         let c = self.bias_credit(k, loop_tau, inv_tau_bias);
         self.inclination.correct(k, c, target);
-        self.turned_inclination *= T::one() - k;
         let a = T::one() - k;
         for (i, c) in [correction.0, correction.1].into_iter().enumerate() {
             let moved = a * self.accel_moved[i] + c;
@@ -399,6 +413,7 @@ impl<T: Real> AttitudeUncertainty<T> {
     pub(crate) fn mag_corrected(
         &mut self,
         k: T,
+        correction: T,
         tau_s: T,
         reading: (T, T),
         reference: (T, T),
@@ -439,6 +454,32 @@ impl<T: Real> AttitudeUncertainty<T> {
         let c = self.bias_credit(k, tau_s, inv_tau_bias);
         self.heading.correct(k, c, target);
         self.turned_heading *= T::one() - k;
+        self.heading_trusted = true;
+        let moved = (T::one() - k) * self.mag_moved + correction;
+        self.mag_moved = moved;
+        let sq = moved * moved;
+        self.mag_moved_sq = if sq > self.mag_moved_sq {
+            sq
+        } else {
+            self.mag_moved_sq + k * (sq - self.mag_moved_sq)
+        };
+    }
+
+    /// A field reading that did not correct heading with trust (disturbed, or corrected by
+    /// an offset learned from the attitude): the turn from now on is unseen by it.
+    #[inline]
+    pub(crate) fn heading_untrusted(&mut self) {
+        self.heading_trusted = false;
+    }
+
+    /// A heading correction with gain `k` by a field less an offset learned from the
+    /// attitude: it tells nothing of the heading's error (the offset took in whatever error
+    /// the attitude had when it was learned), so no variance shrinks, but it holds the
+    /// heading against the gyro's scale error as a trusted field would.
+    #[inline]
+    pub(crate) fn heading_held(&mut self, k: T) {
+        self.turned_heading *= T::one() - k;
+        self.heading_trusted = true;
     }
 
     /// The share `c` (1/s) of a correction with gain `k` and time constant `tau_s` that the
@@ -471,8 +512,7 @@ impl<T: Real> AttitudeUncertainty<T> {
         let s = self.config.gyro_scale_rel;
         (self.inclination.angle
             + self.inclination.measured
-            + self.accel_moved_sq[i]
-            + T::of(s * s) * self.turned_inclination.norm_squared())
+            + self.accel_moved_sq[i])
         .min(T::of(UNINFORMED_VARIANCE_RAD2))
     }
 
@@ -496,13 +536,17 @@ impl<T: Real> AttitudeUncertainty<T> {
             check_finite_in("uncertainty angle-bias covariance", axis.angle_bias)?;
         }
         for v in [
-            &self.turned_inclination,
             &self.turned_heading,
             &self.rate_ned,
         ] {
             check_finite3_in("uncertainty turn", v)?;
         }
-        for v in self.accel_moved.iter().chain(&self.accel_moved_sq) {
+        for v in self
+            .accel_moved
+            .iter()
+            .chain(&self.accel_moved_sq)
+            .chain(&[self.mag_moved, self.mag_moved_sq])
+        {
             check_finite_in("uncertainty acceleration term", *v)?;
         }
         for v in [
@@ -532,6 +576,7 @@ impl<T: Real> AttitudeUncertainty<T> {
         let heading = self.heading.angle
             + self.heading.measured
             + T::of(s * s) * self.turned_heading.norm_squared()
+            + self.mag_moved_sq
             + disturbance;
         // Each term is a variance of the same error; their sum, like each, is at most that
         // of an uninformed attitude (a NaN from an inf − inf cannot arise below it).

@@ -323,13 +323,19 @@ impl<T: Real> QuaternionFilter<T> {
                 let k = self.heading_gain(step, mag_dt_s);
                 let dz = -k * heading_error(&m_ned, horizontal);
                 correction.z = dz;
-                // An offset learned from the attitude cannot also tell its error.
-                if !status.mag_calibrating {
-                    self.credit_heading_uncertainty(step, k, &m_ned, horizontal);
+                // An offset learned from the attitude cannot also tell its error, but the
+                // field it corrects still holds the heading where it was adopted.
+                if status.mag_calibrating {
+                    self.state.uncertainty.heading_held(k);
+                } else {
+                    self.credit_heading_uncertainty(step, k, dz, &m_ned, horizontal);
                 }
                 self.undo_heading_correction(dz);
                 status.mag_used = true;
             }
+        }
+        if !status.mag_used {
+            self.state.uncertainty.heading_untrusted();
         }
     }
 
@@ -374,6 +380,7 @@ impl<T: Real> QuaternionFilter<T> {
         &mut self,
         step: &StepContext<T>,
         k: T,
+        dz: T,
         m_ned: &Vector3<T>,
         horizontal: T,
     ) {
@@ -389,6 +396,7 @@ impl<T: Real> QuaternionFilter<T> {
         };
         self.state.uncertainty.mag_corrected(
             k,
+            dz,
             effective_tau(T::of(tau), step.startup),
             (horizontal, m_ned.z),
             (reference.x, reference.z),
