@@ -448,8 +448,10 @@ impl<T: Real> AttitudeUncertainty<T> {
             Some((_, [_, loop_tau, ..])) if loop_tau > T::zero() => loop_tau / (loop_tau + tau_s),
             _ => T::one(),
         };
-        let acceleration = self.accel_moved_sq[0];
-        let tilt = tan2_dip * (self.inclination_variance(0) - (T::one() - passed) * acceleration);
+        let i = &self.inclination;
+        let tilt = tan2_dip
+            * (i.angle + i.measured + passed * self.accel_moved_sq[0])
+                .min(T::of(UNINFORMED_VARIANCE_RAD2));
         let target = T::of(cfg.mag_heading_rad * cfg.mag_heading_rad) + white + tilt;
         let c = self.bias_credit(k, tau_s, inv_tau_bias);
         self.heading.correct(k, c, target);
@@ -509,11 +511,8 @@ impl<T: Real> AttitudeUncertainty<T> {
     /// latency term.
     #[inline]
     fn inclination_variance(&self, i: usize) -> T {
-        let s = self.config.gyro_scale_rel;
-        (self.inclination.angle
-            + self.inclination.measured
-            + self.accel_moved_sq[i])
-        .min(T::of(UNINFORMED_VARIANCE_RAD2))
+        (self.inclination.angle + self.inclination.measured + self.accel_moved_sq[i])
+            .min(T::of(UNINFORMED_VARIANCE_RAD2))
     }
 
     /// Checks a restored uncertainty against the error model `config` of its filter: the

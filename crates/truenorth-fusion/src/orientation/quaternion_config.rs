@@ -79,6 +79,9 @@ pub struct QuaternionFilterConfig {
     /// `gap`). Half a second also makes a millisecond time column read as seconds a gap at
     /// every step for every IMU up to 2 kHz, which the filter refuses as implausible.
     pub max_gap_s: f64,
+    /// Propagate the attitude's σ and report it as `sigma_rad` (default `true`); `false`
+    /// saves its cost (about a third of an update) and reports none.
+    pub sigma: bool,
     /// The sensors' error model behind `sigma_rad`.
     pub uncertainty: AttitudeUncertaintyConfig,
 }
@@ -102,6 +105,7 @@ impl Default for QuaternionFilterConfig {
             use_mag: true,
             initial_attitude: None,
             max_gap_s: 0.5,
+            sigma: true,
             uncertainty: AttitudeUncertaintyConfig::default(),
         }
     }

@@ -173,7 +173,9 @@ impl<T: Real> QuaternionFilter<T> {
             rotation: *self.state.attitude.to_rotation_matrix().matrix(),
             rate_rps: omega.norm(),
         };
-        self.propagate_uncertainty(&step, &omega);
+        if self.state.config.sigma {
+            self.propagate_uncertainty(&step, &omega);
+        }
         let mut status = AttitudeStatus {
             at_rest,
             ..AttitudeStatus::default()
@@ -290,12 +292,14 @@ impl<T: Real> QuaternionFilter<T> {
         let k = scale * T::of(1.0 / STANDARD_GRAVITY_MPS2);
         correction.x = -lp.y * k;
         correction.y = lp.x * k;
-        s.uncertainty.accel_corrected(
-            step.dt_s,
-            (correction.x, correction.y),
-            effective_tau(T::of(cfg.tau_acc_s), step.startup),
-            inv_tau_bias,
-        );
+        if cfg.sigma {
+            s.uncertainty.accel_corrected(
+                step.dt_s,
+                (correction.x, correction.y),
+                effective_tau(T::of(cfg.tau_acc_s), step.startup),
+                inv_tau_bias,
+            );
+        }
     }
 
     /// Heading: the field `m`, less any hard iron learned online, rotated into NED should
@@ -325,7 +329,9 @@ impl<T: Real> QuaternionFilter<T> {
                 correction.z = dz;
                 // An offset learned from the attitude cannot also tell its error, but the
                 // field it corrects still holds the heading where it was adopted.
-                if status.mag_calibrating {
+                if !self.state.config.sigma {
+                    // No σ to carry.
+                } else if status.mag_calibrating {
                     self.state.uncertainty.heading_held(k);
                 } else {
                     self.credit_heading_uncertainty(step, k, dz, &m_ned, horizontal);
@@ -334,7 +340,7 @@ impl<T: Real> QuaternionFilter<T> {
                 status.mag_used = true;
             }
         }
-        if !status.mag_used {
+        if !status.mag_used && self.state.config.sigma {
             self.state.uncertainty.heading_untrusted();
         }
     }
@@ -455,8 +461,10 @@ impl<T: Real> QuaternionFilter<T> {
         let cfg = &s.config;
         let k = step.gains.bias_rest;
         s.gyro_bias_rps += (s.rest.gyro_mean() - s.gyro_bias_rps) * k;
-        s.uncertainty
-            .at_rest(k, cfg.rest.mean_tau_s, cfg.bias_tau_rest_s);
+        if cfg.sigma {
+            s.uncertainty
+                .at_rest(k, cfg.rest.mean_tau_s, cfg.bias_tau_rest_s);
+        }
         let known_after_s = T::of(cfg.bias_known_after_rest_s);
         if s.rest_s < known_after_s {
             s.rest_s += step.dt_s;
@@ -476,7 +484,7 @@ impl<T: Real> QuaternionFilter<T> {
             attitude: attitude_f64(&s.attitude),
             attitude_6d: Some(attitude_f64(&self.attitude_6d())),
             gyro_bias_rps: s.gyro_bias_rps.map(T::to_f64),
-            sigma_rad: Some(s.uncertainty.sigma_rad().map(T::to_f64)),
+            sigma_rad: self.sigma_rad().map(|v| v.map(T::to_f64)),
             status,
         }
     }
@@ -502,9 +510,13 @@ impl<T: Real> QuaternionFilter<T> {
     }
 
     /// One σ of the attitude error about north, east and down, rad: the estimate's
-    /// `sigma_rad`, in the filter's float type.
-    pub fn sigma_rad(&self) -> Vector3<T> {
-        self.state.uncertainty.sigma_rad()
+    /// `sigma_rad`, in the filter's float type; `None` when the configuration switches the
+    /// σ off.
+    pub fn sigma_rad(&self) -> Option<Vector3<T>> {
+        self.state
+            .config
+            .sigma
+            .then(|| self.state.uncertainty.sigma_rad())
     }
 }
 

@@ -118,9 +118,11 @@ impl<T: Real> QuaternionFilter<T> {
             s.initialised = true;
         }
         s.last_gyr_rps = Some(gyr);
+        let sigma_rad = self.sigma_rad().map(|v| v.map(T::to_f64));
+        let s = &mut self.state;
         s.estimate = Some(AttitudeEstimate {
             t_s,
-            sigma_rad: Some(s.uncertainty.sigma_rad().map(T::to_f64)),
+            sigma_rad,
             ..AttitudeEstimate::initial(attitude_f64(&s.attitude))
         });
     }
@@ -153,10 +155,12 @@ impl<T: Real> QuaternionFilter<T> {
             gap: true,
             ..AttitudeStatus::default()
         };
+        let sigma_rad = self.sigma_rad().map(|v| v.map(T::to_f64));
+        let s = &mut self.state;
         s.estimate = Some(AttitudeEstimate {
             t_s,
             gyro_bias_rps: s.gyro_bias_rps.map(T::to_f64),
-            sigma_rad: Some(s.uncertainty.sigma_rad().map(T::to_f64)),
+            sigma_rad,
             status,
             ..AttitudeEstimate::initial(attitude_f64(&s.attitude))
         });
@@ -212,7 +216,7 @@ impl OrientationEstimator for QuaternionFilter {
     fn estimate(&self) -> AttitudeEstimate {
         let s = &self.state;
         s.estimate.unwrap_or_else(|| AttitudeEstimate {
-            sigma_rad: Some(s.uncertainty.sigma_rad()),
+            sigma_rad: self.sigma_rad(),
             ..AttitudeEstimate::initial(s.attitude)
         })
     }
