@@ -166,7 +166,11 @@ fn sigma_is_a_one_sigma_on_broad() {
                 "{group:<12} {what:<8} beyond 3σ {:5.2} %, largest {largest:5.2}σ, mean NEES {nees:4.2} ({ratio:4.2} × expected)",
                 100.0 * share
             );
-            assert!(share <= 0.02, "{group} {what}: {:.2} % beyond 3σ", 100.0 * share);
+            assert!(
+                share <= 0.02,
+                "{group} {what}: {:.2} % beyond 3σ",
+                100.0 * share
+            );
             let (low, high) = if (group, what) == ("disturbed", "heading") {
                 (0.25, 1.5)
             } else {
@@ -176,7 +180,11 @@ fn sigma_is_a_one_sigma_on_broad() {
                 (low..=high).contains(&ratio),
                 "{group} {what}: mean NEES {ratio:.2} × expected, not within {low}–{high}"
             );
-            let max = if (group, what) == ("disturbed", "tilt") { 7.0 } else { 6.0 };
+            let max = if (group, what) == ("disturbed", "tilt") {
+                7.0
+            } else {
+                6.0
+            };
             assert!(largest <= max, "{group} {what}: {largest:.2}σ");
         }
     }

@@ -534,10 +534,7 @@ impl<T: Real> AttitudeUncertainty<T> {
             )?;
             check_finite_in("uncertainty angle-bias covariance", axis.angle_bias)?;
         }
-        for v in [
-            &self.turned_heading,
-            &self.rate_ned,
-        ] {
+        for v in [&self.turned_heading, &self.rate_ned] {
             check_finite3_in("uncertainty turn", v)?;
         }
         for v in self

@@ -104,11 +104,17 @@ mod tests {
         let (mut y, mut v, mut peak) = (0.0f64, 0.0, 0.0f64);
         for k in 0..200_000 {
             let u = (k as f64 * dt / tau).sin();
-            (y, v) = (u + phi[0] * (y - u) + phi[1] * v, phi[2] * (y - u) + phi[3] * v);
+            (y, v) = (
+                u + phi[0] * (y - u) + phi[1] * v,
+                phi[2] * (y - u) + phi[3] * v,
+            );
             if k > 100_000 {
                 peak = peak.max(y.abs());
             }
         }
-        assert!((peak - core::f64::consts::FRAC_1_SQRT_2).abs() < 2e-3, "{peak}");
+        assert!(
+            (peak - core::f64::consts::FRAC_1_SQRT_2).abs() < 2e-3,
+            "{peak}"
+        );
     }
 }
