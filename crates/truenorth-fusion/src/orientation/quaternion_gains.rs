@@ -3,9 +3,6 @@
 
 use truenorth_core::Real;
 
-#[cfg(not(feature = "std"))]
-use truenorth_core::Float as _;
-
 use super::quaternion_config::QuaternionFilterConfig;
 
 /// The per-sample gains, derived from the parameters and the sample interval; recomputed
@@ -41,16 +38,18 @@ impl<T: Real> Coefficients<T> {
     /// [`STARTUP_TAU_S`].
     pub(crate) fn new(cfg: &QuaternionFilterConfig, dt_s: T, startup: bool) -> Self {
         let gain = |tau: f64| (dt_s / effective_tau(T::of(tau), startup)).min(T::one());
-        let tau_acc_s = effective_tau(T::of(cfg.tau_acc_s), startup).to_f64();
         Self {
             dt_s,
-            acc_lowpass: butterworth_step(tau_acc_s, dt_s.to_f64()).map(T::of),
+            acc_lowpass: butterworth_step(effective_tau(T::of(cfg.tau_acc_s), startup), dt_s),
             mag: gain(cfg.tau_mag_s),
             mag_rest: gain(cfg.tau_mag_rest_s),
             bias_rest: gain(cfg.bias_tau_rest_s),
         }
     }
 }
+
+/// Below this `σ dt`, [`butterworth_step`] sums its series.
+const SERIES_MAX: f64 = 0.1;
 
 /// The exact (zero-order-hold) transition over `dt_s` of the second-order Butterworth
 /// low-pass with time constant `tau_s`, `τ² ÿ + √2 τ ẏ + y = u`, as the matrix
@@ -59,19 +58,31 @@ impl<T: Real> Coefficients<T> {
 /// are `−ω/√2 ± i ω/√2`, so `Φ = e^{−σ dt} (cos(σ dt) I + sin(σ dt)/σ (A + σ I))` with
 /// `σ = ω/√2` (the matrix exponential of a 2 × 2 matrix with complex poles). Exact for any
 /// step, so a long interval (a slow accelerometer, the start-up's short time constant)
-/// cannot make it unstable; computed only when the interval changes.
-pub(crate) fn butterworth_step(tau_s: f64, dt_s: f64) -> [f64; 4] {
-    let w = 1.0 / tau_s;
-    let sigma = w * core::f64::consts::FRAC_1_SQRT_2;
+/// cannot make it unstable. `e^{−x}(cos x + i sin x) = e^{(−1 + i) x}` is summed as its
+/// series below `x = σ dt = 0.1` (the first term left out, `|z|⁸/8!` with `|z| = √2 x`,
+/// is under 10⁻¹¹), so that an interval that changes in its last bits, as a float
+/// timestamp's differences do, costs no exponential or sine (on a Cortex-M4F those are
+/// `f64` software routines even for an `f32` filter).
+pub(crate) fn butterworth_step<T: Real>(tau_s: T, dt_s: T) -> [T; 4] {
+    let w = T::one() / tau_s;
+    let sigma = w * T::of(core::f64::consts::FRAC_1_SQRT_2);
     let x = sigma * dt_s;
-    let decay = (-x).exp();
-    let (sin, cos) = (x.sin(), x.cos());
-    [
-        decay * (cos + sin),
-        decay * sin / sigma,
-        -decay * w * w * sin / sigma,
-        decay * (cos - sin),
-    ]
+    let (c, s) = if x < T::of(SERIES_MAX) {
+        // Σ zⁿ/n! for z = (−1 + i) x, n ≤ 7.
+        let (mut re, mut im) = (T::one(), T::zero());
+        let (mut tr, mut ti) = (T::one(), T::zero());
+        for n in 1..8 {
+            let k = x / T::of(f64::from(n));
+            (tr, ti) = ((-tr - ti) * k, (tr - ti) * k);
+            re += tr;
+            im += ti;
+        }
+        (re, im)
+    } else {
+        let decay = (-x).exp();
+        (decay * x.cos(), decay * x.sin())
+    };
+    [c + s, s / sigma, -w * w * s / sigma, c - s]
 }
 
 #[cfg(test)]
@@ -80,8 +91,8 @@ mod tests {
     use proptest::prelude::*;
 
     proptest! {
-        /// The transition over one step equals that over many smaller ones (it is exact),
-        /// and a constant input is the fixed point at any step.
+        /// The transition over one step equals that over many smaller ones (it is exact,
+        /// whether summed as a series or not).
         #[test]
         fn the_lowpass_step_is_exact(tau in 0.05f64..20.0, dt in 1e-4f64..2.0, n in 2usize..50) {
             let one = butterworth_step(tau, dt);
@@ -93,6 +104,18 @@ mod tests {
             let (y1, v1) = (one[0] + one[1] * 0.3, one[2] + one[3] * 0.3);
             prop_assert!((y - y1).abs() < 1e-9 * (1.0 + y1.abs()), "{y} {y1}");
             prop_assert!((v - v1).abs() < 1e-9 * (1.0 + v1.abs()), "{v} {v1}");
+        }
+    }
+
+    #[test]
+    fn the_series_meets_the_exact_functions() {
+        // Just below and above the switch: the two ways agree.
+        let tau = 1.0;
+        let sigma = core::f64::consts::FRAC_1_SQRT_2;
+        let below = butterworth_step(tau, SERIES_MAX / sigma * (1.0 - 1e-12));
+        let above = butterworth_step(tau, SERIES_MAX / sigma);
+        for (a, b) in below.iter().zip(&above) {
+            assert!((a - b).abs() < 1e-10, "{a} {b}");
         }
     }
 
