@@ -81,6 +81,7 @@ use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 use truenorth_core::{Error, Real, Result, STANDARD_GRAVITY_MPS2, Validate, check_range};
 
+use super::min_max::{at_least, at_most};
 use super::real_checks::{check_finite_in, check_finite3_in, check_range_in};
 
 /// The sensors' error model behind the filter's σ: what a typical consumer MEMS IMU with a
@@ -176,6 +177,92 @@ impl Validate for AttitudeUncertaintyConfig {
     }
 }
 
+/// The error model's values in the filter's float type `T`, as the per-sample steps use
+/// them: converted once by the filter, not per sample.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct UncertaintyConstants<T> {
+    /// The gyro's white-noise density and bias walk, squared: per second of strapdown.
+    gyro_noise2: T,
+    bias_walk2: T,
+    /// A field reading's relative noise and the calibration's heading error, squared.
+    mag_noise2: T,
+    mag_heading2: T,
+    /// The variance the bias estimate at rest settles to (see [`AttitudeUncertainty::at_rest`]).
+    rest_bias_floor: T,
+    /// The accelerometer's bias and white-noise density over g, squared (rad² of tilt, and
+    /// per hertz).
+    accel_bias2: T,
+    accel_noise2: T,
+}
+
+/// The inclination loop as the σ follows it (see [`AttitudeUncertainty::accel_corrected`])
+/// for one time constant `τ` of the low-pass.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct InclinationConstants<T> {
+    /// `τ_i = √2 τ`, the first-order loop's with the same lag behind a steady drift, s, and
+    /// its inverse.
+    loop_tau: T,
+    inv_loop_tau: T,
+    /// `1/(2π τ)`: the envelope's decay (see `accel_corrected`), 1/s.
+    inv_period: T,
+    /// The variance the accelerometer's bias and noise leave, rad².
+    target: T,
+}
+
+impl<T: Real> UncertaintyConstants<T> {
+    /// For the filter's validated parameters.
+    pub(crate) fn of(cfg: &crate::QuaternionFilterConfig) -> Self {
+        let u = &cfg.uncertainty;
+        let g = STANDARD_GRAVITY_MPS2;
+        let n = u.gyro_noise_rps_per_sqrt_hz;
+        let walk = u.gyro_bias_walk_rps_per_sqrt_s;
+        Self {
+            gyro_noise2: T::of(n * n),
+            bias_walk2: T::of(walk * walk),
+            mag_noise2: T::of(u.mag_noise_rel * u.mag_noise_rel),
+            mag_heading2: T::of(u.mag_heading_rad * u.mag_heading_rad),
+            // The rest detector's mean (time constant `rest.mean_tau_s`) of the gyro's white
+            // noise, followed by the bias estimate's own low-pass (`bias_tau_rest_s`).
+            rest_bias_floor: T::of(n * n / (2.0 * (cfg.rest.mean_tau_s + cfg.bias_tau_rest_s))),
+            accel_bias2: T::of(u.accel_bias_mps2 * u.accel_bias_mps2 / (g * g)),
+            accel_noise2: T::of(
+                u.accel_noise_mps2_per_sqrt_hz * u.accel_noise_mps2_per_sqrt_hz / (g * g),
+            ),
+        }
+    }
+
+    /// The inclination loop's constants for the low-pass's time constant `tau_s`.
+    pub(crate) fn inclination(&self, tau_s: T) -> InclinationConstants<T> {
+        let loop_tau = T::of(SQRT_2) * tau_s;
+        InclinationConstants {
+            loop_tau,
+            inv_loop_tau: T::one() / loop_tau,
+            // The envelope of the square (see `accel_corrected`) follows a rise at once
+            // (the error an acceleration causes builds as fast as the corrections it
+            // causes) and decays over the low-pass's natural period 2π τ (13 s by
+            // default), so that it holds through the swings of an acceleration slow enough
+            // to pass the low-pass.
+            inv_period: T::one() / (T::of(core::f64::consts::TAU) * tau_s),
+            // White noise through the Butterworth low-pass: its noise bandwidth is
+            // 1/(2√2 τ) (∫|H|² df).
+            target: self.accel_bias2 + self.accel_noise2 / (T::of(2.0 * SQRT_2) * tau_s),
+        }
+    }
+}
+
+/// A heading correction, as the σ takes it ([`AttitudeUncertainty::mag_corrected`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct HeadingCorrection<T> {
+    /// Its gain (covering the time since the last reading) and its loop's time constant, s.
+    pub(crate) k: T,
+    pub(crate) tau_s: T,
+    /// The turn it applied about the vertical, rad.
+    pub(crate) dz: T,
+    /// The bias estimate's `1/τ_b`, 1/s (0 when it does not learn: at rest or in the
+    /// start-up).
+    pub(crate) inv_tau_bias: T,
+}
+
 /// The variance of the error about one kind of reference axis (inclination or heading).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 // `Real` includes serde's bounds on `T`.
@@ -227,8 +314,8 @@ impl<T: Real> AxisVariance<T> {
         let (pe, pb) = (self.angle, self.angle_bias);
         self.angle = a * a * pe;
         self.angle_bias = a * (pb - c * pe);
-        self.bias = (self.bias - c * (T::of(2.0) * pb - c * pe)).max(T::zero());
-        let target = target.min(T::of(UNINFORMED_VARIANCE_RAD2));
+        self.bias = at_least(self.bias - c * (T::of(2.0) * pb - c * pe), T::zero());
+        let target = at_most(target, T::of(UNINFORMED_VARIANCE_RAD2));
         self.measured += (T::one() - a * a) * (target - self.measured);
     }
 }
@@ -262,10 +349,6 @@ pub struct AttitudeUncertainty<T: Real = f64> {
     /// Reference-frame rate and its norm at the last step.
     rate_ned: Vector3<T>,
     rate_rps: T,
-    /// The inclination correction's constants for the last (interval, time constant): the
-    /// loop's gain and time constant, the variance target and the envelope's gain,
-    /// recomputed only when those change; `None` before the first inclination correction.
-    accel_constants: Option<([T; 2], [T; 4])>,
 }
 
 /// Inclination σ assumed before the first correction, rad: the tilt the first reading
@@ -309,7 +392,6 @@ impl<T: Real> AttitudeUncertainty<T> {
             half_inv_cos2_dip: T::of(0.5),
             rate_ned: Vector3::zeros(),
             rate_rps: T::zero(),
-            accel_constants: None,
         }
     }
 
@@ -330,16 +412,14 @@ impl<T: Real> AttitudeUncertainty<T> {
     #[inline]
     pub(crate) fn propagate(
         &mut self,
+        c: &UncertaintyConstants<T>,
         dt_s: T,
         omega_rps: &Vector3<T>,
         rate_rps: T,
         r: &Matrix3<T>,
     ) {
-        let cfg = &self.config;
-        let angle_noise =
-            T::of(cfg.gyro_noise_rps_per_sqrt_hz * cfg.gyro_noise_rps_per_sqrt_hz) * dt_s;
-        let walk = cfg.gyro_bias_walk_rps_per_sqrt_s;
-        let bias_noise = T::of(walk * walk) * dt_s;
+        let angle_noise = c.gyro_noise2 * dt_s;
+        let bias_noise = c.bias_walk2 * dt_s;
         self.inclination.propagate(dt_s, angle_noise, bias_noise);
         self.heading.propagate(dt_s, angle_noise, bias_noise);
         self.rate_ned = r * omega_rps;
@@ -350,47 +430,28 @@ impl<T: Real> AttitudeUncertainty<T> {
         }
         // The body's turn mixes the reference axes' bias uncertainties (two inclination
         // axes and one heading axis), by the fraction of a radian turned.
-        let mix = (rate_rps * dt_s).min(T::one());
+        let mix = at_most(rate_rps * dt_s, T::one());
         let mean = (T::of(2.0) * self.inclination.bias + self.heading.bias) * T::of(1.0 / 3.0);
         self.inclination.bias += mix * (mean - self.inclination.bias);
         self.heading.bias += mix * (mean - self.heading.bias);
     }
 
-    /// The inclination correction of this step of `dt_s`: the correction applied about x
-    /// and y (rad), the low-pass's time constant `tau_s` and the bias estimate's `1/τ_b` (0
-    /// when it does not learn: at rest or in the start-up). The error follows the low-pass
-    /// as it would a first-order loop with the same lag behind a steady drift, `√2 τ`.
+    /// The inclination correction of this step of `dt_s`: the constants of the loop `c`,
+    /// the correction applied about x and y (rad) and the bias estimate's `1/τ_b` (0 when it
+    /// does not learn: at rest or in the start-up). The error follows the low-pass as it
+    /// would a first-order loop with the same lag behind a steady drift, `√2 τ`.
     #[inline]
     pub(crate) fn accel_corrected(
         &mut self,
+        c: &InclinationConstants<T>,
         dt_s: T,
         correction: (T, T),
-        tau_s: T,
         inv_tau_bias: T,
     ) {
-        if self.accel_constants.map(|c| c.0) != Some([dt_s, tau_s]) {
-            let cfg = &self.config;
-            let g = T::of(STANDARD_GRAVITY_MPS2);
-            let bias = T::of(cfg.accel_bias_mps2) / g;
-            let white = T::of(cfg.accel_noise_mps2_per_sqrt_hz) / g;
-            // White noise through the Butterworth low-pass: its noise bandwidth is
-            // 1/(2√2 τ) (∫|H|² df).
-            let target = bias * bias + white * white / (T::of(2.0 * SQRT_2) * tau_s);
-            let loop_tau = T::of(SQRT_2) * tau_s;
-            let k = (dt_s / loop_tau).min(T::one());
-            // The envelope of the square (below) follows a rise at once (the error an
-            // acceleration causes builds as fast as the corrections it causes) and decays
-            // over the low-pass's natural period 2π τ (13 s by default), so that it holds
-            // through the swings of an acceleration slow enough to pass the low-pass.
-            let period = T::of(core::f64::consts::TAU) * tau_s;
-            let k_env = (dt_s / period).min(T::one());
-            self.accel_constants = Some(([dt_s, tau_s], [k, loop_tau, target, k_env]));
-        }
-        let Some((_, [k, loop_tau, target, k_env])) = self.accel_constants else {
-            return;
-        };
-        let c = self.bias_credit(k, loop_tau, inv_tau_bias);
-        self.inclination.correct(k, c, target);
+        let k = at_most(dt_s * c.inv_loop_tau, T::one());
+        let k_env = at_most(dt_s * c.inv_period, T::one());
+        let credit = self.bias_credit(k, c.loop_tau, inv_tau_bias);
+        self.inclination.correct(k, credit, c.target);
         let a = T::one() - k;
         for (i, c) in [correction.0, correction.1].into_iter().enumerate() {
             let moved = a * self.accel_moved[i] + c;
@@ -405,21 +466,25 @@ impl<T: Real> AttitudeUncertainty<T> {
         }
     }
 
-    /// A heading correction that the field may be trusted for (not rejected, no offset
-    /// learned from the attitude subtracted): gain `k` (covering the time since the last
-    /// reading) with time constant `tau_s`, the reading's horizontal and vertical components
-    /// in the level frame and the reference's, and the bias estimate's `1/τ_b`.
+    /// A heading correction `correction` that the field may be trusted for (not rejected,
+    /// no offset learned from the attitude subtracted), by a reading whose horizontal and
+    /// vertical components in the level frame are `reading`, the reference's `reference`;
+    /// the inclination loop in effect is `inclination`.
     #[inline]
     pub(crate) fn mag_corrected(
         &mut self,
-        k: T,
-        correction: T,
-        tau_s: T,
+        constants: &UncertaintyConstants<T>,
+        inclination: &InclinationConstants<T>,
+        correction: &HeadingCorrection<T>,
         reading: (T, T),
         reference: (T, T),
-        inv_tau_bias: T,
     ) {
-        let cfg = &self.config;
+        let HeadingCorrection {
+            k,
+            tau_s,
+            dz,
+            inv_tau_bias,
+        } = *correction;
         let (h, v) = reading;
         let (h0, v0) = reference;
         let n02 = h0 * h0 + v0 * v0;
@@ -435,29 +500,28 @@ impl<T: Real> AttitudeUncertainty<T> {
         self.norm_departure += k * (rn - self.norm_departure);
         self.dip_departure += k * (rd - self.dip_departure);
         // 1/cos² dip = |m₀|²/h₀², the horizontal field kept above 10⁻³ of the whole.
-        let inv_cos2_dip = n02 / (h0 * h0).max(T::of(1e-6) * n02);
+        let inv_cos2_dip = n02 / at_least(h0 * h0, T::of(1e-6) * n02);
         self.half_inv_cos2_dip = T::of(0.5) * inv_cos2_dip;
         let tan2_dip = inv_cos2_dip - T::one();
         // A reading's heading noise, σ/cos dip, through the loop: k/2 of its variance.
-        let white = T::of(cfg.mag_noise_rel * cfg.mag_noise_rel) * inv_cos2_dip * T::of(0.5) * k;
+        let white = constants.mag_noise2 * inv_cos2_dip * T::of(0.5) * k;
         // The inclination error about north is the one the dip turns into heading. The parts
         // of it that persist (the biases' and the scale error's) pass the heading loop
         // whole; the accelerations' varies with the inclination loop's time constant and
         // passes by τ_acc/(τ_acc + τ_mag).
-        let passed = match self.accel_constants {
-            Some((_, [_, loop_tau, ..])) if loop_tau > T::zero() => loop_tau / (loop_tau + tau_s),
-            _ => T::one(),
-        };
+        let passed = inclination.loop_tau / (inclination.loop_tau + tau_s);
         let i = &self.inclination;
         let tilt = tan2_dip
-            * (i.angle + i.measured + passed * self.accel_moved_sq[0])
-                .min(T::of(UNINFORMED_VARIANCE_RAD2));
-        let target = T::of(cfg.mag_heading_rad * cfg.mag_heading_rad) + white + tilt;
+            * at_most(
+                i.angle + i.measured + passed * self.accel_moved_sq[0],
+                T::of(UNINFORMED_VARIANCE_RAD2),
+            );
+        let target = constants.mag_heading2 + white + tilt;
         let c = self.bias_credit(k, tau_s, inv_tau_bias);
         self.heading.correct(k, c, target);
         self.turned_heading *= T::one() - k;
         self.heading_trusted = true;
-        let moved = (T::one() - k) * self.mag_moved + correction;
+        let moved = (T::one() - k) * self.mag_moved + dz;
         self.mag_moved = moved;
         let sq = moved * moved;
         self.mag_moved_sq = if sq > self.mag_moved_sq {
@@ -497,9 +561,8 @@ impl<T: Real> AttitudeUncertainty<T> {
 
     /// A step at rest: the bias follows the rest detector's mean with gain `k`.
     #[inline]
-    pub(crate) fn at_rest(&mut self, k: T, mean_tau_s: f64, rest_tau_s: f64) {
-        let n = self.config.gyro_noise_rps_per_sqrt_hz;
-        let floor = T::of(n * n / (2.0 * (mean_tau_s + rest_tau_s)));
+    pub(crate) fn at_rest(&mut self, constants: &UncertaintyConstants<T>, k: T) {
+        let floor = constants.rest_bias_floor;
         let a = (T::one() - k) * (T::one() - k);
         for axis in [&mut self.inclination, &mut self.heading] {
             axis.bias = a * axis.bias + (T::one() - a) * floor;
@@ -552,11 +615,6 @@ impl<T: Real> AttitudeUncertainty<T> {
             self.rate_rps,
         ] {
             check_finite_in("uncertainty field term", v)?;
-        }
-        if let Some((key, constants)) = self.accel_constants {
-            for v in key.iter().chain(&constants) {
-                check_finite_in("uncertainty inclination constant", *v)?;
-            }
         }
         Ok(())
     }

@@ -5,8 +5,8 @@
 use nalgebra::{UnitQuaternion, Vector3};
 use serde::{Deserialize, Serialize};
 use truenorth_core::{
-    AttitudeEstimate, Error, Real, Result, TimeStep, Validate, check_finite, check_finite3,
-    check_range,
+    AttitudeEstimate, AttitudeStatus, Error, Real, Result, TimeStep, Validate, check_finite,
+    check_finite3, check_range,
 };
 
 use super::attitude_uncertainty::AttitudeUncertainty;
@@ -68,8 +68,9 @@ pub struct QuaternionFilterState<T: Real = f64> {
     pub initialised: bool,
     /// The σ of the attitude, propagated alongside it.
     pub uncertainty: AttitudeUncertainty<T>,
-    /// The estimate after the last sample; `None` before the first.
-    pub estimate: Option<AttitudeEstimate>,
+    /// What the filter made of the last sample (default before the first): with the rest of
+    /// the state, the estimate after it, which is built only when it is asked for.
+    pub status: AttitudeStatus,
     /// The time of the last sample.
     pub clock: TimeStep,
     /// The steps taken and the gaps among them.
@@ -99,7 +100,7 @@ impl<T: Real> QuaternionFilterState<T> {
             since_start_s: T::zero(),
             initialised: config.initial_attitude.is_some(),
             uncertainty: AttitudeUncertainty::new(config.uncertainty, !config.use_mag),
-            estimate: None,
+            status: AttitudeStatus::default(),
             clock: TimeStep::new(),
             gaps: GapMonitor::new(config.max_gap_s),
             rest: RestDetector::with_config(config.rest),
@@ -111,7 +112,7 @@ impl<T: Real> QuaternionFilterState<T> {
 
 impl<T: Real> Validate for QuaternionFilterState<T> {
     /// Valid parameters; a unit attitude and heading undo; finite vectors; a bias within
-    /// `max_bias_rps`; times ≥ 0; a finite estimate; parts built for these parameters.
+    /// `max_bias_rps`; times ≥ 0; parts built for these parameters.
     fn validate(&self) -> Result<()> {
         let cfg = &self.config;
         cfg.validate()?;
@@ -149,9 +150,6 @@ impl<T: Real> Validate for QuaternionFilterState<T> {
             ("since_start_s", self.since_start_s),
         ] {
             check_range_in(what, v, 0.0, f64::MAX)?;
-        }
-        if let Some(e) = &self.estimate {
-            check_estimate(e)?;
         }
         if let Some(t) = self.clock.last_s() {
             check_finite("time of the last sample", t)?;
