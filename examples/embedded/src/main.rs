@@ -226,13 +226,31 @@ fn sigma_off_measured(
         meter.measure(|| shared_run::update(&mut filter, &s))?;
         meter.classify_last(s.since_first_s >= config.startup_s);
     }
-    let (all, steady) = meter.per_update(calibration);
     let q = filter.attitude();
+    peer_measured(
+        out,
+        calibration,
+        &meter,
+        "quaternion_sigma_off",
+        [q.w, q.i, q.j, q.k],
+    )
+}
+
+/// The `measured` line of a filter run beside the quaternion filter's: its mean instructions
+/// per update (all, and after the start-up), its name and its final quaternion.
+fn peer_measured(
+    out: &mut impl core::fmt::Write,
+    calibration: &Calibration,
+    meter: &SysTickMeter,
+    filter: &str,
+    [w, i, j, k]: [f32; 4],
+) -> Result<(), shared_run::RunError> {
+    let (all, steady) = meter.per_update(calibration);
     writeln!(
         out,
         "measured peer_instructions_per_update={all:.0} after_startup={steady:.0} updates={} \
-         filter=quaternion_sigma_off float=f32 final_q={} {} {} {}",
-        meter.updates, q.w, q.i, q.j, q.k
+         filter={filter} float=f32 final_q={w} {i} {j} {k}",
+        meter.updates
     )?;
     Ok(())
 }
@@ -272,15 +290,8 @@ fn madgwick_measured(
         meter.measure(|| madgwick_update(&mut filter, &g, &a, &m));
         meter.classify_last(s.since_first_s >= startup_s);
     }
-    let (all, steady) = meter.per_update(calibration);
     let q = filter.quat;
-    writeln!(
-        out,
-        "measured peer_instructions_per_update={all:.0} after_startup={steady:.0} updates={} \
-         filter=madgwick float=f32 final_q={} {} {} {}",
-        meter.updates, q.w, q.i, q.j, q.k
-    )?;
-    Ok(())
+    peer_measured(out, calibration, &meter, "madgwick", [q.w, q.i, q.j, q.k])
 }
 
 /// The online ellipse calibrator's part of the shared run in the float type `R`, then a
