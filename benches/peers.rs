@@ -4,7 +4,8 @@
 //! `../shared/data/broad/`; the bench prints SKIPPED and measures nothing without it).
 //!
 //! The filters and their parameters (`peers/filters.rs`):
-//! - truenorth `QuaternionFilter`, default configuration, 9-D and 6-D (`use_mag: false`);
+//! - truenorth `QuaternionFilter`, default configuration, 9-D and 6-D (`use_mag: false`),
+//!   and with its σ switched off (`sigma: false`);
 //! - `ahrs` 0.8 Madgwick, β = 0.12, and Mahony, Kp = 0.74, Ki = 0.0012 (BROAD's
 //!   trial-agnostic good parameters), 9-D `update`, 6-D `update_imu`, at dt = 3.5 ms,
 //!   started from the first sample's accelerometer (and field);
@@ -56,6 +57,16 @@ fn bench(c: &mut Criterion) {
                 })
             });
         }
+        g.bench_function(format!("{}, σ off {dims}", Kind::Truenorth.name()), |b| {
+            b.iter(|| {
+                let mut peer: Box<dyn filters::Peer> =
+                    Box::new(filters::Truenorth::with_sigma(use_mag, false));
+                for s in &samples {
+                    peer.update(black_box(s));
+                    black_box(peer.attitude_enu());
+                }
+            })
+        });
     }
     g.finish();
 }

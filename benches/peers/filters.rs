@@ -179,8 +179,14 @@ pub struct Truenorth {
 impl Truenorth {
     /// The default configuration, magnetometer on or off.
     pub fn new(use_mag: bool) -> Self {
+        Self::with_sigma(use_mag, true)
+    }
+
+    /// The default configuration, magnetometer and σ on or off.
+    pub fn with_sigma(use_mag: bool, sigma: bool) -> Self {
         let config = QuaternionFilterConfig {
             use_mag,
+            sigma,
             ..QuaternionFilterConfig::default()
         };
         Self {

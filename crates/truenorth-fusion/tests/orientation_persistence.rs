@@ -265,3 +265,42 @@ fn a_damaged_euler_detector_state_is_refused() {
         Err(Error::SnapshotVersion { found: 99, .. })
     ));
 }
+
+/// A configuration or a saved state that names the removed `acc_lowpass_s` (written before
+/// the inclination low-pass became one second-order filter of `tau_acc_s`) is refused on
+/// reading, with what replaced it, never read with its `tau_acc_s` meaning something else;
+/// one without it reads, each absent field at its default.
+#[test]
+fn a_configuration_naming_the_removed_lowpass_is_refused_with_its_replacement() {
+    let says_what_replaced_it = |e: &serde_json::Error| {
+        let m = e.to_string();
+        m.contains("acc_lowpass_s is no longer a parameter") && m.contains("set tau_acc_s anew")
+    };
+    let old = r#"{"tau_acc_s": 3.0, "acc_lowpass_s": 1.0}"#;
+    let e = serde_json::from_str::<QuaternionFilterConfig>(old).unwrap_err();
+    assert!(says_what_replaced_it(&e), "{e}");
+
+    let mut snapshot = serde_json::to_value(
+        QuaternionFilter::new(QuaternionFilterConfig::default())
+            .unwrap()
+            .snapshot(),
+    )
+    .unwrap();
+    snapshot["version"] = serde_json::json!(1);
+    snapshot["state"]["config"]["acc_lowpass_s"] = serde_json::json!(1.0);
+    let e = serde_json::from_value::<Snapshot<QuaternionFilterState>>(snapshot).unwrap_err();
+    assert!(says_what_replaced_it(&e), "{e}");
+
+    let new: QuaternionFilterConfig = serde_json::from_str(r#"{"tau_acc_s": 3.0}"#).unwrap();
+    assert_eq!(
+        new,
+        QuaternionFilterConfig {
+            tau_acc_s: 3.0,
+            ..QuaternionFilterConfig::default()
+        }
+    );
+    let written = serde_json::to_string(&QuaternionFilterConfig::default()).unwrap();
+    assert!(!written.contains("acc_lowpass_s"), "{written}");
+    let read: QuaternionFilterConfig = serde_json::from_str(&written).unwrap();
+    assert_eq!(read, QuaternionFilterConfig::default());
+}

@@ -22,6 +22,7 @@ use cortex_m_semihosting::{debug, hio};
 use panic_semihosting as _;
 
 use shared_run::UpdateMeter;
+use truenorth_fusion::{QuaternionFilter, QuaternionFilterConfig};
 
 /// The library links `alloc` (truenorth-calib's saved states hold `Vec`s) but the filter, the
 /// compass and the online calibrator (its pushes and its solve) never allocate. This allocator refuses every request, so the run proves it:
@@ -70,14 +71,14 @@ fn known_block() {
     }
 }
 
-/// Sums the SysTick ticks of each measured update, and separately those of the pushes
-/// classified as the per-sample path alone.
+/// Sums the SysTick ticks of each measured update, and separately those of the updates
+/// classified as the steady path (after the start-up; a push without a refresh stage).
 struct SysTickMeter {
     ticks: u64,
     updates: u32,
     last_ticks: u32,
-    plain_ticks: u64,
-    plain: u32,
+    steady_ticks: u64,
+    steady: u32,
 }
 
 impl SysTickMeter {
@@ -86,9 +87,17 @@ impl SysTickMeter {
             ticks: 0,
             updates: 0,
             last_ticks: 0,
-            plain_ticks: 0,
-            plain: 0,
+            steady_ticks: 0,
+            steady: 0,
         }
+    }
+
+    /// Mean instructions per measured update, over all and over the steady ones.
+    fn per_update(&self, calibration: &Calibration) -> (f64, f64) {
+        (
+            calibration.instructions(self.ticks, self.updates),
+            calibration.instructions(self.steady_ticks, self.steady),
+        )
     }
 }
 
@@ -103,10 +112,10 @@ impl UpdateMeter for SysTickMeter {
         result
     }
 
-    fn classify_last(&mut self, per_sample_only: bool) {
-        if per_sample_only {
-            self.plain_ticks += u64::from(self.last_ticks);
-            self.plain += 1;
+    fn classify_last(&mut self, steady: bool) {
+        if steady {
+            self.steady_ticks += u64::from(self.last_ticks);
+            self.steady += 1;
         }
     }
 }
@@ -137,7 +146,8 @@ fn main() -> ! {
     loop {}
 }
 
-/// The shared run in `f32`, then in `f64`, each followed by the measured cost of an update.
+/// The shared run in `f32`, then in `f64`, each followed by the measured cost of an update;
+/// between them, the cost of the `f32` filter with its σ switched off and of Madgwick's.
 fn run() -> Result<(), shared_run::RunError> {
     let mut out = hio::hstdout().map_err(|()| shared_run::RunError::Output(core::fmt::Error))?;
     let mut syst = cortex_m::Peripherals::take()
@@ -158,6 +168,8 @@ fn run() -> Result<(), shared_run::RunError> {
 
     run_measured::<f32>(&mut out, &calibration)?;
     calibrate_measured::<f32>(&mut out, &calibration)?;
+    sigma_off_measured(&mut out, &calibration)?;
+    madgwick_measured(&mut out, &calibration)?;
     run_measured::<f64>(&mut out, &calibration)?;
     calibrate_measured::<f64>(&mut out, &calibration)
 }
@@ -170,28 +182,116 @@ struct Calibration {
     overhead_ticks: f64,
 }
 
+impl Calibration {
+    /// Mean instructions of `n` measurements that took `ticks` in all.
+    fn instructions(&self, ticks: u64, n: u32) -> f64 {
+        (ticks as f64 / f64::from(n) - self.overhead_ticks) * self.instructions_per_tick
+    }
+}
+
 /// The shared run in the float type `R`, then a `measured` line with the mean instructions
-/// of one filter update.
+/// of one filter update, over all updates and over those after the start-up.
 fn run_measured<R: truenorth_core::Real>(
     out: &mut impl core::fmt::Write,
     calibration: &Calibration,
 ) -> Result<(), shared_run::RunError> {
     let mut meter = SysTickMeter::new();
     shared_run::run::<R>(out, &mut meter)?;
-    let Calibration {
-        instructions_per_tick,
-        overhead_ticks,
-    } = *calibration;
-    let per_update =
-        (meter.ticks as f64 / f64::from(meter.updates) - overhead_ticks) * instructions_per_tick;
+    let (all, steady) = meter.per_update(calibration);
     writeln!(
         out,
-        "measured instructions_per_update={per_update:.0} updates={} float={} \
-         instructions_per_tick={instructions_per_tick:.3} meter_overhead_ticks={overhead_ticks:.3}",
+        "measured instructions_per_update={all:.0} after_startup={steady:.0} updates={} float={} \
+         instructions_per_tick={:.3} meter_overhead_ticks={:.3}",
         meter.updates,
-        core::any::type_name::<R>()
+        core::any::type_name::<R>(),
+        calibration.instructions_per_tick,
+        calibration.overhead_ticks,
     )?;
     Ok(())
+}
+
+/// The `f32` filter with `sigma: false` over the same recording: a `measured` line of the
+/// same form as [`run_measured`]'s, with `filter=quaternion_sigma_off`.
+fn sigma_off_measured(
+    out: &mut impl core::fmt::Write,
+    calibration: &Calibration,
+) -> Result<(), shared_run::RunError> {
+    let config = QuaternionFilterConfig {
+        sigma: false,
+        ..QuaternionFilterConfig::default()
+    };
+    let mut filter = QuaternionFilter::<f32>::with_precision(config)?;
+    let mut meter = SysTickMeter::new();
+    for s in shared_run::samples::<f32>()? {
+        meter.measure(|| shared_run::update(&mut filter, &s))?;
+        meter.classify_last(s.since_first_s >= config.startup_s);
+    }
+    let q = filter.attitude();
+    peer_measured(
+        out,
+        calibration,
+        &meter,
+        "quaternion_sigma_off",
+        [q.w, q.i, q.j, q.k],
+    )
+}
+
+/// The `measured` line of a filter run beside the quaternion filter's: its mean instructions
+/// per update (all, and after the start-up), its name and its final quaternion.
+fn peer_measured(
+    out: &mut impl core::fmt::Write,
+    calibration: &Calibration,
+    meter: &SysTickMeter,
+    filter: &str,
+    [w, i, j, k]: [f32; 4],
+) -> Result<(), shared_run::RunError> {
+    let (all, steady) = meter.per_update(calibration);
+    writeln!(
+        out,
+        "measured peer_instructions_per_update={all:.0} after_startup={steady:.0} updates={} \
+         filter={filter} float=f32 final_q={w} {i} {j} {k}",
+        meter.updates
+    )?;
+    Ok(())
+}
+
+/// A vector as `ahrs` names it: with nalgebra 0.34, the crate's own dependency.
+type AhrsVector = ahrs_nalgebra::Vector3<f32>;
+
+/// One update of Madgwick's filter by gyro `g`, accelerometer `a` and field `m`, made as
+/// [`shared_run::update`] makes the quaternion filter's. A zero accelerometer or field
+/// reading is refused and leaves the filter as it was: the recording has none.
+#[inline(never)]
+fn madgwick_update(
+    filter: &mut ahrs::Madgwick<f32>,
+    g: &AhrsVector,
+    a: &AhrsVector,
+    m: &AhrsVector,
+) {
+    use ahrs::Ahrs as _;
+    let _ = core::hint::black_box(filter).update(g, a, m);
+}
+
+/// Madgwick's filter (the `ahrs` crate, β = 0.12 as the peers bench runs it, 9-D `update`)
+/// in `f32` over the same recording: a `measured` line of the same form, with
+/// `filter=madgwick`. Its start-up is no different from the rest, so `after_startup`
+/// counts the same updates as the quaternion filter's.
+fn madgwick_measured(
+    out: &mut impl core::fmt::Write,
+    calibration: &Calibration,
+) -> Result<(), shared_run::RunError> {
+    let dt = shared_run::SAMPLE_INTERVAL_S as f32;
+    let mut filter = ahrs::Madgwick::new(dt, 0.12f32);
+    let mut meter = SysTickMeter::new();
+    let startup_s = QuaternionFilterConfig::default().startup_s;
+    let v = |v: nalgebra::Vector3<f32>| AhrsVector::new(v.x, v.y, v.z);
+    for s in shared_run::samples::<f32>()? {
+        let (g, a, m) = (v(s.gyr_rps), v(s.acc_mps2), v(s.mag_ut));
+        meter.measure(|| madgwick_update(&mut filter, &g, &a, &m));
+        meter.classify_last(s.since_first_s >= startup_s);
+    }
+    let q = filter.quat;
+    peer_measured(out, calibration, &meter, "madgwick", [q.w, q.i, q.j, q.k])
 }
 
 /// The online ellipse calibrator's part of the shared run in the float type `R`, then a
@@ -204,19 +304,12 @@ fn calibrate_measured<R: truenorth_core::Real>(
 ) -> Result<(), shared_run::RunError> {
     let mut meter = SysTickMeter::new();
     shared_run::calibrate::<R>(out, &mut meter)?;
-    let Calibration {
-        instructions_per_tick,
-        overhead_ticks,
-    } = *calibration;
-    let mean =
-        |ticks: u64, n: u32| (ticks as f64 / f64::from(n) - overhead_ticks) * instructions_per_tick;
+    let (all, steady) = meter.per_update(calibration);
     writeln!(
         out,
-        "measured instructions_per_push={:.0} per_sample_path={:.0} pushes={} per_sample_pushes={} float={}",
-        mean(meter.ticks, meter.updates),
-        mean(meter.plain_ticks, meter.plain),
+        "measured instructions_per_push={all:.0} per_sample_path={steady:.0} pushes={} per_sample_pushes={} float={}",
         meter.updates,
-        meter.plain,
+        meter.steady,
         core::any::type_name::<R>()
     )?;
     Ok(())

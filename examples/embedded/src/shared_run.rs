@@ -15,7 +15,7 @@ use core::fmt::{self, Write};
 use nalgebra::{Matrix2, Matrix3, Quaternion, UnitQuaternion, Vector2, Vector3};
 use truenorth_calib::{OnlineEllipseCalibrator, OnlineEllipseConfig};
 use truenorth_compass::CompassCalibration3d;
-use truenorth_core::{Calibrator, EulerZyx, Real, ned_to_enu};
+use truenorth_core::{AttitudeStatus, Calibrator, EulerZyx, Real, ned_to_enu};
 use truenorth_fusion::{QuaternionFilter, QuaternionFilterConfig};
 
 /// The recording, as written by `tests/embedded_twin.rs` (`embedded_data_is_the_broad_slice`):
@@ -41,9 +41,10 @@ pub trait UpdateMeter {
     /// Runs `update` and accounts for it.
     fn measure<T>(&mut self, update: impl FnOnce() -> T) -> T;
 
-    /// Says whether the last measured push was the per-sample path alone (`true`), or also
-    /// ran a stage of the calibrator's refresh (`false`).
-    fn classify_last(&mut self, _per_sample_only: bool) {}
+    /// Says whether the last measured call was the steady path (`true`): a filter update
+    /// after the start-up (whose gains are the start-up's own), a calibrator push that ran
+    /// the per-sample path alone (no stage of its refresh).
+    fn classify_last(&mut self, _steady: bool) {}
 }
 
 /// Readings of the simulated turn fed to the online ellipse calibrator: one per degree.
@@ -129,18 +130,23 @@ fn reference_ned() -> Option<UnitQuaternion<f64>> {
     Some(ned_to_enu().inverse() * enu)
 }
 
-/// The readings of one sample in the float type `R`: gyro (rad/s), accelerometer (m/s²),
+/// One sample in the float type `R`: its timestamp and time since the first sample (s,
+/// `f64` in both precisions, as the filter takes them), gyro (rad/s), accelerometer (m/s²),
 /// magnetometer (µT), sensor axes.
-struct Readings<R: Real> {
-    gyr_rps: Vector3<R>,
-    acc_mps2: Vector3<R>,
-    mag_ut: Vector3<R>,
+pub struct Readings<R: Real> {
+    pub t_s: f64,
+    pub since_first_s: f64,
+    pub gyr_rps: Vector3<R>,
+    pub acc_mps2: Vector3<R>,
+    pub mag_ut: Vector3<R>,
 }
 
-/// Sample `k` of the slice.
-fn readings<R: Real>(k: usize) -> Option<Readings<R>> {
+/// Sample `k` of the slice, whose first sample is sample `first_index` of the trial.
+fn readings<R: Real>(k: usize, first_index: f64) -> Option<Readings<R>> {
     let v: [R; SAMPLE_VALUES] = values(HEADER_VALUES + SAMPLE_VALUES * k)?;
     Some(Readings {
+        t_s: (first_index + k as f64) * SAMPLE_INTERVAL_S,
+        since_first_s: k as f64 * SAMPLE_INTERVAL_S,
         gyr_rps: Vector3::new(v[0], v[1], v[2]),
         acc_mps2: Vector3::new(v[3], v[4], v[5]),
         mag_ut: Vector3::new(v[6], v[7], v[8]),
@@ -163,12 +169,8 @@ fn to_f64<R: Real>(q: &UnitQuaternion<R>) -> UnitQuaternion<f64> {
     ))
 }
 
-/// Runs the filter in the float type `R` (`f32` or `f64`) over the recording, then the
-/// compass, also in `R`, on its last reading, writing one `name value...` line per result
-/// (numbers in Rust's shortest round-trip form for `R`, so equal text means equal bits).
-/// The first line names the float: `float f32: ...`; `.ci/embedded` takes the tolerance of
-/// the lines that follow from it.
-pub fn run<R: Real>(out: &mut impl Write, meter: &mut impl UpdateMeter) -> Result<(), RunError> {
+/// The number of samples in the recording and the index in the trial of the first.
+fn layout() -> Result<(usize, f64), RunError> {
     let body = RECORDING
         .len()
         .checked_sub(4 * HEADER_VALUES)
@@ -176,8 +178,42 @@ pub fn run<R: Real>(out: &mut impl Write, meter: &mut impl UpdateMeter) -> Resul
     if !body.is_multiple_of(4 * SAMPLE_VALUES) || !RECORDING.len().is_multiple_of(4) {
         return Err(RunError::Recording);
     }
-    let n = body / (4 * SAMPLE_VALUES);
     let first_index = f64::from(value(0).ok_or(RunError::Recording)?);
+    Ok((body / (4 * SAMPLE_VALUES), first_index))
+}
+
+/// The recording's samples in the float type `R`, in order.
+pub fn samples<R: Real>() -> Result<impl Iterator<Item = Readings<R>>, RunError> {
+    let (n, first_index) = layout()?;
+    // Every sample is there: `layout` checked the length.
+    Ok((0..n).filter_map(move |k| readings(k, first_index)))
+}
+
+/// One update of `filter` by the sample `s`, as an application makes it: a call, on a filter
+/// the compiler knows nothing about (as one kept in a static, behind an interrupt), so that
+/// it can neither hoist the update's work on the parameters out of the caller's loop nor
+/// drop what the loop does not read, and the count is the update's however the caller is
+/// compiled.
+#[inline(never)]
+pub fn update<R: Real>(
+    filter: &mut QuaternionFilter<R>,
+    s: &Readings<R>,
+) -> Result<AttitudeStatus, truenorth_core::Error> {
+    core::hint::black_box(filter).update_readings(
+        s.t_s,
+        s.gyr_rps,
+        Some(s.acc_mps2),
+        Some(s.mag_ut),
+    )
+}
+
+/// Runs the filter in the float type `R` (`f32` or `f64`) over the recording, then the
+/// compass, also in `R`, on its last reading, writing one `name value...` line per result
+/// (numbers in Rust's shortest round-trip form for `R`, so equal text means equal bits).
+/// The first line names the float: `float f32: ...`; `.ci/embedded` takes the tolerance of
+/// the lines that follow from it.
+pub fn run<R: Real>(out: &mut impl Write, meter: &mut impl UpdateMeter) -> Result<(), RunError> {
+    let (n, first_index) = layout()?;
     let cal = calibration()
         .ok_or(RunError::Recording)?
         .to_precision::<R>();
@@ -190,14 +226,12 @@ pub fn run<R: Real>(out: &mut impl Write, meter: &mut impl UpdateMeter) -> Resul
         first_index + n as f64,
     )?;
 
-    let mut filter = QuaternionFilter::<R>::with_precision(QuaternionFilterConfig::default())?;
+    let config = QuaternionFilterConfig::default();
+    let mut filter = QuaternionFilter::<R>::with_precision(config)?;
     let mut last_mag = Vector3::zeros();
-    for k in 0..n {
-        let s = readings::<R>(k).ok_or(RunError::Recording)?;
-        // The timestamp stays f64 in both precisions (the filter takes it so).
-        let t_s = (first_index + k as f64) * SAMPLE_INTERVAL_S;
-        meter
-            .measure(|| filter.update_readings(t_s, s.gyr_rps, Some(s.acc_mps2), Some(s.mag_ut)))?;
+    for (k, s) in samples::<R>()?.enumerate() {
+        meter.measure(|| update(&mut filter, &s))?;
+        meter.classify_last(s.since_first_s >= config.startup_s);
         last_mag = s.mag_ut;
         if (k + 1).is_multiple_of(PRINT_EVERY) {
             let q = filter.attitude();

@@ -14,7 +14,9 @@
 //!   Systems*, 2nd ed., 2013, §4.4.6 and §14.2.7): white noise adds `N² dt` to the variance of
 //!   the angle error `e`; a bias error `β` (a random constant plus a random walk) adds to it
 //!   through the pair `(e, β)`, whose 2 × 2 covariance is propagated exactly. Each applied
-//!   correction multiplies `e` by `1 − k`; in motion the filter's bias estimate integrates
+//!   correction multiplies `e` by `1 − k` (for inclination, whose low-pass sets the
+//!   dynamics, `k = dt/τ_i` with `τ_i = √2 τ_acc`, the first-order loop with the
+//!   Butterworth low-pass's lag behind a steady drift); in motion the filter's bias estimate integrates
 //!   the corrections (`β ← β − (k/τ_b) e`), which is credited only with the in-phase part
 //!   of a first-order loop's response to a bias that turns with the body at `|ω|`,
 //!   `1/(1 + (|ω| τ)²)`: a fast-turning body shows its bias to the corrections only
@@ -24,31 +26,38 @@
 //!   the three reference axes mix (a body axis that was horizontal becomes vertical).
 //! - **Gyro scale and axis errors** `S` (relative, `s` per element): the error rate `R S ω`
 //!   accumulates coherently while the body keeps turning the same way and cancels when it
-//!   turns back, so it is `s |ψ|` with `ψ` the reference-frame rotation of the last
-//!   correction time constant, `ψ ← (1 − k) ψ + R ω dt` (exact for scale errors and a
-//!   rotation about one body axis).
+//!   turns back. While a sensor corrects the axis, the drift it causes shows in the
+//!   corrections (a loop's error behind a steady drift is the drift over its time
+//!   constant, which is what its corrections add up to over that time), and is counted
+//!   there (below: what the sensors say). Only heading goes without correction (the field
+//!   rejected, or absent): then it is `s |ψ|` with `ψ` the reference-frame rotation since
+//!   the field was last trusted, `ψ ← ψ + R ω dt`, decaying as `ψ ← (1 − k) ψ` with the
+//!   corrections once the field returns (exact for scale errors and a rotation about one
+//!   body axis). Counting the prior `s |ψ|` while the corrections show the drift counted
+//!   it twice: on BROAD's 20 trials the inclination σ was 4 times its RMS error.
 //! - **Latency**: a gyro's digital low-pass delays it by a few milliseconds (InvenSense
 //!   MPU-9250 register map, register 26: 2.9 ms at its widest bandwidth, 5.9 ms at 41 Hz),
 //!   so the attitude stands for a slightly earlier instant: an error `|R ω| δ` per axis.
 //! - **What the corrections trust**: the accelerometer's bias (`b/g` of tilt, a constant
-//!   passed fully) and white noise (through the two low-passes in cascade, variance
-//!   `N_a²/(2 g² (τ_lp + τ_acc))`); for heading, the magnetometer's residual calibration
+//!   passed fully) and white noise (through the Butterworth low-pass, whose noise bandwidth
+//!   is `1/(2√2 τ_acc)`: variance `N_a²/(2√2 g² τ_acc)`); for heading, the magnetometer's residual calibration
 //!   error (a constant), its white noise (`σ_h² k/2`: a first-order low-pass of white
 //!   noise) and the inclination error about north, which the dip turns into a heading error
 //!   `e_x tan(dip)` (the east component of `e × m`). Of that, the parts that persist (the
 //!   biases' and the scale error's) pass the heading loop whole; the accelerations' varies
-//!   with the inclination loop's time constant and passes by `τ_acc/(τ_acc + τ_mag)`, the
+//!   with the inclination loop's time constant `τ_i` and passes by `τ_i/(τ_i + τ_mag)`, the
 //!   variance a first-order low-pass leaves of a first-order Gauss–Markov process (Gelb,
 //!   *Applied Optimal Estimation*, 1974, §3.8). Such a variance `C` enters as
 //!   `P ← (1 − k)² P + (1 − (1 − k)²) C`, so it is reached with the correction's own time
 //!   constant and kept while corrections are suspended.
 //! - **What the sensors say the model cannot explain** (covariance matching on the
 //!   corrections, Mehra, *Approaches to adaptive filtering*, IEEE TAC 17(5), 1972):
-//!   - *accelerations*: the body's accelerations show in the inclination corrections; their
-//!     recent sum `ε ← (1 − k) ε + correction` is what the accelerometer has moved the
-//!     attitude by within the loop's time constant, and the envelope of its square is added
-//!     per axis (rising with it at once, decaying over the loop's natural period
-//!     `2π √(τ_lp τ_acc)`). A *sustained* horizontal acceleration (a vehicle's turn) looks exactly like a
+//!   - *accelerations and drift*: the body's accelerations and the gyro's drift show in
+//!     the inclination corrections; their recent sum `ε ← (1 − k) ε + correction` is what
+//!     the accelerometer has moved the attitude by within the loop's time constant, and the
+//!     envelope of its square is added per axis (rising with it at once, decaying over the
+//!     low-pass's natural period `2π τ_acc`). Likewise the trusted heading corrections'
+//!     recent sum, its envelope decaying with the heading loop's time constant. A *sustained* horizontal acceleration (a vehicle's turn) looks exactly like a
 //!     tilt and is not seen: like the filter itself, σ assumes that the body's
 //!     accelerations average out over a few seconds.
 //!   - *magnetic disturbances*: the field's norm and dip departures from the learned
@@ -66,10 +75,13 @@
 //! Without a magnetometer the heading is relative to the start and its σ is the drift
 //! since the start. Everything is a few scalars per axis, cheap enough for every sample.
 
+use core::f64::consts::SQRT_2;
+
 use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 use truenorth_core::{Error, Real, Result, STANDARD_GRAVITY_MPS2, Validate, check_range};
 
+use super::min_max::{at_least, at_most};
 use super::real_checks::{check_finite_in, check_finite3_in, check_range_in};
 
 /// The sensors' error model behind the filter's σ: what a typical consumer MEMS IMU with a
@@ -165,6 +177,92 @@ impl Validate for AttitudeUncertaintyConfig {
     }
 }
 
+/// The error model's values in the filter's float type `T`, as the per-sample steps use
+/// them: converted once by the filter, not per sample.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct UncertaintyConstants<T> {
+    /// The gyro's white-noise density and bias walk, squared: per second of strapdown.
+    gyro_noise2: T,
+    bias_walk2: T,
+    /// A field reading's relative noise and the calibration's heading error, squared.
+    mag_noise2: T,
+    mag_heading2: T,
+    /// The variance the bias estimate at rest settles to (see [`AttitudeUncertainty::at_rest`]).
+    rest_bias_floor: T,
+    /// The accelerometer's bias and white-noise density over g, squared (rad² of tilt, and
+    /// per hertz).
+    accel_bias2: T,
+    accel_noise2: T,
+}
+
+/// The inclination loop as the σ follows it (see [`AttitudeUncertainty::accel_corrected`])
+/// for one time constant `τ` of the low-pass.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct InclinationConstants<T> {
+    /// `τ_i = √2 τ`, the first-order loop's with the same lag behind a steady drift, s, and
+    /// its inverse.
+    loop_tau: T,
+    inv_loop_tau: T,
+    /// `1/(2π τ)`: the envelope's decay (see `accel_corrected`), 1/s.
+    inv_period: T,
+    /// The variance the accelerometer's bias and noise leave, rad².
+    target: T,
+}
+
+impl<T: Real> UncertaintyConstants<T> {
+    /// For the filter's validated parameters.
+    pub(crate) fn of(cfg: &crate::QuaternionFilterConfig) -> Self {
+        let u = &cfg.uncertainty;
+        let g = STANDARD_GRAVITY_MPS2;
+        let n = u.gyro_noise_rps_per_sqrt_hz;
+        let walk = u.gyro_bias_walk_rps_per_sqrt_s;
+        Self {
+            gyro_noise2: T::of(n * n),
+            bias_walk2: T::of(walk * walk),
+            mag_noise2: T::of(u.mag_noise_rel * u.mag_noise_rel),
+            mag_heading2: T::of(u.mag_heading_rad * u.mag_heading_rad),
+            // The rest detector's mean (time constant `rest.mean_tau_s`) of the gyro's white
+            // noise, followed by the bias estimate's own low-pass (`bias_tau_rest_s`).
+            rest_bias_floor: T::of(n * n / (2.0 * (cfg.rest.mean_tau_s + cfg.bias_tau_rest_s))),
+            accel_bias2: T::of(u.accel_bias_mps2 * u.accel_bias_mps2 / (g * g)),
+            accel_noise2: T::of(
+                u.accel_noise_mps2_per_sqrt_hz * u.accel_noise_mps2_per_sqrt_hz / (g * g),
+            ),
+        }
+    }
+
+    /// The inclination loop's constants for the low-pass's time constant `tau_s`.
+    pub(crate) fn inclination(&self, tau_s: T) -> InclinationConstants<T> {
+        let loop_tau = T::of(SQRT_2) * tau_s;
+        InclinationConstants {
+            loop_tau,
+            inv_loop_tau: T::one() / loop_tau,
+            // The envelope of the square (see `accel_corrected`) follows a rise at once
+            // (the error an acceleration causes builds as fast as the corrections it
+            // causes) and decays over the low-pass's natural period 2π τ (13 s by
+            // default), so that it holds through the swings of an acceleration slow enough
+            // to pass the low-pass.
+            inv_period: T::one() / (T::of(core::f64::consts::TAU) * tau_s),
+            // White noise through the Butterworth low-pass: its noise bandwidth is
+            // 1/(2√2 τ) (∫|H|² df).
+            target: self.accel_bias2 + self.accel_noise2 / (T::of(2.0 * SQRT_2) * tau_s),
+        }
+    }
+}
+
+/// A heading correction, as the σ takes it ([`AttitudeUncertainty::mag_corrected`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct HeadingCorrection<T> {
+    /// Its gain (covering the time since the last reading) and its loop's time constant, s.
+    pub(crate) k: T,
+    pub(crate) tau_s: T,
+    /// The turn it applied about the vertical, rad.
+    pub(crate) dz: T,
+    /// The bias estimate's `1/τ_b`, 1/s (0 when it does not learn: at rest or in the
+    /// start-up).
+    pub(crate) inv_tau_bias: T,
+}
+
 /// The variance of the error about one kind of reference axis (inclination or heading).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 // `Real` includes serde's bounds on `T`.
@@ -216,8 +314,8 @@ impl<T: Real> AxisVariance<T> {
         let (pe, pb) = (self.angle, self.angle_bias);
         self.angle = a * a * pe;
         self.angle_bias = a * (pb - c * pe);
-        self.bias = (self.bias - c * (T::of(2.0) * pb - c * pe)).max(T::zero());
-        let target = target.min(T::of(UNINFORMED_VARIANCE_RAD2));
+        self.bias = at_least(self.bias - c * (T::of(2.0) * pb - c * pe), T::zero());
+        let target = at_most(target, T::of(UNINFORMED_VARIANCE_RAD2));
         self.measured += (T::one() - a * a) * (target - self.measured);
     }
 }
@@ -232,13 +330,18 @@ pub struct AttitudeUncertainty<T: Real = f64> {
     config: AttitudeUncertaintyConfig,
     inclination: AxisVariance<T>,
     heading: AxisVariance<T>,
-    /// Reference-frame rotation within the inclination and heading loops' time constants.
-    turned_inclination: Vector3<T>,
+    /// Reference-frame rotation since the field was last trusted, decaying with the
+    /// heading loop's time constant once it is again.
     turned_heading: Vector3<T>,
+    /// The last field reading corrected heading with trust (the turn since it is seen).
+    heading_trusted: bool,
     /// Recent sum of the inclination corrections about x and y, and the envelope of its
     /// square per axis.
     accel_moved: [T; 2],
     accel_moved_sq: [T; 2],
+    /// Recent sum of the trusted heading corrections, and the envelope of its square.
+    mag_moved: T,
+    mag_moved_sq: T,
     /// Low-passed relative norm and dip departures of the field, and `1/(2 cos² dip)`.
     norm_departure: T,
     dip_departure: T,
@@ -246,10 +349,6 @@ pub struct AttitudeUncertainty<T: Real = f64> {
     /// Reference-frame rate and its norm at the last step.
     rate_ned: Vector3<T>,
     rate_rps: T,
-    /// The inclination correction's constants for the last (gain, time constant, low-pass):
-    /// variance target and the envelope's gain, recomputed only when those change; `None`
-    /// before the first inclination correction.
-    accel_constants: Option<([T; 3], T, T)>,
 }
 
 /// Inclination σ assumed before the first correction, rad: the tilt the first reading
@@ -282,16 +381,17 @@ impl<T: Real> AttitudeUncertainty<T> {
                 bias,
             ),
             heading: AxisVariance::new(heading, bias),
-            turned_inclination: Vector3::zeros(),
             turned_heading: Vector3::zeros(),
+            heading_trusted: false,
             accel_moved: [T::zero(); 2],
             accel_moved_sq: [T::zero(); 2],
+            mag_moved: T::zero(),
+            mag_moved_sq: T::zero(),
             norm_departure: T::zero(),
             dip_departure: T::zero(),
             half_inv_cos2_dip: T::of(0.5),
             rate_ned: Vector3::zeros(),
             rate_rps: T::zero(),
-            accel_constants: None,
         }
     }
 
@@ -312,63 +412,46 @@ impl<T: Real> AttitudeUncertainty<T> {
     #[inline]
     pub(crate) fn propagate(
         &mut self,
+        c: &UncertaintyConstants<T>,
         dt_s: T,
         omega_rps: &Vector3<T>,
         rate_rps: T,
         r: &Matrix3<T>,
     ) {
-        let cfg = &self.config;
-        let angle_noise =
-            T::of(cfg.gyro_noise_rps_per_sqrt_hz * cfg.gyro_noise_rps_per_sqrt_hz) * dt_s;
-        let walk = cfg.gyro_bias_walk_rps_per_sqrt_s;
-        let bias_noise = T::of(walk * walk) * dt_s;
+        let angle_noise = c.gyro_noise2 * dt_s;
+        let bias_noise = c.bias_walk2 * dt_s;
         self.inclination.propagate(dt_s, angle_noise, bias_noise);
         self.heading.propagate(dt_s, angle_noise, bias_noise);
         self.rate_ned = r * omega_rps;
         self.rate_rps = rate_rps;
         let step = self.rate_ned * dt_s;
-        self.turned_inclination += step;
-        self.turned_heading += step;
+        if !self.heading_trusted {
+            self.turned_heading += step;
+        }
         // The body's turn mixes the reference axes' bias uncertainties (two inclination
         // axes and one heading axis), by the fraction of a radian turned.
-        let mix = (rate_rps * dt_s).min(T::one());
+        let mix = at_most(rate_rps * dt_s, T::one());
         let mean = (T::of(2.0) * self.inclination.bias + self.heading.bias) * T::of(1.0 / 3.0);
         self.inclination.bias += mix * (mean - self.inclination.bias);
         self.heading.bias += mix * (mean - self.heading.bias);
     }
 
-    /// The inclination correction of this step: gain `k`, the correction applied about
-    /// x and y (rad), and the bias estimate's `1/τ_b` (0 when it does not learn: at rest or
-    /// in the start-up).
+    /// The inclination correction of this step of `dt_s`: the constants of the loop `c`,
+    /// the correction applied about x and y (rad) and the bias estimate's `1/τ_b` (0 when it
+    /// does not learn: at rest or in the start-up). The error follows the low-pass as it
+    /// would a first-order loop with the same lag behind a steady drift, `√2 τ`.
     #[inline]
     pub(crate) fn accel_corrected(
         &mut self,
-        k: T,
+        c: &InclinationConstants<T>,
+        dt_s: T,
         correction: (T, T),
-        tau_s: T,
         inv_tau_bias: T,
-        lowpass_s: T,
     ) {
-        if self.accel_constants.map(|c| c.0) != Some([k, tau_s, lowpass_s]) {
-            let cfg = &self.config;
-            let g = T::of(STANDARD_GRAVITY_MPS2);
-            let bias = T::of(cfg.accel_bias_mps2) / g;
-            let white = T::of(cfg.accel_noise_mps2_per_sqrt_hz) / g;
-            let target = bias * bias + white * white / (T::of(2.0) * (lowpass_s + tau_s));
-            // The envelope of the square (below) follows a rise at once (the error an
-            // acceleration causes builds as fast as the corrections it causes) and decays
-            // over the loop's natural period 2π √(τ_lp τ_acc) (11 s by default), so that it
-            // holds through the swings of an acceleration slow enough to pass the loop.
-            let period = T::of(core::f64::consts::TAU) * (lowpass_s * tau_s).sqrt();
-            let k_env = (k * tau_s / period).min(T::one());
-            self.accel_constants = Some(([k, tau_s, lowpass_s], target, k_env));
-        }
-        let Some((_, target, k_env)) = self.accel_constants else {
-            return;
-        };
-        let c = self.bias_credit(k, tau_s, inv_tau_bias);
-        self.inclination.correct(k, c, target);
-        self.turned_inclination *= T::one() - k;
+        let k = at_most(dt_s * c.inv_loop_tau, T::one());
+        let k_env = at_most(dt_s * c.inv_period, T::one());
+        let credit = self.bias_credit(k, c.loop_tau, inv_tau_bias);
+        self.inclination.correct(k, credit, c.target);
         let a = T::one() - k;
         for (i, c) in [correction.0, correction.1].into_iter().enumerate() {
             let moved = a * self.accel_moved[i] + c;
@@ -383,20 +466,25 @@ impl<T: Real> AttitudeUncertainty<T> {
         }
     }
 
-    /// A heading correction that the field may be trusted for (not rejected, no offset
-    /// learned from the attitude subtracted): gain `k` (covering the time since the last
-    /// reading) with time constant `tau_s`, the reading's horizontal and vertical components
-    /// in the level frame and the reference's, and the bias estimate's `1/τ_b`.
+    /// A heading correction `correction` that the field may be trusted for (not rejected,
+    /// no offset learned from the attitude subtracted), by a reading whose horizontal and
+    /// vertical components in the level frame are `reading`, the reference's `reference`;
+    /// the inclination loop in effect is `inclination`.
     #[inline]
     pub(crate) fn mag_corrected(
         &mut self,
-        k: T,
-        tau_s: T,
+        constants: &UncertaintyConstants<T>,
+        inclination: &InclinationConstants<T>,
+        correction: &HeadingCorrection<T>,
         reading: (T, T),
         reference: (T, T),
-        inv_tau_bias: T,
     ) {
-        let cfg = &self.config;
+        let HeadingCorrection {
+            k,
+            tau_s,
+            dz,
+            inv_tau_bias,
+        } = *correction;
         let (h, v) = reading;
         let (h0, v0) = reference;
         let n02 = h0 * h0 + v0 * v0;
@@ -412,27 +500,52 @@ impl<T: Real> AttitudeUncertainty<T> {
         self.norm_departure += k * (rn - self.norm_departure);
         self.dip_departure += k * (rd - self.dip_departure);
         // 1/cos² dip = |m₀|²/h₀², the horizontal field kept above 10⁻³ of the whole.
-        let inv_cos2_dip = n02 / (h0 * h0).max(T::of(1e-6) * n02);
+        let inv_cos2_dip = n02 / at_least(h0 * h0, T::of(1e-6) * n02);
         self.half_inv_cos2_dip = T::of(0.5) * inv_cos2_dip;
         let tan2_dip = inv_cos2_dip - T::one();
         // A reading's heading noise, σ/cos dip, through the loop: k/2 of its variance.
-        let white = T::of(cfg.mag_noise_rel * cfg.mag_noise_rel) * inv_cos2_dip * T::of(0.5) * k;
+        let white = constants.mag_noise2 * inv_cos2_dip * T::of(0.5) * k;
         // The inclination error about north is the one the dip turns into heading. The parts
         // of it that persist (the biases' and the scale error's) pass the heading loop
         // whole; the accelerations' varies with the inclination loop's time constant and
         // passes by τ_acc/(τ_acc + τ_mag).
-        let passed = match self.accel_constants {
-            Some(([_, tau_acc_s, _], ..)) if tau_acc_s > T::zero() => {
-                tau_acc_s / (tau_acc_s + tau_s)
-            }
-            _ => T::one(),
-        };
-        let acceleration = self.accel_moved_sq[0];
-        let tilt = tan2_dip * (self.inclination_variance(0) - (T::one() - passed) * acceleration);
-        let target = T::of(cfg.mag_heading_rad * cfg.mag_heading_rad) + white + tilt;
+        let passed = inclination.loop_tau / (inclination.loop_tau + tau_s);
+        let i = &self.inclination;
+        let tilt = tan2_dip
+            * at_most(
+                i.angle + i.measured + passed * self.accel_moved_sq[0],
+                T::of(UNINFORMED_VARIANCE_RAD2),
+            );
+        let target = constants.mag_heading2 + white + tilt;
         let c = self.bias_credit(k, tau_s, inv_tau_bias);
         self.heading.correct(k, c, target);
         self.turned_heading *= T::one() - k;
+        self.heading_trusted = true;
+        let moved = (T::one() - k) * self.mag_moved + dz;
+        self.mag_moved = moved;
+        let sq = moved * moved;
+        self.mag_moved_sq = if sq > self.mag_moved_sq {
+            sq
+        } else {
+            self.mag_moved_sq + k * (sq - self.mag_moved_sq)
+        };
+    }
+
+    /// A field reading that did not correct heading with trust (disturbed, or corrected by
+    /// an offset learned from the attitude): the turn from now on is unseen by it.
+    #[inline]
+    pub(crate) fn heading_untrusted(&mut self) {
+        self.heading_trusted = false;
+    }
+
+    /// A heading correction with gain `k` by a field less an offset learned from the
+    /// attitude: it tells nothing of the heading's error (the offset took in whatever error
+    /// the attitude had when it was learned), so no variance shrinks, but it holds the
+    /// heading against the gyro's scale error as a trusted field would.
+    #[inline]
+    pub(crate) fn heading_held(&mut self, k: T) {
+        self.turned_heading *= T::one() - k;
+        self.heading_trusted = true;
     }
 
     /// The share `c` (1/s) of a correction with gain `k` and time constant `tau_s` that the
@@ -448,9 +561,8 @@ impl<T: Real> AttitudeUncertainty<T> {
 
     /// A step at rest: the bias follows the rest detector's mean with gain `k`.
     #[inline]
-    pub(crate) fn at_rest(&mut self, k: T, mean_tau_s: f64, rest_tau_s: f64) {
-        let n = self.config.gyro_noise_rps_per_sqrt_hz;
-        let floor = T::of(n * n / (2.0 * (mean_tau_s + rest_tau_s)));
+    pub(crate) fn at_rest(&mut self, constants: &UncertaintyConstants<T>, k: T) {
+        let floor = constants.rest_bias_floor;
         let a = (T::one() - k) * (T::one() - k);
         for axis in [&mut self.inclination, &mut self.heading] {
             axis.bias = a * axis.bias + (T::one() - a) * floor;
@@ -462,12 +574,8 @@ impl<T: Real> AttitudeUncertainty<T> {
     /// latency term.
     #[inline]
     fn inclination_variance(&self, i: usize) -> T {
-        let s = self.config.gyro_scale_rel;
-        (self.inclination.angle
-            + self.inclination.measured
-            + self.accel_moved_sq[i]
-            + T::of(s * s) * self.turned_inclination.norm_squared())
-        .min(T::of(UNINFORMED_VARIANCE_RAD2))
+        (self.inclination.angle + self.inclination.measured + self.accel_moved_sq[i])
+            .min(T::of(UNINFORMED_VARIANCE_RAD2))
     }
 
     /// Checks a restored uncertainty against the error model `config` of its filter: the
@@ -489,14 +597,15 @@ impl<T: Real> AttitudeUncertainty<T> {
             )?;
             check_finite_in("uncertainty angle-bias covariance", axis.angle_bias)?;
         }
-        for v in [
-            &self.turned_inclination,
-            &self.turned_heading,
-            &self.rate_ned,
-        ] {
+        for v in [&self.turned_heading, &self.rate_ned] {
             check_finite3_in("uncertainty turn", v)?;
         }
-        for v in self.accel_moved.iter().chain(&self.accel_moved_sq) {
+        for v in self
+            .accel_moved
+            .iter()
+            .chain(&self.accel_moved_sq)
+            .chain(&[self.mag_moved, self.mag_moved_sq])
+        {
             check_finite_in("uncertainty acceleration term", *v)?;
         }
         for v in [
@@ -506,11 +615,6 @@ impl<T: Real> AttitudeUncertainty<T> {
             self.rate_rps,
         ] {
             check_finite_in("uncertainty field term", v)?;
-        }
-        if let Some((key, target, k_env)) = self.accel_constants {
-            for v in key.iter().chain(&[target, k_env]) {
-                check_finite_in("uncertainty inclination constant", *v)?;
-            }
         }
         Ok(())
     }
@@ -526,6 +630,7 @@ impl<T: Real> AttitudeUncertainty<T> {
         let heading = self.heading.angle
             + self.heading.measured
             + T::of(s * s) * self.turned_heading.norm_squared()
+            + self.mag_moved_sq
             + disturbance;
         // Each term is a variance of the same error; their sum, like each, is at most that
         // of an uninformed attitude (a NaN from an inf − inf cannot arise below it).

@@ -22,6 +22,7 @@ use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 use truenorth_core::{Error, Real, Result, Validate, check_positive, check_range};
 
+use super::min_max::at_most;
 use super::real_checks::{check_finite3_in, check_range_in};
 
 /// Thresholds of the [`HardIronEstimator`]. Field quantities are relative to the reference
@@ -77,8 +78,35 @@ impl Validate for HardIronConfig {
     }
 }
 
+/// The thresholds of a [`HardIronConfig`] in the estimator's float type, squared where they
+/// are compared with squares: converted once by the filter that owns the estimator, not
+/// per sample.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct HardIronThresholds<T> {
+    min_offset2: T,
+    max_spread2: T,
+    min_turn_rad: T,
+    /// Twice the statistics' time constant: the consistent time an offset needs.
+    min_consistent_s: T,
+    /// `1/mean_tau_s`, 1/s.
+    inv_mean_tau: T,
+}
+
+impl<T: Real> HardIronThresholds<T> {
+    pub(crate) fn of(config: &HardIronConfig) -> Self {
+        let (min, max) = (T::of(config.min_offset_rel), T::of(config.max_spread_rel));
+        Self {
+            min_offset2: min * min,
+            max_spread2: max * max,
+            min_turn_rad: T::of(config.min_turn_rad),
+            min_consistent_s: T::of(2.0 * config.mean_tau_s),
+            inv_mean_tau: T::of(1.0 / config.mean_tau_s),
+        }
+    }
+}
+
 /// The running residual statistics and the adopted offset, in the float type `T` (the
-/// thresholds stay `f64`, converted where they are compared).
+/// thresholds stay `f64`, converted for each update; the filter converts them once).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 // `Real` includes serde's bounds on `T`.
 #[serde(bound = "")]
@@ -140,6 +168,21 @@ impl<T: Real> HardIronEstimator<T> {
         rate_rps: T,
         dt_s: T,
     ) -> Option<Vector3<T>> {
+        let th = HardIronThresholds::of(&self.config);
+        self.update_with(&th, m, r, reference_ned, rate_rps, dt_s)
+    }
+
+    /// [`Self::update`] with the thresholds already converted (`th` of this estimator's
+    /// configuration).
+    pub(crate) fn update_with(
+        &mut self,
+        th: &HardIronThresholds<T>,
+        m: &Vector3<T>,
+        r: &Matrix3<T>,
+        reference_ned: &Vector3<T>,
+        rate_rps: T,
+        dt_s: T,
+    ) -> Option<Vector3<T>> {
         if !self.config.enabled {
             return None;
         }
@@ -150,14 +193,13 @@ impl<T: Real> HardIronEstimator<T> {
             return self.offset;
         }
         if self.gain.0 != dt_s {
-            self.gain = (dt_s, (dt_s / T::of(self.config.mean_tau_s)).min(T::one()));
+            self.gain = (dt_s, at_most(dt_s * th.inv_mean_tau, T::one()));
         }
         let k = self.gain.1;
         self.mean += (r - self.mean) * k;
         self.spread2 += ((r - self.mean).norm_squared() - self.spread2) * k;
         let n2 = reference_ned.norm_squared();
-        let min = T::of(self.config.min_offset_rel);
-        if self.mean.norm_squared() < T::of(0.25) * min * min * n2 {
+        if self.mean.norm_squared() < T::of(0.25) * th.min_offset2 * n2 {
             // The raw reading agrees with the earth's field again: the magnet is gone.
             // (No consistency is asked for: removing it is a transient.)
             self.offset = None;
@@ -165,8 +207,7 @@ impl<T: Real> HardIronEstimator<T> {
             self.consistent_s = T::zero();
             return None;
         }
-        let max_spread = T::of(self.config.max_spread_rel);
-        if self.spread2 > max_spread * max_spread * n2 {
+        if self.spread2 > th.max_spread2 * n2 {
             // Not one body-fixed offset (or the attitude is off): keep what was adopted.
             self.turned_rad = T::zero();
             self.consistent_s = T::zero();
@@ -178,9 +219,9 @@ impl<T: Real> HardIronEstimator<T> {
         // offset from a heading error (at rest both are constant), so the offset is adopted
         // and followed only then, and only once the running statistics span twice their
         // time constant of such a period.
-        if self.turned_rad >= T::of(self.config.min_turn_rad)
-            && self.consistent_s >= T::of(2.0 * self.config.mean_tau_s)
-            && self.mean.norm_squared() > min * min * n2
+        if self.turned_rad >= th.min_turn_rad
+            && self.consistent_s >= th.min_consistent_s
+            && self.mean.norm_squared() > th.min_offset2 * n2
         {
             self.offset = Some(self.mean);
         }

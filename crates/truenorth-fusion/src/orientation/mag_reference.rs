@@ -11,6 +11,7 @@
 use serde::{Deserialize, Serialize};
 use truenorth_core::{Error, Real, Result, Validate, check_positive, check_range};
 
+use super::min_max::at_most;
 use super::real_checks::{check_finite_in, check_range_in};
 
 #[cfg(not(feature = "std"))]
@@ -64,11 +65,50 @@ impl Validate for MagReferenceConfig {
     }
 }
 
+/// The tolerances of a [`MagReferenceConfig`] in the reference's float type, as
+/// [`MagReference`] compares with them: converted once by the filter that owns it, not per
+/// sample.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct MagThresholds<T> {
+    /// `(1 − norm_tol_rel)²` (0 beyond a tolerance of 1) and `(1 + norm_tol_rel)²`.
+    norm_low2: T,
+    norm_high2: T,
+    new_reference_s: T,
+    /// The moving time a candidate needs, a fifth of `new_reference_s`.
+    new_reference_moving_s: T,
+    new_reference_min_rate_rps: T,
+    /// `1/reference_tau_s` and `1/new_reference_s`, 1/s.
+    inv_reference_tau: T,
+    inv_new_reference: T,
+}
+
+impl<T: Real> MagThresholds<T> {
+    pub(crate) fn of(config: &MagReferenceConfig) -> Self {
+        let tol = T::of(config.norm_tol_rel);
+        let low = if tol < T::one() {
+            T::one() - tol
+        } else {
+            T::zero()
+        };
+        let high = T::one() + tol;
+        Self {
+            norm_low2: low * low,
+            norm_high2: high * high,
+            new_reference_s: T::of(config.new_reference_s),
+            new_reference_moving_s: T::of(0.2 * config.new_reference_s),
+            new_reference_min_rate_rps: T::of(config.new_reference_min_rate_rps),
+            inv_reference_tau: T::of(1.0 / config.reference_tau_s),
+            inv_new_reference: T::of(1.0 / config.new_reference_s),
+        }
+    }
+}
+
 /// The learned field reference and the candidate for a new one, each kept as its horizontal
 /// and vertical components in the level frame (so that no angle has to be computed per
 /// sample: the dip test compares `sin(dip − dip_ref)`, a cross product of the two).
 ///
-/// In the float type `T`; the tolerances stay `f64`, converted where they are compared.
+/// In the float type `T`; the tolerances stay `f64`, converted for each update (the filter
+/// converts them once).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 // `Real` includes serde's bounds on `T`.
 #[serde(bound = "")]
@@ -128,18 +168,29 @@ impl<T: Real> MagReference<T> {
     /// one while rotating at `rate_rps`. Returns `true` when it is undisturbed (and may
     /// correct heading).
     pub fn update(&mut self, horizontal: T, vertical: T, rate_rps: T, dt_s: T) -> bool {
+        let th = MagThresholds::of(&self.config);
+        self.update_with(&th, horizontal, vertical, rate_rps, dt_s)
+    }
+
+    /// [`Self::update`] with the tolerances already converted (`th` of this reference's
+    /// configuration).
+    pub(crate) fn update_with(
+        &mut self,
+        th: &MagThresholds<T>,
+        horizontal: T,
+        vertical: T,
+        rate_rps: T,
+        dt_s: T,
+    ) -> bool {
         if !self.valid {
             self.adopt(horizontal, vertical);
             return true;
         }
         if self.gain.0 != dt_s {
-            self.gain = (
-                dt_s,
-                (dt_s / T::of(self.config.reference_tau_s)).min(T::one()),
-            );
+            self.gain = (dt_s, at_most(dt_s * th.inv_reference_tau, T::one()));
         }
         let k = self.gain.1;
-        if self.agrees(self.horizontal, self.vertical, horizontal, vertical) {
+        if self.agrees(th, self.horizontal, self.vertical, horizontal, vertical) {
             self.horizontal += (horizontal - self.horizontal) * k;
             self.vertical += (vertical - self.vertical) * k;
             self.candidate_s = T::zero();
@@ -148,6 +199,7 @@ impl<T: Real> MagReference<T> {
         }
         if self.candidate_s > T::zero()
             && self.agrees(
+                th,
                 self.candidate_horizontal,
                 self.candidate_vertical,
                 horizontal,
@@ -155,10 +207,10 @@ impl<T: Real> MagReference<T> {
             )
         {
             self.candidate_s += dt_s;
-            if rate_rps >= T::of(self.config.new_reference_min_rate_rps) {
+            if rate_rps >= th.new_reference_min_rate_rps {
                 self.candidate_moving_s += dt_s;
             }
-            let kc = (dt_s / T::of(self.config.new_reference_s)).min(T::one());
+            let kc = at_most(dt_s * th.inv_new_reference, T::one());
             self.candidate_horizontal += (horizontal - self.candidate_horizontal) * kc;
             self.candidate_vertical += (vertical - self.candidate_vertical) * kc;
         } else {
@@ -168,8 +220,8 @@ impl<T: Real> MagReference<T> {
             self.candidate_s = dt_s.max(T::of(f64::MIN_POSITIVE));
             self.candidate_moving_s = T::zero();
         }
-        if self.candidate_s >= T::of(self.config.new_reference_s)
-            && self.candidate_moving_s >= T::of(0.2 * self.config.new_reference_s)
+        if self.candidate_s >= th.new_reference_s
+            && self.candidate_moving_s >= th.new_reference_moving_s
         {
             self.adopt(self.candidate_horizontal, self.candidate_vertical);
             return true;
@@ -196,14 +248,17 @@ impl<T: Real> MagReference<T> {
     }
 
     /// Norm within `norm_tol_rel` and dip within `dip_tol_rad` of the reference `(h0, v0)`:
-    /// `|sin(dip − dip₀)| = |v·h₀ − h·v₀| / (|m| |m₀|)`, the dips being within ±90°.
-    fn agrees(&self, h0: T, v0: T, h: T, v: T) -> bool {
+    /// `|sin(dip − dip₀)| = |v·h₀ − h·v₀| / (|m| |m₀|)`, the dips being within ±90°. Both
+    /// tests are taken squared, which needs no square root: `(1 − tol)² |m₀|² ≤ |m|² ≤
+    /// (1 + tol)² |m₀|²` and `(v·h₀ − h·v₀)² ≤ sin²(dip_tol) |m|² |m₀|²`.
+    fn agrees(&self, th: &MagThresholds<T>, h0: T, v0: T, h: T, v: T) -> bool {
         // Components of real fields (and of the clamped readings the filter passes) are far
-        // from overflowing a square, so no `hypot` is needed.
-        let n0 = (h0 * h0 + v0 * v0).sqrt();
-        let n = (h * h + v * v).sqrt();
-        (n - n0).abs() <= T::of(self.config.norm_tol_rel) * n0
-            && (v * h0 - h * v0).abs() <= self.sin_dip_tol * n * n0
+        // from overflowing a square or a product of two.
+        let n02 = h0 * h0 + v0 * v0;
+        let n2 = h * h + v * v;
+        let cross = v * h0 - h * v0;
+        let sin2 = self.sin_dip_tol * self.sin_dip_tol;
+        n2 <= th.norm_high2 * n02 && n2 >= th.norm_low2 * n02 && cross * cross <= sin2 * n2 * n02
     }
 
     /// Checks a restored reference against the tolerances `config` of its filter: the same

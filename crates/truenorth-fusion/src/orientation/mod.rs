@@ -14,6 +14,7 @@ mod euler_state;
 mod gyro_conditioner;
 mod hard_iron;
 mod mag_reference;
+mod min_max;
 mod moving_average;
 mod quaternion_config;
 mod quaternion_filter;

@@ -1,8 +1,9 @@
 //! Parameters of the [`crate::QuaternionFilter`] (the derived per-sample gains are computed
 //! in the filter from these and the sample interval).
 
+use serde::de::IgnoredAny;
 use serde::{Deserialize, Serialize};
-use truenorth_core::{Result, Validate, check_positive, check_range};
+use truenorth_core::{Error, Result, Validate, check_positive, check_range};
 
 use super::attitude_uncertainty::AttitudeUncertaintyConfig;
 use super::hard_iron::HardIronConfig;
@@ -27,16 +28,23 @@ pub enum GyroTiming {
 }
 
 /// Parameters of the [`crate::QuaternionFilter`]. Times in seconds, rates in rad/s.
+///
+/// Read with serde, every field is optional (its default when absent). A configuration that
+/// names `acc_lowpass_s` is refused, with what replaced it: that was the time constant of a
+/// first-order low-pass ahead of a correction of time constant `tau_acc_s` (until the
+/// filter's state layout 2), and both are now the one second-order low-pass of
+/// `tau_acc_s`, so such a file's `tau_acc_s` meant something else.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(default)]
+#[serde(try_from = "ConfigFields")]
 pub struct QuaternionFilterConfig {
     /// How the gyro's samples are integrated (default [`GyroTiming::IntervalMean`]).
     pub gyro_timing: GyroTiming,
-    /// Time constant of the inclination correction, s (default 3).
+    /// Time constant of the inclination correction, s (default 2): that of the second-order
+    /// Butterworth low-pass (cut-off `1/(2π τ)`) the specific force passes in the
+    /// almost-inertial frame before it levels the attitude. Chosen on the BROAD trials
+    /// (`tests/broad.rs`): 1.5 s is best on the half with most fast rotation, 2.5 s on the
+    /// half with most translation, 2 s within 2 % of either's best.
     pub tau_acc_s: f64,
-    /// Time constant of the low-pass applied to the specific force in the reference frame
-    /// before the inclination correction, s (default 1).
-    pub acc_lowpass_s: f64,
     /// Time constant of the heading correction while the sensor moves, s (default 15).
     pub tau_mag_s: f64,
     /// Time constant of the heading correction while the sensor rests, s (default 5): at
@@ -78,6 +86,9 @@ pub struct QuaternionFilterConfig {
     /// `gap`). Half a second also makes a millisecond time column read as seconds a gap at
     /// every step for every IMU up to 2 kHz, which the filter refuses as implausible.
     pub max_gap_s: f64,
+    /// Propagate the attitude's σ and report it as `sigma_rad` (default `true`); `false`
+    /// saves its cost (about a third of an update) and reports none.
+    pub sigma: bool,
     /// The sensors' error model behind `sigma_rad`.
     pub uncertainty: AttitudeUncertaintyConfig,
 }
@@ -86,8 +97,7 @@ impl Default for QuaternionFilterConfig {
     fn default() -> Self {
         Self {
             gyro_timing: GyroTiming::IntervalMean,
-            tau_acc_s: 3.0,
-            acc_lowpass_s: 1.0,
+            tau_acc_s: 2.0,
             tau_mag_s: 15.0,
             tau_mag_rest_s: 5.0,
             bias_tau_motion_s: 400.0,
@@ -102,15 +112,105 @@ impl Default for QuaternionFilterConfig {
             use_mag: true,
             initial_attitude: None,
             max_gap_s: 0.5,
+            sigma: true,
             uncertainty: AttitudeUncertaintyConfig::default(),
         }
+    }
+}
+
+/// A [`QuaternionFilterConfig`] as read, before the check for the parameter it no longer has.
+#[derive(Deserialize)]
+#[serde(default)]
+struct ConfigFields {
+    gyro_timing: GyroTiming,
+    tau_acc_s: f64,
+    tau_mag_s: f64,
+    tau_mag_rest_s: f64,
+    bias_tau_motion_s: f64,
+    bias_tau_unknown_s: f64,
+    bias_known_after_rest_s: f64,
+    bias_tau_rest_s: f64,
+    max_bias_rps: f64,
+    startup_s: f64,
+    rest: RestConfig,
+    mag: MagReferenceConfig,
+    hard_iron: HardIronConfig,
+    use_mag: bool,
+    initial_attitude: Option<[f64; 4]>,
+    max_gap_s: f64,
+    sigma: bool,
+    uncertainty: AttitudeUncertaintyConfig,
+    /// Any value: the key alone is refused.
+    acc_lowpass_s: Option<IgnoredAny>,
+}
+
+impl Default for ConfigFields {
+    fn default() -> Self {
+        let d = QuaternionFilterConfig::default();
+        Self {
+            gyro_timing: d.gyro_timing,
+            tau_acc_s: d.tau_acc_s,
+            tau_mag_s: d.tau_mag_s,
+            tau_mag_rest_s: d.tau_mag_rest_s,
+            bias_tau_motion_s: d.bias_tau_motion_s,
+            bias_tau_unknown_s: d.bias_tau_unknown_s,
+            bias_known_after_rest_s: d.bias_known_after_rest_s,
+            bias_tau_rest_s: d.bias_tau_rest_s,
+            max_bias_rps: d.max_bias_rps,
+            startup_s: d.startup_s,
+            rest: d.rest,
+            mag: d.mag,
+            hard_iron: d.hard_iron,
+            use_mag: d.use_mag,
+            initial_attitude: d.initial_attitude,
+            max_gap_s: d.max_gap_s,
+            sigma: d.sigma,
+            uncertainty: d.uncertainty,
+            acc_lowpass_s: None,
+        }
+    }
+}
+
+impl TryFrom<ConfigFields> for QuaternionFilterConfig {
+    type Error = Error;
+
+    fn try_from(f: ConfigFields) -> Result<Self> {
+        if f.acc_lowpass_s.is_some() {
+            return Err(Error::Unsupported {
+                reason: "acc_lowpass_s is no longer a parameter of the quaternion filter: the \
+                         inclination's low-pass is one second-order Butterworth filter of time \
+                         constant tau_acc_s (default 2 s), which also replaces the correction \
+                         tau_acc_s used to name. Remove acc_lowpass_s and set tau_acc_s anew \
+                         (the same lag behind a steady drift as the old pair: (acc_lowpass_s + \
+                         tau_acc_s)/√2)",
+            });
+        }
+        Ok(Self {
+            gyro_timing: f.gyro_timing,
+            tau_acc_s: f.tau_acc_s,
+            tau_mag_s: f.tau_mag_s,
+            tau_mag_rest_s: f.tau_mag_rest_s,
+            bias_tau_motion_s: f.bias_tau_motion_s,
+            bias_tau_unknown_s: f.bias_tau_unknown_s,
+            bias_known_after_rest_s: f.bias_known_after_rest_s,
+            bias_tau_rest_s: f.bias_tau_rest_s,
+            max_bias_rps: f.max_bias_rps,
+            startup_s: f.startup_s,
+            rest: f.rest,
+            mag: f.mag,
+            hard_iron: f.hard_iron,
+            use_mag: f.use_mag,
+            initial_attitude: f.initial_attitude,
+            max_gap_s: f.max_gap_s,
+            sigma: f.sigma,
+            uncertainty: f.uncertainty,
+        })
     }
 }
 
 impl Validate for QuaternionFilterConfig {
     fn validate(&self) -> Result<()> {
         check_positive("tau_acc_s", self.tau_acc_s)?;
-        check_positive("acc_lowpass_s", self.acc_lowpass_s)?;
         check_positive("tau_mag_s", self.tau_mag_s)?;
         check_positive("tau_mag_rest_s", self.tau_mag_rest_s)?;
         check_range(

@@ -5,14 +5,17 @@
 //! Per sample (body → NED quaternion `q`, Hamilton, scalar first):
 //! 1. **Strapdown**: `q ← q ⊗ exp((ω − b̂) dt / 2)`, with the rate the gyro's timing calls
 //!    for ([`GyroTiming`]).
-//! 2. **Inclination**: the specific force rotated into NED and low-passed there (its mean
-//!    over a swing is gravity alone) should point up, `(0, 0, −1)`; `q` is turned about the
-//!    horizontal axis by `dt/τ_acc` times the horizontal part of it over g — a
-//!    complementary filter (Mahony, Hamel & Pflimlin, IEEE TAC 53(5), 2008) with the error
-//!    formed in the reference frame so that heading is untouched, and the low-pass of the
-//!    reference-frame acceleration that VQF introduced (Laidig & Seel, Information Fusion
-//!    91, 2023). The low-passed vector is turned with every correction so that it stays in
-//!    the frame of `q`.
+//! 2. **Inclination**: the specific force rotated into NED is low-passed there by a
+//!    second-order Butterworth filter of time constant `τ_acc`, and `q` is turned about the
+//!    horizontal axis so that the low-passed force points up, `(0, 0, −1)`: its horizontal
+//!    part over g, wholly, every sample. This is VQF's inclination correction (Laidig &
+//!    Seel, *VQF*, Information Fusion 91, 2023, §IV-B): low-passed in the frame the gyro
+//!    alone keeps (almost inertial), the body's accelerations average out before they tilt
+//!    anything, while a gyro error moves that frame only slowly; the low-passed vector and
+//!    its rate are turned with every correction so that they stay in that frame. A
+//!    Butterworth low-pass rejects a swing's acceleration three times better than a
+//!    first-order low-pass followed by a first-order correction with the same lag behind a
+//!    steady drift (`1/(τ²ω²)` against `1/(3τ²ω²)` at high frequency for a lag of `√2 τ`).
 //!    The correction is linear in the specific force (its horizontal part over g), so the
 //!    body's own accelerations, which average to zero over any swing, cancel; weighting
 //!    readings by how far |a| is from g, or using the angle, biases the average.
@@ -49,17 +52,18 @@ use truenorth_core::{
     AttitudeEstimate, AttitudeStatus, Real, Result, STANDARD_GRAVITY_MPS2, Validate,
 };
 
+use super::attitude_uncertainty::HeadingCorrection;
 use super::quaternion_config::{GyroTiming, QuaternionFilterConfig};
-use super::quaternion_gains::{Coefficients, effective_tau};
+use super::quaternion_gains::{Coefficients, Gains};
 use super::quaternion_state::QuaternionFilterState;
-use super::rotation::{rotation_from_vector, small_rotation};
+use super::rotation::{inv_norm, renormalized, rotation_from_vector, small_rotation};
 
 /// What the parts of one step share.
 struct StepContext<T> {
     dt_s: T,
     /// The step falls in the start-up (fast corrections, no bias learning).
     startup: bool,
-    gains: Coefficients<T>,
+    gains: Gains<T>,
     at_rest: bool,
     /// Body → NED after the strapdown, before the step's corrections: one rotation matrix
     /// serves every vector rotated in the step.
@@ -131,7 +135,7 @@ impl<T: Real> QuaternionFilter<T> {
     /// The filter continuing from a valid `state`.
     pub(super) fn with_state(state: QuaternionFilterState<T>) -> Self {
         Self {
-            coefficients: Coefficients::new(&state.config, T::zero(), false),
+            coefficients: Coefficients::new(&state.config),
             state,
         }
     }
@@ -147,21 +151,25 @@ impl<T: Real> QuaternionFilter<T> {
         self.state.hard_iron.offset()
     }
 
-    /// One step of `dt_s` ending at `t_s`, in the order of the module documentation: the
+    /// One step of `dt_s`, in the order of the module documentation: the
     /// strapdown, the σ carried through it, the corrections the sample's readings allow
     /// (applied together at the end: at most 10⁻³ rad each), the gyro bias.
     pub(super) fn step(
         &mut self,
-        t_s: f64,
         dt_s: T,
         gyr: Vector3<T>,
         acc: Option<Vector3<T>>,
         mag: Option<Vector3<T>>,
     ) -> AttitudeStatus {
         let startup = self.advance_time(dt_s);
-        let gains = self.gains(dt_s, startup);
+        let gains = self.coefficients.gains(dt_s, startup);
         let omega = self.strapdown(dt_s, gyr);
-        let at_rest = acc.is_some_and(|a| self.state.rest.update(&gyr, &a, mag.as_ref(), dt_s));
+        let rest = &self.coefficients.rest;
+        let at_rest = acc.is_some_and(|a| {
+            self.state
+                .rest
+                .update_with(rest, &gyr, &a, mag.as_ref(), dt_s)
+        });
         let step = StepContext {
             dt_s,
             startup,
@@ -170,7 +178,9 @@ impl<T: Real> QuaternionFilter<T> {
             rotation: *self.state.attitude.to_rotation_matrix().matrix(),
             rate_rps: omega.norm(),
         };
-        self.propagate_uncertainty(&step, &omega);
+        if self.state.config.sigma {
+            self.propagate_uncertainty(&step, &omega);
+        }
         let mut status = AttitudeStatus {
             at_rest,
             ..AttitudeStatus::default()
@@ -191,26 +201,14 @@ impl<T: Real> QuaternionFilter<T> {
         if !startup {
             self.estimate_bias(&step, &correction);
         }
-        self.state.estimate = Some(self.estimate_at(t_s, status));
+        self.state.status = status;
         status
     }
 
     /// Counts the step's time and says whether it falls in the start-up.
     fn advance_time(&mut self, dt_s: T) -> bool {
         self.state.since_start_s += dt_s;
-        self.state.since_start_s < T::of(self.state.config.startup_s)
-    }
-
-    /// The gains for a step of `dt_s`: the start-up's computed afresh, the others kept
-    /// until the interval changes.
-    fn gains(&mut self, dt_s: T, startup: bool) -> Coefficients<T> {
-        if startup {
-            return Coefficients::new(&self.state.config, dt_s, true);
-        }
-        if self.coefficients.dt_s != dt_s {
-            self.coefficients = Coefficients::new(&self.state.config, dt_s, false);
-        }
-        self.coefficients
+        self.state.since_start_s < self.coefficients.startup_s
     }
 
     /// Strapdown: `q ← q ⊗ exp((ω − b̂) dt / 2)` with the rate the gyro's timing calls for.
@@ -223,17 +221,19 @@ impl<T: Real> QuaternionFilter<T> {
         };
         s.last_gyr_rps = Some(gyr);
         let omega = rate - s.gyro_bias_rps;
-        s.attitude = UnitQuaternion::new_normalize(
-            s.attitude.into_inner() * rotation_from_vector(&(omega * dt_s)),
-        );
+        s.attitude = renormalized(s.attitude.into_inner() * rotation_from_vector(&(omega * dt_s)));
         omega
     }
 
     /// Carries the σ through the strapdown step at body rate `omega` (bias removed).
     fn propagate_uncertainty(&mut self, step: &StepContext<T>, omega: &Vector3<T>) {
-        self.state
-            .uncertainty
-            .propagate(step.dt_s, omega, step.rate_rps, &step.rotation);
+        self.state.uncertainty.propagate(
+            &self.coefficients.uncertainty,
+            step.dt_s,
+            omega,
+            step.rate_rps,
+            &step.rotation,
+        );
     }
 
     /// The in-motion bias estimate's 1/τ as the σ credits it: none while the bias does not
@@ -247,8 +247,7 @@ impl<T: Real> QuaternionFilter<T> {
     }
 
     /// Inclination: the specific force `a` rotated into NED and low-passed there should
-    /// point up; adds the turn about the horizontal that moves it there by `dt/τ_acc` to
-    /// `correction`.
+    /// point up; adds the turn about the horizontal that moves it there to `correction`.
     fn correct_inclination(
         &mut self,
         step: &StepContext<T>,
@@ -256,15 +255,18 @@ impl<T: Real> QuaternionFilter<T> {
         correction: &mut Vector3<T>,
     ) {
         let inv_tau_bias = self.bias_inv_tau_credited(step);
+        let loop_constants = &self.coefficients.taus(step.startup).inclination;
         let s = &mut self.state;
-        let cfg = &s.config;
         // Linear in the specific force: the body's own accelerations average out over a
-        // swing, where an angle (atan of horizontal over vertical) would not. A first
-        // low-pass in the reference frame before the proportional correction makes the
-        // response to acceleration second order.
+        // swing, where an angle (atan of horizontal over vertical) would not.
         let f = step.rotation * a;
         let lp = match s.acc_lowpass_ned_mps2 {
-            Some(lp) => lp + (f - lp) * step.gains.acc_lowpass,
+            Some(lp) => {
+                let [p11, p12, p21, p22] = step.gains.acc_lowpass;
+                let (e, rate) = (lp - f, s.acc_lowpass_rate_ned_mps3);
+                s.acc_lowpass_rate_ned_mps3 = e * p21 + rate * p22;
+                f + e * p11 + rate * p12
+            }
             None => f,
         };
         s.acc_lowpass_ned_mps2 = Some(lp);
@@ -272,7 +274,7 @@ impl<T: Real> QuaternionFilter<T> {
         // (sin θ ≈ θ); a force of g shows at most sin θ = 1, so a horizontal
         // part beyond g·π/2 (a shock, a saturated or corrupt reading) is no tilt the
         // linearised correction describes and counts as π/2 of it: the step's correction
-        // stays within `dt/τ_acc · π/2`, and the σ's record of it within π/2.
+        // stays within π/2 (and within the 0.1 rad `small_rotation` turns per step).
         let max_h = T::of(STANDARD_GRAVITY_MPS2 * core::f64::consts::FRAC_PI_2);
         let h2 = lp.x * lp.x + lp.y * lp.y;
         let scale = if h2 > max_h * max_h {
@@ -280,17 +282,19 @@ impl<T: Real> QuaternionFilter<T> {
         } else {
             T::one()
         };
-        let k = step.gains.acc * scale;
-        // down × ẑ with down = −lp/g.
+        // The whole tilt the low-passed force shows is corrected at once: the low-pass
+        // alone sets the dynamics. down × ẑ with down = −lp/g.
+        let k = scale * T::of(1.0 / STANDARD_GRAVITY_MPS2);
         correction.x = -lp.y * k;
         correction.y = lp.x * k;
-        s.uncertainty.accel_corrected(
-            step.gains.acc * T::of(STANDARD_GRAVITY_MPS2),
-            (correction.x, correction.y),
-            effective_tau(T::of(cfg.tau_acc_s), step.startup),
-            inv_tau_bias,
-            effective_tau(T::of(cfg.acc_lowpass_s), step.startup),
-        );
+        if s.config.sigma {
+            s.uncertainty.accel_corrected(
+                loop_constants,
+                step.dt_s,
+                (correction.x, correction.y),
+                inv_tau_bias,
+            );
+        }
     }
 
     /// Heading: the field `m`, less any hard iron learned online, rotated into NED should
@@ -309,22 +313,33 @@ impl<T: Real> QuaternionFilter<T> {
         let m_ned = step.rotation * (m - offset.unwrap_or_else(Vector3::zeros));
         let horizontal = m_ned.xy().norm();
         if horizontal > T::zero() {
-            let undisturbed =
-                self.state
-                    .mag_reference
-                    .update(horizontal, m_ned.z, step.rate_rps, mag_dt_s);
+            let undisturbed = self.state.mag_reference.update_with(
+                &self.coefficients.mag,
+                horizontal,
+                m_ned.z,
+                step.rate_rps,
+                mag_dt_s,
+            );
             status.mag_disturbed = !undisturbed;
             if undisturbed && horizontal > T::of(1e-9) * m_ned.z.abs() {
                 let k = self.heading_gain(step, mag_dt_s);
                 let dz = -k * heading_error(&m_ned, horizontal);
                 correction.z = dz;
-                // An offset learned from the attitude cannot also tell its error.
-                if !status.mag_calibrating {
-                    self.credit_heading_uncertainty(step, k, &m_ned, horizontal);
+                // An offset learned from the attitude cannot also tell its error, but the
+                // field it corrects still holds the heading where it was adopted.
+                if !self.state.config.sigma {
+                    // No σ to carry.
+                } else if status.mag_calibrating {
+                    self.state.uncertainty.heading_held(k);
+                } else {
+                    self.credit_heading_uncertainty(step, k, dz, &m_ned, horizontal);
                 }
                 self.undo_heading_correction(dz);
                 status.mag_used = true;
             }
+        }
+        if !status.mag_used && self.state.config.sigma {
+            self.state.uncertainty.heading_untrusted();
         }
     }
 
@@ -343,9 +358,14 @@ impl<T: Real> QuaternionFilter<T> {
         } else {
             step.rate_rps
         };
-        self.state
-            .hard_iron
-            .update(m, &step.rotation, &reference, turning_rps, mag_dt_s)
+        self.state.hard_iron.update_with(
+            &self.coefficients.hard_iron,
+            m,
+            &step.rotation,
+            &reference,
+            turning_rps,
+            mag_dt_s,
+        )
     }
 
     /// The heading correction's gain: at rest or in motion, and covering the samples
@@ -356,10 +376,10 @@ impl<T: Real> QuaternionFilter<T> {
             (true, true) => c.mag_rest,
             (false, true) => c.mag,
             // A reading after samples without one covers their time too.
-            (rest, false) => {
-                let g = Coefficients::new(&self.state.config, mag_dt_s, step.startup);
-                if rest { g.mag_rest } else { g.mag }
-            }
+            (rest, false) => self
+                .coefficients
+                .taus(step.startup)
+                .mag_gain(mag_dt_s, rest),
         }
     }
 
@@ -369,6 +389,7 @@ impl<T: Real> QuaternionFilter<T> {
         &mut self,
         step: &StepContext<T>,
         k: T,
+        dz: T,
         m_ned: &Vector3<T>,
         horizontal: T,
     ) {
@@ -376,18 +397,24 @@ impl<T: Real> QuaternionFilter<T> {
             return;
         };
         let inv_tau_bias = self.bias_inv_tau_credited(step);
-        let cfg = &self.state.config;
-        let tau = if step.at_rest {
-            cfg.tau_mag_rest_s
-        } else {
-            cfg.tau_mag_s
+        let c = &self.coefficients;
+        let taus = c.taus(step.startup);
+        let correction = HeadingCorrection {
+            k,
+            tau_s: if step.at_rest {
+                taus.mag_rest
+            } else {
+                taus.mag
+            },
+            dz,
+            inv_tau_bias,
         };
         self.state.uncertainty.mag_corrected(
-            k,
-            effective_tau(T::of(tau), step.startup),
+            &c.uncertainty,
+            &taus.inclination,
+            &correction,
             (horizontal, m_ned.z),
             (reference.x, reference.z),
-            inv_tau_bias,
         );
     }
 
@@ -397,8 +424,8 @@ impl<T: Real> QuaternionFilter<T> {
         let (c, sn) = self.state.undo_heading;
         let h = T::of(0.5) * dz;
         let (c, sn) = (c + sn * h, sn - c * h);
-        let n = (c * c + sn * sn).sqrt();
-        self.state.undo_heading = (c / n, sn / n);
+        let n = inv_norm(c * c + sn * sn);
+        self.state.undo_heading = (c * n, sn * n);
     }
 
     /// Turns the attitude by the step's `correction` (in the reference frame), and the
@@ -413,6 +440,7 @@ impl<T: Real> QuaternionFilter<T> {
             let turn = small_rotation(correction);
             s.attitude = turn * s.attitude;
             s.acc_lowpass_ned_mps2 = s.acc_lowpass_ned_mps2.map(|lp| turn * lp);
+            s.acc_lowpass_rate_ned_mps3 = turn * s.acc_lowpass_rate_ned_mps3;
         }
     }
 
@@ -430,7 +458,7 @@ impl<T: Real> QuaternionFilter<T> {
             let s = &mut self.state;
             s.gyro_bias_rps -= step.rotation.tr_mul(correction) * s.bias_inv_tau_motion_per_s;
         }
-        let lim = T::of(self.state.config.max_bias_rps);
+        let lim = self.coefficients.max_bias_rps;
         self.state.gyro_bias_rps = self.state.gyro_bias_rps.map(|b| b.clamp(-lim, lim));
     }
 
@@ -438,32 +466,34 @@ impl<T: Real> QuaternionFilter<T> {
     /// moves from `bias_tau_unknown_s` to `bias_tau_motion_s` as rest time accumulates.
     fn learn_bias_at_rest(&mut self, step: &StepContext<T>) {
         let s = &mut self.state;
-        let cfg = &s.config;
+        let c = &self.coefficients;
         let k = step.gains.bias_rest;
         s.gyro_bias_rps += (s.rest.gyro_mean() - s.gyro_bias_rps) * k;
-        s.uncertainty
-            .at_rest(k, cfg.rest.mean_tau_s, cfg.bias_tau_rest_s);
-        let known_after_s = T::of(cfg.bias_known_after_rest_s);
+        if s.config.sigma {
+            s.uncertainty.at_rest(&c.uncertainty, k);
+        }
+        let known_after_s = c.bias_known_after_rest_s;
         if s.rest_s < known_after_s {
             s.rest_s += step.dt_s;
             let known = (s.rest_s / known_after_s).min(T::one());
-            let tau = T::of(cfg.bias_tau_unknown_s)
-                + known * T::of(cfg.bias_tau_motion_s - cfg.bias_tau_unknown_s);
+            let tau = c.bias_tau_unknown_s + known * c.bias_tau_change_s;
             s.bias_inv_tau_motion_per_s = T::one() / tau;
         }
     }
 
-    /// The estimate after the step: the attitude, the 6-D attitude with every heading
-    /// correction undone, the bias and σ, as the `f64` record every estimator returns.
-    fn estimate_at(&self, t_s: f64, status: AttitudeStatus) -> AttitudeEstimate {
+    /// The estimate after the last sample (before the first: the initial attitude, time
+    /// NaN): the attitude, the 6-D attitude with every heading correction undone, the bias
+    /// and σ, as the `f64` record every estimator returns. Built from the state when asked
+    /// for, so that an update that is not read costs none of it.
+    pub(super) fn estimate_now(&self) -> AttitudeEstimate {
         let s = &self.state;
         AttitudeEstimate {
-            t_s,
+            t_s: s.clock.last_s().unwrap_or(f64::NAN),
             attitude: attitude_f64(&s.attitude),
             attitude_6d: Some(attitude_f64(&self.attitude_6d())),
             gyro_bias_rps: s.gyro_bias_rps.map(T::to_f64),
-            sigma_rad: Some(s.uncertainty.sigma_rad().map(T::to_f64)),
-            status,
+            sigma_rad: self.sigma_rad().map(|v| v.map(T::to_f64)),
+            status: s.status,
         }
     }
 
@@ -477,6 +507,10 @@ impl<T: Real> QuaternionFilter<T> {
     /// estimate's `attitude_6d`, in the filter's float type.
     pub fn attitude_6d(&self) -> UnitQuaternion<T> {
         let (c, sn) = self.state.undo_heading;
+        if (c, sn) == (T::one(), T::zero()) {
+            // No heading correction yet (or since a gap): the attitude itself, bit for bit.
+            return self.state.attitude;
+        }
         let undo = UnitQuaternion::new_unchecked(Quaternion::new(c, T::zero(), T::zero(), sn));
         undo * self.state.attitude
     }
@@ -488,13 +522,17 @@ impl<T: Real> QuaternionFilter<T> {
     }
 
     /// One σ of the attitude error about north, east and down, rad: the estimate's
-    /// `sigma_rad`, in the filter's float type.
-    pub fn sigma_rad(&self) -> Vector3<T> {
-        self.state.uncertainty.sigma_rad()
+    /// `sigma_rad`, in the filter's float type; `None` when the configuration switches the
+    /// σ off.
+    pub fn sigma_rad(&self) -> Option<Vector3<T>> {
+        self.state
+            .config
+            .sigma
+            .then(|| self.state.uncertainty.sigma_rad())
     }
 }
 
 /// `q` as an `f64` quaternion (exact: every `T` converts to `f64` exactly).
-pub(super) fn attitude_f64<T: Real>(q: &UnitQuaternion<T>) -> UnitQuaternion<f64> {
+fn attitude_f64<T: Real>(q: &UnitQuaternion<T>) -> UnitQuaternion<f64> {
     UnitQuaternion::new_unchecked(Quaternion::from(q.coords.map(T::to_f64)))
 }

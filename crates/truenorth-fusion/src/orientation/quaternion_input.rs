@@ -11,13 +11,13 @@
 use nalgebra::Vector3;
 use truenorth_core::{
     AttitudeEstimate, AttitudeStatus, Error, ImuSample, OrientationEstimator, Persistent, Real,
-    Result, Validate, check_finite,
+    Result, Validate,
 };
 
 use super::quaternion_config::QuaternionFilterConfig;
-use super::quaternion_filter::{QuaternionFilter, attitude_f64};
+use super::quaternion_filter::QuaternionFilter;
 use super::quaternion_state::QuaternionFilterState;
-use super::real_checks::check_finite3_in;
+use super::real_checks::{check_finite_time, check_finite3_in};
 use super::sample_bounds::check_bounds;
 use super::time_gap::Step;
 use super::triad::attitude_from;
@@ -53,7 +53,7 @@ impl<T: Real> QuaternionFilter<T> {
         acc_mps2: Option<Vector3<T>>,
         mag: Option<Vector3<T>>,
     ) -> Result<AttitudeStatus> {
-        check_finite("timestamp t_s", t_s)?;
+        check_finite_time("timestamp t_s", t_s)?;
         check_finite3_in("gyro reading", &gyr_rps)?;
         if let Some(a) = &acc_mps2 {
             check_finite3_in("accelerometer reading", a)?;
@@ -90,26 +90,20 @@ impl<T: Real> QuaternionFilter<T> {
             self.state.gaps.count(step);
         }
         if let (Some(gap_s), Some(Step::Gap)) = (dt, step) {
-            return Ok(self.restart(t_s, gap_s, gyr, acc, mag));
+            return Ok(self.restart(gap_s, gyr, acc, mag));
         }
         let Some(dt_s) = dt else {
-            self.first_sample(t_s, gyr, acc, mag);
+            self.first_sample(gyr, acc, mag);
             return Ok(AttitudeStatus::default());
         };
-        let status = self.step(t_s, T::of(dt_s), gyr, acc, mag);
+        let status = self.step(T::of(dt_s), gyr, acc, mag);
         debug_assert!(self.state.attitude.coords.iter().all(|v| v.is_finite()));
         Ok(status)
     }
 
     /// The first sample: the attitude from its accelerometer (and magnetometer) unless one
     /// was given.
-    fn first_sample(
-        &mut self,
-        t_s: f64,
-        gyr: Vector3<T>,
-        acc: Option<Vector3<T>>,
-        mag: Option<Vector3<T>>,
-    ) {
+    fn first_sample(&mut self, gyr: Vector3<T>, acc: Option<Vector3<T>>, mag: Option<Vector3<T>>) {
         let s = &mut self.state;
         if !s.initialised
             && let Some(q) = acc.and_then(|a| attitude_from(&a, mag.as_ref()))
@@ -118,11 +112,7 @@ impl<T: Real> QuaternionFilter<T> {
             s.initialised = true;
         }
         s.last_gyr_rps = Some(gyr);
-        s.estimate = Some(AttitudeEstimate {
-            t_s,
-            sigma_rad: Some(s.uncertainty.sigma_rad().map(T::to_f64)),
-            ..AttitudeEstimate::initial(attitude_f64(&s.attitude))
-        });
+        s.status = AttitudeStatus::default();
     }
 
     /// Starts again after a gap of `gap_s` that the gyro cannot bridge: the attitude from
@@ -131,7 +121,6 @@ impl<T: Real> QuaternionFilter<T> {
     /// are properties of the sensor and carry over.
     fn restart(
         &mut self,
-        t_s: f64,
         gap_s: f64,
         gyr: Vector3<T>,
         acc: Option<Vector3<T>>,
@@ -143,23 +132,17 @@ impl<T: Real> QuaternionFilter<T> {
         }
         s.undo_heading = (T::one(), T::zero());
         s.acc_lowpass_ned_mps2 = None;
+        s.acc_lowpass_rate_ned_mps3 = Vector3::zeros();
         s.last_gyr_rps = Some(gyr);
         s.since_mag_s = T::zero();
         s.since_start_s = T::zero();
         s.uncertainty.restart(false, gap_s);
         s.rest.reset();
-        let status = AttitudeStatus {
+        s.status = AttitudeStatus {
             gap: true,
             ..AttitudeStatus::default()
         };
-        s.estimate = Some(AttitudeEstimate {
-            t_s,
-            gyro_bias_rps: s.gyro_bias_rps.map(T::to_f64),
-            sigma_rad: Some(s.uncertainty.sigma_rad().map(T::to_f64)),
-            status,
-            ..AttitudeEstimate::initial(attitude_f64(&s.attitude))
-        });
-        status
+        s.status
     }
 }
 
@@ -209,11 +192,7 @@ impl OrientationEstimator for QuaternionFilter {
     /// The estimate after the last sample; before the first, the initial attitude with
     /// its σ.
     fn estimate(&self) -> AttitudeEstimate {
-        let s = &self.state;
-        s.estimate.unwrap_or_else(|| AttitudeEstimate {
-            sigma_rad: Some(s.uncertainty.sigma_rad()),
-            ..AttitudeEstimate::initial(s.attitude)
-        })
+        self.estimate_now()
     }
 
     /// Back to the state before any sample, with the same parameters.
@@ -224,7 +203,10 @@ impl OrientationEstimator for QuaternionFilter {
 
 impl Persistent for QuaternionFilter {
     type State = QuaternionFilterState;
-    const SNAPSHOT_VERSION: u32 = 1;
+    /// 2: the inclination low-pass became second order (its rate joined the state, its
+    /// time constant replaced `acc_lowpass_s`) and the state keeps the last status instead
+    /// of the last estimate.
+    const SNAPSHOT_VERSION: u32 = 2;
 
     fn state(&self) -> QuaternionFilterState {
         self.state

@@ -5,8 +5,8 @@
 use nalgebra::{UnitQuaternion, Vector3};
 use serde::{Deserialize, Serialize};
 use truenorth_core::{
-    AttitudeEstimate, Error, Real, Result, TimeStep, Validate, check_finite, check_finite3,
-    check_range,
+    AttitudeEstimate, AttitudeStatus, Error, Real, Result, TimeStep, Validate, check_finite,
+    check_finite3, check_range,
 };
 
 use super::attitude_uncertainty::AttitudeUncertainty;
@@ -49,6 +49,9 @@ pub struct QuaternionFilterState<T: Real = f64> {
     pub gyro_bias_rps: Vector3<T>,
     /// The low-passed specific force in NED, m/s²; `None` before the first reading.
     pub acc_lowpass_ned_mps2: Option<Vector3<T>>,
+    /// The rate of change of the low-passed specific force (the low-pass's second state),
+    /// m/s³.
+    pub acc_lowpass_rate_ned_mps3: Vector3<T>,
     /// Time spent at rest since the start, s (counted up to `bias_known_after_rest_s`):
     /// how well the bias is known.
     pub rest_s: T,
@@ -65,8 +68,9 @@ pub struct QuaternionFilterState<T: Real = f64> {
     pub initialised: bool,
     /// The σ of the attitude, propagated alongside it.
     pub uncertainty: AttitudeUncertainty<T>,
-    /// The estimate after the last sample; `None` before the first.
-    pub estimate: Option<AttitudeEstimate>,
+    /// What the filter made of the last sample (default before the first): with the rest of
+    /// the state, the estimate after it, which is built only when it is asked for.
+    pub status: AttitudeStatus,
     /// The time of the last sample.
     pub clock: TimeStep,
     /// The steps taken and the gaps among them.
@@ -88,6 +92,7 @@ impl<T: Real> QuaternionFilterState<T> {
             undo_heading: (T::one(), T::zero()),
             gyro_bias_rps: Vector3::zeros(),
             acc_lowpass_ned_mps2: None,
+            acc_lowpass_rate_ned_mps3: Vector3::zeros(),
             rest_s: T::zero(),
             bias_inv_tau_motion_per_s: T::of(1.0 / config.bias_tau_unknown_s),
             last_gyr_rps: None,
@@ -95,7 +100,7 @@ impl<T: Real> QuaternionFilterState<T> {
             since_start_s: T::zero(),
             initialised: config.initial_attitude.is_some(),
             uncertainty: AttitudeUncertainty::new(config.uncertainty, !config.use_mag),
-            estimate: None,
+            status: AttitudeStatus::default(),
             clock: TimeStep::new(),
             gaps: GapMonitor::new(config.max_gap_s),
             rest: RestDetector::with_config(config.rest),
@@ -107,7 +112,7 @@ impl<T: Real> QuaternionFilterState<T> {
 
 impl<T: Real> Validate for QuaternionFilterState<T> {
     /// Valid parameters; a unit attitude and heading undo; finite vectors; a bias within
-    /// `max_bias_rps`; times ≥ 0; a finite estimate; parts built for these parameters.
+    /// `max_bias_rps`; times ≥ 0; parts built for these parameters.
     fn validate(&self) -> Result<()> {
         let cfg = &self.config;
         cfg.validate()?;
@@ -128,9 +133,13 @@ impl<T: Real> Validate for QuaternionFilterState<T> {
                 reason: "the gyro bias exceeds max_bias_rps",
             });
         }
-        for v in [self.acc_lowpass_ned_mps2, self.last_gyr_rps]
-            .iter()
-            .flatten()
+        for v in [
+            self.acc_lowpass_ned_mps2,
+            Some(self.acc_lowpass_rate_ned_mps3),
+            self.last_gyr_rps,
+        ]
+        .iter()
+        .flatten()
         {
             check_finite3_in("saved vector", v)?;
         }
@@ -141,9 +150,6 @@ impl<T: Real> Validate for QuaternionFilterState<T> {
             ("since_start_s", self.since_start_s),
         ] {
             check_range_in(what, v, 0.0, f64::MAX)?;
-        }
-        if let Some(e) = &self.estimate {
-            check_estimate(e)?;
         }
         if let Some(t) = self.clock.last_s() {
             check_finite("time of the last sample", t)?;

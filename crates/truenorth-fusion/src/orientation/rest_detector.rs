@@ -17,6 +17,7 @@ use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 use truenorth_core::{Error, Real, Result, Validate, check_positive, check_range};
 
+use super::min_max::at_most;
 use super::real_checks::{check_finite3_in, check_range_in};
 
 /// Thresholds of the rest detector (derived values live in [`RestDetector`]).
@@ -61,8 +62,35 @@ impl Validate for RestConfig {
     }
 }
 
+/// The thresholds of a [`RestConfig`] in the detector's float type, as [`RestDetector`]
+/// compares with them: converted once by the filter that owns the detector, not per sample.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct RestThresholds<T> {
+    gyro_dev2: T,
+    acc_dev2: T,
+    /// `sin²` of the largest turn of the field (at most 1.5 rad, within a quarter turn).
+    sin2_turn: T,
+    min_time_s: T,
+    /// `1/mean_tau_s`, 1/s.
+    inv_mean_tau: T,
+}
+
+impl<T: Real> RestThresholds<T> {
+    pub(crate) fn of(config: &RestConfig) -> Self {
+        let (g, a) = (T::of(config.gyro_dev_rps), T::of(config.acc_dev_mps2));
+        let sin = T::of(config.mag_turn_rad).min(T::of(1.5)).sin();
+        Self {
+            gyro_dev2: g * g,
+            acc_dev2: a * a,
+            sin2_turn: sin * sin,
+            min_time_s: T::of(config.min_time_s),
+            inv_mean_tau: T::of(1.0 / config.mean_tau_s),
+        }
+    }
+}
+
 /// Running means and the time the sensor has looked still, in the float type `T` (the
-/// thresholds stay `f64`, converted where they are compared).
+/// thresholds stay `f64`, converted for each update; the filter converts them once).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 // `Real` includes serde's bounds on `T`.
 #[serde(bound = "")]
@@ -120,6 +148,19 @@ impl<T: Real> RestDetector<T> {
         mag: Option<&Vector3<T>>,
         dt_s: T,
     ) -> bool {
+        self.update_with(&RestThresholds::of(&self.config), gyr, acc, mag, dt_s)
+    }
+
+    /// [`Self::update`] with the thresholds already converted (`th` of this detector's
+    /// configuration).
+    pub(crate) fn update_with(
+        &mut self,
+        th: &RestThresholds<T>,
+        gyr: &Vector3<T>,
+        acc: &Vector3<T>,
+        mag: Option<&Vector3<T>>,
+        dt_s: T,
+    ) -> bool {
         if !self.primed {
             self.gyr_mean = *gyr;
             self.acc_mean = *acc;
@@ -128,17 +169,13 @@ impl<T: Real> RestDetector<T> {
             return false;
         }
         if self.gain.0 != dt_s {
-            self.gain = (dt_s, (dt_s / T::of(self.config.mean_tau_s)).min(T::one()));
+            self.gain = (dt_s, at_most(dt_s * th.inv_mean_tau, T::one()));
         }
         let k = self.gain.1;
         self.gyr_mean += (gyr - self.gyr_mean) * k;
         self.acc_mean += (acc - self.acc_mean) * k;
-        let (g, a) = (
-            T::of(self.config.gyro_dev_rps),
-            T::of(self.config.acc_dev_mps2),
-        );
-        let mut still = (gyr - self.gyr_mean).norm_squared() < g * g
-            && (acc - self.acc_mean).norm_squared() < a * a;
+        let mut still = (gyr - self.gyr_mean).norm_squared() < th.gyro_dev2
+            && (acc - self.acc_mean).norm_squared() < th.acc_dev2;
         match (mag, self.mag_mean.as_mut()) {
             (Some(m), Some(mean)) => *mean += (m - *mean) * k,
             (Some(m), None) => self.mag_mean = Some(*m),
@@ -146,10 +183,9 @@ impl<T: Real> RestDetector<T> {
         }
         if still && let (Some(start), Some(mean)) = (self.mag_at_start, self.mag_mean) {
             // angle < θ ⇔ dot > 0 and |a × b|² < sin²θ |a|² |b|² (θ < 90°): no arccosine.
-            let sin = T::of(self.config.mag_turn_rad).min(T::of(1.5)).sin();
             still = start.dot(&mean) > T::zero()
                 && start.cross(&mean).norm_squared()
-                    < sin * sin * start.norm_squared() * mean.norm_squared();
+                    < th.sin2_turn * start.norm_squared() * mean.norm_squared();
         }
         if still {
             if self.still_s == T::zero() {
@@ -160,7 +196,7 @@ impl<T: Real> RestDetector<T> {
             self.still_s = T::zero();
             self.mag_at_start = None;
         }
-        self.still_s >= T::of(self.config.min_time_s)
+        self.still_s >= th.min_time_s
     }
 
     /// Running mean of the raw gyro, rad/s: the bias while at rest.
