@@ -44,6 +44,7 @@ mod sample;
 mod sensor_model;
 mod units;
 mod validate;
+mod vehicle_sensors;
 pub mod verdict;
 
 pub use angle::{Unwrapper, angle_diff, unwrap_near, wrap_pi, wrap_two_pi};
@@ -77,6 +78,7 @@ pub use validate::{
     TimeStep, Validate, check_dt, check_finite, check_finite2, check_finite3, check_positive,
     check_range,
 };
+pub use vehicle_sensors::{Travel, VehicleSensors};
 pub use verdict::{Cause, Grade, Verdict};
 
 /// Float methods (`sin`, `sqrt`, `atan2`, …) for `f64` that work with and without `std`.
