@@ -100,8 +100,8 @@ pub use fits::mag_accel::{
     MagAccelConfig, MagAccelQuality, MagAccelReading, MagAccelSample, MagAccelStore, fit_mag_accel,
     fit_mag_accel_readings, mag_accel_reading,
 };
-pub use fits::readings::{READINGS_RUN_MULTIPLE, ReadingStore, Readings};
 pub use numerics::circumcentre::{Circumcircle, circumcircle};
+pub use numerics::readings::{READINGS_RUN_MULTIPLE, ReadingStore, Readings};
 pub use online::conic_sums::{RetainedSnapshot, SumsSnapshot};
 pub use online::ellipse::{
     ONLINE_SLOTS_2D, OnlineConicState, OnlineEllipseCalibrator, OnlineEllipseConfig,

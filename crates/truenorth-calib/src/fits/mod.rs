@@ -8,6 +8,3 @@ pub mod ellipsoid;
 pub(crate) mod lm;
 pub mod mag_accel;
 pub(crate) mod normalise;
-pub mod readings;
-#[cfg(test)]
-pub(crate) mod readings_tests;

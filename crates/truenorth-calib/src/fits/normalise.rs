@@ -16,7 +16,7 @@
 use nalgebra::SVector;
 use truenorth_core::{Error, Result, check_finite};
 
-use crate::fits::readings::{Readings, replay_points};
+use crate::numerics::readings::{Readings, replay_points};
 use crate::numerics::segments::{RunFold, fold};
 
 #[cfg(not(feature = "std"))]

@@ -21,8 +21,8 @@ extern crate alloc;
 use nalgebra::SVector;
 use truenorth_core::Result;
 
-use crate::fits::readings::Readings;
 use crate::numerics::blocks::{BLOCK, blocks};
+use crate::numerics::readings::Readings;
 
 /// Readings per segment: a multiple of [`BLOCK`] (so that no block straddles two
 /// segments, and the blocks fall where one slice would have them), large enough that a
@@ -182,7 +182,7 @@ mod threads {
     use truenorth_core::{Error, Result};
 
     use super::{Fold, SEGMENT, merge_into};
-    use crate::fits::readings::Readings;
+    use crate::numerics::readings::Readings;
 
     /// Threads a pass may use: what the system offers (`available_parallelism`), asked
     /// once per process, as the answer reads the cgroup's quota from files.
@@ -281,7 +281,7 @@ mod threads {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::fits::readings_tests::{Cut, FAILED};
+    use crate::numerics::readings_tests::{Cut, FAILED};
     use nalgebra::Vector2;
     use proptest::prelude::*;
 

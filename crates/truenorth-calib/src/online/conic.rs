@@ -226,7 +226,7 @@ pub(crate) fn refuse_fit(
 }
 
 /// The state and per-sample logic of an online conic calibrator (see the
-/// `online_ellipse` module for the scheme), its sums and retained readings in `T`.
+/// `ellipse` module for the scheme), its sums and retained readings in `T`.
 ///
 /// The per-sample path (the sums, the sorting of a reading into its slot) runs in `T`; a
 /// refresh converts its copies of the sums and readings to `f64` (exact) and fits in

@@ -38,7 +38,7 @@ pub use crate::online::retained::RetainedSnapshot;
 #[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 
-pub(crate) use crate::online::monomial_layout::{
+pub(crate) use crate::numerics::monomial_layout::{
     LAYOUT_2D, LAYOUT_3D, Layout, MONOMIALS_2D, MONOMIALS_3D,
 };
 
@@ -145,7 +145,7 @@ impl<T: Real, const D: usize, const M: usize> ConicSums<T, D, M> {
     }
 
     /// The sums in `f64` (exact), for a fit: the fit runs in `f64` whatever `T` is, see
-    /// the `online_ellipse` module.
+    /// the `ellipse` module.
     pub fn widened(&self) -> ConicSums<f64, D, M> {
         ConicSums {
             origin: self.origin.map(T::to_f64),
@@ -336,7 +336,7 @@ pub(crate) fn sigma_kappa(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::online::monomial_layout::design2;
+    use crate::numerics::monomial_layout::design2;
     use nalgebra::Vector2;
 
     #[test]

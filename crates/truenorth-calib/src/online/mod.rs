@@ -6,10 +6,5 @@
 pub(crate) mod conic;
 pub mod conic_sums;
 pub mod ellipse;
-pub(crate) mod ellipse_config;
-pub(crate) mod ellipse_refresh;
 pub mod ellipsoid;
-pub(crate) mod ellipsoid_config;
-pub(crate) mod ellipsoid_refresh;
-pub(crate) mod monomial_layout;
 pub(crate) mod retained;

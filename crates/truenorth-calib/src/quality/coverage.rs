@@ -8,8 +8,8 @@ use truenorth_compass::CompassCalibration2d;
 
 use super::direction_bins::{bin_if_clear, coarse_fixed, fine_bin, fine_bin_exact, fine_bin_xy};
 use super::support::{GAP_BINS, Support2d};
-use crate::fits::readings::{Readings, replay_points};
 use crate::numerics::blocks::{BLOCK, blocks};
+use crate::numerics::readings::{Readings, replay_points};
 use crate::numerics::segments::{RunFold, by_blocks, fold};
 use truenorth_core::Result;
 

@@ -14,7 +14,7 @@
 //! turned a given angle from another, as `atan2` decides it, found mostly without it), bounds (information matrices and heading-error bounds),
 //! uncertainty (what the readings determine: the dilution of the information matrix, the predicted
 //! parameter σ, and the determination test that replaces a share of direction cells), pass_2d (the
-//! one pass over 2-D readings the report is built from), report (assembly of the
+//! one pass over 2-D readings the report is built from), report_2d and report_3d (assembly of the
 //! [`CompassQuality`](truenorth_core::CompassQuality), its [`CompassUncertainty`] included) and
 //! field (the fitted field against an expected one). The report's data types and its verdict (good /
 //! usable / poor, [`Verdict`]) live in `truenorth-core`, beside the calibrator trait, and are
@@ -53,7 +53,8 @@ mod direction_turn;
 mod field;
 mod limits;
 mod pass_2d;
-mod report;
+mod report_2d;
+mod report_3d;
 mod sphere_cells;
 mod support;
 mod uncertainty;
@@ -77,11 +78,10 @@ pub use field::{
 };
 pub use limits::FitLimits;
 pub(crate) use pass_2d::ReportSums;
-pub use report::{Assessment2d, assess_2d, assess_3d, quality_2d};
-pub(crate) use report::{
-    Moments2, SupportFigures, assess_2d_from_moments, assess_3d_of, assess_3d_with_harmonics_of,
-    direction_harmonics, support_dilution_3d,
-};
+pub use report_2d::{Assessment2d, assess_2d, quality_2d};
+pub(crate) use report_2d::{Moments2, SupportFigures, assess_2d_from_moments, direction_harmonics};
+pub use report_3d::assess_3d;
+pub(crate) use report_3d::{assess_3d_of, assess_3d_with_harmonics_of, support_dilution_3d};
 pub use sphere_cells::{
     MIN_SPHERE_COVERAGE, SPHERE_BANDS, SPHERE_CELLS, SPHERE_SECTORS, require_sphere_coverage,
     sphere_coverage,

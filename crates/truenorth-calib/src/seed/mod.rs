@@ -4,6 +4,7 @@
 //! (US 4,788,645), and the quality report they share.
 
 pub mod binned;
+pub(crate) mod direction_slots;
 pub mod extrema;
 pub(crate) mod fit_gap;
 pub mod merit_circle;

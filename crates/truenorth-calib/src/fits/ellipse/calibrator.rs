@@ -18,8 +18,8 @@ use crate::fits::ellipse::config::EllipseConfig;
 #[cfg(doc)]
 use crate::fits::ellipse::fit::fit_ellipse;
 use crate::fits::ellipse::fit::fit_ellipse_readings;
-use crate::fits::readings::{ReadingStore, bbox_centre};
 use crate::numerics::reading::read_by_coordinate;
+use crate::numerics::readings::{ReadingStore, bbox_centre};
 /// Least-squares ellipse calibrator (batch): stores every reading pushed and fits them all
 /// with [`fit_ellipse`] on `solve`.
 ///

@@ -9,8 +9,8 @@ use truenorth_compass::CompassCalibration2d;
 use truenorth_core::{Error, Result};
 
 use crate::fits::normalise::Normaliser;
-use crate::fits::readings::Readings;
 use crate::numerics::linalg::{constrained_min3, sym_eigen2, sym_eigen3, sym_sqrt2};
+use crate::numerics::readings::Readings;
 use crate::numerics::segments::{RunFold, add_sums, fold};
 use crate::quality::Moments2;
 

@@ -50,9 +50,9 @@ use truenorth_core::{Error, Result, Solution, Validate};
 
 use crate::fits::lm::{self, NormalAccumulator, NormalEquations};
 use crate::fits::normalise::Normaliser;
-use crate::fits::readings::{Readings, replay_points};
 use crate::numerics::blocks::BLOCK;
 use crate::numerics::linalg::sym_sqrt2;
+use crate::numerics::readings::{Readings, replay_points};
 use crate::numerics::segments::{RunFold, by_blocks, fold};
 use crate::quality::{self, Assessment2d, BOUND_SIGMAS, Moments2};
 

@@ -18,8 +18,8 @@ use crate::fits::ellipsoid::config::EllipsoidConfig;
 #[cfg(doc)]
 use crate::fits::ellipsoid::fit::fit_ellipsoid;
 use crate::fits::ellipsoid::fit::fit_ellipsoid_readings;
-use crate::fits::readings::{ReadingStore, Readings, bbox_centre, replay_points};
 use crate::numerics::reading::read_by_coordinate3;
+use crate::numerics::readings::{ReadingStore, Readings, bbox_centre, replay_points};
 /// Least-squares ellipsoid calibrator (batch): stores every reading pushed and fits them
 /// all with [`fit_ellipsoid`] on `solve`.
 ///

@@ -8,12 +8,12 @@ use truenorth_compass::CompassCalibration3d;
 use truenorth_core::{Error, Result};
 
 use crate::fits::normalise::Normaliser;
-use crate::fits::readings::Readings;
 use crate::numerics::blocks::{BLOCK, dot_block};
 use crate::numerics::linalg::{constrained_min6, sym_eigen3, sym_eigen6, sym_sqrt3};
+use crate::numerics::readings::Readings;
 use crate::numerics::segments::{RunFold, add_sums, by_blocks, fold};
 // The quadric's terms `(x², y², z², 2yz, 2xz, 2xy, 2x, 2y, 2z, 1)`, the online fit's too.
-use crate::online::monomial_layout::TERMS_3D as TERMS;
+use crate::numerics::monomial_layout::TERMS_3D as TERMS;
 
 use crate::fits::ellipsoid::config::MIN_POINTS_3D;
 #[cfg(not(feature = "std"))]

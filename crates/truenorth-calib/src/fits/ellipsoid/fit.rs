@@ -41,9 +41,9 @@ use truenorth_core::{Error, Result, Solution, Validate};
 
 use crate::fits::lm::{self, NormalAccumulator, NormalEquations};
 use crate::fits::normalise::Normaliser;
-use crate::fits::readings::Readings;
 use crate::numerics::blocks::BLOCK;
 use crate::numerics::linalg::sym_sqrt3;
+use crate::numerics::readings::Readings;
 use crate::numerics::segments::{RunFold, by_blocks, fold};
 use crate::quality::{self, CompassUncertainty};
 

@@ -57,17 +57,18 @@ use crate::fits::mag_accel::calibration::{MagAccelCalibration, MagAccelSample};
 use crate::fits::mag_accel::config::{
     INITIAL_FIT_BOUND_DEG, MIN_MAG_ACCEL_READINGS, MagAccelConfig,
 };
+use crate::fits::mag_accel::data::{Data, GroupSums, Weights};
+use crate::fits::mag_accel::model::{
+    BA, BM, CA, CM, LIMITS, Limits, Model, P, S, level_direction, unsym,
+};
 use crate::fits::mag_accel::readings::{
     MagAccelReading, MagAccelStore, SampleSlice, Sensor, SensorReadings,
 };
 use crate::fits::mag_accel::report::{MagAccelQuality, assemble};
 use crate::fits::mag_accel::runs::{RunFinder, RunRule};
-use crate::fits::mag_accel::solve::{
-    BA, BM, CA, CM, Data, GroupSums, LIMITS, Limits, Model, P, S, Weights, aim_rms,
-    level_direction, normal_equations, unsym,
-};
+use crate::fits::mag_accel::solve::{aim_rms, normal_equations};
 use crate::fits::normalise::Normaliser;
-use crate::fits::readings::Readings;
+use crate::numerics::readings::Readings;
 use crate::quality::{self, FitLimits};
 
 #[cfg(not(feature = "std"))]

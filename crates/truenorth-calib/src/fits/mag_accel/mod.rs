@@ -1,11 +1,13 @@
 //! Joint calibration of a magnetometer and an accelerometer mounted together: its
 //! configuration, the calibration it produces, the readings it keeps, the calibrator and
-//! its fit, the least-squares problem, the runs of shots aimed at one target and their
+//! its fit, the least-squares problem (its parameters, its data and its normal equations), the runs of shots aimed at one target and their
 //! rows, and the report.
 
 pub(crate) mod calibration;
 pub(crate) mod calibrator;
 pub(crate) mod config;
+pub(crate) mod data;
+pub(crate) mod model;
 pub(crate) mod readings;
 #[cfg(test)]
 mod readings_tests;

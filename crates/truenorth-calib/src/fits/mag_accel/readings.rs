@@ -11,7 +11,7 @@ use nalgebra::{SVector, Vector3};
 use truenorth_core::Result;
 
 use crate::fits::mag_accel::calibration::MagAccelSample;
-use crate::fits::readings::{READINGS_RUN_MULTIPLE, ReadingStore, Readings};
+use crate::numerics::readings::{READINGS_RUN_MULTIPLE, ReadingStore, Readings};
 
 /// One reading of both sensors, as the joint fit keeps it: `[mag_x, mag_y, mag_z, acc_x,
 /// acc_y, acc_z]` in their raw units (the time is not kept: the fit does not use it).

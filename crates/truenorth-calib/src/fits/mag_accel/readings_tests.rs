@@ -6,12 +6,12 @@ use proptest::prelude::*;
 use truenorth_core::Calibrator;
 
 use crate::fits::mag_accel::calibrator::fit_mag_accel_within;
-use crate::fits::mag_accel::solve::Limits;
+use crate::fits::mag_accel::model::Limits;
 use crate::fits::mag_accel::{
     MagAccelCalibrator, MagAccelConfig, MagAccelReading, MagAccelSample, fit_mag_accel,
     fit_mag_accel_readings, mag_accel_reading,
 };
-use crate::fits::readings_tests::{Cut, FAILED};
+use crate::numerics::readings_tests::{Cut, FAILED};
 
 /// Pseudo-noise in [−0.5, 0.5) of reading `k`, channel `c` (deterministic).
 fn wobble(k: usize, c: usize) -> f64 {

@@ -14,10 +14,10 @@ use truenorth_core::{
 
 use crate::fits::mag_accel::calibration::MagAccelCalibration;
 use crate::fits::mag_accel::config::MagAccelConfig;
+use crate::fits::mag_accel::data::{Data, GroupSums, Weights};
+use crate::fits::mag_accel::model::{BM, CA, CM, Model, OMEGA, P, level_direction};
 use crate::fits::mag_accel::readings::{Sensor, SensorReadings};
-use crate::fits::mag_accel::solve::{
-    BM, CA, CM, Data, GroupSums, Model, OMEGA, P, Weights, aim_rms, level_direction,
-};
+use crate::fits::mag_accel::solve::aim_rms;
 use crate::fits::normalise::Normaliser;
 use crate::numerics::linalg::sym_eigen3;
 use crate::quality::{self, CompassUncertainty};

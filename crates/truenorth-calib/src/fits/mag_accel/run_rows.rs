@@ -11,7 +11,8 @@ use core::ops::Range;
 use nalgebra::{Rotation3, SMatrix, SVector, Vector3};
 use truenorth_core::Result;
 
-use crate::fits::mag_accel::solve::{Data, GroupSums, Model, P, Weights, add_row, level_direction};
+use crate::fits::mag_accel::data::{Data, GroupSums, Weights, add_row};
+use crate::fits::mag_accel::model::{Model, P, level_direction};
 
 /// The level-frame direction of the pointing axis for the shot `(a, mg)` (normalised)
 /// under `theta`.

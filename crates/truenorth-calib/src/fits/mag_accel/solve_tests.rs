@@ -5,10 +5,10 @@ use nalgebra::{Rotation3, SVector, Vector3};
 use proptest::prelude::*;
 
 use crate::fits::mag_accel::MagAccelSample;
+use crate::fits::mag_accel::data::{Data, Weights, add_row};
+use crate::fits::mag_accel::model::{BA, BM, LIMITS, Model, P, S};
 use crate::fits::mag_accel::readings::{Sensor, SensorReadings};
-use crate::fits::mag_accel::solve::{
-    BA, BM, Data, LIMITS, Model, P, S, Weights, add_row, normal_equations, reading_rows,
-};
+use crate::fits::mag_accel::solve::{normal_equations, reading_rows};
 use crate::fits::normalise::Normaliser;
 
 /// Readings of two sensors turned through many attitudes (not a consistent instrument: the

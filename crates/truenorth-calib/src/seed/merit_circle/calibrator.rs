@@ -65,11 +65,11 @@ use truenorth_core::{
 };
 
 use crate::numerics::circumcentre::{BEST_AMPLIFICATION_SQ, Circumcircle, circumcircle};
-use crate::numerics::direction_slots::{DirectionSlots, SLOTS};
 use crate::numerics::reading::read_by_coordinate;
 use crate::quality::{
     Coverage, Direction, coverage, mean_corrected_norm_2d, require_arc, turned_at_least,
 };
+use crate::seed::direction_slots::{DirectionSlots, SLOTS};
 use crate::seed::fit_gap::complete_bound;
 use crate::seed::seed_quality::{SeedJob, seed_assessment, with_expected_field};
 

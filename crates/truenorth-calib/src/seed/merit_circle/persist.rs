@@ -9,7 +9,7 @@ use serde::{Deserialize, Serialize};
 use truenorth_compass::CompassCalibration2d;
 use truenorth_core::{Error, Persistent, Result, Solution, Validate};
 
-use crate::numerics::direction_slots::{DirectionSlots, SLOTS};
+use crate::seed::direction_slots::{DirectionSlots, SLOTS};
 use crate::seed::seed_quality::SeedJob;
 
 use crate::seed::merit_circle::calibrator::MeritCircleCalibrator;

@@ -14,8 +14,8 @@ use truenorth_core::{
     TimeStep, Validate, check_finite, check_finite2,
 };
 
-use crate::numerics::direction_slots::{DirectionSlots, SLOTS};
 use crate::quality::{calibrated_coverage_2d, require_arc};
+use crate::seed::direction_slots::{DirectionSlots, SLOTS};
 use crate::seed::seed_quality::{seed_assessment, with_expected_field};
 
 use super::config::TurnConfig;

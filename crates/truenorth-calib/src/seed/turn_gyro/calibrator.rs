@@ -12,8 +12,8 @@ use truenorth_core::{
 };
 use truenorth_gyro::{GyroCalibration, YawIncrement};
 
-use crate::numerics::direction_slots::DirectionSlots;
 use crate::quality::{self, calibrated_coverage_2d, require_arc};
+use crate::seed::direction_slots::DirectionSlots;
 use crate::seed::extrema::ExtremumKind;
 use crate::seed::seed_quality::seed_assessment;
 use crate::seed::turn::{TurnConfig, TurnEllipse, TurnExtrema};
@@ -424,7 +424,7 @@ impl TurnCalibrator {
 
     fn accepted(&self) -> Result<(TurnEllipse, TurnCalibration, TurnQuality)> {
         let fit = self.extrema.solve()?;
-        let mut buf = [Vector2::zeros(); crate::numerics::direction_slots::SLOTS];
+        let mut buf = [Vector2::zeros(); crate::seed::direction_slots::SLOTS];
         let n = self.slots.collect(&mut buf);
         require_arc(
             &calibrated_coverage_2d(&buf[..n], &fit.calibration()),

@@ -9,7 +9,7 @@ use serde::{Deserialize, Serialize};
 use truenorth_core::extended_float::check_plain_numbers_finite;
 use truenorth_core::{Error, Persistent, Result, TimeStep, Validate};
 
-use crate::numerics::direction_slots::DirectionSlots;
+use crate::seed::direction_slots::DirectionSlots;
 use crate::seed::turn::{TurnConfig, TurnExtrema, TurnExtremaState};
 
 use super::calibrator::{BLOCKS, Block, Kept, PENDING, PLACED, RING, RawHeading, TurnCalibrator};

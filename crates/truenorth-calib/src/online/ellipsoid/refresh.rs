@@ -16,7 +16,7 @@ use crate::fits::ellipsoid::config::ORIENTATION_HINT;
 use crate::fits::ellipsoid::direct::{Ellipsoid, Reduced};
 use crate::online::conic::{ConicRefresh, RefreshBase, bound_deg, refuse_fit, report};
 use crate::online::conic_sums::{ConicSums, LAYOUT_3D, MONOMIALS_3D, Retained};
-use crate::online::ellipsoid_config::OnlineEllipsoidConfig;
+use crate::online::ellipsoid::config::OnlineEllipsoidConfig;
 use crate::quality::{self, SPHERE_CELLS};
 
 mod fit_stages;

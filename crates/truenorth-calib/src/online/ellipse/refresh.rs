@@ -1,6 +1,6 @@
 //! A staged refresh of the [`crate::OnlineEllipseCalibrator`]'s estimate: the direct fit from
 //! a copy of the running sums and the retained readings, then its quality and refusals, one
-//! short stage per push (see the `online_ellipse` module for the scheme and the
+//! short stage per push (see the `ellipse` module for the scheme and the
 //! approximations the sums imply).
 
 // `!(x <= limit)` and `!(x > 0.0)` are deliberate: they are true for NaN, so a NaN fails
@@ -27,7 +27,7 @@ use crate::quality::{self, COVERAGE_BINS, Coverage, GAP_BINS, turns, turns_in};
 use crate::online::conic::{
     ConicRefresh, RefreshBase, bound_deg, noise_factor, refuse_fit, report,
 };
-use crate::online::ellipse_config::OnlineEllipseConfig;
+use crate::online::ellipse::config::OnlineEllipseConfig;
 use crate::quality::{anisotropy_2d, direct_fit_bias_rad};
 
 #[cfg(not(feature = "std"))]

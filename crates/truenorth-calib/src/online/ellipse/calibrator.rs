@@ -9,7 +9,7 @@
 //! [`OnlineEllipseConfig::refresh_interval_samples`] readings (or a 64th of the readings
 //! the sums weigh, if that is more) a refresh of the estimate starts on a copy of the sums and runs one short stage per push (normalise; direct fit;
 //! coverage; residual, information matrix and the condition of the headings seen;
-//! heading-error bound and refusals; the `online_ellipse_refresh` module), so that no push
+//! heading-error bound and refusals; the `refresh` module), so that no push
 //! pays for a whole solve. A refresh publishes only what [`Calibrator::solve`] would
 //! accept: both run the same stages and refusals, those of the batch fit. None depends on
 //! the order of the readings (the sums do not, and coverage is measured on the readings
@@ -36,12 +36,10 @@ use truenorth_core::{
     Result, Solution,
 };
 
-use crate::online::conic::OnlineCore;
-pub use crate::online::conic::{OnlineConicState, PendingRefresh};
+use crate::online::conic::{OnlineConicState, OnlineCore};
 use crate::online::conic_sums::MONOMIALS_2D;
-pub use crate::online::ellipse_config::OnlineEllipseConfig;
-pub use crate::online::ellipse_refresh::ONLINE_SLOTS_2D;
-use crate::online::ellipse_refresh::Refresh;
+use crate::online::ellipse::config::OnlineEllipseConfig;
+use crate::online::ellipse::refresh::{ONLINE_SLOTS_2D, Refresh};
 
 /// Online least-squares ellipse calibrator: the direct fit of [`crate::EllipseCalibrator`]
 /// from running sums, O(1) memory and O(1) per push (see the module documentation).
@@ -204,7 +202,7 @@ impl Persistent for OnlineEllipseCalibrator {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::online::ellipse_refresh::STAGES;
+    use crate::online::ellipse::refresh::STAGES;
     use nalgebra::Vector2;
     use truenorth_core::Error;
 

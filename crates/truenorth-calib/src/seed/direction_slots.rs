@@ -1,4 +1,4 @@
-//! A fixed-size sample of raw readings spread by direction, kept by the online calibrators so
+//! A fixed-size sample of raw readings spread by direction, kept by the seed calibrators so
 //! that their quality report can be computed on real readings without storing every sample.
 
 extern crate alloc;

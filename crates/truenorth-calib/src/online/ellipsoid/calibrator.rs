@@ -20,8 +20,8 @@ use truenorth_core::{
 
 use crate::online::conic::{OnlineConicState, OnlineCore};
 use crate::online::conic_sums::MONOMIALS_3D;
-pub use crate::online::ellipsoid_config::OnlineEllipsoidConfig;
-use crate::online::ellipsoid_refresh::Refresh;
+use crate::online::ellipsoid::config::OnlineEllipsoidConfig;
+use crate::online::ellipsoid::refresh::Refresh;
 use crate::quality::SPHERE_CELLS;
 
 /// Online least-squares ellipsoid calibrator: the direct fit of

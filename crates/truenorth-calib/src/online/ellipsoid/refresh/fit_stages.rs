@@ -14,7 +14,7 @@ use crate::fits::ellipsoid::direct::{
 use crate::numerics::linalg::sym_eigen3;
 use crate::online::conic::noise_factor;
 use crate::online::conic_sums::LAYOUT_3D;
-use crate::online::ellipsoid_config::OnlineEllipsoidConfig;
+use crate::online::ellipsoid::config::OnlineEllipsoidConfig;
 use crate::quality;
 use crate::quality::{anisotropy_3d, direct_fit_bias_rad};
 

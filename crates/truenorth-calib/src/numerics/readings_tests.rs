@@ -11,7 +11,7 @@ use crate::fits::ellipse::{EllipseCalibrator, EllipseConfig, fit_ellipse, fit_el
 use crate::fits::ellipsoid::{
     EllipsoidCalibrator, EllipsoidConfig, fit_ellipsoid, fit_ellipsoid_readings,
 };
-use crate::fits::readings::{READINGS_RUN_MULTIPLE, ReadingStore, Readings};
+use crate::numerics::readings::{READINGS_RUN_MULTIPLE, ReadingStore, Readings};
 
 /// Readings replayed in runs of the given numbers of [`READINGS_RUN_MULTIPLE`] (cycled),
 /// failing on replay number `fail_at` (counting from 0) after its first run, if given.
