@@ -10,23 +10,12 @@ use truenorth_core::{
     MagneticHeading, Real, Result, Tilt, Validate, check_finite, check_finite2, check_finite3,
 };
 
-use crate::{level_field, tilt_compensated_heading_in};
+use crate::{
+    heading_from_horizontal, heading_from_horizontal_in, level_field, tilt_compensated_heading_in,
+};
 
 #[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
-
-/// Heading (radians, clockwise from magnetic north, (-π, π]) of a horizontal field vector in
-/// body axes (x forward, y right): `ψ = atan2(−h_y, h_x)`.
-#[inline]
-pub fn heading_from_horizontal(h: &Vector2<f64>) -> f64 {
-    heading_from_horizontal_in(h)
-}
-
-/// [`heading_from_horizontal`] in the float type `T`.
-#[inline]
-pub fn heading_from_horizontal_in<T: Real>(h: &Vector2<T>) -> T {
-    (-h.y).atan2(h.x)
-}
 
 /// A two-axis compass calibration in `f64`, the form every calibrator produces and every
 /// file holds (see [`CompassCalibration2dIn`]).

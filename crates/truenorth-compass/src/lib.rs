@@ -68,7 +68,6 @@ mod tilt;
 
 pub use calibration::{
     CompassCalibration2d, CompassCalibration2dIn, CompassCalibration3d, CompassCalibration3dIn,
-    heading_from_horizontal, heading_from_horizontal_in,
 };
 pub use disturbance::{Disturbance, DisturbanceShape, Disturbances, MAX_DISTURBANCES};
 pub use model2d::{HeadingTruth, MagnetometerModel2d};
@@ -77,8 +76,8 @@ pub use mz_reconstruction::MzReconstruction;
 pub use phasors::{EllipsePhasors, ITERATIVE_MAX_STEPS};
 pub use soft_iron::{EllipseAxes, ellipse_axes, soft_iron_from_axes};
 pub use tilt::{
-    level_field, level_field_in, tilt_compensated_heading, tilt_compensated_heading_checked,
-    tilt_compensated_heading_in,
+    heading_from_horizontal, heading_from_horizontal_in, level_field, level_field_in,
+    tilt_compensated_heading, tilt_compensated_heading_checked, tilt_compensated_heading_in,
 };
 
 /// The code blocks of the crate's README, compiled and run as doctests.

@@ -1,5 +1,5 @@
-//! Tilt compensation: the horizontal field, and so the heading, from a three-axis reading on a
-//! tilted body.
+//! Heading from the field: of a horizontal field vector, and, by tilt compensation, of a
+//! three-axis reading on a tilted body.
 //!
 //! With `R = Rz(ψ) · Ry(θ) · Rx(φ)` (body → NED), the body reading is `m = Rᵀ f`, so
 //! `Ry(θ) · Rx(φ) · m = Rz(ψ)ᵀ f`: undoing pitch and roll leaves the field as a *level* body at
@@ -7,10 +7,21 @@
 //! (WO 00/36376 writes it as `Hx = cos P·Mx + sin P·Mz`, with roll; the form here is that
 //! formula with both angles, derived from the rotation.)
 
-use nalgebra::Vector3;
+use nalgebra::{Vector2, Vector3};
 use truenorth_core::{Real, Result, Tilt, check_finite, check_finite3};
 
-use crate::heading_from_horizontal_in;
+/// Heading (radians, clockwise from magnetic north, (-π, π]) of a horizontal field vector in
+/// body axes (x forward, y right): `ψ = atan2(−h_y, h_x)`.
+#[inline]
+pub fn heading_from_horizontal(h: &Vector2<f64>) -> f64 {
+    heading_from_horizontal_in(h)
+}
+
+/// [`heading_from_horizontal`] in the float type `T`.
+#[inline]
+pub fn heading_from_horizontal_in<T: Real>(h: &Vector2<T>) -> T {
+    (-h.y).atan2(h.x)
+}
 
 /// The field as a level body at the same heading would see it: `Ry(pitch) · Rx(roll) · m`.
 ///

@@ -131,6 +131,14 @@ impl CompassUncertainty {
     }
 }
 
+impl Verdict {
+    /// The verdict on a report (also [`CompassQuality::verdict`]): its heading-error bound and
+    /// per-reading noise ([`Verdict::from_figures`]).
+    pub fn of(q: &CompassQuality) -> Self {
+        Self::from_figures(q.heading_error_bound_deg(), q.heading_noise_rms_deg)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

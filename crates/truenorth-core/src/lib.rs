@@ -32,6 +32,7 @@ pub mod compass_quality;
 mod error;
 mod estimator;
 pub mod extended_float;
+mod fit_quality;
 mod heading;
 mod heading_source;
 mod inertial_calibration;
@@ -49,16 +50,14 @@ pub mod verdict;
 
 pub use angle::{Unwrapper, angle_diff, unwrap_near, wrap_pi, wrap_two_pi};
 pub use attitude::{EulerZyx, Tilt, ned_to_enu};
-pub use calibrator::{
-    Calibration, Calibrator, FitQuality, OnlineCalibrator, Progress, Pushed, ScalarQuality,
-    Solution,
-};
+pub use calibrator::{Calibration, Calibrator, OnlineCalibrator, Progress, Pushed, Solution};
 pub use compass_quality::{CompassQuality, CompassUncertainty};
 pub use error::Error;
 pub use estimator::{
     AttitudeEstimate, AttitudeStatus, HeadingEstimator, NavEstimate, NavStatus,
     OrientationEstimator, Unobserved,
 };
+pub use fit_quality::{FitQuality, ScalarQuality};
 pub use heading::{Declination, MagneticHeading, TrueHeading};
 pub use heading_source::{
     AbsoluteHeading, AbsoluteHeadingSource, RelativeHeadingSource, RelativeStep,

@@ -3,9 +3,9 @@
 //! It reads two numbers of the report, each in degrees of heading so that one scale judges
 //! both:
 //! * the bound on the error the calibration itself adds
-//!   ([`CompassQuality::heading_error_bound_deg`]: 3σ of the parameter uncertainty plus the
+//!   ([`CompassQuality::heading_error_bound_deg`](crate::CompassQuality::heading_error_bound_deg): 3σ of the parameter uncertainty plus the
 //!   method's systematic error), which every later heading carries;
-//! * the per-reading heading noise ([`CompassQuality::heading_noise_rms_deg`]), which is the
+//! * the per-reading heading noise ([`CompassQuality::heading_noise_rms_deg`](crate::CompassQuality::heading_noise_rms_deg)), which is the
 //!   residual of the fit in angle: large for a noisy sensor, or when the readings do not lie
 //!   on the fitted circle or ellipsoid (a disturbed site, a sensor that moved against its
 //!   mount, the wrong model).
@@ -27,7 +27,7 @@
 
 use core::fmt;
 
-use crate::{CompassQuality, Fixed};
+use crate::Fixed;
 use serde::{Deserialize, Serialize};
 
 /// Largest calibration bound of a `good` calibration, degrees.
@@ -105,10 +105,9 @@ pub struct Verdict {
 }
 
 impl Verdict {
-    /// The verdict on a report (also [`CompassQuality::verdict`]).
-    pub fn of(q: &CompassQuality) -> Self {
-        let bound_deg = q.heading_error_bound_deg();
-        let noise_deg = q.heading_noise_rms_deg;
+    /// The verdict on a heading-error bound and a per-reading noise, both in degrees (a
+    /// report's: [`Verdict::of`]).
+    pub fn from_figures(bound_deg: f64, noise_deg: f64) -> Self {
         // Written so that NaN is poor.
         let grade = if bound_deg <= GOOD_DEG && noise_deg <= GOOD_NOISE_DEG {
             Grade::Good
@@ -177,6 +176,7 @@ impl fmt::Display for Verdict {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::CompassQuality;
     extern crate alloc;
     use alloc::string::ToString;
     use proptest::prelude::*;

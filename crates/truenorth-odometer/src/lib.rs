@@ -88,6 +88,7 @@ mod odometer_model;
 mod odometry_step;
 mod patent_track;
 mod track_table;
+mod wheel_distances;
 mod wheels;
 
 pub use ackermann::{AckermannCoefficients, AckermannGeometry, AckermannParams, RigidMotion};
@@ -103,9 +104,8 @@ pub use odometer_model::{
 pub use odometry_step::{OdometryStep, OdometryTurn, differential_gains};
 pub use patent_track::PatentAckermannTrack;
 pub use track_table::EffectiveTrackTable;
-pub use wheels::{
-    OdometerWheels, TRACK_RANGE_M, WheelDistances, WheelGeometry, WheelMotion, check_track,
-};
+pub use wheel_distances::{TRACK_RANGE_M, WheelDistances, check_track};
+pub use wheels::{OdometerWheels, WheelGeometry, WheelMotion};
 
 /// The code blocks of the crate's README, compiled and run as doctests.
 #[cfg(doctest)]

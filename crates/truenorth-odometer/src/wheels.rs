@@ -2,8 +2,9 @@
 //! vehicle, the odometer model and the heading computation.
 
 use serde::{Deserialize, Serialize};
-use truenorth_core::{Error, Result, Validate, check_finite, check_range};
+use truenorth_core::{Error, Result, Validate, check_finite};
 
+use crate::wheel_distances::{WheelDistances, check_track};
 use crate::{AckermannGeometry, AckermannParams, RigidMotion};
 
 /// Which pair of wheels the odometer senses, on what kind of vehicle (the parameters; see
@@ -55,20 +56,8 @@ impl OdometerWheels {
     }
 }
 
-/// The tracks a wheeled vehicle can have, m: from a 1 cm micro-robot to 100 m, ten times a
-/// mining truck's. A track is the lever that turns the wheels' difference into a turn
-/// (`Δθ = Δd/T`): one far below any vehicle's (10⁻³⁰⁰ m passes a positivity test) turns a
-/// millimetre of difference into 10³⁰⁰ rad, whose square overflows the heading's variance
-/// and leaves NaN behind; one far above it makes every turn nothing.
-pub const TRACK_RANGE_M: (f64, f64) = (0.01, 100.0);
-
-/// Checks a track `value` (named `what`) against [`TRACK_RANGE_M`].
-pub fn check_track(what: &'static str, value: f64) -> Result<f64> {
-    check_range(what, value, TRACK_RANGE_M.0, TRACK_RANGE_M.1)
-}
-
 impl Validate for OdometerWheels {
-    /// A track within [`TRACK_RANGE_M`], or valid front-axle dimensions
+    /// A track within [`TRACK_RANGE_M`](crate::TRACK_RANGE_M), or valid front-axle dimensions
     /// ([`AckermannParams`]).
     fn validate(&self) -> Result<()> {
         match self {
@@ -177,15 +166,6 @@ impl WheelGeometry {
             Self::Front(g) => g.motion_from_paths(left_m, right_m),
         }
     }
-}
-
-/// Distances of the left and right odometer wheels over one step (or cumulative), m.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
-pub struct WheelDistances {
-    /// Left wheel, m.
-    pub left_m: f64,
-    /// Right wheel, m.
-    pub right_m: f64,
 }
 
 /// The true motion of the vehicle over one step, as a rear-axle kinematic model has it.

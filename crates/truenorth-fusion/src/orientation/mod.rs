@@ -7,6 +7,7 @@
 
 mod attitude_error;
 pub mod attitude_uncertainty;
+mod attitude_uncertainty_config;
 mod broad_rmse;
 mod euler_config;
 mod euler_detector;
@@ -29,7 +30,7 @@ mod time_gap;
 mod triad;
 
 pub use attitude_error::AttitudeError;
-pub use attitude_uncertainty::AttitudeUncertaintyConfig;
+pub use attitude_uncertainty_config::AttitudeUncertaintyConfig;
 pub use broad_rmse::{BroadRmse, broad_rmse};
 pub use euler_config::{
     CorrectionDefinerConfig, EulerDetectorConfig, EulerVariant, GyroConditioning,

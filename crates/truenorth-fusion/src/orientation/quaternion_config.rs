@@ -5,7 +5,7 @@ use serde::de::IgnoredAny;
 use serde::{Deserialize, Serialize};
 use truenorth_core::{Error, Result, Validate, check_positive, check_range};
 
-use super::attitude_uncertainty::AttitudeUncertaintyConfig;
+use super::attitude_uncertainty_config::AttitudeUncertaintyConfig;
 use super::hard_iron::HardIronConfig;
 use super::mag_reference::MagReferenceConfig;
 use super::rest_detector::RestConfig;
