@@ -72,6 +72,13 @@ const POSITION_NOISE_M2_PER_M: f64 = 1e-6;
 /// direction (for the track) and, for steered wheels, the effective track along it.
 const GAP_TURN_SHARE: f64 = 0.3;
 
+/// How far an unsensed heading may wander per metre driven, rad²/m: the variance added to
+/// the heading where odometry moves the vehicle and nothing measures its turning (one
+/// vehicle speed and no gyro, or a gyro gap a single distance cannot bridge). A random
+/// walk of 0.22 rad/√m: after 10 m the heading is known to about 40°, after 50 m not at
+/// all — a car's corner is 15–30 m of road, a robot's pivot a fraction of a metre.
+const UNSENSED_TURN_RAD2_PER_M: f64 = 0.05;
+
 /// Share of a steered axle's turn across a gap that the unknown path leaves unknown: the
 /// effective track changes along the path by up to a tenth between straight and full lock
 /// (`truenorth-odometer`'s table of the exact track).
@@ -85,6 +92,7 @@ impl VehicleEstimator {
             return;
         };
         self.tracking.gyro.last = Some((t_s, raw));
+        self.tracking.gyro.distance_at_last_m = self.est.distance_m;
         let dt = t_s - t0;
         let gap = dt > self.config.max_gap_s;
         let at_rest = self.resting_at(t_s, raw, dt);
@@ -182,7 +190,7 @@ impl VehicleEstimator {
     }
 
     /// Starts the wheels' heading again from the gyro's: equal to it, fully correlated.
-    fn restart_wheel_heading(&mut self) {
+    pub(super) fn restart_wheel_heading(&mut self) {
         self.flush();
         let f = &mut self.filter;
         f.x[PSI_ODO] = f.x[PSI];
@@ -202,9 +210,11 @@ impl VehicleEstimator {
         (3.0 * self.tracking.gyro.interval_s).clamp(MIN_BRIDGE_S, self.config.max_gap_s)
     }
 
-    /// Whether the wheels read recently enough to carry the heading at `t_s`.
+    /// Whether the wheels read recently enough to carry the heading at `t_s` (and say how
+    /// the vehicle turns at all).
     fn wheels_fresh(&self, t_s: f64) -> bool {
         self.est.status.position_known
+            && self.tracking.motion.wheels_turn
             && self.wheels.last_s().is_some_and(|t0| {
                 t_s - t0 <= 2.0 * self.tracking.motion.wheel_interval_s + REST_FRESH_S
             })
@@ -219,7 +229,15 @@ impl VehicleEstimator {
         self.est.status.gap |= gap;
         self.tracking.gyro.smoothed_rps = 0.0;
         self.tracking.gyro.rate_rps = 0.0;
-        if self.est.status.position_known {
+        if self.est.status.position_known && !self.tracking.motion.wheels_turn {
+            // One distance carried the vehicle through the gap and says nothing of how it
+            // turned: the heading is widened by what it may have turned over that distance.
+            let ds = self.est.distance_m - self.tracking.gyro.distance_at_last_m;
+            let mut step = Step::default();
+            step.q[PSI] = UNSENSED_TURN_RAD2_PER_M * ds.abs();
+            self.tracking.batch.add(&step);
+            self.tracking.gyro.distance_at_last_m = self.est.distance_m;
+        } else if self.est.status.position_known {
             let turned = wrap_pi(self.filter.x[PSI_ODO] - self.tracking.gyro.odo_at_last_rad);
             let mut step = Step::default();
             step.q[PSI] = (GAP_TURN_SHARE * turned).powi(2);
@@ -256,8 +274,9 @@ impl VehicleEstimator {
         x[PSI] = wrapped;
     }
 
-    /// Takes a wheel reading at `t_s`.
-    pub(super) fn wheel_reading(&mut self, t_s: f64, reading: WheelReading) {
+    /// Takes a wheel reading at `t_s`; `turns`: the reading says how the vehicle turns (two
+    /// wheels that have differed), else it gives the distance only.
+    pub(super) fn wheel_reading(&mut self, t_s: f64, reading: WheelReading, turns: bool) {
         let x = self.filter.x;
         let cal = WheelCalibration {
             diff: x[WHEEL_DIFF],
@@ -289,14 +308,20 @@ impl VehicleEstimator {
             (SPEED_COEFF, wheel.d_heading_d_speed_coeff),
             (TRACK_SCALE, wheel.d_heading_d_track_scale),
         ];
-        let turned = wheel.heading_change_rad;
+        let turned = if turns { wheel.heading_change_rad } else { 0.0 };
         let mut step = Step::default();
         let gyro_silent = self
             .tracking
             .gyro
             .last
             .is_some_and(|(t0, _)| t_s - t0 > self.gyro_bridge_s());
-        if self.tracking.gyro.active {
+        if !turns {
+            // The distance only: the gyro, if it reads, carries the heading; if not, the
+            // heading is free to wander over the distance driven.
+            if !self.tracking.gyro.active {
+                step.q[PSI] = UNSENSED_TURN_RAD2_PER_M * wheel.ds_m.abs();
+            }
+        } else if self.tracking.gyro.active {
             step.odo_from = wheel_from;
             step.q[PSI_ODO] = wheel_q;
             self.filter.x[PSI_ODO] += turned;
@@ -315,7 +340,7 @@ impl VehicleEstimator {
             self.turn_heading(turned, &mut step);
         }
         if wheel.moved {
-            let compared = self.tracking.gyro.active && !gyro_silent;
+            let compared = turns && self.tracking.gyro.active && !gyro_silent;
             self.tracking
                 .gates
                 .wheel_step(turned, wheel.speed_mps, compared);

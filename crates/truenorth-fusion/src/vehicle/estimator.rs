@@ -30,7 +30,7 @@
 use nalgebra::Matrix2;
 use truenorth_core::{
     HeadingEstimator, MagneticHeading, NavEstimate, Result, TimeStep, Unobserved, Validate,
-    VehicleSample, wrap_pi,
+    VehicleSample, WheelReading, wrap_pi,
 };
 
 use super::compass_learning::CompassLearner;
@@ -322,6 +322,45 @@ impl VehicleEstimator {
         }
     }
 
+    /// The odometry of `sample` as the wheel path takes it, and whether it says how the
+    /// vehicle turns: two wheels as they are once they have differed on any row; one
+    /// distance (`dist_m`, a CAN vehicle speed integrated) as two equal wheels that say
+    /// nothing of turning — read only while no row has carried two wheels, whose counters
+    /// it would otherwise mix with. Two wheels equal on every row so far are one speed
+    /// written twice, and carry no more.
+    fn odometry_of(&self, sample: &VehicleSample) -> Option<(WheelReading, bool)> {
+        let motion = &self.tracking.motion;
+        match (sample.wheels, sample.dist_m) {
+            (Some(w), _) => Some((w, motion.wheels_turn || w.dist_l_m != w.dist_r_m)),
+            (None, Some(d)) if motion.single_distance || !self.est.status.position_known => Some((
+                WheelReading {
+                    dist_l_m: d,
+                    dist_r_m: d,
+                },
+                false,
+            )),
+            _ => None,
+        }
+    }
+
+    /// Keeps what the odometry has shown: the first time two wheels differ after the
+    /// vehicle has moved, their heading starts from the gyro's, since over that distance
+    /// they were not compared with it (equal wheels at a standstill were a true "no turn").
+    fn note_odometry(&mut self, turns: bool, single: bool) {
+        let first_row = !self.est.status.position_known;
+        let motion = &mut self.tracking.motion;
+        if first_row {
+            motion.single_distance = single;
+        }
+        if turns && !motion.wheels_turn {
+            motion.wheels_turn = true;
+            motion.single_distance = false;
+            if self.tracking.gyro.active && self.est.distance_m > 0.0 {
+                self.restart_wheel_heading();
+            }
+        }
+    }
+
     /// Refreshes which learned states the data have not yet separated (at each epoch: it
     /// reads the covariance, which only changes then).
     pub(super) fn refresh_unobserved(&mut self) {
@@ -330,9 +369,9 @@ impl VehicleEstimator {
             gyro_bias: self.tracking.gyro.active && u.gyro_bias,
             gyro_gain_right: self.tracking.gyro.active && u.gyro_gain_right,
             gyro_gain_left: self.tracking.gyro.active && u.gyro_gain_left,
-            wheel_diff: self.est.status.position_known && u.wheel_diff,
-            track_scale: self.est.status.position_known && u.track_scale,
-            speed_coeff: self.est.status.position_known && u.speed_coeff,
+            wheel_diff: self.tracking.motion.wheels_turn && u.wheel_diff,
+            track_scale: self.tracking.motion.wheels_turn && u.track_scale,
+            speed_coeff: self.tracking.motion.wheels_turn && u.speed_coeff,
         };
     }
 }
@@ -345,7 +384,8 @@ impl HeadingEstimator for VehicleEstimator {
     fn update(&mut self, sample: &VehicleSample) -> Result<NavEstimate> {
         sample.validate()?;
         self.tracking.gates.check_time_base()?;
-        if let Some(w) = &sample.wheels {
+        let odometry = self.odometry_of(sample);
+        if let Some((w, _)) = &odometry {
             self.wheels.check_speed(sample.t_s, w)?;
         }
         let dt = self.clock.dt_s(sample.t_s)?;
@@ -356,8 +396,9 @@ impl HeadingEstimator for VehicleEstimator {
         if let Some(g) = sample.gyr_z_rps {
             self.gyro_reading(sample.t_s, g);
         }
-        if let Some(w) = sample.wheels {
-            self.wheel_reading(sample.t_s, w);
+        if let Some((w, turns)) = odometry {
+            self.note_odometry(turns, sample.wheels.is_none());
+            self.wheel_reading(sample.t_s, w, turns);
         }
         self.compass_step(sample);
         self.tracking.rows_since_epoch += 1;

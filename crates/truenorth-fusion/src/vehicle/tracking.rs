@@ -88,6 +88,10 @@ pub(super) struct GyroTrack {
     /// until the next reading, so that a sensor read between two gyro readings is
     /// compared with the heading at its own time.
     pub rate_rps: f64,
+    /// The distance travelled at the last reading, m: what a gap that nothing else bridges
+    /// leaves the heading free to turn over.
+    #[serde(default)]
+    pub distance_at_last_m: f64,
 }
 
 /// How the vehicle moves, from the wheels.
@@ -101,6 +105,14 @@ pub(super) struct Motion {
     pub psi_at_wheels_rad: f64,
     /// The interval between the last two wheel readings, s.
     pub wheel_interval_s: f64,
+    /// The odometry says how the vehicle turns: two wheels (or sides) that have differed.
+    /// A single distance (`dist_m`), or a left and a right equal on every row so far (one
+    /// speed written twice), carries the distance and nothing about turning.
+    #[serde(default)]
+    pub wheels_turn: bool,
+    /// The odometry read so far is one distance, not two wheels.
+    #[serde(default)]
+    pub single_distance: bool,
 }
 
 /// Rest and the bias average.
