@@ -32,6 +32,9 @@ const MIN_BRIDGE_S: f64 = 0.05;
 /// Slack on the freshness of the wheels' word that the vehicle stands still, s.
 const REST_FRESH_S: f64 = 0.05;
 
+/// Readings of a rest after which a reading is held to the rest's own mean.
+const REST_MEAN_READINGS: u32 = 2;
+
 /// Smallest bias-measurement noise at rest, rad/s (vibration of an idling engine).
 const REST_NOISE_FLOOR_RPS: f64 = 2e-5;
 
@@ -161,7 +164,11 @@ impl VehicleEstimator {
     /// that reading is fresh (within two of their intervals), and the gyro does not
     /// contradict it (a rate beyond five standard deviations of the bias and the reading's
     /// noise is a turn the wheels missed: a skid-steer pivoting while its wheel readings
-    /// drop out).
+    /// drop out). Once a few readings of this rest are in, the rate is held to their mean
+    /// rather than to the bias: a gyro at rest reads its bias, whatever the bias is, so a
+    /// reading that leaves the rest's mean by more than its noise is a turn even while the
+    /// bias is still unknown (a car creeping round a corner below the speed a CAN bus
+    /// reports as anything but zero).
     fn resting_at(&self, t_s: f64, raw: f64, dt: f64) -> bool {
         if !self.tracking.motion.at_rest {
             return false;
@@ -169,10 +176,20 @@ impl VehicleEstimator {
         let fresh = self.wheels.last_s().is_some_and(|t0| {
             t_s - t0 <= 2.0 * self.tracking.motion.wheel_interval_s + REST_FRESH_S
         });
-        let spread = (self.filter.p[BIAS][BIAS] + self.coeffs.gyro_noise_rad2_per_s / dt)
+        let rest = &self.tracking.rest;
+        let (reference, reference_var) = if rest.n >= REST_MEAN_READINGS {
+            let mean = rest.sum_raw / f64::from(rest.n);
+            (
+                mean,
+                self.coeffs.gyro_noise_rad2_per_s / rest.span_s.max(dt),
+            )
+        } else {
+            (self.filter.x[BIAS], self.filter.p[BIAS][BIAS])
+        };
+        let spread = (reference_var + self.coeffs.gyro_noise_rad2_per_s / dt)
             .sqrt()
             .max(REST_NOISE_FLOOR_RPS);
-        fresh && (raw - self.filter.x[BIAS]).abs() <= 5.0 * spread
+        fresh && (raw - reference).abs() <= 5.0 * spread
     }
 
     /// Switches the heading to the gyro at its first reading: the wheels' heading starts
