@@ -36,7 +36,10 @@ odometer wheels' track, m (a skid-steer's physical track: the effective one, 1.5
 is learned); wheelbase_m rear axle to front kingpins, m; pitman_ratio P = 2p/T_F (kingpin
 offset p over half the front track; front wheels only). Optional: \"wheel_resolution_m\"
 (distance per odometer pulse, default 0.02 with distance columns on a car and 0.003 with
-speed columns, a CAN bus's 0.01 km/h over one second; 0.001 on a robot) and \"version\": 1.
+speed columns, a CAN bus's 0.01 km/h over one second; 0.001 on a robot),
+\"compass_systematic_deg\" (the compass's systematic heading error, default 3: a level
+two-axis compass on roads whose grade and camber tilt it; about 0.3 for a tilt-compensated
+compass or level ground) and \"version\": 1.
 Unknown keys are refused (naming the closest known one), and so are values no vehicle has.
 
 DRIVE.csv: `t_s` (strictly increasing, seconds) and any of: `dist_l_m,dist_r_m` (cumulative
@@ -231,11 +234,14 @@ fn build_method(
     } else if speeds && !wheels.can_pivot() {
         priors.wheel_resolution_m = SPEED_RESOLUTION_M;
     }
-    let config = VehicleConfig {
+    let mut config = VehicleConfig {
         wheels,
         priors: Some(priors),
         ..VehicleConfig::default()
     };
+    if let Some(s) = vehicle.compass_systematic_deg {
+        config.compass.systematic_deg = s;
+    }
     let bad_config =
         |e: truenorth::core::Error| CliError::file(&args.vehicle, e.to_string()).kind_of(&e);
     let fused = match &args.calibration_in {

@@ -59,8 +59,15 @@ impl Configuration {
             Self::SeedGyroCompass => VehicleMethod::SeedGyroCompass,
             Self::SeedOdometerCompass => VehicleMethod::SeedOdometerCompass,
         };
+        // The simulated world is flat and its compass level: no grade or camber tilts the
+        // field's vertical part into the heading, which the default's 3° systematic error
+        // allows for; the installation's 0.3° is what such a user would configure.
         let fused = VehicleEstimator::new(VehicleConfig {
             wheels,
+            compass: truenorth::fusion::CompassGates {
+                systematic_deg: 0.3,
+                ..truenorth::fusion::CompassGates::default()
+            },
             ..VehicleConfig::default()
         })?;
         let mut runner = method.runner(wheels, fused, false)?;

@@ -188,8 +188,12 @@ pub struct CompassGates {
     pub slow_gate_sigma: f64,
     /// Standard deviation of the heading error that the installation and the road (a
     /// compass mounted a little askew, grade and camber tilting it) leave in every reading
-    /// alike, degrees (0.3): the filter carries it, with the calibration's own error, as a
-    /// state, so that it is not averaged away as if it were noise.
+    /// alike, degrees (3): the filter carries it, with the calibration's own error, as a
+    /// state, so that it is not averaged away as if it were noise. A level two-axis compass
+    /// tilted by θ reads the heading wrong by up to tan(dip)·θ, since the field's vertical
+    /// part leaks into the horizontal axes: a road's grade and camber of 1–3 % (0.6–1.7°)
+    /// at a dip of 50–75° (most of the inhabited world) make 1–6°, and a car's roll in a
+    /// bend adds as much; 3° is one standard deviation of that spread.
     pub systematic_deg: f64,
     /// Correlation time of that error while driving straight, s (300): a road's grade and
     /// camber last for hundreds of metres, and the calibration's error does not change at
@@ -219,7 +223,7 @@ impl Default for CompassGates {
             innovation_gate_sigma: 3.5,
             slow_gate_tau_s: 1.5,
             slow_gate_sigma: 3.0,
-            systematic_deg: 0.3,
+            systematic_deg: 3.0,
             systematic_tau_s: 300.0,
             systematic_turn_rad: 0.7,
             readings_per_update: 10,

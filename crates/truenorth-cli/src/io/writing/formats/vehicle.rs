@@ -21,6 +21,8 @@ const TRACK_RANGE_M: (f64, f64) = (0.05, 10.0);
 const WHEELBASE_RANGE_M: (f64, f64) = (0.1, 20.0);
 /// The distance per odometer pulse, m: up to one revolution of a large wheel.
 const RESOLUTION_RANGE_M: (f64, f64) = (1e-6, 5.0);
+/// The compass's systematic heading error, degrees: the estimator's own range.
+const SYSTEMATIC_RANGE_DEG: (f64, f64) = (1e-3, 45.0);
 
 /// The vehicle file, as written.
 #[derive(Debug, Deserialize)]
@@ -39,6 +41,10 @@ pub struct VehicleFile {
     pub pitman_ratio: Option<f64>,
     /// Distance per odometer pulse, m.
     pub wheel_resolution_m: Option<f64>,
+    /// The compass's systematic heading error, degrees (optional; the estimator's default,
+    /// 3°, is a level two-axis compass on roads that tilt it by their grade and camber; a
+    /// tilt-compensated compass, or one on level ground, leaves about 0.3°).
+    pub compass_systematic_deg: Option<f64>,
 }
 
 impl VehicleFile {
@@ -86,6 +92,14 @@ impl VehicleFile {
         }
         if let Some(r) = self.wheel_resolution_m {
             within("wheel_resolution_m", r, RESOLUTION_RANGE_M, " m")?;
+        }
+        if let Some(s) = self.compass_systematic_deg
+            && !(s.is_finite() && (SYSTEMATIC_RANGE_DEG.0..=SYSTEMATIC_RANGE_DEG.1).contains(&s))
+        {
+            return Err(format!(
+                "`compass_systematic_deg` is {s}, outside {}–{}° (a heading error a compass can leave); check the value and its unit (degrees)",
+                SYSTEMATIC_RANGE_DEG.0, SYSTEMATIC_RANGE_DEG.1
+            ));
         }
         Ok(())
     }
