@@ -5,7 +5,7 @@
 use std::path::{Path, PathBuf};
 
 use truenorth::checks::GyroUnit;
-use truenorth::core::{Fixed, NavEstimate, rad_to_deg};
+use truenorth::core::{Fixed, NavEstimate, VehicleSensors, rad_to_deg};
 use truenorth::fusion::vehicle::VehicleCalibration;
 use truenorth::fusion::{SensorPriors, VehicleConfig, VehicleEstimator};
 use truenorth::odometer::OdometerWheels;
@@ -44,11 +44,15 @@ Unknown keys are refused (naming the closest known one), and so are values no ve
 
 DRIVE.csv: `t_s` (strictly increasing, seconds) and any of: `dist_l_m,dist_r_m` (cumulative
 distance of the left and right odometer wheels as the odometer reports it) or
-`speed_l_mps,speed_r_mps` (wheel speeds, integrated by the trapezoid rule); `gyr_z` (rad/s,
+`speed_l_mps,speed_r_mps` (wheel speeds, integrated by the trapezoid rule), or the vehicle's
+one `dist_m` (cumulative) or `speed_mps` (a CAN bus's vehicle speed): the distance only,
+nothing about turning; `gyr_z` (rad/s,
 or deg/s with --gyro-unit deg/s; raw, positive for a right turn); `mag_x,mag_y` (any unit, uncalibrated; a level compass
 reads mag_x = H cos(heading), mag_y = -H sin(heading)). Each sensor may come at its own
 rate: an empty cell means no reading on that row, and each row is used for what it carries.
-Wheels or a gyro must be present. Other columns are ignored. Frames: x forward, y right,
+Wheels, a gyro or a compass must be present; the summary names the sensor set and warns of
+what it cannot tell (no north without a compass, no gyro gain without a second turn
+reference). A speed beside wheel columns is said unused; other columns are ignored. Frames: x forward, y right,
 z down.
 
 Output: `t_s,north_m,east_m,heading_deg` — the rear-axle centre from the start point, and
@@ -161,6 +165,11 @@ pub fn run(args: &Args) -> CliResult {
     let speeds = samples.kind().speeds();
     let mut method = build_method(args, &vehicle, wheels, speeds)?;
     samples.kind().check_compass(samples.path())?;
+    if let Some(name) = samples.kind().unused_column() {
+        errln!(
+            "truenorth drive: warning: `{name}` is not used: the wheels' own columns give the distance, and the turn besides"
+        );
+    }
     let mut check = Diagnosis::new(vehicle.track_m, wheels.can_pivot(), speeds);
     let mut writer = Writer::create(
         &args.output,
@@ -169,8 +178,15 @@ pub fn run(args: &Args) -> CliResult {
         args.output_options.precision,
     )?;
     let context = diagnosis_context(args, speeds);
-    let samples = estimate(&mut samples, &mut check, method.as_mut(), &mut writer)
-        .map_err(|e| check.check(&context).err().unwrap_or(e))?;
+    let mut sensors = VehicleSensors::default();
+    let samples = estimate(
+        &mut samples,
+        &mut check,
+        &mut sensors,
+        method.as_mut(),
+        &mut writer,
+    )
+    .map_err(|e| check.check(&context).err().unwrap_or(e))?;
     check.check(&context)?;
     let learned = method.calibration();
     if let (Some(out), Some(learned)) = (&args.calibration_out, &learned) {
@@ -192,6 +208,7 @@ pub fn run(args: &Args) -> CliResult {
         last.as_ref(),
         learned.as_ref(),
     );
+    say_sensors(&sensors);
     Ok(())
 }
 
@@ -297,12 +314,14 @@ fn diagnosis_context(args: &Args, speeds: bool) -> Context<'_> {
 fn estimate(
     samples: &mut Samples<Vehicle>,
     check: &mut Diagnosis,
+    sensors: &mut VehicleSensors,
     method: &mut dyn VehicleRun,
     writer: &mut Writer,
 ) -> CliResult<usize> {
     let path = samples.path().to_path_buf();
     let count = samples.for_each(|row, sample| {
         check.push(&sample, row);
+        sensors.add(&sample);
         method
             .push(&sample, &mut |e, filter| writer.write(e, filter))
             .map_err(|e| CliError::row(&path, row, e.to_string()).kind_of(&e))?;
@@ -315,6 +334,14 @@ fn estimate(
         return Err(e);
     }
     Ok(count)
+}
+
+/// The sensor set the log carried, and one warning line for each thing it cannot tell.
+fn say_sensors(sensors: &VehicleSensors) {
+    errln!("truenorth drive: sensors: {}", sensors.name());
+    for limit in sensors.limits() {
+        errln!("truenorth drive: warning: {limit}");
+    }
 }
 
 /// One line on stderr: what was done and what was learned.
@@ -339,7 +366,7 @@ fn summary(
         Fixed(e.distance_m, 0)
     );
     if !e.status.position_known {
-        line += " (no wheels: no position)";
+        line += " (no wheels or speed: no position)";
     }
     line += &format!(", final heading σ {:.2}°", rad_to_deg(e.heading_sigma_rad));
     if let Some(c) = learned {

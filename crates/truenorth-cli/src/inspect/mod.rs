@@ -21,7 +21,7 @@ use crate::io::{CliResult, InputOptions, RowReader, Table};
 use report::Report;
 
 /// Every column `inspect` looks for (body axes, after `--axes` and `--column`).
-pub const COLUMNS: [&str; 13] = [
+pub const COLUMNS: [&str; 15] = [
     "gyr_x",
     "gyr_y",
     "gyr_z",
@@ -35,6 +35,8 @@ pub const COLUMNS: [&str; 13] = [
     "dist_r_m",
     "speed_l_mps",
     "speed_r_mps",
+    "dist_m",
+    "speed_mps",
 ];
 
 /// A recording's columns as read: the time and the [`COLUMNS`] it has (NaN where a cell is
@@ -118,6 +120,7 @@ pub fn analyse(file: &str, rec: &Recording, opts: &InputOptions) -> Report {
         mag: sensors::mag(rec),
         wheels: wheels::wheels(rec),
         yaw: wheels::yaw(rec, opts),
+        vehicle: wheels::vehicle_sensors(rec),
     }
 }
 
@@ -147,7 +150,7 @@ mod tests {
         fn inspect_never_panics(
             t in proptest::collection::vec(cell(), 0..300),
             present in proptest::collection::vec(any::<bool>(), COLUMNS.len()),
-            seed in proptest::collection::vec(cell(), 300 * 13),
+            seed in proptest::collection::vec(cell(), 300 * COLUMNS.len()),
             ramp in any::<bool>(),
         ) {
             let t_s: Vec<f64> = if ramp {

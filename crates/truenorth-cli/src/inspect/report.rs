@@ -10,7 +10,7 @@ use serde::Serialize;
 
 use super::column_stats::ColumnStats;
 use super::sensors::{AccReport, AxesReport, GyroReport, MagReport};
-use super::wheels::{WheelReport, YawReport};
+use super::wheels::{VehicleSetReport, WheelReport, YawReport};
 
 /// What `inspect` found.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -33,6 +33,8 @@ pub struct Report {
     pub wheels: Option<WheelReport>,
     /// The yaw gyro against the wheels, if both are present.
     pub yaw: Option<YawReport>,
+    /// A drive log's sensor set and what it cannot tell, if the file is one.
+    pub vehicle: Option<VehicleSetReport>,
 }
 
 /// The report with the options, as `--json` writes it.
@@ -139,6 +141,12 @@ impl Report {
         }
         if let Some(y) = &self.yaw {
             yaw_line(s, y);
+        }
+        if let Some(v) = &self.vehicle {
+            let _ = writeln!(s, "vehicle sensors: {}", v.set);
+            for l in &v.cannot_tell {
+                let _ = writeln!(s, "  cannot tell: {l}");
+            }
         }
     }
 }

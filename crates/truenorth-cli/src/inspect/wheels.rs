@@ -140,3 +140,43 @@ pub fn yaw(rec: &Recording, opts: &InputOptions) -> Option<YawReport> {
         }),
     })
 }
+
+/// A drive log's sensor set, as `drive` names it, and what that set cannot tell.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct VehicleSetReport {
+    /// The set's name (`truenorth::core::VehicleSensors::name`).
+    pub set: String,
+    /// What the set cannot tell, one sentence each.
+    pub cannot_tell: Vec<String>,
+}
+
+/// The sensor set of a drive log — wheels (two distances or speeds), one distance or speed,
+/// a yaw gyro, a two-axis compass — judged from the columns present; `None` for a file with
+/// a three-axis gyro or an accelerometer (an IMU recording, not a drive log) or none of them.
+pub fn vehicle_sensors(rec: &Recording) -> Option<VehicleSetReport> {
+    use truenorth::core::{Travel, VehicleSensors};
+    let has = |n: &str| rec.col(n).is_some();
+    if has("gyr_x") || has("gyr_y") || has("acc_x") || has("acc_z") || has("mag_z") {
+        return None;
+    }
+    let wheels = (has("dist_l_m") && has("dist_r_m")) || (has("speed_l_mps") && has("speed_r_mps"));
+    let travel = if wheels {
+        Travel::Wheels
+    } else if has("dist_m") || has("speed_mps") {
+        Travel::Speed
+    } else {
+        Travel::None
+    };
+    let set = VehicleSensors {
+        travel,
+        gyro: has("gyr_z"),
+        compass: has("mag_x") && has("mag_y"),
+    };
+    if set == VehicleSensors::default() {
+        return None;
+    }
+    Some(VehicleSetReport {
+        set: set.name().to_string(),
+        cannot_tell: set.limits().map(String::from).collect(),
+    })
+}

@@ -12,7 +12,7 @@ use truenorth::core::{Axes, ImuSample, Mag2Sample, Mag3Sample, VehicleSample};
 
 use super::reader::{RowReader, RowRef};
 use super::samples::SampleKind;
-use super::wheels::WheelColumns;
+use super::wheels::{DistanceColumn, WheelColumns};
 use crate::io::{CliError, CliResult};
 
 const MAG2: [&str; 2] = ["mag_x", "mag_y"];
@@ -333,24 +333,32 @@ impl SampleKind for Imu {
 }
 
 /// The optional columns of a drive log.
-const DRIVE: [&str; 7] = [
+const DRIVE: [&str; 9] = [
     "dist_l_m",
     "dist_r_m",
     "speed_l_mps",
     "speed_r_mps",
+    "dist_m",
+    "speed_mps",
     "gyr_z",
     "mag_x",
     "mag_y",
 ];
 
 /// A vehicle's sensors, each on the rows that carry it: the wheels (cumulative distances,
-/// or speeds integrated into them), the yaw gyro in its declared unit, a raw two-axis
-/// compass. Wheels or a gyro must be there.
+/// or speeds integrated into them) or the vehicle's one distance or speed, the yaw gyro in
+/// its declared unit, a raw two-axis compass. Something that measures the heading or its
+/// changes must be there: wheels, a gyro or a compass.
 #[derive(Debug, Clone)]
 pub struct Vehicle {
     to_rps: f64,
     t: usize,
     wheels: Option<WheelColumns>,
+    /// The vehicle's one distance (`dist_m`) or speed (`speed_mps`), where there are no
+    /// wheels.
+    distance: Option<DistanceColumn>,
+    /// The columns the log gives that the wheels make redundant, said on stderr.
+    unused: Option<&'static str>,
     gyr: Option<usize>,
     /// `mag_x` and `mag_y`, where present.
     mag: [Option<usize>; 2],
@@ -363,14 +371,22 @@ impl Vehicle {
             to_rps: gyro.to_rad_per_s(),
             t: 0,
             wheels: None,
+            distance: None,
+            unused: None,
             gyr: None,
             mag: [None; 2],
         }
     }
 
-    /// Whether the wheel columns are speeds.
+    /// Whether the wheel columns are speeds (or the vehicle's one speed).
     pub fn speeds(&self) -> bool {
         matches!(self.wheels, Some(WheelColumns::Speeds { .. }))
+            || matches!(self.distance, Some(DistanceColumn::Speed { .. }))
+    }
+
+    /// The distance column the log gives beside wheels, which the wheels make unused.
+    pub fn unused_column(&self) -> Option<&'static str> {
+        self.unused
     }
 
     /// Refuses a compass with one axis and not the other (`path` names the file). Asked
@@ -414,11 +430,33 @@ impl SampleKind for Vehicle {
             }),
             _ => None,
         };
-        if self.wheels.is_none() && ix("gyr_z").is_none() {
+        let single = match (ix("dist_m"), ix("speed_mps")) {
+            (Some(c), _) => Some((DistanceColumn::Distance(c), "dist_m")),
+            (None, Some(column)) => Some((
+                DistanceColumn::Speed {
+                    column,
+                    last: None,
+                    dist: 0.0,
+                },
+                "speed_mps",
+            )),
+            (None, None) => None,
+        };
+        match single {
+            Some((_, name)) if self.wheels.is_some() => self.unused = Some(name),
+            Some((c, _)) => self.distance = Some(c),
+            None => {}
+        }
+        let compass = ix("mag_x").is_some() && ix("mag_y").is_some();
+        if self.wheels.is_none() && ix("gyr_z").is_none() && !compass {
             return Err(CliError::row(
                 rows.path(),
                 1,
-                "needs a heading sensor: the wheels (`dist_l_m,dist_r_m` cumulative distances or `speed_l_mps,speed_r_mps` wheel speeds) or a gyro (`gyr_z`, rad/s)",
+                if self.distance.is_some() {
+                    "has a distance or speed but nothing that measures the heading: add a yaw gyro (`gyr_z`, rad/s), the wheels' own distances or speeds (`dist_l_m,dist_r_m` or `speed_l_mps,speed_r_mps`), or a compass (`mag_x,mag_y`)"
+                } else {
+                    "needs a heading sensor: the wheels (`dist_l_m,dist_r_m` cumulative distances or `speed_l_mps,speed_r_mps` wheel speeds) or a gyro (`gyr_z`, rad/s)"
+                },
             ));
         }
         self.mag = [ix("mag_x"), ix("mag_y")];
@@ -438,6 +476,13 @@ impl SampleKind for Vehicle {
                 .map_err(|m| CliError::row(path, row.number, m))?
         {
             sample = sample.with_wheels(l, r);
+        }
+        if let Some(d) = self
+            .distance
+            .as_mut()
+            .and_then(|d| d.cumulative(v[self.t], v))
+        {
+            sample = sample.with_distance(d);
         }
         if let Some(g) = self.gyr.map(|g| v[g]).filter(|g| g.is_finite()) {
             sample = sample.with_gyro(g * self.to_rps);

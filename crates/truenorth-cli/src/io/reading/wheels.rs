@@ -49,3 +49,40 @@ impl WheelColumns {
         }))
     }
 }
+
+/// The vehicle's one distance column of a drive log (a CAN bus's vehicle speed, or a
+/// distance counter): cumulative, or a speed to integrate.
+#[derive(Debug, Clone, Copy)]
+pub enum DistanceColumn {
+    /// Cumulative distance, m (`dist_m`): the column index.
+    Distance(usize),
+    /// Vehicle speed, m/s (`speed_mps`), integrated by the trapezoid rule.
+    Speed {
+        /// The column index.
+        column: usize,
+        /// The last row that carried it: time and speed.
+        last: Option<(f64, f64)>,
+        /// Distance integrated so far, m.
+        dist: f64,
+    },
+}
+
+impl DistanceColumn {
+    /// The cumulative distance at time `t` from row `values`, if the row carries it.
+    pub fn cumulative(&mut self, t: f64, values: &[f64]) -> Option<f64> {
+        match self {
+            Self::Distance(c) => Some(values[*c]).filter(|d| d.is_finite()),
+            Self::Speed { column, last, dist } => {
+                let v = values[*column];
+                if !v.is_finite() {
+                    return None;
+                }
+                if let Some((t0, v0)) = *last {
+                    *dist += 0.5 * (v0 + v) * (t - t0);
+                }
+                *last = Some((t, v));
+                Some(*dist)
+            }
+        }
+    }
+}
