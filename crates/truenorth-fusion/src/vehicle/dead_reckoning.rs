@@ -498,7 +498,12 @@ impl VehicleEstimator {
         let ahead = self.heading_at(t_wheels) - self.filter.x[PSI];
         let nu = wrap_pi(self.filter.x[PSI_ODO] - self.filter.x[PSI] - ahead);
         let h = [(PSI, 1.0), (PSI_ODO, -1.0)];
-        let r = self.coeffs.wheel_quantisation_rad2;
+        // The wheels' and the gyro's readings reach the log with different delays (their
+        // own rows and clocks, a motor controller's or an ABS unit's filtering): the two
+        // headings differ by the turn made in the delay, the rate times it, which says
+        // nothing about either sensor's errors. Exact when driving straight, poor in a turn.
+        let latency = WHEEL_GYRO_DELAY_S * self.tracking.gyro.rate_rps;
+        let r = self.coeffs.wheel_quantisation_rad2 + latency * latency;
         let f = &self.filter;
         let s = f.p[PSI][PSI] - 2.0 * f.p[PSI][PSI_ODO] + f.p[PSI_ODO][PSI_ODO] + r;
         let nis = nu * nu / s;
@@ -511,6 +516,11 @@ impl VehicleEstimator {
         self.filter.update_some(&h, nu, r, learn);
     }
 }
+
+/// Standard deviation of the delay between the wheels' readings and the gyro's as a log
+/// records them, s (0.1): sensors on their own rows and clocks reach a log 50–150 ms apart,
+/// and a controller's speed filter adds as much.
+const WHEEL_GYRO_DELAY_S: f64 = 0.1;
 
 /// A comparison whose normalised innovation squared exceeds this (5σ) is an outlier.
 const OUTLIER_NIS: f64 = 25.0;
