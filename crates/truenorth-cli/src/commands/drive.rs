@@ -207,8 +207,11 @@ pub fn run(args: &Args) -> CliResult {
         gaps,
         last.as_ref(),
         learned.as_ref(),
+        &sensors,
     );
-    say_sensors(&sensors);
+    for limit in sensors.limits() {
+        errln!("truenorth drive: warning: {limit}");
+    }
     Ok(())
 }
 
@@ -336,15 +339,8 @@ fn estimate(
     Ok(count)
 }
 
-/// The sensor set the log carried, and one warning line for each thing it cannot tell.
-fn say_sensors(sensors: &VehicleSensors) {
-    errln!("truenorth drive: sensors: {}", sensors.name());
-    for limit in sensors.limits() {
-        errln!("truenorth drive: warning: {limit}");
-    }
-}
-
-/// One line on stderr: what was done and what was learned.
+/// One line on stderr: what was done, what was learned, and the sensor set the log carried
+/// (what that set cannot tell follows, a warning line each).
 fn summary(
     args: &Args,
     samples: usize,
@@ -352,6 +348,7 @@ fn summary(
     gaps: usize,
     last: Option<&NavEstimate>,
     learned: Option<&VehicleCalibration>,
+    sensors: &VehicleSensors,
 ) {
     let Some(e) = last else { return };
     let reference = if !e.status.heading_absolute {
@@ -398,5 +395,6 @@ fn summary(
     if gaps > 0 {
         line += &format!("; {gaps} gaps in the log, widened rather than bridged");
     }
+    line += &format!("; sensors: {}", sensors.name());
     errln!("{line}");
 }

@@ -448,12 +448,15 @@ impl SampleKind for Vehicle {
             None => {}
         }
         let compass = ix("mag_x").is_some() && ix("mag_y").is_some();
-        if self.wheels.is_none() && ix("gyr_z").is_none() && !compass {
+        let speed_and_compass = compass && self.distance.is_some();
+        if self.wheels.is_none() && ix("gyr_z").is_none() && !speed_and_compass {
             return Err(CliError::row(
                 rows.path(),
                 1,
                 if self.distance.is_some() {
                     "has a distance or speed but nothing that measures the heading: add a yaw gyro (`gyr_z`, rad/s), the wheels' own distances or speeds (`dist_l_m,dist_r_m` or `speed_l_mps,speed_r_mps`), or a compass (`mag_x,mag_y`)"
+                } else if compass {
+                    "needs a heading sensor besides the compass: the wheels (`dist_l_m,dist_r_m` or `speed_l_mps,speed_r_mps`), a gyro (`gyr_z`, rad/s), or a vehicle speed (`speed_mps` or `dist_m`) to travel along it (a compass alone: `truenorth heading`)"
                 } else {
                     "needs a heading sensor: the wheels (`dist_l_m,dist_r_m` cumulative distances or `speed_l_mps,speed_r_mps` wheel speeds) or a gyro (`gyr_z`, rad/s)"
                 },
