@@ -17,8 +17,12 @@ fn vehicle_sample(
     wheels: Option<(f64, f64)>,
     gyr_z: Option<f64>,
     mag: Option<(f64, f64)>,
+    dist_m: Option<f64>,
 ) -> VehicleSample {
     let mut s = VehicleSample::at(t_s);
+    if let Some(d) = dist_m.filter(|d| !d.is_nan()) {
+        s = s.with_distance(d);
+    }
     if let Some((l, r)) = wheels.filter(|(l, r)| !(l.is_nan() && r.is_nan())) {
         s = s.with_wheels(l, r);
     }
@@ -42,8 +46,10 @@ fn contract_row(e: &NavEstimate) -> [f64; 3] {
     [n, east, rad_to_deg(wrap_two_pi(e.heading.rad()))]
 }
 
-/// The fused vehicle estimator: cumulative wheel distances (m), raw yaw rate (rad/s,
-/// positive turning right), raw horizontal magnetometer (any unit), each optional per row;
+/// The fused vehicle estimator: cumulative wheel distances (m) or the vehicle's one
+/// cumulative distance (`dist_m`, a CAN speed integrated: the distance, nothing about
+/// turning), raw yaw rate (rad/s, positive turning right), raw horizontal magnetometer (any
+/// unit), each optional per row;
 /// every sensor calibrated online. `config`: the library's `VehicleConfig` as a dictionary,
 /// e.g. `{"wheels": {"rear": {"track_m": 1.6}}}` (missing fields take their defaults).
 #[pyclass(module = "truenorth")]
@@ -63,7 +69,8 @@ impl VehicleEstimator {
 
     /// Feeds one row; any reading may be `None`. Returns `{"t_s", "north_m", "east_m",
     /// "heading_deg"}` after it.
-    #[pyo3(signature = (t_s, dist_l_m=None, dist_r_m=None, gyr_z=None, mag=None))]
+    #[pyo3(signature = (t_s, dist_l_m=None, dist_r_m=None, gyr_z=None, mag=None, dist_m=None))]
+    #[allow(clippy::too_many_arguments)]
     fn update<'py>(
         &mut self,
         py: Python<'py>,
@@ -72,11 +79,12 @@ impl VehicleEstimator {
         dist_r_m: Option<f64>,
         gyr_z: Option<f64>,
         mag: Option<(f64, f64)>,
+        dist_m: Option<f64>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let wheels = dist_l_m.zip(dist_r_m);
         let e = self
             .inner
-            .update(&vehicle_sample(t_s, wheels, gyr_z, mag))
+            .update(&vehicle_sample(t_s, wheels, gyr_z, mag, dist_m))
             .map_err(lib_err)?;
         let [n, east, h] = contract_row(&e);
         let d = PyDict::new(py);
@@ -88,11 +96,13 @@ impl VehicleEstimator {
     }
 
     /// Runs every row (the loop in Rust, without the GIL): `t_s` (N, s), and any of
-    /// `dist_l_m`, `dist_r_m` (N, cumulative), `gyr_z` (N, rad/s), `mag` (N×2), NaN where a
-    /// row has no reading. Returns a dict of arrays: `t_s`, `north_m`, `east_m` (NaN before
+    /// `dist_l_m`, `dist_r_m` (N, cumulative), `gyr_z` (N, rad/s), `mag` (N×2), `dist_m` (N,
+    /// the vehicle's one cumulative distance, where there are no wheels), NaN where a row
+    /// has no reading. Returns a dict of arrays: `t_s`, `north_m`, `east_m` (NaN before
     /// the wheels give a position), `heading_deg` ([0, 360), magnetic north),
     /// `heading_sigma_deg`, `speed_mps`, `distance_m`, `gap` (bool).
-    #[pyo3(signature = (t_s, dist_l_m=None, dist_r_m=None, gyr_z=None, mag=None))]
+    #[pyo3(signature = (t_s, dist_l_m=None, dist_r_m=None, gyr_z=None, mag=None, dist_m=None))]
+    #[allow(clippy::too_many_arguments)]
     fn update_array<'py>(
         &mut self,
         py: Python<'py>,
@@ -101,6 +111,7 @@ impl VehicleEstimator {
         dist_r_m: Option<PyReadonlyArray1<'py, f64>>,
         gyr_z: Option<PyReadonlyArray1<'py, f64>>,
         mag: Option<PyReadonlyArray2<'py, f64>>,
+        dist_m: Option<PyReadonlyArray1<'py, f64>>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let t = t_s.as_array();
         let n = t.len();
@@ -120,6 +131,7 @@ impl VehicleEstimator {
             col(&dist_r_m, "dist_r_m")?,
             col(&gyr_z, "gyr_z")?,
         );
+        let single = col(&dist_m, "dist_m")?;
         let m = match &mag {
             Some(m) => {
                 let m = rows(m, "mag", &[2])?;
@@ -142,6 +154,7 @@ impl VehicleEstimator {
                     wheels,
                     g.as_ref().map(|g| g[k]),
                     m.as_ref().map(|m| (m[(k, 0)], m[(k, 1)])),
+                    single.as_ref().map(|d| d[k]),
                 );
                 let e = inner.update(&s).map_err(|e| (k, e))?;
                 let [north, east, h] = contract_row(&e);

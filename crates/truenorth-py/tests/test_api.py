@@ -131,6 +131,22 @@ def test_vehicle_estimator_drives_straight_north_with_its_compass():
     assert isinstance(v.calibration(), dict)
 
 
+def test_vehicle_estimator_takes_one_vehicle_distance_with_a_yaw_rate():
+    # A CAN bus's speed integrated (10 m/s) and a yaw rate of 0.05 rad/s for 20 s: an arc of
+    # 200 m through 1 rad. The distance says nothing about turning: the gyro turns it.
+    n = 201
+    t = np.arange(n) * 0.1
+    dist = t * 10.0
+    v = tn.VehicleEstimator({"wheels": {"rear": {"track_m": 1.6}}})
+    r = v.update_array(t, gyr_z=np.full(n, 0.05), dist_m=dist)
+    assert r["north_m"][-1] == pytest.approx(200.0 * math.sin(1.0), abs=1.0)
+    assert r["east_m"][-1] == pytest.approx(200.0 * (1.0 - math.cos(1.0)), abs=1.0)
+    one = tn.VehicleEstimator({"wheels": {"rear": {"track_m": 1.6}}})
+    for k in range(n):
+        last = one.update(t[k], gyr_z=0.05, dist_m=dist[k])
+    assert last["north_m"] == r["north_m"][-1]
+
+
 def test_wmm_matches_the_official_test_values(data):
     """WMM2025_TEST_VALUES.txt: date, height km, lat, lon, X, Y, Z (nT), ..."""
     path = data / "wmm2025" / "WMM2025_TEST_VALUES.txt"

@@ -183,7 +183,7 @@ class VehicleArrays(TypedDict):
     gap: BoolArray
 
 class VehicleEstimator:
-    """The fused vehicle estimator (wheels, yaw gyro, compass)."""
+    """The fused vehicle estimator (wheels or one vehicle distance, yaw gyro, compass)."""
     def __init__(self, config: Optional[dict[str, Any]] = None) -> None: ...
     def update(
         self,
@@ -192,6 +192,7 @@ class VehicleEstimator:
         dist_r_m: Optional[float] = None,
         gyr_z: Optional[float] = None,
         mag: Optional[tuple[float, float]] = None,
+        dist_m: Optional[float] = None,
     ) -> VehicleRow: ...
     def update_array(
         self,
@@ -200,6 +201,7 @@ class VehicleEstimator:
         dist_r_m: Optional[FloatArray] = None,
         gyr_z: Optional[FloatArray] = None,
         mag: Optional[FloatArray] = None,
+        dist_m: Optional[FloatArray] = None,
     ) -> VehicleArrays: ...
     def calibration(self) -> dict[str, Any]: ...
     def reset(self) -> None: ...
