@@ -1,6 +1,7 @@
 //! `truenorth drive` with the sensor sets real vehicles have: a vehicle speed or distance
 //! with a yaw rate, a speed beside wheels (not used, and said so), a speed alone (refused:
-//! nothing measures the heading).
+//! nothing measures the heading), a car's four wheel speeds (the odometer's axle read, the
+//! other said unused; a skid-steered vehicle's sides as each side's mean).
 
 mod common;
 
@@ -76,4 +77,98 @@ fn a_speed_alone_is_refused_with_what_to_add() {
         "{stderr}"
     );
     assert!(stderr.contains("gyr_z"), "{stderr}");
+}
+
+/// The turn of [`log`] (right at 0.05 rad/s, 10 m/s) on wheels 1.6 m apart: the left runs
+/// 0.04 m/s faster than the middle, the right 0.04 m/s slower.
+const LEFT_RIGHT: &str = "10.04,9.96";
+
+#[test]
+fn a_cars_four_wheel_speeds_read_the_odometer_axle() {
+    let dir = scratch("drive_sets", "four");
+    let vehicle = common::rear_vehicle(&dir, 1.6);
+    // The front wheels carry nonsense: were they read, the track would be wrong.
+    let input = dir.join("four.csv");
+    let header = "t_s,speed_fl_mps,speed_fr_mps,speed_rl_mps,speed_rr_mps,gyr_z";
+    let text = log(header, |_| format!("3,25,{LEFT_RIGHT},0.05"));
+    std::fs::write(&input, text).unwrap();
+    let out = dir.join("four-out.csv");
+    let o = common::succeeded(common::drive(&vehicle, &input, &out, &[]));
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        stderr.contains("`speed_fl_mps,speed_fr_mps` is not used"),
+        "{stderr}"
+    );
+    assert!(stderr.contains("sensors: wheels + gyro"), "{stderr}");
+    let (_, rows) = common::table(&out, false);
+    let last = rows.last().unwrap();
+    let (n, e) = (200.0 * 1f64.sin(), 200.0 * (1.0 - 1f64.cos()));
+    assert!((last[1] - n).hypot(last[2] - e) < 1.0, "{last:?}");
+
+    // A skid-steered vehicle turns by its sides: each side's mean is its odometer wheel.
+    // Its wheels slide in the turn, so its sides turn it as wheels twice as far apart would
+    // (the middle of the effective track's prior, 1.5–2.5 times the physical one): ±0.08 m/s.
+    let skid = dir.join("skid.json");
+    std::fs::write(
+        &skid,
+        r#"{"track_m": 1.6, "odometer_wheels": "skid_steer"}"#,
+    )
+    .unwrap();
+    let sides = dir.join("sides.csv");
+    let text = log(header, |_| "10.18,10.02,9.98,9.82,0.05".into());
+    std::fs::write(&sides, text).unwrap();
+    let out = dir.join("sides-out.csv");
+    let o = common::succeeded(common::drive(&skid, &sides, &out, &[]));
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(!stderr.contains("not used"), "{stderr}");
+    let (_, rows) = common::table(&out, false);
+    let last = rows.last().unwrap();
+    // The distance is the sides' mean (the front axle alone would run 1 % further, the rear
+    // 1 % shorter: 1.9 m on this chord); the heading is the estimator's weighing of the sides
+    // against the gyro over the effective track's prior (2° over on this steady turn).
+    let chord = 400.0 * 0.5f64.sin();
+    assert!((last[1].hypot(last[2]) - chord).abs() < 1.0, "{last:?}");
+}
+
+#[test]
+fn some_of_four_wheel_speeds_are_refused() {
+    let dir = scratch("drive_sets", "three");
+    let vehicle = common::rear_vehicle(&dir, 1.6);
+    let input = dir.join("three.csv");
+    let text = log("t_s,speed_fl_mps,speed_rl_mps,speed_rr_mps,gyr_z", |_| {
+        format!("10,{LEFT_RIGHT},0.05")
+    });
+    std::fs::write(&input, text).unwrap();
+    let (ok, stderr) = outcome(&common::drive(&vehicle, &input, &dir.join("o.csv"), &[]));
+    assert!(!ok);
+    assert!(stderr.contains("speed_fr_mps"), "{stderr}");
+}
+
+#[test]
+fn inspect_names_a_drive_logs_sensor_set_and_what_it_cannot_tell() {
+    let dir = scratch("drive_sets", "inspect");
+    for (name, header, cells, set) in [
+        (
+            "speed",
+            "t_s,speed_mps,gyr_z",
+            "10,0.05",
+            "speed + yaw rate",
+        ),
+        (
+            "four",
+            "t_s,speed_fl_mps,speed_fr_mps,speed_rl_mps,speed_rr_mps,gyr_z",
+            "10,10,10,10,0.05",
+            "wheels + gyro",
+        ),
+    ] {
+        let input = dir.join(format!("{name}.csv"));
+        std::fs::write(&input, log(header, |_| cells.into())).unwrap();
+        let o = common::ok(&["inspect", common::p(&input)]);
+        let s = String::from_utf8_lossy(&o.stdout);
+        assert!(
+            s.contains(&format!("vehicle sensors: {set}")),
+            "{name}: {s}"
+        );
+        assert!(s.contains("cannot tell: no north"), "{name}: {s}");
+    }
 }

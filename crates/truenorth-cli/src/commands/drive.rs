@@ -15,6 +15,7 @@ use crate::io::errln;
 use crate::io::reading::Samples;
 use crate::io::reading::kinds::Vehicle;
 use crate::io::reading::logs::AxleTrack;
+use crate::io::reading::wheels::FourWheels;
 use crate::io::{
     CliError, CliResult, Input, InputOptions, OutputOptions, VehicleFile, check_distinct,
     read_learned, write_learned,
@@ -44,7 +45,9 @@ Unknown keys are refused (naming the closest known one), and so are values no ve
 
 DRIVE.csv: `t_s` (strictly increasing, seconds) and any of: `dist_l_m,dist_r_m` (cumulative
 distance of the left and right odometer wheels as the odometer reports it) or
-`speed_l_mps,speed_r_mps` (wheel speeds, integrated by the trapezoid rule), or the vehicle's
+`speed_l_mps,speed_r_mps` (wheel speeds, integrated by the trapezoid rule), or a car's four
+`speed_fl_mps,speed_fr_mps,speed_rl_mps,speed_rr_mps` (the axle odometer_wheels names is read,
+the other said unused; a skid-steered vehicle's sides are each side's mean), or the vehicle's
 one `dist_m` (cumulative) or `speed_mps` (a CAN bus's vehicle speed): the distance only,
 nothing about turning; `gyr_z` (rad/s,
 or deg/s with --gyro-unit deg/s; raw, positive for a right turn); `mag_x,mag_y` (any unit, uncalibrated; a level compass
@@ -52,7 +55,8 @@ reads mag_x = H cos(heading), mag_y = -H sin(heading)). Each sensor may come at 
 rate: an empty cell means no reading on that row, and each row is used for what it carries.
 Wheels, a gyro or a compass must be present; the summary names the sensor set and warns of
 what it cannot tell (no north without a compass, no gyro gain without a second turn
-reference). A speed beside wheel columns is said unused; other columns are ignored. Frames: x forward, y right,
+reference). A speed beside wheel columns is said unused, and so are four wheel speeds beside
+the odometer wheels' own; other columns are ignored. Frames: x forward, y right,
 z down.
 
 Output: `t_s,north_m,east_m,heading_deg` — the rear-axle centre from the start point, and
@@ -158,17 +162,15 @@ pub fn run(args: &Args) -> CliResult {
     let mut samples = Input::new(&args.input, &args.input_options)
         .csv_only(&csv_only)
         .axle(|| axle(args))
-        .samples(Vehicle::new(args.gyro_unit))?;
+        .samples(Vehicle::new(args.gyro_unit, four_wheels(args)))?;
     let vehicle = VehicleFile::read(&args.vehicle)?;
     let wheels = vehicle.wheels(&args.vehicle)?;
     let true_north = args.place.true_north()?;
     let speeds = samples.kind().speeds();
     let mut method = build_method(args, &vehicle, wheels, speeds)?;
     samples.kind().check_compass(samples.path())?;
-    if let Some(name) = samples.kind().unused_column() {
-        errln!(
-            "truenorth drive: warning: `{name}` is not used: the wheels' own columns give the distance, and the turn besides"
-        );
+    for (name, why) in samples.kind().unused_columns() {
+        errln!("truenorth drive: warning: `{name}` is not used: {why}");
     }
     let mut check = Diagnosis::new(vehicle.track_m, wheels.can_pivot(), speeds);
     let mut writer = Writer::create(
@@ -279,6 +281,18 @@ fn build_method(
 
 /// How a flight or robot log's odometry becomes the wheels read: the speeds of a rigid axle
 /// with the vehicle's track, or why the vehicle's wheels are not one.
+/// Which of a car's four wheel speeds are the odometer's: the axle the vehicle's
+/// `odometer_wheels` names, or each side's mean for a skid-steered vehicle (a
+/// differential-drive robot has only its two driven wheels). A vehicle file that cannot be
+/// read is refused just after the log's columns are, so the choice made for it is never used.
+fn four_wheels(args: &Args) -> FourWheels {
+    match VehicleFile::read(&args.vehicle).and_then(|v| v.wheels(&args.vehicle)) {
+        Ok(OdometerWheels::Front(_)) => FourWheels::Front,
+        Ok(OdometerWheels::Rear { .. }) => FourWheels::Rear,
+        _ => FourWheels::SideMeans,
+    }
+}
+
 fn axle(args: &Args) -> CliResult<Result<AxleTrack, String>> {
     let wheels = VehicleFile::read(&args.vehicle)?.wheels(&args.vehicle)?;
     Ok(match wheels {

@@ -21,7 +21,7 @@ use crate::io::{CliResult, InputOptions, RowReader, Table};
 use report::Report;
 
 /// Every column `inspect` looks for (body axes, after `--axes` and `--column`).
-pub const COLUMNS: [&str; 15] = [
+pub const COLUMNS: [&str; 19] = [
     "gyr_x",
     "gyr_y",
     "gyr_z",
@@ -35,6 +35,10 @@ pub const COLUMNS: [&str; 15] = [
     "dist_r_m",
     "speed_l_mps",
     "speed_r_mps",
+    "speed_fl_mps",
+    "speed_fr_mps",
+    "speed_rl_mps",
+    "speed_rr_mps",
     "dist_m",
     "speed_mps",
 ];

@@ -150,8 +150,8 @@ pub struct VehicleSetReport {
     pub cannot_tell: Vec<String>,
 }
 
-/// The sensor set of a drive log — wheels (two distances or speeds), one distance or speed,
-/// a yaw gyro, a two-axis compass — judged from the columns present; `None` for a file with
+/// The sensor set of a drive log — wheels (two distances or speeds, or a car's four
+/// speeds), one distance or speed, a yaw gyro, a two-axis compass — judged from the columns present; `None` for a file with
 /// a three-axis gyro or an accelerometer (an IMU recording, not a drive log) or none of them.
 pub fn vehicle_sensors(rec: &Recording) -> Option<VehicleSetReport> {
     use truenorth::core::{Travel, VehicleSensors};
@@ -159,7 +159,15 @@ pub fn vehicle_sensors(rec: &Recording) -> Option<VehicleSetReport> {
     if has("gyr_x") || has("gyr_y") || has("acc_x") || has("acc_z") || has("mag_z") {
         return None;
     }
-    let wheels = (has("dist_l_m") && has("dist_r_m")) || (has("speed_l_mps") && has("speed_r_mps"));
+    let four = [
+        "speed_fl_mps",
+        "speed_fr_mps",
+        "speed_rl_mps",
+        "speed_rr_mps",
+    ];
+    let wheels = (has("dist_l_m") && has("dist_r_m"))
+        || (has("speed_l_mps") && has("speed_r_mps"))
+        || four.iter().all(|n| has(n));
     let travel = if wheels {
         Travel::Wheels
     } else if has("dist_m") || has("speed_mps") {

@@ -12,7 +12,7 @@ use truenorth::core::{Axes, ImuSample, Mag2Sample, Mag3Sample, VehicleSample};
 
 use super::reader::{RowReader, RowRef};
 use super::samples::SampleKind;
-use super::wheels::{DistanceColumn, WheelColumns};
+use super::wheels::{DistanceColumn, FourWheels, WheelColumns};
 use crate::io::{CliError, CliResult};
 
 const MAG2: [&str; 2] = ["mag_x", "mag_y"];
@@ -333,11 +333,15 @@ impl SampleKind for Imu {
 }
 
 /// The optional columns of a drive log.
-const DRIVE: [&str; 9] = [
+const DRIVE: [&str; 13] = [
     "dist_l_m",
     "dist_r_m",
     "speed_l_mps",
     "speed_r_mps",
+    "speed_fl_mps",
+    "speed_fr_mps",
+    "speed_rl_mps",
+    "speed_rr_mps",
     "dist_m",
     "speed_mps",
     "gyr_z",
@@ -357,22 +361,26 @@ pub struct Vehicle {
     /// The vehicle's one distance (`dist_m`) or speed (`speed_mps`), where there are no
     /// wheels.
     distance: Option<DistanceColumn>,
-    /// The columns the log gives that the wheels make redundant, said on stderr.
-    unused: Option<&'static str>,
+    /// Which of four wheel speeds are the odometer's, where a log gives four.
+    four_wheels: FourWheels,
+    /// The columns the log gives that are not used, each with why, said on stderr.
+    unused: Vec<(&'static str, &'static str)>,
     gyr: Option<usize>,
     /// `mag_x` and `mag_y`, where present.
     mag: [Option<usize>; 2],
 }
 
 impl Vehicle {
-    /// A vehicle's rows with the yaw gyro in `gyro` units.
-    pub fn new(gyro: GyroUnit) -> Self {
+    /// A vehicle's rows with the yaw gyro in `gyro` units, and `four_wheels` the odometer's
+    /// wheels where the log gives a car's four wheel speeds.
+    pub fn new(gyro: GyroUnit, four_wheels: FourWheels) -> Self {
         Self {
             to_rps: gyro.to_rad_per_s(),
             t: 0,
             wheels: None,
             distance: None,
-            unused: None,
+            four_wheels,
+            unused: Vec::new(),
             gyr: None,
             mag: [None; 2],
         }
@@ -380,13 +388,16 @@ impl Vehicle {
 
     /// Whether the wheel columns are speeds (or the vehicle's one speed).
     pub fn speeds(&self) -> bool {
-        matches!(self.wheels, Some(WheelColumns::Speeds { .. }))
-            || matches!(self.distance, Some(DistanceColumn::Speed { .. }))
+        matches!(
+            self.wheels,
+            Some(WheelColumns::Speeds { .. } | WheelColumns::FourSpeeds { .. })
+        ) || matches!(self.distance, Some(DistanceColumn::Speed { .. }))
     }
 
-    /// The distance column the log gives beside wheels, which the wheels make unused.
-    pub fn unused_column(&self) -> Option<&'static str> {
-        self.unused
+    /// The columns the log gives that are not used (a distance beside wheels, the wheels of
+    /// the axle that is not the odometer's), each with why.
+    pub fn unused_columns(&self) -> &[(&'static str, &'static str)] {
+        &self.unused
     }
 
     /// Refuses a compass with one axis and not the other (`path` names the file). Asked
@@ -430,6 +441,38 @@ impl SampleKind for Vehicle {
             }),
             _ => None,
         };
+        let four = [
+            "speed_fl_mps",
+            "speed_fr_mps",
+            "speed_rl_mps",
+            "speed_rr_mps",
+        ]
+        .map(ix);
+        if let [Some(fl), Some(fr), Some(rl), Some(rr)] = four {
+            if self.wheels.is_some() {
+                self.unused.push((
+                    "speed_fl_mps,speed_fr_mps,speed_rl_mps,speed_rr_mps",
+                    "the odometer wheels' own columns give the distance and the turn",
+                ));
+            } else {
+                self.wheels = Some(WheelColumns::FourSpeeds {
+                    columns: [fl, fr, rl, rr],
+                    pick: self.four_wheels,
+                    last: None,
+                    dist: [0.0; 2],
+                });
+                if let Some(name) = self.four_wheels.unused() {
+                    self.unused
+                        .push((name, "the vehicle's odometer_wheels names the other axle"));
+                }
+            }
+        } else if four.iter().any(Option::is_some) {
+            return Err(CliError::row(
+                rows.path(),
+                1,
+                "has some of the four wheel speeds and not all: give `speed_fl_mps,speed_fr_mps,speed_rl_mps,speed_rr_mps` together, or the odometer wheels as `speed_l_mps,speed_r_mps`",
+            ));
+        }
         let single = match (ix("dist_m"), ix("speed_mps")) {
             (Some(c), _) => Some((DistanceColumn::Distance(c), "dist_m")),
             (None, Some(column)) => Some((
@@ -443,7 +486,10 @@ impl SampleKind for Vehicle {
             (None, None) => None,
         };
         match single {
-            Some((_, name)) if self.wheels.is_some() => self.unused = Some(name),
+            Some((_, name)) if self.wheels.is_some() => self.unused.push((
+                name,
+                "the wheels' own columns give the distance, and the turn besides",
+            )),
             Some((c, _)) => self.distance = Some(c),
             None => {}
         }

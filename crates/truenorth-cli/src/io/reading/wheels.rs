@@ -1,5 +1,38 @@
 //! The wheel columns of a drive log: cumulative distances as the odometer reports them, or
-//! wheel speeds integrated into distances.
+//! wheel speeds (two, or a car's four) integrated into distances.
+
+/// Which of a vehicle's four wheel speeds are its odometer's left and right, by the wheels
+/// its description names (VEHICLE.json `odometer_wheels`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FourWheels {
+    /// The front wheels (`speed_fl_mps,speed_fr_mps`); the rear ones are not used.
+    Front,
+    /// The rear wheels (`speed_rl_mps,speed_rr_mps`); the front ones are not used.
+    Rear,
+    /// Each side's mean (a skid-steered vehicle: its sides turn it, front and rear wheels
+    /// of a side driven alike).
+    SideMeans,
+}
+
+impl FourWheels {
+    /// The columns of the four this choice does not use, for the message that says so.
+    pub fn unused(self) -> Option<&'static str> {
+        match self {
+            Self::Front => Some("speed_rl_mps,speed_rr_mps"),
+            Self::Rear => Some("speed_fl_mps,speed_fr_mps"),
+            Self::SideMeans => None,
+        }
+    }
+
+    /// Left and right from the four speeds `[fl, fr, rl, rr]`.
+    fn sides(self, v: [f64; 4]) -> [f64; 2] {
+        match self {
+            Self::Front => [v[0], v[1]],
+            Self::Rear => [v[2], v[3]],
+            Self::SideMeans => [0.5 * (v[0] + v[2]), 0.5 * (v[1] + v[3])],
+        }
+    }
+}
 
 /// The wheel columns, as cumulative distances or as speeds to integrate.
 #[derive(Debug, Clone, Copy)]
@@ -15,6 +48,18 @@ pub enum WheelColumns {
         /// Distances integrated so far, m.
         dist: [f64; 2],
     },
+    /// A car's four wheel speeds, m/s, of which `pick` makes the left and right, integrated
+    /// by the trapezoid rule.
+    FourSpeeds {
+        /// The column indices: front left, front right, rear left, rear right.
+        columns: [usize; 4],
+        /// Which wheels are the odometer's.
+        pick: FourWheels,
+        /// The last row that carried them: time and the left and right speeds.
+        last: Option<(f64, [f64; 2])>,
+        /// Distances integrated so far, m.
+        dist: [f64; 2],
+    },
 }
 
 impl WheelColumns {
@@ -22,22 +67,35 @@ impl WheelColumns {
     /// (speeds are integrated from one row that carries them to the next); a row with one
     /// wheel and not the other is an error.
     pub fn cumulative(&mut self, t: f64, values: &[f64]) -> Result<Option<[f64; 2]>, &'static str> {
-        let [l, r] = match self {
-            Self::Distances(c) | Self::Speeds { columns: c, .. } => *c,
-        };
-        let v = [values[l], values[r]];
-        match (v[0].is_finite(), v[1].is_finite()) {
-            (false, false) => return Ok(None),
-            (true, true) => {}
-            _ => {
-                return Err(
-                    "has one wheel's value and not the other's; give both wheels on a row, or neither",
-                );
+        let (v, present, used) = match self {
+            Self::Distances(c) | Self::Speeds { columns: c, .. } => {
+                let v = [values[c[0]], values[c[1]]];
+                (v, v.iter().filter(|x| x.is_finite()).count(), 2)
             }
+            Self::FourSpeeds { columns, pick, .. } => {
+                let four = columns.map(|c| values[c]);
+                let used: &[usize] = match pick {
+                    FourWheels::Front => &[0, 1],
+                    FourWheels::Rear => &[2, 3],
+                    FourWheels::SideMeans => &[0, 1, 2, 3],
+                };
+                let present = used.iter().filter(|&&k| four[k].is_finite()).count();
+                (pick.sides(four), present, used.len())
+            }
+        };
+        if present == 0 {
+            return Ok(None);
+        }
+        if present < used {
+            return Err(if used == 2 {
+                "has one wheel's value and not the other's; give both wheels on a row, or neither"
+            } else {
+                "has some of the four wheels' speeds and not the others'; give all four on a row, or none"
+            });
         }
         Ok(Some(match self {
             Self::Distances(_) => v,
-            Self::Speeds { last, dist, .. } => {
+            Self::Speeds { last, dist, .. } | Self::FourSpeeds { last, dist, .. } => {
                 if let Some((t0, v0)) = *last {
                     for k in 0..2 {
                         dist[k] += 0.5 * (v0[k] + v[k]) * (t - t0);
