@@ -51,17 +51,19 @@ fn a_speed_or_a_distance_with_a_yaw_rate_draws_the_track() {
 }
 
 #[test]
-fn a_speed_beside_wheels_is_said_unused() {
+fn a_speed_beside_wheels_and_gnss_fixes_are_said_unused() {
     let dir = scratch("drive_sets", "unused");
     let vehicle = common::rear_vehicle(&dir, 1.6);
     let input = dir.join("both.csv");
-    let text = log("t_s,dist_l_m,dist_r_m,speed_mps,gyr_z", |t| {
-        format!("{},{},10,0.0", 10.0 * t, 10.0 * t)
-    });
+    let text = log(
+        "t_s,dist_l_m,dist_r_m,speed_mps,gyr_z,lat_deg,lon_deg",
+        |t| format!("{},{},10,0.0,52.5,13.4", 10.0 * t, 10.0 * t),
+    );
     std::fs::write(&input, text).unwrap();
     let o = common::succeeded(common::drive(&vehicle, &input, &dir.join("o.csv"), &[]));
     let stderr = String::from_utf8_lossy(&o.stderr);
     assert!(stderr.contains("`speed_mps` is not used"), "{stderr}");
+    assert!(stderr.contains("`lat_deg,lon_deg` is not used"), "{stderr}");
 }
 
 #[test]

@@ -56,7 +56,7 @@ rate: an empty cell means no reading on that row, and each row is used for what 
 Wheels, a gyro or a compass must be present; the summary names the sensor set and warns of
 what it cannot tell (no north without a compass, no gyro gain without a second turn
 reference). A speed beside wheel columns is said unused, and so are four wheel speeds beside
-the odometer wheels' own; other columns are ignored. Frames: x forward, y right,
+the odometer wheels' own, and a GNSS fix's `lat_deg,lon_deg`; other columns are ignored. Frames: x forward, y right,
 z down.
 
 Output: `t_s,north_m,east_m,heading_deg` — the rear-axle centre from the start point, and

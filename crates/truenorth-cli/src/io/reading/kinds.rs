@@ -332,8 +332,9 @@ impl SampleKind for Imu {
     }
 }
 
-/// The optional columns of a drive log.
-const DRIVE: [&str; 13] = [
+/// The optional columns of a drive log (a GNSS fix's `lat_deg,lon_deg` only to say that
+/// they are not used).
+const DRIVE: [&str; 15] = [
     "dist_l_m",
     "dist_r_m",
     "speed_l_mps",
@@ -347,6 +348,8 @@ const DRIVE: [&str; 13] = [
     "gyr_z",
     "mag_x",
     "mag_y",
+    "lat_deg",
+    "lon_deg",
 ];
 
 /// A vehicle's sensors, each on the rows that carry it: the wheels (cumulative distances,
@@ -492,6 +495,12 @@ impl SampleKind for Vehicle {
             )),
             Some((c, _)) => self.distance = Some(c),
             None => {}
+        }
+        if ix("lat_deg").is_some() || ix("lon_deg").is_some() {
+            self.unused.push((
+                "lat_deg,lon_deg",
+                "the dead reckoning takes no GNSS fixes; compare its track with them instead",
+            ));
         }
         let compass = ix("mag_x").is_some() && ix("mag_y").is_some();
         let speed_and_compass = compass && self.distance.is_some();
