@@ -7,7 +7,8 @@
 //! the same columns computed here (the raw yaw rate times the speed's distance). Held: the
 //! command's track no worse than plain integration's beyond what holding the heading at a
 //! standstill costs (see `truenorth-fusion/tests/vehicle_smartloc.rs`, which holds the
-//! library's figures), its sensors named, and what the set cannot tell said.
+//! library's figures), its heading σ kept against the reference's course, its sensors
+//! named, and what the set cannot tell said.
 //! `cargo test -p truenorth-cli --test smartloc -- --nocapture` prints the figures.
 
 mod common;
@@ -45,7 +46,12 @@ fn a_cars_speed_and_yaw_rate_as_they_come() {
     let work = scratch("smartloc", "drive");
     let vehicle = common::rear_vehicle(&work, 1.6);
     let out = work.join("out.csv");
-    let o = common::succeeded(common::drive(&vehicle, &dir.join("DRIVE.csv"), &out, &[]));
+    let o = common::succeeded(common::drive(
+        &vehicle,
+        &dir.join("DRIVE.csv"),
+        &out,
+        &["--extra", "sigma"],
+    ));
     let stderr = String::from_utf8_lossy(&o.stderr);
     assert!(stderr.contains("sensors: speed + yaw rate"), "{stderr}");
     assert!(stderr.contains("warning: no north"), "{stderr}");
@@ -81,6 +87,29 @@ fn a_cars_speed_and_yaw_rate_as_they_come() {
         100.0 * f_final / dist,
         100.0 * p_final / dist
     );
+    // The heading against the reference's course (both relative to the start), on rows where
+    // the car moves fast enough for the course to be the heading (over 2 m/s): its σ is a
+    // promise, so few rows beyond 3σ (2 %, room for a course's own noise) and none beyond 6σ.
+    let c_i = col(&rh, "course_deg");
+    let (mut moving, mut beyond3, mut worst) = (0usize, 0usize, 0.0f64);
+    for ((r, d), t) in rows.iter().zip(&drive).zip(&reference) {
+        if d[v_i] < 2.0 {
+            continue;
+        }
+        let truth = t[c_i] - reference[0][c_i];
+        let err = (r[3] - truth + 540.0).rem_euclid(360.0) - 180.0;
+        let z = err.abs() / r[4];
+        moving += 1;
+        beyond3 += usize::from(z > 3.0);
+        worst = worst.max(z);
+    }
+    let share = beyond3 as f64 / moving as f64;
+    println!(
+        "heading on {moving} moving rows: {:.1} % beyond 3σ, worst {worst:.1}σ",
+        100.0 * share
+    );
+    assert!(share <= 0.02, "{:.1} % beyond 3σ", 100.0 * share);
+    assert!(worst < 6.0, "worst {worst:.1}σ");
     // The tolerance of `truenorth-fusion/tests/vehicle_smartloc.rs`: what the heading held at
     // a standstill can cost, with room for the noise of one drive.
     assert!(f_rms <= 1.05 * p_rms, "{f_rms:.1} m vs {p_rms:.1} m");
