@@ -117,6 +117,15 @@ pub fn run(args: &Args) -> CliResult<u8> {
             "batch: give one or more folders, or --list FILE",
         ));
     }
+    if args
+        .ext
+        .iter()
+        .any(|e| e.trim().trim_start_matches('.').is_empty())
+    {
+        return Err(CliError::msg(
+            "batch: --ext has an empty extension, which matches no file; give the endings to run, e.g. --ext csv,csv.gz",
+        ));
+    }
     let jobs = jobs::collect(&jobs::Sources {
         folders: &args.folders,
         list: args.list.as_deref(),

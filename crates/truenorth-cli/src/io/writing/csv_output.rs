@@ -44,15 +44,19 @@ impl RowBlock {
         self.widths.clear();
     }
 
-    /// Appends the block's rows to `text`, cells separated by commas.
+    /// Appends the block's rows to `text`, cells separated by commas. The first cell, every
+    /// output's time `t_s`, is written exactly whatever the precision: rounded to N digits an
+    /// epoch time (1.7·10⁹ s) would run many rows into one.
     fn write_into(&self, text: &mut String) {
         let mut at = 0;
         for &width in &self.widths {
             for (k, &v) in self.values[at..at + width].iter().enumerate() {
                 if k > 0 {
                     text.push(',');
+                    self.precision.write(text, v);
+                } else {
+                    Precision::default().write(text, v);
                 }
-                self.precision.write(text, v);
             }
             text.push('\n');
             at += width;
@@ -281,9 +285,16 @@ mod tests {
             out.row(&row, precision).unwrap();
             let cells: Vec<String> = row
                 .iter()
-                .map(|&v| {
+                .enumerate()
+                .map(|(j, &v)| {
                     let mut s = String::new();
-                    precision.write(&mut s, v);
+                    // The first cell, the time, is written exactly at any precision.
+                    let p = if j == 0 {
+                        Precision::default()
+                    } else {
+                        precision
+                    };
+                    p.write(&mut s, v);
                     s
                 })
                 .collect();

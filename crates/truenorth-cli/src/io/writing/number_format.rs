@@ -39,7 +39,8 @@ impl FromStr for Precision {
 pub struct OutputOptions {
     /// Numbers in the output CSV: `shortest` (the default: the shortest text that reads
     /// back as exactly the computed value) or N significant digits (1 to 17), e.g. 7 for
-    /// headings to about 1e-4 degree and smaller files.
+    /// headings to about 1e-4 degree and smaller files. The time column `t_s` is always
+    /// written exactly, so that rows stay as distinct as the input's.
     #[arg(long, value_name = "DIGITS", default_value = "shortest")]
     pub precision: Precision,
 }
