@@ -40,6 +40,9 @@ pub struct YawRateCheck {
     window: (f64, f64, bool),
     last_wheels: Option<[f64; 2]>,
     last_gyro: Option<(f64, f64)>,
+    /// The time the gyro's turn is integrated to, s: every row's, so that a row without
+    /// a gyro reading does not add the last rate's turn since its reading again.
+    gyro_to_s: f64,
     /// Σ wheels·gyro, Σ gyro², Σ wheels² over the turning windows.
     sums: [f64; 3],
     /// The number of turning windows.
@@ -60,6 +63,7 @@ impl YawRateCheck {
             window: (0.0, 0.0, true),
             last_wheels: None,
             last_gyro: None,
+            gyro_to_s: f64::NEG_INFINITY,
             sums: [0.0; 3],
             windows: 0,
             row: None,
@@ -84,10 +88,10 @@ impl YawRateCheck {
         let t = sample.t_s;
         let start = *self.start_s.get_or_insert(t);
         if let Some((t0, g0)) = self.last_gyro {
-            let dt = t - t0;
-            self.window.1 += g0 * dt;
-            self.window.2 &= dt <= MAX_STEP_S;
+            self.window.1 += g0 * (t - self.gyro_to_s.max(t0));
+            self.window.2 &= t - t0 <= MAX_STEP_S;
         }
+        self.gyro_to_s = t;
         if let Some(g) = sample.gyr_z_rps.filter(|g| g.is_finite()) {
             self.last_gyro = Some((t, g));
         }

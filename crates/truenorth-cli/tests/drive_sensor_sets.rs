@@ -174,3 +174,68 @@ fn inspect_names_a_drive_logs_sensor_set_and_what_it_cannot_tell() {
         assert!(s.contains("cannot tell: no north"), "{name}: {s}");
     }
 }
+
+/// VEHICLE.json for the odometer wheels `wheels`.
+fn vehicle_json(wheels: &truenorth::odometer::OdometerWheels) -> String {
+    use truenorth::odometer::OdometerWheels as W;
+    match wheels {
+        W::Rear { track_m } => format!(r#"{{"track_m": {track_m}, "odometer_wheels": "rear"}}"#),
+        W::Front(a) => format!(
+            r#"{{"track_m": {}, "wheelbase_m": {}, "odometer_wheels": "front", "pitman_ratio": {}}}"#,
+            a.track_m,
+            a.wheelbase_m,
+            a.pitman_ratio()
+        ),
+        W::SkidSteer { track_m } => {
+            format!(r#"{{"track_m": {track_m}, "odometer_wheels": "skid_steer"}}"#)
+        }
+        W::Differential { track_m } => {
+            format!(r#"{{"track_m": {track_m}, "odometer_wheels": "differential"}}"#)
+        }
+    }
+}
+
+/// Every sensor set the simulator writes as a real log, on every kind of vehicle, with a
+/// GNSS receiver's columns beside: read whole, its set named, the GNSS fixes and (on a car's
+/// four wheels) the other axle said unused.
+#[test]
+fn every_real_sensor_set_is_read_and_what_is_unused_said() {
+    use truenorth_sim::log_drive::{LogDrive, LogDriveConfig, SensorSet};
+    let dir = scratch("drive_sets", "every");
+    let mut refused = Vec::new();
+    for kind in truenorth_sim::VehicleKind::ALL {
+        for (k, set) in SensorSet::every(kind).into_iter().enumerate() {
+            let name = format!("{kind:?} {set:?}");
+            let drive = LogDrive::new(LogDriveConfig::new(k as u64, kind, set).with_gnss())
+                .unwrap_or_else(|e| panic!("{name}: {e}"));
+            let input = dir.join(format!("{kind:?}-{k}.csv"));
+            std::fs::write(&input, drive.to_csv()).unwrap();
+            let vehicle = dir.join(format!("{kind:?}-{k}.json"));
+            std::fs::write(&vehicle, vehicle_json(&drive.vehicle.wheels)).unwrap();
+            let out = dir.join(format!("{kind:?}-{k}-out.csv"));
+            let o = common::drive(&vehicle, &input, &out, &[]);
+            let (ok, stderr) = outcome(&o);
+            if !ok {
+                refused.push(format!("{name}: {}", stderr.lines().last().unwrap_or("")));
+                continue;
+            }
+            assert!(stderr.contains("; sensors: "), "{name}: {stderr}");
+            assert!(
+                stderr.contains("`lat_deg,lon_deg` is not used"),
+                "{name}: {stderr}"
+            );
+            let header = drive.to_csv().lines().next().unwrap().to_string();
+            if header.contains("speed_fl_mps")
+                && !matches!(kind, truenorth_sim::VehicleKind::SkidSteer)
+            {
+                assert!(stderr.contains("_mps` is not used"), "{name}: {stderr}");
+            }
+            assert_eq!(
+                common::table(&out, true).1.len(),
+                drive.rows.len(),
+                "{name}: one row per input row"
+            );
+        }
+    }
+    assert!(refused.is_empty(), "refused:\n{}", refused.join("\n"));
+}

@@ -75,8 +75,11 @@ struct CompassTurns {
 impl CompassTurns {
     fn push(&mut self, s: &VehicleSample, track_m: f64, row: usize) {
         let start = *self.start_s.get_or_insert(s.t_s);
+        // Integrated from the previous row on (not from the reading), so that a row without
+        // a gyro reading does not add the last rate's turn since its reading again.
         if let Some((t0, g0)) = self.last_gyro {
             self.window[1] += g0 * (s.t_s - t0);
+            self.last_gyro = Some((s.t_s, g0));
         }
         if let Some(g) = s.gyr_z_rps {
             self.last_gyro = Some((s.t_s, g));
