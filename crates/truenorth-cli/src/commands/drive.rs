@@ -279,8 +279,6 @@ fn build_method(
         .map_err(bad_config)
 }
 
-/// How a flight or robot log's odometry becomes the wheels read: the speeds of a rigid axle
-/// with the vehicle's track, or why the vehicle's wheels are not one.
 /// Which of a car's four wheel speeds are the odometer's: the axle the vehicle's
 /// `odometer_wheels` names, or each side's mean for a skid-steered vehicle (a
 /// differential-drive robot has only its two driven wheels). A vehicle file that cannot be
@@ -293,6 +291,8 @@ fn four_wheels(args: &Args) -> FourWheels {
     }
 }
 
+/// How a flight or robot log's odometry becomes the wheels read: the speeds of a rigid axle
+/// with the vehicle's track, or why the vehicle's wheels are not one.
 fn axle(args: &Args) -> CliResult<Result<AxleTrack, String>> {
     let wheels = VehicleFile::read(&args.vehicle)?.wheels(&args.vehicle)?;
     Ok(match wheels {

@@ -17,7 +17,7 @@ use crate::io::closest_name::likely_meant;
 pub const VECTOR_STEMS: [&str; 3] = ["mag", "acc", "gyr"];
 
 /// The columns of the CSV contract (ARCHITECTURE.md, "CLI contract") by name.
-const CONTRACT_COLUMNS: [&str; 14] = [
+const CONTRACT_COLUMNS: [&str; 20] = [
     "t_s",
     "mag_x",
     "mag_y",
@@ -32,6 +32,12 @@ const CONTRACT_COLUMNS: [&str; 14] = [
     "dist_r_m",
     "speed_l_mps",
     "speed_r_mps",
+    "speed_fl_mps",
+    "speed_fr_mps",
+    "speed_rl_mps",
+    "speed_rr_mps",
+    "speed_mps",
+    "dist_m",
 ];
 
 /// `NAME=HEADER` or `NAME=-HEADER`: read the column truenorth calls NAME from the file's
