@@ -15,29 +15,6 @@ mod common;
 
 use common::scratch;
 
-/// The best rotation about the start of `est` onto `truth`, and the RMS and final distance
-/// after it, m.
-fn rotated_errors(est: &[(f64, f64)], truth: &[(f64, f64)]) -> (f64, f64) {
-    let (mut dot, mut cross) = (0.0, 0.0);
-    for (e, t) in est.iter().zip(truth) {
-        dot += e.0 * t.0 + e.1 * t.1;
-        cross += e.0 * t.1 - e.1 * t.0;
-    }
-    let (s, c) = cross.atan2(dot).sin_cos();
-    let err =
-        |e: &(f64, f64), t: &(f64, f64)| (c * e.0 - s * e.1 - t.0).hypot(s * e.0 + c * e.1 - t.1);
-    let n = est.len() as f64;
-    let rms = (est
-        .iter()
-        .zip(truth)
-        .map(|(e, t)| err(e, t).powi(2))
-        .sum::<f64>()
-        / n)
-        .sqrt();
-    let last = est.len() - 1;
-    (rms, err(&est[last], &truth[last]))
-}
-
 #[test]
 fn a_cars_speed_and_yaw_rate_as_they_come() {
     let Some(dir) = truenorth_sim::shared_data::folder("vehicle_smartloc_berlin").unwrap() else {
@@ -80,8 +57,8 @@ fn a_cars_speed_and_yaw_rate_as_they_come() {
     }
     let truth: Vec<(f64, f64)> = reference.iter().map(|r| (r[n_i], r[e_i])).collect();
     let fused: Vec<(f64, f64)> = rows.iter().map(|r| (r[1], r[2])).collect();
-    let (f_rms, f_final) = rotated_errors(&fused, &truth);
-    let (p_rms, p_final) = rotated_errors(&plain, &truth);
+    let (f_rms, f_final) = truenorth_sim::rotated_track_errors(&fused, &truth).unwrap();
+    let (p_rms, p_final) = truenorth_sim::rotated_track_errors(&plain, &truth).unwrap();
     println!(
         "smartLoc Berlin through `drive`, {dist:.0} m: {f_rms:.1} m RMS, final {f_final:.1} m ({:.2} %); plain integration {p_rms:.1} m RMS, final {p_final:.1} m ({:.2} %)",
         100.0 * f_final / dist,

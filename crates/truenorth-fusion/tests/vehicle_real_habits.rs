@@ -18,8 +18,8 @@
 use truenorth_core::{NavEstimate, VehicleSample, angle_diff};
 use truenorth_fusion::vehicle::{TwoPassConfig, TwoPassStart};
 use truenorth_fusion::{SensorPriors, VehicleConfig, VehicleEstimator};
-use truenorth_sim::VehicleKind;
 use truenorth_sim::log_drive::{LogDrive, LogDriveConfig, SensorSet};
+use truenorth_sim::{VehicleKind, rotated_track_errors};
 
 /// What one drive gave.
 #[derive(Debug, Clone, Copy)]
@@ -47,29 +47,6 @@ fn config(d: &LogDrive) -> VehicleConfig {
         priors: Some(SensorPriors::for_wheels(&d.vehicle.wheels)),
         ..VehicleConfig::default()
     }
-}
-
-/// The best rotation about the start of track `est` onto `truth` (least squares), and the
-/// RMS and final distance after it.
-fn rotated_errors(est: &[(f64, f64)], truth: &[(f64, f64)]) -> (f64, f64) {
-    let (mut dot, mut cross) = (0.0, 0.0);
-    for (e, t) in est.iter().zip(truth) {
-        dot += e.0 * t.0 + e.1 * t.1;
-        cross += e.0 * t.1 - e.1 * t.0;
-    }
-    let (s, c) = cross.atan2(dot).sin_cos();
-    let err =
-        |e: &(f64, f64), t: &(f64, f64)| (c * e.0 - s * e.1 - t.0).hypot(s * e.0 + c * e.1 - t.1);
-    let n = est.len().max(1) as f64;
-    let rms = (est
-        .iter()
-        .zip(truth)
-        .map(|(e, t)| err(e, t).powi(2))
-        .sum::<f64>()
-        / n)
-        .sqrt();
-    let last = est.len() - 1;
-    (rms, err(&est[last], &truth[last]))
 }
 
 /// Plain integration over `samples`: heading from the raw yaw rate less the first second-long
@@ -160,22 +137,24 @@ fn score(d: &LogDrive) -> Score {
         })
         .collect();
     let (fused_rms_m, fused_final_m) = if positioned {
-        rotated_errors(
+        rotated_track_errors(
             &estimates
                 .iter()
                 .map(|e| (e.north_m, e.east_m))
                 .collect::<Vec<_>>(),
             &truth_in_frame,
         )
+        .unwrap()
     } else {
         (f64::NAN, f64::NAN)
     };
     let base = baseline(&samples);
     let (base_rms_m, base_final_m) = match &base {
-        Some(b) if positioned => rotated_errors(
+        Some(b) if positioned => rotated_track_errors(
             &b.iter().map(|x| (x.1, x.2)).collect::<Vec<_>>(),
             &truth_track,
-        ),
+        )
+        .unwrap(),
         _ => (f64::NAN, f64::NAN),
     };
     let (mut rows, mut beyond_3, mut max_z, mut f2, mut b2) = (0, 0, 0.0f64, 0.0, 0.0);

@@ -38,29 +38,6 @@ fn col(header: &[String], name: &str) -> usize {
     header.iter().position(|h| h == name).unwrap()
 }
 
-/// The best rotation about the start of `est` onto `truth`, and the RMS and final distance
-/// after it, m.
-fn rotated_errors(est: &[(f64, f64)], truth: &[(f64, f64)]) -> (f64, f64) {
-    let (mut dot, mut cross) = (0.0, 0.0);
-    for (e, t) in est.iter().zip(truth) {
-        dot += e.0 * t.0 + e.1 * t.1;
-        cross += e.0 * t.1 - e.1 * t.0;
-    }
-    let (s, c) = cross.atan2(dot).sin_cos();
-    let err =
-        |e: &(f64, f64), t: &(f64, f64)| (c * e.0 - s * e.1 - t.0).hypot(s * e.0 + c * e.1 - t.1);
-    let n = est.len() as f64;
-    let rms = (est
-        .iter()
-        .zip(truth)
-        .map(|(e, t)| err(e, t).powi(2))
-        .sum::<f64>()
-        / n)
-        .sqrt();
-    let last = est.len() - 1;
-    (rms, err(&est[last], &truth[last]))
-}
-
 #[test]
 fn a_cars_speed_and_yaw_rate_never_worse_than_plain_integration() {
     let Some(dir) = truenorth_sim::shared_data::folder("vehicle_smartloc_berlin").unwrap() else {
@@ -114,8 +91,10 @@ fn a_cars_speed_and_yaw_rate_never_worse_than_plain_integration() {
     let truth: Vec<(f64, f64)> = reference.iter().map(|r| (r[n_i], r[e_i])).collect();
     let fused_track: Vec<(f64, f64)> = estimates.iter().map(|e| (e.north_m, e.east_m)).collect();
     let plain_track: Vec<(f64, f64)> = plain.iter().map(|p| (p.1, p.2)).collect();
-    let (fused_rms, fused_final) = rotated_errors(&fused_track, &truth);
-    let (plain_rms, plain_final) = rotated_errors(&plain_track, &truth);
+    let (fused_rms, fused_final) =
+        truenorth_sim::rotated_track_errors(&fused_track, &truth).unwrap();
+    let (plain_rms, plain_final) =
+        truenorth_sim::rotated_track_errors(&plain_track, &truth).unwrap();
     let distance = dist;
 
     // Heading against the course over ground (moving rows only), after the one constant

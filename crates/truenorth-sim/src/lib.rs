@@ -49,6 +49,7 @@ mod route;
 pub mod scenario;
 pub mod shared_data;
 mod streams;
+mod track_fit;
 mod vehicle;
 mod vehicle_kind;
 
@@ -74,6 +75,7 @@ pub use streams::{
     ImuSensorParams, VehicleSensorParams, imu_streams, rotated_soft_iron, vehicle_accel_stream,
     vehicle_streams, vehicle_streams_disturbed,
 };
+pub use track_fit::rotated_track_errors;
 pub use vehicle::{MAX_SAMPLES, VehicleTruth, simulate, simulate_at};
 pub use vehicle_kind::{RangeVehicle, Slip, SlipProcess, VehicleKind};
 
