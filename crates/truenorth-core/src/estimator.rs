@@ -111,6 +111,11 @@ pub struct NavStatus {
     /// track, the gyro bias) rather than guessed.
     #[serde(default)]
     pub gap: bool,
+    /// The fused estimate departed from plain integration (the raw gyro less its rest bias,
+    /// along the odometry) by more than both their uncertainties allow, and fell back to it
+    /// at this sample: a learned sensor error was wrong, and was forgotten.
+    #[serde(default)]
+    pub fell_back: bool,
     /// The learned sensor errors the data have not yet told apart.
     #[serde(default)]
     pub unobserved: Unobserved,

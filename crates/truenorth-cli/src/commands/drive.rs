@@ -199,6 +199,7 @@ pub fn run(args: &Args) -> CliResult {
         last,
         rows: written,
         gaps,
+        fallbacks,
         ..
     } = writer;
     out.commit()?;
@@ -206,7 +207,7 @@ pub fn run(args: &Args) -> CliResult {
         args,
         samples,
         written,
-        gaps,
+        (gaps, fallbacks),
         last.as_ref(),
         learned.as_ref(),
         &sensors,
@@ -359,7 +360,7 @@ fn summary(
     args: &Args,
     samples: usize,
     written: usize,
-    gaps: usize,
+    (gaps, fallbacks): (usize, usize),
     last: Option<&NavEstimate>,
     learned: Option<&VehicleCalibration>,
     sensors: &VehicleSensors,
@@ -408,6 +409,11 @@ fn summary(
     }
     if gaps > 0 {
         line += &format!("; {gaps} gaps in the log, widened rather than bridged");
+    }
+    if fallbacks > 0 {
+        line += &format!(
+            "; fell back to plain integration {fallbacks} times (a learned gyro or wheel error that the gyro's own integration contradicted was forgotten)"
+        );
     }
     line += &format!("; sensors: {}", sensors.name());
     errln!("{line}");

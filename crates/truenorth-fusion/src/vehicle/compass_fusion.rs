@@ -238,6 +238,7 @@ impl VehicleEstimator {
         let r = w.variance_rad2 / n + w.noise_after / n;
         self.filter.update_some(&h[..len], w.sum_nu / n, r, learn);
         self.est.status.compass_used = true;
+        self.anchor_plain();
     }
 
     /// Gathers consistent readings and, once there are enough, refers the heading to north.
@@ -325,6 +326,7 @@ impl VehicleEstimator {
         }
         self.tracking.alignment.done = true;
         self.compass.restart_gates();
+        self.anchor_plain();
     }
 
     /// Refers a heading that was lost to north again: the heading (and the wheels' heading
@@ -346,6 +348,7 @@ impl VehicleEstimator {
         }
         self.tracking.alignment.relocking = false;
         self.compass.restart_gates();
+        self.anchor_plain();
     }
 
     /// Closes the open steps and the compass window, then turns the heading (and the

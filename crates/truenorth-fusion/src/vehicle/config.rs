@@ -289,6 +289,11 @@ pub struct VehicleConfig {
     /// widens what the gap left unknown (the heading without wheels, the track, the gyro
     /// bias) and says so in the status.
     pub max_gap_s: f64,
+    /// Run plain integration (the raw gyro less its last rest's bias, along the odometry)
+    /// beside the fused estimate and fall back to it where the two part by more than both
+    /// their uncertainties allow (true). Off, the fused estimate is trusted whatever it
+    /// learned: for comparing the two, not for use.
+    pub plain_guard: bool,
 }
 
 impl Default for VehicleConfig {
@@ -299,6 +304,7 @@ impl Default for VehicleConfig {
             compass: CompassGates::default(),
             standstill_s: 0.5,
             max_gap_s: 2.0,
+            plain_guard: true,
         }
     }
 }

@@ -134,8 +134,9 @@ impl VehicleEstimator {
             self.flush();
             self.measure_bias(&rest);
         }
-        let x = &self.filter.x;
         let trapezoid = YawIncrement::new(raw0, raw, dt);
+        self.plain_gyro(trapezoid.angle_rad(), dt);
+        let x = &self.filter.x;
         let increment = trapezoid.angle_rad() - x[BIAS] * dt;
         let alpha = dt / (dt + TURN_SMOOTHING_S);
         self.tracking.gyro.smoothed_rps +=
@@ -282,6 +283,7 @@ impl VehicleEstimator {
             self.tracking.window = CompassWindow::default();
             self.restart_wheel_heading();
         }
+        self.anchor_plain();
     }
 
     /// Moves the heading by `dpsi` in `step` (which carries its couplings), with the
@@ -361,6 +363,7 @@ impl VehicleEstimator {
                 step.q[PSI] = wheel_q;
                 self.turn_heading(turned, &mut step);
                 self.tracking.gyro.odo_at_last_rad = self.filter.x[PSI_ODO];
+                self.tracking.guard.anchored = false;
             } else if !self.tracking.motion.at_rest && wheel.moved {
                 self.tracking.wheel_check_s += dt;
             }
@@ -424,6 +427,7 @@ impl VehicleEstimator {
         step.q[EAST] += q;
         self.filter.x[NORTH] += ds * c;
         self.filter.x[EAST] += ds * s;
+        self.plain_odometry(ds);
     }
 
     /// The passage of the time since the last epoch: the compass error's decay and the
@@ -495,6 +499,7 @@ impl VehicleEstimator {
         }
         // A wheel pair's difference only grows with speed: `a` is never negative.
         self.filter.project_at_least(SPEED_COEFF, 0.0);
+        self.guard_against_plain();
     }
 
     /// The gyro's mean reading over `rest` measures its bias, to the noise of the rest's
@@ -505,6 +510,7 @@ impl VehicleEstimator {
             + REST_NOISE_FLOOR_RPS * REST_NOISE_FLOOR_RPS;
         self.filter
             .update(&[(BIAS, 1.0)], mean - self.filter.x[BIAS], r);
+        self.plain_rest(mean, r);
     }
 
     /// The wheels' heading minus the gyro's, measured against zero. A comparison far

@@ -101,6 +101,15 @@ impl Coefficients {
             prior_sigma,
         }
     }
+
+    /// The nominal state before anything is learned: the priors' values of the learned
+    /// states, zero heading and track.
+    pub(super) fn prior_x(&self) -> [f64; DIM] {
+        let mut x = [0.0; DIM];
+        x[SPEED_COEFF] = self.priors.speed_coeff_s2_per_m2;
+        x[TRACK_SCALE] = self.priors.track_factor - 1.0;
+        x
+    }
 }
 
 /// The fused vehicle estimator. See the module documentation.
@@ -144,10 +153,7 @@ impl VehicleEstimator {
     pub fn new(config: VehicleConfig) -> Result<Self> {
         config.validate()?;
         let coeffs = Coefficients::new(&config);
-        let p = &coeffs.priors;
-        let mut x = [0.0; DIM];
-        x[SPEED_COEFF] = p.speed_coeff_s2_per_m2;
-        x[TRACK_SCALE] = p.track_factor - 1.0;
+        let x = coeffs.prior_x();
         let mut sigma = [0.0; DIM];
         for i in [WHEEL_DIFF, SPEED_COEFF, TRACK_SCALE] {
             sigma[i] = coeffs.prior_sigma[i];
@@ -217,6 +223,20 @@ impl VehicleEstimator {
         e.learner = self.learner.clone();
         e.tracking.learned_until_s = self.est.t_s;
         Ok(e)
+    }
+
+    /// How many times the fused estimate has fallen back to plain integration (the raw gyro
+    /// less its last rest's bias, along the odometry) because it departed from it beyond both
+    /// their uncertainties; see [`truenorth_core::NavStatus::fell_back`].
+    pub fn fallbacks(&self) -> u32 {
+        self.tracking.guard.fallbacks
+    }
+
+    /// Whether plain integration runs beside the fused estimate now, able to catch it: the
+    /// gyro's bias has been measured at a rest and nothing since has moved the fused
+    /// estimate by what plain integration cannot follow.
+    pub fn plain_guard_active(&self) -> bool {
+        self.tracking.guard.anchored
     }
 
     /// The configuration in use.
@@ -390,6 +410,7 @@ impl HeadingEstimator for VehicleEstimator {
         }
         let dt = self.clock.dt_s(sample.t_s)?;
         self.est.status.gap = false;
+        self.est.status.fell_back = false;
         if let Some(dt) = dt {
             self.tracking.pending_time_s += dt;
         }

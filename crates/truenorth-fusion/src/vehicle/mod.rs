@@ -45,6 +45,7 @@ mod learned;
 mod learning_gates;
 pub mod nav_filter;
 mod observability;
+mod plain_guard;
 mod seed_blend;
 mod seed_gyro_compass;
 mod seed_odometer_compass;

@@ -10,6 +10,7 @@ use super::heading_trig::HeadingTrig;
 use super::innovation_line::InnovationLine;
 use super::learning_gates::LearningGates;
 use super::nav_filter::DIM;
+use super::plain_guard::PlainBaseline;
 use super::step_batch::StepBatch;
 
 /// The vehicle estimator's bookkeeping between samples (the gyro's and the wheels' last
@@ -42,6 +43,9 @@ pub struct VehicleTracking {
     /// already: the estimator is replaying them); `-inf` unless it replays.
     #[serde(with = "truenorth_core::extended_float::scalar")]
     pub(super) learned_until_s: f64,
+    /// Plain integration beside the fused estimate.
+    #[serde(default)]
+    pub(super) guard: PlainBaseline,
 }
 
 impl VehicleTracking {
@@ -63,6 +67,7 @@ impl VehicleTracking {
             rows_since_epoch: 0,
             unobserved_at_s: f64::NEG_INFINITY,
             learned_until_s: f64::NEG_INFINITY,
+            guard: PlainBaseline::default(),
         }
     }
 }

@@ -31,6 +31,8 @@ pub(super) struct Writer {
     pub(super) rows: usize,
     /// Rows where a sensor resumed after a gap.
     pub(super) gaps: usize,
+    /// Rows at which the fused estimate fell back to plain integration.
+    pub(super) fallbacks: usize,
     pub(super) error: Option<CliError>,
     pub(super) last: Option<NavEstimate>,
     /// How the numbers are written.
@@ -52,6 +54,7 @@ impl Writer {
             true_north,
             rows: 0,
             gaps: 0,
+            fallbacks: 0,
             error: None,
             last: None,
             precision,
@@ -106,6 +109,7 @@ impl Writer {
         }
         self.rows += 1;
         self.gaps += usize::from(e.status.gap);
+        self.fallbacks += usize::from(e.status.fell_back);
         self.last = Some(*e);
     }
 
