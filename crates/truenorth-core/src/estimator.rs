@@ -116,6 +116,9 @@ pub struct NavStatus {
     /// at this sample: a learned sensor error was wrong, and was forgotten.
     #[serde(default)]
     pub fell_back: bool,
+    /// A satellite fix corrected the estimate at this sample.
+    #[serde(default)]
+    pub gnss_used: bool,
     /// The learned sensor errors the data have not yet told apart.
     #[serde(default)]
     pub unobserved: Unobserved,

@@ -33,6 +33,7 @@ mod error;
 mod estimator;
 pub mod extended_float;
 mod fit_quality;
+mod gnss_fix;
 mod heading;
 mod heading_source;
 mod inertial_calibration;
@@ -58,6 +59,7 @@ pub use estimator::{
     OrientationEstimator, Unobserved,
 };
 pub use fit_quality::{FitQuality, ScalarQuality};
+pub use gnss_fix::{GnssFix, MAX_GNSS_SIGMA_M, MAX_GNSS_SPEED_MPS};
 pub use heading::{Declination, MagneticHeading, TrueHeading};
 pub use heading_source::{
     AbsoluteHeading, AbsoluteHeadingSource, RelativeHeadingSource, RelativeStep,

@@ -4,7 +4,7 @@
 use nalgebra::{Vector2, Vector3};
 use serde::{Deserialize, Serialize};
 
-use crate::{Result, Validate, check_finite, check_range};
+use crate::{GnssFix, Result, Validate, check_finite, check_range};
 
 /// A two-axis magnetometer reading (any unit; calibration removes it).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -253,6 +253,9 @@ pub struct VehicleSample {
     /// travelled and nothing about the heading; a row with wheels too is read by its wheels.
     #[serde(default)]
     pub dist_m: Option<f64>,
+    /// A satellite fix, if the row carries one.
+    #[serde(default)]
+    pub gnss: Option<GnssFix>,
 }
 
 impl VehicleSample {
@@ -264,6 +267,7 @@ impl VehicleSample {
             gyr_z_rps: None,
             mag: None,
             dist_m: None,
+            gnss: None,
         }
     }
 
@@ -290,6 +294,12 @@ impl VehicleSample {
         self.dist_m = Some(dist_m);
         self
     }
+
+    /// The row with a satellite fix.
+    pub const fn with_gnss(mut self, fix: GnssFix) -> Self {
+        self.gnss = Some(fix);
+        self
+    }
 }
 
 /// Largest yaw rate a vehicle sample may carry, rad/s (2000°/s, the widest range of MEMS
@@ -314,6 +324,9 @@ impl Validate for VehicleSample {
         }
         if let Some(d) = self.dist_m {
             check_finite("dist_m", d)?;
+        }
+        if let Some(g) = &self.gnss {
+            g.validate()?;
         }
         Ok(())
     }

@@ -63,6 +63,7 @@ fn samples(steps: &[Step]) -> Vec<VehicleSample> {
                 gyr_z_rps: *gyro,
                 mag: mag.map(|(x, y)| Vector2::new(x, y)),
                 dist_m: None,
+                gnss: None,
             }
         })
         .collect()
@@ -166,6 +167,7 @@ fn the_seed_gyro_method_does_not_integrate_across_an_endless_gap() {
         gyr_z_rps: Some(0.3),
         mag: None,
         dist_m: None,
+        gnss: None,
     };
     for (k, t_s) in [0.0, 0.1, 0.2, 1e308].into_iter().enumerate() {
         let e = est.update(&s(t_s, k as f64)).unwrap();
@@ -236,6 +238,7 @@ fn a_compass_reading_that_overflows_the_calibration_leaves_the_heading_a_number(
             gyr_z_rps: Some(rate_rps),
             mag: Some(mag),
             dist_m: None,
+            gnss: None,
         };
         let e = nav.update(&s).unwrap();
         assert!(numbers(&e) && e.heading.rad().is_finite(), "row {k}: {e:?}");

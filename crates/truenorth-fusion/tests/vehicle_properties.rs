@@ -75,6 +75,7 @@ fn samples(steps: &[Step]) -> Vec<VehicleSample> {
                 gyr_z_rps: s.gyro,
                 mag: s.mag.map(|(x, y)| Vector2::new(x, y)),
                 dist_m: None,
+                gnss: None,
             }
         })
         .collect()

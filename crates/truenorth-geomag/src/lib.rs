@@ -56,6 +56,7 @@ mod date;
 mod field;
 mod geodetic;
 mod legendre;
+mod local_plane;
 mod model;
 mod synthesis;
 
@@ -72,6 +73,7 @@ pub use geodetic::{
     WGS84_FLATTENING, WGS84_SEMI_MAJOR_AXIS_M,
 };
 pub use legendre::SchmidtLegendre;
+pub use local_plane::LocalTangentPlane;
 pub use model::WorldMagneticModel;
 pub use synthesis::{GEOMAGNETIC_REFERENCE_RADIUS_M, PreparedPoint};
 

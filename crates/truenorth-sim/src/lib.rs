@@ -41,7 +41,6 @@ mod drive;
 mod drive_score;
 mod few_shot;
 mod handheld;
-mod local_plane;
 pub mod log_drive;
 mod range_drive;
 mod range_route;
@@ -61,7 +60,6 @@ pub use few_shot::{
     FewShotInstrument, Shot, pointing_ned, protocol_shots, random_attitude, rolled_run,
 };
 pub use handheld::{HandheldParams, MotionTruth, handheld_motion};
-pub use local_plane::LocalTangentPlane;
 pub use log_drive::{
     Canyons, Clock, CompassConfig, Episodes, FixCondition, GnssConfig, GnssErrors, GnssFix,
     GnssTruth, Habit, Jump, LateFixes, LogDrive, LogDriveConfig, LogErrors, LogRow, Measured,
@@ -76,6 +74,7 @@ pub use streams::{
     vehicle_streams, vehicle_streams_disturbed,
 };
 pub use track_fit::rotated_track_errors;
+pub use truenorth_geomag::LocalTangentPlane;
 pub use vehicle::{MAX_SAMPLES, VehicleTruth, simulate, simulate_at};
 pub use vehicle_kind::{RangeVehicle, Slip, SlipProcess, VehicleKind};
 

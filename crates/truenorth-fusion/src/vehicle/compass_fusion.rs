@@ -131,7 +131,7 @@ impl VehicleEstimator {
         let (sp, cp) = self
             .tracking
             .trig_compass
-            .at(self.heading_at(t_s) + f.x[COMPASS_BIAS]);
+            .at(self.heading_at(t_s) - self.frame_declination_rad() + f.x[COMPASS_BIAS]);
         let nu = small_atan2(-u.y * cp - u.x * sp, u.x * cp - u.y * sp);
         let p_nu = f.p[PSI][PSI]
             + 2.0 * f.p[PSI][COMPASS_BIAS]
@@ -252,6 +252,7 @@ impl VehicleEstimator {
         let Some(fix) = self.compass.fix().copied() else {
             return;
         };
+        let heading = heading + self.frame_declination_rad();
         let line = &mut self.tracking.alignment.line;
         line.push(t_s, wrap_pi(heading - self.filter.x[PSI]));
         if line.len() < self.config.compass.alignment_readings {
@@ -281,8 +282,35 @@ impl VehicleEstimator {
     /// uncorrelated with the calibration states, and the track turned about the start by the
     /// same error. The wheels' heading keeps its difference from the gyro's.
     fn align(&mut self, offset: f64, sigma: f64) {
+        let g = self.turn_frame(offset, sigma);
+        let bias_var = self.compass_bias_var();
+        let f = &mut self.filter;
+        // The readings the offset came from carried the compass's systematic error too:
+        // the heading's error is minus it, until the filter learns otherwise.
+        f.reset_state(COMPASS_BIAS, bias_var.sqrt());
+        for (k, gk) in g.iter().enumerate() {
+            f.p[COMPASS_BIAS][k] -= bias_var * gk;
+            f.p[k][COMPASS_BIAS] -= bias_var * gk;
+        }
+        f.p[COMPASS_BIAS][COMPASS_BIAS] = bias_var;
+        for (i, gi) in g.iter().enumerate() {
+            for (j, gj) in g.iter().enumerate() {
+                f.p[i][j] += bias_var * gi * gj;
+            }
+        }
+        self.tracking.alignment.done = true;
+        self.compass.restart_gates();
+        self.anchor_plain();
+    }
+
+    /// Turns heading, wheel heading and track about the start by `offset`, a measurement of
+    /// the start heading (unknown until now) with standard deviation `sigma`: conditioning
+    /// on it leaves the heading with the measurement's error alone, uncorrelated with the
+    /// calibration states, and the track turned about the start by the same error. Returns
+    /// how that error enters each state.
+    pub(super) fn turn_frame(&mut self, offset: f64, sigma: f64) -> [f64; DIM] {
         self.tracking.alignment.offset_rad = offset;
-        let bias_var = self.refer_heading(offset);
+        self.refer_heading(offset);
         let f = &mut self.filter;
         let (s, c) = offset.sin_cos();
         let (n, e) = (f.x[NORTH], f.x[EAST]);
@@ -311,22 +339,7 @@ impl VehicleEstimator {
         g[NORTH] = -f.x[EAST];
         g[EAST] = f.x[NORTH];
         f.add_common_error(&g, sigma);
-        // The readings the offset came from carried the compass's systematic error too:
-        // the heading's error is minus it, until the filter learns otherwise.
-        f.reset_state(COMPASS_BIAS, bias_var.sqrt());
-        for (k, gk) in g.iter().enumerate() {
-            f.p[COMPASS_BIAS][k] -= bias_var * gk;
-            f.p[k][COMPASS_BIAS] -= bias_var * gk;
-        }
-        f.p[COMPASS_BIAS][COMPASS_BIAS] = bias_var;
-        for (i, gi) in g.iter().enumerate() {
-            for (j, gj) in g.iter().enumerate() {
-                f.p[i][j] += bias_var * gi * gj;
-            }
-        }
-        self.tracking.alignment.done = true;
-        self.compass.restart_gates();
-        self.anchor_plain();
+        g
     }
 
     /// Refers a heading that was lost to north again: the heading (and the wheels' heading
@@ -354,7 +367,7 @@ impl VehicleEstimator {
     /// Closes the open steps and the compass window, then turns the heading (and the
     /// wheels' heading with it) by `offset`; returns the compass's stationary systematic
     /// variance, which both a first alignment and a relock start the compass error from.
-    fn refer_heading(&mut self, offset: f64) -> f64 {
+    pub(super) fn refer_heading(&mut self, offset: f64) -> f64 {
         self.flush();
         self.tracking.window = CompassWindow::default();
         let f = &mut self.filter;

@@ -294,6 +294,98 @@ pub struct VehicleConfig {
     /// their uncertainties allow (true). Off, the fused estimate is trusted whatever it
     /// learned: for comparing the two, not for use.
     pub plain_guard: bool,
+    /// How satellite fixes are used.
+    pub gnss: GnssConfig,
+}
+
+/// How satellite fixes correct the vehicle estimate.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct GnssConfig {
+    /// A fix's 1σ horizontal accuracy where the receiver reports none, m (5: a consumer
+    /// receiver under open sky reports 1.5–3 m, in a town 3–10 m).
+    pub default_sigma_m: f64,
+    /// How long a fix's error stays the same, s (20): a receiver's error comes from the
+    /// atmosphere's delays and multipath, which change over tens of seconds, so fixes a
+    /// second apart are not independent. At most one fix per second is used, with its
+    /// variance widened as if it were one of the few independent fixes within this time.
+    pub error_correlation_s: f64,
+    /// A fix whose distance from the dead-reckoned position exceeds this many standard
+    /// deviations of their difference is rejected (4): a multipath jump, a frozen fix.
+    pub gate_sigma: f64,
+    /// Fixes rejected for this long in a row, s (15), mean the dead-reckoned position is
+    /// what is wrong (a wheel that spun, an outage longer than the sensors' model): the
+    /// position starts again from the next fix.
+    pub rejoin_after_s: f64,
+    /// Speed over ground below which the receiver's course is not used, m/s (3): at walking
+    /// pace the course is the receiver's noise.
+    pub min_course_speed_mps: f64,
+    /// Standard deviation of the receiver's speed over ground, m/s (0.3): the course's
+    /// error is about this over the speed.
+    pub speed_sigma_mps: f64,
+    /// How long after its epoch a fix reaches the log, s (0.25), and the spread of that
+    /// delay, s (0.15): a receiver sends a fix 50–100 ms after it computes it and a logger
+    /// adds as much again or more, so at 20 m/s a fix stamped on arrival lies metres behind
+    /// the vehicle. The fix is compared with where the vehicle was that long before its
+    /// stamp, and the spread, times the speed (and the turn rate, for the course), widens it.
+    pub latency_s: f64,
+    /// The spread of [`GnssConfig::latency_s`], s.
+    pub latency_sigma_s: f64,
+    /// The date the drive was made, decimal year (2026.0), for the declination at the
+    /// first fix (WMM2025, valid 2025.0–2030.0) that relates the compass's magnetic north to
+    /// the fixes' true north.
+    pub decimal_year: f64,
+}
+
+impl Default for GnssConfig {
+    fn default() -> Self {
+        Self {
+            default_sigma_m: 5.0,
+            error_correlation_s: 20.0,
+            gate_sigma: 4.0,
+            rejoin_after_s: 15.0,
+            min_course_speed_mps: 3.0,
+            speed_sigma_mps: 0.3,
+            latency_s: 0.25,
+            latency_sigma_s: 0.15,
+            decimal_year: 2026.0,
+        }
+    }
+}
+
+impl Validate for GnssConfig {
+    fn validate(&self) -> Result<()> {
+        check_range(
+            "gnss default_sigma_m",
+            self.default_sigma_m,
+            1e-3,
+            truenorth_core::MAX_GNSS_SIGMA_M,
+        )?;
+        check_range(
+            "gnss error_correlation_s",
+            self.error_correlation_s,
+            0.0,
+            3600.0,
+        )?;
+        check_range("gnss gate_sigma", self.gate_sigma, 1.0, 100.0)?;
+        check_range("gnss rejoin_after_s", self.rejoin_after_s, 0.0, 3600.0)?;
+        check_range(
+            "gnss min_course_speed_mps",
+            self.min_course_speed_mps,
+            0.0,
+            100.0,
+        )?;
+        check_range("gnss speed_sigma_mps", self.speed_sigma_mps, 1e-3, 10.0)?;
+        check_range("gnss latency_s", self.latency_s, 0.0, 10.0)?;
+        check_range("gnss latency_sigma_s", self.latency_sigma_s, 0.0, 10.0)?;
+        check_range(
+            "gnss decimal_year (WMM2025 holds 2025.0-2030.0)",
+            self.decimal_year,
+            2025.0,
+            2030.0,
+        )?;
+        Ok(())
+    }
 }
 
 impl Default for VehicleConfig {
@@ -305,6 +397,7 @@ impl Default for VehicleConfig {
             standstill_s: 0.5,
             max_gap_s: 2.0,
             plain_guard: true,
+            gnss: GnssConfig::default(),
         }
     }
 }
@@ -324,6 +417,7 @@ impl Validate for VehicleConfig {
         self.compass.validate()?;
         check_range("standstill_s", self.standstill_s, 0.0, 60.0)?;
         check_range("max_gap_s", self.max_gap_s, 0.01, 3600.0)?;
+        self.gnss.validate()?;
         Ok(())
     }
 }

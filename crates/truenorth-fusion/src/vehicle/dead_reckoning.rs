@@ -280,6 +280,7 @@ impl VehicleEstimator {
             self.filter
                 .reset_state(PSI, super::estimator::UNKNOWN_HEADING_SIGMA_RAD);
             self.tracking.alignment = Alignment::default();
+            self.forget_gnss_frame();
             self.tracking.window = CompassWindow::default();
             self.restart_wheel_heading();
         }

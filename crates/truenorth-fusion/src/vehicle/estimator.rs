@@ -280,6 +280,7 @@ impl VehicleEstimator {
     /// that carries only another sensor reports where the vehicle is at its own time.
     fn publish(&mut self, t_s: f64) -> NavEstimate {
         let psi = self.heading_at(t_s);
+        let declination = self.frame_declination_rad();
         let ahead_s = self
             .wheels
             .last_s()
@@ -290,7 +291,8 @@ impl VehicleEstimator {
         e.t_s = t_s;
         e.north_m = f.x[super::nav_filter::NORTH] + travel * psi.cos();
         e.east_m = f.x[super::nav_filter::EAST] + travel * psi.sin();
-        e.heading = MagneticHeading::new(wrap_pi(psi));
+        // Referred to the fixes the heading is true; the estimate's heading is magnetic.
+        e.heading = MagneticHeading::new(wrap_pi(psi - declination));
         // The covariance is carried forward a few times a second; what the steps since
         // then added is composed here.
         let sigma = self.tracking.batch.psi_variance(f).max(0.0).sqrt();
@@ -411,6 +413,7 @@ impl HeadingEstimator for VehicleEstimator {
         let dt = self.clock.dt_s(sample.t_s)?;
         self.est.status.gap = false;
         self.est.status.fell_back = false;
+        self.est.status.gnss_used = false;
         if let Some(dt) = dt {
             self.tracking.pending_time_s += dt;
         }
@@ -422,6 +425,9 @@ impl HeadingEstimator for VehicleEstimator {
             self.wheel_reading(sample.t_s, w, turns);
         }
         self.compass_step(sample);
+        if let Some(fix) = &sample.gnss {
+            self.gnss_step(sample.t_s, fix);
+        }
         self.tracking.rows_since_epoch += 1;
         if self.tracking.window.n >= self.config.compass.readings_per_update
             || self.tracking.rows_since_epoch >= MAX_BATCH_ROWS

@@ -39,6 +39,7 @@ mod compass_monitor;
 mod config;
 mod dead_reckoning;
 mod estimator;
+mod gnss_fusion;
 mod heading_trig;
 mod innovation_line;
 mod learned;
@@ -58,8 +59,9 @@ mod wheel_odometry;
 
 pub use compass_learning::{CompassLearner, CompassLearnerState, Judged};
 pub use compass_monitor::{CompassFix, CompassMonitor, CompassMonitorState, Verdict};
-pub use config::{CompassGates, SensorPriors, VehicleConfig};
+pub use config::{CompassGates, GnssConfig, SensorPriors, VehicleConfig};
 pub use estimator::VehicleEstimator;
+pub use gnss_fusion::GnssCounts;
 pub use learned::{Learned, LearnedCompass, VehicleCalibration};
 pub use learning_gates::SPEED_COEFF_MIN_SPEED_MPS;
 pub use nav_filter::NavFilter;

@@ -6,6 +6,7 @@
 
 use serde::{Deserialize, Serialize};
 
+use super::gnss_fusion::GnssTrack;
 use super::heading_trig::HeadingTrig;
 use super::innovation_line::InnovationLine;
 use super::learning_gates::LearningGates;
@@ -46,6 +47,9 @@ pub struct VehicleTracking {
     /// Plain integration beside the fused estimate.
     #[serde(default)]
     pub(super) guard: PlainBaseline,
+    /// The satellite fixes as used so far.
+    #[serde(default)]
+    pub(super) gnss: GnssTrack,
 }
 
 impl VehicleTracking {
@@ -68,6 +72,7 @@ impl VehicleTracking {
             unobserved_at_s: f64::NEG_INFINITY,
             learned_until_s: f64::NEG_INFINITY,
             guard: PlainBaseline::default(),
+            gnss: GnssTrack::default(),
         }
     }
 }

@@ -12,21 +12,9 @@ use super::streams::{Slot, Track};
 use super::timing::{Clock, Timed};
 use crate::LocalTangentPlane;
 
-/// A fix as the receiver reports it.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct GnssFix {
-    /// Latitude, degrees north (WGS84), in steps of 10⁻⁷° (`lat_deg`).
-    pub lat_deg: f64,
-    /// Longitude, degrees east (WGS84), in steps of 10⁻⁷° (`lon_deg`).
-    pub lon_deg: f64,
-    /// The receiver's 1σ horizontal accuracy, m (`gnss_sigma_m`), if it reports one.
-    pub sigma_m: Option<f64>,
-    /// Speed over ground, m/s (`gnss_speed_mps`), if it reports one.
-    pub speed_mps: Option<f64>,
-    /// Course over ground, degrees clockwise from true north in [0, 360)
-    /// (`gnss_course_deg`), if it reports one.
-    pub course_deg: Option<f64>,
-}
+/// A fix as the receiver reports it: latitude and longitude in steps of 10⁻⁷°, the
+/// accuracy, speed and course when the receiver reports them.
+pub use truenorth_core::GnssFix;
 
 /// What a fix went through.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]

@@ -185,8 +185,8 @@ fn cell(out: &mut String, value: Option<f64>) {
 /// four the odometer axle's pair on a car (the front wheels of a front-wheel car, else the
 /// rear) and each side's mean on a robot; a vehicle speed integrated the same way, and a
 /// single distance as it is, into [`VehicleSample::dist_m`] (a distance with no left and
-/// right, which says nothing about turning); the gyro and the compass as they are. The core's
-/// sample has no GNSS fix: read [`LogRow::gnss`].
+/// right, which says nothing about turning); the gyro, the compass and the GNSS fix as they
+/// are.
 pub fn vehicle_samples(rows: &[LogRow], kind: VehicleKind) -> Vec<VehicleSample> {
     let mut pair = Integral::<2>::default();
     let mut single = Integral::<1>::default();
@@ -195,6 +195,7 @@ pub fn vehicle_samples(rows: &[LogRow], kind: VehicleKind) -> Vec<VehicleSample>
             let mut s = VehicleSample::at(r.t_s);
             s.gyr_z_rps = r.gyr_z_rps;
             s.mag = r.mag;
+            s.gnss = r.gnss;
             match r.odometry {
                 Some(OdometryReading::WheelDistances([l, rr])) => s = s.with_wheels(l, rr),
                 Some(OdometryReading::WheelSpeeds(v)) => {

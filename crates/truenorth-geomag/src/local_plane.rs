@@ -1,7 +1,7 @@
 //! A local tangent plane at a chosen origin: north, east and down metres from it, to and from
 //! WGS84 latitude, longitude and height, through Earth-centred Earth-fixed (ECEF) coordinates.
 //!
-//! The ellipsoid and the geodetic ↔ geocentric conversions are `truenorth-geomag`'s (WGS84,
+//! The ellipsoid and the geodetic ↔ geocentric conversions are this crate's (WGS84,
 //! NGA.STND.0036; WMM2025 Technical Report eqs. 7–8). The plane's axes in ECEF are the
 //! local-level frame's at the origin's geodetic latitude φ and longitude λ, as navigation
 //! texts write them (e.g. Groves, *Principles of GNSS, Inertial, and Multisensor Integrated
@@ -9,8 +9,11 @@
 //! east `(−sin λ, cos λ, 0)`, down `(−cos φ cos λ, −cos φ sin λ, −sin φ)`.
 
 use nalgebra::{Matrix3, Vector3};
+#[cfg(not(feature = "std"))]
+use truenorth_core::Float as _;
 use truenorth_core::{Error, Result};
-use truenorth_geomag::{GeocentricSpherical, Geodetic};
+
+use crate::{GeocentricSpherical, Geodetic};
 
 /// The tangent plane at an origin on (or above) the WGS84 ellipsoid.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -75,8 +78,8 @@ impl LocalTangentPlane {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::{WGS84_ECCENTRICITY_SQUARED, WGS84_SEMI_MAJOR_AXIS_M};
     use proptest::prelude::*;
-    use truenorth_geomag::{WGS84_ECCENTRICITY_SQUARED, WGS84_SEMI_MAJOR_AXIS_M};
 
     /// A small step north or east changes latitude by `dn / (M + h)` and longitude by
     /// `de / ((N + h) cos φ)`, with the meridian radius `M = a(1 − e²)/(1 − e² sin²φ)^{3/2}`

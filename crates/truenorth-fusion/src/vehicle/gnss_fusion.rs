@@ -1,0 +1,386 @@
+//! Satellite fixes in the vehicle estimator: the first fix sets a local tangent plane, the
+//! fixes' course (or their displacement against the dead-reckoned one) refers heading and
+//! track to true north and the plane, and from then each fix corrects the position — and,
+//! through the position's correlation with the heading, the heading and every learned
+//! sensor error — unless it is too far from the dead-reckoned position to be believed.
+//!
+//! A receiver's error is correlated over tens of seconds (the atmosphere's delays,
+//! multipath), so fixes are taken at most once a second, each with its variance widened to
+//! stand for the few independent fixes within [`super::config::GnssConfig::error_correlation_s`]
+//! (treating 10 fixes a second as independent would shrink the track's uncertainty, and
+//! the learned errors' with it, by a factor the data do not carry). Between fixes, and through
+//! outages, the estimate is dead reckoning from the sensors as learned, its uncertainty
+//! growing as their model says.
+
+use serde::{Deserialize, Serialize};
+use truenorth_core::{GnssFix, wrap_pi};
+use truenorth_geomag::{Geodetic, LocalTangentPlane};
+
+use super::estimator::VehicleEstimator;
+use super::innovation_line::InnovationLine;
+use super::nav_filter::{EAST, NORTH, PSI};
+
+#[cfg(not(feature = "std"))]
+use truenorth_core::Float as _;
+
+/// Shortest interval between two fixes used, s.
+const FIX_INTERVAL_S: f64 = 1.0;
+
+/// Courses that must agree before they refer the heading to true north.
+const ALIGNMENT_COURSES: u32 = 5;
+
+/// Displacement between two fixes, in their standard deviations, that gives a course to
+/// refer the heading to true north when the receiver reports none (10: the course to
+/// within 8°).
+const ALIGNMENT_DISPLACEMENT_SIGMAS: f64 = 10.0;
+
+/// Standard deviation of the angle between a vehicle's heading and its course over ground,
+/// rad (2°): the sideslip of a car's rear axle in ordinary driving, a robot's creep.
+const SIDESLIP_RAD: f64 = 2.0 * core::f64::consts::PI / 180.0;
+
+/// The fixes as the estimator has used them.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub(super) struct GnssTrack {
+    /// The first fix, latitude and longitude in degrees: the tangent plane's origin.
+    pub origin: Option<(f64, f64)>,
+    /// Declination at the origin, rad (east positive).
+    pub declination_rad: f64,
+    /// Heading and track are referred to the fixes: the heading to true north, the track
+    /// to the plane.
+    pub aligned: bool,
+    /// When the last fix was used, s.
+    pub last_used_s: Option<f64>,
+    /// When the current run of rejected fixes began, s.
+    pub rejected_since_s: Option<f64>,
+    /// Fixes used, rejected, and restarts of the position from a fix after a run of
+    /// rejections.
+    pub used: u32,
+    pub rejected: u32,
+    pub restarts: u32,
+    /// The courses' differences from the heading, while they are gathered to refer it to
+    /// true north.
+    pub line: InnovationLine,
+    /// Where a displacement to refer the heading to true north started: the fix's north
+    /// and east, and the dead-reckoned position's, m.
+    pub start: Option<[f64; 4]>,
+}
+
+/// What the fixes did over a drive.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct GnssCounts {
+    /// Fixes that corrected the estimate.
+    pub used: u32,
+    /// Fixes rejected as too far from the dead-reckoned position (multipath, a frozen or
+    /// late fix).
+    pub rejected: u32,
+    /// Times the position started again from a fix after a run of rejections.
+    pub restarts: u32,
+}
+
+impl VehicleEstimator {
+    /// The tangent plane's origin (the first fix's latitude and longitude, degrees), once
+    /// a fix has been seen.
+    pub fn gnss_origin(&self) -> Option<(f64, f64)> {
+        self.tracking.gnss.origin
+    }
+
+    /// Whether heading and track are referred to the fixes: the heading to true north (the
+    /// published [`truenorth_core::NavEstimate::heading`] stays magnetic: add
+    /// [`VehicleEstimator::gnss_declination_rad`]), the track to the plane at the first fix.
+    pub fn gnss_aligned(&self) -> bool {
+        self.tracking.gnss.aligned
+    }
+
+    /// The declination at the first fix (WMM2025 at the configured date), rad, east
+    /// positive: true heading = magnetic heading + it.
+    pub fn gnss_declination_rad(&self) -> Option<f64> {
+        self.tracking
+            .gnss
+            .origin
+            .map(|_| self.tracking.gnss.declination_rad)
+    }
+
+    /// How many fixes were used and rejected so far.
+    pub fn gnss_counts(&self) -> GnssCounts {
+        let g = &self.tracking.gnss;
+        GnssCounts {
+            used: g.used,
+            rejected: g.rejected,
+            restarts: g.restarts,
+        }
+    }
+
+    /// The difference between the heading frame and magnetic north, rad: the declination
+    /// once the fixes refer the heading to true north, else zero.
+    pub(super) fn frame_declination_rad(&self) -> f64 {
+        if self.tracking.gnss.aligned {
+            self.tracking.gnss.declination_rad
+        } else {
+            0.0
+        }
+    }
+
+    /// Forgets the fixes' frame: the heading was lost, so the track can no longer be turned
+    /// onto the plane by a heading offset alone.
+    pub(super) fn forget_gnss_frame(&mut self) {
+        let g = &mut self.tracking.gnss;
+        g.aligned = false;
+        g.line = InnovationLine::default();
+        g.start = None;
+    }
+
+    /// Takes the fix a row carries at `t_s`.
+    pub(super) fn gnss_step(&mut self, t_s: f64, fix: &GnssFix) {
+        self.est.status.gnss_used = false;
+        let Some(plane) = self.plane(fix) else {
+            return;
+        };
+        let Ok(point) = Geodetic::from_degrees(fix.lat_deg, fix.lon_deg, 0.0) else {
+            return;
+        };
+        let [north, east, _] = plane.from_geodetic(&point);
+        // Fixes say where the vehicle is; between them only odometry carries it there.
+        if !self.est.status.position_known
+            || self
+                .tracking
+                .gnss
+                .last_used_s
+                .is_some_and(|t0| t_s - t0 < FIX_INTERVAL_S)
+        {
+            return;
+        }
+        let sigma = fix.sigma_m.unwrap_or(self.config.gnss.default_sigma_m);
+        // Where the vehicle was when the fix was computed, and what the delay's spread
+        // leaves unknown along the track.
+        let t_s = t_s - self.config.gnss.latency_s;
+        let lag = self.config.gnss.latency_sigma_s * self.est.speed_mps;
+        let sigma = (sigma * sigma + lag * lag).sqrt();
+        if self.tracking.gnss.aligned {
+            self.correct_with_fix(t_s, north, east, sigma);
+            self.correct_with_course(t_s, fix);
+        } else {
+            self.align_to_fixes(t_s, north, east, sigma, fix);
+        }
+    }
+
+    /// The tangent plane at the first fix (set now if this is it), or `None` if the fix
+    /// cannot be placed.
+    fn plane(&mut self, fix: &GnssFix) -> Option<LocalTangentPlane> {
+        if let Some((lat, lon)) = self.tracking.gnss.origin {
+            return LocalTangentPlane::new(lat, lon, 0.0).ok();
+        }
+        let plane = LocalTangentPlane::new(fix.lat_deg, fix.lon_deg, 0.0).ok()?;
+        self.tracking.gnss.origin = Some((fix.lat_deg, fix.lon_deg));
+        // Where the model has no answer (at the poles) the compass and the fixes are not
+        // related, as without a place.
+        self.tracking.gnss.declination_rad = truenorth_geomag::declination(
+            fix.lat_deg.to_radians(),
+            fix.lon_deg.to_radians(),
+            0.0,
+            self.config.gnss.decimal_year,
+        )
+        .map_or(0.0, |d| d.0);
+        Some(plane)
+    }
+
+    /// The dead-reckoned position at `t_s`: the track's last point carried on (or back)
+    /// along the heading at the speed the wheels last showed.
+    fn position_at(&self, t_s: f64) -> (f64, f64) {
+        let ahead_s = self.wheels.last_s().map_or(0.0, |t0| {
+            (t_s - t0).clamp(-self.config.max_gap_s, self.config.max_gap_s)
+        });
+        let travel = self.est.speed_mps * ahead_s;
+        let (s, c) = self.heading_at(t_s).sin_cos();
+        let x = &self.filter.x;
+        (x[NORTH] + travel * c, x[EAST] + travel * s)
+    }
+
+    /// The fix at (`north`, `east`) of accuracy `sigma` against the dead-reckoned position:
+    /// used if within the gate, else counted as rejected; a run of rejections longer than
+    /// [`super::config::GnssConfig::rejoin_after_s`] starts the position again from it.
+    fn correct_with_fix(&mut self, t_s: f64, north: f64, east: f64, sigma: f64) {
+        self.flush();
+        let (pn, pe) = self.position_at(t_s);
+        let (nu_n, nu_e) = (north - pn, east - pe);
+        let p = &self.filter.p;
+        let var = sigma * sigma;
+        let (a, b, d) = (p[NORTH][NORTH] + var, p[NORTH][EAST], p[EAST][EAST] + var);
+        let det = a * d - b * b;
+        let d2 = (d * nu_n * nu_n - 2.0 * b * nu_n * nu_e + a * nu_e * nu_e) / det;
+        let gate = self.config.gnss.gate_sigma;
+        if !(det > 0.0 && d2.is_finite()) || d2 > gate * gate {
+            let g = &mut self.tracking.gnss;
+            g.rejected += 1;
+            let since = *g.rejected_since_s.get_or_insert(t_s);
+            if t_s - since >= self.config.gnss.rejoin_after_s {
+                g.restarts += 1;
+                g.rejected_since_s = None;
+                self.restart_position(t_s, north, east, sigma);
+            }
+            return;
+        }
+        // One fix of the few independent ones within the error's correlation time.
+        let widened = var * (self.config.gnss.error_correlation_s / FIX_INTERVAL_S).max(1.0);
+        self.filter.update(&[(NORTH, 1.0)], nu_n, widened);
+        let (_, pe) = self.position_at(t_s);
+        self.filter.update(&[(EAST, 1.0)], east - pe, widened);
+        // The fixes' error changes slowly: a position learned from them is no better than
+        // one fix, however many were averaged within its correlation time.
+        for i in [NORTH, EAST] {
+            self.filter.p[i][i] = self.filter.p[i][i].max(var);
+        }
+        let g = &mut self.tracking.gnss;
+        g.rejected_since_s = None;
+        g.last_used_s = Some(t_s);
+        g.used += 1;
+        self.est.status.gnss_used = true;
+        self.anchor_plain();
+    }
+
+    /// The receiver's course against the heading, once referred to true north: used when
+    /// the vehicle moves fast enough for the course to mean its direction.
+    fn correct_with_course(&mut self, t_s: f64, fix: &GnssFix) {
+        let Some((course, sigma)) = self.course_of(fix) else {
+            return;
+        };
+        let nu = wrap_pi(course - self.heading_at(t_s));
+        let lag = self.config.gnss.latency_sigma_s * self.tracking.gyro.rate_rps;
+        let sigma = (sigma * sigma + lag * lag).sqrt();
+        let s = self.filter.p[PSI][PSI] + sigma * sigma;
+        let gate = self.config.gnss.gate_sigma;
+        if nu * nu <= gate * gate * s {
+            self.filter.update(&[(PSI, 1.0)], nu, sigma * sigma);
+        }
+    }
+
+    /// The direction the vehicle heads by the fix's course (rad, true north), and its
+    /// standard deviation, when the receiver reports one at a speed that makes it mean the
+    /// vehicle's direction (reversing: the course less half a turn).
+    fn course_of(&self, fix: &GnssFix) -> Option<(f64, f64)> {
+        let (speed, course_deg) = (fix.speed_mps?, fix.course_deg?);
+        let cfg = &self.config.gnss;
+        if speed < cfg.min_course_speed_mps || self.est.speed_mps.abs() < 0.5 * speed {
+            return None;
+        }
+        let reversing = self.est.speed_mps < 0.0;
+        let course = course_deg.to_radians()
+            + if reversing {
+                core::f64::consts::PI
+            } else {
+                0.0
+            };
+        let sigma = ((cfg.speed_sigma_mps / speed).powi(2) + SIDESLIP_RAD * SIDESLIP_RAD).sqrt();
+        Some((wrap_pi(course), sigma))
+    }
+
+    /// Before the heading is referred to the fixes: gathers the courses' differences from
+    /// the heading (or, with no course, waits for a displacement long enough to give one),
+    /// and once they agree turns heading and track onto true north and the plane.
+    fn align_to_fixes(&mut self, t_s: f64, north: f64, east: f64, sigma: f64, fix: &GnssFix) {
+        let (pn, pe) = self.position_at(t_s);
+        if let Some((course, course_sigma)) = self.course_of(fix) {
+            let nu = wrap_pi(course - self.heading_at(t_s));
+            let line = &mut self.tracking.gnss.line;
+            line.push(t_s, nu);
+            if line.len() < ALIGNMENT_COURSES {
+                return;
+            }
+            let fit = line.fit(course_sigma);
+            self.tracking.gnss.line = InnovationLine::default();
+            if let Some(f) = fit.filter(|f| f.residual_rad <= 3.0 * course_sigma) {
+                self.refer_to_fixes(t_s, north, east, sigma, f.offset_rad, f.sigma_rad);
+            }
+            return;
+        }
+        let Some([n0, e0, pn0, pe0]) = self.tracking.gnss.start else {
+            self.tracking.gnss.start = Some([north, east, pn, pe]);
+            return;
+        };
+        let (fn_, fe) = (north - n0, east - e0);
+        let (dn, de) = (pn - pn0, pe - pe0);
+        let fixed = fn_.hypot(fe);
+        if fixed < ALIGNMENT_DISPLACEMENT_SIGMAS * sigma {
+            return;
+        }
+        self.tracking.gnss.start = Some([north, east, pn, pe]);
+        // The two displacements are chords of one path: one in the plane, the other in the
+        // dead reckoning's frame, turned from it by the offset sought.
+        let reckoned = dn.hypot(de);
+        if reckoned < 0.5 * fixed || reckoned > 2.0 * fixed {
+            return;
+        }
+        let offset = wrap_pi(fe.atan2(fn_) - de.atan2(dn));
+        self.refer_to_fixes(
+            t_s,
+            north,
+            east,
+            sigma,
+            offset,
+            core::f64::consts::SQRT_2 * sigma / fixed,
+        );
+    }
+
+    /// Turns heading and track onto true north by `offset` (standard deviation
+    /// `offset_sigma`) and starts the position at the fix. A heading already referred to
+    /// magnetic north by the compass is turned by the declination instead, which is known:
+    /// the courses then correct it as measurements.
+    fn refer_to_fixes(
+        &mut self,
+        t_s: f64,
+        north: f64,
+        east: f64,
+        sigma: f64,
+        offset: f64,
+        offset_sigma: f64,
+    ) {
+        if self.tracking.alignment.done {
+            self.turn_known(self.tracking.gnss.declination_rad);
+        } else {
+            self.turn_frame(offset, offset_sigma);
+            self.tracking.alignment.done = true;
+            self.compass.restart_gates();
+        }
+        self.tracking.gnss.aligned = true;
+        self.restart_position(t_s, north, east, sigma);
+        let g = &mut self.tracking.gnss;
+        g.last_used_s = Some(t_s);
+        g.used += 1;
+        self.est.status.gnss_used = true;
+        self.anchor_plain();
+    }
+
+    /// Turns heading, wheel heading and track about the start by an exactly known angle.
+    fn turn_known(&mut self, angle: f64) {
+        self.refer_heading(angle);
+        let f = &mut self.filter;
+        let (s, c) = angle.sin_cos();
+        let (n, e) = (f.x[NORTH], f.x[EAST]);
+        f.x[NORTH] = n * c - e * s;
+        f.x[EAST] = n * s + e * c;
+        for k in 0..super::nav_filter::DIM {
+            let (pn, pe) = (f.p[NORTH][k], f.p[EAST][k]);
+            f.p[NORTH][k] = c * pn - s * pe;
+            f.p[EAST][k] = s * pn + c * pe;
+        }
+        for k in 0..super::nav_filter::DIM {
+            let (pn, pe) = (f.p[k][NORTH], f.p[k][EAST]);
+            f.p[k][NORTH] = c * pn - s * pe;
+            f.p[k][EAST] = s * pn + c * pe;
+        }
+    }
+
+    /// Starts the position again at the fix (`north`, `east`) of accuracy `sigma`: the
+    /// track's last point placed where the fix says the vehicle was, less the way it went
+    /// since the wheels last read.
+    fn restart_position(&mut self, t_s: f64, north: f64, east: f64, sigma: f64) {
+        self.flush();
+        let (pn, pe) = self.position_at(t_s);
+        let f = &mut self.filter;
+        f.x[NORTH] += north - pn;
+        f.x[EAST] += east - pe;
+        f.reset_state(NORTH, sigma);
+        f.reset_state(EAST, sigma);
+        self.tracking.gnss.rejected_since_s = None;
+    }
+}
