@@ -50,8 +50,10 @@ fn a_speed_or_a_distance_with_a_yaw_rate_draws_the_track() {
     }
 }
 
+/// A speed beside wheel columns is said unused; fixes without their accuracy are taken, and
+/// the default accuracy they are judged by is said.
 #[test]
-fn a_speed_beside_wheels_and_gnss_fixes_are_said_unused() {
+fn a_speed_beside_wheels_is_said_unused_and_fixes_default_accuracy_said() {
     let dir = scratch("drive_sets", "unused");
     let vehicle = common::rear_vehicle(&dir, 1.6);
     let input = dir.join("both.csv");
@@ -63,7 +65,8 @@ fn a_speed_beside_wheels_and_gnss_fixes_are_said_unused() {
     let o = common::succeeded(common::drive(&vehicle, &input, &dir.join("o.csv"), &[]));
     let stderr = String::from_utf8_lossy(&o.stderr);
     assert!(stderr.contains("`speed_mps` is not used"), "{stderr}");
-    assert!(stderr.contains("`lat_deg,lon_deg` is not used"), "{stderr}");
+    assert!(stderr.contains("carry no `gnss_sigma_m`"), "{stderr}");
+    assert!(stderr.contains("sensors: wheels + gyro + GNSS"), "{stderr}");
 }
 
 #[test]
@@ -196,8 +199,9 @@ fn vehicle_json(wheels: &truenorth::odometer::OdometerWheels) -> String {
 }
 
 /// Every sensor set the simulator writes as a real log, on every kind of vehicle, with a
-/// GNSS receiver's columns beside: read whole, its set named, the GNSS fixes and (on a car's
-/// four wheels) the other axle said unused.
+/// GNSS receiver's columns beside: read whole, its set named, the fixes used where odometry
+/// carries the position between them and said unused where none does, and (on a car's four
+/// wheels) the other axle said unused.
 #[test]
 fn every_real_sensor_set_is_read_and_what_is_unused_said() {
     use truenorth_sim::log_drive::{LogDrive, LogDriveConfig, SensorSet};
@@ -220,10 +224,18 @@ fn every_real_sensor_set_is_read_and_what_is_unused_said() {
                 continue;
             }
             assert!(stderr.contains("; sensors: "), "{name}: {stderr}");
-            assert!(
-                stderr.contains("`lat_deg,lon_deg` is not used"),
-                "{name}: {stderr}"
-            );
+            if matches!(set.odometry, truenorth_sim::log_drive::Odometry::None) {
+                assert!(
+                    stderr.contains("`lat_deg,lon_deg` are not used"),
+                    "{name}: {stderr}"
+                );
+            } else {
+                assert!(stderr.contains("satellite fixes: "), "{name}: {stderr}");
+                assert!(
+                    !stderr.contains("satellite fixes: 0 used"),
+                    "{name}: {stderr}"
+                );
+            }
             let header = drive.to_csv().lines().next().unwrap().to_string();
             if header.contains("speed_fl_mps")
                 && !matches!(kind, truenorth_sim::VehicleKind::SkidSteer)

@@ -119,6 +119,11 @@ pub struct NavStatus {
     /// A satellite fix corrected the estimate at this sample.
     #[serde(default)]
     pub gnss_used: bool,
+    /// The track is in the local tangent plane at the first satellite fix and the heading
+    /// was referred to true north by the fixes (the heading is still given from magnetic
+    /// north: the estimator says the declination it used).
+    #[serde(default)]
+    pub gnss_frame: bool,
     /// The learned sensor errors the data have not yet told apart.
     #[serde(default)]
     pub unobserved: Unobserved,

@@ -45,6 +45,9 @@ pub struct VehicleSensors {
     pub gyro: bool,
     /// A horizontal magnetometer.
     pub compass: bool,
+    /// Satellite fixes.
+    #[serde(default)]
+    pub gnss: bool,
 }
 
 impl VehicleSensors {
@@ -67,6 +70,13 @@ impl VehicleSensors {
         self.travel = self.travel.max(travel);
         self.gyro |= sample.gyr_z_rps.is_some();
         self.compass |= sample.mag.is_some();
+        self.gnss |= sample.gnss.is_some();
+    }
+
+    /// Whether satellite fixes can correct the estimate: there are fixes, and odometry
+    /// carries the position between them.
+    pub fn fixes_used(&self) -> bool {
+        self.gnss && self.travel != Travel::None
     }
 
     /// Whether anything gives the heading's changes: a gyro, two wheels, or a compass.
@@ -79,7 +89,8 @@ impl VehicleSensors {
         self.travel != Travel::None && self.heading_source()
     }
 
-    /// A short name for the set, as a report names it.
+    /// A short name for the set, as a report names it (without the satellite fixes, which
+    /// [`VehicleSensors::gnss`] says).
     pub fn name(&self) -> &'static str {
         match (self.travel, self.gyro, self.compass) {
             (Travel::None, false, false) => "nothing a vehicle estimator can use",
@@ -101,6 +112,7 @@ impl VehicleSensors {
     /// know. Empty for a full set (wheels, gyro and compass).
     pub fn limits(&self) -> impl Iterator<Item = &'static str> {
         let s = *self;
+        let fixes = s.fixes_used();
         let all: [(bool, &'static str); 6] = [
             (
                 !s.heading_source(),
@@ -111,15 +123,15 @@ impl VehicleSensors {
                 "no position: no wheel or speed gives the distance travelled",
             ),
             (
-                !s.compass && s.heading_source(),
+                !s.compass && !fixes && s.heading_source(),
                 "no north: without a compass the heading is relative to the start",
             ),
             (
-                s.gyro && s.travel != Travel::Wheels && !s.compass,
+                s.gyro && s.travel != Travel::Wheels && !s.compass && !fixes,
                 "no gyro gain: nothing else measures the turns, so a yaw-rate scale error is not learned and widens the heading's uncertainty with every turn",
             ),
             (
-                s.gyro && s.travel != Travel::Wheels,
+                s.gyro && s.travel != Travel::Wheels && !fixes,
                 "gyro bias only at rest or against the compass: no wheels say when the vehicle drives straight",
             ),
             (
@@ -173,6 +185,22 @@ mod tests {
             }
             prop_assert_eq!(forward, backward);
         }
+    }
+
+    #[test]
+    fn fixes_give_north_and_the_gyro_s_errors_where_odometry_carries_them() {
+        let fix = crate::GnssFix::at(52.5, 13.4);
+        let s = VehicleSensors::of(
+            &VehicleSample::at(0.0)
+                .with_distance(0.0)
+                .with_gyro(0.0)
+                .with_gnss(fix),
+        );
+        assert!(s.fixes_used());
+        assert_eq!(s.limits().count(), 0);
+        let no_odometry = VehicleSensors::of(&VehicleSample::at(0.0).with_gyro(0.0).with_gnss(fix));
+        assert!(!no_odometry.fixes_used());
+        assert!(no_odometry.limits().any(|l| l.starts_with("no north")));
     }
 
     #[test]

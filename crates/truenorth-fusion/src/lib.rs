@@ -55,7 +55,7 @@ pub use orientation::{
     QuaternionFilter, QuaternionFilterConfig, QuaternionFilterState, RestConfig, RestDetector,
     StartupField, coefficient_table,
 };
-pub use vehicle::{CompassGates, SensorPriors, VehicleConfig, VehicleEstimator};
+pub use vehicle::{CompassGates, GnssConfig, SensorPriors, VehicleConfig, VehicleEstimator};
 
 /// The code blocks of the crate's README, compiled and run as doctests.
 #[cfg(doctest)]

@@ -5,7 +5,7 @@
 use std::path::{Path, PathBuf};
 
 use truenorth::checks::GyroUnit;
-use truenorth::core::{Fixed, NavEstimate, VehicleSensors, rad_to_deg};
+use truenorth::core::{Fixed, VehicleSensors, rad_to_deg};
 use truenorth::fusion::vehicle::VehicleCalibration;
 use truenorth::fusion::{SensorPriors, VehicleConfig, VehicleEstimator};
 use truenorth::odometer::OdometerWheels;
@@ -27,7 +27,7 @@ mod output;
 
 use diagnose::{Context, Diagnosis};
 pub use output::Extra;
-use output::Writer;
+use output::{Tally, Writer};
 
 /// The long help of the command (after the options).
 const AFTER_HELP: &str = "VEHICLE.json: {\"track_m\": 1.55, \"odometer_wheels\": \"rear\"} or
@@ -56,7 +56,12 @@ rate: an empty cell means no reading on that row, and each row is used for what 
 Wheels, a gyro or a compass must be present; the summary names the sensor set and warns of
 what it cannot tell (no north without a compass, no gyro gain without a second turn
 reference). A speed beside wheel columns is said unused, and so are four wheel speeds beside
-the odometer wheels' own, and a GNSS fix's `lat_deg,lon_deg`; other columns are ignored. Frames: x forward, y right,
+the odometer wheels' own; other columns are ignored. Satellite fixes: `lat_deg,lon_deg`
+(WGS84) with `gnss_sigma_m` (1σ, m; 5 where absent) and optionally
+`gnss_speed_mps,gnss_course_deg`, on their own rows: with odometry the fused method refers
+heading and track to them (north_m, east_m in the tangent plane at the first fix, heading
+from true north) and corrects the position with each; `--extra geodetic` adds lat_deg,
+lon_deg. Frames: x forward, y right,
 z down.
 
 Output: `t_s,north_m,east_m,heading_deg` — the rear-axle centre from the start point, and
@@ -172,6 +177,28 @@ pub fn run(args: &Args) -> CliResult {
     for (name, why) in samples.kind().unused_columns() {
         errln!("truenorth drive: warning: `{name}` is not used: {why}");
     }
+    let odometry = samples.kind().has_odometry();
+    if samples.kind().has_gnss() {
+        if args.method != VehicleMethod::Fused {
+            errln!(
+                "truenorth drive: warning: `lat_deg,lon_deg` are not used: only --method fused takes satellite fixes"
+            );
+        } else if !odometry {
+            errln!(
+                "truenorth drive: warning: `lat_deg,lon_deg` are not used: between fixes only odometry (wheels, a speed or a distance) carries the position, and there is none"
+            );
+        } else if !samples.kind().gnss_sigma_given() {
+            errln!(
+                "truenorth drive: warning: the fixes carry no `gnss_sigma_m`: each is taken as {} m (1σ) and judged by that",
+                truenorth::fusion::GnssConfig::default().default_sigma_m
+            );
+        }
+        if args.method == VehicleMethod::Fused && odometry && args.place.is_given() {
+            errln!(
+                "truenorth drive: warning: --lat/--lon are not used for true north: the satellite fixes give it (rows before the first fixes that refer the heading still use them)"
+            );
+        }
+    }
     let mut check = Diagnosis::new(vehicle.track_m, wheels.can_pivot(), speeds);
     let mut writer = Writer::create(
         &args.output,
@@ -194,24 +221,9 @@ pub fn run(args: &Args) -> CliResult {
     if let (Some(out), Some(learned)) = (&args.calibration_out, &learned) {
         write_learned(out, learned)?;
     }
-    let Writer {
-        out,
-        last,
-        rows: written,
-        gaps,
-        fallbacks,
-        ..
-    } = writer;
+    let Writer { out, tally, .. } = writer;
     out.commit()?;
-    summary(
-        args,
-        samples,
-        written,
-        (gaps, fallbacks),
-        last.as_ref(),
-        learned.as_ref(),
-        &sensors,
-    );
+    summary(args, samples, &tally, learned.as_ref(), &sensors);
     for limit in sensors.limits() {
         errln!("truenorth drive: warning: {limit}");
     }
@@ -265,6 +277,10 @@ fn build_method(
     if let Some(s) = vehicle.compass_systematic_deg {
         config.compass.systematic_deg = s;
     }
+    // The declination that relates the compass to the fixes' true north comes from
+    // WMM2025, which holds from 2025.0 to 2030.0; a date outside is taken at its nearest
+    // end (the declination moves by a few tenths of a degree in five years).
+    config.gnss.decimal_year = args.place.decimal_year()?.clamp(2025.0, 2029.999);
     let bad_config =
         |e: truenorth::core::Error| CliError::file(&args.vehicle, e.to_string()).kind_of(&e);
     let fused = match &args.calibration_in {
@@ -341,12 +357,12 @@ fn estimate(
         check.push(&sample, row);
         sensors.add(&sample);
         method
-            .push(&sample, &mut |e, filter| writer.write(e, filter))
+            .push(&sample, &mut |e, fused| writer.write(e, fused))
             .map_err(|e| CliError::row(&path, row, e.to_string()).kind_of(&e))?;
         writer.error.take().map_or(Ok(()), Err)
     })?;
     method
-        .finish(&mut |e, filter| writer.write(e, filter))
+        .finish(&mut |e, fused| writer.write(e, fused))
         .map_err(|e| CliError::file(&path, e.to_string()).kind_of(&e))?;
     if let Some(e) = writer.error.take() {
         return Err(e);
@@ -359,14 +375,21 @@ fn estimate(
 fn summary(
     args: &Args,
     samples: usize,
-    written: usize,
-    (gaps, fallbacks): (usize, usize),
-    last: Option<&NavEstimate>,
+    tally: &Tally,
     learned: Option<&VehicleCalibration>,
     sensors: &VehicleSensors,
 ) {
+    let Tally {
+        rows: written,
+        gaps,
+        fallbacks,
+        gnss,
+        last,
+    } = *tally;
     let Some(e) = last else { return };
-    let reference = if !e.status.heading_absolute {
+    let reference = if e.status.gnss_frame {
+        "true north, from the satellite fixes"
+    } else if !e.status.heading_absolute {
         "relative to the start heading (the compass never calibrated)"
     } else if args.place.is_given() {
         "true north"
@@ -415,6 +438,16 @@ fn summary(
             "; fell back to plain integration {fallbacks} times (a learned gyro or wheel error that the gyro's own integration contradicted was forgotten)"
         );
     }
-    line += &format!("; sensors: {}", sensors.name());
+    if let Some((c, (lat, lon))) = gnss {
+        line += &format!(
+            "; satellite fixes: {} used, {} rejected (too far from the dead-reckoned track), {} restarts of the position after a run of rejections; north_m, east_m from {lat:.7}, {lon:.7} (the first fix)",
+            c.used, c.rejected, c.restarts
+        );
+    }
+    line += &format!(
+        "; sensors: {}{}",
+        sensors.name(),
+        if sensors.gnss { " + GNSS" } else { "" }
+    );
     errln!("{line}");
 }

@@ -77,13 +77,18 @@ impl PlaceArgs {
         self.lat.is_some() || self.lon.is_some()
     }
 
+    /// The date given, as a decimal year (today if none was given).
+    pub fn decimal_year(&self) -> CliResult<f64> {
+        match &self.date {
+            Some(text) => parse_date(text),
+            None => today_decimal_year(),
+        }
+    }
+
     /// The field at this place and date (today if no date was given); an extrapolation
     /// warning goes to stderr.
     pub fn field(&self) -> CliResult<MagneticField> {
-        let year = match &self.date {
-            Some(text) => parse_date(text)?,
-            None => today_decimal_year()?,
-        };
+        let year = self.decimal_year()?;
         let field = evaluate(self, year)?;
         if let Some(w) = field.extrapolated {
             errln!("truenorth: warning: {w}");

@@ -179,12 +179,13 @@ pub fn vehicle_sensors(rec: &Recording) -> Option<VehicleSetReport> {
         travel,
         gyro: has("gyr_z"),
         compass: has("mag_x") && has("mag_y"),
+        gnss: has("lat_deg") && has("lon_deg"),
     };
     if set == VehicleSensors::default() {
         return None;
     }
     Some(VehicleSetReport {
-        set: set.name().to_string(),
+        set: format!("{}{}", set.name(), if set.gnss { " + GNSS" } else { "" }),
         cannot_tell: set.limits().map(String::from).collect(),
     })
 }

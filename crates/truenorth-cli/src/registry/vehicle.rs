@@ -3,8 +3,8 @@
 use truenorth::core::{HeadingEstimator, NavEstimate, Result, VehicleSample};
 use truenorth::fusion::VehicleEstimator;
 use truenorth::fusion::vehicle::{
-    NavFilter, SeedGyroCompass, SeedGyroCompassConfig, SeedOdometerCompass,
-    SeedOdometerCompassConfig, TwoPassConfig, TwoPassStart, VehicleCalibration,
+    SeedGyroCompass, SeedGyroCompassConfig, SeedOdometerCompass, SeedOdometerCompassConfig,
+    TwoPassConfig, TwoPassStart, VehicleCalibration,
 };
 use truenorth::odometer::OdometerWheels;
 
@@ -19,9 +19,9 @@ pub enum VehicleMethod {
     SeedGyroCompass,
 }
 
-/// Receives each sample's final estimate, in order, with the fused filter's state when the
-/// method has one.
-pub type Emit<'a> = dyn FnMut(&NavEstimate, Option<&NavFilter>) + 'a;
+/// Receives each sample's final estimate, in order, with the fused estimator that made it
+/// when the method is the fused one (its filter's state, the fixes' declination).
+pub type Emit<'a> = dyn FnMut(&NavEstimate, Option<&VehicleEstimator>) + 'a;
 
 /// A vehicle method as the commands run it: samples in, each sample's final estimate out in
 /// order. A [`HeadingEstimator`] gives each estimate as its sample comes; the fused
@@ -39,11 +39,11 @@ pub trait VehicleRun {
 
 impl VehicleRun for TwoPassStart {
     fn push(&mut self, sample: &VehicleSample, emit: &mut Emit) -> Result<()> {
-        TwoPassStart::push(self, sample, |_, e, est| emit(e, Some(est.filter())))
+        TwoPassStart::push(self, sample, |_, e, est| emit(e, Some(est)))
     }
 
     fn finish(&mut self, emit: &mut Emit) -> Result<()> {
-        TwoPassStart::finish(self, |_, e, est| emit(e, Some(est.filter())))
+        TwoPassStart::finish(self, |_, e, est| emit(e, Some(est)))
     }
 
     fn calibration(&self) -> Option<VehicleCalibration> {
@@ -55,7 +55,7 @@ impl VehicleRun for TwoPassStart {
 impl VehicleRun for VehicleEstimator {
     fn push(&mut self, sample: &VehicleSample, emit: &mut Emit) -> Result<()> {
         let e = self.update(sample)?;
-        emit(&e, Some(self.filter()));
+        emit(&e, Some(self));
         Ok(())
     }
 

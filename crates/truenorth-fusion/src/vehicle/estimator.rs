@@ -328,6 +328,7 @@ impl VehicleEstimator {
             Matrix2::from_element(f64::INFINITY)
         };
         e.status.heading_absolute = self.tracking.alignment.done;
+        e.status.gnss_frame = self.tracking.gnss.aligned;
         *e
     }
 

@@ -5,7 +5,9 @@ use std::path::Path;
 
 use truenorth::TrueNorth;
 use truenorth::core::{MagneticHeading, NavEstimate, rad_to_deg, wrap_two_pi};
-use truenorth::fusion::vehicle::NavFilter;
+use truenorth::fusion::VehicleEstimator;
+use truenorth::fusion::vehicle::{GnssCounts, NavFilter};
+use truenorth::geomag::LocalTangentPlane;
 
 use crate::io::{CliError, CliResult, CsvOutput, Precision};
 
@@ -21,6 +23,9 @@ pub enum Extra {
     /// gap and the unobserved_* flags: where the estimate leans on the prior rather than
     /// on the data.
     Trust,
+    /// lat_deg, lon_deg of the position (WGS84), on rows whose track is on the satellite
+    /// fixes' tangent plane.
+    Geodetic,
 }
 
 /// The output columns and how each row is written.
@@ -28,15 +33,25 @@ pub(super) struct Writer {
     pub(super) out: CsvOutput,
     pub(super) extra: Vec<Extra>,
     pub(super) true_north: Option<TrueNorth>,
+    /// What was written, for the summary.
+    pub(super) tally: Tally,
+    pub(super) error: Option<CliError>,
+    /// How the numbers are written.
+    pub(super) precision: Precision,
+}
+
+/// What the rows written say, for the summary.
+#[derive(Debug, Clone, Copy, Default)]
+pub(super) struct Tally {
     pub(super) rows: usize,
     /// Rows where a sensor resumed after a gap.
     pub(super) gaps: usize,
     /// Rows at which the fused estimate fell back to plain integration.
     pub(super) fallbacks: usize,
-    pub(super) error: Option<CliError>,
+    /// What the satellite fixes did, and the tangent plane's origin, once there is one.
+    pub(super) gnss: Option<(GnssCounts, (f64, f64))>,
+    /// The last estimate written.
     pub(super) last: Option<NavEstimate>,
-    /// How the numbers are written.
-    pub(super) precision: Precision,
 }
 
 impl Writer {
@@ -52,11 +67,8 @@ impl Writer {
             out: CsvOutput::create(output, &Self::header(extra))?,
             extra: extra.to_vec(),
             true_north,
-            rows: 0,
-            gaps: 0,
-            fallbacks: 0,
+            tally: Tally::default(),
             error: None,
-            last: None,
             precision,
         })
     }
@@ -89,34 +101,53 @@ impl Writer {
                     "unobserved_track_scale",
                     "unobserved_speed_coeff",
                 ],
+                Extra::Geodetic => &["lat_deg", "lon_deg"],
             });
         }
         h
     }
 
-    /// Writes one estimate (nothing after a write has failed: the error is kept for the
-    /// caller).
-    pub(super) fn write(&mut self, e: &NavEstimate, filter: Option<&NavFilter>) {
+    /// Writes one estimate of the fused estimator `fused`, if it is that method's
+    /// (nothing after a write has failed: the error is kept for the caller).
+    pub(super) fn write(&mut self, e: &NavEstimate, fused: Option<&VehicleEstimator>) {
         if self.error.is_some() {
             return;
         }
-        let mut row = self.position_and_heading(e);
+        let origin = fused.and_then(VehicleEstimator::gnss_origin);
+        if let (Some(f), Some(o)) = (fused, origin) {
+            self.tally.gnss = Some((f.gnss_counts(), o));
+        }
+        let declination = fused
+            .and_then(VehicleEstimator::gnss_declination_rad)
+            .filter(|_| e.status.gnss_frame);
+        let mut row = self.position_and_heading(e, declination);
+        let context = Context {
+            filter: fused.map(VehicleEstimator::filter),
+            plane: origin
+                .filter(|_| e.status.gnss_frame)
+                .and_then(|(lat, lon)| LocalTangentPlane::new(lat, lon, 0.0).ok()),
+        };
         for x in &self.extra {
-            extra_cells(*x, e, filter, &mut row);
+            extra_cells(*x, e, &context, &mut row);
         }
         if let Err(err) = self.out.row(&row, self.precision) {
             self.error = Some(err);
         }
-        self.rows += 1;
-        self.gaps += usize::from(e.status.gap);
-        self.fallbacks += usize::from(e.status.fell_back);
-        self.last = Some(*e);
+        let t = &mut self.tally;
+        t.rows += 1;
+        t.gaps += usize::from(e.status.gap);
+        t.fallbacks += usize::from(e.status.fell_back);
+        t.last = Some(*e);
     }
 
-    /// The contract's columns: `t_s,north_m,east_m,heading_deg`.
-    fn position_and_heading(&self, e: &NavEstimate) -> Vec<f64> {
+    /// The contract's columns: `t_s,north_m,east_m,heading_deg`. A row the satellite fixes
+    /// referred to true north (`declination` given) is in their tangent plane already: its
+    /// heading is turned by the declination at the first fix, its track left as it is.
+    fn position_and_heading(&self, e: &NavEstimate, declination: Option<f64>) -> Vec<f64> {
         let (mut n, mut east, mut heading) = (e.north_m, e.east_m, e.heading.rad());
-        if let Some(north) = self.true_north {
+        if let Some(d) = declination {
+            heading += d;
+        } else if let Some(north) = self.true_north {
             // True north: the heading and the whole track turn by the declination.
             heading = north.heading(MagneticHeading::new(heading)).rad();
             (n, east) = north.north_east(n, east);
@@ -129,8 +160,16 @@ impl Writer {
     }
 }
 
+/// What the cells of a row need beside its estimate.
+struct Context<'a> {
+    /// The fused filter's state, for the fused method.
+    filter: Option<&'a NavFilter>,
+    /// The satellite fixes' tangent plane, on rows whose track is on it.
+    plane: Option<LocalTangentPlane>,
+}
+
 /// The cells of one `--extra` group, appended to `row`.
-fn extra_cells(x: Extra, e: &NavEstimate, filter: Option<&NavFilter>, row: &mut Vec<f64>) {
+fn extra_cells(x: Extra, e: &NavEstimate, context: &Context<'_>, row: &mut Vec<f64>) {
     let flags = |b: &[bool]| {
         b.iter()
             .map(|&b| f64::from(u8::from(b)))
@@ -156,7 +195,7 @@ fn extra_cells(x: Extra, e: &NavEstimate, filter: Option<&NavFilter>, row: &mut 
                 s.at_rest,
             ]));
         }
-        Extra::Calibration => match filter {
+        Extra::Calibration => match context.filter {
             Some(f) => {
                 let x = &f.x;
                 use truenorth::fusion::vehicle::nav_filter::*;
@@ -182,6 +221,15 @@ fn extra_cells(x: Extra, e: &NavEstimate, filter: Option<&NavFilter>, row: &mut 
                 u.track_scale,
                 u.speed_coeff,
             ]));
+        }
+        Extra::Geodetic => {
+            let point = context
+                .plane
+                .filter(|_| e.status.position_known)
+                .and_then(|p| p.to_geodetic(e.north_m, e.east_m, 0.0).ok());
+            row.extend(point.map_or([f64::NAN; 2], |g| {
+                [g.lat_rad().to_degrees(), g.lon_rad().to_degrees()]
+            }));
         }
     }
 }

@@ -8,7 +8,7 @@ use std::path::Path;
 use nalgebra::{Vector2, Vector3};
 use truenorth::calib::{MagAccelSample, TurnSample};
 use truenorth::checks::{AccUnit, GyroUnit};
-use truenorth::core::{Axes, ImuSample, Mag2Sample, Mag3Sample, VehicleSample};
+use truenorth::core::{Axes, GnssFix, ImuSample, Mag2Sample, Mag3Sample, VehicleSample};
 
 use super::reader::{RowReader, RowRef};
 use super::samples::SampleKind;
@@ -332,9 +332,8 @@ impl SampleKind for Imu {
     }
 }
 
-/// The optional columns of a drive log (a GNSS fix's `lat_deg,lon_deg` only to say that
-/// they are not used).
-const DRIVE: [&str; 15] = [
+/// The optional columns of a drive log.
+const DRIVE: [&str; 18] = [
     "dist_l_m",
     "dist_r_m",
     "speed_l_mps",
@@ -350,7 +349,21 @@ const DRIVE: [&str; 15] = [
     "mag_y",
     "lat_deg",
     "lon_deg",
+    "gnss_sigma_m",
+    "gnss_speed_mps",
+    "gnss_course_deg",
 ];
+
+/// A satellite fix's columns: latitude and longitude, and what the receiver reports with
+/// them.
+#[derive(Debug, Clone, Copy)]
+struct GnssColumns {
+    lat: usize,
+    lon: usize,
+    sigma: Option<usize>,
+    /// Speed and course over ground, both or neither.
+    velocity: Option<[usize; 2]>,
+}
 
 /// A vehicle's sensors, each on the rows that carry it: the wheels (cumulative distances,
 /// or speeds integrated into them) or the vehicle's one distance or speed, the yaw gyro in
@@ -371,6 +384,8 @@ pub struct Vehicle {
     gyr: Option<usize>,
     /// `mag_x` and `mag_y`, where present.
     mag: [Option<usize>; 2],
+    /// A satellite fix's columns, where present.
+    gnss: Option<GnssColumns>,
 }
 
 impl Vehicle {
@@ -386,7 +401,23 @@ impl Vehicle {
             unused: Vec::new(),
             gyr: None,
             mag: [None; 2],
+            gnss: None,
         }
+    }
+
+    /// Whether the log carries odometry: wheels, or the vehicle's one distance or speed.
+    pub fn has_odometry(&self) -> bool {
+        self.wheels.is_some() || self.distance.is_some()
+    }
+
+    /// Whether the log carries satellite fixes (`lat_deg,lon_deg`).
+    pub fn has_gnss(&self) -> bool {
+        self.gnss.is_some()
+    }
+
+    /// Whether the fixes carry their accuracy (`gnss_sigma_m`).
+    pub fn gnss_sigma_given(&self) -> bool {
+        self.gnss.is_some_and(|g| g.sigma.is_some())
     }
 
     /// Whether the wheel columns are speeds (or the vehicle's one speed).
@@ -415,6 +446,55 @@ impl Vehicle {
             )),
             _ => Ok(()),
         }
+    }
+}
+
+impl Vehicle {
+    /// The satellite fix's columns: latitude and longitude together or neither; speed and
+    /// course over ground together or neither (one without the other is said unused).
+    fn locate_gnss(&mut self, rows: &RowReader) -> CliResult {
+        let ix = |n: &str| rows.index(n);
+        let (lat, lon) = match (ix("lat_deg"), ix("lon_deg")) {
+            (Some(lat), Some(lon)) => (lat, lon),
+            (None, None) => {
+                for name in ["gnss_sigma_m", "gnss_speed_mps", "gnss_course_deg"] {
+                    if ix(name).is_some() {
+                        self.unused
+                            .push((name, "there is no fix (`lat_deg,lon_deg`) to go with it"));
+                    }
+                }
+                return Ok(());
+            }
+            _ => {
+                return Err(CliError::row(
+                    rows.path(),
+                    1,
+                    "has one of lat_deg, lon_deg but not both: a fix needs both (WGS84 degrees), or neither",
+                ));
+            }
+        };
+        let velocity = match (ix("gnss_speed_mps"), ix("gnss_course_deg")) {
+            (Some(s), Some(c)) => Some([s, c]),
+            (Some(_), None) => {
+                self.unused.push((
+                    "gnss_speed_mps",
+                    "a speed over ground is used with its course (`gnss_course_deg`)",
+                ));
+                None
+            }
+            (None, Some(_)) => {
+                self.unused.push(("gnss_course_deg", "a course is used with its speed over ground (`gnss_speed_mps`): below a few m/s it is noise"));
+                None
+            }
+            (None, None) => None,
+        };
+        self.gnss = Some(GnssColumns {
+            lat,
+            lon,
+            sigma: ix("gnss_sigma_m"),
+            velocity,
+        });
+        Ok(())
     }
 }
 
@@ -496,12 +576,7 @@ impl SampleKind for Vehicle {
             Some((c, _)) => self.distance = Some(c),
             None => {}
         }
-        if ix("lat_deg").is_some() || ix("lon_deg").is_some() {
-            self.unused.push((
-                "lat_deg,lon_deg",
-                "the dead reckoning takes no GNSS fixes; compare its track with them instead",
-            ));
-        }
+        self.locate_gnss(rows)?;
         let compass = ix("mag_x").is_some() && ix("mag_y").is_some();
         let speed_and_compass = compass && self.distance.is_some();
         if self.wheels.is_none() && ix("gyr_z").is_none() && !speed_and_compass {
@@ -550,6 +625,20 @@ impl SampleKind for Vehicle {
             && v[y].is_finite()
         {
             sample = sample.with_mag(Vector2::new(v[x], v[y]));
+        }
+        if let Some(g) = self.gnss
+            && v[g.lat].is_finite()
+            && v[g.lon].is_finite()
+        {
+            let mut fix = GnssFix::at(v[g.lat], v[g.lon]);
+            fix.sigma_m = g.sigma.map(|c| v[c]).filter(|s| s.is_finite());
+            if let Some([s, c]) = g.velocity
+                && v[s].is_finite()
+                && v[c].is_finite()
+            {
+                fix = fix.with_velocity(v[s], v[c]);
+            }
+            sample = sample.with_gnss(fix);
         }
         Ok(sample)
     }

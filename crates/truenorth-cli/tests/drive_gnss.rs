@@ -1,0 +1,69 @@
+//! `truenorth drive` with satellite fixes on their own rows (`lat_deg,lon_deg,gnss_sigma_m,
+//! gnss_speed_mps,gnss_course_deg`), on a simulated car whose receiver has a real one's
+//! habits: the track in the tangent plane at the first fix, the heading from true north,
+//! `--extra geodetic` giving each row's latitude and longitude, and the summary saying what
+//! the fixes did.
+
+mod common;
+
+use common::scratch;
+use truenorth::core::angle_diff;
+use truenorth::geomag::Geodetic;
+use truenorth_sim::VehicleKind;
+use truenorth_sim::log_drive::{LogDrive, LogDriveConfig, SensorSet};
+
+#[test]
+fn fixes_put_the_track_on_the_earth_and_the_heading_on_true_north() {
+    let dir = scratch("drive_gnss", "car");
+    let d = LogDrive::new(
+        LogDriveConfig::new(1, VehicleKind::RearWheelCar, SensorSet::WHEELS_GYRO).with_gnss(),
+    )
+    .unwrap();
+    let input = dir.join("drive.csv");
+    std::fs::write(&input, d.to_csv()).unwrap();
+    let track_m = d.vehicle.wheels.track_m();
+    let vehicle = common::rear_vehicle(&dir, track_m);
+    let out = dir.join("out.csv");
+    let o = common::succeeded(common::drive(
+        &vehicle,
+        &input,
+        &out,
+        &["--extra", "status", "--extra", "geodetic"],
+    ));
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        stderr.contains("heading true north, from the satellite fixes"),
+        "{stderr}"
+    );
+    assert!(
+        stderr.contains("satellite fixes: ") && stderr.contains("(the first fix)"),
+        "{stderr}"
+    );
+    assert!(!stderr.contains("no north"), "{stderr}");
+    let (header, rows) = common::table(&out, true);
+    assert_eq!(&header[..4], ["t_s", "north_m", "east_m", "heading_deg"]);
+    assert_eq!(&header[header.len() - 2..], ["lat_deg", "lon_deg"]);
+    let plane = d.plane.unwrap();
+    let (mut sq, mut hsq, mut n) = (0.0, 0.0, 0usize);
+    for (row, t) in rows.iter().zip(&d.truth) {
+        let (lat, lon) = (row[row.len() - 2], row[row.len() - 1]);
+        if lat.is_nan() {
+            continue;
+        }
+        let [pn, pe, _] = plane.from_geodetic(&Geodetic::from_degrees(lat, lon, 0.0).unwrap());
+        sq += (pn - t.north_m).powi(2) + (pe - t.east_m).powi(2);
+        hsq += angle_diff(row[3].to_radians(), t.heading_rad).powi(2);
+        n += 1;
+    }
+    let (rms, heading_rms) = ((sq / n as f64).sqrt(), (hsq / n as f64).sqrt().to_degrees());
+    println!("{n} rows on the fixes: position RMS {rms:.2} m, true heading RMS {heading_rms:.2}°");
+    assert!(
+        n > rows.len() / 2,
+        "only {n} of {} rows on the fixes",
+        rows.len()
+    );
+    // The fixes' own error (σ 0.7-3 m, correlated over 20-200 s), the antenna 0.5-2.5 m
+    // off the axle, outages of up to 90 s and canyons: a few metres.
+    assert!(rms < 6.0, "position RMS {rms:.2} m");
+    assert!(heading_rms < 3.0, "heading RMS {heading_rms:.2}°");
+}
