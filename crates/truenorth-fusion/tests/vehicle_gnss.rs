@@ -327,10 +327,10 @@ fn outages_are_bridged_with_an_honest_sigma() {
 /// the baseline's error, and at most one outage ending beyond 3σ.
 ///
 /// Measured (5 outages): 3.18 % of the distance against the baseline's 7.57 % — 2.4×, a miss
-/// of the 3× asked; 4 of 5 within 3σ, the first (at 41 s, 360 m) at 3.6σ: the yaw rate's
-/// scale error (it reads about 8 % low against the course) is not learned from these fixes —
-/// the gains stay within a percent of zero while the bias moves between −0.01 and −0.12°/s —
-/// where on simulated drives the same estimator learns gains of ±5–7 % to within a percent.
+/// of the 3× asked; 4 of 5 within 3σ, the first (at 41 s, 360 m) at 3.6σ. Not explained:
+/// the learned bias moves between −0.01 and −0.12°/s from one outage's start to the next
+/// while the gains stay within a percent of zero (on simulated drives the same estimator
+/// learns gains of ±5–7 % to within a percent, `fixes_hold_the_track`).
 #[test]
 fn a_real_car_bridges_outages_of_its_fixes() {
     use truenorth_core::{GnssFix, NoiseSource, SplitMix64};
