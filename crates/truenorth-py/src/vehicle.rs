@@ -5,21 +5,40 @@ use numpy::PyReadonlyArray1;
 use numpy::PyReadonlyArray2;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use truenorth::core::{HeadingEstimator, NavEstimate, VehicleSample, rad_to_deg, wrap_two_pi};
+use truenorth::core::{
+    GnssFix, HeadingEstimator, NavEstimate, VehicleSample, rad_to_deg, wrap_two_pi,
+};
 use truenorth::fusion::VehicleEstimator as CoreVehicle;
 use truenorth::nalgebra::Vector2;
 
 use crate::convert::{array1, bools, config_from, lib_err, row_err, rows, same_rows, to_py};
 
-/// The row at `t_s` with whichever readings are finite.
-fn vehicle_sample(
-    t_s: f64,
+/// A row's readings, each optional.
+struct Readings {
     wheels: Option<(f64, f64)>,
     gyr_z: Option<f64>,
     mag: Option<(f64, f64)>,
     dist_m: Option<f64>,
-) -> VehicleSample {
+    /// A satellite fix: latitude, longitude (degrees) and its 1σ accuracy (m, NaN when the
+    /// receiver gives none).
+    gnss: Option<(f64, f64, f64)>,
+}
+
+/// The row at `t_s` with whichever readings are finite.
+fn vehicle_sample(t_s: f64, r: Readings) -> VehicleSample {
+    let Readings {
+        wheels,
+        gyr_z,
+        mag,
+        dist_m,
+        gnss,
+    } = r;
     let mut s = VehicleSample::at(t_s);
+    if let Some((lat, lon, sigma)) = gnss.filter(|(lat, lon, _)| !(lat.is_nan() && lon.is_nan())) {
+        let mut fix = GnssFix::at(lat, lon);
+        fix.sigma_m = Some(sigma).filter(|s| !s.is_nan());
+        s = s.with_gnss(fix);
+    }
     if let Some(d) = dist_m.filter(|d| !d.is_nan()) {
         s = s.with_distance(d);
     }
@@ -35,22 +54,29 @@ fn vehicle_sample(
     s
 }
 
-/// The estimate as `(north_m, east_m, heading_deg)` of the drive output: the position NaN
-/// while no wheel has given it, the heading in [0, 360).
-fn contract_row(e: &NavEstimate) -> [f64; 3] {
+/// The estimate of `nav` as `(north_m, east_m, heading_deg)` of the drive output: the
+/// position NaN while no wheel has given it, the heading in [0, 360), from true north on rows
+/// the satellite fixes referred (as `drive` writes them).
+fn contract_row(e: &NavEstimate, nav: &CoreVehicle) -> [f64; 3] {
     let (n, east) = if e.status.position_known {
         (e.north_m, e.east_m)
     } else {
         (f64::NAN, f64::NAN)
     };
-    [n, east, rad_to_deg(wrap_two_pi(e.heading.rad()))]
+    let declination = nav
+        .gnss_declination_rad()
+        .filter(|_| e.status.gnss_frame)
+        .unwrap_or(0.0);
+    [n, east, rad_to_deg(wrap_two_pi(e.heading.rad() + declination))]
 }
 
 /// The fused vehicle estimator: cumulative wheel distances (m) or the vehicle's one
 /// cumulative distance (`dist_m`, a CAN speed integrated: the distance, nothing about
 /// turning), raw yaw rate (rad/s, positive turning right), raw horizontal magnetometer (any
-/// unit), each optional per row;
-/// every sensor calibrated online. `config`: the library's `VehicleConfig` as a dictionary,
+/// unit), satellite fixes (latitude, longitude in degrees and their 1σ in metres), each
+/// optional per row; every sensor calibrated online. With fixes, `north_m`, `east_m` are in
+/// the tangent plane at the first fix and the heading from true north, on the rows they
+/// refer (`gnss_frame`). `config`: the library's `VehicleConfig` as a dictionary,
 /// e.g. `{"wheels": {"rear": {"track_m": 1.6}}}` (missing fields take their defaults).
 #[pyclass(module = "truenorth")]
 pub struct VehicleEstimator {
@@ -67,9 +93,10 @@ impl VehicleEstimator {
         })
     }
 
-    /// Feeds one row; any reading may be `None`. Returns `{"t_s", "north_m", "east_m",
-    /// "heading_deg"}` after it.
-    #[pyo3(signature = (t_s, dist_l_m=None, dist_r_m=None, gyr_z=None, mag=None, dist_m=None))]
+    /// Feeds one row; any reading may be `None` (`gnss`: `(lat_deg, lon_deg, sigma_m)`,
+    /// sigma NaN when the receiver gives none). Returns `{"t_s", "north_m", "east_m",
+    /// "heading_deg", "gnss_frame"}` after it.
+    #[pyo3(signature = (t_s, dist_l_m=None, dist_r_m=None, gyr_z=None, mag=None, dist_m=None, gnss=None))]
     #[allow(clippy::too_many_arguments)]
     fn update<'py>(
         &mut self,
@@ -80,18 +107,26 @@ impl VehicleEstimator {
         gyr_z: Option<f64>,
         mag: Option<(f64, f64)>,
         dist_m: Option<f64>,
+        gnss: Option<(f64, f64, f64)>,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let wheels = dist_l_m.zip(dist_r_m);
+        let readings = Readings {
+            wheels: dist_l_m.zip(dist_r_m),
+            gyr_z,
+            mag,
+            dist_m,
+            gnss,
+        };
         let e = self
             .inner
-            .update(&vehicle_sample(t_s, wheels, gyr_z, mag, dist_m))
+            .update(&vehicle_sample(t_s, readings))
             .map_err(lib_err)?;
-        let [n, east, h] = contract_row(&e);
+        let [n, east, h] = contract_row(&e, &self.inner);
         let d = PyDict::new(py);
         d.set_item("t_s", e.t_s)?;
         d.set_item("north_m", n)?;
         d.set_item("east_m", east)?;
         d.set_item("heading_deg", h)?;
+        d.set_item("gnss_frame", e.status.gnss_frame)?;
         Ok(d)
     }
 
@@ -99,9 +134,12 @@ impl VehicleEstimator {
     /// `dist_l_m`, `dist_r_m` (N, cumulative), `gyr_z` (N, rad/s), `mag` (N×2), `dist_m` (N,
     /// the vehicle's one cumulative distance, where there are no wheels), NaN where a row
     /// has no reading. Returns a dict of arrays: `t_s`, `north_m`, `east_m` (NaN before
-    /// the wheels give a position), `heading_deg` ([0, 360), magnetic north),
-    /// `heading_sigma_deg`, `speed_mps`, `distance_m`, `gap` (bool).
-    #[pyo3(signature = (t_s, dist_l_m=None, dist_r_m=None, gyr_z=None, mag=None, dist_m=None))]
+    /// the wheels give a position), `heading_deg` ([0, 360), magnetic north, or true north
+    /// where `gnss_frame`), `heading_sigma_deg`, `speed_mps`, `distance_m`, `gap` (bool),
+    /// `gnss_frame` (bool: the row is on the fixes' tangent plane and true north). `gnss`:
+    /// N×3, latitude, longitude (degrees) and 1σ (m, NaN if not given), NaN where a row has
+    /// no fix.
+    #[pyo3(signature = (t_s, dist_l_m=None, dist_r_m=None, gyr_z=None, mag=None, dist_m=None, gnss=None))]
     #[allow(clippy::too_many_arguments)]
     fn update_array<'py>(
         &mut self,
@@ -112,6 +150,7 @@ impl VehicleEstimator {
         gyr_z: Option<PyReadonlyArray1<'py, f64>>,
         mag: Option<PyReadonlyArray2<'py, f64>>,
         dist_m: Option<PyReadonlyArray1<'py, f64>>,
+        gnss: Option<PyReadonlyArray2<'py, f64>>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let t = t_s.as_array();
         let n = t.len();
@@ -140,10 +179,19 @@ impl VehicleEstimator {
             }
             None => None,
         };
+        let fixes = match &gnss {
+            Some(f) => {
+                let f = rows(f, "gnss", &[3])?;
+                same_rows("gnss", f.nrows(), n)?;
+                Some(f)
+            }
+            None => None,
+        };
         let inner = &mut self.inner;
         let out = py.detach(|| {
             let mut out: [Vec<f64>; 6] = std::array::from_fn(|_| Vec::with_capacity(n));
             let mut gap = Vec::with_capacity(n);
+            let mut frame = Vec::with_capacity(n);
             for k in 0..n {
                 let wheels = match (&l, &r) {
                     (Some(l), Some(r)) => Some((l[k], r[k])),
@@ -151,13 +199,16 @@ impl VehicleEstimator {
                 };
                 let s = vehicle_sample(
                     t[k],
-                    wheels,
-                    g.as_ref().map(|g| g[k]),
-                    m.as_ref().map(|m| (m[(k, 0)], m[(k, 1)])),
-                    single.as_ref().map(|d| d[k]),
+                    Readings {
+                        wheels,
+                        gyr_z: g.as_ref().map(|g| g[k]),
+                        mag: m.as_ref().map(|m| (m[(k, 0)], m[(k, 1)])),
+                        dist_m: single.as_ref().map(|d| d[k]),
+                        gnss: fixes.as_ref().map(|f| (f[(k, 0)], f[(k, 1)], f[(k, 2)])),
+                    },
                 );
                 let e = inner.update(&s).map_err(|e| (k, e))?;
-                let [north, east, h] = contract_row(&e);
+                let [north, east, h] = contract_row(&e, inner);
                 for (v, x) in out.iter_mut().zip([
                     north,
                     east,
@@ -169,10 +220,11 @@ impl VehicleEstimator {
                     v.push(x);
                 }
                 gap.push(e.status.gap);
+                frame.push(e.status.gnss_frame);
             }
-            Ok::<_, (usize, truenorth::Error)>((out, gap))
+            Ok::<_, (usize, truenorth::Error)>((out, gap, frame))
         });
-        let (out, gap) = out.map_err(|(k, e)| row_err(k, e))?;
+        let (out, gap, frame) = out.map_err(|(k, e)| row_err(k, e))?;
         let d = PyDict::new(py);
         d.set_item("t_s", array1(py, t.to_vec()))?;
         let names = [
@@ -187,6 +239,7 @@ impl VehicleEstimator {
             d.set_item(name, array1(py, v))?;
         }
         d.set_item("gap", bools(py, gap))?;
+        d.set_item("gnss_frame", bools(py, frame))?;
         Ok(d)
     }
 

@@ -206,3 +206,28 @@ def test_check_imu_names_the_unit_and_the_axes_that_read_the_data_right():
     assert found[0]["kind"] == "axes" and found[0]["fix"] == {"gyro_axes": "x=y,y=x,z=z"}
     with pytest.raises(tn.TruenorthError, match="gyro_unit"):
         tn.check_imu(t, gyr, acc, gyro_unit="rpm")
+
+
+def test_vehicle_estimator_takes_satellite_fixes():
+    # Due east at 10 m/s for 60 s from Berlin, fixes once a second with their course: the
+    # track goes onto the tangent plane at the first fix and the heading onto true north.
+    n = 601
+    t = np.arange(n) * 0.1
+    dist = t * 10.0
+    lat0, lon0 = 52.5, 13.4
+    metres_per_deg_lon = 111_320.0 * math.cos(math.radians(lat0))
+    fixes = np.full((n, 3), np.nan)
+    for k in range(0, n, 10):
+        fixes[k] = (lat0, lon0 + dist[k] / metres_per_deg_lon, 2.0)
+    v = tn.VehicleEstimator({"wheels": {"rear": {"track_m": 1.6}}})
+    r = v.update_array(t, gyr_z=np.zeros(n), dist_m=dist, gnss=fixes)
+    assert r["gnss_frame"][-1]
+    assert r["east_m"][-1] == pytest.approx(600.0, abs=5.0)
+    assert abs(r["north_m"][-1]) < 5.0
+    assert r["heading_deg"][-1] == pytest.approx(90.0, abs=2.0)
+    one = tn.VehicleEstimator({"wheels": {"rear": {"track_m": 1.6}}})
+    for k in range(n):
+        fix = None if np.isnan(fixes[k, 0]) else tuple(fixes[k])
+        last = one.update(t[k], gyr_z=0.0, dist_m=dist[k], gnss=fix)
+    assert last["gnss_frame"]
+    assert last["east_m"] == r["east_m"][-1]

@@ -171,6 +171,7 @@ class VehicleRow(TypedDict):
     north_m: float
     east_m: float
     heading_deg: float
+    gnss_frame: bool
 
 class VehicleArrays(TypedDict):
     t_s: FloatArray
@@ -181,9 +182,11 @@ class VehicleArrays(TypedDict):
     speed_mps: FloatArray
     distance_m: FloatArray
     gap: BoolArray
+    gnss_frame: BoolArray
 
 class VehicleEstimator:
-    """The fused vehicle estimator (wheels or one vehicle distance, yaw gyro, compass)."""
+    """The fused vehicle estimator (wheels or one vehicle distance, yaw gyro, compass,
+    satellite fixes)."""
     def __init__(self, config: Optional[dict[str, Any]] = None) -> None: ...
     def update(
         self,
@@ -193,6 +196,7 @@ class VehicleEstimator:
         gyr_z: Optional[float] = None,
         mag: Optional[tuple[float, float]] = None,
         dist_m: Optional[float] = None,
+        gnss: Optional[tuple[float, float, float]] = None,
     ) -> VehicleRow: ...
     def update_array(
         self,
@@ -202,6 +206,7 @@ class VehicleEstimator:
         gyr_z: Optional[FloatArray] = None,
         mag: Optional[FloatArray] = None,
         dist_m: Optional[FloatArray] = None,
+        gnss: Optional[FloatArray] = None,
     ) -> VehicleArrays: ...
     def calibration(self) -> dict[str, Any]: ...
     def reset(self) -> None: ...
