@@ -67,7 +67,11 @@ fn contract_row(e: &NavEstimate, nav: &CoreVehicle) -> [f64; 3] {
         .gnss_declination_rad()
         .filter(|_| e.status.gnss_frame)
         .unwrap_or(0.0);
-    [n, east, rad_to_deg(wrap_two_pi(e.heading.rad() + declination))]
+    [
+        n,
+        east,
+        rad_to_deg(wrap_two_pi(e.heading.rad() + declination)),
+    ]
 }
 
 /// The fused vehicle estimator: cumulative wheel distances (m) or the vehicle's one
