@@ -5,6 +5,8 @@
 // Each test binary uses its own subset of these helpers.
 #![allow(dead_code)]
 
+pub mod tables;
+
 use std::io::Write as _;
 use std::ops::Deref;
 use std::path::{Path, PathBuf};
