@@ -420,3 +420,124 @@ fn a_real_car_bridges_outages_of_its_fixes() {
     let beyond = all.len() - (within * all.len() as f64).round() as usize;
     assert!(beyond <= 1, "{beyond} outages end beyond 3σ");
 }
+
+/// How long the fixes take to teach each learned state, and which fixes they reject, on
+/// simulated drives with a multipath-heavy city (canyons half the time, 6–12 jumps of
+/// 20–60 m a minute in them). A state counts as learned from the time it comes within 2σ of
+/// its final value and stays there; states the motion never separates (still `unobserved`
+/// at the end) are left out. Printed per state: the median and largest time over the drives;
+/// the fixes rejected by what they went through (of every row with a fix: a fix within a
+/// second of the last one used is not judged). Held: multipath fixes rejected more than three
+/// times as often as open-sky ones.
+///
+/// Measured (4 drives): the gyro bias learned after 153 s at the median and 327 s at most —
+/// the largest misses the 3 minutes asked; the right and left gains after 137 s and 13 s
+/// (median); the wheels' states within 2σ of their final values from the start (their priors
+/// are as narrow as what these drives teach). Multipath fixes 83 % rejected, open-sky 2.6 %,
+/// in a canyon without a jump 6.0 %.
+#[test]
+fn what_the_fixes_teach_and_what_they_reject() {
+    use truenorth_fusion::vehicle::nav_filter::{
+        BIAS, GAIN_NEG, GAIN_POS, SPEED_COEFF, TRACK_SCALE, WHEEL_DIFF,
+    };
+    use truenorth_sim::log_drive::{Canyons, Episodes, Span};
+    let states = [
+        (BIAS, "gyro bias"),
+        (GAIN_POS, "gyro gain right"),
+        (GAIN_NEG, "gyro gain left"),
+        (WHEEL_DIFF, "wheel scale difference"),
+        (TRACK_SCALE, "effective track"),
+        (SPEED_COEFF, "speed coefficient"),
+    ];
+    let mut times: Vec<Vec<f64>> = vec![Vec::new(); states.len()];
+    let mut by_condition: std::collections::BTreeMap<String, (usize, usize)> = Default::default();
+    for seed in 0..4 {
+        let mut c = LogDriveConfig::new(seed, VehicleKind::RearWheelCar, SensorSet::WHEELS_GYRO)
+            .with_gnss();
+        if let Some(g) = c.gnss.as_mut() {
+            g.canyons = Some(Canyons {
+                episodes: Episodes {
+                    first_after_s: 30.0,
+                    mean_gap_s: 60.0,
+                    duration_s: Span::new(60.0, 120.0),
+                },
+                sigma_factor: Span::new(2.0, 4.0),
+                jumps_per_min: Span::new(6.0, 12.0),
+                jump_m: Span::new(20.0, 60.0),
+                jump_s: Span::new(1.0, 8.0),
+            });
+        }
+        let d = LogDrive::new(c).unwrap();
+        let mut nav = VehicleEstimator::new(config(&d)).unwrap();
+        let mut track: Vec<(f64, [f64; 6], [f64; 6])> = Vec::new();
+        for (k, s) in d.vehicle_samples().iter().enumerate() {
+            let before = nav.gnss_counts();
+            nav.update(s).unwrap();
+            let after = nav.gnss_counts();
+            if let Some(truth) = d.measured[k].gnss {
+                let e = by_condition
+                    .entry(format!("{:?}", truth.condition))
+                    .or_default();
+                e.0 += 1;
+                e.1 += usize::from(after.rejected > before.rejected);
+            }
+            let f = nav.filter();
+            track.push((
+                s.t_s,
+                states.map(|(i, _)| f.x[i]),
+                states.map(|(i, _)| f.sigma(i)),
+            ));
+        }
+        let u = nav.estimate().status.unobserved;
+        let open = [
+            u.gyro_bias,
+            u.gyro_gain_right,
+            u.gyro_gain_left,
+            u.wheel_diff,
+            u.track_scale,
+            u.speed_coeff,
+        ];
+        let (_, last, _) = *track.last().unwrap();
+        let t0 = track[0].0;
+        for (j, times) in times.iter_mut().enumerate() {
+            if open[j] {
+                continue;
+            }
+            let learned_at = track
+                .iter()
+                .rev()
+                .take_while(|(_, x, s)| (x[j] - last[j]).abs() <= 2.0 * s[j])
+                .last()
+                .map_or(f64::INFINITY, |(t, _, _)| t - t0);
+            times.push(learned_at);
+        }
+    }
+    for ((_, name), t) in states.iter().zip(&mut times) {
+        t.sort_by(f64::total_cmp);
+        if t.is_empty() {
+            println!("{name:24}: never separated by these drives");
+            continue;
+        }
+        println!(
+            "{name:24}: learned after {:6.1} s (median of {}), {:6.1} s at most",
+            t[t.len() / 2],
+            t.len(),
+            t[t.len() - 1]
+        );
+    }
+    for (condition, (n, rejected)) in &by_condition {
+        println!(
+            "fixes {condition:10}: {n:6}, rejected {rejected:5} ({:.1} %)",
+            100.0 * *rejected as f64 / (*n).max(1) as f64
+        );
+    }
+    let share = |c: &str| {
+        by_condition
+            .get(c)
+            .map_or(0.0, |(n, r)| *r as f64 / (*n).max(1) as f64)
+    };
+    assert!(
+        share("Multipath") > 3.0 * share("Open"),
+        "multipath fixes are rejected no more than open-sky ones"
+    );
+}
