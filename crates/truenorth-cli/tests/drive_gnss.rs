@@ -67,3 +67,34 @@ fn fixes_put_the_track_on_the_earth_and_the_heading_on_true_north() {
     assert!(rms < 6.0, "position RMS {rms:.2} m");
     assert!(heading_rms < 3.0, "heading RMS {heading_rms:.2}°");
 }
+
+/// The antenna's place in VEHICLE.json (`gnss_lever_arm_m`, forward and right of the axle's
+/// centre) is read, and one no vehicle has is refused with the key.
+#[test]
+fn the_antenna_s_lever_arm_is_read_and_checked() {
+    let dir = scratch("drive_gnss", "lever");
+    let d = LogDrive::new(
+        LogDriveConfig::new(2, VehicleKind::RearWheelCar, SensorSet::SPEED_YAW).with_gnss(),
+    )
+    .unwrap();
+    let input = dir.join("drive.csv");
+    std::fs::write(&input, d.to_csv()).unwrap();
+    let [forward, right] = d.gnss.as_ref().unwrap().lever_arm_m;
+    let vehicle = |name: &str, lever: [f64; 2]| {
+        let path = dir.join(name);
+        let json = format!(
+            r#"{{"track_m": {}, "odometer_wheels": "rear", "gnss_lever_arm_m": [{}, {}]}}"#,
+            d.vehicle.wheels.track_m(),
+            lever[0],
+            lever[1]
+        );
+        std::fs::write(&path, json).unwrap();
+        path
+    };
+    let out = dir.join("out.csv");
+    let o = common::drive(&vehicle("ok.json", [forward, right]), &input, &out, &[]);
+    common::succeeded(o);
+    let o = common::drive(&vehicle("far.json", [120.0, 0.0]), &input, &out, &[]);
+    let (ok, stderr) = common::outcome(&o);
+    assert!(!ok && stderr.contains("gnss_lever_arm_m"), "{stderr}");
+}

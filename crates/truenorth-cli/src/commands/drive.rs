@@ -38,7 +38,8 @@ is learned); wheelbase_m rear axle to front kingpins, m; pitman_ratio P = 2p/T_F
 offset p over half the front track; front wheels only). Optional: \"wheel_resolution_m\"
 (distance per odometer pulse, default 0.02 with distance columns on a car and 0.003 with
 speed columns, a CAN bus's 0.01 km/h over one second; 0.001 on a robot),
-\"compass_systematic_deg\" (the compass's systematic heading error, default 3: a level
+\"gnss_lever_arm_m\" ([forward, right] of the GNSS antenna from the axle's centre, m;
+default [0, 0]), \"compass_systematic_deg\" (the compass's systematic heading error, default 3: a level
 two-axis compass on roads whose grade and camber tilt it; about 0.3 for a tilt-compensated
 compass or level ground) and \"version\": 1.
 Unknown keys are refused (naming the closest known one), and so are values no vehicle has.
@@ -276,6 +277,9 @@ fn build_method(
     };
     if let Some(s) = vehicle.compass_systematic_deg {
         config.compass.systematic_deg = s;
+    }
+    if let Some(l) = vehicle.gnss_lever_arm_m {
+        config.gnss.lever_arm_m = l;
     }
     // The declination that relates the compass to the fixes' true north comes from
     // WMM2025, which holds from 2025.0 to 2030.0; a date outside is taken at its nearest

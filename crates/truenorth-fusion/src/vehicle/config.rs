@@ -331,6 +331,11 @@ pub struct GnssConfig {
     pub latency_s: f64,
     /// The spread of [`GnssConfig::latency_s`], s.
     pub latency_sigma_s: f64,
+    /// Where the antenna is from the point the track follows (the rear-axle centre, or a
+    /// robot's centre between its sides), m forward and to the right ([0, 0]): a roof
+    /// antenna a metre or two ahead of a car's rear axle is that far off the track, in a
+    /// direction that turns with the heading.
+    pub lever_arm_m: [f64; 2],
     /// The date the drive was made, decimal year (2026.0), for the declination at the
     /// first fix (WMM2025, valid 2025.0–2030.0) that relates the compass's magnetic north to
     /// the fixes' true north.
@@ -348,6 +353,7 @@ impl Default for GnssConfig {
             speed_sigma_mps: 0.3,
             latency_s: 0.25,
             latency_sigma_s: 0.15,
+            lever_arm_m: [0.0; 2],
             decimal_year: 2026.0,
         }
     }
@@ -378,6 +384,9 @@ impl Validate for GnssConfig {
         check_range("gnss speed_sigma_mps", self.speed_sigma_mps, 1e-3, 10.0)?;
         check_range("gnss latency_s", self.latency_s, 0.0, 10.0)?;
         check_range("gnss latency_sigma_s", self.latency_sigma_s, 0.0, 10.0)?;
+        for l in self.lever_arm_m {
+            check_range("gnss lever_arm_m (forward, right)", l, -50.0, 50.0)?;
+        }
         check_range(
             "gnss decimal_year (WMM2025 holds 2025.0-2030.0)",
             self.decimal_year,

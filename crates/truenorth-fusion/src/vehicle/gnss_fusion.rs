@@ -184,16 +184,29 @@ impl VehicleEstimator {
         Some(plane)
     }
 
-    /// The dead-reckoned position at `t_s`: the track's last point carried on (or back)
-    /// along the heading at the speed the wheels last showed.
+    /// The antenna's dead-reckoned position at `t_s`: the track's last point carried on
+    /// (or back) along the heading at the speed the wheels last showed, plus the lever arm
+    /// turned with the heading.
     fn position_at(&self, t_s: f64) -> (f64, f64) {
         let ahead_s = self.wheels.last_s().map_or(0.0, |t0| {
             (t_s - t0).clamp(-self.config.max_gap_s, self.config.max_gap_s)
         });
-        let travel = self.est.speed_mps * ahead_s;
+        let [forward, right] = self.config.gnss.lever_arm_m;
+        let travel = self.est.speed_mps * ahead_s + forward;
         let (s, c) = self.heading_at(t_s).sin_cos();
         let x = &self.filter.x;
-        (x[NORTH] + travel * c, x[EAST] + travel * s)
+        (
+            x[NORTH] + travel * c - right * s,
+            x[EAST] + travel * s + right * c,
+        )
+    }
+
+    /// How the antenna's position moves with the heading, m/rad north and east: the lever
+    /// arm turning.
+    fn lever_arm_turn(&self, t_s: f64) -> (f64, f64) {
+        let [forward, right] = self.config.gnss.lever_arm_m;
+        let (s, c) = self.heading_at(t_s).sin_cos();
+        (-forward * s - right * c, forward * c - right * s)
     }
 
     /// The fix at (`north`, `east`) of accuracy `sigma` against the dead-reckoned position:
@@ -222,9 +235,12 @@ impl VehicleEstimator {
         }
         // One fix of the few independent ones within the error's correlation time.
         let widened = var * (self.config.gnss.error_correlation_s / FIX_INTERVAL_S).max(1.0);
-        self.filter.update(&[(NORTH, 1.0)], nu_n, widened);
+        let (dn, de) = self.lever_arm_turn(t_s);
+        self.filter
+            .update(&[(NORTH, 1.0), (PSI, dn)], nu_n, widened);
         let (_, pe) = self.position_at(t_s);
-        self.filter.update(&[(EAST, 1.0)], east - pe, widened);
+        self.filter
+            .update(&[(EAST, 1.0), (PSI, de)], east - pe, widened);
         // The fixes' error changes slowly: a position learned from them is no better than
         // one fix, however many were averaged within its correlation time.
         for i in [NORTH, EAST] {
@@ -382,5 +398,50 @@ impl VehicleEstimator {
         f.reset_state(NORTH, sigma);
         f.reset_state(EAST, sigma);
         self.tracking.gnss.rejected_since_s = None;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::vehicle::VehicleConfig;
+    use truenorth_core::{HeadingEstimator, VehicleSample};
+
+    /// Due east at 10 m/s for 60 s with an exact fix of the antenna, 2 m ahead of the axle,
+    /// each second (with its course): where the axle ends, m off, for a configured lever arm.
+    fn end_error(lever_arm_m: [f64; 2]) -> f64 {
+        let plane = LocalTangentPlane::new(52.5, 13.4, 0.0).unwrap();
+        let mut config = VehicleConfig::default();
+        config.gnss.lever_arm_m = lever_arm_m;
+        config.gnss.latency_s = 0.0;
+        let mut nav = VehicleEstimator::new(config).unwrap();
+        let mut last = None;
+        for k in 0..=600 {
+            let t = 0.1 * f64::from(k);
+            let mut s = VehicleSample::at(t).with_distance(10.0 * t).with_gyro(0.0);
+            if k % 10 == 0 {
+                let g = plane.to_geodetic(0.0, 10.0 * t + 2.0, 0.0).unwrap();
+                let fix = GnssFix::at(g.lat_rad().to_degrees(), g.lon_rad().to_degrees())
+                    .with_sigma(0.5)
+                    .with_velocity(10.0, 90.0);
+                s = s.with_gnss(fix);
+            }
+            last = Some(nav.update(&s).unwrap());
+        }
+        let e = last.unwrap();
+        assert!(e.status.gnss_frame);
+        let (lat, lon) = nav.gnss_origin().unwrap();
+        let ours = LocalTangentPlane::new(lat, lon, 0.0).unwrap();
+        let g = ours.to_geodetic(e.north_m, e.east_m, 0.0).unwrap();
+        let [n, east, _] = plane.from_geodetic(&g);
+        n.hypot(east - 600.0)
+    }
+
+    #[test]
+    fn the_lever_arm_puts_the_track_on_the_axle() {
+        let known = end_error([2.0, 0.0]);
+        let unknown = end_error([0.0, 0.0]);
+        assert!(known < 0.3, "{known:.2} m with the lever arm");
+        assert!((unknown - 2.0).abs() < 0.3, "{unknown:.2} m without it");
     }
 }

@@ -21,6 +21,8 @@ const TRACK_RANGE_M: (f64, f64) = (0.05, 10.0);
 const WHEELBASE_RANGE_M: (f64, f64) = (0.1, 20.0);
 /// The distance per odometer pulse, m: up to one revolution of a large wheel.
 const RESOLUTION_RANGE_M: (f64, f64) = (1e-6, 5.0);
+/// How far a GNSS antenna can be from the axle's centre, m, along either axis.
+const LEVER_ARM_RANGE_M: (f64, f64) = (-50.0, 50.0);
 /// The compass's systematic heading error, degrees: the estimator's own range.
 const SYSTEMATIC_RANGE_DEG: (f64, f64) = (1e-3, 45.0);
 
@@ -45,6 +47,9 @@ pub struct VehicleFile {
     /// 3°, is a level two-axis compass on roads that tilt it by their grade and camber; a
     /// tilt-compensated compass, or one on level ground, leaves about 0.3°).
     pub compass_systematic_deg: Option<f64>,
+    /// Where the GNSS antenna is from the axle's centre, m forward and to the right
+    /// (optional; [0, 0]).
+    pub gnss_lever_arm_m: Option<[f64; 2]>,
 }
 
 impl VehicleFile {
@@ -92,6 +97,9 @@ impl VehicleFile {
         }
         if let Some(r) = self.wheel_resolution_m {
             within("wheel_resolution_m", r, RESOLUTION_RANGE_M, " m")?;
+        }
+        for l in self.gnss_lever_arm_m.into_iter().flatten() {
+            within("gnss_lever_arm_m", l, LEVER_ARM_RANGE_M, " m")?;
         }
         if let Some(s) = self.compass_systematic_deg
             && !(s.is_finite() && (SYSTEMATIC_RANGE_DEG.0..=SYSTEMATIC_RANGE_DEG.1).contains(&s))
