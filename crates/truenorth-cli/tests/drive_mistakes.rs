@@ -1,4 +1,4 @@
-//! Nine mistakes a user makes writing a drive log or its vehicle file, each named by
+//! Eleven mistakes a user makes writing a drive log or its vehicle file, each named by
 //! `truenorth drive` for what it is, with the file, the row where the evidence is and the fix.
 
 mod common;
@@ -16,6 +16,15 @@ struct Spoil {
     wheels: [f64; 2],
     swap: bool,
     speeds: bool,
+    /// The compass's y axis negated, or its two axes swapped.
+    mag: Option<Mirror>,
+}
+
+/// How a compass is mirrored.
+#[derive(Clone, Copy)]
+enum Mirror {
+    NegatedY,
+    Swapped,
 }
 
 fn honest() -> Spoil {
@@ -62,14 +71,19 @@ fn write(drive: &SimulatedDrive, path: &Path, spoil: Spoil) {
             lr.swap(0, 1);
         }
         let g = x.gyr_z_rps.unwrap() * spoil.gyro;
+        let (mx, my) = match spoil.mag {
+            None => (m.x, m.y),
+            Some(Mirror::NegatedY) => (m.x, -m.y),
+            Some(Mirror::Swapped) => (m.y, m.x),
+        };
         writeln!(
             s,
             "{},{},{},{g},{},{}",
             x.t_s,
             lr[0] * spoil.wheels[0],
             lr[1] * spoil.wheels[1],
-            m.x,
-            m.y
+            mx,
+            my
         )
         .unwrap();
     }
@@ -179,6 +193,28 @@ fn each_mistake_is_named_for_what_it_is() {
                 "dist_r_m has its sign flipped",
                 "--column dist_r_m=-dist_r_m",
             ],
+        ),
+        (
+            "compass_y_negated",
+            Spoil {
+                mag: Some(Mirror::NegatedY),
+                ..honest()
+            },
+            1.55,
+            &[
+                "row ",
+                "the compass turns against gyr_z and the wheels",
+                "--column mag_y=-mag_y",
+            ],
+        ),
+        (
+            "compass_axes_swapped",
+            Spoil {
+                mag: Some(Mirror::Swapped),
+                ..honest()
+            },
+            1.55,
+            &["row ", "mirrored", "mag_x=mag_y,mag_y=mag_x"],
         ),
         (
             "track_of_15_m",

@@ -1,7 +1,8 @@
 //! What a drive log's own data say about how it was written, before the estimator is
 //! trusted with it: a wheel whose distance runs backwards while the car moves forwards (a
 //! column negated), wheels and gyro turning opposite ways (the gyro negated, or the left
-//! and right wheels swapped: the compass's turns tell which), and the size of the wheels'
+//! and right wheels swapped: the compass's turns tell which), a compass that turns against
+//! both (mirrored: an axis negated or the two swapped), and the size of the wheels'
 //! turns against the gyro's (a unit off by 57, 3.6 or 1000, or a wrong track). Each
 //! finding names the file, the row where the evidence became clear and the fix; it runs
 //! on every row, so that it is ready when the estimator fails and can speak in its place.
@@ -135,6 +136,24 @@ impl CompassTurns {
         })
     }
 
+    /// The compass's correlation with the gyro's turns when it turns against the gyro and
+    /// against the wheels too (or there are none): a mirrored compass — one axis negated,
+    /// or the two swapped — since a level compass's heading turns with the vehicle.
+    fn mirrored(&self) -> Option<f64> {
+        if self.windows < MIN_COMPASS_WINDOWS {
+            return None;
+        }
+        let [cg, cw, cc, gg, ww, _] = self.sums;
+        let with_gyro = cg / (cc * gg).sqrt();
+        let with_wheels = if ww > 0.0 {
+            cw / (cc * ww).sqrt()
+        } else {
+            -1.0
+        };
+        (with_gyro < -MIN_COMPASS_CORRELATION && with_wheels < -MIN_COMPASS_CORRELATION)
+            .then_some(with_gyro)
+    }
+
     /// Whether the compass turns with the gyro (`Some(true)`) or with the wheels
     /// (`Some(false)`), when it clearly does one and not the other.
     fn sides_with_gyro(&self) -> Option<bool> {
@@ -233,6 +252,21 @@ impl Diagnosis {
                     );
                 }
             }
+        }
+        if !opposite && let Some(r) = self.compass.mirrored() {
+            findings.push(Refusal {
+                kind: FindingKind::Axes,
+                message: format!(
+                    "the compass turns against gyr_z{} over {} turning seconds (correlation {r:.2}): a level compass turns with the vehicle, so it is mirrored — one axis negated or the two swapped: pass --column {} if mag_y is negated, {} if mag_x is, or {},{} if they are swapped (each turns it the right way; they differ by a constant offset only the mounting can tell)",
+                    if self.compass.sums[4] > 0.0 { " and the wheels" } else { "" },
+                    self.compass.windows,
+                    context.column_fix("mag_y", "mag_y", true),
+                    context.column_fix("mag_x", "mag_x", true),
+                    context.column_fix("mag_x", "mag_y", false),
+                    context.column_fix("mag_y", "mag_x", false),
+                ),
+                row: self.compass.judged_at_row,
+            });
         }
         let wheels = format!("{left}, {right}");
         let vehicle = context.vehicle.display().to_string();
