@@ -47,6 +47,17 @@ impl CompassCalibration {
         }
     }
 
+    /// The magnitude of the raw reading `mag` corrected by the calibration (a two-axis
+    /// calibration reads x and y only): near the calibration's field, whatever the
+    /// heading, when the calibration describes the sensor.
+    pub fn corrected_magnitude(&self, mag: &Vector3<f64>) -> f64 {
+        match self {
+            Self::TwoD(c) => c.correct(&Vector2::new(mag.x, mag.y)).norm(),
+            Self::ThreeD(c) => c.correct(mag).norm(),
+            Self::Joint(c) => c.field_body(mag).norm(),
+        }
+    }
+
     /// The magnetic heading of the raw reading `mag` (input unit; a two-axis calibration
     /// reads x and y only), and the tilt when a three-axis calibration is given `acc`
     /// (specific force, any unit; the joint calibration corrects and aligns it first):

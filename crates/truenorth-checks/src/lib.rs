@@ -34,6 +34,7 @@
 //! ```
 
 pub mod axes;
+pub mod calibration_fit;
 pub mod compass;
 pub mod field_unit;
 pub mod finding;

@@ -3,6 +3,8 @@
 
 use std::path::PathBuf;
 
+use clap::ValueEnum as _;
+use truenorth::checks::calibration_fit::FieldFit;
 use truenorth::core::{Tilt, rad_to_deg};
 use truenorth::{CompassCalibration, TrueNorth};
 
@@ -13,6 +15,7 @@ use crate::io::{
     CalibrationFile, CliError, CliResult, CsvOutput, Input, InputOptions, OutputOptions, Precision,
     check_distinct,
 };
+use crate::registry::CalibrationMethod;
 
 /// The long help of the command (after the options).
 const AFTER_HELP: &str =
@@ -60,6 +63,10 @@ pub struct Args {
     /// How to write the numbers.
     #[command(flatten)]
     pub output_options: OutputOptions,
+    /// Go on (with a warning on stderr, repeated in the summary) when the calibration does
+    /// not fit the readings, or was edited, instead of refusing.
+    #[arg(long)]
+    pub accept_calibration: bool,
 }
 
 /// True north, if a place was given.
@@ -78,7 +85,19 @@ fn true_north(args: &Args) -> CliResult<Option<TrueNorth>> {
 /// Runs the subcommand.
 pub fn run(args: &Args) -> CliResult {
     check_inputs(args)?;
-    let (_, cal) = CalibrationFile::read(&args.calibration)?;
+    let (file, cal) = CalibrationFile::read(&args.calibration)?;
+    let mut doubts = Vec::new();
+    for (refuse, doubt) in calibration_doubts(&file) {
+        if refuse && !args.accept_calibration {
+            return Err(CliError::file(
+                &args.calibration,
+                format!("{doubt} (or --accept-calibration to go on)"),
+            ));
+        }
+        errln!("truenorth: heading: warning: {doubt}");
+        doubts.push(doubt);
+    }
+    let mut fit = FieldFit::default();
     let true_north = true_north(args)?;
     let mut samples =
         Input::new(&args.input, &args.input_options).samples(Compass::new(cal.dimensions()))?;
@@ -90,6 +109,7 @@ pub fn run(args: &Args) -> CliResult {
     let mut out = CsvOutput::create(&args.output, &header)?;
     let path = samples.path().to_path_buf();
     let count = samples.for_each(|row, reading| {
+        fit.push(cal.corrected_magnitude(&reading.mag), file.field, row);
         let (magnetic, tilt) = cal
             .heading(&reading.mag, reading.acc.as_ref())
             .map_err(|e| CliError::row(&path, row, e.to_string()).kind_of(&e))?;
@@ -105,6 +125,17 @@ pub fn run(args: &Args) -> CliResult {
             tilt,
         )
     })?;
+    if let Some((why, row)) = fit.misfit(cal.dimensions()) {
+        if !args.accept_calibration {
+            let why = format!("{why} (or --accept-calibration to go on)");
+            return Err(match row {
+                Some(r) => CliError::row(&path, r, why),
+                None => CliError::file(&path, why),
+            });
+        }
+        errln!("truenorth: heading: warning: {why}");
+        doubts.push(why);
+    }
     out.commit()?;
     let north = if true_north.is_some() {
         "true"
@@ -112,8 +143,50 @@ pub fn run(args: &Args) -> CliResult {
         "magnetic"
     };
     let how = tilt_summary(&cal, acc);
-    errln!("truenorth: heading: {count} rows, {north} north, {how}");
+    let accepted = if doubts.is_empty() {
+        String::new()
+    } else {
+        format!(
+            "; accepted with --accept-calibration: {}",
+            doubts.join("; ")
+        )
+    };
+    errln!("truenorth: heading: {count} rows, {north} north, {how}{accepted}");
     Ok(())
+}
+
+/// What in a calibration file says it should not be trusted as it is, each with whether it
+/// refuses (unless accepted): a soft iron that is not symmetric (every fit writes a
+/// symmetric one: an edited file) refuses; a method no build of `calibrate` writes (a
+/// hand-written file) and a `poor` verdict (the calibration's own bound judged it) are said.
+fn calibration_doubts(file: &CalibrationFile) -> Vec<(bool, String)> {
+    let mut doubts = Vec::new();
+    let known = CalibrationMethod::value_variants()
+        .iter()
+        .any(|m| m.name() == file.method);
+    if !known {
+        doubts.push((false, format!(
+            "the calibration's method `{}` is none `truenorth calibrate` writes: an edited or foreign file, whose numbers may mean something else",
+            file.method
+        )));
+    }
+    if file.quality.as_ref().is_some_and(|q| q.verdict == "poor") {
+        doubts.push((
+            false,
+            "the calibration's own verdict is `poor`: its headings may be off by more than its bound says; recalibrate with a fuller turn".into(),
+        ));
+    }
+    let s = &file.soft_iron;
+    let scale = s.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
+    let asymmetry = (0..s.len())
+        .flat_map(|i| (0..i).map(move |j| (i, j)))
+        .fold(0.0f64, |m, (i, j)| m.max((s[i][j] - s[j][i]).abs()));
+    if asymmetry > 1e-6 * scale {
+        doubts.push((true, format!(
+            "the calibration's soft_iron is not symmetric (entries differ by {asymmetry:.3e}): every fit writes a symmetric one, so the file was edited; recalibrate"
+        )));
+    }
+    doubts
 }
 
 /// Refuses an output that is one of the inputs, and two inputs on standard input.
