@@ -7,14 +7,15 @@ use std::path::Path;
 
 use truenorth_logs::LogFormat;
 
-use super::columns::AxisConvention;
+use super::columns::{AxisConvention, ColumnMapping};
 use super::logs::{self, AxleOf, AxleTrack, LogInput};
 use super::options::InputOptions;
 use super::reader::{ReadSpec, RowReader};
 use super::records::Delimiter;
 use super::samples::{SampleKind, Samples};
 use super::source::InputPath;
-use crate::io::{CliError, CliResult};
+use crate::io::closest_name::likely_meant;
+use crate::io::{CliError, CliResult, errln};
 
 /// An input named on the command line, with the options it is read with.
 pub struct Input<'a> {
@@ -76,6 +77,7 @@ impl<'a> Input<'a> {
                     ),
                 ));
             }
+            check_mappings(&self.options.columns, spec)?;
             return Ok((RowReader::open(&input, self.options, spec)?, None));
         };
         refuse_csv_options(&name, format, self.options, self.csv_only)?;
@@ -85,6 +87,40 @@ impl<'a> Input<'a> {
         let rows = RowReader::from_log(log.path.clone(), table, spec)?;
         Ok((rows, Some(log)))
     }
+}
+
+/// Refuses a `--column NAME=HEADER` whose NAME the command does not read (naming the
+/// closest one it does), which would otherwise be ignored; says a NAME given twice with two
+/// headers, of which the last is used (the contract: a fix is appended to the options
+/// already given).
+fn check_mappings(mappings: &[ColumnMapping], spec: &ReadSpec<'_>) -> CliResult {
+    let known: Vec<&str> = spec.required.iter().chain(spec.optional).copied().collect();
+    for (k, m) in mappings.iter().enumerate() {
+        if !known.iter().any(|n| n.eq_ignore_ascii_case(&m.name)) {
+            let hint = likely_meant(&m.name, &known)
+                .map_or(String::new(), |n| format!(" (did you mean `{n}`?)"));
+            return Err(CliError::msg(format!(
+                "--column {}={}: `{}` is not a column this command reads{hint}; it reads {}",
+                m.name,
+                m.header,
+                m.name,
+                known.join(", ")
+            )));
+        }
+        if let Some(earlier) = mappings[..k].iter().find(|e| {
+            e.name.eq_ignore_ascii_case(&m.name) && (e.header != m.header || e.negate != m.negate)
+        }) {
+            errln!(
+                "truenorth: warning: --column gives `{}` twice, from `{}{}` and from `{}{}`: the last is used",
+                m.name,
+                if earlier.negate { "-" } else { "" },
+                earlier.header,
+                if m.negate { "-" } else { "" },
+                m.header
+            );
+        }
+    }
+    Ok(())
 }
 
 /// Refuses, in one line, an option that describes a CSV given with a log.

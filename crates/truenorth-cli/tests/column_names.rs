@@ -1,0 +1,50 @@
+//! `--column NAME=HEADER` as a careless user gives it: a NAME the command does not read is
+//! refused with the closest one it does (it was silently ignored), and a NAME given twice
+//! is said, the last being the one used (as a fix appended to the options given).
+
+mod common;
+
+use common::{TURN_HEADER, ellipse_calibration, outcome, scratch, turn_rows};
+
+#[test]
+fn a_misspelt_column_name_is_refused_with_the_closest() {
+    let dir = scratch("column_names", "misspelt");
+    let csv = format!(
+        "{TURN_HEADER}{}",
+        turn_rows(360, 0.1, 30.0, [5.0, -3.0], 0.0)
+    );
+    let (input, cal) = ellipse_calibration(&dir, &csv, &[]);
+    let (ok, err) = outcome(&common::heading(
+        &cal,
+        &input,
+        &dir.join("h.csv"),
+        &["--column", "magx=mag_x"],
+    ));
+    assert!(!ok, "{err}");
+    assert!(
+        err.contains("`magx` is not a column this command reads"),
+        "{err}"
+    );
+    assert!(err.contains("did you mean `mag_x`?"), "{err}");
+    assert_eq!(err.trim().lines().count(), 1, "{err}");
+}
+
+#[test]
+fn a_column_given_twice_is_said_and_the_last_used() {
+    let dir = scratch("column_names", "twice");
+    let text = format!("t_s,mx,my\n{}", turn_rows(360, 0.1, 30.0, [5.0, -3.0], 0.0));
+    let input = dir.join("turn.csv");
+    std::fs::write(&input, text).unwrap();
+    let cal = dir.join("cal.json");
+    let (ok, err) = outcome(&common::calibrate(
+        "ellipse",
+        &input,
+        &cal,
+        &["--column", "mag_x=my,mag_y=my", "--column", "mag_x=mx"],
+    ));
+    assert!(ok, "{err}");
+    assert!(
+        err.contains("--column gives `mag_x` twice, from `my` and from `mx`: the last is used"),
+        "{err}"
+    );
+}
