@@ -73,15 +73,58 @@ impl InputPath {
                 "named .gz but is not gzip-compressed (it does not start with the gzip magic bytes)",
             ));
         }
-        Ok(if gzip {
-            Box::new(BufReader::with_capacity(
-                1 << 16,
-                flate2::bufread::MultiGzDecoder::new(buffered),
-            ))
-        } else {
-            Box::new(buffered)
-        })
+        if !gzip && let Some(what) = not_text(head, false) {
+            return Err(CliError::file(&name, what));
+        }
+        if !gzip {
+            return Ok(Box::new(buffered));
+        }
+        let mut decoded =
+            BufReader::with_capacity(1 << 16, flate2::bufread::MultiGzDecoder::new(buffered));
+        let inner = decoded
+            .fill_buf()
+            .map_err(|e| CliError::file(&name, format!("cannot decompress: {e}")))?;
+        if let Some(what) = not_text(inner, true) {
+            return Err(CliError::file(&name, what));
+        }
+        Ok(Box::new(decoded))
     }
+}
+
+/// What a stream that starts with `head` is when it is not text a CSV reader can read
+/// (by the formats' magic bytes), with what to do; `gunzipped`: `head` is what a gzip
+/// layer held.
+fn not_text(head: &[u8], gunzipped: bool) -> Option<String> {
+    let kinds: [(&[u8], &str); 7] = [
+        (
+            &GZIP_MAGIC,
+            "gzip-compressed twice: decompress it once (`gunzip`)",
+        ),
+        (
+            b"BZh",
+            "bzip2-compressed: decompress it (`bunzip2`) or give it gzip-compressed",
+        ),
+        (
+            &[0xfd, b'7', b'z', b'X', b'Z', 0x00],
+            "xz-compressed: decompress it (`unxz`) or give it gzip-compressed",
+        ),
+        (
+            &[0x28, 0xb5, 0x2f, 0xfd],
+            "zstd-compressed: decompress it (`unzstd`) or give it gzip-compressed",
+        ),
+        (b"PK\x03\x04", "a zip archive: extract the CSV from it"),
+        (&[0xff, 0xfe], "UTF-16 text: save it as UTF-8 (or ASCII)"),
+        (&[0xfe, 0xff], "UTF-16 text: save it as UTF-8 (or ASCII)"),
+    ];
+    let (_, what) = kinds.iter().find(|(magic, _)| head.starts_with(magic))?;
+    if !gunzipped && what.starts_with("gzip") {
+        return None;
+    }
+    Some(if gunzipped && !what.starts_with("gzip") {
+        format!("is gzip-compressed, and what it holds is {what}")
+    } else {
+        format!("is {what}")
+    })
 }
 
 #[cfg(test)]
@@ -113,6 +156,37 @@ mod tests {
         assert!(e.contains("not gzip"), "{e}");
         let missing = InputPath::new(&dir.join("none.csv")).open().err().unwrap();
         assert!(missing.to_string().contains("cannot open"), "{missing}");
+    }
+
+    #[test]
+    fn compressed_and_utf16_inputs_are_named_for_what_they_are() {
+        let dir = tempfile::tempdir().unwrap();
+        let cases: [(&str, Vec<u8>, &str); 5] = [
+            ("b.csv", b"BZh91AY&SY".to_vec(), "bzip2"),
+            ("x.csv", vec![0xfd, b'7', b'z', b'X', b'Z', 0x00, 1], "xz"),
+            ("z.csv", vec![0x28, 0xb5, 0x2f, 0xfd, 0], "zstd"),
+            ("u.csv", vec![0xff, 0xfe, b't', 0], "UTF-16"),
+            (
+                "twice.csv",
+                gzip(&gzip(b"t_s\n1\n")),
+                "gzip-compressed twice",
+            ),
+        ];
+        for (name, bytes, what) in cases {
+            let path = dir.path().join(name);
+            std::fs::write(&path, bytes).unwrap();
+            let e = InputPath::new(&path).open().err().unwrap().to_string();
+            assert!(e.contains(what), "{name}: {e}");
+        }
+        let plain = dir.path().join("ok.csv");
+        std::fs::write(&plain, gzip(b"t_s,mag_x\n1,2\n")).unwrap();
+        assert!(InputPath::new(&plain).open().is_ok());
+    }
+
+    fn gzip(bytes: &[u8]) -> Vec<u8> {
+        let mut e = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::default());
+        e.write_all(bytes).unwrap();
+        e.finish().unwrap()
     }
 
     #[test]
