@@ -109,14 +109,44 @@ impl CliError {
 
 impl fmt::Display for CliError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        // One line, whatever a library or the operating system put into the message.
-        let message = self.message.replace(['\n', '\r'], " ");
+        // One line, whatever a library or the operating system put into the message, and
+        // no control character a file's header or name carried to the terminal (an escape
+        // sequence would be obeyed, not shown): each is written as its escape.
+        let one_line = self.message.replace(['\n', '\r'], " ");
+        let message = printable(&one_line);
         match (&self.file, self.row) {
-            (Some(p), Some(r)) => write!(f, "{}: row {}: {}", p.display(), r, message),
-            (Some(p), None) => write!(f, "{}: {}", p.display(), message),
+            (Some(p), Some(r)) => {
+                write!(
+                    f,
+                    "{}: row {}: {}",
+                    printable(&p.display().to_string()),
+                    r,
+                    message
+                )
+            }
+            (Some(p), None) => write!(f, "{}: {}", printable(&p.display().to_string()), message),
             _ => write!(f, "{message}"),
         }
     }
+}
+
+/// `text` with each control character (an escape sequence's ESC, a bell, a tab) written
+/// as its Rust escape, the rest as it is.
+fn printable(text: &str) -> std::borrow::Cow<'_, str> {
+    if !text.chars().any(char::is_control) {
+        return std::borrow::Cow::Borrowed(text);
+    }
+    std::borrow::Cow::Owned(
+        text.chars()
+            .map(|c| {
+                if c.is_control() {
+                    c.escape_default().to_string()
+                } else {
+                    c.to_string()
+                }
+            })
+            .collect(),
+    )
 }
 
 /// A library error outside any file, its kind kept.
@@ -133,6 +163,21 @@ pub type CliResult<T = ()> = Result<T, CliError>;
 mod tests {
     use super::*;
     use truenorth::core::Error;
+
+    #[test]
+    fn control_characters_reach_the_terminal_escaped() {
+        let e = CliError::row(
+            Path::new("a\u{1b}[2J.csv"),
+            1,
+            "missing column `\u{1b}]0;x\u{7}t_s`",
+        );
+        let shown = e.to_string();
+        assert!(!shown.chars().any(char::is_control), "{shown:?}");
+        assert!(
+            shown.contains("\\u{1b}[2J") && shown.contains("\\u{7}t_s"),
+            "{shown}"
+        );
+    }
 
     #[test]
     fn library_errors_keep_their_kind() {
