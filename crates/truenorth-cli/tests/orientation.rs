@@ -96,7 +96,14 @@ fn attitude_follows_the_simulated_motion_in_both_frames() {
                 "instantaneous",
             ],
         );
-        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert!(o.status.success(), "{stderr}");
+        // The Euler and σ columns' frame is said when it differs from the quaternion's.
+        assert_eq!(
+            stderr.contains("stay relative to north-east-down"),
+            frame == "enu",
+            "{frame}: {stderr}"
+        );
     }
     let (header, ned_rows) = rows(&ned);
     assert_eq!(

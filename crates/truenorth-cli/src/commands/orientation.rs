@@ -179,6 +179,18 @@ pub fn run(args: &Args) -> CliResult {
         check_distinct(p, &[&args.input, &args.output])?;
     }
     let mut samples = read_samples(args)?;
+    if args.frame == Frame::Enu {
+        // The columns' names do not say the frame: a reader taking yaw from an ENU file
+        // would be off by the frames' difference.
+        errln!(
+            "truenorth: orientation: note: --frame enu turns the quaternion only; yaw_deg, pitch_deg, roll_deg{} stay relative to north-east-down (yaw clockwise from north)",
+            if args.status {
+                " and sigma_x/y/z_deg (about north, east, down)"
+            } else {
+                ""
+            }
+        );
+    }
     let first = samples.first_part(CHECKED_ROWS)?;
     check_units(args, &first)?;
     if samples.peek()?.is_some() {
