@@ -212,10 +212,15 @@ fn the_table_gives_each_file_its_status_and_a_rerun_runs_only_what_changed() {
     assert_eq!(journal_lines(&out), 6, "one line per finished file");
 
     // A rerun runs nothing: every row skipped as done, and no line added to the journal
-    // (each run of a command appends one).
+    // (each run of a command appends one); the two failures still stand, and its exit
+    // status says so.
     let before = std::fs::read_to_string(out.join(JOURNAL)).unwrap();
     let (code, stdout, _) = batch(&args(&[l, "--recursive", "--out", o], &CALIBRATE));
-    assert_eq!(code, Some(0), "nothing failed in this batch: {stdout}");
+    assert_eq!(code, Some(3), "earlier failures still stand: {stdout}");
+    assert!(
+        stdout.contains("(2 of them failed in an earlier run: --retry-failed runs them again)"),
+        "{stdout}"
+    );
     assert!(
         stdout.contains("0 ok, 0 refused, 0 failed, 6 skipped-done"),
         "{stdout}"
@@ -231,7 +236,7 @@ fn the_table_gives_each_file_its_status_and_a_rerun_runs_only_what_changed() {
     // One file changed: only it runs again.
     std::fs::write(logs.join("b c.csv"), circle(160, 0.5)).unwrap();
     let (code, stdout, _) = batch(&args(&[l, "--recursive", "--out", o], &CALIBRATE));
-    assert_eq!(code, Some(0), "{stdout}");
+    assert_eq!(code, Some(3), "the earlier failures still stand: {stdout}");
     assert!(
         stdout.contains("1 ok, 0 refused, 0 failed, 5 skipped-done"),
         "{stdout}"

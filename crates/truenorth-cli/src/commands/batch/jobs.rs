@@ -34,14 +34,22 @@ pub struct Sources<'a> {
     pub extensions: &'a [String],
 }
 
+/// A path that is not run, and why.
+pub type Skipped = (PathBuf, &'static str);
+
+/// Why a path that is not a regular file is not run: a FIFO, a device or a socket would
+/// block a worker in `open()` or never end.
+const NOT_REGULAR: &str = "not a regular file (a FIFO, a device or a socket): not read";
+
 /// The jobs of `sources`, sorted by input path, each file once (the same file reached twice,
-/// through two folders or a list, is run once).
-pub fn collect(sources: &Sources<'_>) -> CliResult<Vec<Job>> {
+/// through two folders or a list, is run once), and the paths left out with why.
+pub fn collect(sources: &Sources<'_>) -> CliResult<(Vec<Job>, Vec<Skipped>)> {
+    let mut skipped = Vec::new();
     let several = sources.folders.len() + usize::from(sources.list.is_some()) > 1;
     let mut jobs = Vec::new();
     for folder in sources.folders {
         let mut found = Vec::new();
-        walk(folder, sources, &mut found)?;
+        walk(folder, sources, &mut found, &mut skipped)?;
         for input in found {
             let inside = input.strip_prefix(folder).unwrap_or(&input).to_path_buf();
             // Alone, a folder's files are named from inside it; beside other sources, from
@@ -53,6 +61,10 @@ pub fn collect(sources: &Sources<'_>) -> CliResult<Vec<Job>> {
     if let Some(list) = sources.list {
         for line in read_list(list)? {
             let input = PathBuf::from(&line);
+            if std::fs::metadata(&input).is_ok_and(|m| !m.is_file() && !m.is_dir()) {
+                skipped.push((input, NOT_REGULAR));
+                continue;
+            }
             jobs.push(Job {
                 relative: input.clone(),
                 input,
@@ -62,18 +74,38 @@ pub fn collect(sources: &Sources<'_>) -> CliResult<Vec<Job>> {
     jobs.sort_by(|a, b| a.input.cmp(&b.input));
     let mut seen = HashSet::new();
     jobs.retain(|j| seen.insert(identity(&j.input)));
-    Ok(jobs)
+    Ok((jobs, skipped))
 }
 
-/// What makes two paths the same file: the canonical path where it exists.
-fn identity(path: &Path) -> PathBuf {
-    path.canonicalize().unwrap_or_else(|_| path.to_path_buf())
+/// What makes two paths the same file: the canonical path where it exists, else its
+/// folder's canonical path and its name (a file not written yet).
+pub fn identity(path: &Path) -> PathBuf {
+    if let Ok(p) = path.canonicalize() {
+        return p;
+    }
+    match (path.parent(), path.file_name()) {
+        (Some(dir), Some(name)) => {
+            let dir = if dir.as_os_str().is_empty() {
+                Path::new(".")
+            } else {
+                dir
+            };
+            dir.canonicalize()
+                .map_or_else(|_| path.to_path_buf(), |d| d.join(name))
+        }
+        _ => path.to_path_buf(),
+    }
 }
 
 /// The files of `folder` (and its sub-folders with `--recursive`) that end in one of the
 /// extensions; hidden files (a leading `.`, as the temporaries of unfinished outputs are)
 /// are left out.
-fn walk(folder: &Path, sources: &Sources<'_>, found: &mut Vec<PathBuf>) -> CliResult {
+fn walk(
+    folder: &Path,
+    sources: &Sources<'_>,
+    found: &mut Vec<PathBuf>,
+    skipped: &mut Vec<Skipped>,
+) -> CliResult {
     let entries = std::fs::read_dir(folder)
         .map_err(|e| CliError::file(folder, format!("cannot list the folder: {e}")))?;
     for entry in entries {
@@ -93,10 +125,14 @@ fn walk(folder: &Path, sources: &Sources<'_>, found: &mut Vec<PathBuf>) -> CliRe
         };
         if meta.is_dir() {
             if sources.recursive {
-                walk(&path, sources, found)?;
+                walk(&path, sources, found, skipped)?;
             }
         } else if matches_extension(name, sources.extensions) {
-            found.push(path);
+            if meta.is_file() {
+                found.push(path);
+            } else {
+                skipped.push((path, NOT_REGULAR));
+            }
         }
     }
     Ok(())

@@ -126,7 +126,7 @@ pub fn run(args: &Args) -> CliResult<u8> {
             "batch: --ext has an empty extension, which matches no file; give the endings to run, e.g. --ext csv,csv.gz",
         ));
     }
-    let jobs = jobs::collect(&jobs::Sources {
+    let (mut jobs, skipped) = jobs::collect(&jobs::Sources {
         folders: &args.folders,
         list: args.list.as_deref(),
         recursive: args.recursive,
@@ -138,6 +138,22 @@ pub fn run(args: &Args) -> CliResult<u8> {
         .results
         .clone()
         .unwrap_or_else(|| args.out.join("results.csv"));
+    for (path, why) in &skipped {
+        errln!("batch: {}: {why}", path.display());
+    }
+    // A folder of inputs that holds --out would, on the next run, hand the batch its own
+    // outputs (and results table) as inputs.
+    let out_id = jobs::identity(&args.out);
+    let before = jobs.len();
+    jobs.retain(|j| !jobs::identity(&j.input).starts_with(&out_id));
+    if jobs.len() < before {
+        errln!(
+            "batch: {} files under --out {} are this batch's own outputs and are not read as inputs",
+            before - jobs.len(),
+            args.out.display()
+        );
+    }
+    check_results_path(&results_path, &args.out, &jobs)?;
     let plan = plan(&jobs, &command, &args.out, &results_path)?;
     let exe = std::env::current_exe()
         .map_err(|e| CliError::msg(format!("batch: cannot find its own executable: {e}")))?;
@@ -198,6 +214,26 @@ pub fn run(args: &Args) -> CliResult<u8> {
         0 => Ok(counts.exit_code()),
         s => Ok(u8::try_from(128 + s).unwrap_or(u8::MAX)),
     }
+}
+
+/// Refuses, before anything runs, a results table that would overwrite an input or the
+/// journal (the rerun would then redo everything).
+fn check_results_path(results: &Path, out: &Path, jobs: &[jobs::Job]) -> CliResult {
+    let id = jobs::identity(results);
+    if id == jobs::identity(&out.join(journal::JOURNAL_NAME)) {
+        return Err(CliError::msg(format!(
+            "batch: --results {} names the batch's journal, which says what is done; give another name",
+            results.display()
+        )));
+    }
+    if let Some(j) = jobs.iter().find(|j| jobs::identity(&j.input) == id) {
+        return Err(CliError::msg(format!(
+            "batch: --results {} names the input {}, which it would overwrite; give another name",
+            results.display(),
+            j.input.display()
+        )));
+    }
+    Ok(())
 }
 
 /// Each job's output name and path, refusing an output that would be the results table.

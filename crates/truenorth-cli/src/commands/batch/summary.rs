@@ -11,7 +11,8 @@ use super::results::{Row, Status};
 pub const EXIT_OK: u8 = 0;
 /// Exit code: the batch itself could not run (arguments, the journal, the table).
 pub const EXIT_BATCH_ERROR: u8 = 1;
-/// Exit code: at least one file failed in this batch (clap's usage errors take 2).
+/// Exit code: at least one file failed, in this batch or in an earlier one whose failure
+/// still stands (clap's usage errors take 2).
 pub const EXIT_FILES_FAILED: u8 = 3;
 
 /// The counts of a batch.
@@ -25,6 +26,9 @@ pub struct Counts {
     pub failed: usize,
     /// Files skipped as done by an earlier batch.
     pub skipped: usize,
+    /// Of those, files whose earlier run failed (its command's own error, not run again
+    /// without `--retry-failed`): their failure still stands.
+    pub failed_before: usize,
     /// Files never reached (a stop).
     pub not_run: usize,
     /// Rows read by the commands run now.
@@ -45,7 +49,10 @@ impl Counts {
                 Status::Ok => c.ok += 1,
                 Status::Refused => c.refused += 1,
                 Status::Failed => c.failed += 1,
-                Status::SkippedDone => c.skipped += 1,
+                Status::SkippedDone => {
+                    c.skipped += 1;
+                    c.failed_before += usize::from(r.outcome == Status::Failed);
+                }
             }
             if r.status != Status::SkippedDone {
                 c.run += 1;
@@ -57,7 +64,7 @@ impl Counts {
 
     /// The exit code (see the constants).
     pub fn exit_code(&self) -> u8 {
-        if self.failed > 0 {
+        if self.failed + self.failed_before > 0 {
             EXIT_FILES_FAILED
         } else {
             EXIT_OK
@@ -69,13 +76,21 @@ impl Counts {
     pub fn line(&self, wall: Duration) -> String {
         let secs = wall.as_secs_f64();
         let per_s = |n: f64| if secs > 0.0 { n / secs } else { 0.0 };
+        let before = if self.failed_before > 0 {
+            format!(
+                " ({} of them failed in an earlier run: --retry-failed runs them again)",
+                self.failed_before
+            )
+        } else {
+            String::new()
+        };
         let not_run = if self.not_run > 0 {
             format!(", {} not run (stopped)", self.not_run)
         } else {
             String::new()
         };
         format!(
-            "batch: {} ok, {} refused, {} failed, {} skipped-done{not_run}; {} samples in {} s: {} files/s, {} samples/s",
+            "batch: {} ok, {} refused, {} failed, {} skipped-done{before}{not_run}; {} samples in {} s: {} files/s, {} samples/s",
             self.ok,
             self.refused,
             self.failed,
