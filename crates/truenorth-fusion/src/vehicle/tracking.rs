@@ -6,12 +6,12 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::gnss_fusion::GnssTrack;
+use super::gnss_track::GnssTrack;
 use super::heading_trig::HeadingTrig;
 use super::innovation_line::InnovationLine;
 use super::learning_gates::LearningGates;
 use super::nav_filter::DIM;
-use super::plain_guard::PlainBaseline;
+use super::plain_baseline::PlainBaseline;
 use super::step_batch::StepBatch;
 
 /// The vehicle estimator's bookkeeping between samples (the gyro's and the wheels' last

@@ -1,0 +1,35 @@
+//! What the vehicle estimator keeps of the satellite fixes between samples (see
+//! [`super::gnss_fusion`]): the tangent plane's origin, whether heading and track are
+//! referred to the fixes, the counts, and the courses gathered to refer them.
+
+use serde::{Deserialize, Serialize};
+
+use super::innovation_line::InnovationLine;
+
+/// The fixes as the estimator has used them.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub(super) struct GnssTrack {
+    /// The first fix, latitude and longitude in degrees: the tangent plane's origin.
+    pub origin: Option<(f64, f64)>,
+    /// Declination at the origin, rad (east positive).
+    pub declination_rad: f64,
+    /// Heading and track are referred to the fixes: the heading to true north, the track
+    /// to the plane.
+    pub aligned: bool,
+    /// When the last fix was used, s.
+    pub last_used_s: Option<f64>,
+    /// When the current run of rejected fixes began, s.
+    pub rejected_since_s: Option<f64>,
+    /// Fixes used, rejected, and restarts of the position from a fix after a run of
+    /// rejections.
+    pub used: u32,
+    pub rejected: u32,
+    pub restarts: u32,
+    /// The courses' differences from the heading, while they are gathered to refer it to
+    /// true north.
+    pub line: InnovationLine,
+    /// Where a displacement to refer the heading to true north started: the fix's north
+    /// and east, and the dead-reckoned position's, m.
+    pub start: Option<[f64; 4]>,
+}
