@@ -50,32 +50,22 @@ fn a_results_table_naming_an_input_or_the_journal_is_refused() {
     let out = dir.join("out");
     let a = logs.join("a.csv");
     let before = std::fs::read(&a).unwrap();
-    let o = common::truenorth(&[
-        "batch",
-        p(&logs),
-        "--out",
-        p(&out),
-        "--results",
-        p(&a),
-        "--",
-        "inspect",
-    ]);
-    let (ok, stderr) = common::outcome(&o);
-    assert!(!ok && stderr.contains("names the input"), "{stderr}");
-    assert_eq!(std::fs::read(&a).unwrap(), before, "the input is untouched");
     let journal = out.join(".truenorth-batch-journal.jsonl");
-    let o = common::truenorth(&[
-        "batch",
-        p(&logs),
-        "--out",
-        p(&out),
-        "--results",
-        p(&journal),
-        "--",
-        "inspect",
-    ]);
-    let (ok, stderr) = common::outcome(&o);
-    assert!(!ok && stderr.contains("journal"), "{stderr}");
+    for (results, why) in [(&a, "names the input"), (&journal, "journal")] {
+        let o = common::truenorth(&[
+            "batch",
+            p(&logs),
+            "--out",
+            p(&out),
+            "--results",
+            p(results),
+            "--",
+            "inspect",
+        ]);
+        let (ok, stderr) = common::outcome(&o);
+        assert!(!ok && stderr.contains(why), "{stderr}");
+        assert_eq!(std::fs::read(&a).unwrap(), before, "the input is untouched");
+    }
 }
 
 /// A FIFO among the inputs is left out with its reason (opening it would block a worker for
