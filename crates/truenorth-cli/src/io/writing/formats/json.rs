@@ -53,9 +53,66 @@ pub fn parse_json_strict<T: DeserializeOwned + Serialize>(
     Ok(parsed)
 }
 
-/// Parses the text into a JSON value (a syntax error says where).
+/// Parses the text into a JSON value (a syntax error says where). A key given twice in
+/// one object is refused: a JSON value keeps the last, and the first would be dropped
+/// without a word.
 pub fn parse_value(text: &str, what: &str) -> Result<Value, String> {
+    serde_json::from_str::<NoDuplicateKeys>(text).map_err(|e| format!("{what}: {e}"))?;
     serde_json::from_str(text).map_err(|e| format!("{what}: {e}"))
+}
+
+/// A JSON document walked only to refuse a key given twice in one object, at any depth.
+struct NoDuplicateKeys;
+
+impl<'de> serde::Deserialize<'de> for NoDuplicateKeys {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        d.deserialize_any(NoDuplicateKeys)
+    }
+}
+
+impl<'de> serde::de::Visitor<'de> for NoDuplicateKeys {
+    type Value = Self;
+
+    fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("a JSON value")
+    }
+
+    fn visit_map<A: serde::de::MapAccess<'de>>(self, mut map: A) -> Result<Self, A::Error> {
+        let mut seen = std::collections::HashSet::new();
+        while let Some(key) = map.next_key::<String>()? {
+            if !seen.insert(key.clone()) {
+                return Err(serde::de::Error::custom(format!(
+                    "the key `{key}` is given twice in one object (only one of them would be used); give it once"
+                )));
+            }
+            map.next_value::<NoDuplicateKeys>()?;
+        }
+        Ok(self)
+    }
+
+    fn visit_seq<A: serde::de::SeqAccess<'de>>(self, mut seq: A) -> Result<Self, A::Error> {
+        while seq.next_element::<NoDuplicateKeys>()?.is_some() {}
+        Ok(self)
+    }
+
+    fn visit_bool<E>(self, _: bool) -> Result<Self, E> {
+        Ok(self)
+    }
+    fn visit_i64<E>(self, _: i64) -> Result<Self, E> {
+        Ok(self)
+    }
+    fn visit_u64<E>(self, _: u64) -> Result<Self, E> {
+        Ok(self)
+    }
+    fn visit_f64<E>(self, _: f64) -> Result<Self, E> {
+        Ok(self)
+    }
+    fn visit_str<E>(self, _: &str) -> Result<Self, E> {
+        Ok(self)
+    }
+    fn visit_unit<E>(self) -> Result<Self, E> {
+        Ok(self)
+    }
 }
 
 /// serde's message, with the closest known key after an unknown one, and where in `value`
@@ -170,6 +227,19 @@ pub fn version_of(value: &Value, readable: &[u32], kind: &str) -> Result<Option<
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_key_given_twice_is_refused_at_any_depth() {
+        for text in [
+            r#"{"track_m": 1.5, "track_m": 1.6}"#,
+            r#"{"a": [{"b": 1, "c": {"d": 2, "d": 3}}]}"#,
+        ] {
+            let e = parse_value(text, "vehicle file").unwrap_err();
+            assert!(e.contains("given twice"), "{e}");
+        }
+        let fine = r#"{"a": [{"b": 1}, {"b": 2}], "c": null, "d": -1, "e": 1e300, "f": true}"#;
+        assert!(parse_value(fine, "x").is_ok());
+    }
 
     #[test]
     fn an_unknown_key_is_named_with_the_closest_known_one() {
