@@ -1,6 +1,7 @@
-//! `--column NAME=HEADER` as a careless user gives it: a NAME the command does not read is
-//! refused with the closest one it does (it was silently ignored), and a NAME given twice
-//! is said, the last being the one used (as a fix appended to the options given).
+//! `--column NAME=HEADER` as a careless user gives it: a NAME no command reads is refused
+//! with the closest one this command does, one this command does not read is said (both
+//! were silently ignored), and a NAME given twice is said, the last being the one used (as a
+//! fix appended to the options given).
 
 mod common;
 
@@ -27,6 +28,16 @@ fn a_misspelt_column_name_is_refused_with_the_closest() {
     );
     assert!(err.contains("did you mean `mag_x`?"), "{err}");
     assert_eq!(err.trim().lines().count(), 1, "{err}");
+    // A column another command reads (a script's mapping shared by several) is said, and the
+    // run goes on.
+    let (ok, err) = outcome(&common::heading(
+        &cal,
+        &input,
+        &dir.join("h.csv"),
+        &["--column", "mag_z=mz"],
+    ));
+    assert!(ok, "{err}");
+    assert!(err.contains("this command does not read `mag_z`"), "{err}");
 }
 
 #[test]

@@ -8,6 +8,7 @@ use std::path::Path;
 use truenorth_logs::LogFormat;
 
 use super::columns::{AxisConvention, ColumnMapping};
+use super::kinds::DRIVE;
 use super::logs::{self, AxleOf, AxleTrack, LogInput};
 use super::options::InputOptions;
 use super::reader::{ReadSpec, RowReader};
@@ -89,14 +90,31 @@ impl<'a> Input<'a> {
     }
 }
 
-/// Refuses a `--column NAME=HEADER` whose NAME the command does not read (naming the
-/// closest one it does), which would otherwise be ignored; says a NAME given twice with two
-/// headers, of which the last is used (the contract: a fix is appended to the options
-/// already given).
+/// The columns some command reads: a `--column` name outside them is a misspelling.
+const EVERY_COLUMN: [&str; 10] = [
+    "t_s", "mag_x", "mag_y", "mag_z", "acc_x", "acc_y", "acc_z", "gyr_x", "gyr_y", "gyr_z",
+];
+
+/// Refuses a `--column NAME=HEADER` whose NAME no command reads (a misspelling, named with
+/// the closest one this command reads), and says one this command does not read (a
+/// script's mapping shared by several commands); says a NAME given twice with two headers,
+/// of which the last is used (the contract: a fix is appended to the options already
+/// given).
 fn check_mappings(mappings: &[ColumnMapping], spec: &ReadSpec<'_>) -> CliResult {
     let known: Vec<&str> = spec.required.iter().chain(spec.optional).copied().collect();
     for (k, m) in mappings.iter().enumerate() {
-        if !known.iter().any(|n| n.eq_ignore_ascii_case(&m.name)) {
+        let is = |n: &&str| n.eq_ignore_ascii_case(&m.name);
+        if !known.iter().any(is) {
+            if EVERY_COLUMN.iter().chain(DRIVE.iter()).any(is) {
+                errln!(
+                    "truenorth: warning: --column {}={}: this command does not read `{}`; it reads {}",
+                    m.name,
+                    m.header,
+                    m.name,
+                    known.join(", ")
+                );
+                continue;
+            }
             let hint = likely_meant(&m.name, &known)
                 .map_or(String::new(), |n| format!(" (did you mean `{n}`?)"));
             return Err(CliError::msg(format!(

@@ -333,7 +333,7 @@ impl SampleKind for Imu {
 }
 
 /// The optional columns of a drive log.
-const DRIVE: [&str; 18] = [
+pub(crate) const DRIVE: [&str; 18] = [
     "dist_l_m",
     "dist_r_m",
     "speed_l_mps",
