@@ -214,3 +214,43 @@ fn unusable_calibrations_are_refused_on_load() {
         assert!(!out_path.exists(), "{name}");
     }
 }
+
+/// With the place given, a joint fit whose dip has the wrong sign for it (an accelerometer
+/// giving gravity read as specific force: the fit is as good, the dip −65° where Berlin's
+/// field dips +68°) is refused naming the fix; read right, it is written.
+#[test]
+fn a_dip_of_the_wrong_sign_for_the_place_is_refused() {
+    let dir = scratch("dip_sign");
+    let ins = FewShotInstrument::typical(21);
+    let shots = protocol_shots(&ins, 8, 2, 8, 21);
+    let input = dir.join("shots.csv");
+    std::fs::write(&input, csv(&shots, true)).unwrap();
+    let cal = dir.join("cal.json");
+    let place = [
+        "--mag-unit",
+        "uT",
+        "--lat",
+        "52.5",
+        "--lon",
+        "13.4",
+        "--date",
+        "2026.5",
+    ];
+    let wrong: Vec<&str> = ["--column", "acc_x=gx,acc_y=gy,acc_z=gz"]
+        .into_iter()
+        .chain(place)
+        .collect();
+    let (ok, err) = common::outcome(&common::calibrate("ellipsoid-accel", &input, &cal, &wrong));
+    assert!(!ok, "{err}");
+    assert!(
+        err.contains("the fitted dip is -") && err.contains("acc_x=-"),
+        "{err}"
+    );
+    assert!(!cal.exists(), "nothing written");
+    let right: Vec<&str> = ["--column", "acc_x=-gx,acc_y=-gy,acc_z=-gz"]
+        .into_iter()
+        .chain(place)
+        .collect();
+    let (ok, err) = common::outcome(&common::calibrate("ellipsoid-accel", &input, &cal, &right));
+    assert!(ok, "{err}");
+}
