@@ -168,3 +168,36 @@ fn a_tmpdir_that_cannot_take_the_readings_is_one_clear_line() {
     assert!(!stderr.contains("panicked"), "{stderr}");
     assert!(!out.exists());
 }
+
+/// Readings beyond what the disk may take for one fit (an unending or decompressed-bomb
+/// input) are one clear line, not a temporary file that grows until the disk is full.
+#[test]
+fn readings_beyond_the_disk_share_are_refused() {
+    let dir = scratch("disk-share");
+    let input = dir.join("in.csv");
+    std::fs::write(&input, recording(2)).unwrap();
+    let tmp = dir.join("tmp");
+    std::fs::create_dir(&tmp).unwrap();
+    let out = dir.join("cal.json");
+    let mut cmd = binary();
+    cmd.args(command_args(
+        "calibrate",
+        &["--method", "ellipse"],
+        &input,
+        &out,
+        &[],
+    ))
+    .env("TMPDIR", &tmp)
+    .env("TRUENORTH_TEST_SPILL_MEMORY_BYTES", SMALL_SHARE)
+    // One of the file's chunks of 2-D readings (2^15 of 16 bytes): the recording's
+    // 70,000 rows take two beyond the memory share.
+    .env("TRUENORTH_TEST_SPILL_DISK_BYTES", (16 << 15).to_string());
+    let run = cmd.output().unwrap();
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert_eq!(run.status.code(), Some(1), "{stderr}");
+    assert_eq!(stderr.lines().count(), 1, "{stderr}");
+    assert!(stderr.contains("a calibration needs minutes"), "{stderr}");
+    assert!(!out.exists());
+    let left: Vec<_> = std::fs::read_dir(&tmp).unwrap().collect();
+    assert!(left.is_empty(), "left in TMPDIR: {left:?}");
+}

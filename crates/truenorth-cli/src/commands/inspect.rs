@@ -5,7 +5,7 @@
 use std::path::PathBuf;
 
 use crate::inspect::report::JsonReport;
-use crate::inspect::{COLUMNS, Recording, analyse};
+use crate::inspect::{COLUMNS, Scan, analyse};
 use crate::io::reading::logs::summary;
 use crate::io::{CliError, CliResult, Input, InputOptions, ReadSpec};
 use crate::io::{out, outln};
@@ -44,8 +44,8 @@ pub fn run(args: &Args) -> CliResult {
     let spec = ReadSpec::new(&["t_s"]).optional(&COLUMNS);
     let (rows, log) = Input::new(&args.file, &args.input_options).rows(&spec)?;
     let name = rows.path().display().to_string();
-    let recording = Recording::read(rows)?;
-    let report = analyse(&name, &recording, &args.input_options);
+    let scan = Scan::read(rows)?;
+    let report = analyse(&name, &scan, &args.input_options);
     let failed =
         |e: serde_json::Error| CliError::msg(format!("inspect: cannot write the report: {e}"));
     if args.json {

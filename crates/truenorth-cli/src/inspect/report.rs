@@ -9,6 +9,7 @@ use truenorth::core::Fixed;
 use serde::Serialize;
 
 use super::column_stats::ColumnStats;
+use super::gnss::GnssReport;
 use super::sensors::{AccReport, AxesReport, GyroReport, MagReport};
 use super::wheels::{VehicleSetReport, WheelReport, YawReport};
 
@@ -19,6 +20,9 @@ pub struct Report {
     pub file: String,
     /// Data rows.
     pub rows: usize,
+    /// The first rows, of `rows`, on which the units, axes and wheels were judged (all of
+    /// them up to `truenorth inspect`'s bound of 524,288).
+    pub judged_rows: usize,
     /// Rows whose `t_s` does not come after the previous row's.
     pub time_not_increasing: usize,
     /// `t_s` and every sensor column present.
@@ -35,6 +39,8 @@ pub struct Report {
     pub yaw: Option<YawReport>,
     /// A drive log's sensor set and what it cannot tell, if the file is one.
     pub vehicle: Option<VehicleSetReport>,
+    /// The satellite fixes, if the file has them.
+    pub gnss: Option<GnssReport>,
 }
 
 /// The report with the options, as `--json` writes it.
@@ -86,6 +92,13 @@ impl Report {
             }
         );
         self.columns_table(&mut s);
+        if self.judged_rows < self.rows {
+            let _ = writeln!(
+                s,
+                "units, axes and wheels judged on the first {} rows of {}",
+                self.judged_rows, self.rows
+            );
+        }
         self.sensor_lines(&mut s);
         let options = self.options();
         if !options.is_empty() {
@@ -148,7 +161,36 @@ impl Report {
                 let _ = writeln!(s, "  cannot tell: {l}");
             }
         }
+        if let Some(g) = &self.gnss {
+            gnss_line(s, g);
+        }
     }
+}
+
+/// The fixes' line: how many, how often, the longest outage, their accuracy.
+fn gnss_line(s: &mut String, g: &GnssReport) {
+    let outage = match (g.gaps.count, g.gaps.largest_s, g.gaps.largest_at_t_s) {
+        (0, _, _) => "no gaps".to_string(),
+        (n, Some(l), Some(at)) => format!("{n} gaps (longest {l:.1} s, ending at t_s {at:.3})"),
+        (n, _, _) => format!("{n} gaps"),
+    };
+    let sigma = match g.sigma_m {
+        Some([lo, median, hi]) => {
+            format!("sigma {lo:.2}-{hi:.2} m (median {median:.2} m)")
+        }
+        None => "no gnss_sigma_m: drive assumes 5 m".to_string(),
+    };
+    let course = if g.course {
+        "speed and course given"
+    } else {
+        "no speed or course"
+    };
+    let _ = writeln!(
+        s,
+        "gnss: {} fixes at {} Hz, {outage}; {sigma}; {course}",
+        g.fixes,
+        num(g.rate_hz)
+    );
 }
 
 /// A value with four decimals, `-` when absent.

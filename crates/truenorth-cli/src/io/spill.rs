@@ -36,6 +36,14 @@ pub const SPILL_MEMORY_BYTES: usize = 32 << 20;
 /// recording to spill without writing a large file.
 pub const SPILL_MEMORY_ENV: &str = "TRUENORTH_TEST_SPILL_MEMORY_BYTES";
 
+/// The most one fit's readings may take on disk: 2 GiB, over a week of a 2-D compass at
+/// 100 Hz — far beyond the minutes of turning a calibration needs, so a larger input (a
+/// gzip bomb, a day-long log given whole) is refused rather than filling the disk.
+pub const SPILL_DISK_BYTES: usize = 2 << 30;
+
+/// Environment variable that overrides [`SPILL_DISK_BYTES`] (bytes), for tests.
+pub const SPILL_DISK_ENV: &str = "TRUENORTH_TEST_SPILL_DISK_BYTES";
+
 /// Readings per chunk of the file: written a chunk at a time and read back a chunk at a
 /// time into a buffer of each replay (a multiple of [`READINGS_RUN_MULTIPLE`]).
 const CHUNK_READINGS: usize = 1 << 15;
@@ -52,25 +60,35 @@ const STOPPED: Error = Error::ReadingsUnavailable {
 pub struct ReadingSpill {
     dir: PathBuf,
     memory_bytes: usize,
+    disk_bytes: usize,
     failure: Arc<Mutex<Option<String>>>,
 }
 
 impl ReadingSpill {
     /// Spilling to the temporary directory past [`SPILL_MEMORY_BYTES`] (or the bytes in
     /// [`SPILL_MEMORY_ENV`], when set to a number).
+    /// The disk takes at most [`SPILL_DISK_BYTES`] (or the bytes in [`SPILL_DISK_ENV`]).
     pub fn from_env() -> Self {
-        let memory_bytes = std::env::var(SPILL_MEMORY_ENV)
-            .ok()
-            .and_then(|v| v.trim().parse().ok())
-            .unwrap_or(SPILL_MEMORY_BYTES);
-        Self::new(std::env::temp_dir(), memory_bytes)
+        let bytes = |name: &str, default: usize| {
+            std::env::var(name)
+                .ok()
+                .and_then(|v| v.trim().parse().ok())
+                .unwrap_or(default)
+        };
+        let mut spill = Self::new(
+            std::env::temp_dir(),
+            bytes(SPILL_MEMORY_ENV, SPILL_MEMORY_BYTES),
+        );
+        spill.disk_bytes = bytes(SPILL_DISK_ENV, SPILL_DISK_BYTES);
+        spill
     }
 
-    /// Spilling to `dir` past `memory_bytes` of readings.
+    /// Spilling to `dir` past `memory_bytes` of readings, up to [`SPILL_DISK_BYTES`].
     pub fn new(dir: PathBuf, memory_bytes: usize) -> Self {
         Self {
             dir,
             memory_bytes,
+            disk_bytes: SPILL_DISK_BYTES,
             failure: Arc::new(Mutex::new(None)),
         }
     }
@@ -102,12 +120,17 @@ impl ReadingSpill {
 
     /// Keeps the first failure, `doing` what on which error.
     fn fail(&self, doing: &str, e: &io::Error) -> Error {
+        self.keep(format!(
+            "cannot {doing} the readings kept for the fit in a temporary file in {}: {e}; set TMPDIR to a directory on a disk with room",
+            self.dir.display()
+        ))
+    }
+
+    /// Keeps `failure` if it is the first.
+    fn keep(&self, message: String) -> Error {
         let mut failure = self.failure.lock().unwrap_or_else(PoisonError::into_inner);
         if failure.is_none() {
-            *failure = Some(format!(
-                "cannot {doing} the readings kept for the fit in a temporary file in {}: {e}; set TMPDIR to a directory on a disk with room",
-                self.dir.display()
-            ));
+            *failure = Some(message);
         }
         STOPPED
     }
@@ -248,6 +271,14 @@ impl<const D: usize> ReadingStore<D> for SpillStore<D> {
         }
         self.pending.push(reading);
         if self.pending.len() == CHUNK_READINGS {
+            let on_disk = (self.on_disk + CHUNK_READINGS) * size_of::<SVector<f64, D>>();
+            if on_disk > self.spill.disk_bytes {
+                return Err(self.spill.keep(format!(
+                    "more than {} readings for one fit ({} MB beyond memory): a calibration needs minutes of turning, not this much; give it the stretch of the recording with the turns",
+                    Readings::len(self),
+                    self.spill.disk_bytes >> 20
+                )));
+            }
             self.write_pending()
                 .map_err(|e| self.spill.fail("write", &e))?;
         }
