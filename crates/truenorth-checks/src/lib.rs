@@ -15,7 +15,8 @@
 //! * [`inertial`]: the accelerometer's and gyro's units, then the gyro's axes;
 //! * [`yaw_rate`]: a vehicle's yaw gyro against its wheels, streaming;
 //! * [`field_unit`]: a fitted field against an Earth field in the declared unit;
-//! * [`compass`]: a stored compass calibration that no real compass could have.
+//! * [`compass`]: a stored compass calibration that no real compass could have;
+//! * [`stuck_readings`]: readings no live sensor gives (clipped, frozen, a zero field).
 //!
 //! The `truenorth` command refuses (or warns) by them, naming its own options; the Python
 //! package returns them as dictionaries. Nothing here reads a file or prints.
@@ -40,6 +41,7 @@ pub mod field_unit;
 pub mod finding;
 pub mod inertial;
 pub mod spans;
+pub mod stuck_readings;
 pub mod units;
 pub mod yaw_rate;
 
@@ -48,5 +50,6 @@ pub use field_unit::check_field;
 pub use finding::{Finding, FindingKind, Fix};
 pub use inertial::{check_inertial, check_inertial_units, likely_acc_unit};
 pub use spans::{Inertial, Reference, median, median_magnitude};
+pub use stuck_readings::{StuckKind, StuckReadings, StuckRun};
 pub use units::{AccUnit, GyroUnit, MagUnit};
 pub use yaw_rate::{Turns, YawRateCheck};

@@ -17,7 +17,7 @@ use truenorth::checks::{MagUnit, check_field};
 use truenorth::core::{Calibrator, CompassQuality, Fixed, Mag2Sample, Solution};
 
 use super::field::PlaceArgs;
-use crate::io::checking::say;
+use crate::io::checking::{MagCells, MagWatch, say};
 use crate::io::errln;
 use crate::io::reading::kinds::{Mag2, Mag3, MagAccel as MagAccelRows, Turn};
 use crate::io::reading::{SampleKind, Samples};
@@ -136,6 +136,11 @@ pub struct Args {
     /// Magnetic Model (with a warning).
     #[arg(long)]
     pub accept_field_mismatch: bool,
+    /// Go on (with a warning) when the magnetometer's readings are ones no live sensor gives
+    /// (an axis clipped at its range or frozen, a reading of exactly zero), instead of
+    /// refusing.
+    #[arg(long)]
+    pub accept_sensor_faults: bool,
     /// How to read the input.
     #[command(flatten)]
     pub input_options: InputOptions,
@@ -324,26 +329,30 @@ fn open_input<K: SampleKind>(args: &Args, kind: K) -> CliResult<Samples<K>> {
 }
 
 /// Reads the input once, row by row, pushing each sample into `cal` (a rejected sample
-/// names its row). Nothing is kept here: a batch method keeps its own one copy of the
+/// names its row) and the magnetometer's readings past the watch for readings no live
+/// sensor gives. Nothing is kept here: a batch method keeps its own one copy of the
 /// readings it fits, an online one its running state.
-fn push_rows<K, C>(samples: &mut Samples<K>, cal: &mut C) -> CliResult
+fn push_rows<K, C>(args: &Args, samples: &mut Samples<K>, cal: &mut C) -> CliResult
 where
     K: SampleKind<Sample = C::Sample>,
     C: Calibrator + ?Sized,
+    C::Sample: MagCells,
 {
     let path = samples.path().to_path_buf();
+    let mut watch = MagWatch::new(&path, args.accept_sensor_faults);
     samples.for_each(|row, sample| {
+        watch.push(row, &sample)?;
         cal.push(&sample)
             .map_err(|e| CliError::row(&path, row, e.to_string()).kind_of(&e))?;
         Ok(())
     })?;
-    Ok(())
+    watch.finish()
 }
 
 /// Feeds every row to a 2-D calibrator, solves, and builds the output file.
 fn calibrate_2d(args: &Args, mut cal: Box<Planar>) -> CliResult<Fitted> {
     let mut samples = open_input(args, Mag2::default())?;
-    push_rows(&mut samples, &mut *cal)?;
+    push_rows(args, &mut samples, &mut *cal)?;
     let sol = solve(args, samples.path(), &mut *cal)?;
     Ok(fitted(
         args,
@@ -365,16 +374,19 @@ fn calibrate_turn(
     let mut samples = open_input(args, Turn::default())?;
     if !samples.kind().has_gyro() {
         let path = samples.path().to_path_buf();
+        let mut watch = MagWatch::new(&path, args.accept_sensor_faults);
         samples.for_each(|row, s| {
             let sample = Mag2Sample {
                 t_s: s.t_s,
                 mag: s.mag,
             };
+            watch.push(row, &sample)?;
             compass
                 .push(&sample)
                 .map_err(|e| CliError::row(&path, row, e.to_string()).kind_of(&e))?;
             Ok(())
         })?;
+        watch.finish()?;
         let sol = solve(args, &path, &mut *compass)?;
         return Ok(fitted(
             args,
@@ -383,7 +395,7 @@ fn calibrate_turn(
             sol.quality,
         ));
     }
-    push_rows(&mut samples, &mut *with_gyro)?;
+    push_rows(args, &mut samples, &mut *with_gyro)?;
     let sol = solve(args, samples.path(), &mut *with_gyro)?;
     let (c, q) = (sol.params, sol.quality);
     let mut f = fitted(args, &c.compass.hard_iron, &c.compass.soft_iron, q.compass);
@@ -404,7 +416,7 @@ fn calibrate_turn(
 /// Feeds every row to a 3-D calibrator, solves, and builds the output file.
 fn calibrate_3d(args: &Args, mut cal: Box<Spatial>) -> CliResult<Fitted> {
     let mut samples = open_input(args, Mag3::default())?;
-    push_rows(&mut samples, &mut *cal)?;
+    push_rows(args, &mut samples, &mut *cal)?;
     let sol = solve(args, samples.path(), &mut *cal)?;
     Ok(fitted(
         args,
@@ -417,7 +429,7 @@ fn calibrate_3d(args: &Args, mut cal: Box<Spatial>) -> CliResult<Fitted> {
 /// The joint magnetometer + accelerometer calibration.
 fn calibrate_joint(args: &Args, mut cal: Box<MagAccel>) -> CliResult<Fitted> {
     let mut samples = open_input(args, MagAccelRows::default())?;
-    push_rows(&mut samples, &mut *cal)?;
+    push_rows(args, &mut samples, &mut *cal)?;
     let sol = solve(args, samples.path(), &mut *cal)?;
     let (c, q) = (sol.params, sol.quality);
     let mut f = fitted(args, &c.mag.hard_iron, &c.mag.soft_iron, q.mag);

@@ -11,6 +11,7 @@ use truenorth::fusion::{SensorPriors, VehicleConfig, VehicleEstimator};
 use truenorth::odometer::OdometerWheels;
 
 use super::field::PlaceArgs;
+use crate::io::checking::{MagWatch, StuckWatch};
 use crate::io::errln;
 use crate::io::reading::Samples;
 use crate::io::reading::kinds::Vehicle;
@@ -149,6 +150,11 @@ pub struct Args {
     /// flipped), instead of refusing.
     #[arg(long)]
     pub accept_axes: bool,
+    /// Go on (with a warning on stderr) when the yaw gyro's or the compass's readings are
+    /// ones no live sensor gives (clipped at the range, frozen, a field of exactly zero),
+    /// instead of refusing.
+    #[arg(long)]
+    pub accept_sensor_faults: bool,
     /// Where and when the drive was made, for true heading.
     #[command(flatten)]
     pub place: PlaceArgs,
@@ -209,8 +215,13 @@ pub fn run(args: &Args) -> CliResult {
     )?;
     let context = diagnosis_context(args, speeds);
     let mut sensors = VehicleSensors::default();
+    let mut watch = (
+        StuckWatch::new("gyr_z (rad/s)", &args.input, args.accept_sensor_faults),
+        MagWatch::new(&args.input, args.accept_sensor_faults),
+    );
     let samples = estimate(
         &mut samples,
+        &mut watch,
         &mut check,
         &mut sensors,
         method.as_mut(),
@@ -351,6 +362,7 @@ fn diagnosis_context(args: &Args, speeds: bool) -> Context<'_> {
 /// estimate to `writer`; the number of samples.
 fn estimate(
     samples: &mut Samples<Vehicle>,
+    (gyro, mag): &mut (StuckWatch<1>, MagWatch),
     check: &mut Diagnosis,
     sensors: &mut VehicleSensors,
     method: &mut dyn VehicleRun,
@@ -358,6 +370,12 @@ fn estimate(
 ) -> CliResult<usize> {
     let path = samples.path().to_path_buf();
     let count = samples.for_each(|row, sample| {
+        if let Some(rate) = sample.gyr_z_rps {
+            gyro.push(row, sample.t_s, &[rate])?;
+        }
+        if let Some(m) = &sample.mag {
+            mag.push_cells(row, sample.t_s, m.as_slice())?;
+        }
         check.push(&sample, row);
         sensors.add(&sample);
         method
@@ -365,6 +383,8 @@ fn estimate(
             .map_err(|e| CliError::row(&path, row, e.to_string()).kind_of(&e))?;
         writer.error.take().map_or(Ok(()), Err)
     })?;
+    gyro.finish()?;
+    mag.finish()?;
     method
         .finish(&mut |e, fused| writer.write(e, fused))
         .map_err(|e| CliError::file(&path, e.to_string()).kind_of(&e))?;

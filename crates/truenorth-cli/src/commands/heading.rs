@@ -9,6 +9,7 @@ use truenorth::core::{Tilt, rad_to_deg};
 use truenorth::{CompassCalibration, TrueNorth};
 
 use super::field::PlaceArgs;
+use crate::io::checking::MagWatch;
 use crate::io::errln;
 use crate::io::reading::kinds::Compass;
 use crate::io::{
@@ -67,6 +68,11 @@ pub struct Args {
     /// not fit the readings, or was edited, instead of refusing.
     #[arg(long)]
     pub accept_calibration: bool,
+    /// Go on (with a warning) when the magnetometer's readings are ones no live sensor gives
+    /// (an axis clipped at its range or frozen, a reading of exactly zero), instead of
+    /// refusing.
+    #[arg(long)]
+    pub accept_sensor_faults: bool,
 }
 
 /// True north, if a place was given.
@@ -108,7 +114,10 @@ pub fn run(args: &Args) -> CliResult {
     }
     let mut out = CsvOutput::create(&args.output, &header)?;
     let path = samples.path().to_path_buf();
+    let mut watch = MagWatch::new(&path, args.accept_sensor_faults);
+    let dimensions = cal.dimensions().min(3);
     let count = samples.for_each(|row, reading| {
+        watch.push_cells(row, reading.t_s, &reading.mag.as_slice()[..dimensions])?;
         fit.push(cal.corrected_magnitude(&reading.mag), file.field, row);
         let (magnetic, tilt) = cal
             .heading(&reading.mag, reading.acc.as_ref())
@@ -125,6 +134,7 @@ pub fn run(args: &Args) -> CliResult {
             tilt,
         )
     })?;
+    watch.finish()?;
     if let Some((why, row)) = fit.misfit(cal.dimensions()) {
         if !args.accept_calibration {
             let why = format!("{why} (or --accept-calibration to go on)");

@@ -12,7 +12,7 @@ use truenorth::core::{
     AttitudeEstimate, EulerZyx, Fixed, ImuSample, Precise, ned_to_enu, rad_to_deg,
 };
 
-use crate::io::checking::{refusals, refuse_or_warn, say};
+use crate::io::checking::{StuckWatch, refusals, refuse_or_warn, say};
 use crate::io::errln;
 use crate::io::reading::Samples;
 use crate::io::reading::kinds::Imu;
@@ -117,6 +117,11 @@ pub struct Args {
     /// and magnetometer's (a flipped, swapped or mirrored gyro axis), instead of refusing.
     #[arg(long)]
     pub accept_axes: bool,
+    /// Go on (with a warning on stderr) when a sensor's readings are ones no live sensor
+    /// gives (a gyro or magnetometer axis clipped at its range or frozen, a magnetometer
+    /// reading exactly zero), instead of refusing.
+    #[arg(long)]
+    pub accept_sensor_faults: bool,
     /// How to read the file (delimiter, header, column names, axes).
     #[command(flatten)]
     pub input_options: InputOptions,
@@ -336,6 +341,8 @@ struct Estimation {
     gap_count: usize,
     reports_sigma: bool,
     plot: Option<PlotLines>,
+    /// The gyro (rad/s) and magnetometer watched for readings no live sensor gives.
+    stuck: (StuckWatch<3>, StuckWatch<3>),
 }
 
 impl Estimation {
@@ -357,6 +364,10 @@ impl Estimation {
             gap_count: 0,
             reports_sigma: false,
             plot: args.plot.as_ref().map(|_| PlotLines::default()),
+            stuck: (
+                StuckWatch::new("gyro (rad/s)", &args.input, args.accept_sensor_faults),
+                StuckWatch::magnetometer("magnetometer", &args.input, args.accept_sensor_faults),
+            ),
         }
     }
 
@@ -365,6 +376,13 @@ impl Estimation {
     fn step(&mut self, method: &mut Orientation, sample: &ImuSample, header: &[&str]) -> CliResult {
         let k = self.k;
         // Row k + 2: the data rows counted after the header.
+        let (gyro, mag) = &mut self.stuck;
+        if let Some(g) = sample.gyr_rps.as_xyz() {
+            gyro.push(k + 2, sample.t_s, &g.into())?;
+        }
+        if let Some(m) = sample.mag.as_xyz() {
+            mag.push(k + 2, sample.t_s, &m.into())?;
+        }
         let est = method
             .update(sample)
             .map_err(|e| CliError::row(&self.input, k + 2, e.to_string()).kind_of(&e))?;
@@ -429,7 +447,9 @@ impl Estimation {
     }
 
     /// Writes the plot, finishes the output and says where the gaps were.
-    fn finish(self, args: &Args) -> CliResult {
+    fn finish(mut self, args: &Args) -> CliResult {
+        self.stuck.0.finish()?;
+        self.stuck.1.finish()?;
         if let (Some(p), Some(lines)) = (&args.plot, self.plot) {
             lines.write(p)?;
         }

@@ -8,6 +8,8 @@
 
 pub(crate) mod fixes;
 pub(crate) mod refusal;
+pub(crate) mod stuck;
 
 pub use fixes::{fix_columns, fix_pair, say, shell_word};
 pub use refusal::{Refusal, refusals, refuse_or_warn};
+pub use stuck::{MagCells, MagWatch, StuckWatch};
