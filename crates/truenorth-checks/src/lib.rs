@@ -48,7 +48,9 @@ pub mod yaw_rate;
 pub use axes::{AxisFit, SignedPermutation, axes_are_wrong, fit_gyro_axes};
 pub use field_unit::check_field;
 pub use finding::{Finding, FindingKind, Fix};
-pub use inertial::{check_inertial, check_inertial_units, likely_acc_unit};
+pub use inertial::{
+    check_inertial, check_inertial_units, check_rows, check_rows_units, likely_acc_unit,
+};
 pub use spans::{Inertial, Reference, median, median_magnitude};
 pub use stuck_readings::{StuckKind, StuckReadings, StuckRun};
 pub use units::{AccUnit, GyroUnit, MagUnit};

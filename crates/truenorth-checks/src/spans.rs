@@ -17,7 +17,7 @@ pub const SPAN_S: f64 = 0.5;
 pub const NEAR_MEDIAN: f64 = 0.05;
 
 /// Spans whose direction turned by less than this are left out: noise, not motion.
-const MIN_TURN_RAD: f64 = 0.087;
+pub const MIN_TURN_RAD: f64 = 0.087;
 
 /// A span with a step longer than this is left out: the gyro cannot be integrated over it.
 const LONGEST_STEP_S: f64 = 0.1;
@@ -202,12 +202,18 @@ pub fn median_mismatch_deg(
 /// predict to first order: the factor that turns the rates into rad/s (about 1 for rad/s,
 /// π/180 for deg/s read as rad/s). `None` when the rates predict no turn.
 pub fn turn_ratio(rows: &[Inertial], span: &DirectionSpan, gyro: &Matrix3<f64>) -> Option<f64> {
+    let predicted = predicted_turn_rad(rows, span, gyro);
+    (predicted > 0.0).then(|| span.u0.angle(&span.u1) / predicted)
+}
+
+/// The turn of the direction over `span` that the gyro's rates (through `gyro`) predict to
+/// first order, rad.
+pub fn predicted_turn_rad(rows: &[Inertial], span: &DirectionSpan, gyro: &Matrix3<f64>) -> f64 {
     let turned: Vector3<f64> = rows[span.from..=span.to]
         .windows(2)
         .map(|w| gyro * w[0].gyr * (w[1].t_s - w[0].t_s))
         .sum();
-    let predicted = turned.cross(&span.u0).norm();
-    (predicted > 0.0).then(|| span.u0.angle(&span.u1) / predicted)
+    turned.cross(&span.u0).norm()
 }
 
 /// The median of `v` (sorted in place), `None` when empty.

@@ -41,6 +41,10 @@ pub struct Report {
     pub vehicle: Option<VehicleSetReport>,
     /// The satellite fixes, if the file has them.
     pub gnss: Option<GnssReport>,
+    /// What the physics contradicts that no unit explains (the gyro's turns off by a factor
+    /// no unit gives, an accelerometer that reads no gravity), each with what to check:
+    /// `orientation` refuses these.
+    pub no_unit_fits: Vec<String>,
 }
 
 /// The report with the options, as `--json` writes it.
@@ -163,6 +167,9 @@ impl Report {
         }
         if let Some(g) = &self.gnss {
             gnss_line(s, g);
+        }
+        for finding in &self.no_unit_fits {
+            let _ = writeln!(s, "no unit fits: {finding}");
         }
     }
 }

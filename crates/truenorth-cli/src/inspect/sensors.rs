@@ -6,8 +6,8 @@
 use serde::Serialize;
 
 use truenorth::checks::{
-    AccUnit, AxisFit, GyroUnit, Inertial, Reference, SignedPermutation, axes_are_wrong,
-    fit_gyro_axes, likely_acc_unit, median, median_magnitude,
+    AccUnit, AxisFit, Fix, GyroUnit, Inertial, Reference, SignedPermutation, axes_are_wrong,
+    check_rows, fit_gyro_axes, likely_acc_unit, median, median_magnitude,
 };
 
 use super::Recording;
@@ -210,4 +210,16 @@ pub fn mag(rec: &Recording) -> Option<MagReport> {
             .map(|u| u.0)
             .collect(),
     })
+}
+
+/// What `orientation`'s unit check finds that no unit explains (read as rad/s and m/s², the
+/// file's numbers), each as its evidence and what to check.
+pub fn no_unit_fits(rows: &[Inertial]) -> Vec<String> {
+    check_rows(rows, GyroUnit::RadPerS, AccUnit::MetrePerS2)
+        .into_iter()
+        .filter_map(|f| match f.fix {
+            Fix::Advice(advice) => Some(format!("{}; {advice}", f.seen)),
+            _ => None,
+        })
+        .collect()
 }
