@@ -59,3 +59,46 @@ fn a_column_given_twice_is_said_and_the_last_used() {
         "{err}"
     );
 }
+
+/// Magnetometer columns given but never used — every cell empty, or one of the three
+/// missing — are said: the heading is then relative to the start, which the output's
+/// columns do not show.
+#[test]
+fn magnetometer_columns_that_give_no_reading_are_said() {
+    let dir = scratch("column_names", "empty_mag");
+    let rows: String = (0..3000)
+        .map(|k| {
+            let t = k as f64 * 0.01;
+            format!("{t},0.001,0.002,{},0.01,0.02,-9.81,,,\n", 0.3 * t.sin())
+        })
+        .collect();
+    let empty = dir.join("empty.csv");
+    std::fs::write(
+        &empty,
+        format!("t_s,gyr_x,gyr_y,gyr_z,acc_x,acc_y,acc_z,mag_x,mag_y,mag_z\n{rows}"),
+    )
+    .unwrap();
+    let (ok, err) = outcome(&common::orientation(&empty, &dir.join("a.csv"), &[]));
+    assert!(ok, "{err}");
+    assert!(err.contains("present but empty on every row"), "{err}");
+    assert!(err.contains("relative to the start heading"), "{err}");
+    let two: String = rows
+        .lines()
+        .map(|l| format!("{}\n", &l[..l.len() - 1]))
+        .collect();
+    let partial = dir.join("partial.csv");
+    std::fs::write(
+        &partial,
+        format!("t_s,gyr_x,gyr_y,gyr_z,acc_x,acc_y,acc_z,mag_x,mag_y\n{two}"),
+    )
+    .unwrap();
+    let (ok, err) = outcome(&common::orientation(&partial, &dir.join("b.csv"), &[]));
+    assert!(ok, "{err}");
+    assert!(err.contains("only 2 of mag_x, mag_y, mag_z"), "{err}");
+    let (_, err) = outcome(&common::orientation(
+        &empty,
+        &dir.join("c.csv"),
+        &["--no-mag"],
+    ));
+    assert!(!err.contains("magnetometer"), "{err}");
+}

@@ -196,6 +196,7 @@ pub fn run(args: &Args) -> CliResult {
             }
         );
     }
+    let mag_columns = samples.samples.kind().mag_columns();
     let first = samples.first_part(CHECKED_ROWS)?;
     check_units(args, &first)?;
     if samples.peek()?.is_some() {
@@ -217,6 +218,9 @@ pub fn run(args: &Args) -> CliResult {
     drop(first);
     while let Some(sample) = samples.next_sample()? {
         run.step(&mut *method, &sample, &header)?;
+    }
+    if !args.no_mag {
+        say_unused_magnetometer(args, mag_columns, run.stuck.1.readings());
     }
     run.finish(args)
 }
@@ -250,6 +254,24 @@ fn check_units(args: &Args, samples: &[ImuSample]) -> CliResult {
         )),
         None => Ok(()),
     }
+}
+
+/// Says on stderr when magnetometer columns were given but none was used: some of the three
+/// missing, or every row's cells empty. The heading is then relative to the start, as with
+/// `--no-mag`, which the output's columns alone do not say.
+fn say_unused_magnetometer(args: &Args, columns: usize, readings: usize) {
+    let why = match (columns, readings) {
+        (0, _) => return,
+        (1 | 2, _) => format!(
+            "only {columns} of mag_x, mag_y, mag_z are present and the magnetometer needs all three"
+        ),
+        (_, 0) => "mag_x, mag_y, mag_z are present but empty on every row".to_string(),
+        _ => return,
+    };
+    errln!(
+        "warning: {}: {why}: no magnetometer reading was used, so the heading is relative to the start heading and drifts (as with --no-mag)",
+        args.input.display()
+    );
 }
 
 /// Says on stderr when the first [`CHECKED_ROWS`] rows of a longer recording (`first`) hold

@@ -17,6 +17,7 @@ pub struct StuckWatch<const D: usize> {
     input: PathBuf,
     accept: bool,
     warned: bool,
+    readings: usize,
 }
 
 impl<const D: usize> StuckWatch<D> {
@@ -37,11 +38,18 @@ impl<const D: usize> StuckWatch<D> {
             input: input.to_path_buf(),
             accept,
             warned: false,
+            readings: 0,
         }
+    }
+
+    /// Readings taken so far (finite on every axis or not).
+    pub fn readings(&self) -> usize {
+        self.readings
     }
 
     /// Takes the reading `v` of input row `row` at `t_s`.
     pub fn push(&mut self, row: usize, t_s: f64, v: &[f64; D]) -> CliResult {
+        self.readings += 1;
         match self.check.push(row, t_s, v) {
             Some(run) => self.found(&run),
             None => Ok(()),

@@ -280,9 +280,16 @@ pub struct Imu {
     gyr: [usize; 3],
     acc: [usize; 3],
     mag: Option<[usize; 3]>,
+    mag_columns: usize,
 }
 
 impl Imu {
+    /// How many of `mag_x,mag_y,mag_z` the file has (the magnetometer is read with all
+    /// three).
+    pub fn mag_columns(&self) -> usize {
+        self.mag_columns
+    }
+
     /// IMU rows in `gyro` and `acc` units; the magnetometer read when `use_mag`.
     pub fn new(gyro: GyroUnit, acc: AccUnit, use_mag: bool) -> Self {
         Self {
@@ -293,6 +300,7 @@ impl Imu {
             gyr: [0; 3],
             acc: [0; 3],
             mag: None,
+            mag_columns: 0,
         }
     }
 }
@@ -311,6 +319,7 @@ impl SampleKind for Imu {
         self.t = at(rows, "t_s");
         self.gyr = at3(rows, GYR3);
         self.acc = at3(rows, ACC3);
+        self.mag_columns = MAG3.iter().filter(|n| rows.index(n).is_some()).count();
         self.mag = match MAG3.map(|n| rows.index(n)) {
             [Some(x), Some(y), Some(z)] if self.use_mag => Some([x, y, z]),
             _ => None,
