@@ -183,3 +183,44 @@ fn a_frozen_yaw_gyro_is_refused_by_drive() {
     );
     assert!(!output.exists());
 }
+
+/// A drive's right odometer stalled from row 1502 on (its distance repeated while the left
+/// one goes on): named as a stalled odometer with its row, not blamed on a unit or the
+/// track as it was; with `--accept-sensor-faults` it is a warning, and where the estimator
+/// then refuses the spoiled wheels its message names the stall as the cause.
+#[test]
+fn a_stalled_wheel_is_named_not_blamed_on_units() {
+    let dir = dir("stalled_wheel");
+    let log = common::compass_drive_log(&dir);
+    let vehicle = common::rear_vehicle(&dir, 1.5);
+    let text = std::fs::read_to_string(&log).unwrap();
+    let mut lines: Vec<String> = text.lines().map(String::from).collect();
+    let held = lines[1501].split(',').nth(2).unwrap().to_string();
+    for line in &mut lines[1501..] {
+        let mut cells: Vec<&str> = line.split(',').collect();
+        cells[2] = &held;
+        *line = cells.join(",");
+    }
+    let stalled = dir.join("stalled.csv");
+    std::fs::write(&stalled, lines.join("\n") + "\n").unwrap();
+    let output = dir.join("out.csv");
+    let run = common::drive(&vehicle, &stalled, &output, &[]);
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert_eq!(run.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("the right odometer stalled"), "{stderr}");
+    assert!(stderr.contains("row 1503"), "{stderr}");
+    assert!(!stderr.contains("declared units"), "{stderr}");
+    assert!(!output.exists());
+    let run = common::drive(&vehicle, &stalled, &output, &["--accept-sensor-faults"]);
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(
+        stderr.contains("warning") && stderr.contains("stalled"),
+        "{stderr}"
+    );
+    if !run.status.success() {
+        assert!(
+            stderr.contains("stalled at row 1503 explains this"),
+            "{stderr}"
+        );
+    }
+}

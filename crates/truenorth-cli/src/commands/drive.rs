@@ -227,7 +227,12 @@ pub fn run(args: &Args) -> CliResult {
         method.as_mut(),
         &mut writer,
     )
-    .map_err(|e| check.check(&context).err().unwrap_or(e))?;
+    .map_err(|e| {
+        check
+            .check(&context)
+            .err()
+            .unwrap_or_else(|| check.explain(e))
+    })?;
     check.check(&context)?;
     let learned = method.calibration();
     if let (Some(out), Some(learned)) = (&args.calibration_out, &learned) {
@@ -355,6 +360,7 @@ fn diagnosis_context(args: &Args, speeds: bool) -> Context<'_> {
         speeds,
         accept_units: args.accept_units,
         accept_axes: args.accept_axes,
+        accept_sensor_faults: args.accept_sensor_faults,
     }
 }
 

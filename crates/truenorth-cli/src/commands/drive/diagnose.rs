@@ -14,7 +14,7 @@ use truenorth::checks::{FindingKind, GyroUnit, Turns, YawRateCheck};
 use truenorth::core::VehicleSample;
 
 use crate::io::checking::{Refusal, refusals, refuse_or_warn};
-use crate::io::{CliResult, InputOptions};
+use crate::io::{CliError, CliResult, InputOptions, errln};
 
 /// Driving with one wheel's distance falling while the other's rises, m, before a car's
 /// wheel is called negated: a car's wheels never turn opposite ways (only a pivoting
@@ -37,6 +37,35 @@ const MIN_COMPASS_CORRELATION: f64 = 0.5;
 /// with a raw gyro (`comma2k19`), where nothing is wrong.
 const MIN_KM_R2: f64 = 0.8;
 
+/// One wheel's distance unchanged, to the last bit, while the other's advances this far
+/// (m) and the gyro turns less than half of what pivoting about the still wheel would turn
+/// the vehicle: that wheel's odometer stalled. 5 m is over three radians of pivot for a
+/// 1.5 m track, far beyond what a gyro's bias or a wheel's slip hides.
+const STALL_M: f64 = 5.0;
+
+/// A wheel that has not moved while the other has.
+#[derive(Debug, Clone, Copy, Default)]
+struct StillWheel {
+    /// The row where it stopped changing.
+    from_row: usize,
+    /// Its distance then.
+    at_m: f64,
+    /// How far the other wheel has gone since, m.
+    other_m: f64,
+    /// The gyro's integrated turn when it stopped, rad.
+    turn_at_rad: f64,
+}
+
+/// A stalled odometer: which wheel, where, and the evidence.
+#[derive(Debug, Clone, Copy)]
+struct Stall {
+    side: usize,
+    still: StillWheel,
+    /// What pivoting about it would have turned, and what the gyro turned (if any), rad.
+    pivot_rad: f64,
+    gyro_rad: Option<f64>,
+}
+
 /// The running diagnosis of a drive log.
 #[derive(Debug, Clone)]
 pub struct Diagnosis {
@@ -54,6 +83,12 @@ pub struct Diagnosis {
     negated: Option<(usize, usize)>,
     /// The compass's and the wheels' turns over the windows in which the gyro turned.
     compass: CompassTurns,
+    /// The gyro's turn integrated over the log, rad, and its last reading (time, rate).
+    gyro_turn_rad: f64,
+    last_gyro: Option<(f64, f64)>,
+    /// Each wheel while it stays still and the other moves.
+    still: [Option<StillWheel>; 2],
+    stall: Option<Stall>,
 }
 
 /// The compass's turn per window against the gyro's and the wheels': the sums behind two
@@ -185,6 +220,10 @@ impl Diagnosis {
             opposed_m: [0.0; 2],
             negated: None,
             compass: CompassTurns::default(),
+            gyro_turn_rad: 0.0,
+            last_gyro: None,
+            still: [None; 2],
+            stall: None,
         }
     }
 
@@ -192,8 +231,18 @@ impl Diagnosis {
     pub fn push(&mut self, sample: &VehicleSample, row: usize) {
         self.yaw.push_at(sample, row);
         self.compass.push(sample, self.yaw.track_m(), row);
+        if let Some((t0, g0)) = self.last_gyro {
+            self.gyro_turn_rad += g0 * (sample.t_s - t0);
+            self.last_gyro = Some((sample.t_s, g0));
+        }
+        if let Some(g) = sample.gyr_z_rps.filter(|g| g.is_finite()) {
+            self.last_gyro = Some((sample.t_s, g));
+        }
         let Some(w) = sample.wheels else { return };
         let now = [w.dist_l_m, w.dist_r_m];
+        if let Some(last) = self.last_wheels {
+            self.follow_still_wheels(last, now, row);
+        }
         if let Some(last) = self.last_wheels.replace(now)
             && !self.can_pivot
             && self.negated.is_none()
@@ -207,6 +256,65 @@ impl Diagnosis {
                 }
             }
         }
+    }
+
+    /// Follows each wheel that stays still while the other moves, and finds a stall.
+    fn follow_still_wheels(&mut self, last: [f64; 2], now: [f64; 2], row: usize) {
+        let track_m = self.yaw.track_m();
+        for side in 0..2 {
+            let moved = [now[0] - last[0], now[1] - last[1]];
+            if moved[side] != 0.0 || !moved[side].is_finite() {
+                self.still[side] = None;
+                continue;
+            }
+            if moved[1 - side] == 0.0 || !moved[1 - side].is_finite() {
+                continue;
+            }
+            let turn = self.gyro_turn_rad;
+            let still = self.still[side].get_or_insert(StillWheel {
+                from_row: row,
+                at_m: now[side],
+                other_m: 0.0,
+                turn_at_rad: turn,
+            });
+            still.other_m += moved[1 - side].abs();
+            let pivot_rad = still.other_m / track_m;
+            let gyro_rad = self.last_gyro.map(|_| (turn - still.turn_at_rad).abs());
+            // Without a gyro only a whole circle about the still wheel is beyond doubt.
+            let stalled = match gyro_rad {
+                Some(g) => still.other_m >= STALL_M && g < 0.5 * pivot_rad,
+                None => pivot_rad >= 2.0 * PI,
+            };
+            if stalled && self.stall.is_none() {
+                self.stall = Some(Stall {
+                    side,
+                    still: *still,
+                    pivot_rad,
+                    gyro_rad,
+                });
+            }
+        }
+    }
+
+    /// A stalled odometer, said as the evidence and what to do, and its row.
+    fn stall_message(&self, context: &Context) -> Option<(String, usize)> {
+        let s = self.stall?;
+        let names = context.wheel_names();
+        let (name, other) = (&names[s.side], &names[1 - s.side]);
+        let turned = match s.gyro_rad {
+            Some(g) => format!("the gyro turned {:.0}°", g.to_degrees()),
+            None => "a whole circle about one wheel, which no drive makes".to_string(),
+        };
+        Some((
+            format!(
+                "{name} stayed at {} while {other} went {:.1} m: pivoting about that wheel would have turned the vehicle {:.0}°, and {turned}, so the {} odometer stalled (a stuck encoder or a dropped signal), not a unit: leave its cells empty where it stalled, or cut those rows",
+                s.still.at_m,
+                s.still.other_m,
+                s.pivot_rad.to_degrees(),
+                if s.side == 0 { "left" } else { "right" }
+            ),
+            s.still.from_row,
+        ))
     }
 
     /// Everything found, the most telling first: a negated wheel spoils every other
@@ -289,7 +397,33 @@ impl Diagnosis {
 
     /// Refuses the drive on the first finding not accepted (`--accept-units`,
     /// `--accept-axes`), naming the input and the row; says each accepted one on stderr.
+    /// `e` with what explains it when an odometer stalled (accepted, so the estimator met the
+    /// spoiled wheels and refused by their turns).
+    pub fn explain(&self, mut e: CliError) -> CliError {
+        if let Some(s) = self.stall {
+            e.message += &format!(
+                " — the {} odometer that stalled at row {} explains this",
+                if s.side == 0 { "left" } else { "right" },
+                s.still.from_row
+            );
+        }
+        e
+    }
+
+    /// A stalled odometer comes first, alone: it spoils the wheels' comparisons with the
+    /// gyro (`--accept-sensor-faults` says it and skips them).
     pub fn check(&self, context: &Context) -> CliResult {
+        if let Some((message, row)) = self.stall_message(context) {
+            if !context.accept_sensor_faults {
+                return Err(CliError::row(
+                    &context.input,
+                    row,
+                    format!("{message} (or --accept-sensor-faults to go on)"),
+                ));
+            }
+            errln!("warning: {}: row {row}: {message}", context.input.display());
+            return Ok(());
+        }
         refuse_or_warn(
             &self.findings(context),
             &context.input,
@@ -317,6 +451,8 @@ pub struct Context<'a> {
     pub accept_units: bool,
     /// `--accept-axes`.
     pub accept_axes: bool,
+    /// `--accept-sensor-faults`.
+    pub accept_sensor_faults: bool,
 }
 
 impl Context<'_> {
