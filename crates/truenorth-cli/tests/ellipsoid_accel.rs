@@ -253,4 +253,31 @@ fn a_dip_of_the_wrong_sign_for_the_place_is_refused() {
         .collect();
     let (ok, err) = common::outcome(&common::calibrate("ellipsoid-accel", &input, &cal, &right));
     assert!(ok, "{err}");
+    // The same check where the calibration is used: `heading` with the place refuses a
+    // file whose dip has the other sign (here edited), and says it under
+    // --accept-calibration.
+    let mut json = common::read_json(&cal);
+    let dip = json["dip_deg"].as_f64().unwrap();
+    assert!(dip > 10.0, "{dip}");
+    json["dip_deg"] = serde_json::json!(-dip);
+    let flipped = dir.join("flipped.json");
+    std::fs::write(&flipped, serde_json::to_string_pretty(&json).unwrap()).unwrap();
+    let extra = [
+        "--lat",
+        "52.5",
+        "--lon",
+        "13.4",
+        "--date",
+        "2026.5",
+        "--column",
+        "acc_x=-gx,acc_y=-gy,acc_z=-gz",
+    ];
+    let out = dir.join("h.csv");
+    let (ok, err) = common::outcome(&common::heading(&flipped, &input, &out, &extra));
+    assert!(!ok && err.contains("the calibration's dip is -"), "{err}");
+    let (ok, err) = common::outcome(&common::heading(&cal, &input, &out, &extra));
+    assert!(ok, "{err}");
+    let accepted: Vec<&str> = extra.into_iter().chain(["--accept-calibration"]).collect();
+    let (ok, err) = common::outcome(&common::heading(&flipped, &input, &out, &accepted));
+    assert!(ok && err.contains("warning"), "{err}");
 }

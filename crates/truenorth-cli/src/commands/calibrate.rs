@@ -167,25 +167,17 @@ fn expected_field(args: &Args, dimensions: usize) -> CliResult<Option<f64>> {
     Ok(Some(nt / unit.nanotesla()))
 }
 
-/// Inclination the World Magnetic Model must give before the sign of a fitted dip is judged,
-/// degrees: near the magnetic equator the field is nearly level and either sign is the
-/// place's.
-const DIP_SIGN_MIN_DEG: f64 = 10.0;
-
 /// Why a joint calibration's dip `dip_deg` contradicts the place given (`--lat/--lon`): the
 /// field dips down in the northern magnetic hemisphere and up in the southern, so a fitted
 /// dip of the other sign is an accelerometer giving gravity rather than specific force, or
 /// axes swapped — whatever the fit's own residuals say.
 fn dip_against_place(args: &Args, dip_deg: Option<f64>) -> CliResult<Option<String>> {
-    let Some(dip) = dip_deg.filter(|_| args.place.is_given()) else {
+    let Some((dip, model)) = args.place.dip_of_the_other_sign(dip_deg)? else {
         return Ok(None);
     };
-    let model = args.place.field()?.inclination_deg();
-    Ok((model.abs() >= DIP_SIGN_MIN_DEG && dip * model < 0.0).then(|| {
-        format!(
-            "the fitted dip is {dip:+.1}° where the World Magnetic Model gives {model:+.1}° at this place: the field cannot dip the other way, so the accelerometer gives gravity instead of specific force (negate it: --column acc_x=-HEADER,acc_y=-HEADER,acc_z=-HEADER) or its axes or the magnetometer's are swapped (`truenorth inspect` on the recording names them)"
-        )
-    }))
+    Ok(Some(format!(
+        "the fitted dip is {dip:+.1}° where the World Magnetic Model gives {model:+.1}° at this place: the field cannot dip the other way, so the accelerometer gives gravity instead of specific force (negate it: --column acc_x=-HEADER,acc_y=-HEADER,acc_z=-HEADER) or its axes or the magnetometer's are swapped (`truenorth inspect` on the recording names them)"
+    )))
 }
 
 /// A fitted calibration on its way to the file, with what the checks need.

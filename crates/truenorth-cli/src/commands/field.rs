@@ -71,7 +71,23 @@ pub fn run(args: &Args) -> CliResult {
     Ok(())
 }
 
+/// Inclination the World Magnetic Model must give before the sign of a dip is judged,
+/// degrees: near the magnetic equator the field is nearly level and either sign is the
+/// place's.
+const DIP_SIGN_MIN_DEG: f64 = 10.0;
+
 impl PlaceArgs {
+    /// The dip `dip_deg` and the World Magnetic Model's inclination here, when a place is
+    /// given and they have opposite signs beyond the equator's band (±10°): no field dips
+    /// the other way than the place's.
+    pub fn dip_of_the_other_sign(&self, dip_deg: Option<f64>) -> CliResult<Option<(f64, f64)>> {
+        let Some(dip) = dip_deg.filter(|d| d.is_finite() && self.is_given()) else {
+            return Ok(None);
+        };
+        let model = self.field()?.inclination_deg();
+        Ok((model.abs() >= DIP_SIGN_MIN_DEG && dip * model < 0.0).then_some((dip, model)))
+    }
+
     /// Whether a place was given at all (`--lat` or `--lon`).
     pub fn is_given(&self) -> bool {
         self.lat.is_some() || self.lon.is_some()

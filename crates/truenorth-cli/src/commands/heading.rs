@@ -93,7 +93,13 @@ pub fn run(args: &Args) -> CliResult {
     check_inputs(args)?;
     let (file, cal) = CalibrationFile::read(&args.calibration)?;
     let mut doubts = Vec::new();
-    for (refuse, doubt) in calibration_doubts(&file) {
+    let mut found = calibration_doubts(&file);
+    if let Some((dip, model)) = args.place.dip_of_the_other_sign(file.dip_deg)? {
+        found.push((true, format!(
+            "the calibration's dip is {dip:+.1}° where the World Magnetic Model gives {model:+.1}° at --lat/--lon: no field there dips the other way, so the calibration was fitted with an accelerometer giving gravity instead of specific force, or with swapped axes (or belongs to another hemisphere's recording); recalibrate"
+        )));
+    }
+    for (refuse, doubt) in found {
         if refuse && !args.accept_calibration {
             return Err(CliError::file(
                 &args.calibration,
