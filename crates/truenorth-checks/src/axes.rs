@@ -68,6 +68,24 @@ impl SignedPermutation {
     pub fn is_proper(&self) -> bool {
         self.matrix().determinant() > 0.0
     }
+
+    /// The mapping that undoes this one (its matrix's transpose).
+    pub fn inverse(&self) -> Self {
+        let mut out = *self;
+        for b in 0..3 {
+            out.source[self.source[b]] = b;
+            out.sign[self.source[b]] = self.sign[b];
+        }
+        out
+    }
+
+    /// Every axis read with the other sign.
+    pub fn negated(&self) -> Self {
+        Self {
+            source: self.source,
+            sign: self.sign.map(|s| -s),
+        }
+    }
 }
 
 impl fmt::Display for SignedPermutation {
@@ -140,12 +158,22 @@ pub fn reference_spans(rows: &[Inertial]) -> (Vec<DirectionSpan>, (usize, usize)
 /// `None` with fewer than `MIN_SPANS` spans to judge on.
 pub fn fit_gyro_axes(rows: &[Inertial], scale: f64) -> Option<AxisFit> {
     let (spans, counts) = reference_spans(rows);
+    fit_over(rows, &spans, counts, scale)
+}
+
+/// Tries the 48 mappings over `spans` (`counts` of them on gravity and on the field).
+pub fn fit_over(
+    rows: &[Inertial],
+    spans: &[DirectionSpan],
+    counts: (usize, usize),
+    scale: f64,
+) -> Option<AxisFit> {
     if spans.len() < MIN_SPANS {
         return None;
     }
     let mut scored: Vec<(SignedPermutation, f64)> = SignedPermutation::all()
         .into_iter()
-        .filter_map(|p| Some((p, median_mismatch_deg(rows, &spans, &(p.matrix() * scale))?)))
+        .filter_map(|p| Some((p, median_mismatch_deg(rows, spans, &(p.matrix() * scale))?)))
         .collect();
     scored.sort_by(|a, b| a.1.total_cmp(&b.1));
     let (best, best_deg) = *scored.first()?;
@@ -203,5 +231,9 @@ mod tests {
             assert!((m * m.transpose() - Matrix3::identity()).norm() < 1e-12);
         }
         assert_eq!(SignedPermutation::IDENTITY.to_string(), "x=x,y=y,z=z");
+        for p in &all {
+            assert_eq!(p.inverse().matrix(), p.matrix().transpose());
+            assert_eq!(p.negated().matrix(), -p.matrix());
+        }
     }
 }

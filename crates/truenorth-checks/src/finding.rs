@@ -37,6 +37,14 @@ pub enum Fix {
     GyroAxes(SignedPermutation),
     /// The yaw gyro (`gyr_z`) with its sign flipped.
     GyroZSign,
+    /// The magnetometer's axes read through `mirror` (an axis negated or two swapped) or,
+    /// if it is mounted turned, through `rotation` (each as its columns are read now).
+    MagAxes {
+        /// The mapping that undoes a mirror.
+        mirror: SignedPermutation,
+        /// The mapping that undoes a turned mounting.
+        rotation: SignedPermutation,
+    },
     /// What to do, in words, where no declaration reads the data right (a column to
     /// rescale, a value to check).
     Advice(String),

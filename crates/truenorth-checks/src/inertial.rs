@@ -9,6 +9,7 @@ use truenorth_core::{Fixed, ImuSample};
 
 use crate::axes::{axes_are_wrong, fit_gyro_axes};
 use crate::finding::{Finding, Fix};
+use crate::mag_axes::{magnetometer_reads_the_accelerometer, wrong_magnetometer_axes};
 use crate::spans::{DirectionSpan, MIN_TURN_RAD, mismatch_rad, predicted_turn_rad, turn_ratio};
 use crate::spans::{Inertial, Reference, SPAN_S, direction_spans, median, median_magnitude};
 use crate::units::{AccUnit, GyroUnit, STANDARD_GRAVITY_MPS2};
@@ -61,6 +62,26 @@ pub fn check_inertial(samples: &[ImuSample], gyro: GyroUnit, acc: AccUnit) -> Ve
 pub fn check_rows(rows: &[Inertial], gyro: GyroUnit, acc: AccUnit) -> Vec<Finding> {
     let mut findings = check_rows_units(rows, gyro, acc);
     if !findings.is_empty() {
+        return findings;
+    }
+    if magnetometer_reads_the_accelerometer(rows) {
+        findings.push(Finding::axes(
+            "the magnetometer's readings are parallel to the accelerometer's on every row, which no field and specific force are: its columns hold the accelerometer's".into(),
+            Fix::Advice("map mag_x, mag_y, mag_z to the magnetometer's own columns".into()),
+        ));
+        return findings;
+    }
+    if let Some(m) = wrong_magnetometer_axes(rows) {
+        findings.push(Finding::axes(
+            format!(
+                "the gyro turns gravity's direction as the accelerometer sees it ({} spans) but the magnetic field's only read through another mapping (median mismatch {:.1}° as read, {:.1}° so; {} spans): the magnetometer is mirrored or mounted turned",
+                m.spans.0, m.as_read_deg, m.best_deg, m.spans.1
+            ),
+            Fix::MagAxes {
+                mirror: m.mirror_fix,
+                rotation: m.rotation_fix,
+            },
+        ));
         return findings;
     }
     let Some(fit) = fit_gyro_axes(rows, 1.0) else {

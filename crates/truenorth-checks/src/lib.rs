@@ -12,6 +12,8 @@
 //! * [`spans`]: the turns of gravity's and the field's directions between moments they are
 //!   trusted, against the gyro's integrated rotation;
 //! * [`axes`]: the gyro's axes, the best of the 48 signed permutations;
+//! * [`mag_axes`]: the magnetometer's axes, where the gyro and gravity agree and the field
+//!   does not;
 //! * [`inertial`]: the accelerometer's and gyro's units, then the gyro's axes;
 //! * [`yaw_rate`]: a vehicle's yaw gyro against its wheels, streaming;
 //! * [`field_unit`]: a fitted field against an Earth field in the declared unit;
@@ -40,6 +42,7 @@ pub mod compass;
 pub mod field_unit;
 pub mod finding;
 pub mod inertial;
+pub mod mag_axes;
 pub mod spans;
 pub mod stuck_readings;
 pub mod units;
@@ -51,6 +54,7 @@ pub use finding::{Finding, FindingKind, Fix};
 pub use inertial::{
     check_inertial, check_inertial_units, check_rows, check_rows_units, likely_acc_unit,
 };
+pub use mag_axes::{MagAxes, magnetometer_reads_the_accelerometer, wrong_magnetometer_axes};
 pub use spans::{Inertial, Reference, median, median_magnitude};
 pub use stuck_readings::{StuckKind, StuckReadings, StuckRun};
 pub use units::{AccUnit, GyroUnit, MagUnit};

@@ -52,9 +52,9 @@ fn refused(dir: &Path, input: &Path) -> String {
     let report = String::from_utf8_lossy(&inspect.stdout);
     let line = report
         .lines()
-        .find(|l| l.starts_with("no unit fits: "))
+        .find(|l| l.starts_with("found: "))
         .unwrap_or_else(|| panic!("inspect does not say it: {report}"));
-    let evidence = line["no unit fits: ".len()..].split(';').next().unwrap();
+    let evidence = line["found: ".len()..].split(';').next().unwrap();
     assert!(stderr.contains(evidence), "{stderr} / {line}");
     stderr
 }
@@ -129,5 +129,5 @@ fn a_cars_imu_is_not_taken_for_a_wrong_scale() {
     ));
     let inspect = common::ok(&["inspect", common::p(&input), "--column", columns]);
     let report = String::from_utf8_lossy(&inspect.stdout);
-    assert!(!report.contains("no unit fits"), "{report}");
+    assert!(!report.contains("found: "), "{report}");
 }

@@ -82,6 +82,10 @@ fn finding<'py>(py: Python<'py>, f: &Finding) -> PyResult<Bound<'py, PyDict>> {
         }
         Fix::GyroAxes(p) => fix.set_item("gyro_axes", p.to_string())?,
         Fix::GyroZSign => fix.set_item("gyro_axes", "x=x,y=y,z=-z")?,
+        Fix::MagAxes { mirror, rotation } => {
+            fix.set_item("mag_axes", mirror.to_string())?;
+            fix.set_item("mag_axes_rotation", rotation.to_string())?;
+        }
         Fix::Advice(a) => fix.set_item("advice", a)?,
     }
     d.set_item("fix", fix)?;

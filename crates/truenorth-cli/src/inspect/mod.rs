@@ -228,7 +228,7 @@ pub fn analyse(file: &str, scan: &Scan, opts: &InputOptions) -> Report {
         yaw: wheels::yaw(rec, opts),
         vehicle: wheels::vehicle_sensors(rec),
         gnss: gnss::gnss(rec, &scan.columns),
-        no_unit_fits: sensors::no_unit_fits(&rows),
+        findings: sensors::other_findings(&rows, opts),
     }
 }
 

@@ -41,10 +41,11 @@ pub struct Report {
     pub vehicle: Option<VehicleSetReport>,
     /// The satellite fixes, if the file has them.
     pub gnss: Option<GnssReport>,
-    /// What the physics contradicts that no unit explains (the gyro's turns off by a factor
-    /// no unit gives, an accelerometer that reads no gravity), each with what to check:
+    /// What the physics contradicts beyond the units and the gyro's axes — no unit fits
+    /// (the gyro's turns off by a factor no unit gives, an accelerometer that reads no
+    /// gravity), or the magnetometer read through a wrong mapping — each with what to do:
     /// `orientation` refuses these.
-    pub no_unit_fits: Vec<String>,
+    pub findings: Vec<String>,
 }
 
 /// The report with the options, as `--json` writes it.
@@ -71,7 +72,14 @@ impl Report {
         if let Some(u) = self.acc.as_ref().and_then(|a| a.likely_unit) {
             out.push(format!("--acc-unit {u}"));
         }
-        if let Some(fix) = self.axes().filter(|a| a.wrong).and_then(|a| a.fix.as_ref()) {
+        // A magnetometer read wrong makes the gyro look wrong against the field: its fix is
+        // in `findings`, and the gyro's would make things worse.
+        let magnetometer = self
+            .findings
+            .iter()
+            .any(|f| f.contains("magnetometer is mirrored"));
+        let gyro_fix = self.axes().filter(|a| a.wrong && !magnetometer);
+        if let Some(fix) = gyro_fix.and_then(|a| a.fix.as_ref()) {
             out.push(format!("--column {}", shell_word(fix)));
         } else if let Some(fix) = self.yaw.as_ref().and_then(|y| y.fix.as_ref()) {
             out.push(format!("--column {}", shell_word(fix)));
@@ -168,8 +176,8 @@ impl Report {
         if let Some(g) = &self.gnss {
             gnss_line(s, g);
         }
-        for finding in &self.no_unit_fits {
-            let _ = writeln!(s, "no unit fits: {finding}");
+        for finding in &self.findings {
+            let _ = writeln!(s, "found: {finding}");
         }
     }
 }

@@ -12,7 +12,7 @@ use truenorth::checks::{
 
 use super::Recording;
 use crate::io::InputOptions;
-use crate::io::checking::fix_columns;
+use crate::io::checking::{fix_columns, say};
 
 /// The accelerometer.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -212,14 +212,14 @@ pub fn mag(rec: &Recording) -> Option<MagReport> {
     })
 }
 
-/// What `orientation`'s unit check finds that no unit explains (read as rad/s and m/s², the
-/// file's numbers), each as its evidence and what to check.
-pub fn no_unit_fits(rows: &[Inertial]) -> Vec<String> {
+/// What `orientation`'s checks find that the unit and gyro-axis lines do not say: no unit
+/// fits (the gyro's turns off by a factor no unit gives, an accelerometer reading no
+/// gravity), or the magnetometer, not the gyro, read through a wrong mapping; each said as
+/// `orientation` says it (read as rad/s and m/s², the file's numbers, under `opts`).
+pub fn other_findings(rows: &[Inertial], opts: &InputOptions) -> Vec<String> {
     check_rows(rows, GyroUnit::RadPerS, AccUnit::MetrePerS2)
         .into_iter()
-        .filter_map(|f| match f.fix {
-            Fix::Advice(advice) => Some(format!("{}; {advice}", f.seen)),
-            _ => None,
-        })
+        .filter(|f| matches!(f.fix, Fix::Advice(_) | Fix::MagAxes { .. }))
+        .map(|f| say(&f, opts))
         .collect()
 }

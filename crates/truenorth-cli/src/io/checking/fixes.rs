@@ -40,6 +40,11 @@ pub fn say(finding: &Finding, opts: &InputOptions) -> String {
             "{seen}: pass --column {}",
             shell_word(&fix_pair(&FLIP_Z, 2, opts))
         ),
+        Fix::MagAxes { mirror, rotation } => format!(
+            "{seen}: pass --column {} after the options given if an axis is negated or two swapped, or --column {} if the magnetometer is mounted turned",
+            shell_word(&sensor_columns("mag", mirror, opts)),
+            shell_word(&sensor_columns("mag", rotation, opts))
+        ),
         Fix::Advice(advice) => format!("{seen}: {advice}"),
     }
 }
@@ -49,19 +54,24 @@ pub fn say(finding: &Finding, opts: &InputOptions) -> String {
 /// fix composes with both (a later `--column` overrides an earlier one for the same name).
 /// The value as the program takes it; [`shell_word`] quotes it for a command line.
 pub fn fix_columns(fix: &SignedPermutation, opts: &InputOptions) -> String {
-    let pairs: Vec<String> = (0..3).map(|b| pair(fix, b, opts)).collect();
+    sensor_columns("gyr", fix, opts)
+}
+
+/// [`fix_columns`] for the sensor whose columns are `stem_x`, `stem_y`, `stem_z`.
+fn sensor_columns(stem: &str, fix: &SignedPermutation, opts: &InputOptions) -> String {
+    let pairs: Vec<String> = (0..3).map(|b| pair(stem, fix, b, opts)).collect();
     pairs.join(",")
 }
 
 /// The one `--column` pair of [`fix_columns`] for body axis `b`.
 pub fn fix_pair(fix: &SignedPermutation, b: usize, opts: &InputOptions) -> String {
-    pair(fix, b, opts)
+    pair("gyr", fix, b, opts)
 }
 
-/// `gyr_?=[-]HEADER` that reads body axis `b` as `fix` says.
-fn pair(fix: &SignedPermutation, b: usize, opts: &InputOptions) -> String {
-    let (name, _, axis_sign, _) = read_now(b, opts);
-    let (_, header, from_axis_sign, from_map_sign) = read_now(fix.source[b], opts);
+/// `stem_?=[-]HEADER` that reads body axis `b` as `fix` says.
+fn pair(stem: &str, fix: &SignedPermutation, b: usize, opts: &InputOptions) -> String {
+    let (name, _, axis_sign, _) = read_now(stem, b, opts);
+    let (_, header, from_axis_sign, from_map_sign) = read_now(stem, fix.source[b], opts);
     // The signs are ±1, their own inverses: the new mapping's sign undoes the axis
     // convention's for this axis and carries the source's.
     let sign = axis_sign * f64::from(fix.sign[b]) * from_axis_sign * from_map_sign;
@@ -69,12 +79,12 @@ fn pair(fix: &SignedPermutation, b: usize, opts: &InputOptions) -> String {
     format!("{name}={minus}{header}")
 }
 
-/// How body gyro axis `b` is read under `opts`: the sensor column's name, the header it is
-/// read from, the axis convention's sign and the mapping's.
-fn read_now(b: usize, opts: &InputOptions) -> (String, String, f64, f64) {
+/// How body axis `b` of the sensor `stem` is read under `opts`: the sensor column's name,
+/// the header it is read from, the axis convention's sign and the mapping's.
+fn read_now(stem: &str, b: usize, opts: &InputOptions) -> (String, String, f64, f64) {
     const AXES: [char; 3] = ['x', 'y', 'z'];
     let (i, axis_sign) = opts.axes.source_of(b);
-    let name = format!("gyr_{}", AXES[i]);
+    let name = format!("{stem}_{}", AXES[i]);
     let mapping = opts
         .columns
         .iter()
