@@ -27,6 +27,9 @@ pub struct LogConfig {
     /// MCAP only: the `nav_msgs/msg/Odometry` topic for the body's forward speed and yaw rate
     /// (default: the one with the most messages, if any).
     pub odometry_topic: Option<String>,
+    /// MCAP only: the `sensor_msgs/msg/NavSatFix` topic of the satellite fixes (default: the
+    /// one with the most messages, if any).
+    pub gnss_topic: Option<String>,
     /// Keep the messages before a truncated or damaged tail instead of refusing the file
     /// (default `false`: a log cut off by a power loss is reported, not read silently).
     pub accept_incomplete: bool,
@@ -76,6 +79,7 @@ impl LogConfig {
             ("mag_topic", &self.mag_topic),
             ("attitude_topic", &self.attitude_topic),
             ("odometry_topic", &self.odometry_topic),
+            ("gnss_topic", &self.gnss_topic),
         ] {
             if let Some(name) = value {
                 if name.is_empty() {

@@ -41,7 +41,7 @@ use std::panic::{AssertUnwindSafe, catch_unwind};
 
 pub use config::LogConfig;
 pub use error::{LogError, LogFormat, Result};
-pub use recording::{AttitudeSample, OdometrySample, Recording, StreamInfo, TopicInfo};
+pub use recording::{AttitudeSample, GnssFix, OdometrySample, Recording, StreamInfo, TopicInfo};
 
 /// Reads logs with one validated configuration.
 #[derive(Debug, Clone)]

@@ -13,7 +13,8 @@ use crate::config::{LogConfig, NO_TOPIC};
 use crate::error::{LogError, LogFormat, Result};
 use crate::frames::{enu_flu_to_ned_frd, flu_vector_to_frd};
 use crate::recording::{
-    AttitudeSample, OdometrySample, Recording, StreamInfo, TopicInfo, keep_increasing, rate_hz,
+    AttitudeSample, GnssFix, OdometrySample, Recording, StreamInfo, TopicInfo, keep_increasing,
+    rate_hz,
 };
 use crate::ros_msgs::{self, Quat};
 
@@ -35,6 +36,7 @@ enum Kind {
     Imu,
     MagneticField,
     Odometry,
+    NavSatFix,
 }
 
 impl Kind {
@@ -45,6 +47,7 @@ impl Kind {
                 Some(Self::MagneticField)
             }
             "nav_msgs/msg/Odometry" | "nav_msgs/Odometry" => Some(Self::Odometry),
+            "sensor_msgs/msg/NavSatFix" | "sensor_msgs/NavSatFix" => Some(Self::NavSatFix),
             _ => None,
         }
     }
@@ -54,6 +57,7 @@ impl Kind {
             Self::Imu => "sensor_msgs/msg/Imu",
             Self::MagneticField => "sensor_msgs/msg/MagneticField",
             Self::Odometry => "nav_msgs/msg/Odometry",
+            Self::NavSatFix => "sensor_msgs/msg/NavSatFix",
         }
     }
 }
@@ -68,6 +72,7 @@ struct Topic {
     imu: Vec<ImuSample>,
     mag: Vec<Mag3Sample>,
     odometry: Vec<OdometrySample>,
+    gnss: Vec<GnssFix>,
     attitude: Vec<AttitudeSample>,
     non_finite: usize,
     decode_error: Option<(usize, String)>,
@@ -149,11 +154,38 @@ impl Topic {
                     self.attitude.push(AttitudeSample { t_s, attitude });
                 }
             }),
+            Kind::NavSatFix => ros_msgs::decode::<ros_msgs::NavSatFix>(data).map(|m| {
+                // Status −1: no fix (the numbers are whatever the driver left).
+                if m.status.status < 0 {
+                    return;
+                }
+                let (lat_deg, lon_deg) = (m.latitude, m.longitude);
+                if lat_deg.is_finite() && lon_deg.is_finite() {
+                    let t_s = since(origin, stamp_ns(&m.header.stamp, log_time_ns));
+                    self.gnss.push(GnssFix {
+                        t_s,
+                        lat_deg,
+                        lon_deg,
+                        sigma_m: horizontal_sigma_m(&m),
+                    });
+                } else {
+                    self.non_finite += 1;
+                }
+            }),
         };
         if let Err(e) = result {
             self.decode_error.get_or_insert((index, e));
         }
     }
+}
+
+/// The 1σ horizontal error of a fix: the root of the mean of its east and north variances,
+/// when the receiver gives a covariance (type not 0, "unknown") that is usable.
+fn horizontal_sigma_m(m: &ros_msgs::NavSatFix) -> Option<f64> {
+    let c = &m.position_covariance;
+    let variance = 0.5 * (c[0] + c[4]);
+    (m.position_covariance_type != 0 && variance.is_finite() && variance > 0.0)
+        .then(|| variance.sqrt())
 }
 
 /// Reads an MCAP file's bytes.
@@ -337,6 +369,12 @@ fn select(
         &[Kind::Odometry],
         "odometry",
     )?;
+    let gnss_name = choose(
+        &topics,
+        config.gnss_topic.as_deref(),
+        &[Kind::NavSatFix],
+        "gnss",
+    )?;
     let attitude_name = match config.attitude_topic.as_deref() {
         None => None,
         requested => choose(&topics, requested, &[Kind::Imu, Kind::Odometry], "attitude")?,
@@ -376,6 +414,14 @@ fn select(
                 let d = keep_increasing(&mut topic.mag, |s| s.t_s);
                 (d, topic.mag.len(), rate_hz(topic.mag.iter().map(|s| s.t_s)))
             }
+            "gnss" => {
+                let d = keep_increasing(&mut topic.gnss, |s| s.t_s);
+                (
+                    d,
+                    topic.gnss.len(),
+                    rate_hz(topic.gnss.iter().map(|s| s.t_s)),
+                )
+            }
             "odometry" => {
                 let d = keep_increasing(&mut topic.odometry, |s| s.t_s);
                 (
@@ -405,12 +451,14 @@ fn select(
     let imu = take(&Some(imu_name), "imu")?.imu;
     let mag = take(&mag_name, "mag")?.mag;
     let odometry = take(&odometry_name, "odometry")?.odometry;
+    let gnss = take(&gnss_name, "gnss")?.gnss;
     let attitude = take(&attitude_name, "attitude")?.attitude;
 
     let time_origin_s = [
         imu.first().map(|s| s.t_s),
         mag.first().map(|s| s.t_s),
         odometry.first().map(|s| s.t_s),
+        gnss.first().map(|s| s.t_s),
         attitude.first().map(|s| s.t_s),
     ]
     .into_iter()
@@ -431,6 +479,7 @@ fn select(
         mag,
         attitude,
         odometry,
+        gnss,
     };
     shift_times(&mut recording, origin);
     Ok(recording)
@@ -441,4 +490,58 @@ fn shift_times(r: &mut Recording, origin_s: f64) {
     r.mag.iter_mut().for_each(|s| s.t_s -= origin_s);
     r.attitude.iter_mut().for_each(|s| s.t_s -= origin_s);
     r.odometry.iter_mut().for_each(|s| s.t_s -= origin_s);
+    r.gnss.iter_mut().for_each(|s| s.t_s -= origin_s);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn fix(status: i8, lat: f64, covariance_type: u8, variance: f64) -> Vec<u8> {
+        let mut c = [0.0; 9];
+        (c[0], c[4], c[8]) = (variance, variance * 4.0, 9.0);
+        ros_msgs::encode(&ros_msgs::NavSatFix {
+            header: ros_msgs::Header {
+                stamp: ros_msgs::Time {
+                    sec: 1_700_000_000,
+                    nanosec: 500_000_000,
+                },
+                frame_id: "gps".into(),
+            },
+            status: ros_msgs::NavSatStatus { status, service: 1 },
+            latitude: lat,
+            longitude: 13.4,
+            altitude: 40.0,
+            position_covariance: c,
+            position_covariance_type: covariance_type,
+        })
+        .unwrap()
+    }
+
+    /// A fix is kept with the σ its covariance gives (the root of the mean of the east and
+    /// north variances); "no fix" and non-finite positions are not; an unknown covariance
+    /// gives no σ.
+    #[test]
+    fn fixes_are_read_with_their_sigma_and_no_fix_is_left_out() {
+        let mut topic = Topic::default();
+        let mut origin = None;
+        for (status, lat, kind) in [(0, 52.5, 2), (-1, 52.5, 2), (0, f64::NAN, 2), (1, 52.6, 0)] {
+            topic.messages += 1;
+            topic.take(
+                Kind::NavSatFix,
+                &fix(status, lat, kind, 2.25),
+                0,
+                &mut origin,
+            );
+        }
+        assert_eq!(topic.gnss.len(), 2);
+        assert_eq!(topic.non_finite, 1);
+        let sigma = topic.gnss[0].sigma_m.unwrap();
+        assert!(
+            (sigma - (0.5f64 * (2.25 + 9.0)).sqrt()).abs() < 1e-12,
+            "{sigma}"
+        );
+        assert_eq!((topic.gnss[1].lat_deg, topic.gnss[1].sigma_m), (52.6, None));
+        assert_eq!(Kind::of("sensor_msgs/msg/NavSatFix"), Some(Kind::NavSatFix));
+    }
 }

@@ -26,6 +26,19 @@ pub struct OdometrySample {
     pub yaw_rate_rps: f64,
 }
 
+/// A satellite fix, as a receiver gives it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GnssFix {
+    /// Time, s, on the recording's clock.
+    pub t_s: f64,
+    /// Latitude, degrees (WGS84).
+    pub lat_deg: f64,
+    /// Longitude, degrees (WGS84).
+    pub lon_deg: f64,
+    /// 1σ horizontal error the receiver gives, m, when it gives one.
+    pub sigma_m: Option<f64>,
+}
+
 /// One topic of the file: its name, instance (ULog) or message type (MCAP), and message count.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct TopicInfo {
@@ -89,6 +102,8 @@ pub struct Recording {
     pub attitude: Vec<AttitudeSample>,
     /// Body velocity and yaw rate (MCAP odometry).
     pub odometry: Vec<OdometrySample>,
+    /// Satellite fixes (MCAP `sensor_msgs/msg/NavSatFix` with a fix), if a topic has them.
+    pub gnss: Vec<GnssFix>,
 }
 
 impl Recording {
@@ -173,6 +188,7 @@ mod tests {
                 .collect(),
             attitude: Vec::new(),
             odometry: Vec::new(),
+            gnss: Vec::new(),
         }
     }
 

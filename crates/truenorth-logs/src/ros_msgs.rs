@@ -1,5 +1,6 @@
 //! The ROS 2 messages this crate reads, laid out field for field as their `.msg` definitions
-//! (`sensor_msgs/msg/Imu`, `sensor_msgs/msg/MagneticField`, `nav_msgs/msg/Odometry` and the
+//! (`sensor_msgs/msg/Imu`, `sensor_msgs/msg/MagneticField`, `nav_msgs/msg/Odometry`,
+//! `sensor_msgs/msg/NavSatFix` and the
 //! `std_msgs` / `geometry_msgs` types inside them), and their CDR decoding through the
 //! `cdr-encoding` crate. A serialized ROS 2 message is a 4-byte encapsulation header (its
 //! second byte 0 for big-endian, 1 for little-endian plain CDR; OMG DDS-XTypes 1.3, 7.6.3.1.2)
@@ -86,6 +87,34 @@ pub struct MagneticField {
     pub magnetic_field: Vec3,
     /// Row-major 3×3 covariance.
     pub magnetic_field_covariance: [f64; 9],
+}
+
+/// `sensor_msgs/msg/NavSatStatus`.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct NavSatStatus {
+    /// −1 no fix, 0 fix, 1 with satellite augmentation, 2 with ground augmentation.
+    pub status: i8,
+    /// The constellations used (bit field).
+    pub service: u16,
+}
+
+/// `sensor_msgs/msg/NavSatFix`.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct NavSatFix {
+    /// Stamp and frame.
+    pub header: Header,
+    /// Whether there is a fix.
+    pub status: NavSatStatus,
+    /// Latitude, degrees (WGS84), north positive.
+    pub latitude: f64,
+    /// Longitude, degrees (WGS84), east positive.
+    pub longitude: f64,
+    /// Altitude above the WGS84 ellipsoid, m.
+    pub altitude: f64,
+    /// Row-major 3×3 covariance of the position in east, north, up, m².
+    pub position_covariance: [f64; 9],
+    /// 0 unknown, 1 approximated, 2 diagonal known, 3 known.
+    pub position_covariance_type: u8,
 }
 
 /// `geometry_msgs/msg/Pose`.

@@ -547,5 +547,6 @@ fn finish(mut g: Gathered, config: &LogConfig, complete: bool) -> Result<Recordi
         mag,
         attitude: g.attitude,
         odometry: Vec::new(),
+        gnss: Vec::new(),
     })
 }

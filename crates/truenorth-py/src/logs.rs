@@ -21,6 +21,9 @@ use crate::convert::{TruenorthError, array1, array2};
 ///   estimate;
 /// * `odometry`: `t_s` (J), `velocity_mps` (J×3, body axes), `yaw_rate_rps` (J, positive
 ///   turning right);
+/// * `gnss`: `t_s` (F), `lat_deg`, `lon_deg` (F, WGS84), `sigma_m` (F, 1σ horizontal from the
+///   fix's covariance, NaN where it gives none): an MCAP's `sensor_msgs/msg/NavSatFix` fixes
+///   (messages with no fix left out), ready for `VehicleEstimator`'s `gnss=`;
 /// * `format` (`"PX4 ULog"` or `"MCAP"`), `complete`, `time_origin_s`, `topics` (a list of
 ///   dicts `name`, `kind`, `messages`) and `streams` (`role`, `topic`, `samples`,
 ///   `dropped`, `rate_hz`).
@@ -30,7 +33,7 @@ use crate::convert::{TruenorthError, array1, array2};
 /// topic, a corrupt file or (without `accept_incomplete`) a truncated one raises
 /// `TruenorthError` with the reader's message (a missing topic's names the topics present).
 #[pyfunction]
-#[pyo3(signature = (path, imu_topic=None, mag_topic=None, attitude_topic=None, odometry_topic=None, accept_incomplete=false))]
+#[pyo3(signature = (path, imu_topic=None, mag_topic=None, attitude_topic=None, odometry_topic=None, accept_incomplete=false, gnss_topic=None))]
 pub fn read_log<'py>(
     py: Python<'py>,
     path: PathBuf,
@@ -39,12 +42,14 @@ pub fn read_log<'py>(
     attitude_topic: Option<String>,
     odometry_topic: Option<String>,
     accept_incomplete: bool,
+    gnss_topic: Option<String>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let config = LogConfig {
         imu_topic,
         mag_topic,
         attitude_topic,
         odometry_topic,
+        gnss_topic,
         accept_incomplete,
     };
     let read = py.detach(|| LogReader::new(config)?.read_path(&path));
@@ -132,6 +137,23 @@ fn recording_dict<'py>(py: Python<'py>, r: &Recording) -> PyResult<Bound<'py, Py
         "yaw_rate_rps",
         array1(py, r.odometry.iter().map(|s| s.yaw_rate_rps).collect()),
     )?;
+    let gnss = PyDict::new(py);
+    gnss.set_item("t_s", array1(py, r.gnss.iter().map(|s| s.t_s).collect()))?;
+    gnss.set_item(
+        "lat_deg",
+        array1(py, r.gnss.iter().map(|s| s.lat_deg).collect()),
+    )?;
+    gnss.set_item(
+        "lon_deg",
+        array1(py, r.gnss.iter().map(|s| s.lon_deg).collect()),
+    )?;
+    gnss.set_item(
+        "sigma_m",
+        array1(
+            py,
+            r.gnss.iter().map(|s| s.sigma_m.unwrap_or(f64::NAN)).collect(),
+        ),
+    )?;
     let topics = PyList::empty(py);
     for t in &r.topics {
         let d = PyDict::new(py);
@@ -160,5 +182,6 @@ fn recording_dict<'py>(py: Python<'py>, r: &Recording) -> PyResult<Bound<'py, Py
     out.set_item("mag", mag)?;
     out.set_item("attitude", attitude)?;
     out.set_item("odometry", odometry)?;
+    out.set_item("gnss", gnss)?;
     Ok(out)
 }

@@ -262,6 +262,8 @@ class Log(TypedDict):
     """`t_s` (K), `quaternion` (K x 4, qw qx qy qz, body -> NED)."""
     odometry: dict[str, FloatArray]
     """`t_s` (J), `velocity_mps` (J x 3, body axes), `yaw_rate_rps` (J, + turning right)."""
+    gnss: dict[str, FloatArray]
+    """`t_s`, `lat_deg`, `lon_deg`, `sigma_m` (F each): an MCAP's NavSatFix fixes."""
 
 def read_log(
     path: str | os.PathLike[str],
@@ -270,6 +272,7 @@ def read_log(
     attitude_topic: Optional[str] = None,
     odometry_topic: Optional[str] = None,
     accept_incomplete: bool = False,
+    gnss_topic: Optional[str] = None,
 ) -> Log:
     """A PX4 ULog or ROS 2 MCAP log as arrays per stream (seconds, FRD body axes, rad/s,
     m/s^2, uT), as the `truenorth` command reads it; `mag_topic="none"`: no magnetometer."""
@@ -293,4 +296,5 @@ def check_imu(
     """The gyro's and accelerometer's units and the gyro's axes checked against the physics
     (one gravity at rest; gravity's and the field's directions turning as the gyro says): the
     checks `truenorth orientation` refuses by. Empty when nothing contradicts them; `fix`
-    holds `gyro_unit`, `acc_unit` or `gyro_axes` (`x=-y,y=x,z=z`)."""
+    holds `gyro_unit`, `acc_unit`, `gyro_axes` (`x=-y,y=x,z=z`), `mag_axes` with
+    `mag_axes_rotation` (a mirrored or turned magnetometer) or `advice` (no unit fits)."""

@@ -27,6 +27,10 @@ pub struct LogOptions {
     /// (default: the one with the most messages).
     #[arg(long, value_name = "TOPIC")]
     pub odometry_topic: Option<String>,
+    /// MCAP input: the `sensor_msgs/msg/NavSatFix` topic `drive` reads satellite fixes from
+    /// (default: the one with the most messages, if any).
+    #[arg(long, value_name = "TOPIC")]
+    pub gnss_topic: Option<String>,
     /// ULog/MCAP input: read the messages before a truncated or damaged end (with a warning)
     /// instead of refusing the file.
     #[arg(long)]
@@ -41,6 +45,7 @@ impl LogOptions {
             mag_topic: self.mag_topic.clone(),
             attitude_topic: self.attitude_topic.clone(),
             odometry_topic: self.odometry_topic.clone(),
+            gnss_topic: self.gnss_topic.clone(),
             accept_incomplete: self.accept_incomplete,
         }
     }
@@ -64,6 +69,7 @@ impl LogOptions {
             ("--mag-topic", self.mag_topic.is_some()),
             ("--attitude-topic", self.attitude_topic.is_some()),
             ("--odometry-topic", self.odometry_topic.is_some()),
+            ("--gnss-topic", self.gnss_topic.is_some()),
             ("--accept-incomplete", self.accept_incomplete),
         ] {
             if set {

@@ -20,6 +20,7 @@ pub struct AxleTrack {
 const IMU: [&str; 6] = ["gyr_x", "gyr_y", "gyr_z", "acc_x", "acc_y", "acc_z"];
 const MAG: [&str; 3] = ["mag_x", "mag_y", "mag_z"];
 const WHEELS: [&str; 2] = ["speed_l_mps", "speed_r_mps"];
+const GNSS: [&str; 3] = ["lat_deg", "lon_deg", "gnss_sigma_m"];
 
 /// A log as a table of numbers: the header a CSV of it would have (`t_s` first) and its
 /// rows, one after the other; NaN is an empty cell (no reading of that stream on the row).
@@ -136,15 +137,20 @@ fn imu_rows(r: &Recording, mag_only: bool) -> LogTable {
 }
 
 /// Every stream at its own times: one row per distinct time, an empty cell where a stream
-/// has no reading then; the odometry as wheel speeds when an axle is given.
+/// has no reading then; the odometry as wheel speeds and the satellite fixes when an axle is
+/// given (`drive`).
 fn merged(r: &Recording, axle: Option<AxleTrack>) -> LogTable {
     // (time, stream, index), ordered by time and then by stream, so that readings at the
     // same instant share a row.
     let mut events: Vec<(f64, u8, usize)> = Vec::new();
     events.extend(r.imu.iter().enumerate().map(|(k, s)| (s.t_s, 0, k)));
     events.extend(r.mag.iter().enumerate().map(|(k, s)| (s.t_s, 1, k)));
+    let gnss = axle.is_some() && !r.gnss.is_empty();
     if axle.is_some() {
         events.extend(r.odometry.iter().enumerate().map(|(k, s)| (s.t_s, 2, k)));
+    }
+    if gnss {
+        events.extend(r.gnss.iter().enumerate().map(|(k, s)| (s.t_s, 3, k)));
     }
     events.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
     let mut columns: Vec<&[&'static str]> = vec![&IMU];
@@ -154,11 +160,15 @@ fn merged(r: &Recording, axle: Option<AxleTrack>) -> LogTable {
     if axle.is_some() {
         columns.push(&WHEELS);
     }
+    if gnss {
+        columns.push(&GNSS);
+    }
     let mut table = LogTable::new(&columns, events.len());
     let mut k = 0;
     while k < events.len() {
         let t = events[k].0;
         let (mut imu, mut mag, mut odo) = ([f64::NAN; 6], [f64::NAN; 3], [f64::NAN; 2]);
+        let mut fix = [f64::NAN; 3];
         while k < events.len() && events[k].0 == t {
             let (_, stream, i) = events[k];
             match stream {
@@ -170,6 +180,10 @@ fn merged(r: &Recording, axle: Option<AxleTrack>) -> LogTable {
                     }
                 }
                 1 => mag = [r.mag[i].mag.x, r.mag[i].mag.y, r.mag[i].mag.z],
+                3 => {
+                    let g = &r.gnss[i];
+                    fix = [g.lat_deg, g.lon_deg, g.sigma_m.unwrap_or(f64::NAN)];
+                }
                 _ => {
                     if let Some(AxleTrack { track_m }) = axle {
                         // A right turn (positive yaw rate about z down) drives the left
@@ -189,6 +203,9 @@ fn merged(r: &Recording, axle: Option<AxleTrack>) -> LogTable {
         }
         if axle.is_some() {
             table.values.extend(odo);
+        }
+        if gnss {
+            table.values.extend(fix);
         }
     }
     table
@@ -219,6 +236,7 @@ mod tests {
                 .collect(),
             mag: vec![Mag3Sample::new(0.15, 20.0, -1e-7, 45.5)],
             attitude: Vec::new(),
+            gnss: Vec::new(),
             odometry: vec![OdometrySample {
                 t_s: 0.2,
                 velocity_mps: Vector3::new(1.0, 0.0, 0.0),

@@ -1,0 +1,204 @@
+//! `drive` on a ROS 2 bag with satellite fixes (`sensor_msgs/msg/NavSatFix`): the fixes are
+//! read as the CSV's `lat_deg,lon_deg,gnss_sigma_m` (σ from the fix's covariance; "no fix"
+//! messages left out), so the track is on the fixes' tangent plane and true north, and
+//! `inspect` lists the stream.
+
+mod common;
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use common::{ok, p, scratch};
+use truenorth_logs::ros_msgs::{
+    self, Header, Imu, NavSatFix, NavSatStatus, Odometry, Time, Twist, TwistWithCovariance, Vec3,
+};
+
+const START_SEC: i32 = 1_750_000_000;
+const SPEED_MPS: f64 = 5.0;
+/// Berlin, where the drive starts (WGS84 degrees), and the Earth's radius for the small
+/// steps between fixes, m.
+const LAT0: f64 = 52.5;
+const LON0: f64 = 13.4;
+const EARTH_M: f64 = 6_378_137.0;
+
+fn header(t_s: f64, frame: &str) -> Header {
+    let ns = (t_s * 1e9).round() as u64;
+    Header {
+        stamp: Time {
+            sec: START_SEC + (ns / 1_000_000_000) as i32,
+            nanosec: (ns % 1_000_000_000) as u32,
+        },
+        frame_id: frame.into(),
+    }
+}
+
+/// The yaw rate (NED, positive turning right) at `t_s`: straight east for 20 s, a right
+/// turn at 0.1 rad/s for 15 s, straight again.
+fn yaw_rate(t_s: f64) -> f64 {
+    if (20.0..35.0).contains(&t_s) {
+        0.1
+    } else {
+        0.0
+    }
+}
+
+/// The true track at 100 Hz: (t, north, east, heading).
+fn truth() -> Vec<(f64, f64, f64, f64)> {
+    let (mut n, mut e, mut psi) = (0.0, 0.0, std::f64::consts::FRAC_PI_2);
+    (0..6000)
+        .map(|k| {
+            let t = k as f64 * 0.01;
+            let row = (t, n, e, psi);
+            n += SPEED_MPS * psi.cos() * 0.01;
+            e += SPEED_MPS * psi.sin() * 0.01;
+            psi += yaw_rate(t) * 0.01;
+            row
+        })
+        .collect()
+}
+
+/// A minute of a car in a bag: IMU at 50 Hz, odometry at 20 Hz, fixes at 5 Hz (σ 2 m; the
+/// first second "no fix").
+fn write_bag(path: &Path) -> (f64, f64) {
+    let truth = truth();
+    let ns = |t_s: f64| (START_SEC as u64) * 1_000_000_000 + (t_s * 1e9).round() as u64;
+    let mut messages: Vec<(&str, u64, Vec<u8>)> = Vec::new();
+    for (k, &(t, n, e, _)) in truth.iter().enumerate() {
+        // ROS bodies are FLU: a right turn is a negative rate about z (up).
+        let flu_rate = -yaw_rate(t);
+        if k % 2 == 0 {
+            let m = Imu {
+                header: header(t, "imu"),
+                angular_velocity: Vec3 {
+                    x: 0.0,
+                    y: 0.0,
+                    z: flu_rate,
+                },
+                linear_acceleration: Vec3 {
+                    x: 0.0,
+                    y: 0.0,
+                    z: 9.81,
+                },
+                orientation_covariance: [-1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+                ..Imu::default()
+            };
+            messages.push(("/imu", ns(t), ros_msgs::encode(&m).unwrap()));
+        }
+        if k % 5 == 0 {
+            let m = Odometry {
+                header: header(t, "odom"),
+                child_frame_id: "base_link".into(),
+                twist: TwistWithCovariance {
+                    twist: Twist {
+                        linear: Vec3 {
+                            x: SPEED_MPS,
+                            y: 0.0,
+                            z: 0.0,
+                        },
+                        angular: Vec3 {
+                            x: 0.0,
+                            y: 0.0,
+                            z: flu_rate,
+                        },
+                    },
+                    ..TwistWithCovariance::default()
+                },
+                ..Odometry::default()
+            };
+            messages.push(("/odom", ns(t), ros_msgs::encode(&m).unwrap()));
+        }
+        if k % 20 == 10 {
+            let mut covariance = [0.0; 9];
+            (covariance[0], covariance[4], covariance[8]) = (4.0, 4.0, 16.0);
+            let m = NavSatFix {
+                header: header(t, "gps"),
+                status: NavSatStatus {
+                    status: if t < 1.0 { -1 } else { 0 },
+                    service: 1,
+                },
+                latitude: LAT0 + (n / EARTH_M).to_degrees(),
+                longitude: LON0 + (e / (EARTH_M * LAT0.to_radians().cos())).to_degrees(),
+                altitude: 40.0,
+                position_covariance: covariance,
+                position_covariance_type: 2,
+            };
+            messages.push(("/fix", ns(t), ros_msgs::encode(&m).unwrap()));
+        }
+    }
+    messages.sort_by_key(|m| m.1);
+    let mut bytes = Vec::new();
+    {
+        let mut w = mcap::WriteOptions::new()
+            .create(std::io::Cursor::new(&mut bytes))
+            .unwrap();
+        let mut channels = BTreeMap::new();
+        for (topic, schema) in [
+            ("/imu", "sensor_msgs/msg/Imu"),
+            ("/odom", "nav_msgs/msg/Odometry"),
+            ("/fix", "sensor_msgs/msg/NavSatFix"),
+        ] {
+            let id = w.add_schema(schema, "ros2msg", b"").unwrap();
+            let channel = w.add_channel(id, topic, "cdr", &BTreeMap::new()).unwrap();
+            channels.insert(topic, channel);
+        }
+        for (seq, (topic, log_time, data)) in messages.into_iter().enumerate() {
+            let header = mcap::records::MessageHeader {
+                channel_id: channels[topic],
+                sequence: seq as u32,
+                log_time,
+                publish_time: log_time,
+            };
+            w.write_to_known_channel(&header, &data).unwrap();
+        }
+        w.finish().unwrap();
+    }
+    std::fs::write(path, bytes).unwrap();
+    let &(_, n, e, _) = truth.last().unwrap();
+    (n, e)
+}
+
+#[test]
+fn a_bag_with_fixes_drives_on_them() {
+    let dir = scratch("mcap_gnss", "drive");
+    let bag = dir.join("car.mcap");
+    let (north_m, east_m) = write_bag(&bag);
+    let vehicle = dir.join("car.json");
+    std::fs::write(&vehicle, r#"{"track_m": 1.5, "odometer_wheels": "rear"}"#).unwrap();
+    let track = dir.join("track.csv");
+    let run = ok(&[
+        "drive",
+        "--vehicle",
+        p(&vehicle),
+        "--input",
+        p(&bag),
+        "--output",
+        p(&track),
+        "--extra",
+        "geodetic",
+    ]);
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(stderr.contains("satellite fixes: "), "{stderr}");
+    assert!(stderr.contains("from the satellite fixes"), "{stderr}");
+    let (header, rows) = common::table(&track, true);
+    let col = |name: &str| header.iter().position(|h| h == name).unwrap();
+    let last = rows.last().unwrap();
+    // The tangent plane is at the first fix, 1 s (5 m east) after the start.
+    let (n, e) = (last[col("north_m")], last[col("east_m")]);
+    let error = (n - north_m).hypot(e - (east_m - SPEED_MPS));
+    assert!(
+        error < 3.0,
+        "end {n:.2} N {e:.2} E, truth {north_m:.2} N {:.2} E",
+        east_m - 5.0
+    );
+    let lat = last[col("lat_deg")];
+    assert!(
+        (lat - (LAT0 + (north_m / EARTH_M).to_degrees())).abs() < 3e-5,
+        "{lat}"
+    );
+    let report = ok(&["inspect", p(&bag)]);
+    let report = String::from_utf8_lossy(&report.stdout);
+    assert!(
+        report.contains("/fix (sensor_msgs/msg/NavSatFix, 300 messages"),
+        "{report}"
+    );
+}
