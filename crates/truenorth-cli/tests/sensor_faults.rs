@@ -34,8 +34,16 @@ fn recording(dir: &Path, fault: impl Fn(usize, &mut [f64; 10])) -> PathBuf {
 }
 
 /// `orientation` on `input`: refused with no output, naming `says`; then with
-/// `--accept-sensor-faults` it runs and warns.
+/// `--accept-sensor-faults` it runs and warns; `inspect` names the same fault.
 fn orientation_refuses(dir: &Path, input: &Path, says: &str) {
+    let report = common::ok(&["inspect", common::p(input)]);
+    let report = String::from_utf8_lossy(&report.stdout);
+    assert!(
+        report
+            .lines()
+            .any(|l| l.starts_with("fault: ") && l.contains(says)),
+        "{report}"
+    );
     let output = dir.join("attitude.csv");
     let run = common::orientation(input, &output, &[]);
     let stderr = String::from_utf8_lossy(&run.stderr);
@@ -57,6 +65,8 @@ fn a_clean_recording_runs() {
     let dir = dir("clean");
     let input = recording(&dir, |_, _| {});
     common::succeeded(common::orientation(&input, &dir.join("a.csv"), &[]));
+    let report = common::ok(&["inspect", common::p(&input)]);
+    assert!(!String::from_utf8_lossy(&report.stdout).contains("fault: "));
 }
 
 #[test]

@@ -10,6 +10,7 @@
 //! * [`report`]: the whole report, as a table or JSON, and the options to pass.
 
 pub mod column_stats;
+pub mod faults;
 pub mod gnss;
 pub mod report;
 pub mod sensors;
@@ -21,6 +22,7 @@ use truenorth::checks::Inertial;
 
 use crate::io::{CliError, CliResult, InputOptions, RowReader};
 use column_stats::{ColumnScan, ColumnStats, TimeOrder};
+use faults::FaultScan;
 use report::Report;
 
 /// The units, axes and wheels are judged on a recording's first this many rows (87
@@ -79,6 +81,8 @@ pub struct Scan {
     pub time_not_increasing: usize,
     /// `t_s` and every column of [`COLUMNS`] present, over every row.
     pub columns: Vec<ColumnStats>,
+    /// Readings no live sensor gives, one line a sensor, over every row.
+    pub sensor_faults: Vec<String>,
 }
 
 /// A [`Scan`] as the rows arrive.
@@ -88,6 +92,7 @@ struct Scanner {
     order: TimeOrder,
     /// `t_s`'s summary, then each column's, in the recording's order.
     columns: Vec<ColumnScan>,
+    faults: FaultScan,
 }
 
 impl Scanner {
@@ -103,12 +108,15 @@ impl Scanner {
                 .chain(names.iter().map(String::as_str))
                 .map(ColumnScan::new)
                 .collect(),
+            faults: FaultScan::new(names),
         }
     }
 
-    /// Takes a row: its time and its cells in the order of the names given to `new`.
-    fn push(&mut self, t_s: f64, cells: impl Iterator<Item = f64> + Clone) {
+    /// Takes input row `row`: its time and its cells in the order of the names given to
+    /// `new`.
+    fn push(&mut self, row: usize, t_s: f64, cells: impl Iterator<Item = f64> + Clone) {
         self.rows += 1;
+        self.faults.push(row, t_s, cells.clone());
         self.order.push(t_s);
         self.columns[0].push(t_s, t_s);
         for (scan, v) in self.columns[1..].iter_mut().zip(cells.clone()) {
@@ -128,6 +136,7 @@ impl Scanner {
             rows: self.rows,
             time_not_increasing: self.order.not_increasing,
             columns: self.columns.into_iter().map(ColumnScan::finish).collect(),
+            sensor_faults: self.faults.finish(),
         }
     }
 }
@@ -146,7 +155,7 @@ impl Scan {
         let mut scanner = Scanner::new(&names);
         while let Some(row) = rows.next_row()? {
             let cells = present.iter().map(|(_, i)| row.values[*i]);
-            scanner.push(row.values[t_index], cells);
+            scanner.push(row.number, row.values[t_index], cells);
         }
         if scanner.rows == 0 {
             return Err(CliError::row(
@@ -164,7 +173,7 @@ impl Scan {
         let names: Vec<String> = rec.columns.iter().map(|c| c.0.clone()).collect();
         let mut scanner = Scanner::new(&names);
         for (k, t) in rec.t_s.iter().enumerate() {
-            scanner.push(*t, rec.columns.iter().map(move |c| c.1[k]));
+            scanner.push(k + 2, *t, rec.columns.iter().map(move |c| c.1[k]));
         }
         scanner.finish()
     }
@@ -221,6 +230,7 @@ pub fn analyse(file: &str, scan: &Scan, opts: &InputOptions) -> Report {
         judged_rows: rec.t_s.len(),
         time_not_increasing: scan.time_not_increasing,
         columns: scan.columns.clone(),
+        sensor_faults: scan.sensor_faults.clone(),
         acc: sensors::acc(rec, &rows),
         gyro: sensors::gyro(rec, &rows, opts),
         mag: sensors::mag(rec),

@@ -46,6 +46,9 @@ pub struct Report {
     /// gravity), or the magnetometer read through a wrong mapping — each with what to do:
     /// `orientation` refuses these.
     pub findings: Vec<String>,
+    /// Readings no live sensor gives (clipped, frozen, a zero field), one line a sensor,
+    /// over every row: `calibrate`, `heading`, `orientation` and `drive` refuse these.
+    pub sensor_faults: Vec<String>,
 }
 
 /// The report with the options, as `--json` writes it.
@@ -178,6 +181,9 @@ impl Report {
         }
         for finding in &self.findings {
             let _ = writeln!(s, "found: {finding}");
+        }
+        for fault in &self.sensor_faults {
+            let _ = writeln!(s, "fault: {fault}");
         }
     }
 }
