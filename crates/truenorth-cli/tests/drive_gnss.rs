@@ -98,3 +98,48 @@ fn the_antenna_s_lever_arm_is_read_and_checked() {
     let (ok, stderr) = common::outcome(&o);
     assert!(!ok && stderr.contains("gnss_lever_arm_m"), "{stderr}");
 }
+
+/// The head of a drive, run again once the sensors are known, comes out in the fixes'
+/// plane like the rest: with fixes alone (they refer the heading to true north) and with a
+/// compass that refers it to magnetic north first, every row with a position has its
+/// latitude and the track
+/// no jump larger than the vehicle's own steps and the fixes' corrections (it jumped by the
+/// start's distance from the first fix where the rows before switched frames).
+#[test]
+fn the_whole_track_is_on_the_plane() {
+    for (name, set) in [
+        ("fixes", SensorSet::WHEELS_GYRO),
+        ("compass", SensorSet::WHEELS_GYRO.with_compass()),
+    ] {
+        let dir = scratch("drive_gnss", name);
+        let d = LogDrive::new(LogDriveConfig::new(2, VehicleKind::RearWheelCar, set).with_gnss())
+            .unwrap();
+        let input = dir.join("drive.csv");
+        std::fs::write(&input, d.to_csv()).unwrap();
+        let vehicle = common::rear_vehicle(&dir, d.vehicle.wheels.track_m());
+        let out = dir.join("out.csv");
+        common::succeeded(common::drive(
+            &vehicle,
+            &input,
+            &out,
+            &["--extra", "geodetic"],
+        ));
+        let (header, rows) = common::table(&out, true);
+        let lat = header.iter().position(|h| h == "lat_deg").unwrap();
+        // Rows before the wheels' first reading have no position at all.
+        let without = rows
+            .iter()
+            .filter(|r| r[1].is_finite() && r[lat].is_nan())
+            .count();
+        let step = rows
+            .windows(2)
+            .map(|w| (w[1][1] - w[0][1]).hypot(w[1][2] - w[0][2]))
+            .fold(0.0, f64::max);
+        println!(
+            "{name}: {without} of {} rows off the plane, largest step {step:.2} m",
+            rows.len()
+        );
+        assert_eq!(without, 0, "{name}");
+        assert!(step < 5.0, "{name}: a step of {step:.2} m");
+    }
+}

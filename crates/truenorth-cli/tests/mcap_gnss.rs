@@ -190,6 +190,23 @@ fn a_bag_with_fixes_drives_on_them() {
         "end {n:.2} N {e:.2} E, truth {north_m:.2} N {:.2} E",
         east_m - 5.0
     );
+    // Rows before the fixes referred the heading to true north (the first 5 s here) are
+    // put in the same plane when the head is run again: the track has no jump (it had one
+    // of 4.2 m, the start frame against the plane) and every row has its latitude.
+    let largest_step = rows
+        .windows(2)
+        .map(|w| {
+            (w[1][col("north_m")] - w[0][col("north_m")])
+                .hypot(w[1][col("east_m")] - w[0][col("east_m")])
+        })
+        .fold(0.0, f64::max);
+    assert!(largest_step < 1.0, "a step of {largest_step:.2} m");
+    assert!(rows.iter().all(|r| r[col("lat_deg")].is_finite()));
+    assert!(
+        (rows[0][col("east_m")] + SPEED_MPS).abs() < 3.0,
+        "{:?}",
+        rows[0]
+    );
     let lat = last[col("lat_deg")];
     assert!(
         (lat - (LAT0 + (north_m / EARTH_M).to_degrees())).abs() < 3e-5,

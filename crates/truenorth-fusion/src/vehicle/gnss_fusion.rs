@@ -17,6 +17,7 @@ use truenorth_core::{GnssFix, wrap_pi};
 use truenorth_geomag::{Geodetic, LocalTangentPlane};
 
 use super::estimator::VehicleEstimator;
+use super::gnss_track::PlaneShift;
 use super::innovation_line::InnovationLine;
 use super::nav_filter::{EAST, NORTH, PSI};
 
@@ -62,6 +63,14 @@ impl VehicleEstimator {
     /// [`VehicleEstimator::gnss_declination_rad`]), the track to the plane at the first fix.
     pub fn gnss_aligned(&self) -> bool {
         self.tracking.gnss.aligned
+    }
+
+    /// How the track was put on the fixes' plane, while it is there (see [`PlaneShift`]).
+    pub fn gnss_plane_shift(&self) -> Option<PlaneShift> {
+        self.tracking
+            .gnss
+            .shift
+            .filter(|_| self.tracking.gnss.aligned)
     }
 
     /// The declination at the first fix (WMM2025 at the configured date), rad, east
@@ -322,14 +331,28 @@ impl VehicleEstimator {
         offset: f64,
         offset_sigma: f64,
     ) {
-        if self.tracking.alignment.done {
-            self.turn_known(self.tracking.gnss.declination_rad);
+        let after_compass = self.tracking.alignment.done;
+        let turn_rad = if after_compass {
+            self.tracking.gnss.declination_rad
+        } else {
+            offset
+        };
+        if after_compass {
+            self.turn_known(turn_rad);
         } else {
             self.turn_frame(offset, offset_sigma);
             self.tracking.alignment.done = true;
             self.compass.restart_gates();
         }
         self.tracking.gnss.aligned = true;
+        self.flush();
+        let (pn, pe) = self.position_at(t_s);
+        self.tracking.gnss.shift = Some(PlaneShift {
+            turn_rad,
+            after_compass,
+            north_m: north - pn,
+            east_m: east - pe,
+        });
         self.restart_position(t_s, north, east, sigma);
         let g = &mut self.tracking.gnss;
         g.last_used_s = Some(t_s);

@@ -32,4 +32,24 @@ pub(super) struct GnssTrack {
     /// Where a displacement to refer the heading to true north started: the fix's north
     /// and east, and the dead-reckoned position's, m.
     pub start: Option<[f64; 4]>,
+    /// How the track was put on the plane when the fixes referred it there: see
+    /// [`PlaneShift`].
+    pub shift: Option<PlaneShift>,
+}
+
+/// How the fixes put the track on their plane: turned about the start by `turn_rad` (the
+/// offset that referred a heading relative to the start to true north, or, when the compass
+/// had referred it to magnetic north, the declination), then shifted by `north_m`,
+/// `east_m`. Estimates made before join the plane by the same.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct PlaneShift {
+    /// The turn about the start, rad.
+    pub turn_rad: f64,
+    /// Whether the compass had referred the heading to magnetic north before (the turn is
+    /// then the declination, and the published magnetic heading does not change).
+    pub after_compass: bool,
+    /// The shift after the turn, m.
+    pub north_m: f64,
+    /// See `north_m`.
+    pub east_m: f64,
 }

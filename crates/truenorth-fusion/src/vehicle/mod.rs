@@ -64,6 +64,7 @@ pub use compass_monitor::{CompassFix, CompassMonitor, CompassMonitorState, Verdi
 pub use config::{CompassGates, GnssConfig, SensorPriors, VehicleConfig};
 pub use estimator::VehicleEstimator;
 pub use gnss_fusion::GnssCounts;
+pub use gnss_track::PlaneShift;
 pub use learned::{Learned, LearnedCompass, VehicleCalibration};
 pub use learning_gates::SPEED_COEFF_MIN_SPEED_MPS;
 pub use nav_filter::NavFilter;

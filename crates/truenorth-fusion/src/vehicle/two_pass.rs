@@ -22,6 +22,7 @@ use truenorth_core::{
 };
 
 use super::estimator::VehicleEstimator;
+use super::gnss_track::PlaneShift;
 
 #[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
@@ -146,31 +147,48 @@ impl TwoPassStart {
         emit: &mut impl FnMut(&VehicleSample, &NavEstimate, &VehicleEstimator),
     ) -> Result<()> {
         let mut second = self.estimator.replay_start()?;
+        // Where the first pass put its track on the fixes' plane, the second waits for it
+        // too, so that the whole head comes out in the plane.
+        let expect_plane = self.estimator.gnss_plane_shift().is_some();
         let mut waiting = 0;
+        let mut last_sigma_rad = f64::NAN;
         for (k, s) in self.head.iter().enumerate() {
             // Every sample here was accepted by the first pass, which checks the same.
             let estimate = second.update(s)?;
-            match second.alignment_offset_rad() {
-                None => waiting += 1,
-                Some(offset) => {
-                    for (w, earlier) in self.head[k - waiting..k].iter().enumerate() {
-                        let e = turned(&self.held[w], offset, estimate.heading_sigma_rad);
-                        emit(earlier, &e, &second);
-                    }
-                    waiting = 0;
-                    self.held.clear();
-                    emit(s, &estimate, &second);
-                    continue;
-                }
+            last_sigma_rad = estimate.heading_sigma_rad;
+            let ready = match (second.alignment_offset_rad(), second.gnss_plane_shift()) {
+                (Some(offset), plane) if plane.is_some() || !expect_plane => Some((offset, plane)),
+                _ => None,
+            };
+            let Some((offset, plane)) = ready else {
+                waiting += 1;
+                self.held.push(estimate);
+                continue;
+            };
+            let declination = second.gnss_declination_rad().unwrap_or(0.0);
+            for (w, earlier) in self.head[k - waiting..k].iter().enumerate() {
+                let e = joined(
+                    &self.held[w],
+                    offset,
+                    estimate.heading_sigma_rad,
+                    plane.map(|p| (p, declination)),
+                );
+                emit(earlier, &e, &second);
             }
-            self.held.push(estimate);
+            waiting = 0;
+            self.held.clear();
+            emit(s, &estimate, &second);
         }
-        // Never referred to north: the estimates stay relative to the start.
-        for (earlier, e) in self.head[self.head.len() - waiting..]
-            .iter()
-            .zip(&self.held)
-        {
-            emit(earlier, e, &second);
+        // Never referred to north, or (the second pass not reaching the plane within the
+        // head) only by the compass: what is relative to the start is turned by what is known.
+        let offset = second.alignment_offset_rad();
+        let start = self.head.len() - waiting;
+        for (earlier, e) in self.head[start..].iter().zip(&self.held) {
+            let e = match offset {
+                Some(offset) => joined(e, offset, last_sigma_rad, None),
+                None => *e,
+            };
+            emit(earlier, &e, &second);
         }
         self.held = Vec::new();
         self.estimator = second;
@@ -180,26 +198,53 @@ impl TwoPassStart {
     }
 }
 
-/// An estimate made relative to the start heading, turned by `offset` onto north (heading
-/// and track), with the heading uncertainty of the estimate that found the offset. A
-/// position not known yet (before the wheels' first reading) stays unknown in every
-/// direction: its infinite covariance is not turned, which would mix infinities into NaN.
-fn turned(e: &NavEstimate, offset: f64, heading_sigma_rad: f64) -> NavEstimate {
-    let (s, c) = offset.sin_cos();
+/// An estimate of the head as the estimates after it are: one made relative to the start
+/// heading turned by `offset` onto north (heading and track), with the heading uncertainty
+/// of the estimate that found the offset; and, when the fixes put the track on their plane
+/// (`plane`, with the declination), turned and shifted as the track was (see
+/// [`PlaneShift`]), the heading published magnetic as every estimate's. An estimate already
+/// referred to north is left as it is but for the plane. A position not known yet (before
+/// the wheels' first reading) stays unknown in every direction: its infinite covariance is
+/// not turned, which would mix infinities into NaN.
+fn joined(
+    e: &NavEstimate,
+    offset: f64,
+    heading_sigma_rad: f64,
+    plane: Option<(PlaneShift, f64)>,
+) -> NavEstimate {
+    let relative = !e.status.heading_absolute;
     let mut t = *e;
-    t.north_m = c * e.north_m - s * e.east_m;
-    t.east_m = s * e.north_m + c * e.east_m;
-    t.heading = MagneticHeading::new(e.heading.rad() + offset);
-    t.heading_sigma_rad = heading_sigma_rad;
-    t.status.heading_absolute = true;
+    let mut turn = 0.0;
+    if relative {
+        turn = offset;
+        t.heading = MagneticHeading::new(e.heading.rad() + offset);
+        t.heading_sigma_rad = heading_sigma_rad;
+        t.status.heading_absolute = true;
+    }
+    if let Some((p, declination)) = plane {
+        if p.after_compass {
+            turn += p.turn_rad;
+        } else if relative {
+            // The offset referred the heading to true north; published, it is magnetic.
+            t.heading = MagneticHeading::new(t.heading.rad() - declination);
+        }
+        t.status.gnss_frame = true;
+    }
+    let (s, c) = turn.sin_cos();
+    let (north, east) = (c * e.north_m - s * e.east_m, s * e.north_m + c * e.east_m);
+    let shift = plane.map_or([0.0; 2], |(p, _)| [p.north_m, p.east_m]);
+    t.north_m = north + shift[0];
+    t.east_m = east + shift[1];
     if !e.status.position_known {
         return t;
     }
     let r = nalgebra::Matrix2::new(c, -s, s, c);
-    // The offset's own error turns the track about the start: across it, in proportion
-    // to the distance from the start.
-    let across = nalgebra::Vector2::new(-t.east_m, t.north_m);
-    t.position_cov_m2 = r * e.position_cov_m2 * r.transpose()
-        + heading_sigma_rad * heading_sigma_rad * across * across.transpose();
+    t.position_cov_m2 = r * e.position_cov_m2 * r.transpose();
+    if relative {
+        // The offset's own error turns the track about the start: across it, in
+        // proportion to the distance from the start.
+        let across = nalgebra::Vector2::new(-east, north);
+        t.position_cov_m2 += heading_sigma_rad * heading_sigma_rad * across * across.transpose();
+    }
     t
 }
