@@ -7,38 +7,16 @@ mod common;
 
 use std::path::{Path, PathBuf};
 
-use common::{IMU_HEADER, ScratchDir, csv_line, imu_cells};
-use truenorth_sim::{HandheldParams, ImuSensorParams, handheld_motion, imu_streams};
+use common::ScratchDir;
 
 fn dir(tag: &str) -> ScratchDir {
     common::scratch("cli_orientation_hypotheses", tag)
 }
 
 /// Two minutes of simulated hand-held motion, every row's cells passed through `change`
-/// (with the rows' accelerometer readings for a filter).
-fn recording(dir: &Path, change: impl Fn(usize, &mut [f64; 10], &[[f64; 3]])) -> PathBuf {
-    let truth = handheld_motion(&HandheldParams {
-        duration_s: 120.0,
-        ..HandheldParams::default()
-    })
-    .unwrap();
-    let samples = imu_streams(&truth, &ImuSensorParams::typical(), 9).unwrap();
-    let acc: Vec<[f64; 3]> = samples
-        .iter()
-        .map(|s| {
-            let c = imu_cells(s);
-            [c[4], c[5], c[6]]
-        })
-        .collect();
-    let mut csv = format!("{IMU_HEADER}\n");
-    for (k, s) in samples.iter().enumerate() {
-        let mut cells = imu_cells(s);
-        change(k, &mut cells, &acc);
-        csv += &csv_line(&cells, ",");
-    }
-    let path = dir.join("imu.csv");
-    std::fs::write(&path, csv).unwrap();
-    path
+/// (with every row's cells as simulated, for a filter).
+fn recording(dir: &Path, change: impl Fn(usize, &mut [f64; 10], &[[f64; 10]])) -> PathBuf {
+    common::handheld_csv(dir, 120.0, 9, change)
 }
 
 /// `orientation` refuses `input` with no output; its message, which `inspect` says too.
@@ -92,7 +70,7 @@ fn an_accelerometer_without_gravity_fits_no_unit() {
     let input = recording(&dir, |k, c, acc| {
         let window = &acc[k.saturating_sub(100)..(k + 100).min(acc.len())];
         for i in 0..3 {
-            let mean = window.iter().map(|a| a[i]).sum::<f64>() / window.len() as f64;
+            let mean = window.iter().map(|a| a[4 + i]).sum::<f64>() / window.len() as f64;
             c[4 + i] -= mean;
         }
     });

@@ -7,8 +7,7 @@ mod common;
 
 use std::path::{Path, PathBuf};
 
-use common::{IMU_HEADER, ScratchDir, csv_line, imu_cells, outcome};
-use truenorth_sim::{HandheldParams, ImuSensorParams, handheld_motion, imu_streams};
+use common::{ScratchDir, outcome};
 
 fn dir(tag: &str) -> ScratchDir {
     common::scratch("cli_orientation_magnetometer", tag)
@@ -16,19 +15,7 @@ fn dir(tag: &str) -> ScratchDir {
 
 /// Two minutes of simulated hand-held motion in the contract's columns.
 fn recording(dir: &Path) -> PathBuf {
-    let truth = handheld_motion(&HandheldParams {
-        duration_s: 120.0,
-        ..HandheldParams::default()
-    })
-    .unwrap();
-    let samples = imu_streams(&truth, &ImuSensorParams::typical(), 9).unwrap();
-    let mut csv = format!("{IMU_HEADER}\n");
-    for s in &samples {
-        csv += &csv_line(&imu_cells(s), ",");
-    }
-    let path = dir.join("imu.csv");
-    std::fs::write(&path, csv).unwrap();
-    path
+    common::handheld_csv(dir, 120.0, 9, |_, _, _| {})
 }
 
 /// The `--column` value after `--column ` in `message` (the first one).

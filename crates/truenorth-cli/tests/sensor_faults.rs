@@ -7,8 +7,7 @@ mod common;
 
 use std::path::{Path, PathBuf};
 
-use common::{IMU_HEADER, ScratchDir, TURN_HEADER, csv_line, imu_cells, turn_rows};
-use truenorth_sim::{HandheldParams, ImuSensorParams, handheld_motion, imu_streams};
+use common::{ScratchDir, TURN_HEADER, turn_rows};
 
 fn dir(tag: &str) -> ScratchDir {
     common::scratch("cli_sensor_faults", tag)
@@ -16,21 +15,7 @@ fn dir(tag: &str) -> ScratchDir {
 
 /// A minute of simulated hand-held motion, each row's cells changed by `fault(k, cells)`.
 fn recording(dir: &Path, fault: impl Fn(usize, &mut [f64; 10])) -> PathBuf {
-    let truth = handheld_motion(&HandheldParams {
-        duration_s: 60.0,
-        ..HandheldParams::default()
-    })
-    .unwrap();
-    let samples = imu_streams(&truth, &ImuSensorParams::typical(), 5).unwrap();
-    let mut csv = format!("{IMU_HEADER}\n");
-    for (k, s) in samples.iter().enumerate() {
-        let mut cells = imu_cells(s);
-        fault(k, &mut cells);
-        csv += &csv_line(&cells, ",");
-    }
-    let path = dir.join("imu.csv");
-    std::fs::write(&path, csv).unwrap();
-    path
+    common::handheld_csv(dir, 60.0, 5, |k, cells, _| fault(k, cells))
 }
 
 /// `orientation` on `input`: refused with no output, naming `says`; then with
@@ -165,6 +150,20 @@ fn a_saturated_magnetometer_is_refused_by_calibrate_and_heading() {
     );
 }
 
+/// `log` written to `out` with column `column` holding, on the lines `lines` (0 the header),
+/// the value it has on the first of them.
+fn hold(log: &Path, out: &Path, column: usize, lines: std::ops::Range<usize>) {
+    let text = std::fs::read_to_string(log).unwrap();
+    let mut all: Vec<String> = text.lines().map(String::from).collect();
+    let held = all[lines.start].split(',').nth(column).unwrap().to_string();
+    for line in &mut all[lines] {
+        let mut cells: Vec<&str> = line.split(',').collect();
+        cells[column] = &held;
+        *line = cells.join(",");
+    }
+    std::fs::write(out, all.join("\n") + "\n").unwrap();
+}
+
 /// A drive's yaw gyro frozen on one reading for 400 rows: refused with the row; the
 /// clean log runs.
 #[test]
@@ -173,16 +172,8 @@ fn a_frozen_yaw_gyro_is_refused_by_drive() {
     let log = common::compass_drive_log(&dir);
     let vehicle = common::rear_vehicle(&dir, 1.5);
     common::succeeded(common::drive(&vehicle, &log, &dir.join("clean.csv"), &[]));
-    let text = std::fs::read_to_string(&log).unwrap();
-    let mut lines: Vec<String> = text.lines().map(String::from).collect();
-    let held = lines[1001].split(',').nth(3).unwrap().to_string();
-    for line in &mut lines[1001..1401] {
-        let mut cells: Vec<&str> = line.split(',').collect();
-        cells[3] = &held;
-        *line = cells.join(",");
-    }
     let frozen = dir.join("frozen.csv");
-    std::fs::write(&frozen, lines.join("\n") + "\n").unwrap();
+    hold(&log, &frozen, 3, 1001..1401);
     let output = dir.join("out.csv");
     let run = common::drive(&vehicle, &frozen, &output, &[]);
     let stderr = String::from_utf8_lossy(&run.stderr);
@@ -203,16 +194,9 @@ fn a_stalled_wheel_is_named_not_blamed_on_units() {
     let dir = dir("stalled_wheel");
     let log = common::compass_drive_log(&dir);
     let vehicle = common::rear_vehicle(&dir, 1.5);
-    let text = std::fs::read_to_string(&log).unwrap();
-    let mut lines: Vec<String> = text.lines().map(String::from).collect();
-    let held = lines[1501].split(',').nth(2).unwrap().to_string();
-    for line in &mut lines[1501..] {
-        let mut cells: Vec<&str> = line.split(',').collect();
-        cells[2] = &held;
-        *line = cells.join(",");
-    }
     let stalled = dir.join("stalled.csv");
-    std::fs::write(&stalled, lines.join("\n") + "\n").unwrap();
+    let rows = std::fs::read_to_string(&log).unwrap().lines().count();
+    hold(&log, &stalled, 2, 1501..rows);
     let output = dir.join("out.csv");
     let run = common::drive(&vehicle, &stalled, &output, &[]);
     let stderr = String::from_utf8_lossy(&run.stderr);

@@ -225,6 +225,34 @@ pub fn compass_drive_log(dir: &Path) -> PathBuf {
     log
 }
 
+/// `seconds` of simulated hand-held motion read by a typical consumer IMU (noise seed
+/// `seed`), in the contract's columns, written to `dir/imu.csv`: each row's cells passed
+/// first through `change` (its index, its cells, every row's cells as simulated).
+pub fn handheld_csv(
+    dir: &Path,
+    seconds: f64,
+    seed: u64,
+    mut change: impl FnMut(usize, &mut [f64; 10], &[[f64; 10]]),
+) -> PathBuf {
+    use truenorth_sim::{HandheldParams, ImuSensorParams, handheld_motion, imu_streams};
+    let truth = handheld_motion(&HandheldParams {
+        duration_s: seconds,
+        ..HandheldParams::default()
+    })
+    .unwrap();
+    let samples = imu_streams(&truth, &ImuSensorParams::typical(), seed).unwrap();
+    let all: Vec<[f64; 10]> = samples.iter().map(imu_cells).collect();
+    let mut csv = format!("{IMU_HEADER}\n");
+    for (k, cells) in all.iter().enumerate() {
+        let mut cells = *cells;
+        change(k, &mut cells, &all);
+        csv += &csv_line(&cells, ",");
+    }
+    let path = dir.join("imu.csv");
+    std::fs::write(&path, csv).unwrap();
+    path
+}
+
 /// The contract's IMU columns.
 pub const IMU_HEADER: &str = "t_s,gyr_x,gyr_y,gyr_z,acc_x,acc_y,acc_z,mag_x,mag_y,mag_z";
 
