@@ -124,6 +124,7 @@ impl VehicleEstimator {
             self.tracking.rest.span_s += dt;
             self.tracking.gyro.smoothed_rps = 0.0;
             self.tracking.gyro.rate_rps = 0.0;
+            self.tracking.motion.heading_rate_rps = 0.0;
             self.tracking.gyro.odo_at_last_rad = self.filter.x[PSI_ODO];
             return;
         }
@@ -150,6 +151,7 @@ impl VehicleEstimator {
         let gain = 1.0 + x[gain_state];
         let dpsi = increment / gain;
         self.tracking.gyro.rate_rps = dpsi / dt;
+        self.tracking.motion.heading_rate_rps = dpsi / dt;
         let bias_sigma3 = 3.0 * self.filter.sigma(BIAS);
         let rate = self.tracking.gyro.smoothed_rps.abs();
         let mut step = Step::default();
@@ -363,6 +365,7 @@ impl VehicleEstimator {
                 step.psi_from = wheel_from;
                 step.q[PSI] = wheel_q;
                 self.turn_heading(turned, &mut step);
+                self.tracking.motion.heading_rate_rps = turned / dt.max(1e-3);
                 self.tracking.gyro.odo_at_last_rad = self.filter.x[PSI_ODO];
                 self.tracking.guard.anchored = false;
             } else if !self.tracking.motion.at_rest && wheel.moved {
@@ -372,6 +375,7 @@ impl VehicleEstimator {
             step.psi_from = wheel_from;
             step.q[PSI] = wheel_q;
             self.turn_heading(turned, &mut step);
+            self.tracking.motion.heading_rate_rps = turned / dt.max(1e-3);
         }
         if wheel.moved {
             let compared = turns && self.tracking.gyro.active && !gyro_silent;

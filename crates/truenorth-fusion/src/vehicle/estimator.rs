@@ -295,7 +295,12 @@ impl VehicleEstimator {
         e.heading = MagneticHeading::new(wrap_pi(psi - declination));
         // The covariance is carried forward a few times a second; what the steps since
         // then added is composed here.
-        let sigma = self.tracking.batch.psi_variance(f).max(0.0).sqrt();
+        // A reading reaches its row some 50–150 ms after the motion it measures (a sensor's
+        // filter, a bus, a logger): the heading at the row's time trails by the turn made
+        // meanwhile, an error of the rate times the delay that no state carries and that
+        // vanishes when the turn ends. Published with the heading, not accumulated.
+        let trailing = READING_DELAY_S * self.tracking.motion.heading_rate_rps;
+        let sigma = (self.tracking.batch.psi_variance(f).max(0.0) + trailing * trailing).sqrt();
         // A heading known to no better than the whole circle is uniform on it: π/√3.
         e.heading_sigma_rad = sigma.min(UNKNOWN_HEADING_SIGMA_RAD);
         e.position_cov_m2 = if e.status.position_known {
@@ -472,3 +477,8 @@ impl HeadingEstimator for VehicleEstimator {
         self.est = est;
     }
 }
+
+/// How far a reading's row trails the motion it measures, s (0.1): sensors on their own
+/// rows and clocks reach a log 50–150 ms after the motion (the simulator's real-log habit,
+/// `truenorth_sim::log_drive`, draws the same).
+const READING_DELAY_S: f64 = 0.1;

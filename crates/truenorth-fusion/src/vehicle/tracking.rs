@@ -123,6 +123,9 @@ pub(super) struct Motion {
     /// The odometry read so far is one distance, not two wheels.
     #[serde(default)]
     pub single_distance: bool,
+    /// The rate the heading last turned at, from whichever sensor carried it, rad/s.
+    #[serde(default)]
+    pub heading_rate_rps: f64,
 }
 
 /// Rest and the bias average.
