@@ -256,12 +256,13 @@ fn cells() -> Vec<Cell> {
 /// random walk, is printed, not held). Held on every car with a gyro and on the three
 /// presets of real logs: heading beyond 3σ on at most 2 % of rows, never beyond 6σ.
 ///
-/// Printed, not held — misses, measured with `SEEDS=10`: the generic robots' heading σ with
-/// a gyro (skid-steer 2.5–4.7 % of rows beyond 3σ and up to 7.6σ; differential with wheel
-/// speeds 8.7–10.1 %, 8.4σ), where the wheels' slip, lag and a track that changes with the
-/// ground outrun their noise model; and every set without a gyro, whose heading comes from
-/// the wheels and the compass alone (a differential robot's wheel speeds with a compass:
-/// 14.3 % beyond 3σ, 7.1σ).
+/// Printed, not held — misses, measured with `SEEDS=10`: the generic robots' heading σ
+/// (skid-steer with a compass 3.0–6.9 % of rows beyond 3σ and up to 10.1σ, with a gyro and
+/// wheel speeds 3.8 %, 7.5σ; a differential robot's wheel speeds 9.9 % with a gyro, where
+/// its wheel distances give 0 %), where the wheels' slip, the speeds' lag and a track that
+/// changes with the ground outrun their noise model; and sets without a gyro, whose heading
+/// comes from the wheels and the compass alone (a differential robot's wheel speeds with a
+/// compass: 14.0 % beyond 3σ, 11.1σ; cars' wheel speeds with a compass 2.1–3.4 %, 5.5σ).
 #[test]
 fn real_habits_never_worse_than_plain_integration_and_sigma_holds() {
     let only = std::env::var("ONLY").unwrap_or_default();
