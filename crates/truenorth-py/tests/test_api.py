@@ -204,6 +204,11 @@ def test_check_imu_names_the_unit_and_the_axes_that_read_the_data_right():
     swapped = gyr[:, [1, 0, 2]]
     found = tn.check_imu(t, swapped, acc, mag)
     assert found[0]["kind"] == "axes" and found[0]["fix"] == {"gyro_axes": "x=y,y=x,z=z"}
+    # A magnetometer with x and y swapped: the gyro agrees with gravity, so it is the
+    # magnetometer that is named, with the mapping that undoes a mirror or a turned mount.
+    found = tn.check_imu(t, gyr, acc, mag[:, [1, 0, 2]])
+    assert found[0]["kind"] == "axes"
+    assert found[0]["fix"] == {"mag_axes": "x=y,y=x,z=z", "mag_axes_rotation": "x=-y,y=-x,z=-z"}
     with pytest.raises(tn.TruenorthError, match="gyro_unit"):
         tn.check_imu(t, gyr, acc, gyro_unit="rpm")
 
