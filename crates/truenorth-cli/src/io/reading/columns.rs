@@ -16,6 +16,28 @@ use crate::io::closest_name::likely_meant;
 /// axes.
 pub const VECTOR_STEMS: [&str; 3] = ["mag", "acc", "gyr"];
 
+/// The optional columns of a drive log.
+pub(crate) const DRIVE: [&str; 18] = [
+    "dist_l_m",
+    "dist_r_m",
+    "speed_l_mps",
+    "speed_r_mps",
+    "speed_fl_mps",
+    "speed_fr_mps",
+    "speed_rl_mps",
+    "speed_rr_mps",
+    "dist_m",
+    "speed_mps",
+    "gyr_z",
+    "mag_x",
+    "mag_y",
+    "lat_deg",
+    "lon_deg",
+    "gnss_sigma_m",
+    "gnss_speed_mps",
+    "gnss_course_deg",
+];
+
 /// The columns of the CSV contract (ARCHITECTURE.md, "CLI contract") by name.
 const CONTRACT_COLUMNS: [&str; 20] = [
     "t_s",

@@ -7,8 +7,8 @@ use std::path::Path;
 
 use truenorth_logs::LogFormat;
 
+use super::columns::DRIVE;
 use super::columns::{AxisConvention, ColumnMapping};
-use super::kinds::DRIVE;
 use super::logs::{self, AxleOf, AxleTrack, LogInput};
 use super::options::InputOptions;
 use super::reader::{ReadSpec, RowReader};

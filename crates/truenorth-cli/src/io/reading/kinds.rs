@@ -10,6 +10,7 @@ use truenorth::calib::{MagAccelSample, TurnSample};
 use truenorth::checks::{AccUnit, GyroUnit};
 use truenorth::core::{Axes, GnssFix, ImuSample, Mag2Sample, Mag3Sample, VehicleSample};
 
+use super::columns::DRIVE;
 use super::reader::{RowReader, RowRef};
 use super::samples::SampleKind;
 use super::wheels::{DistanceColumn, FourWheels, WheelColumns};
@@ -340,28 +341,6 @@ impl SampleKind for Imu {
         })
     }
 }
-
-/// The optional columns of a drive log.
-pub(crate) const DRIVE: [&str; 18] = [
-    "dist_l_m",
-    "dist_r_m",
-    "speed_l_mps",
-    "speed_r_mps",
-    "speed_fl_mps",
-    "speed_fr_mps",
-    "speed_rl_mps",
-    "speed_rr_mps",
-    "dist_m",
-    "speed_mps",
-    "gyr_z",
-    "mag_x",
-    "mag_y",
-    "lat_deg",
-    "lon_deg",
-    "gnss_sigma_m",
-    "gnss_speed_mps",
-    "gnss_course_deg",
-];
 
 /// A satellite fix's columns: latitude and longitude, and what the receiver reports with
 /// them.
