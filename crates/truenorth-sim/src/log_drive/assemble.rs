@@ -3,7 +3,7 @@
 
 use truenorth_core::{NoiseSource, SplitMix64};
 
-use super::gnss_receiver::GnssTruth;
+use super::gnss_truth::GnssTruth;
 use super::row::{LogRow, Measured};
 use super::streams::Slot;
 use super::timing::{RowLayout, Timed, TimingConfig, log_clock, rounded};

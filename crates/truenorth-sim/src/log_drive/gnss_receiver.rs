@@ -12,36 +12,7 @@ use super::streams::{Slot, Track};
 use super::timing::{Clock, Timed};
 use crate::LocalTangentPlane;
 
-/// A fix as the receiver reports it: latitude and longitude in steps of 10⁻⁷°, the
-/// accuracy, speed and course when the receiver reports them.
-pub use truenorth_core::GnssFix;
-
-/// What a fix went through.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
-pub enum FixCondition {
-    /// Open sky.
-    Open,
-    /// In an urban canyon (a larger error), no jump.
-    Canyon,
-    /// In a multipath jump.
-    Multipath,
-    /// The last fix sent again.
-    Frozen,
-}
-
-/// The truth behind one fix.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct GnssTruth {
-    /// The epoch it stands for, s on the log's clock (for a frozen fix: when it was sent
-    /// again).
-    pub epoch_s: f64,
-    /// The antenna's true position at the epoch, m north and east of the origin.
-    pub antenna_ne_m: [f64; 2],
-    /// The reported position minus the antenna's true one, m north and east.
-    pub error_ne_m: [f64; 2],
-    /// What the fix went through.
-    pub condition: FixCondition,
-}
+use super::gnss_truth::{FixCondition, GnssFix, GnssTruth};
 
 /// A multipath jump: an offset held for a while.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]

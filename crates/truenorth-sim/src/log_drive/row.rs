@@ -8,7 +8,7 @@ use nalgebra::Vector2;
 use serde::{Deserialize, Serialize};
 use truenorth_core::VehicleSample;
 
-use super::gnss_receiver::{GnssFix, GnssTruth};
+use super::gnss_truth::{GnssFix, GnssTruth};
 use crate::VehicleKind;
 
 /// What the odometry gave on a row.

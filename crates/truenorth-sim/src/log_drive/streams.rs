@@ -9,7 +9,7 @@ use truenorth_core::{NoiseSource, Result, SensorModel, SplitMix64};
 use truenorth_gyro::{GyroAxisModel, RateTruth};
 
 use super::body_tilt::TiltProcess;
-use super::gnss_receiver::{GnssFix, GnssTruth};
+use super::gnss_truth::{GnssFix, GnssTruth};
 use super::row::OdometryReading;
 use super::sensor_set::Odometry;
 use super::skid_ground::{SkidGround, SkidProcess};
