@@ -6,7 +6,9 @@
 use numpy::{PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
-use truenorth::checks::{AccUnit, Finding, FindingKind, Fix, GyroUnit, check_inertial};
+use truenorth::checks::{
+    AccUnit, Finding, FindingKind, Fix, GyroUnit, StuckReadings, StuckRun, check_inertial,
+};
 
 use crate::convert::arg_err;
 use crate::orientation::{imu_arrays, imu_sample};
@@ -17,7 +19,12 @@ use crate::orientation::{imu_arrays, imu_sample};
 /// list of findings, empty when nothing contradicts them, each a dict: `kind` (`"units"`
 /// or `"axes"`), `seen` (the evidence, in words and figures), `fix` (a dict: `gyro_unit` or
 /// `acc_unit` the data are in, or `gyro_axes`, the mapping that reads the gyro along the
-/// other sensors' axes, `x=-y,y=x,z=z`: body axis = column as given) and `row`.
+/// other sensors' axes, `x=-y,y=x,z=z`: body axis = column as given; `mag_axes` and
+/// `mag_axes_rotation` for a mirrored or turned magnetometer; `advice` where no unit fits)
+/// and `row`. Readings no live sensor gives (an axis clipped at its range or frozen, a
+/// magnetometer reading exactly zero: `truenorth::checks::stuck_readings`) come after, one
+/// a sensor, with `kind` `"faults"`, `fix` `{"advice": ...}` and `row` the index of the run's
+/// first reading.
 #[pyfunction]
 #[pyo3(signature = (t_s, gyr, acc, mag=None, gyro_unit="rad/s", acc_unit="m/s2"))]
 #[allow(clippy::too_many_arguments)]
@@ -51,13 +58,49 @@ pub fn check_imu<'py>(
                 )
             })
             .collect();
-        check_inertial(&samples, gyro, accel)
+        let mut gyro_watch = StuckReadings::<3>::new();
+        let mut mag_watch = StuckReadings::<3>::magnetometer();
+        let (mut gyro_run, mut mag_run) = (None, None);
+        for (k, s) in samples.iter().enumerate() {
+            if let Some(v) = s.gyr_rps.as_xyz() {
+                let run = gyro_watch.push(k, s.t_s, &v.into());
+                gyro_run = gyro_run.or(run);
+            }
+            if let Some(v) = s.mag.as_xyz() {
+                let run = mag_watch.push(k, s.t_s, &v.into());
+                mag_run = mag_run.or(run);
+            }
+        }
+        let gyro_run = gyro_run.or_else(|| gyro_watch.finish());
+        let mag_run = mag_run.or_else(|| mag_watch.finish());
+        (
+            check_inertial(&samples, gyro, accel),
+            [("gyro (rad/s)", gyro_run), ("magnetometer", mag_run)],
+        )
     });
+    let (findings, faults) = findings;
     let out = PyList::empty(py);
     for f in &findings {
         out.append(finding(py, f)?)?;
     }
+    for (sensor, run) in &faults {
+        if let Some(run) = run {
+            out.append(fault(py, sensor, run)?)?;
+        }
+    }
     Ok(out)
+}
+
+/// A run no live sensor gives, as a finding's dictionary.
+fn fault<'py>(py: Python<'py>, sensor: &str, run: &StuckRun) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("kind", "faults")?;
+    d.set_item("seen", format!("{sensor}: {run}"))?;
+    let fix = PyDict::new(py);
+    fix.set_item("advice", run.advice())?;
+    d.set_item("fix", fix)?;
+    d.set_item("row", run.from_row)?;
+    Ok(d)
 }
 
 /// One finding as a dictionary.

@@ -34,6 +34,7 @@ use crate::convert::{TruenorthError, array1, array2};
 /// `TruenorthError` with the reader's message (a missing topic's names the topics present).
 #[pyfunction]
 #[pyo3(signature = (path, imu_topic=None, mag_topic=None, attitude_topic=None, odometry_topic=None, accept_incomplete=false, gnss_topic=None))]
+#[allow(clippy::too_many_arguments)]
 pub fn read_log<'py>(
     py: Python<'py>,
     path: PathBuf,
@@ -151,7 +152,10 @@ fn recording_dict<'py>(py: Python<'py>, r: &Recording) -> PyResult<Bound<'py, Py
         "sigma_m",
         array1(
             py,
-            r.gnss.iter().map(|s| s.sigma_m.unwrap_or(f64::NAN)).collect(),
+            r.gnss
+                .iter()
+                .map(|s| s.sigma_m.unwrap_or(f64::NAN))
+                .collect(),
         ),
     )?;
     let topics = PyList::empty(py);

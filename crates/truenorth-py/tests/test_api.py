@@ -209,6 +209,13 @@ def test_check_imu_names_the_unit_and_the_axes_that_read_the_data_right():
     found = tn.check_imu(t, gyr, acc, mag[:, [1, 0, 2]])
     assert found[0]["kind"] == "axes"
     assert found[0]["fix"] == {"mag_axes": "x=y,y=x,z=z", "mag_axes_rotation": "x=-y,y=-x,z=-z"}
+    # A gyro frozen on one reading for 300 rows where it otherwise changes every step.
+    noisy = gyr + 1e-4 * np.sin(np.arange(len(t)) * 12.9898)[:, None]
+    frozen = noisy.copy()
+    frozen[500:800] = frozen[500]
+    assert all(f["kind"] != "faults" for f in tn.check_imu(t, noisy, acc, mag))
+    faults = [f for f in tn.check_imu(t, frozen, acc, mag) if f["kind"] == "faults"]
+    assert faults and faults[0]["row"] == 500 and "stopped updating" in faults[0]["fix"]["advice"]
     with pytest.raises(tn.TruenorthError, match="gyro_unit"):
         tn.check_imu(t, gyr, acc, gyro_unit="rpm")
 

@@ -280,7 +280,7 @@ def read_log(
 class Finding(TypedDict):
     """What contradicts a recording's declared units or the gyro's axes."""
 
-    kind: Literal["units", "axes"]
+    kind: Literal["units", "axes", "faults"]
     seen: str
     fix: dict[str, Any]
     row: Optional[int]
@@ -297,4 +297,6 @@ def check_imu(
     (one gravity at rest; gravity's and the field's directions turning as the gyro says): the
     checks `truenorth orientation` refuses by. Empty when nothing contradicts them; `fix`
     holds `gyro_unit`, `acc_unit`, `gyro_axes` (`x=-y,y=x,z=z`), `mag_axes` with
-    `mag_axes_rotation` (a mirrored or turned magnetometer) or `advice` (no unit fits)."""
+    `mag_axes_rotation` (a mirrored or turned magnetometer) or `advice` (no unit fits).
+    Readings no live sensor gives (clipped, frozen, a zero field) follow with `kind`
+    `"faults"` and `row` the index of the run's first reading."""
