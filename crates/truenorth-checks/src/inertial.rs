@@ -7,7 +7,7 @@
 use nalgebra::Matrix3;
 use truenorth_core::{Fixed, ImuSample};
 
-use crate::axes::{axes_are_wrong, fit_gyro_axes};
+use crate::axes::{axes_are_wrong, fit_over};
 use crate::finding::{Finding, Fix};
 use crate::mag_axes::{magnetometer_reads_the_accelerometer, wrong_magnetometer_axes};
 use crate::spans::{DirectionSpan, MIN_TURN_RAD, mismatch_rad, predicted_turn_rad, turn_ratio};
@@ -36,6 +36,27 @@ pub fn check_inertial_units(samples: &[ImuSample], gyro: GyroUnit, acc: AccUnit)
 
 /// [`check_inertial_units`] on rows already taken apart.
 pub fn check_rows_units(rows: &[Inertial], gyro: GyroUnit, acc: AccUnit) -> Vec<Finding> {
+    units(rows, &Spans::of(rows), gyro, acc)
+}
+
+/// The spans over which gravity's and the field's directions turned: found once, judged
+/// by every check.
+struct Spans {
+    gravity: Vec<DirectionSpan>,
+    field: Vec<DirectionSpan>,
+}
+
+impl Spans {
+    fn of(rows: &[Inertial]) -> Self {
+        Self {
+            gravity: direction_spans(rows, Reference::Gravity),
+            field: direction_spans(rows, Reference::Magnetic),
+        }
+    }
+}
+
+/// The units' findings over `spans`.
+fn units(rows: &[Inertial], spans: &Spans, gyro: GyroUnit, acc: AccUnit) -> Vec<Finding> {
     let mut findings = Vec::new();
     let Some(median) = median_magnitude(rows, Reference::Gravity) else {
         return findings;
@@ -47,7 +68,7 @@ pub fn check_rows_units(rows: &[Inertial], gyro: GyroUnit, acc: AccUnit) -> Vec<
         return findings;
     }
     findings.extend(acc_finding(raw, acc));
-    findings.extend(gyro_finding(rows, gyro));
+    findings.extend(gyro_finding(rows, spans, gyro));
     findings
 }
 
@@ -60,7 +81,8 @@ pub fn check_inertial(samples: &[ImuSample], gyro: GyroUnit, acc: AccUnit) -> Ve
 /// [`check_inertial`] on rows already taken apart, then, when neither a unit nor a mapping
 /// of the axes explains the turns, by what factor they miss ("no unit fits").
 pub fn check_rows(rows: &[Inertial], gyro: GyroUnit, acc: AccUnit) -> Vec<Finding> {
-    let mut findings = check_rows_units(rows, gyro, acc);
+    let spans = Spans::of(rows);
+    let mut findings = units(rows, &spans, gyro, acc);
     if !findings.is_empty() {
         return findings;
     }
@@ -71,7 +93,7 @@ pub fn check_rows(rows: &[Inertial], gyro: GyroUnit, acc: AccUnit) -> Vec<Findin
         ));
         return findings;
     }
-    if let Some(m) = wrong_magnetometer_axes(rows) {
+    if let Some(m) = wrong_magnetometer_axes(rows, &spans.gravity, &spans.field) {
         findings.push(Finding::axes(
             format!(
                 "the gyro turns gravity's direction as the accelerometer sees it ({} spans) but the magnetic field's only read through another mapping (median mismatch {:.1}° as read, {:.1}° so; {} spans): the magnetometer is mirrored or mounted turned",
@@ -84,7 +106,9 @@ pub fn check_rows(rows: &[Inertial], gyro: GyroUnit, acc: AccUnit) -> Vec<Findin
         ));
         return findings;
     }
-    let Some(fit) = fit_gyro_axes(rows, 1.0) else {
+    let pooled: Vec<DirectionSpan> = spans.gravity.iter().chain(&spans.field).copied().collect();
+    let counts = (spans.gravity.len(), spans.field.len());
+    let Some(fit) = fit_over(rows, &pooled, counts, 1.0) else {
         return findings;
     };
     if axes_are_wrong(&fit) {
@@ -100,7 +124,7 @@ pub fn check_rows(rows: &[Inertial], gyro: GyroUnit, acc: AccUnit) -> Vec<Findin
             Fix::GyroAxes(fit.best),
         ));
     } else {
-        findings.extend(scale_finding(rows, &fit.best.matrix(), gyro));
+        findings.extend(scale_finding(rows, &spans, &fit.best.matrix(), gyro));
     }
     findings
 }
@@ -155,7 +179,7 @@ fn acc_finding(raw_median: f64, declared: AccUnit) -> Option<Finding> {
 /// The magnetic field's directions, which no acceleration bends, must not contradict the
 /// verdict: swung at arm's length, a device's specific force is tilted by the swing, and
 /// gravity's spans alone would blame a right unit.
-fn gyro_finding(rows: &[Inertial], declared: GyroUnit) -> Option<Finding> {
+fn gyro_finding(rows: &[Inertial], spans: &Spans, declared: GyroUnit) -> Option<Finding> {
     let other = declared.other();
     let name = other.name();
     // The rates were multiplied by the declared factor; this turns them into the other's.
@@ -163,23 +187,22 @@ fn gyro_finding(rows: &[Inertial], declared: GyroUnit) -> Option<Finding> {
         Matrix3::identity(),
         Matrix3::identity() * (other.to_rad_per_s() / declared.to_rad_per_s()),
     );
-    let spans = direction_spans(rows, Reference::Gravity);
-    if spans.len() < MIN_SPANS {
+    let (gravity, magnetic) = (&spans.gravity, &spans.field);
+    if gravity.len() < MIN_SPANS {
         return None;
     }
-    let declared_deg = median_deg(rows, &spans, &as_read);
-    let other_deg = median_deg(rows, &spans, &rescaled);
+    let declared_deg = median_deg(rows, gravity, &as_read);
+    let other_deg = median_deg(rows, gravity, &rescaled);
     if other_deg * 3.0 >= declared_deg || declared_deg <= 10.0 {
         return None;
     }
-    let magnetic = direction_spans(rows, Reference::Magnetic);
     let field_disagrees = magnetic.len() >= MIN_SPANS
-        && median_deg(rows, &magnetic, &rescaled) >= median_deg(rows, &magnetic, &as_read);
+        && median_deg(rows, magnetic, &rescaled) >= median_deg(rows, magnetic, &as_read);
     (!field_disagrees).then(|| {
         Finding::units(
             format!(
                 "the gyro columns in the declared unit do not turn gravity's direction as the accelerometer sees it (median mismatch {declared_deg:.1}° over {} spans of {SPAN_S} s near rest); in {name} they do ({other_deg:.1}°)",
-                spans.len(),
+                gravity.len(),
             ),
             Fix::GyroUnit(other),
         )
@@ -190,26 +213,30 @@ fn gyro_finding(rows: &[Inertial], declared: GyroUnit) -> Option<Finding> {
 /// turn the rates (through `gyro`, the best mapping) predict says by what factor the rates
 /// or the clock are off: that is the finding, with no unit to pass. The field's turns, which
 /// no acceleration bends, veto it where they fit.
-fn scale_finding(rows: &[Inertial], gyro: &Matrix3<f64>, declared: GyroUnit) -> Option<Finding> {
+fn scale_finding(
+    rows: &[Inertial],
+    spans: &Spans,
+    gyro: &Matrix3<f64>,
+    declared: GyroUnit,
+) -> Option<Finding> {
     let fits = |r: f64| (GAIN_RANGE.0..=GAIN_RANGE.1).contains(&r);
-    let spans = direction_spans(rows, Reference::Gravity);
-    let ratio = turn_ratio_median(rows, &spans, gyro)?;
-    let declared_deg = median_deg(rows, &spans, gyro);
+    let gravity = &spans.gravity;
+    let ratio = turn_ratio_median(rows, gravity, gyro)?;
+    let declared_deg = median_deg(rows, gravity, gyro);
     // Below a few degrees of mismatch the spans' turns are too small to weigh a factor.
     if declared_deg <= MIN_MISMATCH_DEG || fits(ratio) {
         return None;
     }
-    let magnetic = direction_spans(rows, Reference::Magnetic);
-    if turn_ratio_median(rows, &magnetic, gyro).is_some_and(fits) {
+    if turn_ratio_median(rows, &spans.field, gyro).is_some_and(fits) {
         return None;
     }
     let other = declared.other();
     let rescale = other.to_rad_per_s() / declared.to_rad_per_s();
-    let other_deg = median_deg(rows, &spans, &(gyro * rescale));
+    let other_deg = median_deg(rows, gravity, &(gyro * rescale));
     Some(Finding::units(
         format!(
             "the gyro's turns fit no unit: gravity's direction turns {ratio:.3} times what the gyro's rates integrate to (median over {} spans of {SPAN_S} s near rest; mismatch {declared_deg:.1}° in the declared unit, {other_deg:.1}° in {})",
-            spans.len(),
+            gravity.len(),
             other.name()
         ),
         Fix::Advice(format!(

@@ -10,7 +10,9 @@
 //! directions cannot tell a field from its opposite; the fix gives both.
 
 use crate::axes::{MIN_SPANS, SignedPermutation, axes_are_wrong, fit_over};
-use crate::spans::{Inertial, Reference, direction_spans, median};
+#[cfg(any(doc, test))]
+use crate::spans::direction_spans;
+use crate::spans::{DirectionSpan, Inertial, median};
 
 /// What the magnetometer's axes are, read against a gyro that gravity confirms.
 #[derive(Debug, Clone, PartialEq)]
@@ -33,19 +35,22 @@ pub struct MagAxes {
 /// gravity's direction as well as any mapping does (within 1.5 times the best, on turns that
 /// tell mappings apart), and the field's direction turns as the gyro's only through a
 /// rotation other than the identity, beyond doubt (the gyro-axes rule, [`axes_are_wrong`]).
-pub fn wrong_magnetometer_axes(rows: &[Inertial]) -> Option<MagAxes> {
-    let gravity = direction_spans(rows, Reference::Gravity);
-    let field = direction_spans(rows, Reference::Magnetic);
+/// `gravity` and `field` are the rows' spans of each ([`direction_spans`]).
+pub fn wrong_magnetometer_axes(
+    rows: &[Inertial],
+    gravity: &[DirectionSpan],
+    field: &[DirectionSpan],
+) -> Option<MagAxes> {
     if gravity.len() < MIN_SPANS || field.len() < MIN_SPANS {
         return None;
     }
-    let by_gravity = fit_over(rows, &gravity, (gravity.len(), 0), 1.0)?;
+    let by_gravity = fit_over(rows, gravity, (gravity.len(), 0), 1.0)?;
     let gyro_confirmed =
         by_gravity.is_informative() && by_gravity.as_read_deg <= 1.5 * by_gravity.best_deg + 0.5;
     if !gyro_confirmed {
         return None;
     }
-    let by_field = fit_over(rows, &field, (0, field.len()), 1.0)?;
+    let by_field = fit_over(rows, field, (0, field.len()), 1.0)?;
     let p = by_field.best;
     (axes_are_wrong(&by_field) && p.is_proper()).then(|| MagAxes {
         // M = −P or M = P; the columns are read back through M⁻¹ = Mᵀ.
@@ -104,26 +109,33 @@ mod tests {
             .collect()
     }
 
+    /// The magnetometer's axes judged over the rows' own spans.
+    fn judged(rows: &[Inertial]) -> Option<MagAxes> {
+        let gravity = direction_spans(rows, crate::spans::Reference::Gravity);
+        let field = direction_spans(rows, crate::spans::Reference::Magnetic);
+        wrong_magnetometer_axes(rows, &gravity, &field)
+    }
+
     #[test]
     fn a_mirrored_or_turned_magnetometer_is_named_with_its_fix() {
-        assert!(wrong_magnetometer_axes(&tumbling(Matrix3::identity())).is_none());
+        assert!(judged(&tumbling(Matrix3::identity())).is_none());
         let swap = SignedPermutation {
             source: [1, 0, 2],
             sign: [1, 1, 1],
         };
-        let found = wrong_magnetometer_axes(&tumbling(swap.matrix())).expect("found");
+        let found = judged(&tumbling(swap.matrix())).expect("found");
         assert_eq!(found.mirror_fix, swap.inverse());
         let negate_y = SignedPermutation {
             source: [0, 1, 2],
             sign: [1, -1, 1],
         };
-        let found = wrong_magnetometer_axes(&tumbling(negate_y.matrix())).expect("found");
+        let found = judged(&tumbling(negate_y.matrix())).expect("found");
         assert_eq!(found.mirror_fix, negate_y);
         let turned = SignedPermutation {
             source: [1, 0, 2],
             sign: [-1, 1, 1],
         };
-        let found = wrong_magnetometer_axes(&tumbling(turned.matrix())).expect("found");
+        let found = judged(&tumbling(turned.matrix())).expect("found");
         assert_eq!(found.rotation_fix, turned.inverse());
     }
 

@@ -213,6 +213,20 @@ pub fn run(args: &Args) -> CliResult {
     let fitted = fitted.map_err(|e| spill.take_failure().unwrap_or(e))?;
     let input = InputPath::new(&args.input).display_path();
     let warn = |w: &str| errln!("truenorth: warning: {}: {w}", input.display());
+    // A field that does not fit the unit or the place: refused, or said under
+    // --accept-field-mismatch.
+    let mismatch = |problem: String| -> CliResult {
+        if args.accept_field_mismatch {
+            warn(&problem);
+            Ok(())
+        } else {
+            Err(CliError::file(
+                &input,
+                format!("{problem} (write it anyway with --accept-field-mismatch)"),
+            )
+            .refusal())
+        }
+    };
     if let Some(problem) = check_field(
         fitted.quality.field_magnitude,
         args.mag_unit,
@@ -221,29 +235,13 @@ pub fn run(args: &Args) -> CliResult {
     )
     .map(|f| say(&f, &args.input_options))
     {
-        if args.accept_field_mismatch {
-            warn(&problem);
-        } else {
-            return Err(CliError::file(
-                &input,
-                format!("{problem} (write it anyway with --accept-field-mismatch)"),
-            )
-            .refusal());
-        }
+        mismatch(problem)?;
     } else if let Some(w) = expected.and_then(|e| quality::field_mismatch(&fitted.quality, e)) {
         // An expected field given directly: a warning, as the numbers are the user's.
         warn(&w.to_string());
     }
     if let Some(problem) = dip_against_place(args, fitted.file.dip_deg)? {
-        if args.accept_field_mismatch {
-            warn(&problem);
-        } else {
-            return Err(CliError::file(
-                &input,
-                format!("{problem} (write it anyway with --accept-field-mismatch)"),
-            )
-            .refusal());
-        }
+        mismatch(problem)?;
     }
     let verdict = fitted.quality.verdict();
     if verdict.grade == Grade::Poor {

@@ -31,33 +31,9 @@ use report::Report;
 /// are taken over every row.
 pub const JUDGED_ROWS: usize = 1 << 19;
 
-/// Every column `inspect` looks for (body axes, after `--axes` and `--column`).
-pub const COLUMNS: [&str; 24] = [
-    "gyr_x",
-    "gyr_y",
-    "gyr_z",
-    "acc_x",
-    "acc_y",
-    "acc_z",
-    "mag_x",
-    "mag_y",
-    "mag_z",
-    "dist_l_m",
-    "dist_r_m",
-    "speed_l_mps",
-    "speed_r_mps",
-    "speed_fl_mps",
-    "speed_fr_mps",
-    "speed_rl_mps",
-    "speed_rr_mps",
-    "dist_m",
-    "speed_mps",
-    "lat_deg",
-    "lon_deg",
-    "gnss_sigma_m",
-    "gnss_speed_mps",
-    "gnss_course_deg",
-];
+/// Every column `inspect` looks for (body axes, after `--axes` and `--column`): every
+/// sensor column some command reads.
+pub use crate::io::reading::columns::SENSOR_COLUMNS as COLUMNS;
 
 /// A recording's columns as read: the time and the [`COLUMNS`] it has (NaN where a cell is
 /// empty).

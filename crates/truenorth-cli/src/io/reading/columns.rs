@@ -16,6 +16,35 @@ use crate::io::closest_name::likely_meant;
 /// axes.
 pub const VECTOR_STEMS: [&str; 3] = ["mag", "acc", "gyr"];
 
+/// Every sensor column some command reads (body axes, after `--axes` and `--column`): with
+/// `t_s`, the names a `--column` may give.
+pub const SENSOR_COLUMNS: [&str; 24] = [
+    "gyr_x",
+    "gyr_y",
+    "gyr_z",
+    "acc_x",
+    "acc_y",
+    "acc_z",
+    "mag_x",
+    "mag_y",
+    "mag_z",
+    "dist_l_m",
+    "dist_r_m",
+    "speed_l_mps",
+    "speed_r_mps",
+    "speed_fl_mps",
+    "speed_fr_mps",
+    "speed_rl_mps",
+    "speed_rr_mps",
+    "dist_m",
+    "speed_mps",
+    "lat_deg",
+    "lon_deg",
+    "gnss_sigma_m",
+    "gnss_speed_mps",
+    "gnss_course_deg",
+];
+
 /// The optional columns of a drive log.
 pub(crate) const DRIVE: [&str; 18] = [
     "dist_l_m",

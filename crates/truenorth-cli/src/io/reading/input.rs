@@ -7,7 +7,7 @@ use std::path::Path;
 
 use truenorth_logs::LogFormat;
 
-use super::columns::DRIVE;
+use super::columns::SENSOR_COLUMNS;
 use super::columns::{AxisConvention, ColumnMapping};
 use super::logs::{self, AxleOf, AxleTrack, LogInput};
 use super::options::InputOptions;
@@ -90,11 +90,6 @@ impl<'a> Input<'a> {
     }
 }
 
-/// The columns some command reads: a `--column` name outside them is a misspelling.
-const EVERY_COLUMN: [&str; 10] = [
-    "t_s", "mag_x", "mag_y", "mag_z", "acc_x", "acc_y", "acc_z", "gyr_x", "gyr_y", "gyr_z",
-];
-
 /// Refuses a `--column NAME=HEADER` whose NAME no command reads (a misspelling, named with
 /// the closest one this command reads), and says one this command does not read (a
 /// script's mapping shared by several commands); says a NAME given twice with two headers,
@@ -105,7 +100,8 @@ fn check_mappings(mappings: &[ColumnMapping], spec: &ReadSpec<'_>) -> CliResult 
     for (k, m) in mappings.iter().enumerate() {
         let is = |n: &&str| n.eq_ignore_ascii_case(&m.name);
         if !known.iter().any(is) {
-            if EVERY_COLUMN.iter().chain(DRIVE.iter()).any(is) {
+            // A name some other command reads; outside them it is a misspelling.
+            if std::iter::once(&"t_s").chain(SENSOR_COLUMNS.iter()).any(is) {
                 errln!(
                     "truenorth: warning: --column {}={}: this command does not read `{}`; it reads {}",
                     m.name,
