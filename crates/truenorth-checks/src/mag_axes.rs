@@ -139,6 +139,51 @@ mod tests {
         assert_eq!(found.rotation_fix, turned.inverse());
     }
 
+    /// Every mapping of the magnetometer but the identity is found, and the fix it names
+    /// (the mirror's for a mirror image, the rotation's for a rotation) reads it right —
+    /// all but every axis negated, a field read as its opposite, whose directions turn as
+    /// the field's do (the module documentation says so).
+    #[test]
+    fn every_wrong_mapping_is_undone_by_its_fix() {
+        let opposite = SignedPermutation::IDENTITY.negated();
+        for p in SignedPermutation::all() {
+            let found = judged(&tumbling(p.matrix()));
+            if p == SignedPermutation::IDENTITY || p == opposite {
+                assert!(found.is_none());
+                continue;
+            }
+            let found = found.unwrap_or_else(|| panic!("{p} not found"));
+            let fix = if p.is_proper() {
+                found.rotation_fix
+            } else {
+                found.mirror_fix
+            };
+            assert_eq!(fix.matrix() * p.matrix(), Matrix3::identity(), "{p}");
+        }
+    }
+
+    proptest::proptest! {
+        /// Any readings at all: an answer or none, never a panic.
+        #[test]
+        fn no_input_panics(
+            cells in proptest::collection::vec(
+                proptest::prop_oneof![-50.0f64..50.0, proptest::strategy::Just(f64::NAN)], 0..900),
+        ) {
+            let rows: Vec<Inertial> = cells
+                .chunks_exact(9)
+                .enumerate()
+                .map(|(k, c)| Inertial {
+                    t_s: k as f64 * 0.01,
+                    gyr: Vector3::new(c[0], c[1], c[2]),
+                    acc: Vector3::new(c[3], c[4], c[5]),
+                    mag: Some(Vector3::new(c[6], c[7], c[8])),
+                })
+                .collect();
+            let _ = judged(&rows);
+            let _ = magnetometer_reads_the_accelerometer(&rows);
+        }
+    }
+
     #[test]
     fn the_accelerometer_read_as_a_magnetometer_is_found() {
         let mut rows = tumbling(Matrix3::identity());
