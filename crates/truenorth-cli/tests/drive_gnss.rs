@@ -143,3 +143,73 @@ fn the_whole_track_is_on_the_plane() {
         assert!(step < 5.0, "{name}: a step of {step:.2} m");
     }
 }
+
+/// An odometer that reads 1 % long (a tyre's rolling radius taken from its nominal size):
+/// the fixes' speeds teach the scale, the summary says it, `--calibration-out` keeps it,
+/// and `--extra calibration,trust` carries it on every row.
+#[test]
+fn the_fixes_teach_the_odometer_scale() {
+    let dir = scratch("drive_gnss", "scale");
+    let d = LogDrive::new(
+        LogDriveConfig::new(1, VehicleKind::RearWheelCar, SensorSet::WHEELS_GYRO).with_gnss(),
+    )
+    .unwrap();
+    let long = 1.01;
+    let csv = d.to_csv();
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let wheels: Vec<usize> = ["dist_l_m", "dist_r_m"]
+        .iter()
+        .map(|c| header.iter().position(|h| h == c).unwrap())
+        .collect();
+    let mut scaled = header.join(",") + "\n";
+    for line in lines {
+        let cells: Vec<String> = line
+            .split(',')
+            .enumerate()
+            .map(|(k, c)| match c.parse::<f64>() {
+                Ok(v) if wheels.contains(&k) => format!("{:.4}", v * long),
+                _ => c.to_string(),
+            })
+            .collect();
+        scaled += &(cells.join(",") + "\n");
+    }
+    let input = dir.join("drive.csv");
+    std::fs::write(&input, scaled).unwrap();
+    let vehicle = common::rear_vehicle(&dir, d.vehicle.wheels.track_m());
+    let (out, cal) = (dir.join("out.csv"), dir.join("learned.json"));
+    let o = common::succeeded(common::drive(
+        &vehicle,
+        &input,
+        &out,
+        &[
+            "--extra",
+            "calibration,trust",
+            "--calibration-out",
+            cal.to_str().unwrap(),
+        ],
+    ));
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(stderr.contains("odometer scale "), "{stderr}");
+    let learned: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&cal).unwrap()).unwrap();
+    let k = learned["wheel_scale"]["value"].as_f64().unwrap();
+    let sigma = learned["wheel_scale"]["sigma"].as_f64().unwrap();
+    let truth = 1.0 / (long * d.mean_wheel_scale()) - 1.0;
+    println!(
+        "odometer scale error {:+.3} %, learned {:+.3} ± {:.3} %",
+        100.0 * truth,
+        100.0 * k,
+        100.0 * sigma
+    );
+    assert!(
+        (k - truth).abs() <= 3.0 * sigma,
+        "{k} ± {sigma} against {truth}"
+    );
+    assert!(sigma < 0.0015, "σ {sigma}");
+    let (header, rows) = common::table(&out, true);
+    let column = |name: &str| header.iter().position(|h| h == name).unwrap();
+    let last = rows.last().unwrap();
+    assert!((last[column("wheel_scale")] - (1.0 + k)).abs() < 1e-4);
+    assert_eq!(last[column("unobserved_wheel_scale")], 0.0);
+}

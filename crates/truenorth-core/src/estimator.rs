@@ -148,6 +148,8 @@ pub struct Unobserved {
     pub track_scale: bool,
     /// The speed coefficient of the wheels' difference.
     pub speed_coeff: bool,
+    /// The odometer's mean scale (learned only from satellite fixes).
+    pub wheel_scale: bool,
 }
 
 impl Unobserved {
@@ -159,6 +161,7 @@ impl Unobserved {
             || self.wheel_diff
             || self.track_scale
             || self.speed_coeff
+            || self.wheel_scale
     }
 }
 

@@ -461,7 +461,7 @@ fn a_real_car_bridges_outages_of_its_fixes() {
 #[test]
 fn what_the_fixes_teach_and_what_they_reject() {
     use truenorth_fusion::vehicle::nav_filter::{
-        BIAS, GAIN_NEG, GAIN_POS, SPEED_COEFF, TRACK_SCALE, WHEEL_DIFF,
+        BIAS, GAIN_NEG, GAIN_POS, SPEED_COEFF, TRACK_SCALE, WHEEL_DIFF, WHEEL_SCALE,
     };
     use truenorth_sim::log_drive::{Canyons, Episodes, Span};
     let states = [
@@ -471,6 +471,7 @@ fn what_the_fixes_teach_and_what_they_reject() {
         (WHEEL_DIFF, "wheel scale difference"),
         (TRACK_SCALE, "effective track"),
         (SPEED_COEFF, "speed coefficient"),
+        (WHEEL_SCALE, "odometer scale"),
     ];
     let mut times: Vec<Vec<f64>> = vec![Vec::new(); states.len()];
     let mut by_condition: std::collections::BTreeMap<String, (usize, usize)> = Default::default();
@@ -492,7 +493,7 @@ fn what_the_fixes_teach_and_what_they_reject() {
         }
         let d = LogDrive::new(c).unwrap();
         let mut nav = VehicleEstimator::new(config(&d)).unwrap();
-        let mut track: Vec<(f64, [f64; 6], [f64; 6])> = Vec::new();
+        let mut track: Vec<(f64, [f64; 7], [f64; 7])> = Vec::new();
         for (k, s) in d.vehicle_samples().iter().enumerate() {
             let before = nav.gnss_counts();
             nav.update(s).unwrap();
@@ -519,6 +520,7 @@ fn what_the_fixes_teach_and_what_they_reject() {
             u.wheel_diff,
             u.track_scale,
             u.speed_coeff,
+            u.wheel_scale,
         ];
         let (_, last, _) = *track.last().unwrap();
         let t0 = track[0].0;
@@ -563,4 +565,50 @@ fn what_the_fixes_teach_and_what_they_reject() {
         share("Multipath") > 3.0 * share("Open"),
         "multipath fixes are rejected no more than open-sky ones"
     );
+}
+
+/// The odometer's mean scale — a tyre's rolling radius, a CAN speed's calibration — which
+/// nothing on board measures, is learned from the fixes: on simulated drives of each kind
+/// with fixes (the scale drawn from the physical range: ±0.5 % for cars, ±2 % for robots),
+/// the learned value within 3σ of the truth, and σ at most half the prior's where the
+/// drive is long enough to measure it against the fixes' error (the cars: kilometres).
+#[test]
+fn the_fixes_teach_the_odometer_scale() {
+    use truenorth_fusion::vehicle::nav_filter::WHEEL_SCALE;
+    for (kind, set) in [
+        (VehicleKind::RearWheelCar, SensorSet::WHEELS_GYRO),
+        (VehicleKind::RearWheelCar, SensorSet::SPEED_YAW),
+        (VehicleKind::SkidSteer, SensorSet::WHEELS_GYRO),
+    ] {
+        for seed in 0..3 {
+            let d = LogDrive::new(LogDriveConfig::new(seed, kind, set).with_gnss()).unwrap();
+            // The odometer reads the distance times its scale; k undoes it.
+            let truth = 1.0 / d.mean_wheel_scale() - 1.0;
+            let c = config(&d);
+            let prior = c.priors().wheel_scale_sigma;
+            let mut nav = VehicleEstimator::new(c).unwrap();
+            for s in d.vehicle_samples() {
+                nav.update(&s).unwrap();
+            }
+            let f = nav.filter();
+            let (k, sigma) = (f.x[WHEEL_SCALE], f.sigma(WHEEL_SCALE));
+            println!(
+                "{kind:?} {:?} seed {seed}: {:.0} m, odometer scale error k {:+.3} % learned {:+.3} ± {:.3} % (prior σ {:.2} %)",
+                set.odometry,
+                d.distance_m(),
+                100.0 * truth,
+                100.0 * k,
+                100.0 * sigma,
+                100.0 * prior
+            );
+            assert!(
+                (k - truth).abs() <= 3.0 * sigma,
+                "{kind:?} seed {seed}: learned {k:.4} ± {sigma:.4}, truth {truth:.4}"
+            );
+            if kind.is_car() {
+                assert!(sigma <= 0.5 * prior, "{kind:?} seed {seed}: σ {sigma:.4}");
+                assert!(!nav.estimate().status.unobserved.wheel_scale);
+            }
+        }
+    }
 }

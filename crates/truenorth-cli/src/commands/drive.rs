@@ -73,10 +73,12 @@ not zero). `--extra sigma` adds heading_sigma_deg, north_sigma_m, east_sigma_m (
 heading's σ is of the heading change since the start while heading_absolute is 0);
 `--extra status` adds heading_absolute, compass_used, compass_disturbed, at_rest (0/1);
 `--extra calibration` adds the learned gyro_bias_dps, gyro_gain_right, gyro_gain_left,
-wheel_diff, track_scale, speed_coeff_s2_per_m2 (fused method only); `--extra trust` adds
+wheel_diff, track_scale, speed_coeff_s2_per_m2, wheel_scale (the odometer's distance
+gain, learned from satellite fixes) (fused method only); `--extra trust` adds
 gap (a sensor's readings resumed after more than 2 s: what it could not follow was
 widened) and unobserved_gyro_bias, unobserved_gyro_gain_right, unobserved_gyro_gain_left,
-unobserved_wheel_diff, unobserved_track_scale, unobserved_speed_coeff (1 while the data
+unobserved_wheel_diff, unobserved_track_scale, unobserved_speed_coeff,
+unobserved_wheel_scale (1 while the data
 have not told that sensor error apart from the others: a steady circle cannot separate a
 gyro bias from a wheel-size difference).
 
@@ -440,6 +442,13 @@ fn summary(
             rad_to_deg(c.gyro_bias_rps.value),
             100.0 * c.wheel_diff.value
         );
+        if gnss.is_some() {
+            line += &format!(
+                ", odometer scale {:+.2} ± {:.2} % (from the fixes)",
+                100.0 * c.wheel_scale.value,
+                100.0 * c.wheel_scale.sigma
+            );
+        }
     }
     let u = e.status.unobserved;
     let open: Vec<&str> = [
@@ -449,6 +458,7 @@ fn summary(
         (u.wheel_diff, "wheel scale difference"),
         (u.track_scale, "effective track"),
         (u.speed_coeff, "speed coefficient"),
+        (u.wheel_scale, "odometer scale"),
     ]
     .iter()
     .filter(|(o, _)| *o)

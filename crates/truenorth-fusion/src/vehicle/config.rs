@@ -31,9 +31,10 @@ pub struct SensorPriors {
     /// Standard deviation of the differential wheel scale δ before it is learned (0.01:
     /// tyres of one axle differ by tenths of a percent, ±2 % with a soft tyre).
     pub wheel_diff_sigma: f64,
-    /// Standard deviation of the odometer's mean scale, which no sensor here observes; it
-    /// makes the reported along-track uncertainty (0.003 for a car's ABS odometer, 0.012
-    /// for a robot's wheels).
+    /// Standard deviation of the odometer's mean scale error before it is learned (0.003 for
+    /// a car's ABS odometer, whose tyres' rolling radius is known to a few tenths of a
+    /// percent; 0.012 for a robot's wheels). Only satellite fixes measure it; without them
+    /// it makes the along-track uncertainty.
     pub wheel_scale_sigma: f64,
     /// The wheels' effective track over the physical one before it is learned (1 for
     /// rolling wheels; 1.9 for a skid-steer, whose sides slide in a turn).

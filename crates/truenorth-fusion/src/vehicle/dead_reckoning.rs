@@ -8,7 +8,7 @@ use truenorth_gyro::YawIncrement;
 use super::estimator::VehicleEstimator;
 use super::nav_filter::{
     BIAS, COMPASS_BIAS, DIM, EAST, GAIN_NEG, GAIN_POS, NORTH, PSI, PSI_ODO, SPEED_COEFF,
-    TRACK_SCALE, WHEEL_DIFF,
+    TRACK_SCALE, WHEEL_DIFF, WHEEL_SCALE,
 };
 use super::step_batch::Step;
 use super::tracking::{Alignment, CompassWindow, Rest};
@@ -383,10 +383,16 @@ impl VehicleEstimator {
                 .gates
                 .wheel_step(turned, wheel.speed_mps, compared);
         }
+        let scale = 1.0 + self.filter.x[WHEEL_SCALE];
         self.advance_track(t_s, &wheel, gap, &mut step);
         self.tracking.batch.add(&step);
-        self.est.speed_mps = wheel.speed_mps;
-        self.est.distance_m += wheel.ds_m.abs();
+        self.tracking.motion.odometer_m += wheel.ds_m.abs();
+        self.tracking
+            .gnss
+            .odometer
+            .push(t_s, self.tracking.motion.odometer_m);
+        self.est.speed_mps = wheel.speed_mps * scale;
+        self.est.distance_m += (wheel.ds_m * scale).abs();
         self.est.status.at_rest = self.tracking.motion.at_rest;
     }
 
@@ -419,9 +425,11 @@ impl VehicleEstimator {
             .trig
             .at(self.tracking.motion.psi_at_wheels_rad + 0.5 * change);
         self.tracking.motion.psi_at_wheels_rad = psi;
-        let ds = wheel.ds_m;
+        let ds = wheel.ds_m * (1.0 + self.filter.x[WHEEL_SCALE]);
         step.north_from_psi = -ds * s;
         step.east_from_psi = ds * c;
+        step.north_from_scale = wheel.ds_m * c;
+        step.east_from_scale = wheel.ds_m * s;
         let mut q = POSITION_NOISE_M2_PER_M * ds.abs();
         if gap {
             // The path through a gap is unknown: the chord may lie anywhere between the
@@ -432,7 +440,7 @@ impl VehicleEstimator {
         step.q[EAST] += q;
         self.filter.x[NORTH] += ds * c;
         self.filter.x[EAST] += ds * s;
-        self.plain_odometry(ds);
+        self.plain_odometry(wheel.ds_m);
     }
 
     /// The passage of the time since the last epoch: the compass error's decay and the
@@ -460,6 +468,8 @@ impl VehicleEstimator {
             q[SPEED_COEFF] = SPEED_COEFF_WALK * SPEED_COEFF_WALK * dt;
         }
         q[TRACK_SCALE] = GAIN_WALK * GAIN_WALK * dt;
+        // A tyre's rolling radius follows its pressure and temperature over a drive.
+        q[WHEEL_SCALE] = GAIN_WALK * GAIN_WALK * dt;
         self.filter.x[COMPASS_BIAS] *= decay;
         self.tracking.batch.add(&step);
     }

@@ -23,6 +23,10 @@
 //!    bridged by guesswork: the heading crosses the gap on the wheels (or is lost without
 //!    them), the track's uncertainty grows with the distance covered, and the status says
 //!    so.
+//! 5. **Satellite fixes** ([`super::gnss_fusion`]): once they refer heading and track to
+//!    true north and their plane, each corrects the position and, through its
+//!    correlations, the heading and the learned errors; their speeds over ground measure
+//!    the odometer's mean scale `k` ([`super::gnss_speed`]), which nothing else separates.
 //!
 //! Every learned state starts from its kind of vehicle's physical prior
 //! ([`super::SensorPriors::for_wheels`]); the speed coefficient is kept non-negative.
@@ -39,6 +43,7 @@ use super::config::{SensorPriors, VehicleConfig};
 use super::learned::VehicleCalibration;
 use super::nav_filter::{
     BIAS, DIM, GAIN_NEG, GAIN_POS, NavFilter, PSI, SPEED_COEFF, TRACK_SCALE, WHEEL_DIFF,
+    WHEEL_SCALE,
 };
 use super::observability::unobserved;
 use super::tracking::{GyroTrack, VehicleTracking};
@@ -89,6 +94,7 @@ impl Coefficients {
         prior_sigma[WHEEL_DIFF] = p.wheel_diff_sigma;
         prior_sigma[SPEED_COEFF] = p.speed_coeff_sigma;
         prior_sigma[TRACK_SCALE] = p.wheel_track_sigma;
+        prior_sigma[WHEEL_SCALE] = p.wheel_scale_sigma;
         Self {
             priors: p,
             gyro_noise_rad2_per_s: p.gyro_noise_dps_per_sqrt_hz.to_radians().powi(2),
@@ -155,7 +161,7 @@ impl VehicleEstimator {
         let coeffs = Coefficients::new(&config);
         let x = coeffs.prior_x();
         let mut sigma = [0.0; DIM];
-        for i in [WHEEL_DIFF, SPEED_COEFF, TRACK_SCALE] {
+        for i in [WHEEL_DIFF, SPEED_COEFF, TRACK_SCALE, WHEEL_SCALE] {
             sigma[i] = coeffs.prior_sigma[i];
         }
         let filter = NavFilter::new(x, sigma);
@@ -305,8 +311,6 @@ impl VehicleEstimator {
         e.heading_sigma_rad = sigma.min(UNKNOWN_HEADING_SIGMA_RAD);
         e.position_cov_m2 = if e.status.position_known {
             let (n, ea) = (super::nav_filter::NORTH, super::nav_filter::EAST);
-            let p = nalgebra::Vector2::new(f.x[n], f.x[ea]);
-            let scale = self.coeffs.priors.wheel_scale_sigma;
             // The wheels' last reading is off by up to a pulse (uniform: q²/12 per wheel,
             // half of it on their mean), and the track carried on to now at a speed that
             // may have changed by a tenth and that the last step's pulses gave to within
@@ -317,7 +321,6 @@ impl VehicleEstimator {
                 + (0.1 * travel).powi(2)
                 + (ahead_s * speed_quantum).powi(2) / 12.0;
             let cov = Matrix2::new(f.p[n][n], f.p[n][ea], f.p[ea][n], f.p[ea][ea])
-                + scale * scale * p * p.transpose()
                 + Matrix2::identity() * floor;
             if sigma > LINEAR_HEADING_SIGMA_RAD {
                 // The heading is too uncertain for its error to move the track along one
@@ -400,6 +403,8 @@ impl VehicleEstimator {
             wheel_diff: self.tracking.motion.wheels_turn && u.wheel_diff,
             track_scale: self.tracking.motion.wheels_turn && u.track_scale,
             speed_coeff: self.tracking.motion.wheels_turn && u.speed_coeff,
+            // Only fixes measure distance apart from the odometer itself.
+            wheel_scale: self.tracking.gnss.used > 0 && u.wheel_scale,
         };
     }
 }

@@ -135,6 +135,7 @@ impl VehicleEstimator {
         // Where the vehicle was when the fix was computed, and what the delay's spread
         // leaves unknown along the track.
         let t_s = t_s - self.config.gnss.latency_s;
+        self.correct_with_speed(t_s, fix);
         let lag = self.config.gnss.latency_sigma_s * self.est.speed_mps;
         let sigma = (sigma * sigma + lag * lag).sqrt();
         if self.tracking.gnss.aligned {

@@ -4,6 +4,7 @@
 
 use serde::{Deserialize, Serialize};
 
+use super::gnss_speed::{OdometerHistory, SpeedMark};
 use super::innovation_line::InnovationLine;
 
 /// The fixes as the estimator has used them.
@@ -35,6 +36,11 @@ pub(super) struct GnssTrack {
     /// How the track was put on the plane when the fixes referred it there: see
     /// [`PlaneShift`].
     pub shift: Option<PlaneShift>,
+    /// The last fix with a speed over ground that can start a comparison of distances
+    /// with the odometer.
+    pub speed_mark: Option<SpeedMark>,
+    /// The odometer's last readings, for its distance at a fix's epoch.
+    pub odometer: OdometerHistory,
 }
 
 /// How the fixes put the track on their plane: turned about the start by `turn_rad` (the

@@ -12,14 +12,15 @@ use truenorth_core::{
 
 use super::compass_monitor::CompassFix;
 use super::nav_filter::{
-    BIAS, DIM, GAIN_NEG, GAIN_POS, NavFilter, SPEED_COEFF, TRACK_SCALE, WHEEL_DIFF,
+    BIAS, DIM, GAIN_NEG, GAIN_POS, NavFilter, SPEED_COEFF, TRACK_SCALE, WHEEL_DIFF, WHEEL_SCALE,
 };
 
 /// Share of a state's prior standard deviation that it may drift between two drives.
 const DRIFT_SHARE: f64 = 0.1;
 
-/// A learned value and its standard deviation (0: never learned, the prior stands).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+/// A learned value and its standard deviation (0: never learned, the prior stands; the
+/// default).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Learned {
     /// The value.
@@ -72,6 +73,10 @@ pub struct VehicleCalibration {
     pub track_scale: Learned,
     /// Speed coefficient `a` of `1 + aV²` (US 4,788,645 eq. 8), s²/m².
     pub speed_coeff_s2_per_m2: Learned,
+    /// The odometer's mean scale error k (distance = reading × (1 + k)), learned from
+    /// satellite fixes. Absent from a file written before it was learned: never learned.
+    #[serde(default)]
+    pub wheel_scale: Learned,
 }
 
 impl VehicleCalibration {
@@ -88,6 +93,7 @@ impl VehicleCalibration {
             wheel_diff: Learned::of(filter, WHEEL_DIFF),
             track_scale: Learned::of(filter, TRACK_SCALE),
             speed_coeff_s2_per_m2: Learned::of(filter, SPEED_COEFF),
+            wheel_scale: Learned::of(filter, WHEEL_SCALE),
         }
     }
 
@@ -105,6 +111,7 @@ impl VehicleCalibration {
             (WHEEL_DIFF, self.wheel_diff),
             (TRACK_SCALE, self.track_scale),
             (SPEED_COEFF, self.speed_coeff_s2_per_m2),
+            (WHEEL_SCALE, self.wheel_scale),
         ] {
             let prior = prior_sigma[i];
             if l.sigma > 0.0 && prior > 0.0 {
@@ -127,8 +134,8 @@ impl VehicleCalibration {
 }
 
 impl Validate for VehicleCalibration {
-    /// Every value finite, every sigma non-negative; gains and the wheels' scale
-    /// difference within ±50 %, the effective track 0.5–3 times the physical one, the
+    /// Every value finite, every sigma non-negative; gains, the wheels' scale difference
+    /// and their mean scale error within ±50 %, the effective track 0.5–3 times the physical one, the
     /// speed coefficient in 0–0.01 s²/m²; the compass's soft iron invertible, not a
     /// reflection, and the field positive.
     fn validate(&self) -> Result<()> {
@@ -155,6 +162,7 @@ impl Validate for VehicleCalibration {
                 0.0,
                 1e-2,
             ),
+            ("wheel_scale", self.wheel_scale, -0.5, 0.5),
         ] {
             l.check(what)?;
             check_range(what, l.value, lo, hi)?;

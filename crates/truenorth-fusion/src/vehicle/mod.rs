@@ -40,6 +40,7 @@ mod config;
 mod dead_reckoning;
 mod estimator;
 mod gnss_fusion;
+mod gnss_speed;
 mod gnss_track;
 mod heading_trig;
 mod innovation_line;

@@ -32,14 +32,19 @@ pub const SPEED_COEFF: usize = 7;
 /// Heading integrated from the wheels alone, rad (used when a gyro carries the heading).
 pub const PSI_ODO: usize = 8;
 /// Relative error ε of the wheels' effective track: the wheels' heading change is divided
-/// by `T(1 + ε)`. It also takes up the odometer's mean scale error, which scales both
-/// wheels and so their difference.
+/// by `T(1 + ε)`. It also takes up the odometer's mean scale error in the wheels' heading,
+/// which scales both wheels and so their difference: only the distance needs
+/// [`WHEEL_SCALE`].
 pub const TRACK_SCALE: usize = 9;
 /// The compass's slowly varying heading error, rad: what its calibration and the road
 /// (grade, camber) leave in every reading alike for a while (first-order Gauss-Markov).
 pub const COMPASS_BIAS: usize = 10;
+/// The odometer's mean scale error k: the distance driven is the wheels' (or the speed's)
+/// times `1 + k`. Only a measure of distance from outside the wheels — satellite fixes —
+/// separates it; without them it stays at its prior and makes the along-track uncertainty.
+pub const WHEEL_SCALE: usize = 11;
 /// Number of states.
-pub const DIM: usize = 11;
+pub const DIM: usize = 12;
 
 /// A set of states, one bit per index: the states a measurement may correct.
 pub type StateSet = u16;
@@ -216,13 +221,14 @@ mod tests {
     #[test]
     fn predict_matches_the_dense_product() {
         let mut f = filter([
-            0.1, 1.0, 2.0, 0.01, 0.02, 0.03, 0.004, 1e-4, 0.2, 0.01, 0.005,
+            0.1, 1.0, 2.0, 0.01, 0.02, 0.03, 0.004, 1e-4, 0.2, 0.01, 0.005, 0.003,
         ]);
         f.p[BIAS][GAIN_POS] = 1e-4;
         f.p[GAIN_POS][BIAS] = 1e-4;
         let couplings = [
             (NORTH, PSI, -3.0),
             (EAST, PSI, 4.0),
+            (NORTH, WHEEL_SCALE, 2.0),
             (PSI, BIAS, -0.1),
             (PSI, GAIN_POS, -0.5),
             (PSI_ODO, WHEEL_DIFF, -7.0),
@@ -245,7 +251,7 @@ mod tests {
     proptest! {
         #[test]
         fn an_update_never_raises_a_variance_and_keeps_p_symmetric(
-            sig in proptest::array::uniform11(1e-3f64..10.0),
+            sig in proptest::array::uniform12(1e-3f64..10.0),
             corr in -0.9f64..0.9,
             c in -3.0f64..3.0,
             nu in -10.0f64..10.0,
@@ -280,7 +286,7 @@ mod tests {
     proptest! {
         #[test]
         fn a_schmidt_update_leaves_what_it_does_not_learn_and_equals_the_full_one_otherwise(
-            sig in proptest::array::uniform11(1e-3f64..10.0),
+            sig in proptest::array::uniform12(1e-3f64..10.0),
             corr in -0.9f64..0.9,
             nu in -10.0f64..10.0,
             r in 1e-6f64..10.0,
@@ -326,7 +332,7 @@ mod tests {
 
     #[test]
     fn a_measurement_pulls_towards_it_in_proportion_to_trust() {
-        let mut f = filter([1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]);
+        let mut f = filter([1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]);
         f.update(&[(PSI, 1.0)], 2.0, 1.0).unwrap();
         // Equal trust: half way, variance halved.
         assert!((f.x[PSI] - 1.0).abs() < 1e-12);

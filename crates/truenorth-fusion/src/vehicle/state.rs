@@ -116,7 +116,8 @@ pub(super) fn check_fix(fix: Option<&CompassFix>) -> Result<()> {
 
 impl Persistent for VehicleEstimator {
     type State = VehicleEstimatorState;
-    const SNAPSHOT_VERSION: u32 = 1;
+    // 2: the filter gained the odometer's mean scale (12 states).
+    const SNAPSHOT_VERSION: u32 = 2;
 
     fn state(&self) -> VehicleEstimatorState {
         VehicleEstimatorState {

@@ -4,11 +4,12 @@
 //! Each step moves the errors by `e ← (I + E)e + w` with a sparse `E`: the heading takes
 //! the calibration states' errors (`ψ ← cal`, the gyro's or the wheels'), the wheels'
 //! heading likewise (`ψ_w ← cal`), position takes the heading's (`N, E ← ψ`, with the
-//! heading *before* the step) and the compass error decays (`b_c ← λ b_c`). Since the
-//! calibration states do not move, the product over `m` steps keeps that shape:
+//! heading *before* the step, and the odometer's scale: `N, E ← ψ, k`) and the compass
+//! error decays (`b_c ← λ b_c`). Since the calibration states do not move, the product over
+//! `m` steps keeps that shape:
 //!
 //! * `ψ_m = ψ_0 + A_m·cal`, with `A_k = Σ_{j≤k} c_j`;
-//! * `N_m = N_0 + (Σ_k a_k) ψ_0 + (Σ_k a_k A_{k−1})·cal`, and the same for E;
+//! * `N_m = N_0 + (Σ_k a_k) ψ_0 + (Σ_k a_k A_{k−1})·cal + (Σ_k s_k) k`, and the same for E;
 //! * `ψ_w,m = ψ_w,0 + (Σ_k d_k)·cal`; `b_c,m = (Π λ_k) b_c,0`;
 //!
 //! and the heading noise added at step `j` reaches position with weight `S_m − S_j`
@@ -20,7 +21,7 @@
 
 use super::nav_filter::{
     BIAS, COMPASS_BIAS, Coupling, DIM, EAST, GAIN_NEG, GAIN_POS, NORTH, NavFilter, PSI, PSI_ODO,
-    SPEED_COEFF, TRACK_SCALE, WHEEL_DIFF,
+    SPEED_COEFF, TRACK_SCALE, WHEEL_DIFF, WHEEL_SCALE,
 };
 
 /// The calibration states: the only ones the heading is coupled to.
@@ -40,6 +41,10 @@ pub struct Step {
     pub north_from_psi: f64,
     /// See `north_from_psi`.
     pub east_from_psi: f64,
+    /// ∂N/∂k and ∂E/∂k of the step: the odometer's scale error moves the track along it.
+    pub north_from_scale: f64,
+    /// See `north_from_scale`.
+    pub east_from_scale: f64,
     /// The heading's couplings to calibration states (state, coefficient); unused slots
     /// have coefficient 0.
     pub psi_from: [(usize, f64); 3],
@@ -57,6 +62,8 @@ impl Default for Step {
         Self {
             north_from_psi: 0.0,
             east_from_psi: 0.0,
+            north_from_scale: 0.0,
+            east_from_scale: 0.0,
             psi_from: [(0, 0.0); 3],
             odo_from: [(0, 0.0); 3],
             compass_decay: 1.0,
@@ -152,6 +159,8 @@ impl StepBatch {
         }
         self.north_from_psi += step.north_from_psi;
         self.east_from_psi += step.east_from_psi;
+        self.north_from[WHEEL_SCALE] += step.north_from_scale;
+        self.east_from[WHEEL_SCALE] += step.east_from_scale;
         // Heading noise from earlier steps feeds this step's position weight S_k. The
         // moments keep Σ q_j S_j, Σ q_j S_j² … with S_j the weight after step j.
         for &(j, c) in &step.psi_from {
@@ -181,7 +190,7 @@ impl StepBatch {
         if self.steps == 0 {
             return;
         }
-        let mut couplings = [(0, 0, 0.0); 4 * CAL.len() + 3];
+        let mut couplings = [(0, 0, 0.0); 4 * CAL.len() + 5];
         let mut n = 0;
         let mut push = |c: Coupling| {
             if c.2 != 0.0 {
@@ -192,7 +201,7 @@ impl StepBatch {
         // Position first: it reads the heading's row as it was before the batch.
         push((NORTH, PSI, self.north_from_psi));
         push((EAST, PSI, self.east_from_psi));
-        for i in CAL {
+        for i in CAL.into_iter().chain([WHEEL_SCALE]) {
             push((NORTH, i, self.north_from[i]));
             push((EAST, i, self.east_from[i]));
         }
@@ -227,7 +236,12 @@ mod tests {
     use proptest::prelude::*;
 
     fn step_couplings(s: &Step) -> Vec<Coupling> {
-        let mut c = vec![(NORTH, PSI, s.north_from_psi), (EAST, PSI, s.east_from_psi)];
+        let mut c = vec![
+            (NORTH, PSI, s.north_from_psi),
+            (EAST, PSI, s.east_from_psi),
+            (NORTH, WHEEL_SCALE, s.north_from_scale),
+            (EAST, WHEEL_SCALE, s.east_from_scale),
+        ];
         c.extend(s.psi_from.iter().map(|&(j, v)| (PSI, j, v)));
         c.extend(s.odo_from.iter().map(|&(j, v)| (PSI_ODO, j, v)));
         c.push((COMPASS_BIAS, COMPASS_BIAS, s.compass_decay - 1.0));
@@ -242,11 +256,13 @@ mod tests {
                 (-5.0f64..5.0, -5.0f64..5.0, -0.1f64..0.1, -0.1f64..0.1, -3.0f64..3.0,
                  0.9f64..1.0, 0.0f64..1e-3, 0.0f64..1e-3, 0.0f64..1e-2),
                 1..12),
-            sigma in proptest::array::uniform11(0.01f64..2.0),
+            sigma in proptest::array::uniform12(0.01f64..2.0),
         ) {
             let mut one = NavFilter::new([0.0; DIM], sigma);
             one.p[BIAS][GAIN_POS] = 0.3 * sigma[BIAS] * sigma[GAIN_POS];
             one.p[GAIN_POS][BIAS] = one.p[BIAS][GAIN_POS];
+            one.p[WHEEL_SCALE][TRACK_SCALE] = -0.2 * sigma[WHEEL_SCALE] * sigma[TRACK_SCALE];
+            one.p[TRACK_SCALE][WHEEL_SCALE] = one.p[WHEEL_SCALE][TRACK_SCALE];
             let mut batched = one;
             let mut batch = StepBatch::default();
             for &(an, ae, cb, cg, cd, decay, qp, qc, qn) in &steps {
@@ -257,6 +273,8 @@ mod tests {
                 let s = Step {
                     north_from_psi: an,
                     east_from_psi: ae,
+                    north_from_scale: 0.3 * ae,
+                    east_from_scale: -0.7 * an,
                     psi_from: [(BIAS, cb), (GAIN_POS, cg), (TRACK_SCALE, 0.0)],
                     odo_from: [(WHEEL_DIFF, cd), (SPEED_COEFF, 0.1 * cd), (TRACK_SCALE, cg)],
                     compass_decay: decay,

@@ -126,6 +126,10 @@ pub(super) struct Motion {
     /// The rate the heading last turned at, from whichever sensor carried it, rad/s.
     #[serde(default)]
     pub heading_rate_rps: f64,
+    /// The odometer's distance so far before its scale is applied (forward and back
+    /// alike), m.
+    #[serde(default)]
+    pub odometer_m: f64,
 }
 
 /// Rest and the bias average.

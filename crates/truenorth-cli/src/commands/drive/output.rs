@@ -91,6 +91,7 @@ impl Writer {
                     "wheel_diff",
                     "track_scale",
                     "speed_coeff_s2_per_m2",
+                    "wheel_scale",
                 ],
                 Extra::Trust => &[
                     "gap",
@@ -100,6 +101,7 @@ impl Writer {
                     "unobserved_wheel_diff",
                     "unobserved_track_scale",
                     "unobserved_speed_coeff",
+                    "unobserved_wheel_scale",
                 ],
                 Extra::Geodetic => &["lat_deg", "lon_deg"],
             });
@@ -206,9 +208,10 @@ fn extra_cells(x: Extra, e: &NavEstimate, context: &Context<'_>, row: &mut Vec<f
                     x[WHEEL_DIFF],
                     x[TRACK_SCALE],
                     x[SPEED_COEFF],
+                    1.0 + x[WHEEL_SCALE],
                 ]);
             }
-            None => row.extend([f64::NAN; 6]),
+            None => row.extend([f64::NAN; 7]),
         },
         Extra::Trust => {
             let u = e.status.unobserved;
@@ -220,6 +223,7 @@ fn extra_cells(x: Extra, e: &NavEstimate, context: &Context<'_>, row: &mut Vec<f
                 u.wheel_diff,
                 u.track_scale,
                 u.speed_coeff,
+                u.wheel_scale,
             ]));
         }
         Extra::Geodetic => {
