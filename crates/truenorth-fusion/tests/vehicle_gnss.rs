@@ -489,8 +489,8 @@ fn a_real_car_bridges_outages_of_its_fixes() {
 ///
 /// Measured (4 drives): the gyro bias learned after 153 s at the median and 327 s at most —
 /// the largest misses the 3 minutes asked; the right and left gains after 137 s and 13 s
-/// (median); the wheels' states within 2σ of their final values from the start (their priors
-/// are as narrow as what these drives teach). Multipath fixes 83 % rejected, open-sky 2.6 %,
+/// (median); the wheels' states and the odometer's scale within 2σ of their final values from
+/// the start (their priors are as narrow as what these drives teach). Multipath fixes 83 % rejected, open-sky 2.6 %,
 /// in a canyon without a jump 6.0 %.
 #[test]
 fn what_the_fixes_teach_and_what_they_reject() {
