@@ -147,7 +147,7 @@ fn extra_columns_true_north_and_the_learned_calibration_carried_over() {
         ],
     ));
     let (header, rows) = read_rows(&out);
-    assert_eq!(header.len(), 4 + 3 + 4 + 7);
+    assert_eq!(header.len(), 4 + 3 + 4 + 8);
     assert_eq!(
         &header[4..7],
         ["heading_sigma_deg", "north_sigma_m", "east_sigma_m"]

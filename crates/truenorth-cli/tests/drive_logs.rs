@@ -128,7 +128,7 @@ fn every_kind_of_vehicle_from_rows_that_carry_any_subset() {
         );
         let rows = read_rows(&dir.join("out.csv"));
         assert_eq!(rows.len(), drive.samples.len(), "{kind:?}");
-        assert_eq!(rows[0].len(), 4 + 3 + 4 + 8, "{kind:?}");
+        assert_eq!(rows[0].len(), 4 + 3 + 4 + 9, "{kind:?}");
         let (last, t) = (rows.last().unwrap(), drive.truth.last().unwrap());
         // A track never referred to north is drawn as if the start heading were north.
         let (north, east) = if last[7] == 1.0 {

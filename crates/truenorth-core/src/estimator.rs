@@ -150,6 +150,8 @@ pub struct Unobserved {
     pub speed_coeff: bool,
     /// The odometer's mean scale (learned only from satellite fixes).
     pub wheel_scale: bool,
+    /// How far the wheels' readings trail the gyro's (learned from turns, with a gyro).
+    pub wheel_lag: bool,
 }
 
 impl Unobserved {
@@ -162,6 +164,7 @@ impl Unobserved {
             || self.track_scale
             || self.speed_coeff
             || self.wheel_scale
+            || self.wheel_lag
     }
 }
 

@@ -24,7 +24,7 @@
 //! - Both orientation estimators save and restore what they carry between samples as plain
 //!   data ([`truenorth_core::Persistent`]: [`QuaternionFilterState`], [`EulerDetectorState`]).
 //! - [`VehicleEstimator`]: vehicle heading and dead reckoning from wheels, an optional yaw
-//!   gyro and a raw compass, learning every sensor's errors while it drives (a 12-state
+//!   gyro and a raw compass, learning every sensor's errors while it drives (a 13-state
 //!   Kalman filter; [`vehicle`] also holds the two-pass start, the learned calibration
 //!   carried between drives, and the seed configurations of US 4,788,645 and EP 0640207).
 //!

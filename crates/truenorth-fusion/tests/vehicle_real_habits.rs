@@ -257,10 +257,10 @@ fn cells() -> Vec<Cell> {
 /// presets of real logs: heading beyond 3σ on at most 2 % of rows, never beyond 6σ.
 ///
 /// Printed, not held — misses, measured with `SEEDS=10`: the generic robots' heading σ
-/// (skid-steer with a compass 3.0–6.9 % of rows beyond 3σ and up to 10.1σ, with a gyro and
-/// wheel speeds 3.8 %, 7.5σ; a differential robot's wheel speeds 9.9 % with a gyro, where
-/// its wheel distances give 0 %), where the wheels' slip, the speeds' lag and a track that
-/// changes with the ground outrun their noise model; and sets without a gyro, whose heading
+/// (skid-steer with a compass 2.8–6.9 % of rows beyond 3σ and up to 10.1σ, with a gyro and
+/// wheel speeds 3.5 %, 5.8σ; a differential robot's wheel speeds 5.0 %, 7.7σ with a gyro,
+/// where its wheel distances give 0 %), where the wheels' slip and a track that changes with
+/// the ground outrun their noise model; and sets without a gyro, whose heading
 /// comes from the wheels and the compass alone (a differential robot's wheel speeds with a
 /// compass: 14.0 % beyond 3σ, 11.1σ; cars' wheel speeds with a compass 2.1–3.4 %, 5.5σ).
 #[test]

@@ -74,11 +74,12 @@ heading's σ is of the heading change since the start while heading_absolute is 
 `--extra status` adds heading_absolute, compass_used, compass_disturbed, at_rest (0/1);
 `--extra calibration` adds the learned gyro_bias_dps, gyro_gain_right, gyro_gain_left,
 wheel_diff, track_scale, speed_coeff_s2_per_m2, wheel_scale (the odometer's distance
-gain, learned from satellite fixes) (fused method only); `--extra trust` adds
+gain, learned from satellite fixes), wheel_lag_s (how far the wheels' readings trail the
+gyro's) (fused method only); `--extra trust` adds
 gap (a sensor's readings resumed after more than 2 s: what it could not follow was
 widened) and unobserved_gyro_bias, unobserved_gyro_gain_right, unobserved_gyro_gain_left,
 unobserved_wheel_diff, unobserved_track_scale, unobserved_speed_coeff,
-unobserved_wheel_scale (1 while the data
+unobserved_wheel_scale, unobserved_wheel_lag (1 while the data
 have not told that sensor error apart from the others: a steady circle cannot separate a
 gyro bias from a wheel-size difference).
 
@@ -459,6 +460,7 @@ fn summary(
         (u.track_scale, "effective track"),
         (u.speed_coeff, "speed coefficient"),
         (u.wheel_scale, "odometer scale"),
+        (u.wheel_lag, "wheels' delay"),
     ]
     .iter()
     .filter(|(o, _)| *o)

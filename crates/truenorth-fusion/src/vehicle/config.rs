@@ -43,6 +43,13 @@ pub struct SensorPriors {
     /// is learned (0.02 for rolling wheels, whose contact patches sit within a few cm of
     /// the nominal track; 0.3 for a skid-steer, whose factor lies between 1.5 and 2.5).
     pub wheel_track_sigma: f64,
+    /// How far the wheels' readings trail the gyro's before it is learned, s (0.1), and the
+    /// spread of that, s (0.1): sensors on their own rows reach a log 50–150 ms apart, and
+    /// wheel speeds come through a controller's filter of 20–100 ms (a car's ABS unit) to
+    /// 50–300 ms (a robot's motor controller).
+    pub wheel_lag_s: f64,
+    /// See [`SensorPriors::wheel_lag_s`].
+    pub wheel_lag_sigma_s: f64,
     /// Initial speed coefficient `a`, s²/m² (1e-4 for a car; 0 for a robot, which never
     /// goes fast enough for it to show).
     pub speed_coeff_s2_per_m2: f64,
@@ -91,6 +98,8 @@ impl SensorPriors {
             wheel_scale_sigma: 0.003,
             track_factor: 1.0,
             wheel_track_sigma: 0.02,
+            wheel_lag_s: 0.1,
+            wheel_lag_sigma_s: 0.1,
             speed_coeff_s2_per_m2: 1e-4,
             speed_coeff_sigma: 1e-4,
             wheel_heading_noise_deg_per_sqrt_m: 0.01,
@@ -143,6 +152,8 @@ impl Validate for SensorPriors {
         check_range("wheel_scale_sigma", self.wheel_scale_sigma, 0.0, 0.5)?;
         check_range("track_factor", self.track_factor, 0.5, 5.0)?;
         check_range("wheel_track_sigma", self.wheel_track_sigma, 1e-9, 2.0)?;
+        check_range("wheel_lag_s", self.wheel_lag_s, 0.0, 2.0)?;
+        check_range("wheel_lag_sigma_s", self.wheel_lag_sigma_s, 0.0, 2.0)?;
         check_range(
             "speed_coeff_s2_per_m2",
             self.speed_coeff_s2_per_m2,

@@ -8,7 +8,7 @@ use truenorth_gyro::YawIncrement;
 use super::estimator::VehicleEstimator;
 use super::nav_filter::{
     BIAS, COMPASS_BIAS, DIM, EAST, GAIN_NEG, GAIN_POS, NORTH, PSI, PSI_ODO, SPEED_COEFF,
-    TRACK_SCALE, WHEEL_DIFF, WHEEL_SCALE,
+    TRACK_SCALE, WHEEL_DIFF, WHEEL_LAG, WHEEL_SCALE,
 };
 use super::step_batch::Step;
 use super::tracking::{Alignment, CompassWindow, Rest};
@@ -74,6 +74,8 @@ const SLIP_TAU_S: f64 = 3.0;
 const GAIN_WALK: f64 = 1e-5;
 const DIFF_WALK: f64 = 2e-7;
 const SPEED_COEFF_WALK: f64 = 1e-8;
+/// The wheels' delay, s/√s: a logger's buffering may change over a drive.
+const LAG_WALK_S: f64 = 1e-4;
 
 /// Position noise per metre travelled, m²/m (lateral creep, bumps).
 const POSITION_NOISE_M2_PER_M: f64 = 1e-6;
@@ -470,6 +472,7 @@ impl VehicleEstimator {
         q[TRACK_SCALE] = GAIN_WALK * GAIN_WALK * dt;
         // A tyre's rolling radius follows its pressure and temperature over a drive.
         q[WHEEL_SCALE] = GAIN_WALK * GAIN_WALK * dt;
+        q[WHEEL_LAG] = LAG_WALK_S * LAG_WALK_S * dt;
         self.filter.x[COMPASS_BIAS] *= decay;
         self.tracking.batch.add(&step);
     }
@@ -512,8 +515,10 @@ impl VehicleEstimator {
         if self.tracking.window.n >= self.config.compass.readings_per_update {
             self.correct_with_compass();
         }
-        // A wheel pair's difference only grows with speed: `a` is never negative.
+        // A wheel pair's difference only grows with speed: `a` is never negative; and the
+        // wheels cannot read before the motion.
         self.filter.project_at_least(SPEED_COEFF, 0.0);
+        self.filter.project_at_least(WHEEL_LAG, 0.0);
         self.guard_against_plain();
     }
 
@@ -536,16 +541,24 @@ impl VehicleEstimator {
         self.tracking.gates.time_base_window();
         let t_wheels = self.wheels.last_s().unwrap_or(f64::NAN);
         let ahead = self.heading_at(t_wheels) - self.filter.x[PSI];
-        let nu = wrap_pi(self.filter.x[PSI_ODO] - self.filter.x[PSI] - ahead);
-        let h = [(PSI, 1.0), (PSI_ODO, -1.0)];
         // The wheels' and the gyro's readings reach the log with different delays (their
-        // own rows and clocks, a motor controller's or an ABS unit's filtering): the two
-        // headings differ by the turn made in the delay, the rate times it, which says
-        // nothing about either sensor's errors. Exact when driving straight, poor in a turn.
-        let latency = WHEEL_GYRO_DELAY_S * self.tracking.gyro.rate_rps;
-        let r = self.coeffs.wheel_quantisation_rad2 + latency * latency;
+        // own rows and clocks, a motor controller's or an ABS unit's filtering): in a turn
+        // the wheels' heading trails the gyro's by the rate times the delay, which is
+        // learned (it vanishes when the turn ends, where a gain's error stays).
+        let rate = self.tracking.gyro.rate_rps;
+        let nu = wrap_pi(
+            self.filter.x[PSI_ODO] - self.filter.x[PSI] - ahead + self.filter.x[WHEEL_LAG] * rate,
+        );
+        let h = [(PSI, 1.0), (PSI_ODO, -1.0), (WHEEL_LAG, -rate)];
+        // What the delay does beyond a constant: the rows' jitter.
+        let jitter = WHEEL_ROW_JITTER_S * rate;
+        let r = self.coeffs.wheel_quantisation_rad2 + jitter * jitter;
         let f = &self.filter;
-        let s = f.p[PSI][PSI] - 2.0 * f.p[PSI][PSI_ODO] + f.p[PSI_ODO][PSI_ODO] + r;
+        let s = f.p[PSI][PSI] - 2.0 * f.p[PSI][PSI_ODO]
+            + f.p[PSI_ODO][PSI_ODO]
+            + rate * rate * f.p[WHEEL_LAG][WHEEL_LAG]
+            - 2.0 * rate * (f.p[PSI][WHEEL_LAG] - f.p[PSI_ODO][WHEEL_LAG])
+            + r;
         let nis = nu * nu / s;
         let learn = self.tracking.gates.wheel_check_learnable();
         self.tracking.gates.wheel_check_done(nis);
@@ -557,10 +570,9 @@ impl VehicleEstimator {
     }
 }
 
-/// Standard deviation of the delay between the wheels' readings and the gyro's as a log
-/// records them, s (0.1): sensors on their own rows and clocks reach a log 50–150 ms apart,
-/// and a controller's speed filter adds as much.
-const WHEEL_GYRO_DELAY_S: f64 = 0.1;
+/// Standard deviation of the delay between the wheels' readings and the gyro's from one
+/// reading to the next, around its learned mean, s (0.02): a logger's jitter.
+const WHEEL_ROW_JITTER_S: f64 = 0.02;
 
 /// A comparison whose normalised innovation squared exceeds this (5σ) is an outlier.
 const OUTLIER_NIS: f64 = 25.0;

@@ -42,7 +42,7 @@ use super::compass_monitor::{CompassFix, CompassMonitor};
 use super::config::{SensorPriors, VehicleConfig};
 use super::learned::VehicleCalibration;
 use super::nav_filter::{
-    BIAS, DIM, GAIN_NEG, GAIN_POS, NavFilter, PSI, SPEED_COEFF, TRACK_SCALE, WHEEL_DIFF,
+    BIAS, DIM, GAIN_NEG, GAIN_POS, NavFilter, PSI, SPEED_COEFF, TRACK_SCALE, WHEEL_DIFF, WHEEL_LAG,
     WHEEL_SCALE,
 };
 use super::observability::unobserved;
@@ -95,6 +95,7 @@ impl Coefficients {
         prior_sigma[SPEED_COEFF] = p.speed_coeff_sigma;
         prior_sigma[TRACK_SCALE] = p.wheel_track_sigma;
         prior_sigma[WHEEL_SCALE] = p.wheel_scale_sigma;
+        prior_sigma[WHEEL_LAG] = p.wheel_lag_sigma_s;
         Self {
             priors: p,
             gyro_noise_rad2_per_s: p.gyro_noise_dps_per_sqrt_hz.to_radians().powi(2),
@@ -114,6 +115,7 @@ impl Coefficients {
         let mut x = [0.0; DIM];
         x[SPEED_COEFF] = self.priors.speed_coeff_s2_per_m2;
         x[TRACK_SCALE] = self.priors.track_factor - 1.0;
+        x[WHEEL_LAG] = self.priors.wheel_lag_s;
         x
     }
 }
@@ -161,7 +163,7 @@ impl VehicleEstimator {
         let coeffs = Coefficients::new(&config);
         let x = coeffs.prior_x();
         let mut sigma = [0.0; DIM];
-        for i in [WHEEL_DIFF, SPEED_COEFF, TRACK_SCALE, WHEEL_SCALE] {
+        for i in [WHEEL_DIFF, SPEED_COEFF, TRACK_SCALE, WHEEL_SCALE, WHEEL_LAG] {
             sigma[i] = coeffs.prior_sigma[i];
         }
         let filter = NavFilter::new(x, sigma);
@@ -405,6 +407,8 @@ impl VehicleEstimator {
             speed_coeff: self.tracking.motion.wheels_turn && u.speed_coeff,
             // Only fixes measure distance apart from the odometer itself.
             wheel_scale: self.tracking.gnss.used > 0 && u.wheel_scale,
+            // Only a gyro's turns set the wheels' delay apart.
+            wheel_lag: self.tracking.gyro.active && self.tracking.motion.wheels_turn && u.wheel_lag,
         };
     }
 }

@@ -12,7 +12,8 @@ use truenorth_core::{
 
 use super::compass_monitor::CompassFix;
 use super::nav_filter::{
-    BIAS, DIM, GAIN_NEG, GAIN_POS, NavFilter, SPEED_COEFF, TRACK_SCALE, WHEEL_DIFF, WHEEL_SCALE,
+    BIAS, DIM, GAIN_NEG, GAIN_POS, NavFilter, SPEED_COEFF, TRACK_SCALE, WHEEL_DIFF, WHEEL_LAG,
+    WHEEL_SCALE,
 };
 
 /// Share of a state's prior standard deviation that it may drift between two drives.
@@ -77,6 +78,10 @@ pub struct VehicleCalibration {
     /// satellite fixes. Absent from a file written before it was learned: never learned.
     #[serde(default)]
     pub wheel_scale: Learned,
+    /// How far the wheels' readings trail the gyro's, s. Absent from a file written before
+    /// it was learned: never learned.
+    #[serde(default)]
+    pub wheel_lag_s: Learned,
 }
 
 impl VehicleCalibration {
@@ -94,6 +99,7 @@ impl VehicleCalibration {
             track_scale: Learned::of(filter, TRACK_SCALE),
             speed_coeff_s2_per_m2: Learned::of(filter, SPEED_COEFF),
             wheel_scale: Learned::of(filter, WHEEL_SCALE),
+            wheel_lag_s: Learned::of(filter, WHEEL_LAG),
         }
     }
 
@@ -112,6 +118,7 @@ impl VehicleCalibration {
             (TRACK_SCALE, self.track_scale),
             (SPEED_COEFF, self.speed_coeff_s2_per_m2),
             (WHEEL_SCALE, self.wheel_scale),
+            (WHEEL_LAG, self.wheel_lag_s),
         ] {
             let prior = prior_sigma[i];
             if l.sigma > 0.0 && prior > 0.0 {
@@ -135,7 +142,7 @@ impl VehicleCalibration {
 
 impl Validate for VehicleCalibration {
     /// Every value finite, every sigma non-negative; gains, the wheels' scale difference
-    /// and their mean scale error within ±50 %, the effective track 0.5–3 times the physical one, the
+    /// and their mean scale error within ±50 %, the wheels' delay 0–2 s, the effective track 0.5–3 times the physical one, the
     /// speed coefficient in 0–0.01 s²/m²; the compass's soft iron invertible, not a
     /// reflection, and the field positive.
     fn validate(&self) -> Result<()> {
@@ -163,6 +170,7 @@ impl Validate for VehicleCalibration {
                 1e-2,
             ),
             ("wheel_scale", self.wheel_scale, -0.5, 0.5),
+            ("wheel_lag_s", self.wheel_lag_s, 0.0, 2.0),
         ] {
             l.check(what)?;
             check_range(what, l.value, lo, hi)?;

@@ -43,8 +43,12 @@ pub const COMPASS_BIAS: usize = 10;
 /// times `1 + k`. Only a measure of distance from outside the wheels — satellite fixes —
 /// separates it; without them it stays at its prior and makes the along-track uncertainty.
 pub const WHEEL_SCALE: usize = 11;
+/// How far the wheels' readings trail the gyro's, s: a controller's speed filter, a bus and
+/// a logger delay the wheels, so in a turn their heading lags by the rate times this.
+/// Learned where the wheels are compared with a gyro in turns; kept non-negative.
+pub const WHEEL_LAG: usize = 12;
 /// Number of states.
-pub const DIM: usize = 12;
+pub const DIM: usize = 13;
 
 /// A set of states, one bit per index: the states a measurement may correct.
 pub type StateSet = u16;
@@ -221,7 +225,7 @@ mod tests {
     #[test]
     fn predict_matches_the_dense_product() {
         let mut f = filter([
-            0.1, 1.0, 2.0, 0.01, 0.02, 0.03, 0.004, 1e-4, 0.2, 0.01, 0.005, 0.003,
+            0.1, 1.0, 2.0, 0.01, 0.02, 0.03, 0.004, 1e-4, 0.2, 0.01, 0.005, 0.003, 0.1,
         ]);
         f.p[BIAS][GAIN_POS] = 1e-4;
         f.p[GAIN_POS][BIAS] = 1e-4;
@@ -251,7 +255,7 @@ mod tests {
     proptest! {
         #[test]
         fn an_update_never_raises_a_variance_and_keeps_p_symmetric(
-            sig in proptest::array::uniform12(1e-3f64..10.0),
+            sig in proptest::array::uniform13(1e-3f64..10.0),
             corr in -0.9f64..0.9,
             c in -3.0f64..3.0,
             nu in -10.0f64..10.0,
@@ -286,7 +290,7 @@ mod tests {
     proptest! {
         #[test]
         fn a_schmidt_update_leaves_what_it_does_not_learn_and_equals_the_full_one_otherwise(
-            sig in proptest::array::uniform12(1e-3f64..10.0),
+            sig in proptest::array::uniform13(1e-3f64..10.0),
             corr in -0.9f64..0.9,
             nu in -10.0f64..10.0,
             r in 1e-6f64..10.0,
@@ -332,7 +336,9 @@ mod tests {
 
     #[test]
     fn a_measurement_pulls_towards_it_in_proportion_to_trust() {
-        let mut f = filter([1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]);
+        let mut f = filter([
+            1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0,
+        ]);
         f.update(&[(PSI, 1.0)], 2.0, 1.0).unwrap();
         // Equal trust: half way, variance halved.
         assert!((f.x[PSI] - 1.0).abs() < 1e-12);

@@ -9,7 +9,8 @@
 use truenorth_core::Unobserved;
 
 use super::nav_filter::{
-    BIAS, DIM, GAIN_NEG, GAIN_POS, NavFilter, SPEED_COEFF, TRACK_SCALE, WHEEL_DIFF, WHEEL_SCALE,
+    BIAS, DIM, GAIN_NEG, GAIN_POS, NavFilter, SPEED_COEFF, TRACK_SCALE, WHEEL_DIFF, WHEEL_LAG,
+    WHEEL_SCALE,
 };
 
 /// A state whose standard deviation is above this share of its prior's is not yet
@@ -20,7 +21,7 @@ const DETERMINED_SHARE: f64 = 0.5;
 const COMBINED_CORRELATION: f64 = 0.95;
 
 /// The learned states, in the order of [`Unobserved`]'s fields.
-const LEARNED: [usize; 7] = [
+const LEARNED: [usize; 8] = [
     BIAS,
     GAIN_POS,
     GAIN_NEG,
@@ -28,6 +29,7 @@ const LEARNED: [usize; 7] = [
     TRACK_SCALE,
     SPEED_COEFF,
     WHEEL_SCALE,
+    WHEEL_LAG,
 ];
 
 /// Which of `filter`'s learned states are not yet determined, against the prior standard
@@ -59,6 +61,7 @@ pub fn unobserved(filter: &NavFilter, prior_sigma: &[f64; DIM]) -> Unobserved {
         track_scale: open(TRACK_SCALE),
         speed_coeff: open(SPEED_COEFF),
         wheel_scale: open(WHEEL_SCALE),
+        wheel_lag: open(WHEEL_LAG),
     }
 }
 

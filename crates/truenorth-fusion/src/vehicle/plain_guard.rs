@@ -21,7 +21,7 @@
 
 use super::estimator::VehicleEstimator;
 use super::nav_filter::{
-    BIAS, EAST, GAIN_NEG, GAIN_POS, NORTH, PSI, SPEED_COEFF, TRACK_SCALE, WHEEL_DIFF,
+    BIAS, EAST, GAIN_NEG, GAIN_POS, NORTH, PSI, SPEED_COEFF, TRACK_SCALE, WHEEL_DIFF, WHEEL_LAG,
 };
 use super::plain_baseline::PlainErrors;
 
@@ -95,7 +95,14 @@ impl VehicleEstimator {
         let f = &mut self.filter;
         f.x[BIAS] = g.bias_rps;
         f.reset_state(BIAS, since_rest_var.sqrt());
-        for i in [GAIN_POS, GAIN_NEG, WHEEL_DIFF, SPEED_COEFF, TRACK_SCALE] {
+        for i in [
+            GAIN_POS,
+            GAIN_NEG,
+            WHEEL_DIFF,
+            SPEED_COEFF,
+            TRACK_SCALE,
+            WHEEL_LAG,
+        ] {
             f.x[i] = initial[i];
             f.reset_state(i, prior[i]);
         }

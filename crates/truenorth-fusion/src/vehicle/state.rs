@@ -116,7 +116,7 @@ pub(super) fn check_fix(fix: Option<&CompassFix>) -> Result<()> {
 
 impl Persistent for VehicleEstimator {
     type State = VehicleEstimatorState;
-    // 2: the filter gained the odometer's mean scale (12 states).
+    // 2: the filter gained the odometer's mean scale and the wheels' delay (13 states).
     const SNAPSHOT_VERSION: u32 = 2;
 
     fn state(&self) -> VehicleEstimatorState {

@@ -256,7 +256,7 @@ mod tests {
                 (-5.0f64..5.0, -5.0f64..5.0, -0.1f64..0.1, -0.1f64..0.1, -3.0f64..3.0,
                  0.9f64..1.0, 0.0f64..1e-3, 0.0f64..1e-3, 0.0f64..1e-2),
                 1..12),
-            sigma in proptest::array::uniform12(0.01f64..2.0),
+            sigma in proptest::array::uniform13(0.01f64..2.0),
         ) {
             let mut one = NavFilter::new([0.0; DIM], sigma);
             one.p[BIAS][GAIN_POS] = 0.3 * sigma[BIAS] * sigma[GAIN_POS];

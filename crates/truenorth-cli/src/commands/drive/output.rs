@@ -92,6 +92,7 @@ impl Writer {
                     "track_scale",
                     "speed_coeff_s2_per_m2",
                     "wheel_scale",
+                    "wheel_lag_s",
                 ],
                 Extra::Trust => &[
                     "gap",
@@ -102,6 +103,7 @@ impl Writer {
                     "unobserved_track_scale",
                     "unobserved_speed_coeff",
                     "unobserved_wheel_scale",
+                    "unobserved_wheel_lag",
                 ],
                 Extra::Geodetic => &["lat_deg", "lon_deg"],
             });
@@ -209,9 +211,10 @@ fn extra_cells(x: Extra, e: &NavEstimate, context: &Context<'_>, row: &mut Vec<f
                     x[TRACK_SCALE],
                     x[SPEED_COEFF],
                     1.0 + x[WHEEL_SCALE],
+                    x[WHEEL_LAG],
                 ]);
             }
-            None => row.extend([f64::NAN; 7]),
+            None => row.extend([f64::NAN; 8]),
         },
         Extra::Trust => {
             let u = e.status.unobserved;
@@ -224,6 +227,7 @@ fn extra_cells(x: Extra, e: &NavEstimate, context: &Context<'_>, row: &mut Vec<f
                 u.track_scale,
                 u.speed_coeff,
                 u.wheel_scale,
+                u.wheel_lag,
             ]));
         }
         Extra::Geodetic => {
