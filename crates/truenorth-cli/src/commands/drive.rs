@@ -39,6 +39,8 @@ is learned); wheelbase_m rear axle to front kingpins, m; pitman_ratio P = 2p/T_F
 offset p over half the front track; front wheels only). Optional: \"wheel_resolution_m\"
 (distance per odometer pulse, default 0.02 with distance columns on a car and 0.003 with
 speed columns, a CAN bus's 0.01 km/h over one second; 0.001 on a robot),
+\"wheel_speed_quantum_mps\" (the step wheel speeds are sent in, default 0.01 km/h on a car
+and 1 mm/s on a robot: held steady, each wheel's rounding turns the heading),
 \"gnss_lever_arm_m\" ([forward, right] of the GNSS antenna from the axle's centre, m;
 default [0, 0]), \"compass_systematic_deg\" (the compass's systematic heading error, default 3: a level
 two-axis compass on roads whose grade and camber tilt it; about 0.3 for a tilt-compensated
@@ -110,6 +112,14 @@ truenorth drive --vehicle car.json --input drive2.csv.gz --output track2.csv
 /// the one second in which the estimator compares wheels with gyro. The pulse default
 /// (2 cm) would make such wheels look a hundred times noisier than they are.
 const SPEED_RESOLUTION_M: f64 = 0.003;
+
+/// The quantum of a car's CAN wheel speeds when the vehicle file gives none, m/s: 0.01 km/h,
+/// the commonest scaling of a wheel-speed signal.
+const CAN_SPEED_QUANTUM_MPS: f64 = 0.01 / 3.6;
+
+/// The quantum of a robot's wheel speeds when the vehicle file gives none, m/s: the mm/s
+/// of motor controllers' odometry messages.
+const ROBOT_SPEED_QUANTUM_MPS: f64 = 0.001;
 
 /// Arguments of `truenorth drive` (the file layouts are in `AFTER_HELP`, shown by `--help`).
 #[derive(Debug, clap::Args)]
@@ -288,6 +298,16 @@ fn build_method(
         priors.wheel_resolution_m = r;
     } else if speeds && !wheels.can_pivot() {
         priors.wheel_resolution_m = SPEED_RESOLUTION_M;
+    }
+    if speeds {
+        priors.wheel_speed_quantum_mps =
+            vehicle
+                .wheel_speed_quantum_mps
+                .unwrap_or(if wheels.can_pivot() {
+                    ROBOT_SPEED_QUANTUM_MPS
+                } else {
+                    CAN_SPEED_QUANTUM_MPS
+                });
     }
     let mut config = VehicleConfig {
         wheels,

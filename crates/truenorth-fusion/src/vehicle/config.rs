@@ -50,6 +50,12 @@ pub struct SensorPriors {
     pub wheel_lag_s: f64,
     /// See [`SensorPriors::wheel_lag_s`].
     pub wheel_lag_sigma_s: f64,
+    /// The quantum of the wheel speeds the wheel distances were integrated from, m/s (0:
+    /// the wheels are read as distances, from counters). A controller sends speeds rounded
+    /// (a car's CAN 0.01 km/h, a robot's motor controller 1 mm/s); while the speeds hold
+    /// steady each wheel's rounding error holds too, and the heading drifts.
+    #[serde(default)]
+    pub wheel_speed_quantum_mps: f64,
     /// Initial speed coefficient `a`, s²/m² (1e-4 for a car; 0 for a robot, which never
     /// goes fast enough for it to show).
     pub speed_coeff_s2_per_m2: f64,
@@ -100,6 +106,7 @@ impl SensorPriors {
             wheel_track_sigma: 0.02,
             wheel_lag_s: 0.1,
             wheel_lag_sigma_s: 0.1,
+            wheel_speed_quantum_mps: 0.0,
             speed_coeff_s2_per_m2: 1e-4,
             speed_coeff_sigma: 1e-4,
             wheel_heading_noise_deg_per_sqrt_m: 0.01,
@@ -154,6 +161,12 @@ impl Validate for SensorPriors {
         check_range("wheel_track_sigma", self.wheel_track_sigma, 1e-9, 2.0)?;
         check_range("wheel_lag_s", self.wheel_lag_s, 0.0, 2.0)?;
         check_range("wheel_lag_sigma_s", self.wheel_lag_sigma_s, 0.0, 2.0)?;
+        check_range(
+            "wheel_speed_quantum_mps",
+            self.wheel_speed_quantum_mps,
+            0.0,
+            1.0,
+        )?;
         check_range(
             "speed_coeff_s2_per_m2",
             self.speed_coeff_s2_per_m2,

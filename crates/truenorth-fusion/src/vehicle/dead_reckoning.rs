@@ -5,7 +5,7 @@
 use truenorth_core::{STANDARD_GRAVITY_MPS2, WheelReading, wrap_pi};
 use truenorth_gyro::YawIncrement;
 
-use super::estimator::VehicleEstimator;
+use super::estimator::{ROW_JITTER_S, VehicleEstimator};
 use super::nav_filter::{
     BIAS, COMPASS_BIAS, DIM, EAST, GAIN_NEG, GAIN_POS, NORTH, PSI, PSI_ODO, SPEED_COEFF,
     TRACK_SCALE, WHEEL_DIFF, WHEEL_LAG, WHEEL_SCALE,
@@ -339,7 +339,7 @@ impl VehicleEstimator {
             self.tracking.gates.count_step(gap);
             self.est.status.gap |= gap;
         }
-        let wheel_q = self.wheel_noise(&wheel, gap);
+        let wheel_q = self.wheel_noise(&wheel, gap) + self.held_speeds_noise(&wheel, turns);
         let wheel_from = [
             (WHEEL_DIFF, wheel.d_heading_d_diff),
             (SPEED_COEFF, wheel.d_heading_d_speed_coeff),
@@ -416,6 +416,36 @@ impl VehicleEstimator {
             q += (GAP_STEERED_SHARE * turned).powi(2);
         }
         q
+    }
+
+    /// Variance the wheels' heading gains from speeds read in quanta `q` and integrated: each
+    /// wheel's rounding error holds while its speed moves by less than a quantum, and their
+    /// difference turns the heading at a rate of standard deviation `q/(√6·T)` (two uniform
+    /// roundings, track T) for as long as it holds — an error growing with the hold's length,
+    /// `σ²h²`, not with its square root; the increments here sum to that over each hold. Zero
+    /// for distances read from counters (`wheel_speed_quantum_mps` 0).
+    fn held_speeds_noise(&mut self, wheel: &WheelStep, turns: bool) -> f64 {
+        let quantum = self.coeffs.priors.wheel_speed_quantum_mps;
+        if quantum <= 0.0 || !turns || !wheel.moved {
+            return 0.0;
+        }
+        let hold = &mut self.tracking.motion.speed_hold;
+        // A step's speed is the mean of two readings: one quantum in a reading is half here.
+        let renewed = hold
+            .speeds_mps
+            .iter()
+            .zip(wheel.side_speeds_mps)
+            .any(|(a, b)| (a - b).abs() >= 0.5 * quantum);
+        if renewed {
+            *hold = super::tracking::SpeedHold {
+                speeds_mps: wheel.side_speeds_mps,
+                held_s: 0.0,
+            };
+        }
+        let sigma_rate = quantum / (6f64.sqrt() * wheel.effective_track_m);
+        let (h0, h1) = (hold.held_s, hold.held_s + wheel.dt_s);
+        hold.held_s = h1;
+        sigma_rate * sigma_rate * (h1 * h1 - h0 * h0)
     }
 
     /// Draws the track along the heading half-way between this wheel reading and the last.
@@ -551,7 +581,7 @@ impl VehicleEstimator {
         );
         let h = [(PSI, 1.0), (PSI_ODO, -1.0), (WHEEL_LAG, -rate)];
         // What the delay does beyond a constant: the rows' jitter.
-        let jitter = WHEEL_ROW_JITTER_S * rate;
+        let jitter = ROW_JITTER_S * rate;
         let r = self.coeffs.wheel_quantisation_rad2 + jitter * jitter;
         let f = &self.filter;
         let s = f.p[PSI][PSI] - 2.0 * f.p[PSI][PSI_ODO]
@@ -569,10 +599,6 @@ impl VehicleEstimator {
         self.filter.update_some(&h, nu, r, learn);
     }
 }
-
-/// Standard deviation of the delay between the wheels' readings and the gyro's from one
-/// reading to the next, around its learned mean, s (0.02): a logger's jitter.
-const WHEEL_ROW_JITTER_S: f64 = 0.02;
 
 /// A comparison whose normalised innovation squared exceeds this (5σ) is an outlier.
 const OUTLIER_NIS: f64 = 25.0;

@@ -287,6 +287,21 @@ impl VehicleEstimator {
     /// track from the wheels' last reading at the speed they last showed, so that a row
     /// that carries only another sensor reports where the vehicle is at its own time.
     fn publish(&mut self, t_s: f64) -> NavEstimate {
+        // A reading reaches its row some 50–150 ms after the motion it measures (a sensor's
+        // filter, a bus, a logger): the heading at the row's time trails by the turn made
+        // meanwhile, the rate times the delay, an error no heading state carries and that
+        // vanishes when the turn ends. Where the wheels carry the heading their delay is a
+        // state (its prior, with no gyro to learn it against): its mean and spread are
+        // published as the heading's. A gyro's own delay is not known to anything here.
+        let rate = self.tracking.motion.heading_rate_rps;
+        let delay_s = if !self.tracking.gyro.active && self.tracking.motion.wheels_turn {
+            let f = &self.filter;
+            (f.x[WHEEL_LAG].powi(2) + f.p[WHEEL_LAG][WHEEL_LAG].max(0.0) + ROW_JITTER_S.powi(2))
+                .sqrt()
+        } else {
+            READING_DELAY_S
+        };
+        let trailing = delay_s * rate;
         let psi = self.heading_at(t_s);
         let declination = self.frame_declination_rad();
         let ahead_s = self
@@ -302,12 +317,7 @@ impl VehicleEstimator {
         // Referred to the fixes the heading is true; the estimate's heading is magnetic.
         e.heading = MagneticHeading::new(wrap_pi(psi - declination));
         // The covariance is carried forward a few times a second; what the steps since
-        // then added is composed here.
-        // A reading reaches its row some 50–150 ms after the motion it measures (a sensor's
-        // filter, a bus, a logger): the heading at the row's time trails by the turn made
-        // meanwhile, an error of the rate times the delay that no state carries and that
-        // vanishes when the turn ends. Published with the heading, not accumulated.
-        let trailing = READING_DELAY_S * self.tracking.motion.heading_rate_rps;
+        // then added is composed here, and the delay's share (above) with the heading.
         let sigma = (self.tracking.batch.psi_variance(f).max(0.0) + trailing * trailing).sqrt();
         // A heading known to no better than the whole circle is uniform on it: π/√3.
         e.heading_sigma_rad = sigma.min(UNKNOWN_HEADING_SIGMA_RAD);
@@ -491,3 +501,7 @@ impl HeadingEstimator for VehicleEstimator {
 /// rows and clocks reach a log 50–150 ms after the motion (the simulator's real-log habit,
 /// `truenorth_sim::log_drive`, draws the same).
 const READING_DELAY_S: f64 = 0.1;
+
+/// How much a reading's delay varies from one row to the next around its mean, s (0.02):
+/// a logger's jitter.
+pub(super) const ROW_JITTER_S: f64 = 0.02;

@@ -14,6 +14,9 @@ use truenorth_core::GnssFix;
 use super::estimator::VehicleEstimator;
 use super::nav_filter::WHEEL_SCALE;
 
+#[cfg(not(feature = "std"))]
+use truenorth_core::Float as _;
+
 /// Longest time between the two fixes of one comparison, s: over longer the trapezoid
 /// rule misses how the speed changed in between.
 const MAX_SPAN_S: f64 = 2.5;

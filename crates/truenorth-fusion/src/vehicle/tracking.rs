@@ -130,6 +130,20 @@ pub(super) struct Motion {
     /// alike), m.
     #[serde(default)]
     pub odometer_m: f64,
+    /// Wheel speeds held within a quantum: since when, and at what.
+    #[serde(default)]
+    pub speed_hold: SpeedHold,
+}
+
+/// Quantised wheel speeds held steady: each wheel's rounding error stays the same until its
+/// speed moves by a quantum, so their difference turns the wheels' heading at a constant
+/// rate for as long as the hold lasts.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct SpeedHold {
+    /// The speeds when the hold began (left, right), m/s.
+    pub speeds_mps: [f64; 2],
+    /// How long they have held, s.
+    pub held_s: f64,
 }
 
 /// Rest and the bias average.

@@ -84,6 +84,10 @@ pub struct WheelStep {
     pub d_heading_d_track_scale: f64,
     /// Mean speed of the odometer wheels, m/s.
     pub speed_mps: f64,
+    /// Each wheel's speed over the step as read (left, right), m/s.
+    pub side_speeds_mps: [f64; 2],
+    /// The effective track the heading change was computed with, m.
+    pub effective_track_m: f64,
     /// Whether either wheel's reading changed.
     pub moved: bool,
 }
@@ -254,7 +258,8 @@ impl WheelOdometry {
                 s.table.effective_track_m(c).unwrap_or(self.track_m)
             }
         };
-        let turn = step.turn(track_m, (1.0 + track_scale).max(MIN_TRACK_SCALE));
+        let scale = (1.0 + track_scale).max(MIN_TRACK_SCALE);
+        let turn = step.turn(track_m, scale);
         let heading = turn.heading_change_rad;
         let (ds_m, ratio) = match &mut self.steered {
             None => (mean, ratio),
@@ -280,6 +285,8 @@ impl WheelOdometry {
             d_heading_d_speed_coeff: turn.d_heading_d_speed_coeff,
             d_heading_d_track_scale: turn.d_heading_d_track_scale,
             speed_mps,
+            side_speeds_mps: [raw_l / dt_s, raw_r / dt_s],
+            effective_track_m: track_m * scale,
             moved,
         })
     }

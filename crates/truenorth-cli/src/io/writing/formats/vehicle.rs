@@ -21,6 +21,9 @@ const TRACK_RANGE_M: (f64, f64) = (0.05, 10.0);
 const WHEELBASE_RANGE_M: (f64, f64) = (0.1, 20.0);
 /// The distance per odometer pulse, m: up to one revolution of a large wheel.
 const RESOLUTION_RANGE_M: (f64, f64) = (1e-6, 5.0);
+
+/// Quanta a wheel speed is sent in, m/s: from a robot's µm/s to a coarse bus's 1 km/h.
+const SPEED_QUANTUM_RANGE_MPS: (f64, f64) = (1e-6, 1.0);
 /// How far a GNSS antenna can be from the axle's centre, m, along either axis.
 const LEVER_ARM_RANGE_M: (f64, f64) = (-50.0, 50.0);
 /// The compass's systematic heading error, degrees: the estimator's own range.
@@ -43,6 +46,8 @@ pub struct VehicleFile {
     pub pitman_ratio: Option<f64>,
     /// Distance per odometer pulse, m.
     pub wheel_resolution_m: Option<f64>,
+    /// The quantum wheel speeds are sent in, m/s (optional; used with speed columns).
+    pub wheel_speed_quantum_mps: Option<f64>,
     /// The compass's systematic heading error, degrees (optional; the estimator's default,
     /// 3°, is a level two-axis compass on roads that tilt it by their grade and camber; a
     /// tilt-compensated compass, or one on level ground, leaves about 0.3°).
@@ -75,7 +80,12 @@ impl VehicleFile {
                 Ok(())
             } else {
                 Err(format!(
-                    "`{key}` is {v}{unit}, outside {lo}–{hi}{unit} (what a wheeled vehicle can have); check the value and its unit (metres)"
+                    "`{key}` is {v}{unit}, outside {lo}–{hi}{unit} (what a wheeled vehicle can have); check the value and its unit ({})",
+                    if unit == " m/s" {
+                        "metres per second"
+                    } else {
+                        "metres"
+                    }
                 ))
             }
         };
@@ -97,6 +107,14 @@ impl VehicleFile {
         }
         if let Some(r) = self.wheel_resolution_m {
             within("wheel_resolution_m", r, RESOLUTION_RANGE_M, " m")?;
+        }
+        if let Some(q) = self.wheel_speed_quantum_mps {
+            within(
+                "wheel_speed_quantum_mps",
+                q,
+                SPEED_QUANTUM_RANGE_MPS,
+                " m/s",
+            )?;
         }
         for l in self.gnss_lever_arm_m.into_iter().flatten() {
             within("gnss_lever_arm_m", l, LEVER_ARM_RANGE_M, " m")?;
