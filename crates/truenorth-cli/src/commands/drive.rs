@@ -113,14 +113,6 @@ truenorth drive --vehicle car.json --input drive2.csv.gz --output track2.csv
 /// (2 cm) would make such wheels look a hundred times noisier than they are.
 const SPEED_RESOLUTION_M: f64 = 0.003;
 
-/// The quantum of a car's CAN wheel speeds when the vehicle file gives none, m/s: 0.01 km/h,
-/// the commonest scaling of a wheel-speed signal.
-const CAN_SPEED_QUANTUM_MPS: f64 = 0.01 / 3.6;
-
-/// The quantum of a robot's wheel speeds when the vehicle file gives none, m/s: the mm/s
-/// of motor controllers' odometry messages.
-const ROBOT_SPEED_QUANTUM_MPS: f64 = 0.001;
-
 /// Arguments of `truenorth drive` (the file layouts are in `AFTER_HELP`, shown by `--help`).
 #[derive(Debug, clap::Args)]
 #[command(after_long_help = AFTER_HELP)]
@@ -293,21 +285,18 @@ fn build_method(
     wheels: OdometerWheels,
     speeds: bool,
 ) -> CliResult<Box<dyn VehicleRun>> {
-    let mut priors = SensorPriors::for_wheels(&wheels);
+    let mut priors = if speeds {
+        SensorPriors::for_wheel_speeds(&wheels)
+    } else {
+        SensorPriors::for_wheels(&wheels)
+    };
     if let Some(r) = vehicle.wheel_resolution_m {
         priors.wheel_resolution_m = r;
     } else if speeds && !wheels.can_pivot() {
         priors.wheel_resolution_m = SPEED_RESOLUTION_M;
     }
-    if speeds {
-        priors.wheel_speed_quantum_mps =
-            vehicle
-                .wheel_speed_quantum_mps
-                .unwrap_or(if wheels.can_pivot() {
-                    ROBOT_SPEED_QUANTUM_MPS
-                } else {
-                    CAN_SPEED_QUANTUM_MPS
-                });
+    if let Some(q) = vehicle.wheel_speed_quantum_mps.filter(|_| speeds) {
+        priors.wheel_speed_quantum_mps = q;
     }
     let mut config = VehicleConfig {
         wheels,

@@ -143,6 +143,24 @@ impl SensorPriors {
     }
 }
 
+impl SensorPriors {
+    /// The priors of the kind of vehicle `wheels` describes when its wheels are read as
+    /// speeds from a controller and integrated: sent in quanta (0.01 km/h, the commonest
+    /// scaling of a car's CAN wheel-speed signal; the mm/s of a robot's motor controller)
+    /// and delayed by the controller's speed filter besides the bus (a car's ABS unit filters
+    /// over 20–100 ms, a robot's motor controller over 50–300 ms; with the rows' 50–150 ms:
+    /// 0.15 ± 0.1 s and 0.25 ± 0.12 s).
+    pub fn for_wheel_speeds(wheels: &OdometerWheels) -> Self {
+        let robot = wheels.can_pivot();
+        Self {
+            wheel_speed_quantum_mps: if robot { 0.001 } else { 0.01 / 3.6 },
+            wheel_lag_s: if robot { 0.25 } else { 0.15 },
+            wheel_lag_sigma_s: if robot { 0.12 } else { 0.1 },
+            ..Self::for_wheels(wheels)
+        }
+    }
+}
+
 impl Validate for SensorPriors {
     fn validate(&self) -> Result<()> {
         check_positive(
