@@ -8,6 +8,14 @@ use truenorth_geomag::LocalTangentPlane;
 use truenorth_sim::log_drive::{LogDrive, LogDriveConfig, SensorSet};
 use truenorth_sim::{CHI2_2DOF_3SIGMA, VehicleKind};
 
+/// The simulated vehicles with fixes: a car's wheels and gyro, a car's CAN speed and yaw
+/// rate, a skid-steer robot's sides and gyro.
+const KINDS: [(VehicleKind, SensorSet); 3] = [
+    (VehicleKind::RearWheelCar, SensorSet::WHEELS_GYRO),
+    (VehicleKind::RearWheelCar, SensorSet::SPEED_YAW),
+    (VehicleKind::SkidSteer, SensorSet::WHEELS_GYRO),
+];
+
 fn config(d: &LogDrive) -> VehicleConfig {
     VehicleConfig {
         wheels: d.vehicle.wheels,
@@ -58,11 +66,7 @@ impl Truthful {
 /// beyond 3σ for position and heading.
 #[test]
 fn fixes_hold_the_track() {
-    for (kind, set) in [
-        (VehicleKind::RearWheelCar, SensorSet::WHEELS_GYRO),
-        (VehicleKind::RearWheelCar, SensorSet::SPEED_YAW),
-        (VehicleKind::SkidSteer, SensorSet::WHEELS_GYRO),
-    ] {
+    for (kind, set) in KINDS {
         for seed in 0..3 {
             let d = LogDrive::new(LogDriveConfig::new(seed, kind, set).with_gnss()).unwrap();
             let mut nav = VehicleEstimator::new(config(&d)).unwrap();
@@ -317,11 +321,7 @@ fn summarise(name: &str, all: &[Outage]) -> (f64, f64, f64) {
 /// from the last fix too (with the truth's position instead it was 9.42, 9.43 and 44.4 %).
 #[test]
 fn outages_are_bridged_with_an_honest_sigma() {
-    for (kind, set) in [
-        (VehicleKind::RearWheelCar, SensorSet::WHEELS_GYRO),
-        (VehicleKind::RearWheelCar, SensorSet::SPEED_YAW),
-        (VehicleKind::SkidSteer, SensorSet::WHEELS_GYRO),
-    ] {
+    for (kind, set) in KINDS {
         let mut all = Vec::new();
         for seed in 0..3 {
             let d = LogDrive::new(LogDriveConfig::new(seed, kind, set).with_gnss()).unwrap();
@@ -609,11 +609,7 @@ fn what_the_fixes_teach_and_what_they_reject() {
 #[test]
 fn the_fixes_teach_the_odometer_scale() {
     use truenorth_fusion::vehicle::nav_filter::WHEEL_SCALE;
-    for (kind, set) in [
-        (VehicleKind::RearWheelCar, SensorSet::WHEELS_GYRO),
-        (VehicleKind::RearWheelCar, SensorSet::SPEED_YAW),
-        (VehicleKind::SkidSteer, SensorSet::WHEELS_GYRO),
-    ] {
+    for (kind, set) in KINDS {
         for seed in 0..3 {
             let d = LogDrive::new(LogDriveConfig::new(seed, kind, set).with_gnss()).unwrap();
             // The odometer reads the distance times its scale; k undoes it.
