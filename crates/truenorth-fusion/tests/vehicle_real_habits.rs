@@ -267,10 +267,8 @@ fn cells() -> Vec<Cell> {
 /// presets of real logs: heading beyond 3σ on at most 2 % of rows, never beyond 6σ.
 ///
 /// Printed, not held — misses, measured with `SEEDS=10`: the generic robots' heading σ
-/// (skid-steer with a compass 2.8–7.1 % of rows beyond 3σ and up to 9.9σ, with a gyro and
-/// wheel speeds 2.6 %, 4.7σ; a differential robot's wheel speeds 4.2 %, 5.1σ with a gyro,
-/// where its wheel distances give 0 %), where the wheels' slip and a track that changes with
-/// the ground outrun their noise model; and sets without a gyro, whose heading
+/// (skid-steer with a compass up to 7.1 % of rows beyond 3σ and 9.9σ), where the wheels'
+/// slip and a track that changes with the ground outrun their noise model; and sets without a gyro, whose heading
 /// comes from the wheels and the compass alone (a differential robot's wheel speeds with a
 /// compass: 10.5 % beyond 3σ, 6.0σ; cars' wheel speeds with a compass 1.1–2.2 %, 4.2σ).
 #[test]

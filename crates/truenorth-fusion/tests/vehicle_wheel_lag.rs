@@ -16,8 +16,8 @@ use truenorth_sim::log_drive::{LogDrive, LogDriveConfig, SensorSet};
 /// frequency Ω by its group delay τ/(1 + Ω²τ²), less than τ for a turn that starts and
 /// stops. Both known to better than half the prior's σ.
 ///
-/// Measured (4 drives each): distances 0.097–0.114 s learned against 0.105–0.127 s; speeds
-/// 0.176–0.304 s against an upper bound of 0.198–0.366 s.
+/// Measured (4 drives each): distances 0.102–0.114 s learned against 0.105–0.127 s; speeds
+/// 0.187–0.307 s against an upper bound of 0.198–0.366 s.
 #[test]
 fn the_wheels_delay_is_learned_from_turns() {
     for (set, filtered) in [

@@ -574,20 +574,32 @@ impl VehicleEstimator {
         // The wheels' and the gyro's readings reach the log with different delays (their
         // own rows and clocks, a motor controller's or an ABS unit's filtering): in a turn
         // the wheels' heading trails the gyro's by the rate times the delay, which is
-        // learned (it vanishes when the turn ends, where a gain's error stays).
+        // learned (it vanishes when the turn ends, where a gain's error stays). It shows
+        // only in a turn the gyro is known to make: while the bias is uncertain a straight
+        // reads as a turn at the bias's rate, whose product with the delay is no turn at
+        // all — the delay is then only noise, as large as it may be.
         let rate = self.tracking.gyro.rate_rps;
-        let nu = wrap_pi(
-            self.filter.x[PSI_ODO] - self.filter.x[PSI] - ahead + self.filter.x[WHEEL_LAG] * rate,
-        );
-        let h = [(PSI, 1.0), (PSI_ODO, -1.0), (WHEEL_LAG, -rate)];
-        // What the delay does beyond a constant: the rows' jitter.
-        let jitter = ROW_JITTER_S * rate;
-        let r = self.coeffs.wheel_quantisation_rad2 + jitter * jitter;
+        let known_turn = rate.abs() > GAIN_LEARNING_MIN_RATE_RPS + 3.0 * self.filter.sigma(BIAS);
+        let (lag, lag_h) = if known_turn {
+            (self.filter.x[WHEEL_LAG], -rate)
+        } else {
+            (0.0, 0.0)
+        };
+        let nu = wrap_pi(self.filter.x[PSI_ODO] - self.filter.x[PSI] - ahead + lag * rate);
+        let h = [(PSI, 1.0), (PSI_ODO, -1.0), (WHEEL_LAG, lag_h)];
+        // What the delay does beyond what is modelled: the rows' jitter, and in a turn not
+        // known the whole delay.
+        let unmodelled = if known_turn {
+            ROW_JITTER_S * ROW_JITTER_S
+        } else {
+            self.filter.x[WHEEL_LAG].powi(2) + self.filter.p[WHEEL_LAG][WHEEL_LAG]
+        };
+        let r = self.coeffs.wheel_quantisation_rad2 + unmodelled * rate * rate;
         let f = &self.filter;
         let s = f.p[PSI][PSI] - 2.0 * f.p[PSI][PSI_ODO]
             + f.p[PSI_ODO][PSI_ODO]
-            + rate * rate * f.p[WHEEL_LAG][WHEEL_LAG]
-            - 2.0 * rate * (f.p[PSI][WHEEL_LAG] - f.p[PSI_ODO][WHEEL_LAG])
+            + lag_h * lag_h * f.p[WHEEL_LAG][WHEEL_LAG]
+            + 2.0 * lag_h * (f.p[PSI][WHEEL_LAG] - f.p[PSI_ODO][WHEEL_LAG])
             + r;
         let nis = nu * nu / s;
         let learn = self.tracking.gates.wheel_check_learnable();
