@@ -48,9 +48,10 @@ pub(crate) fn assemble(
                 m.odometry_s = at;
                 m.turn_factor = Some(factor);
             }
-            Slot::Gyro(g) => {
+            Slot::Gyro(g, bias) => {
                 row.gyr_z_rps = Some(g);
                 m.gyro_s = at;
+                m.gyro_bias_rps = Some(bias);
             }
             Slot::Compass(c, tilt) => {
                 row.mag = Some(c);

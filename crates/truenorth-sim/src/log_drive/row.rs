@@ -90,6 +90,9 @@ pub struct Measured {
     pub odometry_s: Option<f64>,
     /// The yaw rate.
     pub gyro_s: Option<f64>,
+    /// The gyro's true bias in the row's yaw rate (constant part and random walk), rad/s.
+    #[serde(default)]
+    pub gyro_bias_rps: Option<f64>,
     /// The compass.
     pub compass_s: Option<f64>,
     /// The truth behind the GNSS fix.

@@ -26,8 +26,8 @@ use crate::vehicle_kind::{RangeVehicle, SlipProcess, VehicleKind};
 pub(crate) enum Slot {
     /// The odometry's reading and the wheels' turn factor at its loop step.
     Odometry(OdometryReading, f64),
-    /// A yaw rate, rad/s.
-    Gyro(f64),
+    /// A yaw rate and the gyro's true bias in it (its constant part and random walk), rad/s.
+    Gyro(f64, f64),
     /// A compass reading, µT, and the body's roll and pitch under it, rad.
     Compass(Vector2<f64>, Option<[f64; 2]>),
     /// A GNSS fix and the truth behind it.
@@ -97,10 +97,11 @@ pub(crate) fn gyro_stream(
             temp_c: e.yaw_rate.gyro.ref_temp_c,
         };
         let g = model.sample(&rate, s.t_s - prev, rng)?;
+        let bias = model.bias_rps(rate.temp_c) + model.state().bias_walk_rps;
         out.push((
             s.t_s,
             s.t_s,
-            Slot::Gyro(quantized(g, e.yaw_rate.quantum_rps)),
+            Slot::Gyro(quantized(g, e.yaw_rate.quantum_rps), bias),
         ));
         prev = s.t_s;
     }
