@@ -1,11 +1,12 @@
 //! What the vehicle estimator keeps of the satellite fixes between samples (see
 //! [`super::gnss_fusion`]): the tangent plane's origin, whether heading and track are
-//! referred to the fixes, the counts, and the courses gathered to refer them.
+//! referred to the fixes, the counts, the courses gathered to refer them, and the last fix
+//! whose speed over ground starts a comparison with the odometer.
 
 use serde::{Deserialize, Serialize};
 
-use super::gnss_speed::{OdometerHistory, SpeedMark};
 use super::innovation_line::InnovationLine;
+use super::odometer_history::OdometerHistory;
 
 /// The fixes as the estimator has used them.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
@@ -58,4 +59,15 @@ pub struct PlaneShift {
     pub north_m: f64,
     /// See `north_m`.
     pub east_m: f64,
+}
+
+/// One end of a comparison: a fix with a speed over ground.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub(super) struct SpeedMark {
+    /// The fix's epoch (its stamp less the receiver's delay), s.
+    pub t_s: f64,
+    /// The receiver's speed over ground, m/s.
+    pub fix_mps: f64,
+    /// The odometer's distance at the epoch, before its scale, m.
+    pub odometer_m: f64,
 }

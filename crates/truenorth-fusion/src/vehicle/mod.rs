@@ -48,6 +48,7 @@ mod learned;
 mod learning_gates;
 pub mod nav_filter;
 mod observability;
+mod odometer_history;
 mod plain_baseline;
 mod plain_guard;
 mod seed_blend;
