@@ -11,7 +11,7 @@ use super::nav_filter::{
     TRACK_SCALE, WHEEL_DIFF, WHEEL_LAG, WHEEL_SCALE,
 };
 use super::step_batch::Step;
-use super::tracking::{Alignment, CompassWindow, Rest};
+use super::tracking::{Alignment, CompassWindow, Rest, SpeedHold};
 use super::wheel_odometry::{WheelCalibration, WheelStep};
 
 #[cfg(not(feature = "std"))]
@@ -437,7 +437,7 @@ impl VehicleEstimator {
             .zip(wheel.side_speeds_mps)
             .any(|(a, b)| (a - b).abs() >= 0.5 * quantum);
         if renewed {
-            *hold = super::tracking::SpeedHold {
+            *hold = SpeedHold {
                 speeds_mps: wheel.side_speeds_mps,
                 held_s: 0.0,
             };
@@ -592,7 +592,7 @@ impl VehicleEstimator {
         let unmodelled = if known_turn {
             ROW_JITTER_S * ROW_JITTER_S
         } else {
-            self.filter.x[WHEEL_LAG].powi(2) + self.filter.p[WHEEL_LAG][WHEEL_LAG]
+            self.wheel_delay_s2()
         };
         let r = self.coeffs.wheel_quantisation_rad2 + unmodelled * rate * rate;
         let f = &self.filter;

@@ -283,6 +283,12 @@ impl VehicleEstimator {
         self.tracking.gates.slip_scale2
     }
 
+    /// The mean square of the wheels' delay behind the motion as the filter knows it, s²: its
+    /// learned value squared plus its variance — what it may be where it is not modelled.
+    pub(super) fn wheel_delay_s2(&self) -> f64 {
+        self.filter.x[WHEEL_LAG].powi(2) + self.filter.p[WHEEL_LAG][WHEEL_LAG].max(0.0)
+    }
+
     /// The estimate at `t_s`: the heading carried on from the gyro's last reading and the
     /// track from the wheels' last reading at the speed they last showed, so that a row
     /// that carries only another sensor reports where the vehicle is at its own time.
@@ -295,9 +301,7 @@ impl VehicleEstimator {
         // published as the heading's. A gyro's own delay is not known to anything here.
         let rate = self.tracking.motion.heading_rate_rps;
         let delay_s = if !self.tracking.gyro.active && self.tracking.motion.wheels_turn {
-            let f = &self.filter;
-            (f.x[WHEEL_LAG].powi(2) + f.p[WHEEL_LAG][WHEEL_LAG].max(0.0) + ROW_JITTER_S.powi(2))
-                .sqrt()
+            (self.wheel_delay_s2() + ROW_JITTER_S.powi(2)).sqrt()
         } else {
             READING_DELAY_S
         };
