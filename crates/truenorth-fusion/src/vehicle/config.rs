@@ -83,6 +83,20 @@ pub struct SensorPriors {
     /// wheel speeds, a fraction of a mm for a robot's encoders). Sets the noise of the
     /// wheels' heading against the gyro's.
     pub wheel_resolution_m: f64,
+    /// Standard deviation of the heading error the ground's tilt adds to a level two-axis
+    /// compass beyond [`CompassGates::systematic_deg`], degrees (6 for a robot; 0 for a
+    /// car, whose road that already covers). A robot crosses kerbs, lawns and ramps: its
+    /// body follows a grade of σ 1–4 % that changes within tens of metres, and the field's
+    /// vertical part leaks into a level compass by tan(dip) times the tilt — at a dip of
+    /// 70° (tan 2.75) and a tilt of 2.3° (4 %), 6°.
+    #[serde(default)]
+    pub compass_ground_tilt_deg: f64,
+    /// Distance over which the compass's systematic error changes as the ground under the
+    /// vehicle does, m (30 for a robot, whose ground's tilt changes over 10–50 m; 0: only
+    /// with time and turning, as [`CompassGates`] says — a road's grade changes slowly
+    /// enough for that).
+    #[serde(default)]
+    pub compass_ground_length_m: f64,
 }
 
 impl Default for SensorPriors {
@@ -114,6 +128,8 @@ impl SensorPriors {
             wheel_slip_per_g: 0.02,
             wheel_slip_per_c2: 0.0,
             wheel_resolution_m: 0.02,
+            compass_ground_tilt_deg: 0.0,
+            compass_ground_length_m: 0.0,
         };
         let robot = Self {
             wheel_scale_sigma: 0.012,
@@ -121,6 +137,8 @@ impl SensorPriors {
             speed_coeff_sigma: 0.0,
             wheel_slip_per_g: 0.0,
             wheel_resolution_m: 1e-3,
+            compass_ground_tilt_deg: 6.0,
+            compass_ground_length_m: 30.0,
             ..car
         };
         match wheels {
@@ -198,6 +216,18 @@ impl Validate for SensorPriors {
         )?;
         check_range("wheel_slip", self.wheel_slip, 0.0, 1.0)?;
         check_range("wheel_slip_per_g", self.wheel_slip_per_g, 0.0, 1.0)?;
+        check_range(
+            "compass_ground_tilt_deg",
+            self.compass_ground_tilt_deg,
+            0.0,
+            45.0,
+        )?;
+        check_range(
+            "compass_ground_length_m",
+            self.compass_ground_length_m,
+            0.0,
+            1e5,
+        )?;
         check_range("wheel_slip_per_c2", self.wheel_slip_per_c2, 0.0, 10.0)?;
         check_range("wheel_resolution_m", self.wheel_resolution_m, 1e-6, 1.0)?;
         Ok(())
@@ -236,7 +266,8 @@ pub struct CompassGates {
     /// tilted by θ reads the heading wrong by up to tan(dip)·θ, since the field's vertical
     /// part leaks into the horizontal axes: a road's grade and camber of 1–3 % (0.6–1.7°)
     /// at a dip of 50–75° (most of the inhabited world) make 1–6°, and a car's roll in a
-    /// bend adds as much; 3° is one standard deviation of that spread.
+    /// bend adds as much; 3° is one standard deviation of that spread. A robot's rougher
+    /// ground adds [`SensorPriors::compass_ground_tilt_deg`].
     pub systematic_deg: f64,
     /// Correlation time of that error while driving straight, s (300): a road's grade and
     /// camber last for hundreds of metres, and the calibration's error does not change at

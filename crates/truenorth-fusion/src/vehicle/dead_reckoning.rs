@@ -295,11 +295,8 @@ impl VehicleEstimator {
     /// compass error's growth as the heading turns, keeping it in (−π, π].
     fn turn_heading(&mut self, dpsi: f64, step: &mut Step) {
         // The compass error is a function of the heading: turning decorrelates it.
-        let decay = (-dpsi.abs() / self.config.compass.systematic_turn_rad).exp();
-        step.compass_decay *= decay;
-        step.q[COMPASS_BIAS] += self.compass_bias_var() * (1.0 - decay * decay);
+        self.decorrelate_compass(dpsi.abs() / self.config.compass.systematic_turn_rad, step);
         let x = &mut self.filter.x;
-        x[COMPASS_BIAS] *= decay;
         // Heading kept in (−π, π]: differences of headings stay in range, and the wheels'
         // heading and the heading at the last wheel reading are wrapped with it so that
         // their differences keep their meaning.
@@ -448,6 +445,15 @@ impl VehicleEstimator {
         sigma_rate * sigma_rate * (h1 * h1 - h0 * h0)
     }
 
+    /// Lets the compass's systematic error change by `e`-foldings in `step`, towards its
+    /// stationary spread.
+    fn decorrelate_compass(&mut self, foldings: f64, step: &mut Step) {
+        let decay = (-foldings).exp();
+        step.compass_decay *= decay;
+        step.q[COMPASS_BIAS] += self.compass_bias_var() * (1.0 - decay * decay);
+        self.filter.x[COMPASS_BIAS] *= decay;
+    }
+
     /// Draws the track along the heading half-way between this wheel reading and the last.
     fn advance_track(&mut self, t_s: f64, wheel: &WheelStep, gap: bool, step: &mut Step) {
         let psi = self.heading_at(t_s);
@@ -462,6 +468,12 @@ impl VehicleEstimator {
         step.east_from_psi = ds * c;
         step.north_from_scale = wheel.ds_m * c;
         step.east_from_scale = wheel.ds_m * s;
+        // The ground's tilt changes along the way (one state carries every share of the
+        // compass's systematic error, so all of it is let go: the cautious side).
+        let ground_m = self.coeffs.priors.compass_ground_length_m;
+        if ground_m > 0.0 {
+            self.decorrelate_compass(ds.abs() / ground_m, step);
+        }
         let mut q = POSITION_NOISE_M2_PER_M * ds.abs();
         if gap {
             // The path through a gap is unknown: the chord may lie anywhere between the

@@ -76,8 +76,8 @@ pub(super) struct Coefficients {
     pub wheel_noise_rad2_per_m: f64,
     /// Variance of the wheels' heading from the pulses at each end of a comparison, rad².
     pub wheel_quantisation_rad2: f64,
-    /// Variance of the road's and the installation's share of the compass's systematic
-    /// error, rad² (the calibration's share comes with each calibration).
+    /// Variance of the road's, the ground's and the installation's share of the compass's
+    /// systematic error, rad² (the calibration's share comes with each calibration).
     pub compass_floor_var: f64,
     /// The prior standard deviation of each state (0 where the state is not learned).
     pub prior_sigma: [f64; DIM],
@@ -104,7 +104,8 @@ impl Coefficients {
             // Each wheel's reading is off by up to half a pulse, uniformly, at each end of
             // the comparison: 4 · q²/12 in the difference.
             wheel_quantisation_rad2: q * q / 3.0,
-            compass_floor_var: c.compass.systematic_deg.to_radians().powi(2),
+            compass_floor_var: c.compass.systematic_deg.to_radians().powi(2)
+                + p.compass_ground_tilt_deg.to_radians().powi(2),
             prior_sigma,
         }
     }
