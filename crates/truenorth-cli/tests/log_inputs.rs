@@ -273,6 +273,8 @@ fn inspect_lists_the_topics_and_the_streams_read() {
         "(PX4 ULog), complete",
         "sensor_mag (instance 1, 6 messages",
         "mag: vehicle_magnetometer:0, 319 samples",
+        "gnss: vehicle_gps_position:0, 32 samples",
+        "gnss: 32 fixes at 5.0001 Hz, no gaps; sigma 2.51-3.26 m",
     ] {
         assert!(s.contains(expected), "{expected}: {s}");
     }

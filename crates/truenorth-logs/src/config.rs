@@ -27,8 +27,10 @@ pub struct LogConfig {
     /// MCAP only: the `nav_msgs/msg/Odometry` topic for the body's forward speed and yaw rate
     /// (default: the one with the most messages, if any).
     pub odometry_topic: Option<String>,
-    /// MCAP only: the `sensor_msgs/msg/NavSatFix` topic of the satellite fixes (default: the
-    /// one with the most messages, if any).
+    /// The satellite fixes. ULog: a topic with `latitude_deg`/`longitude_deg` or `lat`/`lon`
+    /// (`vehicle_gps_position`, else `sensor_gps`, by default); MCAP: a
+    /// `sensor_msgs/msg/NavSatFix` topic (default: the one with the most messages, if any).
+    /// `none` reads no fixes.
     pub gnss_topic: Option<String>,
     /// Keep the messages before a truncated or damaged tail instead of refusing the file
     /// (default `false`: a log cut off by a power loss is reported, not read silently).

@@ -9,8 +9,9 @@
 //! gyro's rows the way the `orientation` command reads them.
 //!
 //! Topics are chosen by name ([`LogConfig`]) or by the format's usual defaults
-//! (`sensor_combined`, `vehicle_magnetometer`/`sensor_mag`, `vehicle_attitude` in ULog; the
-//! `sensor_msgs/msg/Imu` and `sensor_msgs/msg/MagneticField` topics in MCAP); a topic asked
+//! (`sensor_combined`, `vehicle_magnetometer`/`sensor_mag`, `vehicle_attitude` and
+//! `vehicle_gps_position`/`sensor_gps` in ULog; the `sensor_msgs/msg/Imu`,
+//! `sensor_msgs/msg/MagneticField` and `sensor_msgs/msg/NavSatFix` topics in MCAP); a topic asked
 //! for and not present is an error that lists the topics the file has.
 //!
 //! ```
@@ -36,6 +37,7 @@ mod mcap_ros;
 mod recording;
 pub mod ros_msgs;
 mod ulog;
+mod ulog_fields;
 
 use std::panic::{AssertUnwindSafe, catch_unwind};
 

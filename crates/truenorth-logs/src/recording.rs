@@ -63,7 +63,7 @@ impl core::fmt::Display for TopicInfo {
 /// A selected stream: where it came from and its rate.
 #[derive(Debug, Clone, PartialEq)]
 pub struct StreamInfo {
-    /// The role: `imu`, `mag`, `attitude` or `odometry`.
+    /// The role: `imu`, `mag`, `attitude`, `odometry` or `gnss`.
     pub role: &'static str,
     /// The topic it was read from (ULog `name:instance`).
     pub topic: String,
@@ -102,7 +102,8 @@ pub struct Recording {
     pub attitude: Vec<AttitudeSample>,
     /// Body velocity and yaw rate (MCAP odometry).
     pub odometry: Vec<OdometrySample>,
-    /// Satellite fixes (MCAP `sensor_msgs/msg/NavSatFix` with a fix), if a topic has them.
+    /// Satellite fixes (MCAP `sensor_msgs/msg/NavSatFix`, ULog `vehicle_gps_position` or
+    /// `sensor_gps`, each with a fix), if a topic has them.
     pub gnss: Vec<GnssFix>,
 }
 

@@ -6,7 +6,10 @@
 //! Field names follow PX4's uORB messages: `sensor_combined` (`gyro_rad[3]` rad/s,
 //! `accelerometer_m_s2[3]` m/s², and in older logs `magnetometer_ga[3]` gauss with
 //! `magnetometer_timestamp_relative` µs), `vehicle_magnetometer` (`magnetometer_ga[3]`),
-//! `sensor_mag` (`x`, `y`, `z` gauss) and `vehicle_attitude` (`q[4]`, w first, FRD → NED).
+//! `sensor_mag` (`x`, `y`, `z` gauss), `vehicle_attitude` (`q[4]`, w first, FRD → NED) and the
+//! satellite fixes of `vehicle_gps_position` or `sensor_gps` (`latitude_deg`/`longitude_deg`
+//! in degrees, or in older logs `lat`/`lon` in 10⁻⁷ degrees; `eph` m; `fix_type`, 2 or more
+//! for a fix).
 //! Times are `timestamp_sample` where the message has it (when the sensor sampled), else
 //! `timestamp` (when the message was published), both µs since boot.
 
@@ -14,13 +17,17 @@ use std::collections::{BTreeMap, HashMap};
 
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 use px4_ulog::stream_parser::LogParser;
-use px4_ulog::stream_parser::model::{DataMessage, FlattenedFieldType, FlattenedFormat};
+use px4_ulog::stream_parser::model::{DataMessage, FlattenedFieldType};
 use truenorth_core::{ImuSample, Mag3Sample};
 
 use crate::config::{LogConfig, NO_TOPIC, TopicSpec};
 use crate::error::{LogError, LogFormat, Result};
 use crate::recording::{
-    AttitudeSample, Recording, StreamInfo, TopicInfo, keep_increasing, rate_hz,
+    AttitudeSample, GnssFix, Recording, StreamInfo, TopicInfo, keep_increasing, rate_hz,
+};
+use crate::ulog_fields::{
+    Fields, GnssFields, ImuFields, MagFields, Num, attitude_fields, field, gnss_fields, imu_fields,
+    mag_fields, read_all,
 };
 
 /// The first bytes of every ULog file: `ULog`, then 0x01 0x12 0x35.
@@ -40,78 +47,13 @@ const HEADER_CHUNK: usize = 256;
 /// Default magnetometer topics, in order of preference.
 const MAG_DEFAULTS: [&str; 3] = ["sensor_combined", "vehicle_magnetometer", "sensor_mag"];
 
-/// A numeric field located by the reader: its byte offset in the message and its type.
-#[derive(Debug, Clone, Copy)]
-enum Num {
-    F32(usize),
-    F64(usize),
-    U64(usize),
-    I32(usize),
-}
+/// Default satellite-fix topics, in order of preference (PX4 renamed the receiver's topic
+/// `vehicle_gps_position` → `sensor_gps` and kept the first for the selected receiver).
+const GNSS_DEFAULTS: [&str; 2] = ["vehicle_gps_position", "sensor_gps"];
 
-impl Num {
-    /// The value, or `None` when the message is shorter than its format says.
-    fn read(self, data: &[u8]) -> Option<f64> {
-        fn bytes<const N: usize>(data: &[u8], at: usize) -> Option<[u8; N]> {
-            data.get(at..at.checked_add(N)?)?.try_into().ok()
-        }
-        Some(match self {
-            Self::F32(at) => f64::from(f32::from_le_bytes(bytes(data, at)?)),
-            Self::F64(at) => f64::from_le_bytes(bytes(data, at)?),
-            // Microseconds since boot stay exact in f64 for 285 years.
-            Self::U64(at) => u64::from_le_bytes(bytes(data, at)?) as f64,
-            Self::I32(at) => f64::from(i32::from_le_bytes(bytes(data, at)?)),
-        })
-    }
-}
-
-fn field(format: &FlattenedFormat, name: &str, types: &[FlattenedFieldType]) -> Option<Num> {
-    types.iter().find_map(|t| {
-        let at = usize::from(format.get_field_offset(name, t.clone()).ok()?);
-        Some(match t {
-            FlattenedFieldType::Float => Num::F32(at),
-            FlattenedFieldType::Double => Num::F64(at),
-            FlattenedFieldType::UInt64 => Num::U64(at),
-            _ => Num::I32(at),
-        })
-    })
-}
-
-const FLOATS: &[FlattenedFieldType] = &[FlattenedFieldType::Float, FlattenedFieldType::Double];
-
-fn float(format: &FlattenedFormat, name: &str) -> Option<Num> {
-    field(format, name, FLOATS)
-}
-
-fn array<const N: usize>(format: &FlattenedFormat, base: &str) -> Option<[Num; N]> {
-    let mut out = [Num::F32(0); N];
-    for (k, slot) in out.iter_mut().enumerate() {
-        *slot = float(format, &format!("{base}[{k}]"))?;
-    }
-    Some(out)
-}
-
-fn read_all<const N: usize>(fields: &[Num; N], data: &[u8]) -> Option<[f64; N]> {
-    let mut out = [0.0; N];
-    for (o, f) in out.iter_mut().zip(fields) {
-        *o = f.read(data)?;
-    }
-    Some(out)
-}
-
-/// The fields of one role in one message format, or why the format cannot serve it.
-type Fields<F> = core::result::Result<F, String>;
-
-struct ImuFields {
-    gyr: [Num; 3],
-    acc: [Num; 3],
-}
-
-struct MagFields {
-    field: [Num; 3],
-    /// `magnetometer_timestamp_relative` in `sensor_combined` (µs after `timestamp`).
-    relative: Option<Num>,
-}
+/// The least `fix_type` that is a position (PX4: 0–1 no fix, 2 a 2D fix, 3 a 3D fix, more
+/// for differential and RTK).
+const FIX_TYPE_2D: f64 = 2.0;
 
 /// How to read one message format (one `msg_id`) for the roles its topic was selected for.
 struct Decoder {
@@ -121,38 +63,8 @@ struct Decoder {
     /// Index into the magnetometer candidates, and the fields.
     mag: Option<(usize, Fields<MagFields>)>,
     attitude: Option<Fields<[Num; 4]>>,
-}
-
-fn imu_fields(format: &FlattenedFormat) -> Fields<ImuFields> {
-    match (
-        array(format, "gyro_rad"),
-        array(format, "accelerometer_m_s2"),
-    ) {
-        (Some(gyr), Some(acc)) => Ok(ImuFields { gyr, acc }),
-        _ => Err("it has no `gyro_rad[3]` and `accelerometer_m_s2[3]` fields".to_string()),
-    }
-}
-
-fn mag_fields(format: &FlattenedFormat) -> Fields<MagFields> {
-    if let Some(field) = array(format, "magnetometer_ga") {
-        let relative = field_i32(format, "magnetometer_timestamp_relative");
-        return Ok(MagFields { field, relative });
-    }
-    match (float(format, "x"), float(format, "y"), float(format, "z")) {
-        (Some(x), Some(y), Some(z)) => Ok(MagFields {
-            field: [x, y, z],
-            relative: None,
-        }),
-        _ => Err("it has neither `magnetometer_ga[3]` nor `x`, `y`, `z` fields".to_string()),
-    }
-}
-
-fn field_i32(format: &FlattenedFormat, name: &str) -> Option<Num> {
-    field(format, name, &[FlattenedFieldType::Int32])
-}
-
-fn attitude_fields(format: &FlattenedFormat) -> Fields<[Num; 4]> {
-    array(format, "q").ok_or_else(|| "it has no `q[4]` field".to_string())
+    /// Index into the satellite-fix candidates, and the fields.
+    gnss: Option<(usize, Fields<GnssFields>)>,
 }
 
 /// What the parser's callback gathers.
@@ -169,7 +81,11 @@ struct Gathered {
     mag_errors: Vec<Option<String>>,
     attitude: Vec<AttitudeSample>,
     attitude_error: Option<String>,
-    non_finite: [usize; 3],
+    gnss_specs: Vec<TopicSpec>,
+    gnss: Vec<Vec<GnssFix>>,
+    gnss_errors: Vec<Option<String>>,
+    /// Readings left out for a non-finite value: imu, mag, attitude, fixes.
+    non_finite: [usize; 4],
 }
 
 fn matches(spec: &TopicSpec, name: &str, instance: u8) -> bool {
@@ -194,6 +110,11 @@ impl Gathered {
                 .as_ref()
                 .filter(|s| matches(s, name, instance))
                 .map(|_| attitude_fields(format)),
+            gnss: self
+                .gnss_specs
+                .iter()
+                .position(|s| matches(s, name, instance))
+                .map(|k| (k, gnss_fields(format))),
         }
     }
 
@@ -277,6 +198,32 @@ impl Gathered {
             }
             Some(Err(e)) => {
                 self.attitude_error.get_or_insert_with(|| e.clone());
+            }
+            None => {}
+        }
+        match &d.gnss {
+            Some((k, Ok(f))) => {
+                let fix_type = f.fix_type.and_then(|n| n.read(data));
+                if fix_type.is_some_and(|t| t < FIX_TYPE_2D) {
+                    return;
+                }
+                if let (Some(t), Some([lat, lon])) = (sampled_us, read_all(&f.lat_lon, data)) {
+                    let (lat_deg, lon_deg) = (lat * f.deg_per_unit, lon * f.deg_per_unit);
+                    let eph = f.eph.and_then(|n| n.read(data));
+                    if lat_deg.abs() <= 90.0 && lon_deg.abs() <= 180.0 {
+                        self.gnss[*k].push(GnssFix {
+                            t_s: t * 1e-6,
+                            lat_deg,
+                            lon_deg,
+                            sigma_m: eph.filter(|e| e.is_finite() && *e > 0.0),
+                        });
+                    } else {
+                        self.non_finite[3] += 1;
+                    }
+                }
+            }
+            Some((k, Err(e))) => {
+                self.gnss_errors[*k].get_or_insert_with(|| e.clone());
             }
             None => {}
         }
@@ -392,6 +339,13 @@ fn check_array_lengths(bytes: &[u8]) -> core::result::Result<(), String> {
 
 /// Reads a ULog file's bytes.
 pub(crate) fn read(bytes: &[u8], config: &LogConfig) -> Result<Recording> {
+    if config.odometry_topic.is_some() {
+        return Err(LogError::InvalidConfig {
+            field: "odometry_topic",
+            reason: "is read from MCAP logs only (a PX4 ULog's odometry is not read); leave it out"
+                .to_string(),
+        });
+    }
     check_array_lengths(bytes).map_err(|detail| LogError::Corrupt {
         format: LogFormat::Ulog,
         detail,
@@ -407,6 +361,11 @@ pub(crate) fn read(bytes: &[u8], config: &LogConfig) -> Result<Recording> {
         Some(name) => Some(TopicSpec::parse(name)),
         None => Some(TopicSpec::plain("vehicle_attitude")),
     };
+    let gnss_specs: Vec<TopicSpec> = match config.gnss_topic.as_deref() {
+        Some(NO_TOPIC) => Vec::new(),
+        Some(name) => vec![TopicSpec::parse(name)],
+        None => GNSS_DEFAULTS.iter().map(|n| TopicSpec::plain(n)).collect(),
+    };
     let mut g = Gathered {
         imu_spec,
         mags: vec![Vec::new(); mag_specs.len()],
@@ -420,7 +379,10 @@ pub(crate) fn read(bytes: &[u8], config: &LogConfig) -> Result<Recording> {
         imu_error: None,
         attitude: Vec::new(),
         attitude_error: None,
-        non_finite: [0; 3],
+        gnss: vec![Vec::new(); gnss_specs.len()],
+        gnss_errors: vec![None; gnss_specs.len()],
+        gnss_specs,
+        non_finite: [0; 4],
     };
     let ending = {
         let mut callback = |msg: &DataMessage| g.take(msg);
@@ -537,6 +499,28 @@ fn finish(mut g: Gathered, config: &LogConfig, complete: bool) -> Result<Recordi
         });
     }
 
+    let mut gnss = Vec::new();
+    if config.gnss_topic.as_deref().is_some_and(|n| n != NO_TOPIC) {
+        let spec = &g.gnss_specs[0];
+        if !has(spec) {
+            return Err(missing("gnss", spec));
+        }
+        if let Some(e) = g.gnss_errors[0].take() {
+            return Err(wrong("gnss", spec, e));
+        }
+    }
+    if let Some(k) = g.gnss.iter().position(|f| !f.is_empty()) {
+        gnss = std::mem::take(&mut g.gnss[k]);
+        let dropped = keep_increasing(&mut gnss, |s| s.t_s) + g.non_finite[3];
+        streams.push(StreamInfo {
+            role: "gnss",
+            topic: spec_name(&g.gnss_specs[k]),
+            samples: gnss.len(),
+            dropped,
+            rate_hz: rate_hz(gnss.iter().map(|s| s.t_s)),
+        });
+    }
+
     Ok(Recording {
         format: LogFormat::Ulog,
         time_origin_s: 0.0,
@@ -547,6 +531,6 @@ fn finish(mut g: Gathered, config: &LogConfig, complete: bool) -> Result<Recordi
         mag,
         attitude: g.attitude,
         odometry: Vec::new(),
-        gnss: Vec::new(),
+        gnss,
     })
 }

@@ -41,7 +41,7 @@ fn check_streams(r: &Recording, expected: &[(&str, &str, usize, f64)]) {
             s.rate_hz, s.dropped
         );
     }
-    assert_eq!(r.streams.len(), expected.len());
+    assert_eq!(r.streams.len(), expected.len(), "{:?}", r.streams);
     let rows = r.imu_with_mag();
     let with_mag = rows.iter().filter(|s| !s.mag.is_empty()).count();
     assert!(with_mag > 0 && with_mag <= r.mag.len());
@@ -77,8 +77,29 @@ fn sample_log_small_newer_layout_with_vehicle_magnetometer() {
             ("imu", "sensor_combined:0", 1298, 204.58),
             ("mag", "vehicle_magnetometer:0", 319, 50.0),
             ("attitude", "vehicle_attitude:0", 1298, 204.58),
+            ("gnss", "vehicle_gps_position:0", 32, 5.0),
         ],
     );
+    // The older integer layout (`lat`, `lon` in 10⁻⁷ degrees), as pyulog 1.2 reads the
+    // first and last messages: lat 634170622, lon 104082151, eph 3.26 m at 20.471648 s;
+    // lat 634170457, lon 104082271, eph 2.507 m at 26.658637 s.
+    let (first, last) = (r.gnss[0], r.gnss[r.gnss.len() - 1]);
+    assert_eq!((first.t_s, last.t_s), (20.471648, 26.658637));
+    for (fix, lat, lon, eph) in [
+        (first, 63.4170622, 10.4082151, 3.26),
+        (last, 63.4170457, 10.4082271, 2.507),
+    ] {
+        assert!((fix.lat_deg - lat).abs() < 1e-9 && (fix.lon_deg - lon).abs() < 1e-9);
+        assert!((fix.sigma_m.unwrap() - eph).abs() < 1e-5);
+    }
+    let none = LogReader::new(LogConfig {
+        gnss_topic: Some("none".into()),
+        ..LogConfig::default()
+    })
+    .unwrap()
+    .read_path(folder().unwrap().join("sample_log_small.ulg"))
+    .unwrap();
+    assert!(none.gnss.is_empty() && none.stream("gnss").is_none());
     // Topic selection by name and instance, and the error listing what is there.
     let dir = folder().unwrap();
     let with = |mag: &str| {

@@ -27,8 +27,9 @@ pub struct LogOptions {
     /// (default: the one with the most messages).
     #[arg(long, value_name = "TOPIC")]
     pub odometry_topic: Option<String>,
-    /// MCAP input: the `sensor_msgs/msg/NavSatFix` topic `drive` reads satellite fixes from
-    /// (default: the one with the most messages, if any).
+    /// ULog/MCAP input: the satellite fixes' topic, listed by `inspect` (default ULog
+    /// `vehicle_gps_position`, else `sensor_gps`; MCAP the `sensor_msgs/msg/NavSatFix` topic
+    /// with the most messages, if any), or `none`.
     #[arg(long, value_name = "TOPIC")]
     pub gnss_topic: Option<String>,
     /// ULog/MCAP input: read the messages before a truncated or damaged end (with a warning)

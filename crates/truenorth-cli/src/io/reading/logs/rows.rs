@@ -87,10 +87,10 @@ pub fn table(
                 ),
             ));
         }
-        return Ok(merged(recording, Some(axle)));
+        return Ok(merged(recording, Some(axle), true));
     }
     if wanted(&WHEELS) {
-        return Ok(merged(recording, None));
+        return Ok(merged(recording, None, wanted(&GNSS)));
     }
     if wanted(&IMU) {
         return Ok(imu_rows(recording, required(&MAG)));
@@ -137,15 +137,15 @@ fn imu_rows(r: &Recording, mag_only: bool) -> LogTable {
 }
 
 /// Every stream at its own times: one row per distinct time, an empty cell where a stream
-/// has no reading then; the odometry as wheel speeds and the satellite fixes when an axle is
-/// given (`drive`).
-fn merged(r: &Recording, axle: Option<AxleTrack>) -> LogTable {
+/// has no reading then; the odometry as wheel speeds when an axle is given (`drive`), the
+/// satellite fixes when `with_gnss`.
+fn merged(r: &Recording, axle: Option<AxleTrack>, with_gnss: bool) -> LogTable {
     // (time, stream, index), ordered by time and then by stream, so that readings at the
     // same instant share a row.
     let mut events: Vec<(f64, u8, usize)> = Vec::new();
     events.extend(r.imu.iter().enumerate().map(|(k, s)| (s.t_s, 0, k)));
     events.extend(r.mag.iter().enumerate().map(|(k, s)| (s.t_s, 1, k)));
-    let gnss = axle.is_some() && !r.gnss.is_empty();
+    let gnss = with_gnss && !r.gnss.is_empty();
     if axle.is_some() {
         events.extend(r.odometry.iter().enumerate().map(|(k, s)| (s.t_s, 2, k)));
     }

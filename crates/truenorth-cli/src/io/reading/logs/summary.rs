@@ -46,7 +46,7 @@ pub fn summary(log: &LogInput) -> Vec<String> {
     }
     let options = match r.format {
         LogFormat::Ulog => {
-            "--imu-topic NAME[:INSTANCE], --mag-topic NAME[:INSTANCE] or none, --attitude-topic NAME[:INSTANCE]"
+            "--imu-topic NAME[:INSTANCE], --mag-topic NAME[:INSTANCE] or none, --attitude-topic NAME[:INSTANCE], --gnss-topic NAME[:INSTANCE] or none"
         }
         LogFormat::Mcap => {
             "--imu-topic TOPIC, --mag-topic TOPIC or none, --attitude-topic TOPIC, --odometry-topic TOPIC, --gnss-topic TOPIC"
