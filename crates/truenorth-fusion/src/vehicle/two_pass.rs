@@ -166,11 +166,15 @@ impl TwoPassStart {
                 continue;
             };
             let declination = second.gnss_declination_rad().unwrap_or(0.0);
+            let drift_end = self.held.last().map_or(0.0, |e| e.heading_sigma_rad);
             for (w, earlier) in self.head[k - waiting..k].iter().enumerate() {
                 let e = joined(
                     &self.held[w],
                     offset,
-                    estimate.heading_sigma_rad,
+                    Sigmas {
+                        offset_rad: estimate.heading_sigma_rad,
+                        drift_end_rad: drift_end,
+                    },
                     plane.map(|p| (p, declination)),
                 );
                 emit(earlier, &e, &second);
@@ -183,9 +187,18 @@ impl TwoPassStart {
         // head) only by the compass: what is relative to the start is turned by what is known.
         let offset = second.alignment_offset_rad();
         let start = self.head.len() - waiting;
+        let drift_end = self.held.last().map_or(0.0, |e| e.heading_sigma_rad);
         for (earlier, e) in self.head[start..].iter().zip(&self.held) {
             let e = match offset {
-                Some(offset) => joined(e, offset, last_sigma_rad, None),
+                Some(offset) => joined(
+                    e,
+                    offset,
+                    Sigmas {
+                        offset_rad: last_sigma_rad,
+                        drift_end_rad: drift_end,
+                    },
+                    None,
+                ),
                 None => *e,
             };
             emit(earlier, &e, &second);
@@ -198,9 +211,20 @@ impl TwoPassStart {
     }
 }
 
+/// The uncertainties a relative estimate of the head is joined with.
+#[derive(Debug, Clone, Copy)]
+struct Sigmas {
+    /// The heading uncertainty of the estimate that found the offset, rad.
+    offset_rad: f64,
+    /// The relative heading's uncertainty at the last estimate before the offset was
+    /// found, rad.
+    drift_end_rad: f64,
+}
+
 /// An estimate of the head as the estimates after it are: one made relative to the start
 /// heading turned by `offset` onto north (heading and track), with the heading uncertainty
-/// of the estimate that found the offset; and, when the fixes put the track on their plane
+/// of the estimate that found the offset and of the drift between it and the estimate
+/// joined; and, when the fixes put the track on their plane
 /// (`plane`, with the declination), turned and shifted as the track was (see
 /// [`PlaneShift`]), the heading published magnetic as every estimate's. An estimate already
 /// referred to north is left as it is but for the plane. A position not known yet (before
@@ -209,16 +233,23 @@ impl TwoPassStart {
 fn joined(
     e: &NavEstimate,
     offset: f64,
-    heading_sigma_rad: f64,
+    sigmas: Sigmas,
     plane: Option<(PlaneShift, f64)>,
 ) -> NavEstimate {
     let relative = !e.status.heading_absolute;
+    let heading_sigma_rad = sigmas.offset_rad;
     let mut t = *e;
     let mut turn = 0.0;
     if relative {
         turn = offset;
         t.heading = MagneticHeading::new(e.heading.rad() + offset);
-        t.heading_sigma_rad = heading_sigma_rad;
+        // The offset refers the heading to north where it was found; an earlier heading is
+        // off besides by the relative heading's drift between the two, whose variance is
+        // what the relative variance grew by in between: exact for independent increments,
+        // and more than a bias's share, whose drift from w to k has variance ∝ (k − w)²
+        // where the difference of variances has k² − w².
+        let drift_var = (sigmas.drift_end_rad.powi(2) - e.heading_sigma_rad.powi(2)).max(0.0);
+        t.heading_sigma_rad = (heading_sigma_rad.powi(2) + drift_var).sqrt();
         t.status.heading_absolute = true;
     }
     if let Some((p, declination)) = plane {
@@ -247,4 +278,38 @@ fn joined(
         t.position_cov_m2 += heading_sigma_rad * heading_sigma_rad * across * across.transpose();
     }
     t
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A relative heading joined to north carries the offset's uncertainty and the drift
+    /// between it and where the offset was found: the relative variance's growth since.
+    #[test]
+    fn a_joined_heading_carries_the_drift_to_where_north_was_found() {
+        let deg = |d: f64| d.to_radians();
+        let sigmas = Sigmas {
+            offset_rad: deg(2.0),
+            drift_end_rad: deg(5.0),
+        };
+        let early = NavEstimate::at_start(1.0, MagneticHeading::new(deg(10.0)), deg(1.0));
+        let e = joined(&early, deg(30.0), sigmas, None);
+        assert!(e.status.heading_absolute);
+        assert!((e.heading.rad() - deg(40.0)).abs() < 1e-12);
+        let expected = (2.0f64.powi(2) + 5.0f64.powi(2) - 1.0).sqrt();
+        assert!((e.heading_sigma_rad.to_degrees() - expected).abs() < 1e-9);
+        // The last relative estimate before the offset: the offset's uncertainty alone.
+        let last = NavEstimate::at_start(2.0, MagneticHeading::new(0.0), deg(5.0));
+        let e = joined(&last, 0.0, sigmas, None);
+        assert!((e.heading_sigma_rad - deg(2.0)).abs() < 1e-12);
+        // An estimate already referred to north is left as it was.
+        let mut absolute = early;
+        absolute.status.heading_absolute = true;
+        let e = joined(&absolute, deg(30.0), sigmas, None);
+        assert_eq!(
+            (e.heading, e.heading_sigma_rad),
+            (absolute.heading, deg(1.0))
+        );
+    }
 }
