@@ -5,7 +5,7 @@
 use std::path::{Path, PathBuf};
 
 use truenorth::checks::GyroUnit;
-use truenorth::core::{Fixed, VehicleSensors, rad_to_deg};
+use truenorth::core::{Fixed, Travel, VehicleSensors, rad_to_deg};
 use truenorth::fusion::vehicle::VehicleCalibration;
 use truenorth::fusion::{SensorPriors, VehicleConfig, VehicleEstimator};
 use truenorth::odometer::OdometerWheels;
@@ -64,8 +64,9 @@ the odometer wheels' own; other columns are ignored. Satellite fixes: `lat_deg,l
 (WGS84) with `gnss_sigma_m` (1σ, m; 5 where absent) and optionally
 `gnss_speed_mps,gnss_course_deg`, on their own rows: with odometry the fused method refers
 heading and track to them (north_m, east_m in the tangent plane at the first fix, heading
-from true north) and corrects the position with each; `--extra geodetic` adds lat_deg,
-lon_deg. Frames: x forward, y right,
+from true north) and corrects the position with each; without odometry their course (at 3 m/s
+or more) refers the heading to true north and corrects it, the position staying empty;
+`--extra geodetic` adds lat_deg, lon_deg. Frames: x forward, y right,
 z down.
 
 Output: `t_s,north_m,east_m,heading_deg` — the rear-axle centre from the start point, and
@@ -195,9 +196,13 @@ pub fn run(args: &Args) -> CliResult {
             errln!(
                 "truenorth drive: warning: `lat_deg,lon_deg` are not used: only --method fused takes satellite fixes"
             );
+        } else if !odometry && !samples.kind().gnss_course_given() {
+            errln!(
+                "truenorth drive: warning: `lat_deg,lon_deg` are not used: between fixes only odometry (wheels, a speed or a distance) carries the position, and there is none; with `gnss_speed_mps,gnss_course_deg` their course would refer the heading to true north"
+            );
         } else if !odometry {
             errln!(
-                "truenorth drive: warning: `lat_deg,lon_deg` are not used: between fixes only odometry (wheels, a speed or a distance) carries the position, and there is none"
+                "truenorth drive: warning: `lat_deg,lon_deg` give no position: between fixes only odometry (wheels, a speed or a distance) carries it, and there is none; their course (at 3 m/s or more) refers the heading to true north and corrects it"
             );
         } else if !samples.kind().gnss_sigma_given() {
             errln!(
@@ -205,7 +210,10 @@ pub fn run(args: &Args) -> CliResult {
                 truenorth::fusion::GnssConfig::default().default_sigma_m
             );
         }
-        if args.method == VehicleMethod::Fused && odometry && args.place.is_given() {
+        if args.method == VehicleMethod::Fused
+            && (odometry || samples.kind().gnss_course_given())
+            && args.place.is_given()
+        {
             errln!(
                 "truenorth drive: warning: --lat/--lon are not used for true north: the satellite fixes give it (rows before the first fixes that refer the heading still use them)"
             );
@@ -490,10 +498,17 @@ fn summary(
         );
     }
     if let Some((c, (lat, lon))) = gnss {
-        line += &format!(
-            "; satellite fixes: {} used, {} rejected (too far from the dead-reckoned track), {} restarts of the position after a run of rejections; north_m, east_m from {lat:.7}, {lon:.7} (the first fix)",
-            c.used, c.rejected, c.restarts
-        );
+        if sensors.travel == Travel::None {
+            line += &format!(
+                "; satellite fixes: {} courses used (no odometry: no position)",
+                c.used
+            );
+        } else {
+            line += &format!(
+                "; satellite fixes: {} used, {} rejected (too far from the dead-reckoned track), {} restarts of the position after a run of rejections; north_m, east_m from {lat:.7}, {lon:.7} (the first fix)",
+                c.used, c.rejected, c.restarts
+            );
+        }
     }
     line += &format!(
         "; sensors: {}{}",

@@ -354,7 +354,13 @@ impl VehicleEstimator {
         };
         e.status.heading_absolute = self.tracking.alignment.done;
         e.status.gnss_frame = self.tracking.gnss.aligned;
-        *e
+        let mut out = *e;
+        if self.tracking.gnss.course_only {
+            // A track not yet on the fixes' plane has no place in it.
+            out.status.position_known = false;
+            out.position_cov_m2 = Matrix2::from_element(f64::INFINITY);
+        }
+        out
     }
 
     /// The heading at `t_s`: the gyro's carried on at its last rate from its last reading

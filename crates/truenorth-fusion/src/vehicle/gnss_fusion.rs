@@ -107,6 +107,7 @@ impl VehicleEstimator {
     pub(super) fn forget_gnss_frame(&mut self) {
         let g = &mut self.tracking.gnss;
         g.aligned = false;
+        g.course_only = false;
         g.line = InnovationLine::default();
         g.start = None;
     }
@@ -121,23 +122,35 @@ impl VehicleEstimator {
             return;
         };
         let [north, east, _] = plane.from_geodetic(&point);
-        // Fixes say where the vehicle is; between them only odometry carries it there.
-        if !self.est.status.position_known
-            || self
-                .tracking
-                .gnss
-                .last_used_s
-                .is_some_and(|t0| t_s - t0 < FIX_INTERVAL_S)
+        if self
+            .tracking
+            .gnss
+            .last_used_s
+            .is_some_and(|t0| t_s - t0 < FIX_INTERVAL_S)
         {
             return;
         }
-        let sigma = fix.sigma_m.unwrap_or(self.config.gnss.default_sigma_m);
-        // Where the vehicle was when the fix was computed, and what the delay's spread
-        // leaves unknown along the track.
+        // Where the vehicle was when the fix was computed.
         let t_s = t_s - self.config.gnss.latency_s;
+        // Fixes say where the vehicle is; between them only odometry carries it there.
+        // Without any, their course still says where it heads.
+        if !self.est.status.position_known {
+            self.course_without_odometry(t_s, fix);
+            return;
+        }
+        let sigma = fix.sigma_m.unwrap_or(self.config.gnss.default_sigma_m);
+        // What the delay's spread leaves unknown along the track.
         self.correct_with_speed(t_s, fix);
         let lag = self.config.gnss.latency_sigma_s * self.est.speed_mps;
         let sigma = (sigma * sigma + lag * lag).sqrt();
+        if self.tracking.gnss.course_only {
+            // The heading is on true north already; the track joins the plane here.
+            self.tracking.gnss.course_only = false;
+            self.restart_position(t_s, north, east, sigma);
+            self.note_fix_used(t_s);
+            self.anchor_plain();
+            return;
+        }
         if self.tracking.gnss.aligned {
             self.correct_with_fix(t_s, north, east, sigma);
             self.correct_with_course(t_s, fix);
@@ -236,32 +249,86 @@ impl VehicleEstimator {
         self.anchor_plain();
     }
 
-    /// The receiver's course against the heading, once referred to true north: used when
-    /// the vehicle moves fast enough for the course to mean its direction.
-    fn correct_with_course(&mut self, t_s: f64, fix: &GnssFix) {
-        let Some((course, sigma)) = self.course_of(fix) else {
+    /// The receiver's course on a drive with no odometry (yet): a vehicle with a gyro or a
+    /// compass and no wheels, whose heading the courses refer to true north and correct
+    /// (the fixes' positions cannot be carried between them, so the position stays
+    /// unknown). Without odometry nothing tells a reversing vehicle: a course is taken as
+    /// the vehicle's heading when the receiver's speed is at least
+    /// [`super::config::GnssConfig::min_course_speed_mps`], which few vehicles reach in reverse;
+    /// one that does is off by half a turn and fails the gate once referred.
+    fn course_without_odometry(&mut self, t_s: f64, fix: &GnssFix) {
+        if !self.tracking.gnss.aligned {
+            let Some((course, course_sigma)) = self.course_of(fix, None) else {
+                return;
+            };
+            let nu = wrap_pi(course - self.heading_at(t_s));
+            let line = &mut self.tracking.gnss.line;
+            line.push(t_s, nu);
+            if line.len() < ALIGNMENT_COURSES {
+                return;
+            }
+            let fit = line.fit(course_sigma);
+            self.tracking.gnss.line = InnovationLine::default();
+            if let Some(f) = fit.filter(|f| f.residual_rad <= 3.0 * course_sigma) {
+                let after_compass = self.tracking.alignment.done;
+                let turn_rad = self.refer_heading_to_fixes(f.offset_rad, f.sigma_rad);
+                // No track to move onto the plane: only the heading's turn.
+                self.tracking.gnss.shift = Some(PlaneShift {
+                    turn_rad,
+                    after_compass,
+                    north_m: 0.0,
+                    east_m: 0.0,
+                });
+                self.tracking.gnss.course_only = true;
+                self.note_fix_used(t_s);
+            }
             return;
+        }
+        if self.correct_with_course(t_s, fix) {
+            self.note_fix_used(t_s);
+        }
+    }
+
+    /// Counts a fix used at `t_s`.
+    fn note_fix_used(&mut self, t_s: f64) {
+        let g = &mut self.tracking.gnss;
+        g.last_used_s = Some(t_s);
+        g.used += 1;
+        self.est.status.gnss_used = true;
+    }
+
+    /// The receiver's course against the heading, once referred to true north: used when
+    /// the vehicle moves fast enough for the course to mean its direction. Whether it was.
+    fn correct_with_course(&mut self, t_s: f64, fix: &GnssFix) -> bool {
+        let odometer_speed = self.est.status.position_known.then_some(self.est.speed_mps);
+        let Some((course, sigma)) = self.course_of(fix, odometer_speed) else {
+            return false;
         };
         let nu = wrap_pi(course - self.heading_at(t_s));
         let lag = self.config.gnss.latency_sigma_s * self.tracking.gyro.rate_rps;
         let sigma = (sigma * sigma + lag * lag).sqrt();
         let s = self.filter.p[PSI][PSI] + sigma * sigma;
         let gate = self.config.gnss.gate_sigma;
-        if nu * nu <= gate * gate * s {
-            self.filter.update(&[(PSI, 1.0)], nu, sigma * sigma);
+        if nu * nu > gate * gate * s {
+            return false;
         }
+        self.flush();
+        self.filter.update(&[(PSI, 1.0)], nu, sigma * sigma);
+        true
     }
 
     /// The direction the vehicle heads by the fix's course (rad, true north), and its
     /// standard deviation, when the receiver reports one at a speed that makes it mean the
-    /// vehicle's direction (reversing: the course less half a turn).
-    fn course_of(&self, fix: &GnssFix) -> Option<(f64, f64)> {
+    /// vehicle's direction: one the odometer's speed (`None`: no odometry) bears out
+    /// (reversing: the course less half a turn).
+    fn course_of(&self, fix: &GnssFix, odometer_speed: Option<f64>) -> Option<(f64, f64)> {
         let (speed, course_deg) = (fix.speed_mps?, fix.course_deg?);
         let cfg = &self.config.gnss;
-        if speed < cfg.min_course_speed_mps || self.est.speed_mps.abs() < 0.5 * speed {
+        let moving = odometer_speed.unwrap_or(speed);
+        if speed < cfg.min_course_speed_mps || moving.abs() < 0.5 * speed {
             return None;
         }
-        let reversing = self.est.speed_mps < 0.0;
+        let reversing = moving < 0.0;
         let course = course_deg.to_radians()
             + if reversing {
                 core::f64::consts::PI
@@ -277,7 +344,7 @@ impl VehicleEstimator {
     /// and once they agree turns heading and track onto true north and the plane.
     fn align_to_fixes(&mut self, t_s: f64, north: f64, east: f64, sigma: f64, fix: &GnssFix) {
         let (pn, pe) = self.position_at(t_s);
-        if let Some((course, course_sigma)) = self.course_of(fix) {
+        if let Some((course, course_sigma)) = self.course_of(fix, Some(self.est.speed_mps)) {
             let nu = wrap_pi(course - self.heading_at(t_s));
             let line = &mut self.tracking.gnss.line;
             line.push(t_s, nu);
@@ -333,19 +400,7 @@ impl VehicleEstimator {
         offset_sigma: f64,
     ) {
         let after_compass = self.tracking.alignment.done;
-        let turn_rad = if after_compass {
-            self.tracking.gnss.declination_rad
-        } else {
-            offset
-        };
-        if after_compass {
-            self.turn_known(turn_rad);
-        } else {
-            self.turn_frame(offset, offset_sigma);
-            self.tracking.alignment.done = true;
-            self.compass.restart_gates();
-        }
-        self.tracking.gnss.aligned = true;
+        let turn_rad = self.refer_heading_to_fixes(offset, offset_sigma);
         self.flush();
         let (pn, pe) = self.position_at(t_s);
         self.tracking.gnss.shift = Some(PlaneShift {
@@ -360,6 +415,27 @@ impl VehicleEstimator {
         g.used += 1;
         self.est.status.gnss_used = true;
         self.anchor_plain();
+    }
+
+    /// Refers the heading to true north: by the declination if the compass referred it to
+    /// magnetic north already, else by `offset` (standard deviation `offset_sigma`) found
+    /// from the fixes. The angle turned.
+    fn refer_heading_to_fixes(&mut self, offset: f64, offset_sigma: f64) -> f64 {
+        let after_compass = self.tracking.alignment.done;
+        let turn_rad = if after_compass {
+            self.tracking.gnss.declination_rad
+        } else {
+            offset
+        };
+        if after_compass {
+            self.turn_known(turn_rad);
+        } else {
+            self.turn_frame(offset, offset_sigma);
+            self.tracking.alignment.done = true;
+            self.compass.restart_gates();
+        }
+        self.tracking.gnss.aligned = true;
+        turn_rad
     }
 
     /// Turns heading, wheel heading and track about the start by an exactly known angle.

@@ -37,6 +37,10 @@ pub(super) struct GnssTrack {
     /// How the track was put on the plane when the fixes referred it there: see
     /// [`PlaneShift`].
     pub shift: Option<PlaneShift>,
+    /// The heading was referred to true north by courses taken with no odometry, and the
+    /// track is not on the plane yet: it is put there at the first fix after the odometry
+    /// starts, and its position is not published before.
+    pub course_only: bool,
     /// The last fix with a speed over ground that can start a comparison of distances
     /// with the odometer.
     pub speed_mark: Option<SpeedMark>,

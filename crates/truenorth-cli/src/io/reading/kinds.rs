@@ -403,6 +403,11 @@ impl Vehicle {
         self.gnss.is_some()
     }
 
+    /// Whether the fixes carry their speed and course over ground.
+    pub fn gnss_course_given(&self) -> bool {
+        self.gnss.is_some_and(|g| g.velocity.is_some())
+    }
+
     /// Whether the fixes carry their accuracy (`gnss_sigma_m`).
     pub fn gnss_sigma_given(&self) -> bool {
         self.gnss.is_some_and(|g| g.sigma.is_some())
