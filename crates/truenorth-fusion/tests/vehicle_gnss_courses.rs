@@ -117,3 +117,71 @@ fn courses_refer_and_correct_the_heading_of_a_vehicle_without_odometry() {
     assert!(share <= 0.02, "{kind:?}: {:.2} % beyond 3σ", 100.0 * share);
     assert!(max_z < 6.0, "{kind:?}: {max_z:.2}σ");
 }
+
+/// A car whose wheels start reading 30 s into the drive, after its fixes' courses referred
+/// the heading: no position until the next fix after the wheels start, then the track on
+/// the fixes' plane, within a few metres of the truth and within its 3σ at that fix.
+#[test]
+fn wheels_that_start_late_join_the_plane_at_the_next_fix() {
+    use truenorth_geomag::LocalTangentPlane;
+    for seed in 0..3 {
+        let d = LogDrive::new(
+            LogDriveConfig::new(
+                seed,
+                VehicleKind::RearWheelCar,
+                SensorSet::WHEELS_GYRO.with_compass(),
+            )
+            .with_gnss(),
+        )
+        .unwrap();
+        let t0 = d.truth[0].t_s;
+        let samples: Vec<VehicleSample> = d
+            .vehicle_samples()
+            .iter()
+            .map(|s| VehicleSample {
+                wheels: s.wheels.filter(|_| s.t_s - t0 >= 30.0),
+                ..*s
+            })
+            .collect();
+        let mut nav = VehicleEstimator::new(VehicleConfig {
+            wheels: d.vehicle.wheels,
+            priors: Some(SensorPriors::for_wheels(&d.vehicle.wheels)),
+            ..VehicleConfig::default()
+        })
+        .unwrap();
+        let truth_plane = d.plane.unwrap();
+        let mut placed_at = None;
+        for (k, (s, t)) in samples.iter().zip(&d.truth).enumerate() {
+            let e = nav.update(s).unwrap();
+            if s.t_s - t0 < 30.0 {
+                assert!(!e.status.position_known, "seed {seed} row {k}");
+                continue;
+            }
+            if !e.status.position_known {
+                assert!(placed_at.is_none(), "seed {seed}: a placed track lost");
+                continue;
+            }
+            assert!(e.status.gnss_frame, "seed {seed} row {k}");
+            if placed_at.is_none() {
+                let (lat, lon) = nav.gnss_origin().unwrap();
+                let ours = LocalTangentPlane::new(lat, lon, 0.0).unwrap();
+                let g = ours.to_geodetic(e.north_m, e.east_m, 0.0).unwrap();
+                let [n, east, _] = truth_plane.from_geodetic(&g);
+                let off = (n - t.north_m).hypot(east - t.east_m);
+                let sigma = e.position_cov_m2.trace().sqrt();
+                println!(
+                    "seed {seed}: the track joined the plane at {:.1} s, {off:.2} m from the truth (σ {sigma:.2} m)",
+                    s.t_s - t0
+                );
+                assert!(
+                    s.t_s - t0 < 32.0,
+                    "seed {seed}: joined at {:.1} s",
+                    s.t_s - t0
+                );
+                assert!(off < 3.0 * sigma, "seed {seed}: {off:.2} m, σ {sigma:.2} m");
+                placed_at = Some(k);
+            }
+        }
+        assert!(placed_at.is_some(), "seed {seed}: never placed");
+    }
+}
