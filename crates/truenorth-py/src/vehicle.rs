@@ -8,7 +8,8 @@ use pyo3::types::PyDict;
 use truenorth::core::{
     GnssFix, HeadingEstimator, NavEstimate, VehicleSample, rad_to_deg, wrap_two_pi,
 };
-use truenorth::fusion::VehicleEstimator as CoreVehicle;
+use truenorth::fusion::{SensorPriors, VehicleEstimator as CoreVehicle};
+use truenorth::odometer::OdometerWheels;
 use truenorth::nalgebra::Vector2;
 
 use crate::convert::{array1, bools, config_from, lib_err, row_err, rows, same_rows, to_py};
@@ -245,6 +246,27 @@ impl VehicleEstimator {
         d.set_item("gap", bools(py, gap))?;
         d.set_item("gnss_frame", bools(py, frame))?;
         Ok(d)
+    }
+
+    /// The sensors' priors of a kind of vehicle, as a dictionary for `config["priors"]`:
+    /// `wheels` as in the configuration (`{"skid_steer": {"track_m": 0.57}}`); `speeds`: the
+    /// wheel distances are integrated wheel speeds from a controller (their quantum and the
+    /// controller filter's delay, as `truenorth drive` assumes for speed columns).
+    #[staticmethod]
+    #[pyo3(signature = (wheels, speeds=false))]
+    fn priors<'py>(
+        py: Python<'py>,
+        wheels: &Bound<'py, PyAny>,
+        speeds: bool,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let wheels: OdometerWheels = pythonize::depythonize(wheels)
+            .map_err(|e| crate::convert::arg_err(format!("invalid wheels: {e}")))?;
+        let priors = if speeds {
+            SensorPriors::for_wheel_speeds(&wheels)
+        } else {
+            SensorPriors::for_wheels(&wheels)
+        };
+        to_py(py, &priors)
     }
 
     /// What the estimator has learned about the sensors, as a dictionary (the form a later

@@ -131,6 +131,20 @@ def test_vehicle_estimator_drives_straight_north_with_its_compass():
     assert isinstance(v.calibration(), dict)
 
 
+def test_vehicle_priors_of_a_kind_go_into_the_configuration():
+    skid = {"skid_steer": {"track_m": 0.57}}
+    counted = tn.VehicleEstimator.priors(skid)
+    speeds = tn.VehicleEstimator.priors(skid, speeds=True)
+    assert counted["wheel_speed_quantum_mps"] == 0.0
+    assert speeds["wheel_speed_quantum_mps"] == pytest.approx(0.001)
+    assert speeds["compass_ground_tilt_deg"] == 6.0
+    car = tn.VehicleEstimator.priors({"rear": {"track_m": 1.6}}, speeds=True)
+    assert car["compass_ground_tilt_deg"] == 0.0
+    tn.VehicleEstimator({"wheels": skid, "priors": speeds})
+    with pytest.raises(tn.TruenorthError, match="invalid wheels"):
+        tn.VehicleEstimator.priors({"tracked": {"track_m": 1.0}})
+
+
 def test_vehicle_estimator_takes_one_vehicle_distance_with_a_yaw_rate():
     # A CAN bus's speed integrated (10 m/s) and a yaw rate of 0.05 rad/s for 20 s: an arc of
     # 200 m through 1 rad. The distance says nothing about turning: the gyro turns it.
