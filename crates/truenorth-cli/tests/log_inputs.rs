@@ -274,7 +274,7 @@ fn inspect_lists_the_topics_and_the_streams_read() {
         "sensor_mag (instance 1, 6 messages",
         "mag: vehicle_magnetometer:0, 319 samples",
         "gnss: vehicle_gps_position:0, 32 samples",
-        "gnss: 32 fixes at 5.0001 Hz, no gaps; sigma 2.51-3.26 m",
+        "gnss: 32 fixes at 5.0001 Hz, no gaps; sigma 2.51-3.26 m (median 2.83 m); speed and course given",
     ] {
         assert!(s.contains(expected), "{expected}: {s}");
     }
@@ -488,20 +488,6 @@ fn every_refusal_is_one_line() {
         ],
         "no mag topic `foo:0` in the log; topics present: actuator_controls_0",
     );
-    let vehicle = dir.join("car.json");
-    std::fs::write(&vehicle, r#"{"track_m": 1.5, "odometer_wheels": "rear"}"#).unwrap();
-    refused(
-        &[
-            "drive",
-            "--vehicle",
-            p(&vehicle),
-            "--input",
-            log,
-            "--output",
-            o,
-        ],
-        "has no odometry",
-    );
     let bytes = std::fs::read(log).unwrap();
     let cut = dir.join("cut.ulg");
     std::fs::write(&cut, &bytes[..bytes.len() / 2 + 7]).unwrap();
@@ -519,4 +505,48 @@ fn every_refusal_is_one_line() {
         &["orientation", "--input", p(&bad), "--output", o],
         "corrupt",
     );
+}
+
+/// A PX4 ULog has no odometry: `drive` reads it as a vehicle with a gyro, a compass and
+/// fixes and no wheels (its `vel_m_s` and `cog_rad` as the fixes' speed and course): the
+/// heading on every row, no position, and the fixes said to give none. `sample_log_small`
+/// stands still (0.02–0.28 m/s), so no course is used.
+#[test]
+fn drive_reads_a_ulog_as_gyro_compass_and_fixes_without_wheels() {
+    let Some(log) = px4("sample_log_small.ulg") else {
+        return;
+    };
+    let dir = scratch("log_inputs", "ulog_drive");
+    let vehicle = dir.join("car.json");
+    std::fs::write(
+        &vehicle,
+        r#"{"track_m": 1.5, "odometer_wheels": "skid_steer"}"#,
+    )
+    .unwrap();
+    let out = dir.join("out.csv");
+    let o = ok(&[
+        "drive",
+        "--vehicle",
+        p(&vehicle),
+        "--input",
+        p(&log),
+        "--output",
+        p(&out),
+    ]);
+    let stderr = text(&o.stderr);
+    for expected in [
+        "`lat_deg,lon_deg` give no position",
+        "0 courses used (no odometry: no position)",
+        "sensors: gyro + compass, no wheels + GNSS",
+    ] {
+        assert!(stderr.contains(expected), "{expected}: {stderr}");
+    }
+    let csv = std::fs::read_to_string(&out).unwrap();
+    let rows: Vec<&str> = csv.lines().skip(1).collect();
+    assert_eq!(rows.len(), 1649);
+    for r in &rows {
+        let cells: Vec<&str> = r.split(',').collect();
+        assert!(cells[1].is_empty() && cells[2].is_empty(), "{r}");
+        assert!(cells[3].parse::<f64>().is_ok(), "{r}");
+    }
 }

@@ -167,6 +167,7 @@ impl Topic {
                         lat_deg,
                         lon_deg,
                         sigma_m: horizontal_sigma_m(&m),
+                        velocity: None,
                     });
                 } else {
                     self.non_finite += 1;

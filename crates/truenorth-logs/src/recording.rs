@@ -37,6 +37,9 @@ pub struct GnssFix {
     pub lon_deg: f64,
     /// 1σ horizontal error the receiver gives, m, when it gives one.
     pub sigma_m: Option<f64>,
+    /// Speed over ground, m/s, and course over ground, degrees clockwise from true north,
+    /// when the receiver gives both (PX4's `vel_m_s` and `cog_rad`; a NavSatFix has none).
+    pub velocity: Option<(f64, f64)>,
 }
 
 /// One topic of the file: its name, instance (ULog) or message type (MCAP), and message count.

@@ -9,7 +9,7 @@
 //! `sensor_mag` (`x`, `y`, `z` gauss), `vehicle_attitude` (`q[4]`, w first, FRD → NED) and the
 //! satellite fixes of `vehicle_gps_position` or `sensor_gps` (`latitude_deg`/`longitude_deg`
 //! in degrees, or in older logs `lat`/`lon` in 10⁻⁷ degrees; `eph` m; `fix_type`, 2 or more
-//! for a fix).
+//! for a fix; `vel_m_s` and `cog_rad`, the course over ground, unless `vel_ned_valid` is 0).
 //! Times are `timestamp_sample` where the message has it (when the sensor sampled), else
 //! `timestamp` (when the message was published), both µs since boot.
 
@@ -210,12 +210,19 @@ impl Gathered {
                 if let (Some(t), Some([lat, lon])) = (sampled_us, read_all(&f.lat_lon, data)) {
                     let (lat_deg, lon_deg) = (lat * f.deg_per_unit, lon * f.deg_per_unit);
                     let eph = f.eph.and_then(|n| n.read(data));
+                    let valid = f.velocity_valid.and_then(|n| n.read(data)) != Some(0.0);
+                    let velocity = f
+                        .velocity
+                        .and_then(|v| read_all(&v, data))
+                        .filter(|[v, c]| valid && v.is_finite() && *v >= 0.0 && c.is_finite())
+                        .map(|[v, c]| (v, c.to_degrees().rem_euclid(360.0)));
                     if lat_deg.abs() <= 90.0 && lon_deg.abs() <= 180.0 {
                         self.gnss[*k].push(GnssFix {
                             t_s: t * 1e-6,
                             lat_deg,
                             lon_deg,
                             sigma_m: eph.filter(|e| e.is_finite() && *e > 0.0),
+                            velocity,
                         });
                     } else {
                         self.non_finite[3] += 1;

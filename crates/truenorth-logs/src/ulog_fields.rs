@@ -45,7 +45,7 @@ pub(crate) fn field(
             FlattenedFieldType::Float => Num::F32(at),
             FlattenedFieldType::Double => Num::F64(at),
             FlattenedFieldType::UInt64 => Num::U64(at),
-            FlattenedFieldType::UInt8 => Num::U8(at),
+            FlattenedFieldType::UInt8 | FlattenedFieldType::Bool => Num::U8(at),
             _ => Num::I32(at),
         })
     })
@@ -95,6 +95,10 @@ pub(crate) struct GnssFields {
     pub(crate) deg_per_unit: f64,
     pub(crate) eph: Option<Num>,
     pub(crate) fix_type: Option<Num>,
+    /// Speed and course over ground (`vel_m_s`, `cog_rad`), where the format has both.
+    pub(crate) velocity: Option<[Num; 2]>,
+    /// `vel_ned_valid`: whether the velocity holds one.
+    pub(crate) velocity_valid: Option<Num>,
 }
 
 pub(crate) fn gnss_fields(format: &FlattenedFormat) -> Fields<GnssFields> {
@@ -117,6 +121,10 @@ pub(crate) fn gnss_fields(format: &FlattenedFormat) -> Fields<GnssFields> {
         deg_per_unit,
         eph: float(format, "eph"),
         fix_type: field(format, "fix_type", &[FlattenedFieldType::UInt8]),
+        velocity: float(format, "vel_m_s")
+            .zip(float(format, "cog_rad"))
+            .map(|(v, c)| [v, c]),
+        velocity_valid: field(format, "vel_ned_valid", &[FlattenedFieldType::Bool]),
     })
 }
 

@@ -92,6 +92,13 @@ fn sample_log_small_newer_layout_with_vehicle_magnetometer() {
         assert!((fix.lat_deg - lat).abs() < 1e-9 && (fix.lon_deg - lon).abs() < 1e-9);
         assert!((fix.sigma_m.unwrap() - eph).abs() < 1e-5);
     }
+    // `vel_m_s` 0.076 and `cog_rad` 0.57123244 (f32) on the first.
+    let (speed, course) = first.velocity.unwrap();
+    assert!((speed - 0.076).abs() < 1e-6, "{speed}");
+    assert!(
+        (course - 0.571_232_44f64.to_degrees()).abs() < 1e-4,
+        "{course}"
+    );
     let none = LogReader::new(LogConfig {
         gnss_topic: Some("none".into()),
         ..LogConfig::default()

@@ -50,24 +50,28 @@ fn ulog(gnss_format: &str, payloads: &[Vec<u8>]) -> Vec<u8> {
     out
 }
 
-fn double_fix(lat: f64, lon: f64, eph: f32, fix_type: u8) -> Vec<u8> {
+/// A fix moving at 12.5 m/s on a course of −90° (west), its velocity valid or not.
+fn double_fix(lat: f64, lon: f64, eph: f32, fix_type: u8, velocity_valid: bool) -> Vec<u8> {
     let mut p = lat.to_le_bytes().to_vec();
     p.extend_from_slice(&lon.to_le_bytes());
     p.extend_from_slice(&eph.to_le_bytes());
     p.push(fix_type);
+    p.extend_from_slice(&12.5f32.to_le_bytes());
+    p.extend_from_slice(&(-core::f32::consts::FRAC_PI_2).to_le_bytes());
+    p.push(u8::from(velocity_valid));
     p
 }
 
-const DOUBLES: &str = "sensor_gps:uint64_t timestamp;double latitude_deg;double longitude_deg;float eph;uint8_t fix_type;";
+const DOUBLES: &str = "sensor_gps:uint64_t timestamp;double latitude_deg;double longitude_deg;float eph;uint8_t fix_type;float vel_m_s;float cog_rad;bool vel_ned_valid;";
 
 #[test]
 fn newer_layout_in_degrees_with_its_accuracy_and_no_fix_left_out() {
     let bytes = ulog(
         DOUBLES,
         &[
-            double_fix(52.5123456789, 13.3987654321, 2.5, 3),
-            double_fix(0.0, 0.0, 99.0, 1),
-            double_fix(52.5123556789, 13.3987754321, 1.5, 6),
+            double_fix(52.5123456789, 13.3987654321, 2.5, 3, true),
+            double_fix(0.0, 0.0, 99.0, 1, true),
+            double_fix(52.5123556789, 13.3987754321, 1.5, 6, false),
         ],
     );
     let r = LogReader::new(LogConfig::default())
@@ -87,11 +91,17 @@ fn newer_layout_in_degrees_with_its_accuracy_and_no_fix_left_out() {
         (52.5123456789, 13.3987654321)
     );
     assert_eq!((r.gnss[1].t_s, r.gnss[1].sigma_m), (1.4, Some(1.5)));
+    // The course clockwise from north in [0, 360); none where the receiver says the
+    // velocity is not valid.
+    let (speed, course) = r.gnss[0].velocity.unwrap();
+    assert_eq!(speed, 12.5);
+    assert!((course - 270.0).abs() < 1e-5, "{course}");
+    assert_eq!(r.gnss[1].velocity, None);
 }
 
 #[test]
 fn a_fix_topic_named_must_be_there_and_serve() {
-    let bytes = ulog(DOUBLES, &[double_fix(52.5, 13.4, 2.5, 3)]);
+    let bytes = ulog(DOUBLES, &[double_fix(52.5, 13.4, 2.5, 3, true)]);
     let read = |topic: &str| {
         LogReader::new(LogConfig {
             gnss_topic: Some(topic.into()),

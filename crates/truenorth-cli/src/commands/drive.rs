@@ -455,12 +455,14 @@ fn summary(
     }
     line += &format!(", final heading σ {:.2}°", rad_to_deg(e.heading_sigma_rad));
     if let Some(c) = learned {
-        line += &format!(
-            ", gyro bias {:.3}°/s, wheel scale difference {:.3} %",
-            rad_to_deg(c.gyro_bias_rps.value),
-            100.0 * c.wheel_diff.value
-        );
-        if gnss.is_some() {
+        line += &format!(", gyro bias {:.3}°/s", rad_to_deg(c.gyro_bias_rps.value));
+        if sensors.travel == Travel::Wheels {
+            line += &format!(
+                ", wheel scale difference {:.3} %",
+                100.0 * c.wheel_diff.value
+            );
+        }
+        if gnss.is_some() && sensors.travel != Travel::None {
             line += &format!(
                 ", odometer scale {:+.2} ± {:.2} % (from the fixes)",
                 100.0 * c.wheel_scale.value,

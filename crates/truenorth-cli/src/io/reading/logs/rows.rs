@@ -21,6 +21,7 @@ const IMU: [&str; 6] = ["gyr_x", "gyr_y", "gyr_z", "acc_x", "acc_y", "acc_z"];
 const MAG: [&str; 3] = ["mag_x", "mag_y", "mag_z"];
 const WHEELS: [&str; 2] = ["speed_l_mps", "speed_r_mps"];
 const GNSS: [&str; 3] = ["lat_deg", "lon_deg", "gnss_sigma_m"];
+const GNSS_VELOCITY: [&str; 2] = ["gnss_speed_mps", "gnss_course_deg"];
 
 /// A log as a table of numbers: the header a CSV of it would have (`t_s` first) and its
 /// rows, one after the other; NaN is an empty cell (no reading of that stream on the row).
@@ -77,16 +78,12 @@ pub fn table(
         ));
     }
     if let Some(axle) = axle {
-        let axle = axle.map_err(|why| CliError::file(name, why))?;
+        // A log without odometry is a vehicle with a gyro (and a compass, and fixes) and no
+        // wheels, which `drive` takes as such.
         if recording.odometry.is_empty() {
-            return Err(CliError::file(
-                name,
-                format!(
-                    "drive needs the wheels' speeds and this {} file has no odometry: give a ROS 2 MCAP log with a nav_msgs/msg/Odometry topic (--odometry-topic), or a CSV",
-                    recording.format
-                ),
-            ));
+            return Ok(merged(recording, None, true));
         }
+        let axle = axle.map_err(|why| CliError::file(name, why))?;
         return Ok(merged(recording, Some(axle), true));
     }
     if wanted(&WHEELS) {
@@ -163,12 +160,16 @@ fn merged(r: &Recording, axle: Option<AxleTrack>, with_gnss: bool) -> LogTable {
     if gnss {
         columns.push(&GNSS);
     }
+    let velocity = gnss && r.gnss.iter().any(|f| f.velocity.is_some());
+    if velocity {
+        columns.push(&GNSS_VELOCITY);
+    }
     let mut table = LogTable::new(&columns, events.len());
     let mut k = 0;
     while k < events.len() {
         let t = events[k].0;
         let (mut imu, mut mag, mut odo) = ([f64::NAN; 6], [f64::NAN; 3], [f64::NAN; 2]);
-        let mut fix = [f64::NAN; 3];
+        let mut fix = [f64::NAN; 5];
         while k < events.len() && events[k].0 == t {
             let (_, stream, i) = events[k];
             match stream {
@@ -182,7 +183,14 @@ fn merged(r: &Recording, axle: Option<AxleTrack>, with_gnss: bool) -> LogTable {
                 1 => mag = [r.mag[i].mag.x, r.mag[i].mag.y, r.mag[i].mag.z],
                 3 => {
                     let g = &r.gnss[i];
-                    fix = [g.lat_deg, g.lon_deg, g.sigma_m.unwrap_or(f64::NAN)];
+                    let (speed, course) = g.velocity.unwrap_or((f64::NAN, f64::NAN));
+                    fix = [
+                        g.lat_deg,
+                        g.lon_deg,
+                        g.sigma_m.unwrap_or(f64::NAN),
+                        speed,
+                        course,
+                    ];
                 }
                 _ => {
                     if let Some(AxleTrack { track_m }) = axle {
@@ -205,7 +213,7 @@ fn merged(r: &Recording, axle: Option<AxleTrack>, with_gnss: bool) -> LogTable {
             table.values.extend(odo);
         }
         if gnss {
-            table.values.extend(fix);
+            table.values.extend(&fix[..if velocity { 5 } else { 3 }]);
         }
     }
     table
@@ -289,8 +297,12 @@ mod tests {
         r.odometry.clear();
         let name = Path::new("x.mcap");
         let t = ["t_s"];
-        let e = table(name, &r, &t, &[], Some(Ok(AxleTrack { track_m: 1.0 }))).unwrap_err();
-        assert!(e.to_string().contains("no odometry"), "{e}");
+        // No odometry: the rows without wheels, whatever the axle.
+        for axle in [Ok(AxleTrack { track_m: 1.0 }), Err("steering".to_string())] {
+            let rows = table(name, &r, &t, &[], Some(axle)).unwrap();
+            assert!(!rows.header.contains(&"speed_l_mps"), "{:?}", rows.header);
+        }
+        r.odometry = recording().odometry;
         let e = table(name, &r, &t, &[], Some(Err("steering wheels".to_string()))).unwrap_err();
         assert!(e.to_string().contains("steering"), "{e}");
         r.mag.clear();
