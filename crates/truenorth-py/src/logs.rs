@@ -21,9 +21,11 @@ use crate::convert::{TruenorthError, array1, array2};
 ///   estimate;
 /// * `odometry`: `t_s` (J), `velocity_mps` (J×3, body axes), `yaw_rate_rps` (J, positive
 ///   turning right);
-/// * `gnss`: `t_s` (F), `lat_deg`, `lon_deg` (F, WGS84), `sigma_m` (F, 1σ horizontal from the
-///   fix's covariance, NaN where it gives none): an MCAP's `sensor_msgs/msg/NavSatFix` fixes
-///   (messages with no fix left out), ready for `VehicleEstimator`'s `gnss=`;
+/// * `gnss`: `t_s` (F), `lat_deg`, `lon_deg` (F, WGS84), `sigma_m` (F, 1σ horizontal, NaN
+///   where the receiver gives none), `speed_mps`, `course_deg` (F, over ground, NaN where it
+///   gives none): an MCAP's `sensor_msgs/msg/NavSatFix` fixes or a ULog's
+///   `vehicle_gps_position`/`sensor_gps` (messages with no fix left out), ready for
+///   `VehicleEstimator`'s `gnss=` (stacked as columns);
 /// * `format` (`"PX4 ULog"` or `"MCAP"`), `complete`, `time_origin_s`, `topics` (a list of
 ///   dicts `name`, `kind`, `messages`) and `streams` (`role`, `topic`, `samples`,
 ///   `dropped`, `rate_hz`).
@@ -158,6 +160,14 @@ fn recording_dict<'py>(py: Python<'py>, r: &Recording) -> PyResult<Bound<'py, Py
                 .collect(),
         ),
     )?;
+    let velocity = |pick: fn((f64, f64)) -> f64| -> Vec<f64> {
+        r.gnss
+            .iter()
+            .map(|s| s.velocity.map_or(f64::NAN, pick))
+            .collect()
+    };
+    gnss.set_item("speed_mps", array1(py, velocity(|(v, _)| v)))?;
+    gnss.set_item("course_deg", array1(py, velocity(|(_, c)| c)))?;
     let topics = PyList::empty(py);
     for t in &r.topics {
         let d = PyDict::new(py);

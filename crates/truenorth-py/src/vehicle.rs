@@ -20,9 +20,23 @@ struct Readings {
     gyr_z: Option<f64>,
     mag: Option<(f64, f64)>,
     dist_m: Option<f64>,
-    /// A satellite fix: latitude, longitude (degrees) and its 1σ accuracy (m, NaN when the
-    /// receiver gives none).
-    gnss: Option<(f64, f64, f64)>,
+    /// A satellite fix: latitude, longitude (degrees), its 1σ accuracy (m), speed over
+    /// ground (m/s) and course over ground (degrees clockwise from true north), each NaN
+    /// when the receiver gives none.
+    gnss: Option<[f64; 5]>,
+}
+
+/// A fix given as 3 values (latitude, longitude, σ) or 5 (and speed, course over ground),
+/// NaN for what the receiver does not give.
+fn fix_values(values: &[f64]) -> PyResult<[f64; 5]> {
+    match *values {
+        [lat, lon, sigma] => Ok([lat, lon, sigma, f64::NAN, f64::NAN]),
+        [lat, lon, sigma, speed, course] => Ok([lat, lon, sigma, speed, course]),
+        _ => Err(crate::convert::arg_err(format!(
+            "`gnss` is (lat_deg, lon_deg, sigma_m) or (lat_deg, lon_deg, sigma_m, speed_mps, course_deg), got {} values",
+            values.len()
+        ))),
+    }
 }
 
 /// The row at `t_s` with whichever readings are finite.
@@ -35,9 +49,15 @@ fn vehicle_sample(t_s: f64, r: Readings) -> VehicleSample {
         gnss,
     } = r;
     let mut s = VehicleSample::at(t_s);
-    if let Some((lat, lon, sigma)) = gnss.filter(|(lat, lon, _)| !(lat.is_nan() && lon.is_nan())) {
+    if let Some([lat, lon, sigma, speed, course]) =
+        gnss.filter(|[lat, lon, ..]| !(lat.is_nan() && lon.is_nan()))
+    {
         let mut fix = GnssFix::at(lat, lon);
         fix.sigma_m = Some(sigma).filter(|s| !s.is_nan());
+        if !(speed.is_nan() || course.is_nan()) {
+            fix.speed_mps = Some(speed);
+            fix.course_deg = Some(course);
+        }
         s = s.with_gnss(fix);
     }
     if let Some(d) = dist_m.filter(|d| !d.is_nan()) {
@@ -98,8 +118,9 @@ impl VehicleEstimator {
         })
     }
 
-    /// Feeds one row; any reading may be `None` (`gnss`: `(lat_deg, lon_deg, sigma_m)`,
-    /// sigma NaN when the receiver gives none). Returns `{"t_s", "north_m", "east_m",
+    /// Feeds one row; any reading may be `None` (`gnss`: `(lat_deg, lon_deg, sigma_m)` or
+    /// `(lat_deg, lon_deg, sigma_m, speed_mps, course_deg)`, a value NaN when the receiver
+    /// gives none). Returns `{"t_s", "north_m", "east_m",
     /// "heading_deg", "gnss_frame"}` after it.
     #[pyo3(signature = (t_s, dist_l_m=None, dist_r_m=None, gyr_z=None, mag=None, dist_m=None, gnss=None))]
     #[allow(clippy::too_many_arguments)]
@@ -112,14 +133,14 @@ impl VehicleEstimator {
         gyr_z: Option<f64>,
         mag: Option<(f64, f64)>,
         dist_m: Option<f64>,
-        gnss: Option<(f64, f64, f64)>,
+        gnss: Option<Vec<f64>>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let readings = Readings {
             wheels: dist_l_m.zip(dist_r_m),
             gyr_z,
             mag,
             dist_m,
-            gnss,
+            gnss: gnss.as_deref().map(fix_values).transpose()?,
         };
         let e = self
             .inner
@@ -186,7 +207,7 @@ impl VehicleEstimator {
         };
         let fixes = match &gnss {
             Some(f) => {
-                let f = rows(f, "gnss", &[3])?;
+                let f = rows(f, "gnss", &[3, 5])?;
                 same_rows("gnss", f.nrows(), n)?;
                 Some(f)
             }
@@ -209,7 +230,10 @@ impl VehicleEstimator {
                         gyr_z: g.as_ref().map(|g| g[k]),
                         mag: m.as_ref().map(|m| (m[(k, 0)], m[(k, 1)])),
                         dist_m: single.as_ref().map(|d| d[k]),
-                        gnss: fixes.as_ref().map(|f| (f[(k, 0)], f[(k, 1)], f[(k, 2)])),
+                        gnss: fixes.as_ref().map(|f| {
+                            let v = |j: usize| if j < f.ncols() { f[(k, j)] } else { f64::NAN };
+                            [v(0), v(1), v(2), v(3), v(4)]
+                        }),
                     },
                 );
                 let e = inner.update(&s).map_err(|e| (k, e))?;

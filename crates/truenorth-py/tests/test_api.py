@@ -257,3 +257,27 @@ def test_vehicle_estimator_takes_satellite_fixes():
         last = one.update(t[k], gyr_z=0.0, dist_m=dist[k], gnss=fix)
     assert last["gnss_frame"]
     assert last["east_m"] == r["east_m"][-1]
+
+
+def test_vehicle_estimator_without_odometry_takes_the_fixes_course():
+    # A gyro alone, due east at 10 m/s, fixes with speed and course once a second: the
+    # heading goes onto true north, and there is no position without odometry.
+    n = 601
+    t = np.arange(n) * 0.1
+    lat0, lon0 = 52.5, 13.4
+    metres_per_deg_lon = 111_320.0 * math.cos(math.radians(lat0))
+    fixes = np.full((n, 5), np.nan)
+    for k in range(0, n, 10):
+        fixes[k] = (lat0, lon0 + 10.0 * t[k] / metres_per_deg_lon, 2.0, 10.0, 90.0)
+    v = tn.VehicleEstimator({"wheels": {"rear": {"track_m": 1.6}}})
+    r = v.update_array(t, gyr_z=np.zeros(n), gnss=fixes)
+    assert r["gnss_frame"][-1]
+    assert r["heading_deg"][-1] == pytest.approx(90.0, abs=2.0)
+    assert np.isnan(r["north_m"][-1]) and np.isnan(r["east_m"][-1])
+    one = tn.VehicleEstimator({"wheels": {"rear": {"track_m": 1.6}}})
+    for k in range(n):
+        fix = None if np.isnan(fixes[k, 0]) else tuple(fixes[k])
+        last = one.update(t[k], gyr_z=0.0, gnss=fix)
+    assert last["heading_deg"] == r["heading_deg"][-1]
+    with pytest.raises(tn.TruenorthError, match="got 4 values"):
+        one.update(61.0, gyr_z=0.0, gnss=(lat0, lon0, 2.0, 10.0))

@@ -196,7 +196,7 @@ class VehicleEstimator:
         gyr_z: Optional[float] = None,
         mag: Optional[tuple[float, float]] = None,
         dist_m: Optional[float] = None,
-        gnss: Optional[tuple[float, float, float]] = None,
+        gnss: Optional[tuple[float, ...]] = None,
     ) -> VehicleRow: ...
     def update_array(
         self,
