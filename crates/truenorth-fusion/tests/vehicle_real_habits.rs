@@ -263,12 +263,8 @@ fn cells() -> Vec<Cell> {
 /// Held on every cell with a plain baseline (a gyro and a distance), over its seeds: the
 /// track's RMS no worse than plain integration's by more than a tenth (the two-pass start
 /// and the rest hold move the path a little either way; the final error, one point of a
-/// random walk, is printed, not held). Held on every set with a gyro, every robot's set and
-/// the three presets of real logs: heading beyond 3σ on at most 2 % of a set's rows, never
-/// beyond 6σ.
-///
-/// Printed, not held — a miss: cars with wheel speeds and a compass but no gyro, whose heading
-/// comes from the wheels and the compass alone (rear wheels 2.2 % of rows beyond 3σ).
+/// random walk, is printed, not held). Held on every set and the three presets of real
+/// logs: heading beyond 3σ on at most 2 % of a set's rows, never beyond 6σ.
 #[test]
 fn real_habits_never_worse_than_plain_integration_and_sigma_holds() {
     let only = std::env::var("ONLY").unwrap_or_default();
@@ -281,10 +277,6 @@ fn real_habits_never_worse_than_plain_integration_and_sigma_holds() {
         }
         let (mut rows, mut beyond, mut max_z) = (0usize, 0usize, 0.0f64);
         let (mut fused_sq, mut plain_sq, mut n) = (0.0, 0.0, 0.0);
-        let config = make(0);
-        // The σ held: every set with a gyro, every robot's, every preset of a real log
-        // (see above).
-        let held = config.sensors.gyro || !config.kind.is_car() || name.starts_with("real");
         for seed in 0..seeds() {
             let d = LogDrive::new(make(seed)).unwrap();
             let s = score(&d);
@@ -324,14 +316,12 @@ fn real_habits_never_worse_than_plain_integration_and_sigma_holds() {
                 "-".to_string()
             }
         );
-        if held {
-            assert!(
-                share <= 0.02,
-                "{name}: {:.2} % of rows beyond 3σ",
-                100.0 * share
-            );
-            assert!(max_z < 6.0, "{name}: {max_z:.2}σ");
-        }
+        assert!(
+            share <= 0.02,
+            "{name}: {:.2} % of rows beyond 3σ",
+            100.0 * share
+        );
+        assert!(max_z < 6.0, "{name}: {max_z:.2}σ");
         if n > 0.0 {
             let ratio = (fused_sq / plain_sq).sqrt();
             if ratio > worst_ratio.0 {

@@ -29,6 +29,13 @@ const SUSPECT_AFTER_S: f64 = 60.0;
 /// Turning that must accompany [`SUSPECT_AFTER_S`] of rejection, rad (90°).
 const SUSPECT_TURN_RAD: f64 = core::f64::consts::FRAC_PI_2;
 
+/// …or distance driven, m: farther than a disturbance on the road reaches (a parked car, a
+/// bridge's steel, a tram line's current: metres to a few hundred). On a straight the
+/// readings cannot show a wrong calibration, which is a function of the heading, but a
+/// field that disagrees with the dead reckoning by a steady or steadily growing offset over
+/// half a kilometre is the dead reckoning's error, not the road's.
+const SUSPECT_DISTANCE_M: f64 = 500.0;
+
 /// What a long rejection of the compass says.
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum Suspect {
@@ -46,45 +53,69 @@ enum Suspect {
     Calibration,
 }
 
+/// A judged reading as the outage counts it: its time, the heading and the distance driven
+/// then, and its innovation, rad.
+#[derive(Debug, Clone, Copy)]
+struct Counted {
+    t_s: f64,
+    psi: f64,
+    distance_m: f64,
+    nu_rad: f64,
+}
+
 impl Outage {
-    /// Counts one judged reading at time `t_s` with innovation `nu_rad` against the heading
-    /// `psi`; `noise_rad` is one reading's noise. After [`SUSPECT_AFTER_S`] of rejection
-    /// with [`SUSPECT_TURN_RAD`] of turning it says what the rejection means: a field that
-    /// is disturbed on the road is local and changes with place and heading, so readings
-    /// that keep one offset from the dead reckoning through a turn mean that the dead
-    /// reckoning is off, and readings that do not, that the calibration is.
-    fn count(&mut self, t_s: f64, psi: f64, nu_rad: f64, noise_rad: f64, used: bool) -> Suspect {
+    /// Counts one judged `reading`; `noise_rad` is one reading's noise. After
+    /// [`SUSPECT_AFTER_S`] of rejection with [`SUSPECT_TURN_RAD`] of turning or
+    /// [`SUSPECT_DISTANCE_M`] driven it says what the rejection means: a field that is
+    /// disturbed on the road is local and changes with place and heading, so readings that
+    /// keep one offset (or drift steadily) from the dead reckoning mean that the dead
+    /// reckoning is off, and readings that do not through a turn, that the calibration is.
+    fn count(&mut self, reading: Counted, noise_rad: f64, used: bool) -> Suspect {
+        let Counted {
+            t_s,
+            psi,
+            distance_m,
+            nu_rad,
+        } = reading;
         if let (Some((t0, psi0)), false) = (self.last, used) {
             self.rejected_s += t_s - t0;
             self.turned_rad += wrap_pi(psi - psi0).abs();
+            self.travelled_m += (distance_m - self.last_distance_m).abs();
         }
         self.last = Some((t_s, psi));
+        self.last_distance_m = distance_m;
         if used {
             self.rejected_s = 0.0;
             self.turned_rad = 0.0;
+            self.travelled_m = 0.0;
             self.line = InnovationLine::default();
             return Suspect::None;
         }
         self.line.push(t_s, nu_rad);
+        let turned = self.turned_rad >= SUSPECT_TURN_RAD;
         if self.relearning
             || self.rejected_s < SUSPECT_AFTER_S
-            || self.turned_rad < SUSPECT_TURN_RAD
+            || !(turned || self.travelled_m >= SUSPECT_DISTANCE_M)
         {
             return Suspect::None;
         }
         let fit = self.line.fit(noise_rad);
         self.rejected_s = 0.0;
         self.turned_rad = 0.0;
+        self.travelled_m = 0.0;
         self.line = InnovationLine::default();
         match fit {
             Some(f) if f.residual_rad <= 3.0 * noise_rad => Suspect::DeadReckoning {
                 offset_rad: f.offset_rad,
                 sigma_rad: f.sigma_rad,
             },
-            _ => {
+            // Readings that disagree among themselves through a turn: the calibration is
+            // wrong. Without the turn they say nothing the road could not.
+            _ if turned => {
                 self.relearning = true;
                 Suspect::Calibration
             }
+            _ => Suspect::None,
         }
     }
 }
@@ -143,11 +174,13 @@ impl VehicleEstimator {
             self.take_compass(nu, variance_rad2);
         }
         let noise = self.compass.fix().map_or(0.0, |f| f.noise_rad);
-        match self
-            .tracking
-            .outage
-            .count(t_s, self.filter.x[PSI], nu, noise, used)
-        {
+        let reading = Counted {
+            t_s,
+            psi: self.filter.x[PSI],
+            distance_m: self.est.distance_m,
+            nu_rad: nu,
+        };
+        match self.tracking.outage.count(reading, noise, used) {
             Suspect::None => {}
             Suspect::Calibration => self.learner.relearn(),
             Suspect::DeadReckoning {

@@ -154,12 +154,20 @@ pub(super) struct Rest {
     pub span_s: f64,
 }
 
-/// How long the compass has been rejected, and how far the vehicle turned meanwhile.
+/// How long the compass has been rejected, and how far the vehicle turned and drove
+/// meanwhile.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
 pub(super) struct Outage {
     pub rejected_s: f64,
     pub turned_rad: f64,
+    /// Distance driven while rejected, m.
+    #[serde(default)]
+    pub travelled_m: f64,
+    /// Time and heading at the last reading.
     pub last: Option<(f64, f64)>,
+    /// Distance driven at the last reading, m.
+    #[serde(default)]
+    pub last_distance_m: f64,
     /// The calibration in use was found wanting: a new one is being learned from readings
     /// the gates cannot judge.
     pub relearning: bool,
