@@ -524,15 +524,8 @@ fn drive_reads_a_ulog_as_gyro_compass_and_fixes_without_wheels() {
     )
     .unwrap();
     let out = dir.join("out.csv");
-    let o = ok(&[
-        "drive",
-        "--vehicle",
-        p(&vehicle),
-        "--input",
-        p(&log),
-        "--output",
-        p(&out),
-    ]);
+    let o = common::drive(&vehicle, &log, &out, &[]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
     let stderr = text(&o.stderr);
     for expected in [
         "`lat_deg,lon_deg` give no position",

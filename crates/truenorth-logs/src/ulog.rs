@@ -423,6 +423,45 @@ fn spec_name(s: &TopicSpec) -> String {
     format!("{}:{}", s.name, s.instance)
 }
 
+/// The candidate topics of one role, in order of preference, and what each gave.
+struct Candidates<'a, T> {
+    role: &'static str,
+    specs: &'a [TopicSpec],
+    samples: &'a mut [Vec<T>],
+    errors: &'a mut [Option<String>],
+    /// Readings left out for a non-finite value.
+    non_finite: usize,
+}
+
+impl<T> Candidates<'_, T> {
+    /// The first candidate that gave samples: its samples in increasing time and its
+    /// summary (none without one). A topic `named` for the role (not `none`), the only
+    /// candidate then, must be in the file and serve the role (`check`).
+    fn select(
+        self,
+        named: Option<&str>,
+        check: &impl Fn(&'static str, &TopicSpec, Option<String>) -> Result<()>,
+        t_s: impl Fn(&T) -> f64,
+    ) -> Result<(Vec<T>, Option<StreamInfo>)> {
+        if named.is_some_and(|n| n != NO_TOPIC) {
+            check(self.role, &self.specs[0], self.errors[0].take())?;
+        }
+        let Some(k) = self.samples.iter().position(|s| !s.is_empty()) else {
+            return Ok((Vec::new(), None));
+        };
+        let mut samples = std::mem::take(&mut self.samples[k]);
+        let dropped = keep_increasing(&mut samples, &t_s) + self.non_finite;
+        let info = StreamInfo {
+            role: self.role,
+            topic: spec_name(&self.specs[k]),
+            samples: samples.len(),
+            dropped,
+            rate_hz: rate_hz(samples.iter().map(&t_s)),
+        };
+        Ok((samples, Some(info)))
+    }
+}
+
 /// Selects the streams from what was gathered and checks the requested topics exist.
 fn finish(mut g: Gathered, config: &LogConfig, complete: bool) -> Result<Recording> {
     let topics: Vec<TopicInfo> = g
@@ -447,12 +486,13 @@ fn finish(mut g: Gathered, config: &LogConfig, complete: bool) -> Result<Recordi
         detail,
     };
 
-    if !has(&g.imu_spec) {
-        return Err(missing("imu", &g.imu_spec));
-    }
-    if let Some(e) = g.imu_error.take() {
-        return Err(wrong("imu", &g.imu_spec, e));
-    }
+    let check = |role, s: &TopicSpec, error: Option<String>| -> Result<()> {
+        if !has(s) {
+            return Err(missing(role, s));
+        }
+        error.map_or(Ok(()), |e| Err(wrong(role, s, e)))
+    };
+    check("imu", &g.imu_spec, g.imu_error.take())?;
     let mut streams = Vec::new();
     let dropped = keep_increasing(&mut g.imu, |s| s.t_s) + g.non_finite[0];
     streams.push(StreamInfo {
@@ -463,37 +503,20 @@ fn finish(mut g: Gathered, config: &LogConfig, complete: bool) -> Result<Recordi
         rate_hz: rate_hz(g.imu.iter().map(|s| s.t_s)),
     });
 
-    let mut mag = Vec::new();
-    if config.mag_topic.as_deref().is_some_and(|n| n != NO_TOPIC) {
-        let spec = &g.mag_specs[0];
-        if !has(spec) {
-            return Err(missing("mag", spec));
-        }
-        if let Some(e) = g.mag_errors[0].take() {
-            return Err(wrong("mag", spec, e));
-        }
+    let (mag, info) = Candidates {
+        role: "mag",
+        specs: &g.mag_specs,
+        samples: &mut g.mags,
+        errors: &mut g.mag_errors,
+        non_finite: g.non_finite[1],
     }
-    if let Some(k) = g.mags.iter().position(|m| !m.is_empty()) {
-        mag = std::mem::take(&mut g.mags[k]);
-        let dropped = keep_increasing(&mut mag, |s| s.t_s) + g.non_finite[1];
-        streams.push(StreamInfo {
-            role: "mag",
-            topic: spec_name(&g.mag_specs[k]),
-            samples: mag.len(),
-            dropped,
-            rate_hz: rate_hz(mag.iter().map(|s| s.t_s)),
-        });
-    }
+    .select(config.mag_topic.as_deref(), &check, |s| s.t_s)?;
+    streams.extend(info);
 
     if let (Some(name), Some(spec)) = (config.attitude_topic.as_deref(), &g.attitude_spec)
         && name != NO_TOPIC
     {
-        if !has(spec) {
-            return Err(missing("attitude", spec));
-        }
-        if let Some(e) = g.attitude_error.take() {
-            return Err(wrong("attitude", spec, e));
-        }
+        check("attitude", spec, g.attitude_error.take())?;
     }
     if let Some(spec) = g.attitude_spec.as_ref().filter(|_| !g.attitude.is_empty()) {
         let dropped = keep_increasing(&mut g.attitude, |s| s.t_s) + g.non_finite[2];
@@ -506,27 +529,15 @@ fn finish(mut g: Gathered, config: &LogConfig, complete: bool) -> Result<Recordi
         });
     }
 
-    let mut gnss = Vec::new();
-    if config.gnss_topic.as_deref().is_some_and(|n| n != NO_TOPIC) {
-        let spec = &g.gnss_specs[0];
-        if !has(spec) {
-            return Err(missing("gnss", spec));
-        }
-        if let Some(e) = g.gnss_errors[0].take() {
-            return Err(wrong("gnss", spec, e));
-        }
+    let (gnss, info) = Candidates {
+        role: "gnss",
+        specs: &g.gnss_specs,
+        samples: &mut g.gnss,
+        errors: &mut g.gnss_errors,
+        non_finite: g.non_finite[3],
     }
-    if let Some(k) = g.gnss.iter().position(|f| !f.is_empty()) {
-        gnss = std::mem::take(&mut g.gnss[k]);
-        let dropped = keep_increasing(&mut gnss, |s| s.t_s) + g.non_finite[3];
-        streams.push(StreamInfo {
-            role: "gnss",
-            topic: spec_name(&g.gnss_specs[k]),
-            samples: gnss.len(),
-            dropped,
-            rate_hz: rate_hz(gnss.iter().map(|s| s.t_s)),
-        });
-    }
+    .select(config.gnss_topic.as_deref(), &check, |s| s.t_s)?;
+    streams.extend(info);
 
     Ok(Recording {
         format: LogFormat::Ulog,

@@ -18,7 +18,7 @@ use truenorth_geomag::{Geodetic, LocalTangentPlane};
 
 use super::estimator::VehicleEstimator;
 use super::gnss_track::PlaneShift;
-use super::innovation_line::InnovationLine;
+use super::innovation_line::{InnovationLine, LineFit};
 use super::nav_filter::{EAST, NORTH, PSI};
 
 #[cfg(not(feature = "std"))]
@@ -258,18 +258,10 @@ impl VehicleEstimator {
     /// one that does is off by half a turn and fails the gate once referred.
     fn course_without_odometry(&mut self, t_s: f64, fix: &GnssFix) {
         if !self.tracking.gnss.aligned {
-            let Some((course, course_sigma)) = self.course_of(fix, None) else {
+            let Some(course) = self.course_of(fix, None) else {
                 return;
             };
-            let nu = wrap_pi(course - self.heading_at(t_s));
-            let line = &mut self.tracking.gnss.line;
-            line.push(t_s, nu);
-            if line.len() < ALIGNMENT_COURSES {
-                return;
-            }
-            let fit = line.fit(course_sigma);
-            self.tracking.gnss.line = InnovationLine::default();
-            if let Some(f) = fit.filter(|f| f.residual_rad <= 3.0 * course_sigma) {
+            if let Some(f) = self.agreeing_courses(t_s, course) {
                 let after_compass = self.tracking.alignment.done;
                 let turn_rad = self.refer_heading_to_fixes(f.offset_rad, f.sigma_rad);
                 // No track to move onto the plane: only the heading's turn.
@@ -287,6 +279,21 @@ impl VehicleEstimator {
         if self.correct_with_course(t_s, fix) {
             self.note_fix_used(t_s);
         }
+    }
+
+    /// Gathers a course (rad, and its standard deviation) at `t_s` against the heading; once
+    /// [`ALIGNMENT_COURSES`] are gathered, their offset from the heading if they agree (the
+    /// gathering starts again either way).
+    fn agreeing_courses(&mut self, t_s: f64, (course, sigma): (f64, f64)) -> Option<LineFit> {
+        let nu = wrap_pi(course - self.heading_at(t_s));
+        let line = &mut self.tracking.gnss.line;
+        line.push(t_s, nu);
+        if line.len() < ALIGNMENT_COURSES {
+            return None;
+        }
+        let fit = line.fit(sigma);
+        self.tracking.gnss.line = InnovationLine::default();
+        fit.filter(|f| f.residual_rad <= 3.0 * sigma)
     }
 
     /// Counts a fix used at `t_s`.
@@ -344,16 +351,8 @@ impl VehicleEstimator {
     /// and once they agree turns heading and track onto true north and the plane.
     fn align_to_fixes(&mut self, t_s: f64, north: f64, east: f64, sigma: f64, fix: &GnssFix) {
         let (pn, pe) = self.position_at(t_s);
-        if let Some((course, course_sigma)) = self.course_of(fix, Some(self.est.speed_mps)) {
-            let nu = wrap_pi(course - self.heading_at(t_s));
-            let line = &mut self.tracking.gnss.line;
-            line.push(t_s, nu);
-            if line.len() < ALIGNMENT_COURSES {
-                return;
-            }
-            let fit = line.fit(course_sigma);
-            self.tracking.gnss.line = InnovationLine::default();
-            if let Some(f) = fit.filter(|f| f.residual_rad <= 3.0 * course_sigma) {
+        if let Some(course) = self.course_of(fix, Some(self.est.speed_mps)) {
+            if let Some(f) = self.agreeing_courses(t_s, course) {
                 self.refer_to_fixes(t_s, north, east, sigma, f.offset_rad, f.sigma_rad);
             }
             return;
