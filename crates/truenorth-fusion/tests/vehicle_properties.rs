@@ -1,10 +1,13 @@
 //! Properties of the vehicle estimators on arbitrary input: no panic on any finite or
 //! non-finite value, a typed refusal that changes nothing for a non-finite value or a
-//! timestamp that does not increase, and finite estimates from every accepted sample.
+//! timestamp that does not increase, and finite estimates from every accepted sample —
+//! satellite fixes with and without their course among the rows, odometry or not.
 
 use nalgebra::Vector2;
 use proptest::prelude::*;
-use truenorth_core::{HeadingEstimator, NavEstimate, VehicleSample, WheelReading};
+use truenorth_core::{
+    GnssFix, HeadingEstimator, NavEstimate, Validate, VehicleSample, WheelReading,
+};
 use truenorth_fusion::vehicle::{
     SeedGyroCompass, SeedGyroCompassConfig, SeedOdometerCompass, SeedOdometerCompassConfig,
     TwoPassConfig, TwoPassStart,
@@ -34,6 +37,26 @@ struct Step {
     dr_m: f64,
     gyro: Option<f64>,
     mag: Option<(f64, f64)>,
+    fix: Option<Fix>,
+}
+
+/// A fix: north and east of the origin, m (turned into latitude and longitude), σ, and
+/// speed and course over ground, or, now and then, arbitrary values.
+type Fix = (f64, f64, f64, Option<(f64, f64)>);
+
+fn fix() -> impl Strategy<Value = Option<Fix>> {
+    proptest::option::weighted(
+        0.2,
+        (
+            prop_oneof![8 => -500.0f64..500.0, 1 => any_value()],
+            prop_oneof![8 => -500.0f64..500.0, 1 => any_value()],
+            prop_oneof![8 => 0.5f64..10.0, 1 => any_value()],
+            proptest::option::of((
+                prop_oneof![8 => 0.0f64..30.0, 1 => any_value()],
+                prop_oneof![8 => 0.0f64..360.0, 1 => any_value()],
+            )),
+        ),
+    )
 }
 
 fn step() -> impl Strategy<Value = Step> {
@@ -47,14 +70,16 @@ fn step() -> impl Strategy<Value = Step> {
             prop_oneof![8 => -60.0f64..60.0, 1 => any_value()],
             prop_oneof![8 => -60.0f64..60.0, 1 => any_value()],
         )),
+        fix(),
     )
-        .prop_map(|(dt_s, wheels, dl_m, dr_m, gyro, mag)| Step {
+        .prop_map(|(dt_s, wheels, dl_m, dr_m, gyro, mag, fix)| Step {
             dt_s,
             wheels,
             dl_m,
             dr_m,
             gyro,
             mag,
+            fix,
         })
 }
 
@@ -75,7 +100,15 @@ fn samples(steps: &[Step]) -> Vec<VehicleSample> {
                 gyr_z_rps: s.gyro,
                 mag: s.mag.map(|(x, y)| Vector2::new(x, y)),
                 dist_m: None,
-                gnss: None,
+                // 52.5° N, 13.4° E plus the step's metres (1e-5° is about 1.1 m of
+                // latitude): a fix's degrees as arbitrary as its metres.
+                gnss: s.fix.map(|(n, e, sigma, velocity)| {
+                    let fix = GnssFix::at(52.5 + n * 9e-6, 13.4 + e * 1.5e-5).with_sigma(sigma);
+                    match velocity {
+                        Some((v, c)) => fix.with_velocity(v, c),
+                        None => fix,
+                    }
+                }),
             }
         })
         .collect()
@@ -86,7 +119,8 @@ fn valid(s: &VehicleSample, last_t: Option<f64>) -> bool {
         && s.wheels
             .is_none_or(|w| w.dist_l_m.is_finite() && w.dist_r_m.is_finite())
         && s.gyr_z_rps.is_none_or(f64::is_finite)
-        && s.mag.is_none_or(|m| m.x.is_finite() && m.y.is_finite());
+        && s.mag.is_none_or(|m| m.x.is_finite() && m.y.is_finite())
+        && s.gnss.is_none_or(|f| f.validate().is_ok());
     finite && last_t.is_none_or(|t0| s.t_s > t0)
 }
 
@@ -144,8 +178,14 @@ proptest! {
         kind in 0usize..4,
     ) {
         let input = samples(&steps);
-        let nav = VehicleEstimator::new(VehicleConfig { wheels: wheels(kind), ..VehicleConfig::default() }).unwrap();
-        check(Box::new(nav), &input)?;
+        let config = VehicleConfig { wheels: wheels(kind), ..VehicleConfig::default() };
+        check(Box::new(VehicleEstimator::new(config).unwrap()), &input)?;
+        // No odometry at all: the fixes' courses alone refer the heading.
+        let no_odometry: Vec<VehicleSample> = input
+            .iter()
+            .map(|s| VehicleSample { wheels: None, ..*s })
+            .collect();
+        check(Box::new(VehicleEstimator::new(config).unwrap()), &no_odometry)?;
     }
 
     #[test]
