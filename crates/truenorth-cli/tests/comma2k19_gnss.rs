@@ -7,7 +7,8 @@
 //! With every fix the track follows the reference to the fixes' own error; with the fixes
 //! withheld after the first 30 s, the last 30 s are dead reckoned from what the first 30 s
 //! taught — the raw gyro's bias above all, which no rest on this drive could give — beside
-//! plain dead reckoning with the same sensors from the fixes' track direction.
+//! plain dead reckoning with the same sensors from the fixes' track direction. Without its
+//! wheels, the raw yaw rate and the fixes' course alone give the heading.
 //! `cargo test -p truenorth-cli --test comma2k19_gnss -- --nocapture` prints the figures.
 
 mod common;
@@ -27,10 +28,11 @@ const TRACK_M: f64 = 1.57;
 /// Seconds of fixes before they are withheld.
 const FIXES_FOR_S: f64 = 30.0;
 
-/// Writes DRIVE.csv: rows at the wheel speeds' rate with the rear wheels and the raw yaw rate
-/// (the IMU's down axis, positive turning right) interpolated to them, and each u-blox fix
-/// on a row of its own; fixes after `fixes_until_s` (log time) left out.
-fn write_drive(dir: &Path, path: &Path, fixes_until_s: f64) {
+/// Writes DRIVE.csv: rows at the wheel speeds' rate with the rear wheels (`wheels`; else
+/// without them) and the raw yaw rate (the IMU's down axis, positive turning right)
+/// interpolated to them, and each u-blox fix on a row of its own; fixes after
+/// `fixes_until_s` (log time) left out.
+fn write_drive(dir: &Path, path: &Path, fixes_until_s: f64, wheels_on: bool) {
     let wheels = Table::read(&dir.join("can_speed_wheels.csv"));
     let imu = Table::read(&dir.join("imu.csv"));
     let fixes = Table::read(&dir.join("gnss_ublox_fix.csv"));
@@ -40,16 +42,19 @@ fn write_drive(dir: &Path, path: &Path, fixes_until_s: f64) {
     let tf = fixes.col("t_boot_s");
     let (lat, lon) = (fixes.col("lat_deg"), fixes.col("lon_deg"));
     let (speed, course) = (fixes.col("speed_mps"), fixes.col("bearing_deg"));
-    let mut s = String::from(
-        "t_s,speed_l_mps,speed_r_mps,gyr_z,lat_deg,lon_deg,gnss_speed_mps,gnss_course_deg\n",
-    );
+    let mut s = String::from(if wheels_on {
+        "t_s,speed_l_mps,speed_r_mps,gyr_z,lat_deg,lon_deg,gnss_speed_mps,gnss_course_deg\n"
+    } else {
+        "t_s,gyr_z,lat_deg,lon_deg,gnss_speed_mps,gnss_course_deg\n"
+    });
+    let blank_wheels = if wheels_on { ",," } else { "" };
     let mut f = tf.partition_point(|&x| x <= t[0]);
     for k in 0..t.len() {
         while f < tf.len() && tf[f] < t[k] {
             if tf[f] <= fixes_until_s {
                 writeln!(
                     s,
-                    "{},,,,{},{},{},{}",
+                    "{}{blank_wheels},,{},{},{},{}",
                     tf[f], lat[f], lon[f], speed[f], course[f]
                 )
                 .unwrap();
@@ -59,15 +64,12 @@ fn write_drive(dir: &Path, path: &Path, fixes_until_s: f64) {
         if f < tf.len() && tf[f] == t[k] {
             f += 1;
         }
-        writeln!(
-            s,
-            "{},{},{},{},,,,",
-            t[k],
-            vl[k],
-            vr[k],
-            interp(&t_imu, &rate, t[k])
-        )
-        .unwrap();
+        let rate_k = interp(&t_imu, &rate, t[k]);
+        if wheels_on {
+            writeln!(s, "{},{},{},{rate_k},,,,", t[k], vl[k], vr[k]).unwrap();
+        } else {
+            writeln!(s, "{},{rate_k},,,,", t[k]).unwrap();
+        }
     }
     std::fs::write(path, s).unwrap();
 }
@@ -165,7 +167,7 @@ fn a_real_car_with_its_own_fixes() {
     let t0 = Table::read(&dir.join("can_speed_wheels.csv")).col("t_boot_s")[0];
     let run = |name: &str, until_s: f64| {
         let input = scratch.join(format!("{name}.csv"));
-        write_drive(&dir, &input, until_s);
+        write_drive(&dir, &input, until_s, true);
         let out = scratch.join(format!("{name}-out.csv"));
         let o = common::succeeded(common::drive(
             &vehicle,
@@ -205,4 +207,77 @@ fn a_real_car_with_its_own_fixes() {
         end <= 1.1 * zeroed,
         "{end:.2} m against the zeroed gyro's {zeroed:.2} m"
     );
+}
+
+/// The same car without its wheels: the raw yaw rate (3.9°/s of bias, no rest) and the
+/// u-blox fixes' course. The courses refer the heading to true north and teach the bias;
+/// against the reference's course over ground the heading's error RMS on the rows referred,
+/// with the position cells empty on every row.
+#[test]
+fn without_its_wheels_the_courses_refer_the_heading() {
+    let Some(dir) = truenorth_sim::shared_data::folder(FOLDER).unwrap() else {
+        return;
+    };
+    let scratch = scratch("comma2k19_gnss", "courses");
+    let pose = Table::read(&dir.join("pose_reference.csv"));
+    let (tp, cog) = (pose.col("t_boot_s"), pose.col("course_over_ground_deg"));
+    let vehicle = common::rear_vehicle(&scratch, TRACK_M);
+    let input = scratch.join("no_wheels.csv");
+    write_drive(&dir, &input, f64::INFINITY, false);
+    let out = scratch.join("no_wheels-out.csv");
+    let o = common::succeeded(common::drive(
+        &vehicle,
+        &input,
+        &out,
+        &[
+            "--extra",
+            "sigma",
+            "--extra",
+            "status",
+            "--extra",
+            "calibration",
+            "--single-pass",
+        ],
+    ));
+    let stderr = String::from_utf8_lossy(&o.stderr).to_string();
+    assert!(
+        stderr.contains("true north, from the satellite fixes"),
+        "{stderr}"
+    );
+    let (header, rows) = common::table(&out, true);
+    let col = |name: &str| {
+        header
+            .iter()
+            .position(|h| h == name)
+            .unwrap_or_else(|| panic!("{name} not in {header:?}"))
+    };
+    let (heading, sigma, bias) = (
+        col("heading_deg"),
+        col("heading_sigma_deg"),
+        col("gyro_bias_dps"),
+    );
+    let absolute = col("heading_absolute");
+    let (mut sq, mut n, mut beyond) = (0.0, 0usize, 0usize);
+    for r in &rows {
+        assert!(
+            r[1].is_nan() && r[2].is_nan(),
+            "a position without odometry: {r:?}"
+        );
+        if r[0] > *tp.last().unwrap() || r[absolute] != 1.0 {
+            continue;
+        }
+        let err = (r[heading] - interp(&tp, &cog, r[0]) + 540.0).rem_euclid(360.0) - 180.0;
+        sq += err * err;
+        n += 1;
+        beyond += usize::from(err.abs() > 3.0 * r[sigma]);
+    }
+    let rms = (sq / n.max(1) as f64).sqrt();
+    let last_bias = rows.last().unwrap()[bias];
+    println!(
+        "no wheels, raw gyro + courses: heading against the reference's course {rms:.2}° RMS over {n} rows, {:.2} % beyond 3σ; gyro bias learned {last_bias:.3}°/s (the reference implies 3.884)",
+        100.0 * beyond as f64 / n.max(1) as f64
+    );
+    assert!(n > rows.len() / 2, "{n} of {} rows referred", rows.len());
+    assert!(rms < 3.0, "{rms:.2}°");
+    assert!(beyond * 50 <= n, "{beyond} of {n} rows beyond 3σ");
 }
