@@ -48,6 +48,9 @@ pub struct VehicleSensors {
     /// Satellite fixes.
     #[serde(default)]
     pub gnss: bool,
+    /// Satellite fixes with their course over ground (and speed).
+    #[serde(default)]
+    pub gnss_course: bool,
 }
 
 impl VehicleSensors {
@@ -71,12 +74,15 @@ impl VehicleSensors {
         self.gyro |= sample.gyr_z_rps.is_some();
         self.compass |= sample.mag.is_some();
         self.gnss |= sample.gnss.is_some();
+        self.gnss_course |= sample
+            .gnss
+            .is_some_and(|f| f.course_deg.is_some() && f.speed_mps.is_some());
     }
 
     /// Whether satellite fixes can correct the estimate: there are fixes, and odometry
-    /// carries the position between them.
+    /// carries the position between them or they give their course (the heading's).
     pub fn fixes_used(&self) -> bool {
-        self.gnss && self.travel != Travel::None
+        self.gnss && (self.travel != Travel::None || self.gnss_course)
     }
 
     /// Whether anything gives the heading's changes: a gyro, two wheels, or a compass.
@@ -201,6 +207,17 @@ mod tests {
         let no_odometry = VehicleSensors::of(&VehicleSample::at(0.0).with_gyro(0.0).with_gnss(fix));
         assert!(!no_odometry.fixes_used());
         assert!(no_odometry.limits().any(|l| l.starts_with("no north")));
+        // Without odometry a fix's course still refers the heading and the gyro's errors:
+        // only the position is missing.
+        let courses = VehicleSensors::of(
+            &VehicleSample::at(0.0)
+                .with_gyro(0.0)
+                .with_gnss(fix.with_velocity(10.0, 90.0)),
+        );
+        assert!(courses.fixes_used());
+        let limits: Vec<_> = courses.limits().collect();
+        assert_eq!(limits.len(), 1, "{limits:?}");
+        assert!(limits[0].starts_with("no position"));
     }
 
     #[test]

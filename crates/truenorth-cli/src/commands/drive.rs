@@ -471,15 +471,20 @@ fn summary(
         }
     }
     let u = e.status.unobserved;
+    // The wheels' states say nothing of a drive without them.
+    let (wheels, odometer) = (
+        sensors.travel == Travel::Wheels,
+        sensors.travel != Travel::None,
+    );
     let open: Vec<&str> = [
         (u.gyro_bias, "gyro bias"),
         (u.gyro_gain_right, "gyro gain right"),
         (u.gyro_gain_left, "gyro gain left"),
-        (u.wheel_diff, "wheel scale difference"),
-        (u.track_scale, "effective track"),
-        (u.speed_coeff, "speed coefficient"),
-        (u.wheel_scale, "odometer scale"),
-        (u.wheel_lag, "wheels' delay"),
+        (u.wheel_diff && wheels, "wheel scale difference"),
+        (u.track_scale && wheels, "effective track"),
+        (u.speed_coeff && wheels, "speed coefficient"),
+        (u.wheel_scale && odometer, "odometer scale"),
+        (u.wheel_lag && wheels, "wheels' delay"),
     ]
     .iter()
     .filter(|(o, _)| *o)

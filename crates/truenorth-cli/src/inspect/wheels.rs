@@ -180,6 +180,7 @@ pub fn vehicle_sensors(rec: &Recording) -> Option<VehicleSetReport> {
         gyro: has("gyr_z"),
         compass: has("mag_x") && has("mag_y"),
         gnss: has("lat_deg") && has("lon_deg"),
+        gnss_course: has("lat_deg") && has("gnss_speed_mps") && has("gnss_course_deg"),
     };
     if set == VehicleSensors::default() {
         return None;
