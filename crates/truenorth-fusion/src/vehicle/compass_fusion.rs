@@ -378,7 +378,7 @@ impl VehicleEstimator {
     /// Refers a heading that was lost to north again: the heading (and the wheels' heading
     /// with it) turns by `offset`, measured with standard deviation `sigma` plus the
     /// compass's systematic error; the track already drawn stays as it is.
-    fn relock(&mut self, offset: f64, sigma: f64) {
+    pub(super) fn relock(&mut self, offset: f64, sigma: f64) {
         let bias_var = self.refer_heading(offset);
         let f = &mut self.filter;
         f.x[COMPASS_BIAS] = 0.0;

@@ -30,6 +30,11 @@ const FIX_INTERVAL_S: f64 = 1.0;
 /// Courses that must agree before they refer the heading to true north.
 const ALIGNMENT_COURSES: u32 = 5;
 
+/// Courses rejected one after another that, agreeing on one offset from the heading, refer
+/// it to them again: twice the first referral's, as the heading they contradict had passed
+/// the gates before.
+const RELOCK_COURSES: u32 = 2 * ALIGNMENT_COURSES;
+
 /// Displacement between two fixes, in their standard deviations, that gives a course to
 /// refer the heading to true north when the receiver reports none (10: the course to
 /// within 8°).
@@ -317,11 +322,32 @@ impl VehicleEstimator {
         let s = self.filter.p[PSI][PSI] + sigma * sigma;
         let gate = self.config.gnss.gate_sigma;
         if nu * nu > gate * gate * s {
+            self.course_rejected(t_s, nu, sigma);
             return false;
         }
+        self.tracking.gnss.line = InnovationLine::default();
         self.flush();
         self.filter.update(&[(PSI, 1.0)], nu, sigma * sigma);
         true
+    }
+
+    /// A course the gate rejected, at `t_s` with innovation `nu` and standard deviation
+    /// `sigma`. A course is the vehicle's direction within its sideslip whatever the fix's
+    /// position error (a multipath jump moves the position, not the course), so
+    /// [`RELOCK_COURSES`] rejected in a row that agree on one offset say the heading is what
+    /// is wrong — referred once by courses taken while reversing, or drifted beyond its σ
+    /// — and it is referred to them again.
+    fn course_rejected(&mut self, t_s: f64, nu: f64, sigma: f64) {
+        let line = &mut self.tracking.gnss.line;
+        line.push(t_s, nu);
+        if line.len() < RELOCK_COURSES {
+            return;
+        }
+        let fit = line.fit(sigma);
+        self.tracking.gnss.line = InnovationLine::default();
+        if let Some(f) = fit.filter(|f| f.residual_rad <= 3.0 * sigma) {
+            self.relock(f.offset_rad, f.sigma_rad);
+        }
     }
 
     /// The direction the vehicle heads by the fix's course (rad, true north), and its
@@ -514,5 +540,43 @@ mod tests {
         let unknown = end_error([0.0, 0.0]);
         assert!(known < 0.3, "{known:.2} m with the lever arm");
         assert!((unknown - 2.0).abs() < 0.3, "{unknown:.2} m without it");
+    }
+
+    /// A car without odometry heading east at 10 m/s, whose first fixes report the
+    /// opposite course (as when reversing at that speed): the courses refer its heading half
+    /// a turn off, and the courses after, rejected by the gate one after another, refer it
+    /// again.
+    #[test]
+    fn courses_rejected_in_a_row_refer_the_heading_again() {
+        let plane = LocalTangentPlane::new(52.5, 13.4, 0.0).unwrap();
+        let mut nav = VehicleEstimator::new(VehicleConfig::default()).unwrap();
+        let mut last = None;
+        let mut wrong_at_10_s = f64::NAN;
+        for k in 0..=600 {
+            let t = 0.1 * f64::from(k);
+            let mut s = VehicleSample::at(t).with_gyro(0.0);
+            if k % 10 == 0 {
+                let course = if t < 8.0 { 270.0 } else { 90.0 };
+                let g = plane.to_geodetic(0.0, 10.0 * t, 0.0).unwrap();
+                let fix = GnssFix::at(g.lat_rad().to_degrees(), g.lon_rad().to_degrees())
+                    .with_sigma(2.0)
+                    .with_velocity(10.0, course);
+                s = s.with_gnss(fix);
+            }
+            let e = nav.update(&s).unwrap();
+            let true_heading = e.heading.rad() + nav.gnss_declination_rad().unwrap_or(0.0);
+            if k == 100 {
+                wrong_at_10_s = wrap_pi(true_heading - core::f64::consts::FRAC_PI_2).abs();
+            }
+            last = Some((e, true_heading));
+        }
+        let (e, true_heading) = last.unwrap();
+        assert!(e.status.gnss_frame);
+        assert!(
+            wrong_at_10_s > 3.0,
+            "referred to the reversed courses: {wrong_at_10_s}"
+        );
+        let off = wrap_pi(true_heading - core::f64::consts::FRAC_PI_2).abs();
+        assert!(off < 2f64.to_radians(), "{:.1}° off", off.to_degrees());
     }
 }
