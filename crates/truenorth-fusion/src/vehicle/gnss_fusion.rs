@@ -260,7 +260,9 @@ impl VehicleEstimator {
     /// unknown). Without odometry nothing tells a reversing vehicle: a course is taken as
     /// the vehicle's heading when the receiver's speed is at least
     /// [`super::config::GnssConfig::min_course_speed_mps`], which few vehicles reach in reverse;
-    /// one that does is off by half a turn and fails the gate once referred.
+    /// one that does is off by half a turn, fails the gate once the heading is referred, and
+    /// courses that contradict a heading referred by such ones refer it again
+    /// ([`RELOCK_COURSES`]).
     fn course_without_odometry(&mut self, t_s: f64, fix: &GnssFix) {
         if !self.tracking.gnss.aligned {
             let Some(course) = self.course_of(fix, None) else {
