@@ -113,12 +113,7 @@ fn a_cars_four_wheel_speeds_read_the_odometer_axle() {
     // A skid-steered vehicle turns by its sides: each side's mean is its odometer wheel.
     // Its wheels slide in the turn, so its sides turn it as wheels twice as far apart would
     // (the middle of the effective track's prior, 1.5–2.5 times the physical one): ±0.08 m/s.
-    let skid = dir.join("skid.json");
-    std::fs::write(
-        &skid,
-        r#"{"track_m": 1.6, "odometer_wheels": "skid_steer"}"#,
-    )
-    .unwrap();
+    let skid = common::vehicle_file(&dir, "skid.json", 1.6, "skid_steer");
     let sides = dir.join("sides.csv");
     let text = log(header, |_| "10.18,10.02,9.98,9.82,0.05".into());
     std::fs::write(&sides, text).unwrap();

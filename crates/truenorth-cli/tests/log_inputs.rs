@@ -315,12 +315,7 @@ fn the_mcap_bag_drives_orients_and_heads() {
     let dir = scratch("log_inputs", "mcap");
     let bag = mcap();
     // The robot turns left at 0.5 rad/s for 0.995 s: its heading falls by 28.5°.
-    let vehicle = dir.join("robot.json");
-    std::fs::write(
-        &vehicle,
-        r#"{"track_m": 0.5, "odometer_wheels": "differential"}"#,
-    )
-    .unwrap();
+    let vehicle = common::vehicle_file(&dir, "robot.json", 0.5, "differential");
     let track = dir.join("track.csv");
     ok(&[
         "drive",
@@ -517,12 +512,7 @@ fn drive_reads_a_ulog_as_gyro_compass_and_fixes_without_wheels() {
         return;
     };
     let dir = scratch("log_inputs", "ulog_drive");
-    let vehicle = dir.join("car.json");
-    std::fs::write(
-        &vehicle,
-        r#"{"track_m": 1.5, "odometer_wheels": "skid_steer"}"#,
-    )
-    .unwrap();
+    let vehicle = common::vehicle_file(&dir, "robot.json", 0.57, "skid_steer");
     let out = dir.join("out.csv");
     let o = common::drive(&vehicle, &log, &out, &[]);
     assert!(o.status.success(), "{}", text(&o.stderr));

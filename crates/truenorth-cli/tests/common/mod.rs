@@ -192,8 +192,14 @@ pub fn ellipse_calibration(dir: &Path, csv: &str, extra: &[&str]) -> (PathBuf, P
 
 /// Writes `dir/vehicle.json`: a vehicle of track `track_m` with odometers on the rear wheels.
 pub fn rear_vehicle(dir: &Path, track_m: f64) -> PathBuf {
-    let vehicle = dir.join("vehicle.json");
-    let json = format!(r#"{{"track_m": {track_m}, "odometer_wheels": "rear"}}"#);
+    vehicle_file(dir, "vehicle.json", track_m, "rear")
+}
+
+/// Writes `dir/name`: a vehicle of track `track_m` whose odometer wheels are `wheels`
+/// (`rear`, `skid_steer` or `differential`).
+pub fn vehicle_file(dir: &Path, name: &str, track_m: f64, wheels: &str) -> PathBuf {
+    let vehicle = dir.join(name);
+    let json = format!(r#"{{"track_m": {track_m}, "odometer_wheels": "{wheels}"}}"#);
     std::fs::write(&vehicle, json).unwrap();
     vehicle
 }
