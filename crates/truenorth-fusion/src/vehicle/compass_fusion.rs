@@ -29,11 +29,13 @@ const SUSPECT_AFTER_S: f64 = 60.0;
 /// Turning that must accompany [`SUSPECT_AFTER_S`] of rejection, rad (90°).
 const SUSPECT_TURN_RAD: f64 = core::f64::consts::FRAC_PI_2;
 
-/// …or distance driven, m: farther than a disturbance on the road reaches (a parked car, a
-/// bridge's steel, a tram line's current: metres to a few hundred). On a straight the
-/// readings cannot show a wrong calibration, which is a function of the heading, but a
-/// field that disagrees with the dead reckoning by a steady or steadily growing offset over
-/// half a kilometre is the dead reckoning's error, not the road's.
+/// …or distance driven, m, where the wheels carry the heading: farther than a disturbance
+/// on the road reaches (a parked car, a bridge's steel, a tram line's current: metres to a
+/// few hundred). On a straight the readings cannot show a wrong calibration, which is a
+/// function of the heading, but a field that disagrees with a wheels' heading by a steady
+/// or steadily growing offset over half a kilometre is the wheels' drift, not the road's.
+/// A gyro drifts too little over that for the same reading: there, a long disagreement on
+/// a straight is left to the compass's gates.
 const SUSPECT_DISTANCE_M: f64 = 500.0;
 
 /// What a long rejection of the compass says.
@@ -61,6 +63,9 @@ struct Counted {
     psi: f64,
     distance_m: f64,
     nu_rad: f64,
+    /// The wheels carry the heading (no gyro): it drifts with their scale difference and
+    /// the speeds' roundings, degrees a minute on a long straight.
+    wheels_heading: bool,
 }
 
 impl Outage {
@@ -76,6 +81,7 @@ impl Outage {
             psi,
             distance_m,
             nu_rad,
+            wheels_heading,
         } = reading;
         if let (Some((t0, psi0)), false) = (self.last, used) {
             self.rejected_s += t_s - t0;
@@ -95,7 +101,7 @@ impl Outage {
         let turned = self.turned_rad >= SUSPECT_TURN_RAD;
         if self.relearning
             || self.rejected_s < SUSPECT_AFTER_S
-            || !(turned || self.travelled_m >= SUSPECT_DISTANCE_M)
+            || !(turned || (wheels_heading && self.travelled_m >= SUSPECT_DISTANCE_M))
         {
             return Suspect::None;
         }
@@ -179,6 +185,7 @@ impl VehicleEstimator {
             psi: self.filter.x[PSI],
             distance_m: self.est.distance_m,
             nu_rad: nu,
+            wheels_heading: !self.tracking.gyro.active,
         };
         match self.tracking.outage.count(reading, noise, used) {
             Suspect::None => {}
