@@ -6,7 +6,7 @@
 //! gains nothing from them.
 
 use truenorth_core::{HeadingEstimator, VehicleSample, angle_diff};
-use truenorth_fusion::{SensorPriors, VehicleConfig, VehicleEstimator};
+use truenorth_fusion::{VehicleConfig, VehicleEstimator};
 use truenorth_sim::VehicleKind;
 use truenorth_sim::log_drive::{LogDrive, LogDriveConfig, SensorSet};
 
@@ -23,13 +23,17 @@ struct Run {
     courses: u32,
 }
 
-fn run(d: &LogDrive, samples: &[VehicleSample]) -> Run {
-    let mut nav = VehicleEstimator::new(VehicleConfig {
+/// The estimator for `d`'s vehicle, under its kind's priors.
+fn estimator(d: &LogDrive) -> VehicleEstimator {
+    VehicleEstimator::new(VehicleConfig {
         wheels: d.vehicle.wheels,
-        priors: Some(SensorPriors::for_wheels(&d.vehicle.wheels)),
         ..VehicleConfig::default()
     })
-    .unwrap();
+    .unwrap()
+}
+
+fn run(d: &LogDrive, samples: &[VehicleSample]) -> Run {
+    let mut nav = estimator(d);
     let (psi0, decl) = (d.truth[0].heading_rad, d.errors.declination_rad);
     let mut r = Run {
         rms_rad: 0.0,
@@ -143,12 +147,7 @@ fn wheels_that_start_late_join_the_plane_at_the_next_fix() {
                 ..*s
             })
             .collect();
-        let mut nav = VehicleEstimator::new(VehicleConfig {
-            wheels: d.vehicle.wheels,
-            priors: Some(SensorPriors::for_wheels(&d.vehicle.wheels)),
-            ..VehicleConfig::default()
-        })
-        .unwrap();
+        let mut nav = estimator(&d);
         let truth_plane = d.plane.unwrap();
         let mut placed_at = None;
         for (k, (s, t)) in samples.iter().zip(&d.truth).enumerate() {

@@ -91,10 +91,7 @@ impl Outage {
         self.last = Some((t_s, psi));
         self.last_distance_m = distance_m;
         if used {
-            self.rejected_s = 0.0;
-            self.turned_rad = 0.0;
-            self.travelled_m = 0.0;
-            self.line = InnovationLine::default();
+            self.restart();
             return Suspect::None;
         }
         self.line.push(t_s, nu_rad);
@@ -106,10 +103,7 @@ impl Outage {
             return Suspect::None;
         }
         let fit = self.line.fit(noise_rad);
-        self.rejected_s = 0.0;
-        self.turned_rad = 0.0;
-        self.travelled_m = 0.0;
-        self.line = InnovationLine::default();
+        self.restart();
         match fit {
             Some(f) if f.residual_rad <= 3.0 * noise_rad => Suspect::DeadReckoning {
                 offset_rad: f.offset_rad,
@@ -123,6 +117,14 @@ impl Outage {
             }
             _ => Suspect::None,
         }
+    }
+
+    /// Starts counting a rejection afresh (the last reading is kept).
+    fn restart(&mut self) {
+        self.rejected_s = 0.0;
+        self.turned_rad = 0.0;
+        self.travelled_m = 0.0;
+        self.line = InnovationLine::default();
     }
 }
 
