@@ -1,16 +1,18 @@
 //! `drive` on a ROS 2 bag with satellite fixes (`sensor_msgs/msg/NavSatFix`): the fixes are
 //! read as the CSV's `lat_deg,lon_deg,gnss_sigma_m` (σ from the fix's covariance; "no fix"
 //! messages left out), so the track is on the fixes' tangent plane and true north, and
-//! `inspect` lists the stream.
+//! `inspect` lists the stream; the receiver's velocity (`geometry_msgs/msg/
+//! TwistWithCovarianceStamped` in the fixes' frame) as their `gnss_speed_mps,gnss_course_deg`.
 
 mod common;
 
 use std::collections::BTreeMap;
 use std::path::Path;
 
-use common::{ok, p, scratch};
+use common::{ok, p, scratch, truenorth};
 use truenorth_logs::ros_msgs::{
-    self, Header, Imu, NavSatFix, NavSatStatus, Odometry, Time, Twist, TwistWithCovariance, Vec3,
+    self, Header, Imu, NavSatFix, NavSatStatus, Odometry, Time, Twist, TwistStamped,
+    TwistWithCovariance, TwistWithCovarianceStamped, Vec3,
 };
 
 const START_SEC: i32 = 1_750_000_000;
@@ -57,13 +59,19 @@ fn truth() -> Vec<(f64, f64, f64, f64)> {
         .collect()
 }
 
+fn vec3(x: f64, y: f64) -> Vec3 {
+    Vec3 { x, y, z: 0.0 }
+}
+
 /// A minute of a car in a bag: IMU at 50 Hz, odometry at 20 Hz, fixes at 5 Hz (σ 2 m; the
-/// first second "no fix").
-fn write_bag(path: &Path) -> (f64, f64) {
+/// first second "no fix"); with `velocity`, the receiver's velocity on each fix's stamp
+/// (`/fix_velocity`, ENU, the fixes' frame) and a body's `cmd_vel` (`TwistStamped` in
+/// `base_link`, pointing the wrong way if it were read as ENU).
+fn write_bag(path: &Path, velocity: bool) -> (f64, f64) {
     let truth = truth();
     let ns = |t_s: f64| (START_SEC as u64) * 1_000_000_000 + (t_s * 1e9).round() as u64;
     let mut messages: Vec<(&str, u64, Vec<u8>)> = Vec::new();
-    for (k, &(t, n, e, _)) in truth.iter().enumerate() {
+    for (k, &(t, n, e, psi)) in truth.iter().enumerate() {
         // ROS bodies are FLU: a right turn is a negative rate about z (up).
         let flu_rate = -yaw_rate(t);
         if k % 2 == 0 {
@@ -123,6 +131,30 @@ fn write_bag(path: &Path) -> (f64, f64) {
                 position_covariance_type: 2,
             };
             messages.push(("/fix", ns(t), ros_msgs::encode(&m).unwrap()));
+            if velocity {
+                let (east, north) = (SPEED_MPS * psi.sin(), SPEED_MPS * psi.cos());
+                let m = TwistWithCovarianceStamped {
+                    header: header(t, "gps"),
+                    twist: TwistWithCovariance {
+                        twist: Twist {
+                            linear: vec3(east, north),
+                            ..Twist::default()
+                        },
+                        ..TwistWithCovariance::default()
+                    },
+                };
+                messages.push(("/fix_velocity", ns(t), ros_msgs::encode(&m).unwrap()));
+            }
+        }
+        if velocity && k % 5 == 0 {
+            let m = TwistStamped {
+                header: header(t, "base_link"),
+                twist: Twist {
+                    linear: vec3(0.0, SPEED_MPS),
+                    ..Twist::default()
+                },
+            };
+            messages.push(("/cmd_vel", ns(t), ros_msgs::encode(&m).unwrap()));
         }
     }
     messages.sort_by_key(|m| m.1);
@@ -136,6 +168,11 @@ fn write_bag(path: &Path) -> (f64, f64) {
             ("/imu", "sensor_msgs/msg/Imu"),
             ("/odom", "nav_msgs/msg/Odometry"),
             ("/fix", "sensor_msgs/msg/NavSatFix"),
+            (
+                "/fix_velocity",
+                "geometry_msgs/msg/TwistWithCovarianceStamped",
+            ),
+            ("/cmd_vel", "geometry_msgs/msg/TwistStamped"),
         ] {
             let id = w.add_schema(schema, "ros2msg", b"").unwrap();
             let channel = w.add_channel(id, topic, "cdr", &BTreeMap::new()).unwrap();
@@ -161,7 +198,7 @@ fn write_bag(path: &Path) -> (f64, f64) {
 fn a_bag_with_fixes_drives_on_them() {
     let dir = scratch("mcap_gnss", "drive");
     let bag = dir.join("car.mcap");
-    let (north_m, east_m) = write_bag(&bag);
+    let (north_m, east_m) = write_bag(&bag, false);
     let vehicle = dir.join("car.json");
     std::fs::write(&vehicle, r#"{"track_m": 1.5, "odometer_wheels": "rear"}"#).unwrap();
     let track = dir.join("track.csv");
@@ -218,4 +255,76 @@ fn a_bag_with_fixes_drives_on_them() {
         report.contains("/fix (sensor_msgs/msg/NavSatFix, 300 messages"),
         "{report}"
     );
+}
+
+/// The receiver's velocity in the fixes' frame is found by default and gives the fixes their
+/// course: without odometry (`--odometry-topic none`) it alone refers the gyro's heading to true
+/// north. The body's `cmd_vel` is never taken for it unless named, and a topic of another type
+/// named for it is refused.
+#[test]
+fn the_receivers_velocity_gives_the_fixes_their_course() {
+    let dir = scratch("mcap_gnss", "velocity");
+    let bag = dir.join("car.mcap");
+    write_bag(&bag, true);
+    let report = ok(&["inspect", p(&bag)]);
+    let report = String::from_utf8_lossy(&report.stdout);
+    // The five velocities of the first second have no fix to ride on.
+    assert!(
+        report.contains(
+            "gnss_velocity: /fix_velocity, 300 samples, 5.00 Hz (median step), 5 left out"
+        ),
+        "{report}"
+    );
+    let vehicle = dir.join("car.json");
+    std::fs::write(&vehicle, r#"{"track_m": 1.5, "odometer_wheels": "rear"}"#).unwrap();
+    let track = dir.join("track.csv");
+    let drive = |extra: &[&str]| {
+        let mut args = vec![
+            "drive",
+            "--vehicle",
+            p(&vehicle),
+            "--input",
+            p(&bag),
+            "--output",
+            p(&track),
+            "--odometry-topic",
+            "none",
+        ];
+        args.extend_from_slice(extra);
+        truenorth(&args)
+    };
+    let run = drive(&[]);
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(run.status.success(), "{stderr}");
+    let used: usize = stderr
+        .split("satellite fixes: ")
+        .nth(1)
+        .and_then(|s| s.split(' ').next())
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("{stderr}"));
+    // One course a second is used (the fixes' errors are correlated over longer).
+    assert!(used >= 55, "{used} courses used: {stderr}");
+    assert!(
+        stderr.contains("courses used (no odometry: no position)"),
+        "{stderr}"
+    );
+    let (header, rows) = common::table(&track, true);
+    let col = |name: &str| header.iter().position(|h| h == name).unwrap();
+    let truth = truth();
+    let &(_, _, _, psi) = truth.last().unwrap();
+    let last = rows.last().unwrap();
+    let error_deg = (last[col("heading_deg")] - psi.to_degrees() + 180.0).rem_euclid(360.0) - 180.0;
+    assert!(error_deg.abs() < 2.0, "end heading off by {error_deg:.2}°");
+    assert!(last[col("north_m")].is_nan(), "no odometry, no position");
+
+    // Named away, the fixes have no course: unused, and said so.
+    let run = drive(&["--gnss-velocity-topic", "none"]);
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(
+        stderr.contains("`lat_deg,lon_deg` are not used"),
+        "{stderr}"
+    );
+    let run = drive(&["--gnss-velocity-topic", "/imu"]);
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(!run.status.success() && stderr.contains("/imu"), "{stderr}");
 }

@@ -32,6 +32,15 @@ pub struct LogConfig {
     /// `sensor_msgs/msg/NavSatFix` topic (default: the one with the most messages, if any).
     /// `none` reads no fixes.
     pub gnss_topic: Option<String>,
+    /// MCAP only: the receiver's velocity, a `geometry_msgs/msg/TwistWithCovarianceStamped` or
+    /// `geometry_msgs/msg/TwistStamped` topic with east and north in its linear x and y (ENU,
+    /// as `ublox_gps`'s `fix_velocity` and `nmea_navsat_driver`'s `vel` publish it). Each fix
+    /// takes the velocity stamped nearest to it, within half the time to its neighbouring
+    /// fixes and at most 0.5 s, as its speed and course over ground. Default: of the topics
+    /// of those types whose frame (`header.frame_id`) is the fixes' own, the one with the
+    /// most messages, if any; a twist in another frame (a body's `cmd_vel`) is never taken
+    /// unless named. `none` reads no velocity. A ULog's fixes carry their velocity.
+    pub gnss_velocity_topic: Option<String>,
     /// Keep the messages before a truncated or damaged tail instead of refusing the file
     /// (default `false`: a log cut off by a power loss is reported, not read silently).
     pub accept_incomplete: bool,
@@ -82,6 +91,7 @@ impl LogConfig {
             ("attitude_topic", &self.attitude_topic),
             ("odometry_topic", &self.odometry_topic),
             ("gnss_topic", &self.gnss_topic),
+            ("gnss_velocity_topic", &self.gnss_velocity_topic),
         ] {
             if let Some(name) = value {
                 if name.is_empty() {

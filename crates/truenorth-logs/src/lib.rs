@@ -11,8 +11,9 @@
 //! Topics are chosen by name ([`LogConfig`]) or by the format's usual defaults
 //! (`sensor_combined`, `vehicle_magnetometer`/`sensor_mag`, `vehicle_attitude` and
 //! `vehicle_gps_position`/`sensor_gps` in ULog; the `sensor_msgs/msg/Imu`,
-//! `sensor_msgs/msg/MagneticField` and `sensor_msgs/msg/NavSatFix` topics in MCAP); a topic asked
-//! for and not present is an error that lists the topics the file has.
+//! `sensor_msgs/msg/MagneticField` and `sensor_msgs/msg/NavSatFix` topics in MCAP, with the
+//! receiver's velocity from a twist topic stamped in the fixes' frame); a topic asked for and
+//! not present is an error that lists the topics the file has.
 //!
 //! ```
 //! use truenorth_logs::{LogConfig, LogError, LogReader};

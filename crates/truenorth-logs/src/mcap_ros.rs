@@ -37,6 +37,8 @@ enum Kind {
     MagneticField,
     Odometry,
     NavSatFix,
+    TwistStamped,
+    TwistWithCovarianceStamped,
 }
 
 impl Kind {
@@ -48,6 +50,11 @@ impl Kind {
             }
             "nav_msgs/msg/Odometry" | "nav_msgs/Odometry" => Some(Self::Odometry),
             "sensor_msgs/msg/NavSatFix" | "sensor_msgs/NavSatFix" => Some(Self::NavSatFix),
+            "geometry_msgs/msg/TwistStamped" | "geometry_msgs/TwistStamped" => {
+                Some(Self::TwistStamped)
+            }
+            "geometry_msgs/msg/TwistWithCovarianceStamped"
+            | "geometry_msgs/TwistWithCovarianceStamped" => Some(Self::TwistWithCovarianceStamped),
             _ => None,
         }
     }
@@ -58,17 +65,37 @@ impl Kind {
             Self::MagneticField => "sensor_msgs/msg/MagneticField",
             Self::Odometry => "nav_msgs/msg/Odometry",
             Self::NavSatFix => "sensor_msgs/msg/NavSatFix",
+            Self::TwistStamped => "geometry_msgs/msg/TwistStamped",
+            Self::TwistWithCovarianceStamped => "geometry_msgs/msg/TwistWithCovarianceStamped",
         }
     }
 }
 
-/// One topic as read: its type, encoding, count and, for the types read, its samples in
-/// absolute time.
+/// The types a receiver's velocity comes in.
+const VELOCITY_KINDS: [Kind; 2] = [Kind::TwistWithCovarianceStamped, Kind::TwistStamped];
+
+/// Longest time between a fix and the velocity it takes, s: a receiver stamps both from one
+/// solution (`ublox_gps`), an NMEA driver from sentences of one epoch a few hundred
+/// milliseconds apart at 4800 baud.
+const MAX_VELOCITY_SKEW_S: f64 = 0.5;
+
+/// A receiver's velocity over ground (ENU as REP-103 and the GNSS drivers give it).
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct GroundVelocity {
+    t_s: f64,
+    east_mps: f64,
+    north_mps: f64,
+}
+
+/// One topic as read: its type, encoding, count, the frame of its first stamped message and,
+/// for the types read, its samples in absolute time.
 #[derive(Default)]
 struct Topic {
     schema: String,
     encoding: String,
     messages: usize,
+    frame_id: Option<String>,
+    velocity: Vec<GroundVelocity>,
     imu: Vec<ImuSample>,
     mag: Vec<Mag3Sample>,
     odometry: Vec<OdometrySample>,
@@ -159,6 +186,7 @@ impl Topic {
                 if m.status.status < 0 {
                     return;
                 }
+                self.frame_id.get_or_insert(m.header.frame_id.clone());
                 let (lat_deg, lon_deg) = (m.latitude, m.longitude);
                 if lat_deg.is_finite() && lon_deg.is_finite() {
                     let t_s = since(origin, stamp_ns(&m.header.stamp, log_time_ns));
@@ -173,11 +201,91 @@ impl Topic {
                     self.non_finite += 1;
                 }
             }),
+            Kind::TwistStamped => ros_msgs::decode::<ros_msgs::TwistStamped>(data)
+                .map(|m| self.take_velocity(&m.header, &m.twist, log_time_ns, origin)),
+            Kind::TwistWithCovarianceStamped => {
+                ros_msgs::decode::<ros_msgs::TwistWithCovarianceStamped>(data)
+                    .map(|m| self.take_velocity(&m.header, &m.twist.twist, log_time_ns, origin))
+            }
         };
         if let Err(e) = result {
             self.decode_error.get_or_insert((index, e));
         }
     }
+}
+
+impl Topic {
+    fn take_velocity(
+        &mut self,
+        header: &ros_msgs::Header,
+        twist: &ros_msgs::Twist,
+        log_time_ns: u64,
+        origin: &mut Option<i128>,
+    ) {
+        self.frame_id.get_or_insert(header.frame_id.clone());
+        let (east_mps, north_mps) = (twist.linear.x, twist.linear.y);
+        if east_mps.is_finite() && north_mps.is_finite() {
+            let t_s = since(origin, stamp_ns(&header.stamp, log_time_ns));
+            self.velocity.push(GroundVelocity {
+                t_s,
+                east_mps,
+                north_mps,
+            });
+        } else {
+            self.non_finite += 1;
+        }
+    }
+}
+
+/// Gives each fix the speed and course over ground (degrees clockwise from true north in
+/// [0, 360)) of the velocity stamped nearest to it, within half the time to its neighbouring
+/// fixes and [`MAX_VELOCITY_SKEW_S`]; a fix without one keeps none. Both are in time order.
+/// Returns how many of the velocities were taken.
+fn attach_velocity(fixes: &mut [GnssFix], velocity: &[GroundVelocity]) -> usize {
+    let times: Vec<f64> = fixes.iter().map(|f| f.t_s).collect();
+    let (mut taken, mut last_taken) = (0, None);
+    for (i, fix) in fixes.iter_mut().enumerate() {
+        let gap = |j: Option<usize>| j.and_then(|j| times.get(j)).map(|t| (t - fix.t_s).abs());
+        let window = [gap(i.checked_sub(1)), gap(Some(i + 1))]
+            .into_iter()
+            .flatten()
+            .fold(2.0 * MAX_VELOCITY_SKEW_S, f64::min)
+            * 0.5;
+        let at = velocity.partition_point(|v| v.t_s < fix.t_s);
+        let skew = |j: &usize| (velocity[*j].t_s - fix.t_s).abs();
+        let nearest = [at.checked_sub(1), Some(at)]
+            .into_iter()
+            .flatten()
+            .filter(|&j| j < velocity.len())
+            .min_by(|a, b| skew(a).total_cmp(&skew(b)));
+        let finite =
+            |j: &usize| velocity[*j].east_mps.is_finite() && velocity[*j].north_mps.is_finite();
+        if let Some(j) = nearest.filter(|j| skew(j) <= window && finite(j)) {
+            let v = velocity[j];
+            let course_deg = v.east_mps.atan2(v.north_mps).to_degrees().rem_euclid(360.0);
+            let course_deg = if course_deg < 360.0 { course_deg } else { 0.0 };
+            fix.velocity = Some((v.east_mps.hypot(v.north_mps), course_deg));
+            if last_taken != Some(j) {
+                (taken, last_taken) = (taken + 1, Some(j));
+            }
+        }
+    }
+    taken
+}
+
+/// The receiver's velocity topic by default: of the velocity types, those stamped in the
+/// fixes' own frame, the one with the most messages (the first by name among equals).
+fn velocity_in_frame_of(topics: &BTreeMap<String, Topic>, fixes: &str) -> Option<String> {
+    let frame = topics.get(fixes)?.frame_id.as_deref()?;
+    topics
+        .iter()
+        .filter(|(_, t)| {
+            t.encoding == "cdr"
+                && Kind::of(&t.schema).is_some_and(|k| VELOCITY_KINDS.contains(&k))
+                && t.frame_id.as_deref() == Some(frame)
+        })
+        .max_by(|a, b| a.1.messages.cmp(&b.1.messages).then(b.0.cmp(a.0)))
+        .map(|(name, _)| name.clone())
 }
 
 /// The 1σ horizontal error of a fix: the root of the mean of its east and north variances,
@@ -376,6 +484,21 @@ fn select(
         &[Kind::NavSatFix],
         "gnss",
     )?;
+    let velocity_name = match config.gnss_velocity_topic.as_deref() {
+        None => gnss_name
+            .as_deref()
+            .and_then(|fixes| velocity_in_frame_of(&topics, fixes)),
+        requested => choose(&topics, requested, &VELOCITY_KINDS, "gnss_velocity")?,
+    };
+    if velocity_name.is_some() && gnss_name.is_none() {
+        return Err(LogError::InvalidConfig {
+            field: "gnss_velocity_topic",
+            reason: "names the receiver's velocity, and no fixes are read to carry it (it is \
+                     taken as the fixes' speed and course over ground); name the fixes with \
+                     `gnss_topic`, or leave it out"
+                .to_string(),
+        });
+    }
     let attitude_name = match config.attitude_topic.as_deref() {
         None => None,
         requested => choose(&topics, requested, &[Kind::Imu, Kind::Odometry], "attitude")?,
@@ -423,6 +546,14 @@ fn select(
                     rate_hz(topic.gnss.iter().map(|s| s.t_s)),
                 )
             }
+            "gnss_velocity" => {
+                let d = keep_increasing(&mut topic.velocity, |s| s.t_s);
+                (
+                    d,
+                    topic.velocity.len(),
+                    rate_hz(topic.velocity.iter().map(|s| s.t_s)),
+                )
+            }
             "odometry" => {
                 let d = keep_increasing(&mut topic.odometry, |s| s.t_s);
                 (
@@ -452,8 +583,16 @@ fn select(
     let imu = take(&Some(imu_name), "imu")?.imu;
     let mag = take(&mag_name, "mag")?.mag;
     let odometry = take(&odometry_name, "odometry")?.odometry;
-    let gnss = take(&gnss_name, "gnss")?.gnss;
+    let mut gnss = take(&gnss_name, "gnss")?.gnss;
+    let velocity = take(&velocity_name, "gnss_velocity")?.velocity;
     let attitude = take(&attitude_name, "attitude")?.attitude;
+    if velocity_name.is_some() {
+        let taken = attach_velocity(&mut gnss, &velocity);
+        // The velocities no fix took are left out, as a stream's unreadable messages are.
+        if let Some(s) = streams.iter_mut().find(|s| s.role == "gnss_velocity") {
+            s.dropped += velocity.len() - taken;
+        }
+    }
 
     let time_origin_s = [
         imu.first().map(|s| s.t_s),
@@ -544,5 +683,127 @@ mod tests {
         );
         assert_eq!((topic.gnss[1].lat_deg, topic.gnss[1].sigma_m), (52.6, None));
         assert_eq!(Kind::of("sensor_msgs/msg/NavSatFix"), Some(Kind::NavSatFix));
+    }
+
+    fn velocity(t_s: f64, east_mps: f64, north_mps: f64) -> GroundVelocity {
+        GroundVelocity {
+            t_s,
+            east_mps,
+            north_mps,
+        }
+    }
+
+    /// Each fix takes the velocity nearest in time as speed and course over ground (clockwise
+    /// from north), only within half the time to its neighbours: a velocity between two fixes
+    /// a second apart is taken by neither when 0.6 s from both sides' nearest.
+    #[test]
+    fn each_fix_takes_the_nearest_velocity_within_its_epoch() {
+        let mut fixes: Vec<GnssFix> = [0.0, 1.0, 2.0, 3.0]
+            .map(|t_s| GnssFix {
+                t_s,
+                lat_deg: 52.5,
+                lon_deg: 13.4,
+                sigma_m: None,
+                velocity: None,
+            })
+            .to_vec();
+        let v = [
+            velocity(0.02, 3.0, 4.0),
+            velocity(0.4, 0.0, 9.0),
+            velocity(1.6, -2.0, 0.0),
+            velocity(2.9, 0.0, -1.0),
+        ];
+        assert_eq!(attach_velocity(&mut fixes, &v), 3);
+        let (speed, course) = fixes[0].velocity.unwrap();
+        assert!((speed - 5.0).abs() < 1e-12);
+        assert!((course - 3f64.atan2(4.0).to_degrees()).abs() < 1e-12);
+        assert_eq!(
+            fixes[1].velocity, None,
+            "0.4 s and 0.6 s away, beyond 0.5 s"
+        );
+        assert_eq!(fixes[2].velocity, Some((2.0, 270.0)));
+        assert_eq!(fixes[3].velocity, Some((1.0, 180.0)));
+        let mut none = fixes.clone();
+        none.iter_mut().for_each(|f| f.velocity = None);
+        assert_eq!(attach_velocity(&mut none, &[]), 0);
+        assert!(none.iter().all(|f| f.velocity.is_none()));
+    }
+
+    /// By default only a twist stamped in the fixes' frame is their velocity: a busier
+    /// `cmd_vel` in the body's frame is not taken.
+    #[test]
+    fn the_default_velocity_is_in_the_fixes_frame() {
+        let topic = |schema: &str, frame: &str, messages: usize| Topic {
+            schema: schema.into(),
+            encoding: "cdr".into(),
+            messages,
+            frame_id: Some(frame.into()),
+            ..Topic::default()
+        };
+        let mut topics = BTreeMap::new();
+        topics.insert("/fix".into(), topic("sensor_msgs/msg/NavSatFix", "gps", 10));
+        topics.insert(
+            "/cmd_vel".into(),
+            topic("geometry_msgs/msg/TwistStamped", "base_link", 500),
+        );
+        assert_eq!(velocity_in_frame_of(&topics, "/fix"), None);
+        topics.insert(
+            "/vel".into(),
+            topic("geometry_msgs/TwistStamped", "gps", 10),
+        );
+        topics.insert(
+            "/fix_velocity".into(),
+            topic("geometry_msgs/msg/TwistWithCovarianceStamped", "gps", 10),
+        );
+        assert_eq!(
+            velocity_in_frame_of(&topics, "/fix").as_deref(),
+            Some("/fix_velocity")
+        );
+    }
+
+    proptest::proptest! {
+        /// Whatever the stamps and values (NaN and infinities included), a fix takes a
+        /// velocity only from within 0.5 s and half the time to its neighbours, its speed is
+        /// not negative and its course is in [0, 360); no more velocities are counted taken
+        /// than there are.
+        #[test]
+        fn a_velocity_is_taken_only_near_its_fix(
+            fix_steps in proptest::collection::vec(0.0f64..2.0, 0..12),
+            samples in proptest::collection::vec(
+                (-1.0f64..20.0, proptest::num::f64::ANY, proptest::num::f64::ANY),
+                0..24,
+            ),
+        ) {
+            let mut t = 0.0;
+            let mut fixes: Vec<GnssFix> = fix_steps
+                .iter()
+                .map(|step| {
+                    t += step + 0.01;
+                    GnssFix { t_s: t, lat_deg: 0.0, lon_deg: 0.0, sigma_m: None, velocity: None }
+                })
+                .collect();
+            let mut v: Vec<GroundVelocity> = samples
+                .iter()
+                .map(|&(t_s, e, n)| velocity(t_s, e, n))
+                .collect();
+            v.sort_by(|a, b| a.t_s.total_cmp(&b.t_s));
+            let taken = attach_velocity(&mut fixes, &v);
+            proptest::prop_assert!(taken <= v.len());
+            for (i, fix) in fixes.iter().enumerate() {
+                let Some((speed, course)) = fix.velocity else { continue };
+                let near = v.iter().any(|s| {
+                    let skew = (s.t_s - fix.t_s).abs();
+                    let neighbours = [i.checked_sub(1), Some(i + 1)]
+                        .into_iter()
+                        .flatten()
+                        .filter_map(|j| fixes.get(j))
+                        .all(|f| skew <= 0.5 * (f.t_s - fix.t_s).abs() + 1e-12);
+                    skew <= MAX_VELOCITY_SKEW_S && neighbours
+                });
+                proptest::prop_assert!(near, "fix {i} took a velocity from too far");
+                proptest::prop_assert!(speed.is_finite() && speed >= 0.0, "speed {speed}");
+                proptest::prop_assert!((0.0..360.0).contains(&course), "course {course}");
+            }
+        }
     }
 }

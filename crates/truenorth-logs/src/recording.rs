@@ -38,7 +38,8 @@ pub struct GnssFix {
     /// 1σ horizontal error the receiver gives, m, when it gives one.
     pub sigma_m: Option<f64>,
     /// Speed over ground, m/s, and course over ground, degrees clockwise from true north,
-    /// when the receiver gives both (PX4's `vel_m_s` and `cog_rad`; a NavSatFix has none).
+    /// when the receiver gives both (PX4's `vel_m_s` and `cog_rad`; for a NavSatFix, the
+    /// receiver's velocity topic nearest in time, [`crate::LogConfig::gnss_velocity_topic`]).
     pub velocity: Option<(f64, f64)>,
 }
 
@@ -94,7 +95,8 @@ pub struct Recording {
     pub complete: bool,
     /// Every topic in the file.
     pub topics: Vec<TopicInfo>,
-    /// The selected streams, in the order imu, mag, attitude, odometry (those present).
+    /// The selected streams (those present): ULog imu, mag, attitude, gnss; MCAP imu, mag,
+    /// odometry, gnss, gnss_velocity, attitude.
     pub streams: Vec<StreamInfo>,
     /// Gyro (rad/s) and accelerometer (m/s², specific force) readings, FRD body axes, no
     /// magnetometer: one per message of the IMU topic.

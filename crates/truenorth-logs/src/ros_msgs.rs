@@ -1,7 +1,8 @@
 //! The ROS 2 messages this crate reads, laid out field for field as their `.msg` definitions
 //! (`sensor_msgs/msg/Imu`, `sensor_msgs/msg/MagneticField`, `nav_msgs/msg/Odometry`,
-//! `sensor_msgs/msg/NavSatFix` and the
-//! `std_msgs` / `geometry_msgs` types inside them), and their CDR decoding through the
+//! `sensor_msgs/msg/NavSatFix`, `geometry_msgs/msg/TwistStamped`,
+//! `geometry_msgs/msg/TwistWithCovarianceStamped` and the `std_msgs` / `geometry_msgs` types
+//! inside them), and their CDR decoding through the
 //! `cdr-encoding` crate. A serialized ROS 2 message is a 4-byte encapsulation header (its
 //! second byte 0 for big-endian, 1 for little-endian plain CDR; OMG DDS-XTypes 1.3, 7.6.3.1.2)
 //! followed by the CDR body, aligned from the body's first byte.
@@ -154,6 +155,26 @@ pub struct TwistWithCovariance {
     pub twist: Twist,
     /// Its covariance.
     pub covariance: Covariance6,
+}
+
+/// `geometry_msgs/msg/TwistStamped` (a GNSS driver's velocity, e.g. `nmea_navsat_driver`'s
+/// `vel`, east and north in `linear.x`, `linear.y`).
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct TwistStamped {
+    /// Stamp and frame.
+    pub header: Header,
+    /// The twist.
+    pub twist: Twist,
+}
+
+/// `geometry_msgs/msg/TwistWithCovarianceStamped` (a GNSS driver's velocity, e.g.
+/// `ublox_gps`'s `fix_velocity`, east and north in `twist.twist.linear.x`, `.y`).
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct TwistWithCovarianceStamped {
+    /// Stamp and frame.
+    pub header: Header,
+    /// The twist and its covariance.
+    pub twist: TwistWithCovariance,
 }
 
 /// `nav_msgs/msg/Odometry`.

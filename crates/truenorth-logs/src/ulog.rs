@@ -353,6 +353,14 @@ pub(crate) fn read(bytes: &[u8], config: &LogConfig) -> Result<Recording> {
                 .to_string(),
         });
     }
+    if config.gnss_velocity_topic.is_some() {
+        return Err(LogError::InvalidConfig {
+            field: "gnss_velocity_topic",
+            reason: "is read from MCAP logs only (a PX4 ULog's fixes carry their own velocity, \
+                     `vel_m_s` and `cog_rad`); leave it out"
+                .to_string(),
+        });
+    }
     check_array_lengths(bytes).map_err(|detail| LogError::Corrupt {
         format: LogFormat::Ulog,
         detail,

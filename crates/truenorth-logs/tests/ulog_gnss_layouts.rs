@@ -135,4 +135,19 @@ fn a_fix_topic_named_must_be_there_and_serve() {
             ..
         }
     ));
+    // A ULog fix carries its own velocity: a velocity topic named is refused, not ignored.
+    let velocity = LogReader::new(LogConfig {
+        gnss_velocity_topic: Some("vehicle_gps_position".into()),
+        ..LogConfig::default()
+    })
+    .unwrap()
+    .read_bytes(&bytes)
+    .unwrap_err();
+    assert!(matches!(
+        velocity,
+        LogError::InvalidConfig {
+            field: "gnss_velocity_topic",
+            ..
+        }
+    ));
 }

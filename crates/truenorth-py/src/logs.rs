@@ -23,7 +23,8 @@ use crate::convert::{TruenorthError, array1, array2};
 ///   turning right);
 /// * `gnss`: `t_s` (F), `lat_deg`, `lon_deg` (F, WGS84), `sigma_m` (F, 1σ horizontal, NaN
 ///   where the receiver gives none), `speed_mps`, `course_deg` (F, over ground, NaN where it
-///   gives none): an MCAP's `sensor_msgs/msg/NavSatFix` fixes or a ULog's
+///   gives none; an MCAP's from `gnss_velocity_topic`, by default a twist topic in the fixes'
+///   frame): an MCAP's `sensor_msgs/msg/NavSatFix` fixes or a ULog's
 ///   `vehicle_gps_position`/`sensor_gps` (messages with no fix left out), ready for
 ///   `VehicleEstimator`'s `gnss=` (stacked as columns);
 /// * `format` (`"PX4 ULog"` or `"MCAP"`), `complete`, `time_origin_s`, `topics` (a list of
@@ -35,7 +36,7 @@ use crate::convert::{TruenorthError, array1, array2};
 /// topic, a corrupt file or (without `accept_incomplete`) a truncated one raises
 /// `TruenorthError` with the reader's message (a missing topic's names the topics present).
 #[pyfunction]
-#[pyo3(signature = (path, imu_topic=None, mag_topic=None, attitude_topic=None, odometry_topic=None, accept_incomplete=false, gnss_topic=None))]
+#[pyo3(signature = (path, imu_topic=None, mag_topic=None, attitude_topic=None, odometry_topic=None, accept_incomplete=false, gnss_topic=None, gnss_velocity_topic=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn read_log<'py>(
     py: Python<'py>,
@@ -46,6 +47,7 @@ pub fn read_log<'py>(
     odometry_topic: Option<String>,
     accept_incomplete: bool,
     gnss_topic: Option<String>,
+    gnss_velocity_topic: Option<String>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let config = LogConfig {
         imu_topic,
@@ -53,6 +55,7 @@ pub fn read_log<'py>(
         attitude_topic,
         odometry_topic,
         gnss_topic,
+        gnss_velocity_topic,
         accept_incomplete,
     };
     let read = py.detach(|| LogReader::new(config)?.read_path(&path));

@@ -265,7 +265,9 @@ class Log(TypedDict):
     odometry: dict[str, FloatArray]
     """`t_s` (J), `velocity_mps` (J x 3, body axes), `yaw_rate_rps` (J, + turning right)."""
     gnss: dict[str, FloatArray]
-    """`t_s`, `lat_deg`, `lon_deg`, `sigma_m` (F each): an MCAP's NavSatFix fixes."""
+    """`t_s`, `lat_deg`, `lon_deg`, `sigma_m`, `speed_mps`, `course_deg` (F each; NaN where
+    not given): an MCAP's NavSatFix fixes (velocity from a twist topic in their frame) or a
+    ULog's `vehicle_gps_position`/`sensor_gps`."""
 
 def read_log(
     path: str | os.PathLike[str],
@@ -275,6 +277,7 @@ def read_log(
     odometry_topic: Optional[str] = None,
     accept_incomplete: bool = False,
     gnss_topic: Optional[str] = None,
+    gnss_velocity_topic: Optional[str] = None,
 ) -> Log:
     """A PX4 ULog or ROS 2 MCAP log as arrays per stream (seconds, FRD body axes, rad/s,
     m/s^2, uT), as the `truenorth` command reads it; `mag_topic="none"`: no magnetometer."""

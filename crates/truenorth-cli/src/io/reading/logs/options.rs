@@ -32,6 +32,11 @@ pub struct LogOptions {
     /// with the most messages, if any), or `none`.
     #[arg(long, value_name = "TOPIC")]
     pub gnss_topic: Option<String>,
+    /// MCAP input: the receiver's velocity (`geometry_msgs/msg/TwistWithCovarianceStamped` or
+    /// `TwistStamped`, east and north in linear x and y), taken as each fix's speed and course
+    /// over ground (default: such a topic in the fixes' frame, if any), or `none`.
+    #[arg(long, value_name = "TOPIC")]
+    pub gnss_velocity_topic: Option<String>,
     /// ULog/MCAP input: read the messages before a truncated or damaged end (with a warning)
     /// instead of refusing the file.
     #[arg(long)]
@@ -47,6 +52,7 @@ impl LogOptions {
             attitude_topic: self.attitude_topic.clone(),
             odometry_topic: self.odometry_topic.clone(),
             gnss_topic: self.gnss_topic.clone(),
+            gnss_velocity_topic: self.gnss_velocity_topic.clone(),
             accept_incomplete: self.accept_incomplete,
         }
     }
@@ -71,6 +77,7 @@ impl LogOptions {
             ("--attitude-topic", self.attitude_topic.is_some()),
             ("--odometry-topic", self.odometry_topic.is_some()),
             ("--gnss-topic", self.gnss_topic.is_some()),
+            ("--gnss-velocity-topic", self.gnss_velocity_topic.is_some()),
             ("--accept-incomplete", self.accept_incomplete),
         ] {
             if set {

@@ -49,7 +49,7 @@ pub fn summary(log: &LogInput) -> Vec<String> {
             "--imu-topic NAME[:INSTANCE], --mag-topic NAME[:INSTANCE] or none, --attitude-topic NAME[:INSTANCE], --gnss-topic NAME[:INSTANCE] or none"
         }
         LogFormat::Mcap => {
-            "--imu-topic TOPIC, --mag-topic TOPIC or none, --attitude-topic TOPIC, --odometry-topic TOPIC, --gnss-topic TOPIC"
+            "--imu-topic TOPIC, --mag-topic TOPIC or none, --attitude-topic TOPIC, --odometry-topic TOPIC, --gnss-topic TOPIC, --gnss-velocity-topic TOPIC"
         }
     };
     lines.push(format!("other streams: {options} (names as listed above)"));
