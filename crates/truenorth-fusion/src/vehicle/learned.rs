@@ -19,6 +19,18 @@ use super::nav_filter::{
 /// Share of a state's prior standard deviation that it may drift between two drives.
 const DRIFT_SHARE: f64 = 0.1;
 
+/// The physical range of each learned state, as (low, high): what a stored calibration may
+/// hold, and where a snapshot of the filter is kept — the filter can carry a state past its
+/// bound between two projections onto it (a fix's correction moving the wheels' delay below
+/// zero), and the snapshot is restored by a replay.
+const BIAS_RANGE_RPS: (f64, f64) = (-1.75, 1.75);
+const GAIN_RANGE: (f64, f64) = (-0.5, 0.5);
+const WHEEL_DIFF_RANGE: (f64, f64) = (-0.5, 0.5);
+const TRACK_SCALE_RANGE: (f64, f64) = (-0.5, 2.0);
+const SPEED_COEFF_RANGE_S2_PER_M2: (f64, f64) = (0.0, 1e-2);
+const WHEEL_SCALE_RANGE: (f64, f64) = (-0.5, 0.5);
+const WHEEL_LAG_RANGE_S: (f64, f64) = (0.0, 2.0);
+
 /// A learned value and its standard deviation (0: never learned, the prior stands; the
 /// default).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
@@ -31,9 +43,10 @@ pub struct Learned {
 }
 
 impl Learned {
-    fn of(filter: &NavFilter, i: usize) -> Self {
+    /// State `i` of `filter`, kept within `(low, high)`.
+    fn of(filter: &NavFilter, i: usize, (low, high): (f64, f64)) -> Self {
         Self {
-            value: filter.x[i],
+            value: filter.x[i].clamp(low, high),
             sigma: filter.sigma(i),
         }
     }
@@ -92,14 +105,14 @@ impl VehicleCalibration {
                 calibration: f.calibration,
                 quality: f.quality,
             }),
-            gyro_bias_rps: Learned::of(filter, BIAS),
-            gyro_gain_error_right: Learned::of(filter, GAIN_POS),
-            gyro_gain_error_left: Learned::of(filter, GAIN_NEG),
-            wheel_diff: Learned::of(filter, WHEEL_DIFF),
-            track_scale: Learned::of(filter, TRACK_SCALE),
-            speed_coeff_s2_per_m2: Learned::of(filter, SPEED_COEFF),
-            wheel_scale: Learned::of(filter, WHEEL_SCALE),
-            wheel_lag_s: Learned::of(filter, WHEEL_LAG),
+            gyro_bias_rps: Learned::of(filter, BIAS, BIAS_RANGE_RPS),
+            gyro_gain_error_right: Learned::of(filter, GAIN_POS, GAIN_RANGE),
+            gyro_gain_error_left: Learned::of(filter, GAIN_NEG, GAIN_RANGE),
+            wheel_diff: Learned::of(filter, WHEEL_DIFF, WHEEL_DIFF_RANGE),
+            track_scale: Learned::of(filter, TRACK_SCALE, TRACK_SCALE_RANGE),
+            speed_coeff_s2_per_m2: Learned::of(filter, SPEED_COEFF, SPEED_COEFF_RANGE_S2_PER_M2),
+            wheel_scale: Learned::of(filter, WHEEL_SCALE, WHEEL_SCALE_RANGE),
+            wheel_lag_s: Learned::of(filter, WHEEL_LAG, WHEEL_LAG_RANGE_S),
         }
     }
 
@@ -150,27 +163,29 @@ impl Validate for VehicleCalibration {
         check_range(
             "gyro_bias_rps (a bias beyond 100 °/s is no gyro's)",
             self.gyro_bias_rps.value,
-            -1.75,
-            1.75,
+            BIAS_RANGE_RPS.0,
+            BIAS_RANGE_RPS.1,
         )?;
-        for (what, l, lo, hi) in [
+        for (what, l, (lo, hi)) in [
             (
                 "gyro_gain_error_right",
                 self.gyro_gain_error_right,
-                -0.5,
-                0.5,
+                GAIN_RANGE,
             ),
-            ("gyro_gain_error_left", self.gyro_gain_error_left, -0.5, 0.5),
-            ("wheel_diff", self.wheel_diff, -0.5, 0.5),
-            ("track_scale", self.track_scale, -0.5, 2.0),
+            (
+                "gyro_gain_error_left",
+                self.gyro_gain_error_left,
+                GAIN_RANGE,
+            ),
+            ("wheel_diff", self.wheel_diff, WHEEL_DIFF_RANGE),
+            ("track_scale", self.track_scale, TRACK_SCALE_RANGE),
             (
                 "speed_coeff_s2_per_m2",
                 self.speed_coeff_s2_per_m2,
-                0.0,
-                1e-2,
+                SPEED_COEFF_RANGE_S2_PER_M2,
             ),
-            ("wheel_scale", self.wheel_scale, -0.5, 0.5),
-            ("wheel_lag_s", self.wheel_lag_s, 0.0, 2.0),
+            ("wheel_scale", self.wheel_scale, WHEEL_SCALE_RANGE),
+            ("wheel_lag_s", self.wheel_lag_s, WHEEL_LAG_RANGE_S),
         ] {
             l.check(what)?;
             check_range(what, l.value, lo, hi)?;
@@ -198,5 +213,26 @@ impl Validate for VehicleCalibration {
             }
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A snapshot of a filter whose states stand past their physical bounds (the wheels'
+    /// delay a hair below zero after a fix's correction, a speed coefficient below zero)
+    /// is a calibration that validates, so a replay restoring it cannot fail: a drive with
+    /// fixes 2 s late once stopped with "wheel_lag_s = -1.092e-4 is outside its valid range".
+    #[test]
+    fn a_snapshot_past_the_bounds_still_validates() {
+        let mut x = [0.0; DIM];
+        (x[WHEEL_LAG], x[SPEED_COEFF], x[GAIN_POS], x[BIAS]) = (-1.1e-4, -1e-9, 0.7, -3.0);
+        let filter = NavFilter::new(x, [0.1; DIM]);
+        let c = VehicleCalibration::from_filter(&filter, None);
+        c.validate().unwrap();
+        assert_eq!(c.wheel_lag_s.value, 0.0);
+        assert_eq!(c.gyro_gain_error_right.value, GAIN_RANGE.1);
+        assert_eq!(c.gyro_bias_rps.value, BIAS_RANGE_RPS.0);
     }
 }
