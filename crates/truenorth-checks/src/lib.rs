@@ -16,6 +16,7 @@
 //!   does not;
 //! * [`inertial`]: the accelerometer's and gyro's units, then the gyro's axes;
 //! * [`yaw_rate`]: a vehicle's yaw gyro against its wheels, streaming;
+//! * [`course_lag`]: the satellite fixes' clock against the gyro's, by the course's turns;
 //! * [`field_unit`]: a fitted field against an Earth field in the declared unit;
 //! * [`compass`]: a stored compass calibration that no real compass could have;
 //! * [`stuck_readings`]: readings no live sensor gives (clipped, frozen, a zero field).
@@ -39,6 +40,7 @@
 pub mod axes;
 pub mod calibration_fit;
 pub mod compass;
+pub mod course_lag;
 pub mod field_unit;
 pub mod finding;
 pub mod inertial;
@@ -49,6 +51,7 @@ pub mod units;
 pub mod yaw_rate;
 
 pub use axes::{AxisFit, SignedPermutation, axes_are_wrong, fit_gyro_axes};
+pub use course_lag::{CourseLag, CourseLagCheck};
 pub use field_unit::check_field;
 pub use finding::{Finding, FindingKind, Fix};
 pub use inertial::{

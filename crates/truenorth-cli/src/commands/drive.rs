@@ -24,9 +24,11 @@ use crate::io::{
 use crate::registry::{VehicleMethod, VehicleRun};
 
 mod diagnose;
+mod fix_check;
 mod output;
 
 use diagnose::{Context, Diagnosis};
+use fix_check::FixTimes;
 pub use output::Extra;
 use output::{Tally, Writer};
 
@@ -228,6 +230,7 @@ pub fn run(args: &Args) -> CliResult {
     )?;
     let context = diagnosis_context(args, speeds);
     let mut sensors = VehicleSensors::default();
+    let mut fix_times = FixTimes::default();
     let mut watch = (
         StuckWatch::new("gyr_z (rad/s)", &args.input, args.accept_sensor_faults),
         MagWatch::new(&args.input, args.accept_sensor_faults),
@@ -236,7 +239,7 @@ pub fn run(args: &Args) -> CliResult {
         &mut samples,
         &mut watch,
         &mut check,
-        &mut sensors,
+        (&mut sensors, &mut fix_times),
         method.as_mut(),
         &mut writer,
     )
@@ -256,6 +259,11 @@ pub fn run(args: &Args) -> CliResult {
     summary(args, samples, &tally, learned.as_ref(), &sensors);
     for limit in sensors.limits() {
         errln!("truenorth drive: warning: {limit}");
+    }
+    if args.method == VehicleMethod::Fused {
+        for warning in fix_times.warnings(tally.gnss.map(|(counts, _)| counts)) {
+            errln!("truenorth drive: warning: {warning}");
+        }
     }
     Ok(())
 }
@@ -390,7 +398,7 @@ fn estimate(
     samples: &mut Samples<Vehicle>,
     (gyro, mag): &mut (StuckWatch<1>, MagWatch),
     check: &mut Diagnosis,
-    sensors: &mut VehicleSensors,
+    (sensors, fix_times): (&mut VehicleSensors, &mut FixTimes),
     method: &mut dyn VehicleRun,
     writer: &mut Writer,
 ) -> CliResult<usize> {
@@ -404,6 +412,7 @@ fn estimate(
         }
         check.push(&sample, row);
         sensors.add(&sample);
+        fix_times.push(&sample);
         method
             .push(&sample, &mut |e, fused| writer.write(e, fused))
             .map_err(|e| CliError::row(&path, row, e.to_string()).kind_of(&e))?;
