@@ -343,7 +343,7 @@ fn fixes_stamped_late_are_said() {
     let dir = scratch("mcap_gnss", "late");
     let vehicle = dir.join("car.json");
     std::fs::write(&vehicle, r#"{"track_m": 1.5, "odometer_wheels": "rear"}"#).unwrap();
-    let said = |delay_s: f64| {
+    let said = |delay_s: f64, vehicle: &Path| {
         let bag = dir.join(format!("car{delay_s}.mcap"));
         write_bag(&bag, true, delay_s);
         let track = dir.join("track.csv");
@@ -364,9 +364,17 @@ fn fixes_stamped_late_are_said() {
             .and_then(|n| n.parse().ok());
         (lag, stderr)
     };
-    let (lag, stderr) = said(2.0);
-    let lag = lag.unwrap_or_else(|| panic!("{stderr}"));
-    assert!((lag - 2.0).abs() < 0.2, "{stderr}");
-    let (lag, stderr) = said(0.0);
+    let (lag, stderr) = said(2.0, &vehicle);
+    let found = lag.unwrap_or_else(|| panic!("{stderr}"));
+    assert!((found - 2.0).abs() < 0.2, "{stderr}");
+    let (lag, stderr) = said(0.0, &vehicle);
+    assert!(lag.is_none(), "{stderr}");
+    let told = dir.join("told.json");
+    std::fs::write(
+        &told,
+        format!(r#"{{"track_m": 1.5, "odometer_wheels": "rear", "gnss_latency_s": {found}}}"#),
+    )
+    .unwrap();
+    let (lag, stderr) = said(2.0, &told);
     assert!(lag.is_none(), "{stderr}");
 }

@@ -44,7 +44,8 @@ speed columns, a CAN bus's 0.01 km/h over one second; 0.001 on a robot),
 \"wheel_speed_quantum_mps\" (the step wheel speeds are sent in, default 0.01 km/h on a car
 and 1 mm/s on a robot: held steady, each wheel's rounding turns the heading),
 \"gnss_lever_arm_m\" ([forward, right] of the GNSS antenna from the axle's centre, m;
-default [0, 0]), \"compass_systematic_deg\" (the compass's systematic heading error, default 3: a level
+default [0, 0]), \"gnss_latency_s\" (how long after its epoch a fix is stamped, s; default
+0.1, and drive says when the fixes' course shows another), \"compass_systematic_deg\" (the compass's systematic heading error, default 3: a level
 two-axis compass on roads whose grade and camber tilt it; about 0.3 for a tilt-compensated
 compass or level ground) and \"version\": 1.
 Unknown keys are refused (naming the closest known one), and so are values no vehicle has.
@@ -230,7 +231,11 @@ pub fn run(args: &Args) -> CliResult {
     )?;
     let context = diagnosis_context(args, speeds);
     let mut sensors = VehicleSensors::default();
-    let mut fix_times = FixTimes::default();
+    let mut fix_times = FixTimes::new(
+        vehicle
+            .gnss_latency_s
+            .unwrap_or(truenorth::fusion::GnssConfig::default().latency_s),
+    );
     let mut watch = (
         StuckWatch::new("gyr_z (rad/s)", &args.input, args.accept_sensor_faults),
         MagWatch::new(&args.input, args.accept_sensor_faults),
@@ -324,6 +329,9 @@ fn build_method(
     }
     if let Some(l) = vehicle.gnss_lever_arm_m {
         config.gnss.lever_arm_m = l;
+    }
+    if let Some(l) = vehicle.gnss_latency_s {
+        config.gnss.latency_s = l;
     }
     // The declination that relates the compass to the fixes' true north comes from
     // WMM2025, which holds from 2025.0 to 2030.0; a date outside is taken at its nearest

@@ -24,8 +24,14 @@ use super::nav_filter::{EAST, NORTH, PSI};
 #[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
 
-/// Shortest interval between two fixes used, s.
+/// The interval the fixes are used at, s: one a second.
 const FIX_INTERVAL_S: f64 = 1.0;
+
+/// How much shorter than [`FIX_INTERVAL_S`] two fixes' epochs may be and both be used, s: a
+/// receiver at 1 Hz stamps its fixes a second apart within tens of milliseconds, and a
+/// logger's stamps jitter by as much, so an exact second would skip every other fix; half
+/// a 10 Hz receiver's step, so that its fixes are used a second apart, not 0.9 s.
+const FIX_JITTER_S: f64 = 0.05;
 
 /// Courses that must agree before they refer the heading to true north.
 const ALIGNMENT_COURSES: u32 = 5;
@@ -127,16 +133,16 @@ impl VehicleEstimator {
             return;
         };
         let [north, east, _] = plane.from_geodetic(&point);
+        // Where the vehicle was when the fix was computed (the time a fix is noted used at).
+        let t_s = t_s - self.config.gnss.latency_s;
         if self
             .tracking
             .gnss
             .last_used_s
-            .is_some_and(|t0| t_s - t0 < FIX_INTERVAL_S)
+            .is_some_and(|t0| t_s - t0 < FIX_INTERVAL_S - FIX_JITTER_S)
         {
             return;
         }
-        // Where the vehicle was when the fix was computed.
-        let t_s = t_s - self.config.gnss.latency_s;
         // Fixes say where the vehicle is; between them only odometry carries it there.
         // Without any, their course still says where it heads.
         if !self.est.status.position_known {

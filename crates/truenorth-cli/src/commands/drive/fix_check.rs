@@ -31,6 +31,8 @@ const NO_FIT_MISFIT: f64 = 4.0;
 /// When the fixes came against the other sensors' rows.
 #[derive(Debug, Default)]
 pub(super) struct FixTimes {
+    /// The fixes' delay the estimator assumes, s.
+    latency_s: f64,
     fixes: usize,
     /// Fixes on rows before any other sensor's, and since the last.
     before: usize,
@@ -47,6 +49,14 @@ fn widen(span: &mut Option<(f64, f64)>, t_s: f64) {
 }
 
 impl FixTimes {
+    /// A check of fixes the estimator takes to be `latency_s` late.
+    pub(super) fn new(latency_s: f64) -> Self {
+        Self {
+            latency_s,
+            ..Self::default()
+        }
+    }
+
     /// Notes a row.
     pub(super) fn push(&mut self, sample: &VehicleSample) {
         self.lag.push(sample);
@@ -115,11 +125,12 @@ impl FixTimes {
 
     /// The fixes' delay, where their course's turns refute the one the estimator assumes.
     fn lag_warning(&self) -> Option<String> {
-        let gnss = GnssConfig::default();
+        let spread_s = GnssConfig::default().latency_sigma_s;
+        let latency_s = self.latency_s;
         let found = self.lag.lag();
         let refuted = self
             .lag
-            .excess_at(gnss.latency_s)
+            .excess_at(latency_s)
             .is_some_and(|e| e > REFUTED_EXCESS);
         match found {
             Some(f) if f.misfit > NO_FIT_MISFIT && refuted => Some(format!(
@@ -128,17 +139,25 @@ impl FixTimes {
                  noise): the fixes are stamped on another clock than the gyro, or the course is \
                  not the vehicle's; their positions are judged as if taken {} s before their \
                  stamps",
-                f.pairs, f.misfit, gnss.latency_s
+                f.pairs, f.misfit, latency_s
             )),
-            Some(f) if refuted && (f.lag_s - gnss.latency_s).abs() > 3.0 * gnss.latency_sigma_s => {
+            Some(f) if refuted && (f.lag_s - latency_s).abs() > 3.0 * spread_s => {
+                let remedy = if f.lag_s > 0.0 {
+                    format!(
+                        "set \"gnss_latency_s\": {:.2} in the vehicle file, or give the fix rows \
+                         the time of their epoch",
+                        f.lag_s
+                    )
+                } else {
+                    "give the fix rows the time of their epoch".to_string()
+                };
                 Some(format!(
                     "the satellite fixes are stamped {:.2} ± {:.2} s after the epoch they \
                      describe (their course follows the gyro's turns that late; {} pairs of \
-                     courses), where {} ± {} s is assumed: they are stamped on another clock than \
-                     the gyro, or queued by the logger; the estimator learns such a delay as a \
-                     gyro bias and a track off by the speed times it — give the fix rows the time \
-                     of their epoch",
-                    f.lag_s, f.sigma_s, f.pairs, gnss.latency_s, gnss.latency_sigma_s
+                     courses), where {latency_s} ± {spread_s} s is assumed: they are stamped on \
+                     another clock than the gyro, or queued by the logger; the estimator learns \
+                     such a delay as a gyro bias and a track off by the speed times it — {remedy}",
+                    f.lag_s, f.sigma_s, f.pairs
                 ))
             }
             _ => None,
@@ -165,7 +184,7 @@ mod tests {
     /// Fixes after the sensors' last row (another clock) are said; fixes among them are not.
     #[test]
     fn fixes_beyond_the_sensors_rows_are_said() {
-        let mut apart = FixTimes::default();
+        let mut apart = FixTimes::new(0.1);
         (0..10).for_each(|k| apart.push(&row(f64::from(k), true, false)));
         (0..10).for_each(|k| apart.push(&row(1000.0 + f64::from(k), false, true)));
         let w = apart.warnings(None);
@@ -175,7 +194,7 @@ mod tests {
             "{w:?}"
         );
 
-        let mut among = FixTimes::default();
+        let mut among = FixTimes::new(0.1);
         for k in 0..10 {
             among.push(&row(f64::from(k), true, false));
             among.push(&row(f64::from(k) + 0.5, false, true));
@@ -198,6 +217,6 @@ mod tests {
         };
         assert!(among.warnings(Some(fewer)).is_empty());
         assert!(among.warnings(None)[0].starts_with("none of the 10"));
-        assert!(FixTimes::default().warnings(None).is_empty());
+        assert!(FixTimes::new(0.1).warnings(None).is_empty());
     }
 }

@@ -26,6 +26,8 @@ const RESOLUTION_RANGE_M: (f64, f64) = (1e-6, 5.0);
 const SPEED_QUANTUM_RANGE_MPS: (f64, f64) = (1e-6, 1.0);
 /// How far a GNSS antenna can be from the axle's centre, m, along either axis.
 const LEVER_ARM_RANGE_M: (f64, f64) = (-50.0, 50.0);
+/// A fix's delay a logger can add, s: the estimator's own range for it.
+const LATENCY_RANGE_S: (f64, f64) = (0.0, 10.0);
 /// The compass's systematic heading error, degrees: the estimator's own range.
 const SYSTEMATIC_RANGE_DEG: (f64, f64) = (1e-3, 45.0);
 
@@ -55,6 +57,9 @@ pub struct VehicleFile {
     /// Where the GNSS antenna is from the axle's centre, m forward and to the right
     /// (optional; [0, 0]).
     pub gnss_lever_arm_m: Option<[f64; 2]>,
+    /// How long after its epoch a fix is stamped, s (optional; 0.1: a receiver's and a
+    /// logger's delay). `drive` says when the fixes' course shows another.
+    pub gnss_latency_s: Option<f64>,
 }
 
 impl VehicleFile {
@@ -118,6 +123,14 @@ impl VehicleFile {
         }
         for l in self.gnss_lever_arm_m.into_iter().flatten() {
             within("gnss_lever_arm_m", l, LEVER_ARM_RANGE_M, " m")?;
+        }
+        if let Some(l) = self.gnss_latency_s
+            && !(l.is_finite() && (LATENCY_RANGE_S.0..=LATENCY_RANGE_S.1).contains(&l))
+        {
+            return Err(format!(
+                "`gnss_latency_s` is {l}, outside {}–{} s (how long after its epoch a fix is stamped; a fix cannot be stamped before it); check the value and its unit (seconds)",
+                LATENCY_RANGE_S.0, LATENCY_RANGE_S.1
+            ));
         }
         if let Some(s) = self.compass_systematic_deg
             && !(s.is_finite() && (SYSTEMATIC_RANGE_DEG.0..=SYSTEMATIC_RANGE_DEG.1).contains(&s))
