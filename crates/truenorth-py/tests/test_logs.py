@@ -69,6 +69,9 @@ def test_mcap_fixture_streams_and_frames():
 def test_log_errors_are_the_packages_exception(tmp_path):
     with pytest.raises(tn.TruenorthError, match="topics present: /chatter"):
         tn.read_log(MCAP, imu_topic="/nope")
+    # A receiver's velocity topic is checked for its type like any other.
+    with pytest.raises(tn.TruenorthError, match="cannot serve as gnss_velocity"):
+        tn.read_log(MCAP, gnss_velocity_topic="/chatter")
     text = tmp_path / "x.csv"
     text.write_text("t_s,gyr_x\n0,1\n")
     with pytest.raises(tn.TruenorthError, match="not a PX4 ULog or MCAP"):
