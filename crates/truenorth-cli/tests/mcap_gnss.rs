@@ -350,7 +350,7 @@ fn fixes_stamped_late_are_said() {
         let run = ok(&[
             "drive",
             "--vehicle",
-            p(&vehicle),
+            p(vehicle),
             "--input",
             p(&bag),
             "--output",
