@@ -367,6 +367,10 @@ fn fixes_stamped_late_are_said() {
     let (lag, stderr) = said(2.0, &vehicle);
     let found = lag.unwrap_or_else(|| panic!("{stderr}"));
     assert!((found - 2.0).abs() < 0.2, "{stderr}");
+    // `inspect` shows the same before anything is driven.
+    let report = ok(&["inspect", p(&dir.join("car2.mcap"))]);
+    let report = String::from_utf8_lossy(&report.stdout);
+    assert!(report.contains("the course turning 2.0"), "{report}");
     let (lag, stderr) = said(0.0, &vehicle);
     assert!(lag.is_none(), "{stderr}");
     let told = dir.join("told.json");

@@ -1,8 +1,11 @@
 //! A drive log's satellite fixes (`lat_deg,lon_deg` on rows of their own): how many, how
 //! often, where they stop, and how accurate the receiver says they are — what `drive` will
-//! be leaning on between its dead-reckoned stretches.
+//! be leaning on between its dead-reckoned stretches — and, where their course and a yaw gyro
+//! are both given, how late the fixes are stamped by their course's turns.
 
 use serde::Serialize;
+use truenorth::checks::CourseLagCheck;
+use truenorth::core::{GnssFix, VehicleSample};
 
 use super::Recording;
 use super::column_stats::{ColumnStats, Gaps};
@@ -22,6 +25,29 @@ pub struct GnssReport {
     pub sigma_m: Option<[f64; 3]>,
     /// Whether speed and course over ground are given (`gnss_speed_mps,gnss_course_deg`).
     pub course: bool,
+    /// How long after the epoch they describe the fixes are stamped, s, and its σ, as their
+    /// course's turns against the gyro's show it (`truenorth_checks::CourseLagCheck`; the
+    /// gyro's unit, sign, bias and scale do not matter); `None` without both, or where the
+    /// turns do not tell.
+    pub course_lag_s: Option<[f64; 2]>,
+}
+
+/// The fixes' delay by their course against `gyr_z`.
+fn course_lag(rec: &Recording) -> Option<[f64; 2]> {
+    let gyr = rec.col("gyr_z")?;
+    let [lat, lon, speed, course] =
+        ["lat_deg", "lon_deg", "gnss_speed_mps", "gnss_course_deg"].map(|c| rec.col(c));
+    let (lat, lon, speed, course) = (lat?, lon?, speed?, course?);
+    let mut check = Box::new(CourseLagCheck::new());
+    for (k, &t) in rec.t_s.iter().enumerate() {
+        let mut s = VehicleSample::at(t);
+        s.gyr_z_rps = gyr[k].is_finite().then_some(gyr[k]);
+        if lat[k].is_finite() && lon[k].is_finite() && speed[k].is_finite() {
+            s.gnss = Some(GnssFix::at(lat[k], lon[k]).with_velocity(speed[k], course[k]));
+        }
+        check.push(&s);
+    }
+    check.lag().map(|l| [l.lag_s, l.sigma_s])
 }
 
 /// The fixes' report, if the recording has `lat_deg` and `lon_deg`; `columns` are the
@@ -45,6 +71,7 @@ pub fn gnss(rec: &Recording, columns: &[ColumnStats]) -> Option<GnssReport> {
         gaps: lat.gaps.clone(),
         sigma_m: sigma,
         course: stats("gnss_speed_mps").is_some() && stats("gnss_course_deg").is_some(),
+        course_lag_s: course_lag(rec),
     })
 }
 
@@ -96,5 +123,6 @@ mod tests {
         assert!((report.gaps.largest_s.unwrap() - 30.2).abs() < 1e-6);
         assert_eq!(report.sigma_m, Some([1.0, 2.0, 4.0]));
         assert!(!report.course);
+        assert_eq!(report.course_lag_s, None);
     }
 }

@@ -123,9 +123,15 @@ impl Report {
     }
 
     fn columns_table(&self, s: &mut String) {
+        // Wide enough for the longest name (`gnss_course_deg`), so the columns line up.
+        let w = self
+            .columns
+            .iter()
+            .map(|c| c.name.len())
+            .fold(12, usize::max);
         let _ = writeln!(
             s,
-            "{:<12} {:>8} {:>9} {:>5} {:>10} {:>11} {:>12} {:>12} {:>10}",
+            "{:<w$} {:>8} {:>9} {:>5} {:>10} {:>11} {:>12} {:>12} {:>10}",
             "column",
             "readings",
             "rate_Hz",
@@ -140,7 +146,7 @@ impl Report {
         for c in &self.columns {
             let _ = writeln!(
                 s,
-                "{:<12} {:>8} {:>9} {:>5} {:>10} {:>11} {:>12} {:>12} {:>10}",
+                "{:<w$} {:>8} {:>9} {:>5} {:>10} {:>11} {:>12} {:>12} {:>10}",
                 c.name,
                 c.readings,
                 num(c.rate_hz, 2),
@@ -201,10 +207,12 @@ fn gnss_line(s: &mut String, g: &GnssReport) {
         }
         None => "no gnss_sigma_m: drive assumes 5 m".to_string(),
     };
-    let course = if g.course {
-        "speed and course given"
-    } else {
-        "no speed or course"
+    let course = match (g.course, g.course_lag_s) {
+        (true, Some([lag, sigma])) => format!(
+            "speed and course given, the course turning {lag:.2} ± {sigma:.2} s after the gyro by the stamps"
+        ),
+        (true, None) => "speed and course given".to_string(),
+        (false, _) => "no speed or course".to_string(),
     };
     let _ = writeln!(
         s,
