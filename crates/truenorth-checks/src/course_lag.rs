@@ -6,6 +6,11 @@
 //! stamps then learns the delay as a gyro bias (a car's fixes 5 s late taught one −0.14°/s
 //! where the truth was 0). Nothing else in a drive shows it while the fixes pass their gate.
 //!
+//! Without a course (a `sensor_msgs/NavSatFix` alone) the chord between two fixes 0.5–2 s
+//! apart stands for the course at their middle: a receiver's position error changes little
+//! within a second (it is correlated over tens of seconds), so the chord's direction is good
+//! to a few degrees at road speeds.
+//!
 //! For every lag from [`MIN_LAG_S`] to [`MAX_LAG_S`] the check fits the course changes of
 //! pairs of fixes 0.5–2 s apart to the gyro's turns over the same epochs that lag earlier,
 //! with the gyro's bias and scale error free (a raw yaw rate has both), and keeps each lag's
@@ -44,6 +49,14 @@ const SPEED_SIGMA_MPS: f64 = 0.3;
 const OTHER_SIGMA_RAD: f64 = PI / 180.0;
 /// Pairs needed before a delay is given.
 pub const MIN_PAIRS: usize = 30;
+/// How much a receiver's position error changes between two fixes a second or so apart, m:
+/// the error of a chord's length, and so of its direction times its length.
+const CHORD_SIGMA_M: f64 = 0.5;
+/// A course change no vehicle makes between two fixes at most 2 s apart, rad (90°, 45°/s
+/// at speed): a chord across a multipath jump, a course at a standstill, not a turn.
+const MAX_COURSE_CHANGE_RAD: f64 = PI / 2.0;
+/// Metres per radian of latitude (WGS84 equatorial radius): enough for a chord's direction.
+const EARTH_RADIUS_M: f64 = 6_378_137.0;
 
 /// The fixes' delay found ([`CourseLagCheck::lag`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -80,6 +93,10 @@ pub struct CourseLagCheck {
     last_gyro: Option<(f64, f64, f64)>,
     /// The last course taken: time, course, its variance.
     last_course: Option<(f64, f64, f64)>,
+    /// Whether any fix carried its course (then chords are not used).
+    course_given: bool,
+    /// The last fix a chord starts from: time, latitude and longitude, rad.
+    last_position: Option<(f64, f64, f64)>,
     pending: [Option<Pair>; PENDING],
     /// Per lag: Σ w r², Σ w r Δt, Σ w r Δh, Σ w Δt², Σ w Δt Δh, Σ w Δh².
     sums: [[f64; 6]; LAGS],
@@ -108,6 +125,8 @@ impl CourseLagCheck {
             ticks_kept: 0,
             last_gyro: None,
             last_course: None,
+            course_given: false,
+            last_position: None,
             pending: [None; PENDING],
             sums: [[0.0; 6]; LAGS],
             pairs: 0,
@@ -124,14 +143,40 @@ impl CourseLagCheck {
         if let Some(rate) = sample.gyr_z_rps.filter(|r| r.is_finite()) {
             self.push_rate(t, rate);
         }
-        if let Some(fix) = &sample.gnss
-            && let (Some(speed), Some(course_deg)) = (fix.speed_mps, fix.course_deg)
+        let Some(fix) = &sample.gnss else {
+            return;
+        };
+        if let (Some(speed), Some(course_deg)) = (fix.speed_mps, fix.course_deg)
             && speed.is_finite()
             && course_deg.is_finite()
-            && speed >= MIN_SPEED_MPS
         {
-            self.push_course(t, course_deg.to_radians(), speed);
+            self.course_given = true;
+            if speed >= MIN_SPEED_MPS {
+                let variance = (SPEED_SIGMA_MPS / speed).powi(2);
+                self.push_course(t, course_deg.to_radians(), variance);
+            }
+        } else if !self.course_given && fix.lat_deg.is_finite() && fix.lon_deg.is_finite() {
+            self.push_position(t, fix.lat_deg.to_radians(), fix.lon_deg.to_radians());
         }
+    }
+
+    /// A fix without course: the chord from the last one, 0.5–2 s before, is a course at
+    /// their middle.
+    fn push_position(&mut self, t: f64, lat: f64, lon: f64) {
+        match self.last_position {
+            Some((t0, ..)) if t - t0 < MIN_PAIR_S && t >= t0 => return,
+            Some((t0, lat0, lon0)) if t - t0 <= MAX_PAIR_S => {
+                let north = (lat - lat0) * EARTH_RADIUS_M;
+                let east = wrap(lon - lon0) * EARTH_RADIUS_M * lat0.cos();
+                let chord = north.hypot(east);
+                if chord >= MIN_SPEED_MPS * (t - t0) {
+                    let variance = (CHORD_SIGMA_M / chord).powi(2);
+                    self.push_course(0.5 * (t0 + t), east.atan2(north), variance);
+                }
+            }
+            _ => {}
+        }
+        self.last_position = Some((t, lat, lon));
     }
 
     fn tick_time(k: i64) -> f64 {
@@ -167,11 +212,12 @@ impl CourseLagCheck {
         }
     }
 
-    fn push_course(&mut self, t: f64, course_rad: f64, speed: f64) {
-        let variance = (SPEED_SIGMA_MPS / speed).powi(2);
+    fn push_course(&mut self, t: f64, course_rad: f64, variance: f64) {
         match self.last_course {
             Some((t0, ..)) if t - t0 < MIN_PAIR_S && t >= t0 => return,
-            Some((t0, c0, v0)) if t - t0 <= MAX_PAIR_S => {
+            Some((t0, c0, v0))
+                if t - t0 <= MAX_PAIR_S && wrap(course_rad - c0).abs() <= MAX_COURSE_CHANGE_RAD =>
+            {
                 let pair = Pair {
                     t0_s: t0,
                     t1_s: t,
@@ -319,8 +365,19 @@ mod tests {
 
     /// A car at 12 m/s turning as a sum of slow sines (up to 0.3 rad/s), its raw gyro at
     /// 50 Hz reading `scale` × the rate + 0.02 rad/s, its fixes at 5 Hz stamped `lag_s`
-    /// after the epoch whose course they carry (course noise 0.5°); `turning` false: straight.
+    /// after the epoch whose course they carry (course noise 0.5°); `turning` false: straight;
+    /// `chords`: positions only (an error wandering 0.1 m a fix, and 0.2 m of noise).
     fn drive(lag_s: f64, scale: f64, turning: bool, seconds: f64) -> CourseLagCheck {
+        drive_with(lag_s, scale, turning, seconds, false)
+    }
+
+    fn drive_with(
+        lag_s: f64,
+        scale: f64,
+        turning: bool,
+        seconds: f64,
+        chords: bool,
+    ) -> CourseLagCheck {
         let rate = |t: f64| {
             if turning {
                 0.2 * (0.21 * t).sin() + 0.1 * (0.67 * t + 1.0).sin()
@@ -351,13 +408,33 @@ mod tests {
         let mut check = CourseLagCheck::new();
         let mut rows: Vec<VehicleSample> = Vec::new();
         let n = (seconds * 50.0) as usize;
+        // The track at every step (north, east, m), and the receiver's wandering error.
+        let mut track = Vec::with_capacity(n);
+        let (mut north, mut east) = (0.0, 0.0);
+        for k in 0..n {
+            track.push((north, east));
+            let h = heading(k as f64 * 0.02);
+            (north, east) = (north + 12.0 * 0.02 * h.cos(), east + 12.0 * 0.02 * h.sin());
+        }
+        let mut wander = (0.0, 0.0);
         for k in 0..n {
             let t = k as f64 * 0.02;
             rows.push(VehicleSample::at(t).with_gyro(scale * rate(t) + 0.02));
             if k % 10 == 0 && t >= lag_s.max(0.0) {
                 let epoch = t - lag_s;
-                let course = (heading(epoch) + 0.5f64.to_radians() * normal()).to_degrees();
-                let fix = GnssFix::at(52.5, 13.4).with_velocity(12.0, course.rem_euclid(360.0));
+                let fix = if chords {
+                    let (n, e) = track[(epoch / 0.02).round() as usize];
+                    wander = (wander.0 + 0.1 * normal(), wander.1 + 0.1 * normal());
+                    let (n, e) = (n + wander.0 + 0.2 * normal(), e + wander.1 + 0.2 * normal());
+                    let m_per_deg = EARTH_RADIUS_M.to_radians();
+                    GnssFix::at(
+                        52.5 + n / m_per_deg,
+                        13.4 + e / (m_per_deg * 52.5f64.to_radians().cos()),
+                    )
+                } else {
+                    let course = (heading(epoch) + 0.5f64.to_radians() * normal()).to_degrees();
+                    GnssFix::at(52.5, 13.4).with_velocity(12.0, course.rem_euclid(360.0))
+                };
                 rows.push(VehicleSample::at(t).with_gnss(fix));
             }
         }
@@ -387,6 +464,21 @@ mod tests {
             } else if lag == 0.1 {
                 assert!(excess < 9.0, "the true lag refuted: {excess:.1}");
             }
+        }
+    }
+
+    /// Positions alone: the chords between fixes find the delay as the course does.
+    #[test]
+    fn the_chords_between_fixes_find_it_without_a_course() {
+        for lag in [0.1, 2.5] {
+            let check = drive_with(lag, 1.06, true, 300.0, true);
+            let found = check.lag().expect("a delay from the chords");
+            assert!(
+                (found.lag_s - lag).abs() < 3.0 * found.sigma_s.max(0.01) && found.sigma_s < 0.2,
+                "lag {lag}: found {found:?}"
+            );
+            let excess = check.excess_at(0.1).unwrap();
+            assert_eq!(excess > 25.0, lag > 1.0, "lag {lag}: {excess:.1}");
         }
     }
 

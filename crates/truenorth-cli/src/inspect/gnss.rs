@@ -26,24 +26,29 @@ pub struct GnssReport {
     /// Whether speed and course over ground are given (`gnss_speed_mps,gnss_course_deg`).
     pub course: bool,
     /// How long after the epoch they describe the fixes are stamped, s, and its σ, as their
-    /// course's turns against the gyro's show it (`truenorth_checks::CourseLagCheck`; the
-    /// gyro's unit, sign, bias and scale do not matter); `None` without both, or where the
-    /// turns do not tell.
+    /// course's turns (without a course, their track's: the chords between fixes) against the
+    /// gyro's show it (`truenorth_checks::CourseLagCheck`; the gyro's unit, sign, bias and scale
+    /// do not matter); `None` without a gyro, or where the turns do not tell.
     pub course_lag_s: Option<[f64; 2]>,
 }
 
 /// The fixes' delay by their course against `gyr_z`.
 fn course_lag(rec: &Recording) -> Option<[f64; 2]> {
     let gyr = rec.col("gyr_z")?;
-    let [lat, lon, speed, course] =
-        ["lat_deg", "lon_deg", "gnss_speed_mps", "gnss_course_deg"].map(|c| rec.col(c));
-    let (lat, lon, speed, course) = (lat?, lon?, speed?, course?);
+    let (lat, lon) = (rec.col("lat_deg")?, rec.col("lon_deg")?);
+    let velocity = rec.col("gnss_speed_mps").zip(rec.col("gnss_course_deg"));
     let mut check = Box::new(CourseLagCheck::new());
     for (k, &t) in rec.t_s.iter().enumerate() {
         let mut s = VehicleSample::at(t);
         s.gyr_z_rps = gyr[k].is_finite().then_some(gyr[k]);
-        if lat[k].is_finite() && lon[k].is_finite() && speed[k].is_finite() {
-            s.gnss = Some(GnssFix::at(lat[k], lon[k]).with_velocity(speed[k], course[k]));
+        if lat[k].is_finite() && lon[k].is_finite() {
+            let mut fix = GnssFix::at(lat[k], lon[k]);
+            if let Some((speed, course)) = velocity
+                && speed[k].is_finite()
+            {
+                fix = fix.with_velocity(speed[k], course[k]);
+            }
+            s.gnss = Some(fix);
         }
         check.push(&s);
     }

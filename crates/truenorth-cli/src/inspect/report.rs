@@ -212,7 +212,10 @@ fn gnss_line(s: &mut String, g: &GnssReport) {
             "speed and course given, the course turning {lag:.2} ± {sigma:.2} s after the gyro by the stamps"
         ),
         (true, None) => "speed and course given".to_string(),
-        (false, _) => "no speed or course".to_string(),
+        (false, Some([lag, sigma])) => format!(
+            "no speed or course, the track turning {lag:.2} ± {sigma:.2} s after the gyro by the stamps"
+        ),
+        (false, None) => "no speed or course".to_string(),
     };
     let _ = writeln!(
         s,
