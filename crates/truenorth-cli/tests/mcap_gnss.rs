@@ -7,7 +7,8 @@
 mod common;
 
 use std::collections::BTreeMap;
-use std::path::Path;
+use std::path::{Path, PathBuf};
+use std::process::Output;
 
 use common::{ok, p, scratch, truenorth};
 use truenorth_logs::ros_msgs::{
@@ -64,6 +65,30 @@ fn truth() -> Vec<(f64, f64, f64, f64)> {
 
 fn vec3(x: f64, y: f64) -> Vec3 {
     Vec3 { x, y, z: 0.0 }
+}
+
+/// A rear-wheel car's vehicle file in `dir`.
+fn car(dir: &Path) -> PathBuf {
+    let vehicle = dir.join("car.json");
+    std::fs::write(&vehicle, r#"{"track_m": 1.5, "odometer_wheels": "rear"}"#).unwrap();
+    vehicle
+}
+
+/// `drive` of `bag` as `vehicle`, with `extra` arguments, into `track.csv` beside the bag:
+/// the run and the track's path.
+fn drive(vehicle: &Path, bag: &Path, extra: &[&str]) -> (Output, PathBuf) {
+    let track = bag.with_file_name("track.csv");
+    let mut args = vec![
+        "drive",
+        "--vehicle",
+        p(vehicle),
+        "--input",
+        p(bag),
+        "--output",
+        p(&track),
+    ];
+    args.extend_from_slice(extra);
+    (truenorth(&args), track)
 }
 
 /// A minute of a car in a bag: IMU at 50 Hz, odometry at 20 Hz, fixes at 5 Hz (σ 2 m; the
@@ -205,21 +230,9 @@ fn a_bag_with_fixes_drives_on_them() {
     let dir = scratch("mcap_gnss", "drive");
     let bag = dir.join("car.mcap");
     let (north_m, east_m) = write_bag(&bag, false, 0.0);
-    let vehicle = dir.join("car.json");
-    std::fs::write(&vehicle, r#"{"track_m": 1.5, "odometer_wheels": "rear"}"#).unwrap();
-    let track = dir.join("track.csv");
-    let run = ok(&[
-        "drive",
-        "--vehicle",
-        p(&vehicle),
-        "--input",
-        p(&bag),
-        "--output",
-        p(&track),
-        "--extra",
-        "geodetic",
-    ]);
+    let (run, track) = drive(&car(&dir), &bag, &["--extra", "geodetic"]);
     let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(run.status.success(), "{stderr}");
     assert!(stderr.contains("satellite fixes: "), "{stderr}");
     assert!(stderr.contains("from the satellite fixes"), "{stderr}");
     let (header, rows) = common::table(&track, true);
@@ -281,25 +294,13 @@ fn the_receivers_velocity_gives_the_fixes_their_course() {
         ),
         "{report}"
     );
-    let vehicle = dir.join("car.json");
-    std::fs::write(&vehicle, r#"{"track_m": 1.5, "odometer_wheels": "rear"}"#).unwrap();
-    let track = dir.join("track.csv");
-    let drive = |extra: &[&str]| {
-        let mut args = vec![
-            "drive",
-            "--vehicle",
-            p(&vehicle),
-            "--input",
-            p(&bag),
-            "--output",
-            p(&track),
-            "--odometry-topic",
-            "none",
-        ];
+    let vehicle = car(&dir);
+    let without_odometry = |extra: &[&str]| {
+        let mut args = vec!["--odometry-topic", "none"];
         args.extend_from_slice(extra);
-        truenorth(&args)
+        drive(&vehicle, &bag, &args)
     };
-    let run = drive(&[]);
+    let (run, track) = without_odometry(&[]);
     let stderr = String::from_utf8_lossy(&run.stderr);
     assert!(run.status.success(), "{stderr}");
     let used: usize = stderr
@@ -324,13 +325,13 @@ fn the_receivers_velocity_gives_the_fixes_their_course() {
     assert!(last[col("north_m")].is_nan(), "no odometry, no position");
 
     // Named away, the fixes have no course: unused, and said so.
-    let run = drive(&["--gnss-velocity-topic", "none"]);
+    let (run, _) = without_odometry(&["--gnss-velocity-topic", "none"]);
     let stderr = String::from_utf8_lossy(&run.stderr);
     assert!(
         stderr.contains("`lat_deg,lon_deg` are not used"),
         "{stderr}"
     );
-    let run = drive(&["--gnss-velocity-topic", "/imu"]);
+    let (run, _) = without_odometry(&["--gnss-velocity-topic", "/imu"]);
     let stderr = String::from_utf8_lossy(&run.stderr);
     assert!(!run.status.success() && stderr.contains("/imu"), "{stderr}");
 }
@@ -344,22 +345,13 @@ fn the_receivers_velocity_gives_the_fixes_their_course() {
 #[test]
 fn fixes_stamped_late_are_said() {
     let dir = scratch("mcap_gnss", "late");
-    let vehicle = dir.join("car.json");
-    std::fs::write(&vehicle, r#"{"track_m": 1.5, "odometer_wheels": "rear"}"#).unwrap();
+    let vehicle = car(&dir);
     let said = |delay_s: f64, vehicle: &Path, velocity: bool| {
         let bag = dir.join(format!("car{delay_s}{velocity}.mcap"));
         write_bag(&bag, velocity, delay_s);
-        let track = dir.join("track.csv");
-        let run = ok(&[
-            "drive",
-            "--vehicle",
-            p(vehicle),
-            "--input",
-            p(&bag),
-            "--output",
-            p(&track),
-        ]);
+        let (run, _) = drive(vehicle, &bag, &[]);
         let stderr = String::from_utf8_lossy(&run.stderr).to_string();
+        assert!(run.status.success(), "{stderr}");
         let lag: Option<f64> = stderr
             .split("satellite fixes are stamped ")
             .nth(1)
