@@ -1,14 +1,16 @@
 //! Per-sample cost of the vehicle heading estimators (goal for the fused estimator
 //! ≤ 100 ns), on a simulated 8 km mixed drive: at 10 Hz with every sensor on every sample
 //! (the worst case: a compass reading on every sample), and at 50 Hz with the compass at
-//! 10 Hz (a usual automotive mix).
+//! 10 Hz (a usual automotive mix); and of the fixes' delay check (`CourseLagCheck`) on the
+//! 50 Hz drive with a fix and its course at 5 Hz.
 //!
 //! Run: `cargo bench --bench vehicle -- --warm-up-time 1 --measurement-time 3`.
 
 use std::hint::black_box;
 
 use criterion::{BatchSize, Criterion, Throughput, criterion_group, criterion_main};
-use truenorth::core::{HeadingEstimator, VehicleSample};
+use truenorth::checks::CourseLagCheck;
+use truenorth::core::{GnssFix, HeadingEstimator, VehicleSample};
 use truenorth::fusion::vehicle::{
     SeedGyroCompass, SeedGyroCompassConfig, SeedOdometerCompass, SeedOdometerCompassConfig,
 };
@@ -82,6 +84,32 @@ fn bench(c: &mut Criterion) {
     );
     run(&mut g, "seed EP 0640207 (gyro + compass)", &samples, || {
         SeedGyroCompass::new(SeedGyroCompassConfig::default()).expect("valid config")
+    });
+    let with_courses: Vec<VehicleSample> = fast
+        .samples
+        .iter()
+        .zip(&fast.truth)
+        .enumerate()
+        .map(|(k, (s, t))| VehicleSample {
+            gnss: (k % 10 == 0).then(|| {
+                GnssFix::at(52.5, 13.4)
+                    .with_velocity(t.speed_mps, t.heading_rad.to_degrees().rem_euclid(360.0))
+            }),
+            ..*s
+        })
+        .collect();
+    g.throughput(Throughput::Elements(with_courses.len() as u64));
+    g.bench_function("course lag check, 50 Hz, fixes 5 Hz", |b| {
+        b.iter_batched(
+            || Box::new(CourseLagCheck::new()),
+            |mut check| {
+                for s in &with_courses {
+                    check.push(black_box(s));
+                }
+                check
+            },
+            BatchSize::LargeInput,
+        )
     });
     g.finish();
 }
