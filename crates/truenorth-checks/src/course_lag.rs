@@ -286,7 +286,9 @@ impl CourseLagCheck {
             let w = 1.0 / p.variance;
             let dt = p.t1_s - p.t0_s;
             for (s, dh) in self.sums.iter_mut().zip(changes) {
-                let r = wrap(p.course_change_rad - dh);
+                // Not wrapped: the gyro's turn is in its own unit (a rate in °/s read as
+                // rad/s turns 57 times too far), which the fitted scale takes out.
+                let r = p.course_change_rad - dh;
                 let terms = [r * r, r * dt, r * dh, dt * dt, dt * dh, dh * dh];
                 for (s, x) in s.iter_mut().zip(terms) {
                     *s += w * x;
@@ -480,6 +482,18 @@ mod tests {
             let excess = check.excess_at(0.1).unwrap();
             assert_eq!(excess > 25.0, lag > 1.0, "lag {lag}: {excess:.1}");
         }
+    }
+
+    /// The gyro's unit and sign do not matter: a rate in °/s, its axis flipped, finds the
+    /// same delay (the fitted scale takes them out).
+    #[test]
+    fn any_gyro_unit_and_sign_find_it() {
+        let check = drive(2.5, -1.06f64.to_degrees(), true, 300.0);
+        let found = check.lag().expect("a delay");
+        assert!(
+            (found.lag_s - 2.5).abs() < 3.0 * found.sigma_s && found.sigma_s < 0.1,
+            "{found:?}"
+        );
     }
 
     /// A straight drive shows no delay: every lag fits alike.

@@ -8,7 +8,8 @@
 //! arrays run in Rust without the GIL; the library's errors are raised as
 //! `truenorth.TruenorthError`, a `ValueError`, with the library's message. `read_log` reads
 //! PX4 ULog and ROS 2 MCAP files into arrays of the same frames and units; `check_imu` checks
-//! a recording's declared units and the gyro's axes against its physics.
+//! a recording's declared units and the gyro's axes against its physics, `check_gnss_delay`
+//! how late a drive's satellite fixes are stamped.
 //!
 //! The bindings wrap the library's public types only (the registry's method names, the
 //! traits' samples and estimates), so this crate holds conversions and no method of its own.
@@ -33,6 +34,7 @@ mod calibrators;
 mod checks;
 mod convert;
 mod geomag;
+mod gnss_delay;
 mod logs;
 mod orientation;
 mod quality;
@@ -62,5 +64,6 @@ fn _truenorth(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(broad::broad_rmse, m)?)?;
     m.add_function(wrap_pyfunction!(logs::read_log, m)?)?;
     m.add_function(wrap_pyfunction!(checks::check_imu, m)?)?;
+    m.add_function(wrap_pyfunction!(gnss_delay::check_gnss_delay, m)?)?;
     Ok(())
 }

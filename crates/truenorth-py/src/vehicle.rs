@@ -9,8 +9,8 @@ use truenorth::core::{
     GnssFix, HeadingEstimator, NavEstimate, VehicleSample, rad_to_deg, wrap_two_pi,
 };
 use truenorth::fusion::{SensorPriors, VehicleEstimator as CoreVehicle};
-use truenorth::odometer::OdometerWheels;
 use truenorth::nalgebra::Vector2;
+use truenorth::odometer::OdometerWheels;
 
 use crate::convert::{array1, bools, config_from, lib_err, row_err, rows, same_rows, to_py};
 

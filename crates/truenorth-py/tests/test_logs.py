@@ -82,3 +82,26 @@ def test_log_errors_are_the_packages_exception(tmp_path):
         tn.read_log(cut)
     with pytest.raises(tn.TruenorthError, match="x.ulg"):
         tn.read_log(tmp_path / "x.ulg")
+
+
+def test_check_gnss_delay_finds_fixes_stamped_late():
+    # A car at 12 m/s weaving, its gyro in deg/s with a bias; fixes at 5 Hz carry the
+    # course of the epoch 2 s before their stamp.
+    t = np.arange(0.0, 300.0, 0.02)
+    heading = -0.2 / 0.21 * np.cos(0.21 * t) - 0.1 / 0.67 * np.cos(0.67 * t + 1.0)
+    rate = 0.2 * np.sin(0.21 * t) + 0.1 * np.sin(0.67 * t + 1.0)
+    gyr = np.degrees(rate) + 1.0
+    fix = (np.arange(len(t)) % 10 == 0) & (t >= 2.0)
+    lat = np.where(fix, 52.5, np.nan)
+    lon = np.where(fix, 13.4, np.nan)
+    speed = np.where(fix, 12.0, np.nan)
+    course = np.where(fix, np.degrees(np.interp(t - 2.0, t, heading)) % 360.0, np.nan)
+    found = tn.check_gnss_delay(t, gyr, lat, lon, speed, course)
+    assert abs(found["lag_s"] - 2.0) < 3 * found["sigma_s"] and found["sigma_s"] < 0.1
+    assert found["excess_at_assumed"] > 25
+    on_time = np.where(fix, np.degrees(heading) % 360.0, np.nan)
+    found = tn.check_gnss_delay(t, gyr, lat, lon, speed, on_time)
+    assert abs(found["lag_s"]) < 0.1 and found["excess_at_assumed"] < 9
+    assert tn.check_gnss_delay(t[:100], gyr[:100], lat[:100], lon[:100]) is None
+    with pytest.raises(ValueError, match="together"):
+        tn.check_gnss_delay(t, gyr, lat, lon, speed)

@@ -290,6 +290,28 @@ class Finding(TypedDict):
     fix: dict[str, Any]
     row: Optional[int]
 
+class GnssDelay(TypedDict):
+    """How late a drive's fixes are stamped, by their course's turns against the gyro's."""
+
+    lag_s: float
+    sigma_s: float
+    pairs: int
+    misfit: float
+    excess_at_assumed: Optional[float]
+
+def check_gnss_delay(
+    t_s: FloatArray,
+    gyr_z: FloatArray,
+    lat_deg: FloatArray,
+    lon_deg: FloatArray,
+    speed_mps: Optional[FloatArray] = None,
+    course_deg: Optional[FloatArray] = None,
+    assumed_s: float = 0.1,
+) -> Optional[GnssDelay]:
+    """How long after their epoch the fixes are stamped (rows of `t_s`; NaN latitude where a
+    row has no fix; any gyro unit and sign), or None where the turns do not tell;
+    `excess_at_assumed` beyond 25 refutes `assumed_s` at 5 sigma, as `truenorth drive` warns."""
+
 def check_imu(
     t_s: FloatArray,
     gyr: FloatArray,
