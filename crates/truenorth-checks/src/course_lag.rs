@@ -165,7 +165,8 @@ impl CourseLagCheck {
     fn push_position(&mut self, t: f64, lat: f64, lon: f64) {
         match self.last_position {
             Some((t0, ..)) if t - t0 < MIN_PAIR_S && t >= t0 => return,
-            Some((t0, lat0, lon0)) if t - t0 <= MAX_PAIR_S => {
+            // Time going back starts the chords again.
+            Some((t0, lat0, lon0)) if t > t0 && t - t0 <= MAX_PAIR_S => {
                 let north = (lat - lat0) * EARTH_RADIUS_M;
                 let east = wrap(lon - lon0) * EARTH_RADIUS_M * lat0.cos();
                 let chord = north.hypot(east);
@@ -216,7 +217,9 @@ impl CourseLagCheck {
         match self.last_course {
             Some((t0, ..)) if t - t0 < MIN_PAIR_S && t >= t0 => return,
             Some((t0, c0, v0))
-                if t - t0 <= MAX_PAIR_S && wrap(course_rad - c0).abs() <= MAX_COURSE_CHANGE_RAD =>
+                if t > t0
+                    && t - t0 <= MAX_PAIR_S
+                    && wrap(course_rad - c0).abs() <= MAX_COURSE_CHANGE_RAD =>
             {
                 let pair = Pair {
                     t0_s: t0,
