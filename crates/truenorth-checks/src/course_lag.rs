@@ -16,6 +16,11 @@
 //! with the gyro's bias and scale error free (a raw yaw rate has both), and keeps each lag's
 //! weighted squared residual; the lag that leaves the least is the fixes' delay, with a σ
 //! from the residual's curvature there. Streaming, fixed-size: nothing grows with the log.
+//!
+//! What it finds is the delay less the lead an antenna ahead of the axle gives its course
+//! in a turn (the lever arm over the speed: 0.04–0.24 s for 0.8–2.4 m at road speeds), which
+//! moves the course as an earlier stamp would; `tests/course_lag_drives.rs` holds the found
+//! delay within 4σ of the stamp delay less that lead on drives with a real receiver's habits.
 
 use core::f64::consts::PI;
 
