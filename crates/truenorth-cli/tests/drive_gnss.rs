@@ -69,7 +69,8 @@ fn fixes_put_the_track_on_the_earth_and_the_heading_on_true_north() {
 }
 
 /// The antenna's place in VEHICLE.json (`gnss_lever_arm_m`, forward and right of the axle's
-/// centre) is read, and one no vehicle has is refused with the key.
+/// centre) is read, and one no vehicle has is refused with the key; given for a log without
+/// fixes, it is said unused.
 #[test]
 fn the_antenna_s_lever_arm_is_read_and_checked() {
     let dir = scratch("drive_gnss", "lever");
@@ -97,6 +98,20 @@ fn the_antenna_s_lever_arm_is_read_and_checked() {
     let o = common::drive(&vehicle("far.json", [120.0, 0.0]), &input, &out, &[]);
     let (ok, stderr) = common::outcome(&o);
     assert!(!ok && stderr.contains("gnss_lever_arm_m"), "{stderr}");
+    let no_fixes = LogDrive::new(LogDriveConfig::new(
+        2,
+        VehicleKind::RearWheelCar,
+        SensorSet::SPEED_YAW,
+    ))
+    .unwrap();
+    let input = dir.join("no_fixes.csv");
+    std::fs::write(&input, no_fixes.to_csv()).unwrap();
+    let o = common::drive(&vehicle("ok.json", [forward, right]), &input, &out, &[]);
+    let (ok, stderr) = common::outcome(&o);
+    assert!(
+        ok && stderr.contains("`gnss_lever_arm_m` in the vehicle file is not used"),
+        "{stderr}"
+    );
 }
 
 /// The head of a drive, run again once the sensors are known, comes out in the fixes'

@@ -221,6 +221,17 @@ pub fn run(args: &Args) -> CliResult {
                 "truenorth drive: warning: --lat/--lon are not used for true north: the satellite fixes give it (rows before the first fixes that refer the heading still use them)"
             );
         }
+    } else {
+        for (key, given) in [
+            ("gnss_lever_arm_m", vehicle.gnss_lever_arm_m.is_some()),
+            ("gnss_latency_s", vehicle.gnss_latency_s.is_some()),
+        ] {
+            if given {
+                errln!(
+                    "truenorth drive: warning: `{key}` in the vehicle file is not used: the log has no satellite fixes"
+                );
+            }
+        }
     }
     let mut check = Diagnosis::new(vehicle.track_m, wheels.can_pivot(), speeds);
     let mut writer = Writer::create(
