@@ -11,10 +11,10 @@ use truenorth::fusion::GnssConfig;
 use truenorth::fusion::vehicle::GnssCounts;
 
 /// Share of the fixes judged beyond which rejections are said: the gate's 4σ rejects a
-/// fix in ten thousand that is as good as it claims, a city's multipath a few percent
-/// (2.7 % under open sky, 5.9 % in canyons between jumps, 82.5 % within jumps in the
-/// simulated multipath-heavy city of `truenorth-fusion`'s `vehicle_gnss` test); a quarter
-/// is more than even that city gives over a drive.
+/// fix in ten thousand that is as good as it claims; the simulated receivers of
+/// `truenorth-fusion`'s `vehicle_gnss` test, 2.7 % under open sky, 5.9 % in canyons between
+/// jumps and 82.9 % within jumps, which is a quarter over a drive in its multipath-heavy
+/// city — a drive worth a warning that names multipath first.
 const REJECTED_SHARE: f64 = 0.25;
 
 /// Fewest rejections said: a handful is a jump or two.
