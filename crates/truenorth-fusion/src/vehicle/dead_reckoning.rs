@@ -302,6 +302,7 @@ impl VehicleEstimator {
         // their differences keep their meaning.
         let wrapped = wrap_pi(x[PSI] + dpsi);
         let shift = wrapped - (x[PSI] + dpsi);
+        self.tracking.gnss.trail.turn(dpsi);
         x[PSI_ODO] += shift;
         self.tracking.motion.psi_at_wheels_rad += shift;
         self.tracking.gyro.odo_at_last_rad += shift;
@@ -484,6 +485,7 @@ impl VehicleEstimator {
         step.q[EAST] += q;
         self.filter.x[NORTH] += ds * c;
         self.filter.x[EAST] += ds * s;
+        self.tracking.gnss.trail.step(t_s, ds);
         self.plain_odometry(wheel.ds_m);
     }
 

@@ -20,6 +20,7 @@ use super::estimator::VehicleEstimator;
 use super::gnss_track::PlaneShift;
 use super::innovation_line::{InnovationLine, LineFit};
 use super::nav_filter::{EAST, NORTH, PSI};
+use super::path_trail::PathSince;
 
 #[cfg(not(feature = "std"))]
 use truenorth_core::Float as _;
@@ -32,6 +33,12 @@ const FIX_INTERVAL_S: f64 = 1.0;
 /// logger's stamps jitter by as much, so an exact second would skip every other fix; half
 /// a 10 Hz receiver's step, so that its fixes are used a second apart, not 0.9 s.
 const FIX_JITTER_S: f64 = 0.05;
+
+/// How far before the last wheel reading a fix's epoch lies before the trail of the path
+/// gives where the vehicle was, s: nearer, a line drawn back along the heading of then
+/// strays from the path by half its length times the turn, 0.13 m at 20 m/s in a 0.2 rad/s
+/// turn, well within a fix's error (and the default delay, 0.1 s, never reaches the trail).
+const TRAIL_AFTER_S: f64 = 0.25;
 
 /// Courses that must agree before they refer the heading to true north.
 const ALIGNMENT_COURSES: u32 = 5;
@@ -190,20 +197,42 @@ impl VehicleEstimator {
         Some(plane)
     }
 
-    /// The antenna's dead-reckoned position at `t_s`: the track's last point carried on
-    /// (or back) along the heading at the speed the wheels last showed, plus the lever arm
-    /// turned with the heading.
+    /// The path driven since `t_s`, when `t_s` lies more than [`TRAIL_AFTER_S`] before the
+    /// last wheel reading and within the trail kept; nearer, a line along the heading is as
+    /// good.
+    fn path_since(&self, t_s: f64) -> Option<PathSince> {
+        let last = self.wheels.last_s()?;
+        (last - t_s > TRAIL_AFTER_S)
+            .then(|| self.tracking.gnss.trail.since(t_s, self.filter.x[PSI]))
+            .flatten()
+    }
+
+    /// The heading at `t_s`: the heading now less the turns since, from the trail, or the
+    /// gyro's rate carried to it.
+    fn heading_then(&self, t_s: f64) -> f64 {
+        self.path_since(t_s)
+            .map_or_else(|| self.heading_at(t_s), |p| self.filter.x[PSI] - p.turn_rad)
+    }
+
+    /// The antenna's dead-reckoned position at `t_s`: the track's last point less the path
+    /// driven since (from the trail), or carried on (or back) along the heading at the speed
+    /// the wheels last showed; plus the lever arm turned with the heading.
     fn position_at(&self, t_s: f64) -> (f64, f64) {
-        let ahead_s = self.wheels.last_s().map_or(0.0, |t0| {
-            (t_s - t0).clamp(-self.config.max_gap_s, self.config.max_gap_s)
-        });
         let [forward, right] = self.config.gnss.lever_arm_m;
-        let travel = self.est.speed_mps * ahead_s + forward;
-        let (s, c) = self.heading_at(t_s).sin_cos();
         let x = &self.filter.x;
+        let (s, c) = self.heading_then(t_s).sin_cos();
+        let (north, east, forward) = match self.path_since(t_s) {
+            Some(p) => (x[NORTH] - p.north_m, x[EAST] - p.east_m, forward),
+            None => {
+                let ahead_s = self.wheels.last_s().map_or(0.0, |t0| {
+                    (t_s - t0).clamp(-self.config.max_gap_s, self.config.max_gap_s)
+                });
+                (x[NORTH], x[EAST], self.est.speed_mps * ahead_s + forward)
+            }
+        };
         (
-            x[NORTH] + travel * c - right * s,
-            x[EAST] + travel * s + right * c,
+            north + forward * c - right * s,
+            east + forward * s + right * c,
         )
     }
 
@@ -211,7 +240,7 @@ impl VehicleEstimator {
     /// arm turning.
     fn lever_arm_turn(&self, t_s: f64) -> (f64, f64) {
         let [forward, right] = self.config.gnss.lever_arm_m;
-        let (s, c) = self.heading_at(t_s).sin_cos();
+        let (s, c) = self.heading_then(t_s).sin_cos();
         (-forward * s - right * c, forward * c - right * s)
     }
 
@@ -298,7 +327,7 @@ impl VehicleEstimator {
     /// [`ALIGNMENT_COURSES`] are gathered, their offset from the heading if they agree (the
     /// gathering starts again either way).
     fn agreeing_courses(&mut self, t_s: f64, (course, sigma): (f64, f64)) -> Option<LineFit> {
-        let nu = wrap_pi(course - self.heading_at(t_s));
+        let nu = wrap_pi(course - self.heading_then(t_s));
         let line = &mut self.tracking.gnss.line;
         line.push(t_s, nu);
         if line.len() < ALIGNMENT_COURSES {
@@ -324,7 +353,7 @@ impl VehicleEstimator {
         let Some((course, sigma)) = self.course_of(fix, odometer_speed) else {
             return false;
         };
-        let nu = wrap_pi(course - self.heading_at(t_s));
+        let nu = wrap_pi(course - self.heading_then(t_s));
         let lag = self.config.gnss.latency_sigma_s * self.tracking.gyro.rate_rps;
         let sigma = (sigma * sigma + lag * lag).sqrt();
         let s = self.filter.p[PSI][PSI] + sigma * sigma;

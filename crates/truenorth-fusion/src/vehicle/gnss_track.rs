@@ -7,6 +7,7 @@ use serde::{Deserialize, Serialize};
 
 use super::innovation_line::InnovationLine;
 use super::odometer_history::OdometerHistory;
+use super::path_trail::PathTrail;
 
 /// The fixes as the estimator has used them.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
@@ -46,6 +47,9 @@ pub(super) struct GnssTrack {
     pub speed_mark: Option<SpeedMark>,
     /// The odometer's last readings, for its distance at a fix's epoch.
     pub odometer: OdometerHistory,
+    /// The dead-reckoned path's last seconds, for where the vehicle was at the epoch of a
+    /// fix stamped long after it.
+    pub trail: PathTrail,
 }
 
 /// How the fixes put the track on their plane: turned about the start by `turn_rad` (the

@@ -49,6 +49,7 @@ mod learning_gates;
 pub mod nav_filter;
 mod observability;
 mod odometer_history;
+mod path_trail;
 mod plain_baseline;
 mod plain_guard;
 mod seed_blend;
