@@ -9,6 +9,8 @@
 //! the heading now less the turns since, in whatever frame the estimate is in now.
 
 use serde::{Deserialize, Serialize};
+#[cfg(not(feature = "std"))]
+use truenorth_core::Float as _;
 
 /// Snapshots kept, one per [`STEP_S`] or a little more (at the first step after it): 12.8 s
 /// of path at least, in rows of [`ROW`] (serde derives arrays of up to 32 elements).
