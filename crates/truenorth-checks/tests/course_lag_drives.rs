@@ -9,7 +9,6 @@
 //! Run: `cargo test --release -p truenorth-checks --test course_lag_drives -- --nocapture`.
 
 use truenorth_checks::CourseLagCheck;
-use truenorth_core::VehicleSample;
 use truenorth_sim::VehicleKind;
 use truenorth_sim::log_drive::{LogDrive, LogDriveConfig, SensorSet};
 
@@ -18,25 +17,6 @@ use truenorth_sim::log_drive::{LogDrive, LogDriveConfig, SensorSet};
 fn warned(check: &CourseLagCheck) -> bool {
     let refuted = check.excess_at(0.1).is_some_and(|e| e > 25.0);
     refuted && check.lag().is_some_and(|l| (l.lag_s - 0.1).abs() > 0.45)
-}
-
-/// The drive's rows with every fix moved `late_s` later (onto the first row at or after).
-fn stamped_late(samples: &[VehicleSample], late_s: f64) -> Vec<VehicleSample> {
-    let mut out: Vec<VehicleSample> = samples
-        .iter()
-        .map(|s| VehicleSample { gnss: None, ..*s })
-        .collect();
-    let mut j = 0;
-    for s in samples {
-        let Some(fix) = s.gnss else { continue };
-        while j < out.len() && out[j].t_s < s.t_s + late_s {
-            j += 1;
-        }
-        if let Some(row) = out.get_mut(j) {
-            row.gnss = Some(fix);
-        }
-    }
-    out
 }
 
 #[test]
@@ -71,7 +51,7 @@ fn the_delay_is_found_on_drives_with_a_real_receivers_habits() {
             for (extra_s, late) in [(0.0, false), (2.0, true)] {
                 let mut check = Box::new(CourseLagCheck::new());
                 let rows = if late {
-                    stamped_late(&samples, extra_s)
+                    d.samples_with_fixes_late(extra_s)
                 } else {
                     samples.clone()
                 };

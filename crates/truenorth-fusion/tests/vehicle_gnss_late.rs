@@ -14,25 +14,6 @@ use truenorth_sim::log_drive::{LogDrive, LogDriveConfig, SensorSet};
 /// How much later than the receiver's own delay the fixes are stamped, s.
 const LATE_S: f64 = 2.0;
 
-/// The drive's rows with every fix moved `late_s` later (onto the first row at or after).
-fn stamped_late(samples: &[VehicleSample], late_s: f64) -> Vec<VehicleSample> {
-    let mut out: Vec<VehicleSample> = samples
-        .iter()
-        .map(|s| VehicleSample { gnss: None, ..*s })
-        .collect();
-    let mut j = 0;
-    for s in samples {
-        let Some(fix) = s.gnss else { continue };
-        while j < out.len() && out[j].t_s < s.t_s + late_s {
-            j += 1;
-        }
-        if let Some(row) = out.get_mut(j) {
-            row.gnss = Some(fix);
-        }
-    }
-    out
-}
-
 /// One run: heading RMS against the truth once referred to true north (°), and the fixes
 /// rejected.
 fn run(d: &LogDrive, rows: &[VehicleSample], latency_s: f64) -> (f64, u32) {
@@ -67,7 +48,7 @@ fn fixes_stamped_late_are_taken_at_their_epoch_when_told() {
             .with_gnss();
         let d = LogDrive::new(config).unwrap();
         let samples = d.vehicle_samples();
-        let late = stamped_late(&samples, LATE_S);
+        let late = d.samples_with_fixes_late(LATE_S);
         let on_time = run(&d, &samples, default_latency);
         let told = run(&d, &late, default_latency + LATE_S);
         let untold = run(&d, &late, default_latency);

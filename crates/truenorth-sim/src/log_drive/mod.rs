@@ -293,6 +293,28 @@ impl LogDrive {
         vehicle_samples(&self.rows, self.vehicle.kind)
     }
 
+    /// The rows as the core's samples with every fix stamped `late_s` later than the receiver
+    /// stamped it (moved onto the first row at or after: there is one every few hundredths
+    /// of a second), as a logger's queue or a receiver on another clock would stamp it.
+    pub fn samples_with_fixes_late(&self, late_s: f64) -> Vec<VehicleSample> {
+        let samples = self.vehicle_samples();
+        let mut out: Vec<VehicleSample> = samples
+            .iter()
+            .map(|s| VehicleSample { gnss: None, ..*s })
+            .collect();
+        let mut j = 0;
+        for s in &samples {
+            let Some(fix) = s.gnss else { continue };
+            while j < out.len() && out[j].t_s < s.t_s + late_s {
+                j += 1;
+            }
+            if let Some(row) = out.get_mut(j) {
+                row.gnss = Some(fix);
+            }
+        }
+        out
+    }
+
     /// Distance driven by the end of the last row, m.
     pub fn distance_m(&self) -> f64 {
         self.truth.last().map_or(0.0, |t| t.distance_m)
