@@ -24,7 +24,7 @@
 
 use core::f64::consts::PI;
 
-use truenorth_core::VehicleSample;
+use truenorth_core::{VehicleSample, wrap_pi};
 
 /// The heading is kept at this step, s.
 const STEP_S: f64 = 0.05;
@@ -115,12 +115,6 @@ impl Default for CourseLagCheck {
     }
 }
 
-/// `a` wrapped into (−π, π].
-fn wrap(a: f64) -> f64 {
-    let w = (a + PI).rem_euclid(2.0 * PI) - PI;
-    if w <= -PI { w + 2.0 * PI } else { w }
-}
-
 impl CourseLagCheck {
     /// An empty check.
     pub fn new() -> Self {
@@ -173,7 +167,7 @@ impl CourseLagCheck {
             // Time going back starts the chords again.
             Some((t0, lat0, lon0)) if t > t0 && t - t0 <= MAX_PAIR_S => {
                 let north = (lat - lat0) * EARTH_RADIUS_M;
-                let east = wrap(lon - lon0) * EARTH_RADIUS_M * lat0.cos();
+                let east = wrap_pi(lon - lon0) * EARTH_RADIUS_M * lat0.cos();
                 let chord = north.hypot(east);
                 if chord >= MIN_SPEED_MPS * (t - t0) {
                     let variance = (CHORD_SIGMA_M / chord).powi(2);
@@ -221,31 +215,34 @@ impl CourseLagCheck {
     fn push_course(&mut self, t: f64, course_rad: f64, variance: f64) {
         match self.last_course {
             Some((t0, ..)) if t - t0 < MIN_PAIR_S && t >= t0 => return,
-            Some((t0, c0, v0))
-                if t > t0
-                    && t - t0 <= MAX_PAIR_S
-                    && wrap(course_rad - c0).abs() <= MAX_COURSE_CHANGE_RAD =>
-            {
-                let pair = Pair {
-                    t0_s: t0,
-                    t1_s: t,
-                    course_change_rad: wrap(course_rad - c0),
-                    variance: v0 + variance + OTHER_SIGMA_RAD.powi(2),
-                };
-                // The oldest waiting pair gives way if the gyro has stopped.
-                let slot = self
-                    .pending
-                    .iter()
-                    .position(Option::is_none)
-                    .unwrap_or_else(|| {
-                        self.pending.rotate_left(1);
-                        PENDING - 1
+            Some((t0, c0, v0)) if t > t0 && t - t0 <= MAX_PAIR_S => {
+                let change = wrap_pi(course_rad - c0);
+                if change.abs() <= MAX_COURSE_CHANGE_RAD {
+                    self.wait(Pair {
+                        t0_s: t0,
+                        t1_s: t,
+                        course_change_rad: change,
+                        variance: v0 + variance + OTHER_SIGMA_RAD.powi(2),
                     });
-                self.pending[slot] = Some(pair);
+                }
             }
             _ => {}
         }
         self.last_course = Some((t, course_rad, variance));
+    }
+
+    /// Keeps `pair` until the gyro has passed it; the oldest waiting gives way if the gyro
+    /// has stopped.
+    fn wait(&mut self, pair: Pair) {
+        let slot = self
+            .pending
+            .iter()
+            .position(Option::is_none)
+            .unwrap_or_else(|| {
+                self.pending.rotate_left(1);
+                PENDING - 1
+            });
+        self.pending[slot] = Some(pair);
     }
 
     /// The integrated heading at `t`, interpolated between ticks kept.
