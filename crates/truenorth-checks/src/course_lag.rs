@@ -24,7 +24,7 @@
 
 use core::f64::consts::PI;
 
-use truenorth_core::{VehicleSample, wrap_pi};
+use truenorth_core::{GnssFix, VehicleSample, wrap_pi};
 
 /// The heading is kept at this step, s.
 const STEP_S: f64 = 0.05;
@@ -157,6 +157,29 @@ impl CourseLagCheck {
         } else if !self.course_given && fix.lat_deg.is_finite() && fix.lon_deg.is_finite() {
             self.push_position(t, fix.lat_deg.to_radians(), fix.lon_deg.to_radians());
         }
+    }
+
+    /// Takes a row of columns, NaN where a reading is absent: the yaw rate (any unit), the
+    /// fix's latitude and longitude, degrees, and its speed (m/s) and course (degrees) where
+    /// the log has them — as [`CourseLagCheck::push`] takes a sample.
+    pub fn push_columns(
+        &mut self,
+        t_s: f64,
+        gyr_z: f64,
+        lat_deg: f64,
+        lon_deg: f64,
+        velocity: Option<(f64, f64)>,
+    ) {
+        let mut s = VehicleSample::at(t_s);
+        s.gyr_z_rps = gyr_z.is_finite().then_some(gyr_z);
+        if lat_deg.is_finite() && lon_deg.is_finite() {
+            let mut fix = GnssFix::at(lat_deg, lon_deg);
+            if let Some((speed, course)) = velocity {
+                (fix.speed_mps, fix.course_deg) = (Some(speed), Some(course));
+            }
+            s.gnss = Some(fix);
+        }
+        self.push(&s);
     }
 
     /// A fix without course: the chord from the last one, 0.5–2 s before, is a course at

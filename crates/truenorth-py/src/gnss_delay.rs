@@ -6,7 +6,6 @@ use numpy::PyReadonlyArray1;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use truenorth::checks::CourseLagCheck;
-use truenorth::core::{GnssFix, VehicleSample};
 
 use crate::convert::arg_err;
 
@@ -60,16 +59,10 @@ pub fn check_gnss_delay<'py>(
     let (found, excess) = py.detach(|| {
         let mut check = Box::new(CourseLagCheck::new());
         for k in 0..n {
-            let mut s = VehicleSample::at(t[k]);
-            s.gyr_z_rps = g[k].is_finite().then_some(g[k]);
-            if lat[k].is_finite() && lon[k].is_finite() {
-                let mut fix = GnssFix::at(lat[k], lon[k]);
-                if let Some((speed, course)) = &velocity {
-                    (fix.speed_mps, fix.course_deg) = (Some(speed[k]), Some(course[k]));
-                }
-                s.gnss = Some(fix);
-            }
-            check.push(&s);
+            let v = velocity
+                .as_ref()
+                .map(|(speed, course)| (speed[k], course[k]));
+            check.push_columns(t[k], g[k], lat[k], lon[k], v);
         }
         (check.lag(), check.excess_at(assumed_s))
     });

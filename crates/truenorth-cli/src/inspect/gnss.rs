@@ -5,7 +5,6 @@
 
 use serde::Serialize;
 use truenorth::checks::CourseLagCheck;
-use truenorth::core::{GnssFix, VehicleSample};
 
 use super::Recording;
 use super::column_stats::{ColumnStats, Gaps};
@@ -39,18 +38,8 @@ fn course_lag(rec: &Recording) -> Option<[f64; 2]> {
     let velocity = rec.col("gnss_speed_mps").zip(rec.col("gnss_course_deg"));
     let mut check = Box::new(CourseLagCheck::new());
     for (k, &t) in rec.t_s.iter().enumerate() {
-        let mut s = VehicleSample::at(t);
-        s.gyr_z_rps = gyr[k].is_finite().then_some(gyr[k]);
-        if lat[k].is_finite() && lon[k].is_finite() {
-            let mut fix = GnssFix::at(lat[k], lon[k]);
-            if let Some((speed, course)) = velocity
-                && speed[k].is_finite()
-            {
-                fix = fix.with_velocity(speed[k], course[k]);
-            }
-            s.gnss = Some(fix);
-        }
-        check.push(&s);
+        let v = velocity.map(|(speed, course)| (speed[k], course[k]));
+        check.push_columns(t, gyr[k], lat[k], lon[k], v);
     }
     check.lag().map(|l| [l.lag_s, l.sigma_s])
 }

@@ -220,16 +220,22 @@ impl VehicleEstimator {
     fn position_at(&self, t_s: f64) -> (f64, f64) {
         let [forward, right] = self.config.gnss.lever_arm_m;
         let x = &self.filter.x;
-        let (s, c) = self.heading_then(t_s).sin_cos();
-        let (north, east, forward) = match self.path_since(t_s) {
-            Some(p) => (x[NORTH] - p.north_m, x[EAST] - p.east_m, forward),
+        let (north, east, heading, forward) = match self.path_since(t_s) {
+            Some(p) => (
+                x[NORTH] - p.north_m,
+                x[EAST] - p.east_m,
+                x[PSI] - p.turn_rad,
+                forward,
+            ),
             None => {
                 let ahead_s = self.wheels.last_s().map_or(0.0, |t0| {
                     (t_s - t0).clamp(-self.config.max_gap_s, self.config.max_gap_s)
                 });
-                (x[NORTH], x[EAST], self.est.speed_mps * ahead_s + forward)
+                let travel = self.est.speed_mps * ahead_s + forward;
+                (x[NORTH], x[EAST], self.heading_at(t_s), travel)
             }
         };
+        let (s, c) = heading.sin_cos();
         (
             north + forward * c - right * s,
             east + forward * s + right * c,

@@ -112,7 +112,7 @@ impl FixTimes {
                  agree with it",
                 counts.rejected
             ));
-        } else if counts.used == 0 && out.is_empty() && fixes > 0 {
+        } else if counts.used == 0 && out.is_empty() {
             out.push(format!(
                 "none of the {fixes} satellite fixes was used ({} rejected): a fix is used once \
                  the vehicle moves, and without odometry only its course, at 3 m/s or more",
