@@ -158,4 +158,28 @@ mod tests {
                 && (turned.east_m - plain.north_m).abs() < 1e-9
         );
     }
+
+    proptest::proptest! {
+        /// Whatever the steps (time going back, gaps, any distances and turns), the path
+        /// since a time is finite, and no longer than all the distance driven.
+        #[test]
+        fn the_path_since_is_never_longer_than_the_distance(
+            steps in proptest::collection::vec((-0.5f64..2.0, -3.0f64..3.0, -1.0f64..1.0), 1..300),
+            back in 0.0f64..20.0,
+            heading in -4.0f64..4.0,
+        ) {
+            let mut trail = PathTrail::default();
+            let mut t = 0.0;
+            for (dt, ds, dpsi) in &steps {
+                t += dt;
+                trail.turn(*dpsi);
+                trail.step(t, *ds);
+            }
+            let total: f64 = steps.iter().map(|s| s.1.abs()).sum();
+            if let Some(p) = trail.since(t - back, heading) {
+                proptest::prop_assert!(p.north_m.is_finite() && p.east_m.is_finite() && p.turn_rad.is_finite());
+                proptest::prop_assert!(p.north_m.hypot(p.east_m) <= total + 1e-9);
+            }
+        }
+    }
 }
